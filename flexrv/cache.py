@@ -1,0 +1,106 @@
+"""Content-addressed caching and atomic file writes.
+
+Every cached artefact (mesh, reduced body, EHL map) is stored under a key that
+hashes *everything it depends on* (parameters, mesh size, library versions), and
+every file is written to a temporary name in the same directory and renamed, so a
+crash never leaves a half-written file under the final name.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+#: Root of the mesh / reduced-body / EHL-map cache (``meshes/`` at the repo top
+#: level, overridable with the environment variable ``FLEXRV_CACHE``).
+def cache_dir() -> Path:
+    """Directory of cached meshes and reduced bodies (created on demand)."""
+    root = os.environ.get("FLEXRV_CACHE")
+    if root:
+        path = Path(root)
+    else:
+        path = Path(__file__).resolve().parent.parent / "meshes"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _canonical(obj: Any) -> Any:
+    """Convert ``obj`` to a JSON-serialisable canonical form for hashing."""
+    if isinstance(obj, dict):
+        return {str(k): _canonical(v) for k, v in sorted(obj.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(obj, (list, tuple)):
+        return [_canonical(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return {"__ndarray__": hashlib.sha256(np.ascontiguousarray(obj).tobytes()).hexdigest(),
+                "shape": list(obj.shape), "dtype": str(obj.dtype)}
+    if isinstance(obj, (np.floating, float)):
+        return repr(float(obj))
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if hasattr(obj, "model_dump"):
+        return _canonical(obj.model_dump())
+    return obj
+
+
+def library_versions(*names: str) -> dict[str, str]:
+    """Installed versions of the named distributions (part of every cache key)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {}
+    for name in names:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "absent"
+    return out
+
+
+def content_hash(*parts: Any, length: int = 16) -> str:
+    """Stable hex hash of arbitrary nested data (dicts, lists, arrays, models)."""
+    payload = json.dumps(_canonical(list(parts)), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(payload.encode()).hexdigest()[:length]
+
+
+@contextlib.contextmanager
+def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path next to ``target``; rename it onto ``target`` on
+    success, delete it on failure.
+
+    Examples
+    --------
+    >>> with atomic_path("out.nc") as tmp:          # doctest: +SKIP
+    ...     dataset.to_netcdf(tmp)
+    """
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + target.suffix, dir=target.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.replace(tmp_path, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp_path.unlink()
+        raise
+
+
+def atomic_write_text(target: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` to ``target`` atomically; return the final path."""
+    with atomic_path(target) as tmp:
+        tmp.write_text(text)
+    return Path(target)
+
+
+def atomic_write_bytes(target: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``target`` atomically; return the final path."""
+    with atomic_path(target) as tmp:
+        tmp.write_bytes(data)
+    return Path(target)

@@ -1,0 +1,80 @@
+"""Shared helpers of the CLI command modules: output in JSON or as a table."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any, Callable
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+console = Console()
+
+JSON_HELP = "Print machine-readable JSON on stdout instead of a table."
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Recursively convert numpy scalars/arrays and dataclasses to JSON types.
+
+    Non-finite floats become ``None`` so the output is strict JSON.
+    """
+    if hasattr(obj, "model_dump"):
+        return to_jsonable(obj.model_dump())
+    if hasattr(obj, "__dataclass_fields__"):
+        return {k: to_jsonable(getattr(obj, k)) for k in obj.__dataclass_fields__}
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+def print_json(data: Any) -> None:
+    """Write ``data`` as indented strict JSON to stdout."""
+    print(json.dumps(to_jsonable(data), indent=2))
+
+
+def emit(data: Any, as_json: bool, render: Callable[[Any], None]) -> None:
+    """Print ``data`` as JSON (``as_json``) or through the human ``render`` function."""
+    if as_json:
+        print_json(data)
+    else:
+        render(data)
+
+
+def kv_table(title: str, rows: list[tuple[str, Any, str]]) -> Table:
+    """A three-column table (quantity, value, unit)."""
+    table = Table(title=title, title_justify="left")
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    for name, value, unit in rows:
+        table.add_row(name, fmt(value), unit)
+    return table
+
+
+def fmt(value: Any) -> str:
+    """Compact engineering formatting of a number (or ``str(value)``)."""
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        if v == 0 or not math.isfinite(v):
+            return f"{v:g}"
+        if 1e-3 <= abs(v) < 1e5:
+            return f"{v:.5g}"
+        return f"{v:.4e}"
+    return str(value)

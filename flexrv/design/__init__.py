@@ -1,0 +1,161 @@
+"""Reducer designs: the validated data model, the built-in presets, load/export.
+
+>>> from flexrv.design import load
+>>> rv = load("rv40e")            # a preset name, or a path to a TOML file
+>>> rv.second_stage.pin_count
+40
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+from pydantic import BaseModel, ValidationError
+
+from flexrv.design.model import Reducer
+from flexrv.errors import ConfigError
+
+__all__ = ["Reducer", "load", "loads", "from_dict", "list_presets", "to_toml", "preset_path"]
+
+_PRESET_PACKAGE = "flexrv.design.presets"
+
+
+def list_presets() -> list[str]:
+    """Names of the built-in presets."""
+    folder = resources.files(_PRESET_PACKAGE)
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def preset_path(name: str) -> Path:
+    """Path of a built-in preset's TOML file."""
+    return Path(str(resources.files(_PRESET_PACKAGE) / f"{name}.toml"))
+
+
+def load(preset_or_path: str | Path | Reducer) -> Reducer:
+    """Load a design by preset name (``"rv221"``) or TOML path; validate it.
+
+    Raises
+    ------
+    ConfigError
+        Unknown preset, unreadable file, invalid TOML, or any field invalid; the
+        message names the field, the value and the allowed range.
+    """
+    if isinstance(preset_or_path, Reducer):
+        return preset_or_path
+    text_name = str(preset_or_path)
+    path = Path(text_name)
+    if text_name in list_presets():
+        path = preset_path(text_name)
+    elif not (path.suffix == ".toml" or path.exists()):
+        raise ConfigError(f"unknown preset {text_name!r}: choose one of {list_presets()} or give a path to a .toml file")
+    if not path.is_file():
+        raise ConfigError(f"design file {str(path)!r} does not exist")
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f"cannot read design file {str(path)!r}: {exc}") from None
+    return loads(text, source=str(path))
+
+
+def loads(text: str, source: str = "<string>") -> Reducer:
+    """Parse and validate a design from TOML text."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: invalid TOML: {exc}") from None
+    return from_dict(data, source=source)
+
+
+def from_dict(data: dict[str, Any], source: str = "<dict>") -> Reducer:
+    """Validate a nested dict (as read from TOML) into a :class:`Reducer`."""
+    try:
+        return Reducer.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(format_validation_error(exc, source)) from None
+
+
+def to_toml(reducer: Reducer) -> str:
+    """Serialise a design to TOML that :func:`loads` reads back unchanged."""
+    data = reducer.model_dump(mode="python")
+    head = {k: data.pop(k) for k in ("name", "description", "sources")}
+    provenance = data.pop("provenance")
+    ordered = {**head, **data, "provenance": provenance}
+    return tomli_w.dumps(ordered)
+
+
+# ----------------------------------------------------------------- error messages
+def _field_info(model: type[BaseModel], loc: tuple) -> Any:
+    """FieldInfo of the field addressed by a pydantic error location (or None)."""
+    info = None
+    current: Any = model
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        fields = getattr(current, "model_fields", None)
+        if not fields or part not in fields:
+            return info if part == loc[-1] else None
+        info = fields[part]
+        current = info.annotation
+        args = getattr(current, "__args__", None)
+        if args:  # dict[str, Material] -> Material
+            current = args[-1]
+    return info
+
+
+def _allowed_range(info: Any) -> str:
+    """Human description of a field's numeric bounds, from its metadata."""
+    if info is None:
+        return ""
+    lo = hi = None
+    lo_op = hi_op = ""
+    for meta in info.metadata:
+        for attr, op in (("gt", "<"), ("ge", "<=")):
+            if getattr(meta, attr, None) is not None:
+                lo, lo_op = getattr(meta, attr), op
+        for attr, op in (("lt", "<"), ("le", "<=")):
+            if getattr(meta, attr, None) is not None:
+                hi, hi_op = getattr(meta, attr), op
+    if lo is None and hi is None:
+        return ""
+    left = f"{lo:g} {lo_op} " if lo is not None else ""
+    right = f" {hi_op} {hi:g}" if hi is not None else ""
+    return f"{left}value{right}"
+
+
+def format_validation_error(exc: ValidationError, source: str) -> str:
+    """One line per problem: ``field = value: reason (allowed: range)``."""
+    lines = [f"{source}: invalid design ({exc.error_count()} problem{'s' if exc.error_count() > 1 else ''})"]
+    for err in exc.errors(include_url=False):
+        loc = tuple(err["loc"])
+        field = ".".join(str(p) for p in loc) or "<design>"
+        kind = err["type"]
+        value = err.get("input")
+        info = _field_info(Reducer, loc)
+        rng = _allowed_range(info)
+        if kind == "extra_forbidden":
+            parent = _field_info(Reducer, loc[:-1])
+            allowed = ""
+            sub = getattr(parent, "annotation", Reducer) if parent is not None else Reducer
+            if hasattr(sub, "model_fields"):
+                allowed = f"; allowed fields here: {', '.join(sub.model_fields)}"
+            lines.append(f"  {field}: unknown field{allowed}")
+        elif kind == "missing":
+            desc = f" ({info.description})" if info is not None and info.description else ""
+            lines.append(f"  {field}: missing required field{desc}" + (f"; allowed: {rng}" if rng else ""))
+        elif kind == "value_error":
+            msg = str(err["msg"]).removeprefix("Value error, ")
+            lines.append(f"  {msg}")
+        else:
+            shown = value
+            if isinstance(value, float) and not math.isfinite(value):
+                shown = str(value)
+            text = f"  {field} = {shown!r}: {err['msg']}"
+            if rng:
+                text += f" (allowed: {rng})"
+            lines.append(text)
+    return "\n".join(lines)

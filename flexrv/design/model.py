@@ -1,0 +1,408 @@
+"""Validated data model of an RV reducer (pydantic v2).
+
+Field names carry their unit whenever it is not SI (``module_mm``,
+``pressure_angle_deg``); the ``Reducer`` object exposes SI accessors for everything
+the lower layers need (``reducer.first_stage.module`` in metres, etc.).
+
+Every model forbids unknown fields and NaN/inf, and every number has an allowed
+range; cross-field consistency (pin count vs disc teeth, undercut, parts that do
+not fit) is checked in ``model_validator``s so a bad design fails with one clear
+message naming the field, the value and the allowed range.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+DEG = math.pi / 180.0
+
+
+class _Strict(BaseModel):
+    """Base: unknown fields and non-finite numbers are errors, values are frozen."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True, validate_default=True)
+
+
+def _bad(field: str, value, allowed: str, why: str = "") -> ValueError:
+    """Build the uniform cross-field error message."""
+    msg = f"{field} = {value!r} is not allowed: {allowed}"
+    if why:
+        msg += f" ({why})"
+    return ValueError(msg)
+
+
+# --------------------------------------------------------------------------- stages
+class FirstStage(_Strict):
+    """Involute planetary first stage: sun on the input shaft, N planets each fixed
+    to one crankshaft (N planets = N crankshafts)."""
+
+    sun_teeth: int = Field(ge=8, le=200, description="Sun gear teeth z_s [-]")
+    planet_teeth: int = Field(ge=8, le=400, description="Planet gear teeth z_p [-]")
+    module_mm: float = Field(gt=0.2, le=20.0, description="Normal module m_n [mm]")
+    pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="Pressure angle alpha_n [deg]")
+    sun_profile_shift: float = Field(ge=-1.0, le=1.5, description="Sun profile shift coefficient x_1 [-]")
+    planet_profile_shift: float = Field(ge=-1.5, le=1.5, description="Planet profile shift coefficient x_2 [-]")
+    face_width_mm: float = Field(gt=0.0, le=200.0, description="Common face width b [mm]")
+    n_planets: int = Field(ge=2, le=6, description="Number of planets = crankshafts [-]")
+    backlash_um: float = Field(ge=0.0, le=500.0, description="Circumferential backlash on the pitch circle [um]")
+    mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Mesh damping ratio xi_12 [-]")
+
+    @property
+    def module(self) -> float:
+        """Module [m]."""
+        return self.module_mm * 1e-3
+
+    @property
+    def pressure_angle(self) -> float:
+        """Pressure angle [rad]."""
+        return self.pressure_angle_deg * DEG
+
+    @property
+    def face_width(self) -> float:
+        """Face width [m]."""
+        return self.face_width_mm * 1e-3
+
+    @property
+    def backlash(self) -> float:
+        """Circumferential backlash [m]."""
+        return self.backlash_um * 1e-6
+
+    @property
+    def center_distance(self) -> float:
+        """Working centre distance sun-planet [m] (= crank circle radius).
+
+        Computed from the operating pressure angle of the shifted pair
+        (inv alpha_w = inv alpha + 2 tan(alpha) (x1+x2)/(z1+z2)); ISO 21771.
+        """
+        from flexrv.geometry.involute import working_center_distance
+
+        return float(working_center_distance(self.sun_teeth, self.planet_teeth, self.module,
+                                             self.pressure_angle, self.sun_profile_shift,
+                                             self.planet_profile_shift))
+
+
+class SecondStage(_Strict):
+    """Cycloid-pin second stage with profile modifications (equidistant, shift,
+    rotation), the profile being the envelope of a pin of radius r_rp + dr_rp on a
+    pin circle of radius R_p + dR_p."""
+
+    disc_teeth: int = Field(ge=10, le=200, description="Cycloid disc teeth z_c [-]")
+    pin_count: int = Field(ge=11, le=201, description="Number of pins z_rp [-]")
+    pin_circle_radius_mm: float = Field(gt=5.0, le=1000.0, description="Pin centre circle radius R_p [mm]")
+    pin_radius_mm: float = Field(gt=0.2, le=50.0, description="Pin radius r_rp [mm]")
+    eccentricity_mm: float = Field(gt=0.05, le=20.0, description="Crank eccentricity a [mm]")
+    disc_width_mm: float = Field(gt=0.5, le=200.0, description="Width of one disc b_c [mm]")
+    n_discs: int = Field(ge=1, le=3, description="Number of discs (phased 360/n deg) [-]")
+    modification_equidistant_mm: float = Field(ge=-0.2, le=0.2, description="Equidistant modification dr_rp [mm]")
+    modification_shift_mm: float = Field(ge=-0.2, le=0.2, description="Shift (pin-circle) modification dR_p [mm]")
+    modification_rotation_deg: float = Field(ge=-1.0, le=1.0, description="Rotation modification d_delta [deg]")
+    center_hole_radius_mm: float = Field(ge=0.0, le=500.0, description="Radius of the disc's centre hole [mm]")
+    mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Pin-disc contact damping ratio xi_34 [-]")
+
+    @property
+    def pin_circle_radius(self) -> float:
+        return self.pin_circle_radius_mm * 1e-3
+
+    @property
+    def pin_radius(self) -> float:
+        return self.pin_radius_mm * 1e-3
+
+    @property
+    def eccentricity(self) -> float:
+        return self.eccentricity_mm * 1e-3
+
+    @property
+    def disc_width(self) -> float:
+        return self.disc_width_mm * 1e-3
+
+    @property
+    def modification_equidistant(self) -> float:
+        return self.modification_equidistant_mm * 1e-3
+
+    @property
+    def modification_shift(self) -> float:
+        return self.modification_shift_mm * 1e-3
+
+    @property
+    def modification_rotation(self) -> float:
+        return self.modification_rotation_deg * DEG
+
+    @property
+    def center_hole_radius(self) -> float:
+        return self.center_hole_radius_mm * 1e-3
+
+    @property
+    def shortening_coefficient(self) -> float:
+        """K1 = a z_rp / R_p [-] (must be < 1 for a usable epitrochoid)."""
+        return self.eccentricity_mm * self.pin_count / self.pin_circle_radius_mm
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "SecondStage":
+        if self.pin_count - self.disc_teeth != 1:
+            raise _bad("second_stage.pin_count", self.pin_count,
+                       f"must equal disc_teeth + 1 = {self.disc_teeth + 1}",
+                       "an RV cycloid stage has one pin more than disc teeth")
+        spacing = 2.0 * self.pin_circle_radius_mm * math.sin(math.pi / self.pin_count)
+        if 2.0 * self.pin_radius_mm >= spacing:
+            raise _bad("second_stage.pin_radius_mm", self.pin_radius_mm,
+                       f"must be < {spacing / 2:.4g} mm (half the pin spacing on R_p = "
+                       f"{self.pin_circle_radius_mm:g} mm)", "neighbouring pins would overlap")
+        k1 = self.shortening_coefficient
+        if k1 >= 1.0:
+            raise _bad("second_stage.eccentricity_mm", self.eccentricity_mm,
+                       f"must be < R_p/z_rp = {self.pin_circle_radius_mm / self.pin_count:.4g} mm "
+                       f"(shortening coefficient K1 = a z_rp / R_p = {k1:.3f} must be < 1)",
+                       "the pin-centre curve loops and the disc profile undercuts")
+        from flexrv.geometry.cycloid import min_convex_curvature_radius
+
+        rho_min = min_convex_curvature_radius(self.pin_count, self.pin_circle_radius + self.modification_shift,
+                                              self.eccentricity)
+        offset = self.pin_radius + self.modification_equidistant
+        if offset >= rho_min:
+            raise _bad("second_stage.pin_radius_mm", self.pin_radius_mm,
+                       f"pin radius + equidistant modification must be < {rho_min * 1e3:.4g} mm, the minimum "
+                       "convex curvature radius of the pin-centre epitrochoid",
+                       "the disc profile would undercut; reduce the eccentricity or the pin radius")
+        return self
+
+
+class Crankshaft(_Strict):
+    """Crankshaft: planet-gear seat, two eccentric journals 180 deg apart, two
+    support journals in the carrier (axial order: gear seat, support A, eccentric 1,
+    eccentric 2, support B)."""
+
+    gear_seat_diameter_mm: float = Field(gt=1.0, le=200.0)
+    gear_seat_length_mm: float = Field(gt=1.0, le=200.0)
+    support_journal_diameter_mm: float = Field(gt=1.0, le=200.0)
+    support_journal_length_mm: float = Field(gt=1.0, le=200.0)
+    eccentric_journal_diameter_mm: float = Field(gt=1.0, le=200.0, description="Needle-bearing inner raceway diameter [mm]")
+    eccentric_journal_length_mm: float = Field(gt=1.0, le=200.0)
+    support_bearing_radial_stiffness_N_per_m: float = Field(gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing")
+    support_bearing_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
+
+
+class NeedleBearing(_Strict):
+    """Needle bearing between an eccentric journal and its disc hole."""
+
+    roller_count: int = Field(ge=6, le=80)
+    roller_diameter_mm: float = Field(gt=0.5, le=50.0)
+    roller_length_mm: float = Field(gt=0.5, le=100.0)
+    radial_clearance_um: float = Field(ge=0.0, le=100.0)
+    model: Literal["empirical", "rollers"] = Field(description="Seed 004 empirical stiffness or roller-resolved Hertz")
+
+
+class MainBearing(_Strict):
+    """Back-to-back pair of angular contact ball bearings carrying the carrier.
+
+    ``inner_ring_bore_diameter_mm`` / ``outer_ring_outer_diameter_mm`` are the ring
+    fit diameters; groove-bottom (raceway) diameters follow from the pitch diameter,
+    ball diameter and contact angle (see :mod:`flexrv.geometry.bearing`).
+    """
+
+    ball_diameter_mm: float = Field(gt=1.0, le=200.0)
+    pitch_diameter_mm: float = Field(gt=10.0, le=3000.0)
+    ball_count: int = Field(ge=6, le=200)
+    contact_angle_deg: float = Field(ge=10.0, le=60.0)
+    inner_conformity: float = Field(ge=0.501, le=0.6, description="f_i = groove radius / ball diameter")
+    outer_conformity: float = Field(ge=0.501, le=0.6, description="f_o = groove radius / ball diameter")
+    inner_ring_bore_diameter_mm: float = Field(gt=1.0, le=3000.0)
+    outer_ring_outer_diameter_mm: float = Field(gt=1.0, le=3000.0)
+    ring_width_mm: float = Field(gt=1.0, le=300.0, description="Axial width of one ring (one row)")
+    row_spacing_mm: float = Field(gt=1.0, le=1000.0, description="Axial distance between the two rows' ball centres")
+    axial_preload_um: float = Field(ge=-100.0, le=100.0, description="Axial interference per row (+ preload, - clearance)")
+    ball_damping_Ns_per_m: float = Field(ge=0.0, le=1e7, description="Max contact damping c_max of the impact law")
+
+    @model_validator(mode="after")
+    def _fits(self) -> "MainBearing":
+        d, dm = self.ball_diameter_mm, self.pitch_diameter_mm
+        bore, od = self.inner_ring_bore_diameter_mm, self.outer_ring_outer_diameter_mm
+        min_wall = 0.1 * d
+        if not bore < dm < od:
+            raise _bad("main_bearing.pitch_diameter_mm", dm, f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm")
+        if dm - d - bore < 2 * min_wall:
+            raise _bad("main_bearing.ball_diameter_mm", d,
+                       f"must be <= {dm - bore - 2 * min_wall:.4g} mm so the inner ring keeps a wall >= 0.1 D under its groove",
+                       "ball larger than the ring section")
+        if od - dm - d < 2 * min_wall:
+            raise _bad("main_bearing.ball_diameter_mm", d,
+                       f"must be <= {od - dm - 2 * min_wall:.4g} mm so the outer ring keeps a wall >= 0.1 D under its groove",
+                       "ball larger than the ring section")
+        if math.pi * dm / self.ball_count <= d * 1.05:
+            raise _bad("main_bearing.ball_count", self.ball_count,
+                       f"must be <= {int(math.pi * dm / (1.05 * d))} for D = {d:g} mm on d_m = {dm:g} mm", "balls would touch")
+        if self.row_spacing_mm < self.ring_width_mm:
+            raise _bad("main_bearing.row_spacing_mm", self.row_spacing_mm, f"must be >= ring_width_mm = {self.ring_width_mm:g}")
+        return self
+
+    @property
+    def ball_diameter(self) -> float:
+        return self.ball_diameter_mm * 1e-3
+
+    @property
+    def pitch_diameter(self) -> float:
+        return self.pitch_diameter_mm * 1e-3
+
+    @property
+    def contact_angle(self) -> float:
+        return self.contact_angle_deg * DEG
+
+
+class Material(_Strict):
+    """Isotropic linear-elastic material."""
+
+    youngs_modulus_GPa: float = Field(gt=1.0, le=1000.0)
+    poisson_ratio: float = Field(ge=0.0, lt=0.5)
+    density_kg_m3: float = Field(gt=100.0, le=25000.0)
+
+    @property
+    def youngs_modulus(self) -> float:
+        """E [Pa]."""
+        return self.youngs_modulus_GPa * 1e9
+
+
+class PartMaterials(_Strict):
+    """Which material (a key of ``materials``) each part is made of."""
+
+    gears: str
+    crankshaft: str
+    cycloid_disc: str
+    pins: str
+    carrier: str
+    housing: str
+    bearing_rings: str
+    rolling_elements: str
+
+
+class Lubricant(_Strict):
+    """Lubricant for the EHL contacts (isothermal).
+
+    Roelands: eta(p) = eta0 exp{(ln eta0 + 9.67)[(1 + p/p0)^z - 1]},
+    Dowson-Higginson: rho(p) = rho0 (1 + a p / (1 + b p)).
+    """
+
+    name: str
+    viscosity_Pa_s: float = Field(gt=1e-4, le=10.0, description="Dynamic viscosity eta0 at the operating temperature")
+    pressure_viscosity_1_per_GPa: float = Field(gt=1.0, le=60.0, description="Barus coefficient alpha (for Hamrock-Dowson)")
+    roelands_z: float = Field(gt=0.2, le=1.5)
+    roelands_p0_Pa: float = Field(gt=1e7, le=1e9)
+    density_kg_m3: float = Field(gt=500.0, le=2000.0)
+    dowson_higginson_a_1_per_GPa: float = Field(ge=0.0, le=5.0)
+    dowson_higginson_b_1_per_GPa: float = Field(ge=0.0, le=10.0)
+
+    @property
+    def viscosity(self) -> float:
+        return self.viscosity_Pa_s
+
+    @property
+    def pressure_viscosity(self) -> float:
+        """alpha [1/Pa]."""
+        return self.pressure_viscosity_1_per_GPa * 1e-9
+
+
+class Inertia(_Strict):
+    """Mass properties not derivable from the modelled geometry."""
+
+    input_shaft_inertia_kg_m2: float = Field(gt=0.0, le=10.0, description="Input shaft + sun about its axis")
+    carrier_mass_kg: float = Field(gt=0.0, le=1000.0)
+    carrier_inertia_kg_m2: float = Field(gt=0.0, le=100.0, description="Carrier + output flange about the axis")
+
+
+class ContactSettings(_Strict):
+    """Contact-law settings shared by the pin, roller and ball contacts."""
+
+    pin_law: Literal["hertz_line", "impact"] = Field(description="Pin-disc force law")
+    impact_exponent: float = Field(ge=1.0, le=3.0, description="Exponent e of the impact law")
+    impact_damping_depth_mm: float = Field(gt=0.0, le=1.0, description="Penetration d over which damping ramps to c_max")
+    pin_max_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
+    ehl: Literal["dry", "hamrock_dowson", "map"] = Field(description="EHL correction of lubricated contacts")
+
+
+class OperatingPoint(_Strict):
+    """Drive and load as in the seeds: input speed step 0 -> n_in over
+    [0, speed_ramp_time], load torque T_max * step(t, t1, 0, t2, 1) on the carrier."""
+
+    input_speed_rpm: float = Field(gt=0.0, le=20000.0)
+    speed_ramp_time_s: float = Field(ge=0.0, le=100.0)
+    load_torque_Nm: float = Field(ge=-1e5, le=1e5, description="Load torque on the output")
+    load_ramp_start_s: float = Field(ge=0.0, le=100.0)
+    load_ramp_end_s: float = Field(ge=0.0, le=100.0)
+    rated_torque_Nm: float = Field(gt=0.0, le=1e5, description="Rated output torque (stiffness test range)")
+    external_axial_force_N: float = Field(ge=-1e6, le=1e6)
+    external_radial_force_N: float = Field(ge=-1e6, le=1e6)
+    tilting_moment_Nm: float = Field(ge=-1e6, le=1e6)
+    temperature_C: float = Field(ge=-40.0, le=200.0)
+
+    @model_validator(mode="after")
+    def _ramp(self) -> "OperatingPoint":
+        if self.load_ramp_end_s < self.load_ramp_start_s:
+            raise _bad("operating.load_ramp_end_s", self.load_ramp_end_s,
+                       f"must be >= load_ramp_start_s = {self.load_ramp_start_s:g} s")
+        return self
+
+    @property
+    def input_speed(self) -> float:
+        """Input angular speed [rad/s]."""
+        return self.input_speed_rpm * 2.0 * math.pi / 60.0
+
+
+# --------------------------------------------------------------------------- reducer
+class Reducer(_Strict):
+    """A complete RV reducer design. Load one with :func:`flexrv.design.load`."""
+
+    name: str = Field(min_length=1, max_length=64)
+    description: str
+    sources: list[str] = Field(description="Where the values come from (seeds, handbooks)")
+    provenance: dict[str, str] = Field(description="field path -> note, for every estimated value")
+    first_stage: FirstStage
+    second_stage: SecondStage
+    crankshaft: Crankshaft
+    needle_bearing: NeedleBearing
+    main_bearing: MainBearing
+    materials: dict[str, Material]
+    parts: PartMaterials
+    lubricant: Lubricant
+    inertia: Inertia
+    contact: ContactSettings
+    operating: OperatingPoint
+
+    def material(self, part: str) -> Material:
+        """Material of a part (``gears``, ``crankshaft``, ``cycloid_disc``, ...)."""
+        return self.materials[getattr(self.parts, part)]
+
+    @property
+    def crank_hole_radius(self) -> float:
+        """Radius of a crank-bearing hole in the disc = needle outer raceway [m]."""
+        nb, cs = self.needle_bearing, self.crankshaft
+        return 0.5e-3 * (cs.eccentric_journal_diameter_mm + 2.0 * nb.roller_diameter_mm) + nb.radial_clearance_um * 1e-6
+
+    @model_validator(mode="after")
+    def _cross(self) -> "Reducer":
+        for part, key in self.parts.model_dump().items():
+            if key not in self.materials:
+                raise _bad(f"parts.{part}", key, f"must be one of the materials {sorted(self.materials)}")
+        fs, ss = self.first_stage, self.second_stage
+        a_w = fs.center_distance
+        r_root = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
+        r_hole = self.crank_hole_radius
+        if a_w + r_hole >= r_root:
+            raise _bad("first_stage.module_mm", fs.module_mm,
+                       f"crank circle radius a_w = {a_w * 1e3:.4g} mm plus crank hole radius {r_hole * 1e3:.4g} mm "
+                       f"must stay inside the disc root radius R_p - r_rp - a = {r_root * 1e3:.4g} mm",
+                       "the crank-bearing holes would cut through the cycloid teeth")
+        if ss.center_hole_radius >= a_w - r_hole:
+            raise _bad("second_stage.center_hole_radius_mm", ss.center_hole_radius_mm,
+                       f"must be < {(a_w - r_hole) * 1e3:.4g} mm (crank circle radius minus crank hole radius)",
+                       "centre hole would cut into the crank-bearing holes")
+        n = fs.n_planets
+        if 2.0 * a_w * math.sin(math.pi / n) <= 2.0 * r_hole:
+            raise _bad("first_stage.n_planets", n, "crank-bearing holes would overlap; use fewer planets")
+        tip_planet = 0.5 * fs.module * (fs.planet_teeth + 2.0 + 2.0 * fs.planet_profile_shift)
+        if 2.0 * a_w * math.sin(math.pi / n) <= 2.0 * tip_planet:
+            raise _bad("first_stage.n_planets", n, f"planet tip circles (r_a = {tip_planet * 1e3:.4g} mm) would overlap on a_w = {a_w * 1e3:.4g} mm")
+        if self.crankshaft.eccentric_journal_diameter_mm / 2.0 <= ss.eccentricity_mm:
+            raise _bad("crankshaft.eccentric_journal_diameter_mm", self.crankshaft.eccentric_journal_diameter_mm,
+                       f"must be > 2 a = {2 * ss.eccentricity_mm:g} mm")
+        return self
