@@ -222,14 +222,22 @@ class MainBearing(_Strict):
         min_wall = 0.1 * d
         if not bore < dm < od:
             raise _bad("main_bearing.pitch_diameter_mm", dm, f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm")
-        if dm - d - bore < 2 * min_wall:
+        ca = math.cos(self.contact_angle_deg * DEG)
+        # groove bottoms (torus of radius f D about the curvature centres, flexrv.geometry.bearing)
+        bottom_i = dm / 2 + (self.inner_conformity - 0.5) * d * ca - self.inner_conformity * d
+        bottom_o = dm / 2 - (self.outer_conformity - 0.5) * d * ca + self.outer_conformity * d
+        if bottom_i - bore / 2 < min_wall:
             raise _bad("main_bearing.ball_diameter_mm", d,
-                       f"must be <= {dm - bore - 2 * min_wall:.4g} mm so the inner ring keeps a wall >= 0.1 D under its groove",
-                       "ball larger than the ring section")
-        if od - dm - d < 2 * min_wall:
+                       f"too large for the inner ring section: the wall under the groove is {bottom_i - bore / 2:.4g} mm, "
+                       f"must be >= 0.1 D = {min_wall:.4g} mm", "ball larger than the ring section")
+        if od / 2 - bottom_o < min_wall:
             raise _bad("main_bearing.ball_diameter_mm", d,
-                       f"must be <= {od - dm - 2 * min_wall:.4g} mm so the outer ring keeps a wall >= 0.1 D under its groove",
-                       "ball larger than the ring section")
+                       f"too large for the outer ring section: the wall under the groove is {od / 2 - bottom_o:.4g} mm, "
+                       f"must be >= 0.1 D = {min_wall:.4g} mm", "ball larger than the ring section")
+        half_contact = 0.5 * d * math.sin(self.contact_angle_deg * DEG)
+        if self.ring_width_mm < 2.2 * half_contact:
+            raise _bad("main_bearing.ring_width_mm", self.ring_width_mm,
+                       f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} mm) lies on the raceway")
         if math.pi * dm / self.ball_count <= d * 1.05:
             raise _bad("main_bearing.ball_count", self.ball_count,
                        f"must be <= {int(math.pi * dm / (1.05 * d))} for D = {d:g} mm on d_m = {dm:g} mm", "balls would touch")

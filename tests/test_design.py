@@ -1,0 +1,194 @@
+"""Design data model: presets load, round-trip, and every kind of bad input gives one
+clear ConfigError naming the field (property-based with hypothesis)."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from flexrv.cli import app
+from flexrv.design import from_dict, list_presets, load, loads, preset_path, to_toml
+from flexrv.design.model import Reducer
+from flexrv.errors import ConfigError
+
+PRESETS = list_presets()
+RAW = {name: tomllib.loads(preset_path(name).read_text()) for name in PRESETS}
+
+
+def _numeric_fields(data, prefix=()):
+    """(path, value) of every numeric leaf of a preset dict (excluding provenance)."""
+    for key, value in data.items():
+        if key == "provenance":
+            continue
+        path = prefix + (key,)
+        if isinstance(value, dict):
+            yield from _numeric_fields(value, path)
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            yield path, value
+
+
+FIELDS = {name: list(_numeric_fields(RAW[name])) for name in PRESETS}
+
+
+def _set(data, path, value):
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    return data
+
+
+def _delete(data, path):
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    del node[path[-1]]
+    return data
+
+
+def test_presets_listed():
+    assert {"rv221", "rv40e"} <= set(PRESETS)
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_preset_roundtrip_toml(name):
+    """`flexrv show --toml` output loads back to an identical design."""
+    reducer = load(name)
+    assert loads(to_toml(reducer)) == reducer
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_every_estimate_has_provenance(name):
+    """Every provenance key names an existing field and is non-empty."""
+    reducer = load(name)
+    dumped = reducer.model_dump()
+    for key, note in reducer.provenance.items():
+        section, _, field = key.partition(".")
+        assert section in dumped and note.strip(), key
+        if field and isinstance(dumped[section], dict):
+            assert field in dumped[section], key
+
+
+def test_seed_values_present():
+    """The presets carry the seeds' key numbers (ratio-relevant teeth, module, a)."""
+    rv221, rv40e = load("rv221"), load("rv40e")
+    assert (rv221.first_stage.sun_teeth, rv221.first_stage.planet_teeth) == (12, 44)
+    assert (rv221.second_stage.disc_teeth, rv221.second_stage.pin_count) == (59, 60)
+    assert rv221.first_stage.module_mm == 3.0 and rv221.second_stage.eccentricity_mm == 2.4
+    assert rv221.main_bearing.ball_count == 26 and rv221.main_bearing.contact_angle_deg == 40.0
+    assert math.isclose(rv221.operating.input_speed_rpm * 6.0, 9000.0)  # 9000 deg/s
+    assert (rv40e.first_stage.sun_teeth, rv40e.first_stage.planet_teeth) == (16, 32)
+    assert (rv40e.second_stage.disc_teeth, rv40e.second_stage.pin_count) == (39, 40)
+    assert math.isclose(rv40e.second_stage.shortening_coefficient, 0.8125)  # seed 002 Table 1
+    assert rv40e.needle_bearing.roller_count == 15
+
+
+def test_physics_override_of_rv221_pin_circle_is_documented():
+    """R_p = 82.5 mm (seed 000) is rejected by validation; the preset uses 165 mm and says why."""
+    data = _set(RAW["rv221"], ("second_stage", "pin_circle_radius_mm"), 82.5)
+    with pytest.raises(ConfigError, match="second_stage.pin_radius_mm"):
+        from_dict(data)
+    assert "PHYSICS OVERRIDES SEED" in load("rv221").provenance["second_stage.pin_circle_radius_mm"]
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_inconsistent_teeth(name):
+    data = _set(RAW[name], ("second_stage", "pin_count"), RAW[name]["second_stage"]["disc_teeth"] + 2)
+    with pytest.raises(ConfigError, match=r"second_stage.pin_count.*disc_teeth \+ 1"):
+        from_dict(data)
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_eccentricity_undercut(name):
+    ss = RAW[name]["second_stage"]
+    limit = ss["pin_circle_radius_mm"] / ss["pin_count"]
+    data = _set(RAW[name], ("second_stage", "eccentricity_mm"), limit * 1.05)
+    with pytest.raises(ConfigError, match="second_stage.eccentricity_mm.*undercut"):
+        from_dict(data)
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_ball_larger_than_ring(name):
+    mb = RAW[name]["main_bearing"]
+    big = (mb["outer_ring_outer_diameter_mm"] - mb["inner_ring_bore_diameter_mm"]) / 2.0
+    data = _set(RAW[name], ("main_bearing", "ball_diameter_mm"), min(big, 199.0))
+    with pytest.raises(ConfigError, match="main_bearing.ball_diameter_mm"):
+        from_dict(data)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(name=st.sampled_from(PRESETS), data=st.data(),
+       bad=st.sampled_from([-1.0, 0.0, float("nan"), float("inf"), -1e9, 1e12, "text"]))
+def test_bad_numeric_value_names_field(name, data, bad):
+    """Negative, zero, NaN, inf, huge or non-numeric values either are valid for that
+    field or raise ConfigError naming exactly that field."""
+    path, _ = data.draw(st.sampled_from(FIELDS[name]))
+    mutated = _set(RAW[name], path, bad)
+    try:
+        from_dict(mutated)
+    except ConfigError as exc:
+        assert ".".join(path) in str(exc) or path[-1] in str(exc)
+    else:
+        # accepted: must be a legal value for this field (e.g. 0 for a damping ratio)
+        assert isinstance(bad, float) and math.isfinite(bad)
+
+
+@settings(max_examples=40, deadline=None)
+@given(name=st.sampled_from(PRESETS), data=st.data())
+def test_missing_field_named(name, data):
+    path, _ = data.draw(st.sampled_from(FIELDS[name]))
+    with pytest.raises(ConfigError, match="missing required field") as info:
+        from_dict(_delete(RAW[name], path))
+    assert ".".join(path) in str(info.value)
+
+
+@settings(max_examples=40, deadline=None)
+@given(name=st.sampled_from(PRESETS), data=st.data(),
+       key=st.text(alphabet="abcdefghijklmnopqrstuvwxyz_", min_size=3, max_size=12))
+def test_unknown_field_named(name, data, key):
+    section = data.draw(st.sampled_from([k for k, v in RAW[name].items() if isinstance(v, dict) and k not in ("provenance", "materials")]))
+    if key in RAW[name][section]:
+        return
+    mutated = _set(RAW[name], (section, key), 1.0)
+    with pytest.raises(ConfigError, match=f"{section}.{key}: unknown field"):
+        from_dict(mutated)
+
+
+def test_range_in_message():
+    data = _set(RAW["rv40e"], ("first_stage", "module_mm"), -1.5)
+    with pytest.raises(ConfigError) as info:
+        from_dict(data)
+    msg = str(info.value)
+    assert "first_stage.module_mm = -1.5" in msg and "0.2 < value <= 20" in msg
+
+
+def test_cli_bad_file_exit_2_no_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(to_toml(load("rv40e")).replace("ball_count = 38", "ball_count = -3"))
+    from flexrv.cli import main
+    import subprocess, sys
+    proc = subprocess.run([sys.executable, "-c", "from flexrv.cli import main; main()", "show", str(bad)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "main_bearing.ball_count" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_cli_show_toml_roundtrip():
+    result = CliRunner().invoke(app, ["show", "rv221", "--toml"])
+    assert result.exit_code == 0
+    assert loads(result.stdout) == load("rv221")
+
+
+def test_reducer_is_frozen():
+    r = load("rv40e")
+    with pytest.raises(Exception):
+        r.name = "x"  # type: ignore[misc]
+    assert isinstance(r, Reducer)
