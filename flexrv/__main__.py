@@ -1,0 +1,5 @@
+"""``python -m flexrv`` runs the CLI."""
+
+from flexrv.cli import main
+
+main()
