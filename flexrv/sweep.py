@@ -1,0 +1,392 @@
+"""Parameter sweeps on dask.distributed, resumable.
+
+A sweep is described by a TOML spec::
+
+    name = "modification"                 # results/<name>/ (or --out)
+    preset = "rv40e"                      # preset name or design TOML path
+    task = "design"                       # a registered task or "package.module:function"
+    outputs = ["pin_load_rated.max_force_N", "torsional.C_W_Nm_per_arcmin"]
+
+    [options]                             # keyword arguments of the task (optional)
+
+    [grid]                                # cartesian product over design fields (dotted paths)
+    "second_stage.modification_equidistant_mm" = [0.0, 0.005, 0.01]
+    "operating.load_torque_Nm" = [100.0, 412.0]
+
+    [[cases]]                             # and/or an explicit list of variations
+    "second_stage.eccentricity_mm" = 1.0
+
+Each case is the base design with its overrides applied and validated (a case whose
+design is invalid is recorded as failed with the validation message). Cases are
+identified by a hash of (design, task, options), so re-running the same spec skips
+every case whose result file exists: kill the sweep at any point and run the same
+command again to finish only the missing cases. Failed cases are recorded with their
+error and do not stop the others (``retry_failed=True`` recomputes them).
+
+A task is a function ``task(reducer, **options) -> dict`` returning a nested dict
+of JSON-serialisable numbers; the spec's ``outputs`` pick dotted keys from it into
+the sweep table (NetCDF + CSV) and plots.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import itertools
+import json
+import math
+import os
+import time
+import tomllib
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from flexrv.cache import atomic_write_text, content_hash
+from flexrv.errors import ConfigError, FlexrvError
+
+#: Built-in tasks: name -> "module:function" (imported lazily on the worker).
+TASKS: dict[str, str] = {
+    "design": "flexrv.analysis.report:design_report",
+    "simulate": "flexrv.sweep:simulate_task",
+}
+
+
+def simulate_task(reducer, model: str = "rigid", t_end: float = 0.5, dt: float | None = None) -> dict:
+    """Sweep task: run a dynamic simulation and return its summary numbers."""
+    from flexrv.simulation import Simulation
+
+    results = Simulation(reducer, model=model).run(t_end=t_end, dt=dt, progress=False)
+    return results.summary()
+
+_SPEC_KEYS = {"name", "preset", "task", "outputs", "options", "grid", "cases", "description"}
+
+
+@dataclass
+class SweepSpec:
+    """A validated sweep specification (see module docstring)."""
+
+    name: str
+    preset: str
+    task: str
+    outputs: list[str]
+    options: dict[str, Any] = field(default_factory=dict)
+    grid: dict[str, list[Any]] = field(default_factory=dict)
+    cases: list[dict[str, Any]] = field(default_factory=list)
+    description: str = ""
+
+    def variations(self) -> list[dict[str, Any]]:
+        """All case overrides: the grid's cartesian product, then the explicit list."""
+        out: list[dict[str, Any]] = []
+        if self.grid:
+            keys = list(self.grid)
+            for values in itertools.product(*(self.grid[k] for k in keys)):
+                out.append(dict(zip(keys, values)))
+        out.extend(dict(c) for c in self.cases)
+        return out
+
+
+def load_spec(path: str | os.PathLike) -> SweepSpec:
+    """Read and validate a sweep spec TOML; :class:`ConfigError` names the problem."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"sweep spec {str(path)!r} does not exist")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: invalid TOML: {exc}") from None
+    unknown = set(data) - _SPEC_KEYS
+    if unknown:
+        raise ConfigError(f"{path}: unknown sweep field(s) {sorted(unknown)}; allowed: {sorted(_SPEC_KEYS)}")
+    for key in ("name", "preset", "task", "outputs"):
+        if key not in data:
+            raise ConfigError(f"{path}: missing required sweep field {key!r}")
+    if not isinstance(data["outputs"], list) or not all(isinstance(o, str) for o in data["outputs"]):
+        raise ConfigError(f"{path}: 'outputs' must be a list of dotted result keys")
+    grid = data.get("grid", {})
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"{path}: grid.{key} must be a non-empty list of values")
+    cases = data.get("cases", [])
+    if not grid and not cases:
+        raise ConfigError(f"{path}: a sweep needs a [grid] or [[cases]]")
+    spec = SweepSpec(name=str(data["name"]), preset=str(data["preset"]), task=str(data["task"]),
+                     outputs=list(data["outputs"]), options=dict(data.get("options", {})), grid=dict(grid),
+                     cases=list(cases), description=str(data.get("description", "")))
+    if spec.task not in TASKS and ":" not in spec.task:
+        raise ConfigError(f"{path}: task {spec.task!r} is neither a built-in task {sorted(TASKS)} nor 'module:function'")
+    return spec
+
+
+# ------------------------------------------------------------------ case logic
+def apply_overrides(base: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """Return a copy of the design dict with dotted-path overrides applied.
+
+    Raises ConfigError for a path that does not exist in the design."""
+    data = copy.deepcopy(base)
+    for dotted, value in overrides.items():
+        keys = dotted.split(".")
+        node = data
+        for key in keys[:-1]:
+            if not isinstance(node, dict) or key not in node:
+                raise ConfigError(f"sweep parameter {dotted!r}: no field {key!r} in the design")
+            node = node[key]
+        if not isinstance(node, dict) or keys[-1] not in node:
+            raise ConfigError(f"sweep parameter {dotted!r}: no field {keys[-1]!r} in the design")
+        node[keys[-1]] = value
+    return data
+
+
+def resolve_task(name: str) -> Callable[..., dict]:
+    """Import a task function from its registered name or 'module:function'."""
+    target = TASKS.get(name, name)
+    module_name, _, func_name = target.partition(":")
+    module = importlib.import_module(module_name)
+    return getattr(module, func_name)
+
+
+def pick(result: dict[str, Any], dotted: str) -> Any:
+    """Value at a dotted key of a nested result dict (None if absent)."""
+    node: Any = result
+    for key in dotted.split("."):
+        if isinstance(node, dict) and key in node:
+            node = node[key]
+        else:
+            return None
+    return node
+
+
+def run_case(design: dict[str, Any], task: str, options: dict[str, Any]) -> dict[str, Any]:
+    """Run one case (on a worker): validate the design, call the task, never raise.
+
+    Returns a record with ``status`` ("ok" or "failed"), ``result`` or ``error``,
+    and the wall time.
+    """
+    from flexrv.cli._common import to_jsonable
+    from flexrv.design import from_dict
+
+    start = time.perf_counter()
+    try:
+        reducer = from_dict(design, source="sweep case")
+        result = resolve_task(task)(reducer, **options)
+        record = {"status": "ok", "result": to_jsonable(result)}
+    except FlexrvError as exc:
+        record = {"status": "failed", "error": f"{type(exc).__name__}: {exc}"}
+    except Exception as exc:  # a failing case must not stop the sweep
+        record = {"status": "failed", "error": f"{type(exc).__name__}: {exc}",
+                  "traceback": traceback.format_exc(limit=8)}
+    record["wall_time_s"] = time.perf_counter() - start
+    return record
+
+
+@dataclass
+class Case:
+    """One sweep case: its id, overrides and full design dict."""
+
+    case_id: str
+    overrides: dict[str, Any]
+    design: dict[str, Any]
+
+
+def build_cases(spec: SweepSpec) -> list[Case]:
+    """Expand the spec into cases with stable ids (hash of design, task, options)."""
+    from flexrv.design import load
+
+    base = load(spec.preset).model_dump(mode="python")
+    cases = []
+    for overrides in spec.variations():
+        design = apply_overrides(base, overrides)
+        cid = content_hash(design, spec.task, spec.options, length=12)
+        cases.append(Case(case_id=cid, overrides=overrides, design=design))
+    return cases
+
+
+def case_file(out_dir: Path, case: Case) -> Path:
+    return out_dir / "cases" / f"{case.case_id}.json"
+
+
+def _write_case(out_dir: Path, case: Case, record: dict[str, Any]) -> None:
+    payload = {"case_id": case.case_id, "overrides": case.overrides, **record}
+    atomic_write_text(case_file(out_dir, case), json.dumps(payload, indent=1))
+
+
+def pending_cases(out_dir: Path, cases: list[Case], retry_failed: bool = False) -> list[Case]:
+    """Cases without a stored result (or failed ones with ``retry_failed``)."""
+    todo = []
+    for case in cases:
+        path = case_file(out_dir, case)
+        if not path.exists():
+            todo.append(case)
+            continue
+        if retry_failed:
+            status = json.loads(path.read_text()).get("status")
+            if status != "ok":
+                todo.append(case)
+    return todo
+
+
+# ------------------------------------------------------------------ execution
+@dataclass
+class SweepSummary:
+    """What a sweep run did."""
+
+    out_dir: Path
+    total: int
+    computed: int
+    skipped: int
+    failed: int
+    table_csv: Path | None
+    table_nc: Path | None
+    plots: list[Path]
+
+
+def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, scheduler: str | None = None,
+              n_workers: int | None = None, retry_failed: bool = False, progress: bool = True) -> SweepSummary:
+    """Run the missing cases of a sweep on dask.distributed and write the table.
+
+    Parameters
+    ----------
+    spec : the sweep specification.
+    out_dir : results directory (default ``results/<spec.name>``).
+    scheduler : address of an existing dask scheduler; a LocalCluster with
+        ``n_workers`` (default: CPU count) single-threaded worker processes otherwise.
+    retry_failed : recompute cases recorded as failed.
+    """
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    out = Path(out_dir) if out_dir else Path("results") / spec.name
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / "spec.json", json.dumps(spec.__dict__, indent=1, default=str))
+    cases = build_cases(spec)
+    todo = pending_cases(out, cases, retry_failed)
+    failed = 0
+    if todo:
+        cluster = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            workers = n_workers or os.cpu_count() or 1
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=40)
+            client = Client(cluster)
+        try:
+            futures = {client.submit(run_case, c.design, spec.task, spec.options, key=f"case-{c.case_id}", pure=False): c
+                       for c in todo}
+            bar = _progress(progress, len(cases), len(cases) - len(todo))
+            with bar:
+                task_id = bar.add_task(f"sweep {spec.name}", total=len(cases), completed=len(cases) - len(todo))
+                for future in as_completed(futures):
+                    case = futures[future]
+                    try:
+                        record = future.result()
+                    except Exception as exc:  # worker died
+                        record = {"status": "failed", "error": f"worker error: {type(exc).__name__}: {exc}"}
+                    _write_case(out, case, record)
+                    failed += record["status"] != "ok"
+                    bar.advance(task_id)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    csv_path, nc_path, plots = write_table(spec, cases, out)
+    total_failed = sum(json.loads(case_file(out, c).read_text()).get("status") != "ok" for c in cases)
+    return SweepSummary(out_dir=out, total=len(cases), computed=len(todo), skipped=len(cases) - len(todo),
+                        failed=total_failed, table_csv=csv_path, table_nc=nc_path, plots=plots)
+
+
+def _progress(enabled: bool, total: int, done: int):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                    disable=not enabled, transient=False)
+
+
+def _as_float(value: Any) -> float:
+    if isinstance(value, bool):
+        return float(value)
+    if isinstance(value, (int, float)):
+        return float(value)
+    return math.nan
+
+
+def write_table(spec: SweepSpec, cases: list[Case], out: Path) -> tuple[Path, Path, list[Path]]:
+    """Collect all stored case results into ``table.csv``, ``table.nc`` and plots."""
+    import numpy as np
+    import xarray as xr
+
+    from flexrv.cache import atomic_path
+
+    params = sorted({k for c in cases for k in c.overrides})
+    rows = []
+    for case in cases:
+        path = case_file(out, case)
+        record = json.loads(path.read_text()) if path.exists() else {"status": "missing"}
+        row = {"case_id": case.case_id, "status": record.get("status", "missing"),
+               "error": record.get("error", ""), "wall_time_s": record.get("wall_time_s", math.nan)}
+        for p in params:
+            row[p] = case.overrides.get(p, math.nan)
+        result = record.get("result", {})
+        for o in spec.outputs:
+            row[o] = _as_float(pick(result, o)) if result else math.nan
+        rows.append(row)
+    columns = ["case_id", "status", *params, *spec.outputs, "wall_time_s", "error"]
+    csv_path = out / "table.csv"
+    lines = [",".join(columns)]
+    for row in rows:
+        lines.append(",".join(json.dumps(row[c]) if isinstance(row[c], str) else repr(row[c]) for c in columns))
+    atomic_write_text(csv_path, "\n".join(lines) + "\n")
+
+    data_vars = {}
+    for c in [*params, *spec.outputs, "wall_time_s"]:
+        values = [_as_float(r[c]) for r in rows]
+        data_vars[c.replace("/", "_")] = ("case", np.asarray(values, dtype=float))
+    data_vars["status"] = ("case", np.asarray([r["status"] for r in rows], dtype=str))
+    data_vars["error"] = ("case", np.asarray([r["error"] for r in rows], dtype=str))
+    ds = xr.Dataset(data_vars, coords={"case": [r["case_id"] for r in rows]},
+                    attrs={"sweep": spec.name, "preset": spec.preset, "task": spec.task})
+    nc_path = out / "table.nc"
+    with atomic_path(nc_path) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    plots = _plot_table(spec, rows, params, out)
+    return csv_path, nc_path, plots
+
+
+def _plot_table(spec: SweepSpec, rows: list[dict], params: list[str], out: Path) -> list[Path]:
+    """One PNG per output: vs the first varied parameter, one line per value of the
+    others."""
+    if not params or not spec.outputs:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flexrv.cache import atomic_path
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    x_key = params[0]
+    others = params[1:]
+    paths = []
+    for output in spec.outputs:
+        fig, ax = plt.subplots(figsize=(6, 4))
+        groups: dict[tuple, list[dict]] = {}
+        for r in ok:
+            groups.setdefault(tuple(r[o] for o in others), []).append(r)
+        for key, members in sorted(groups.items(), key=lambda kv: str(kv[0])):
+            members = sorted(members, key=lambda r: _as_float(r[x_key]))
+            label = ", ".join(f"{o}={v}" for o, v in zip(others, key)) or None
+            ax.plot([_as_float(r[x_key]) for r in members], [r[output] for r in members], "o-", label=label)
+        ax.set_xlabel(x_key)
+        ax.set_ylabel(output)
+        ax.set_title(f"{spec.name}: {output}")
+        if others:
+            ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+        fig.tight_layout()
+        path = out / f"sweep_{output.replace('.', '_').replace('/', '_')}.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
+        plt.close(fig)
+        paths.append(path)
+    return paths
