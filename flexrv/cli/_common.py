@@ -78,3 +78,58 @@ def fmt(value: Any) -> str:
             return f"{v:.5g}"
         return f"{v:.4e}"
     return str(value)
+
+
+def render_nested(title: str, data: dict[str, Any]) -> None:
+    """Render a nested result dict as one table per section.
+
+    Leaves are shown as ``key | value``; the unit is read from the key suffix
+    convention used throughout flexrv (``max_force_N``, ``stiffness_Nm_per_rad``).
+    Lists of numbers are shown compactly; lists of dicts as sub-tables.
+    """
+    console.print(f"[bold]{title}[/]")
+    flat: list[tuple[str, Any, str]] = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            _render_section(key, value)
+        elif isinstance(value, list) and value and isinstance(value[0], dict):
+            _render_records(key, value)
+        else:
+            flat.append((key, _compact(value), ""))
+    if flat:
+        console.print(kv_table("", flat))
+
+
+def _compact(value: Any) -> Any:
+    if isinstance(value, (list, tuple, np.ndarray)):
+        arr = list(value)
+        if len(arr) > 8:
+            return "[" + ", ".join(fmt(v) for v in arr[:6]) + f", ... ({len(arr)} values)]"
+        return "[" + ", ".join(fmt(v) for v in arr) + "]"
+    return value
+
+
+def _render_section(name: str, section: dict[str, Any], prefix: str = "") -> None:
+    rows: list[tuple[str, Any, str]] = []
+    nested: list[tuple[str, dict]] = []
+    for key, value in section.items():
+        if isinstance(value, dict):
+            nested.append((key, value))
+        elif isinstance(value, list) and value and isinstance(value[0], dict):
+            _render_records(f"{prefix}{name}.{key}", value)
+        else:
+            rows.append((key, _compact(value), ""))
+    if rows:
+        console.print(kv_table(f"{prefix}{name}", rows))
+    for key, value in nested:
+        _render_section(key, value, prefix=f"{prefix}{name}.")
+
+
+def _render_records(name: str, records: list[dict[str, Any]]) -> None:
+    table = Table(title=name, title_justify="left")
+    columns = list(records[0].keys())
+    for col in columns:
+        table.add_column(col, justify="right")
+    for rec in records[:60]:
+        table.add_row(*(fmt(_compact(rec.get(c))) for c in columns))
+    console.print(table)

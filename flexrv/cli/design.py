@@ -7,7 +7,7 @@ from typing import Any
 import typer
 from rich.table import Table
 
-from flexrv.cli._common import JSON_HELP, console, emit, fmt
+from flexrv.cli._common import JSON_HELP, console, emit, fmt, render_nested
 from flexrv.design import list_presets, load, to_toml
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
@@ -67,11 +67,11 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
     """Analytic design report at the preset's operating point (kinematics, ISO 6336
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
     loads, Hertz, film thickness, life)."""
-    from flexrv.analysis.report import design_report, render_report
+    from flexrv.analysis.report import design_report
 
     reducer = load(preset)
     report = design_report(reducer)
-    emit(report, json, lambda rep: render_report(rep, console))
+    emit(report, json, lambda rep: render_nested(f"Design report: {reducer.name}", rep))
 
 
 def register(app: typer.Typer) -> None:
