@@ -71,3 +71,256 @@ def profile_points(phi, z_rp: int, pin_circle_radius: float, pin_radius: float, 
         cr, sr = np.cos(d_rotation), np.sin(d_rotation)
         pts = np.stack([cr * pts[..., 0] - sr * pts[..., 1], sr * pts[..., 0] + cr * pts[..., 1]], axis=-1)
     return pts
+
+
+# =========================================================================== pose of the pins
+def pin_positions(z_rp: int, pin_circle_radius: float):
+    """Pin centres [m] in the housing frame, shape (z_rp, 2).
+
+    Pin j sits at curve angle psi_j = 2 pi j / z_rp on the pin circle, in the same
+    clockwise-from-+y convention as :func:`center_curve`: R (sin psi_j, cos psi_j).
+    """
+    psi = 2.0 * np.pi * np.arange(z_rp) / z_rp
+    return pin_circle_radius * np.stack([np.sin(psi), np.cos(psi)], axis=-1)
+
+
+def nominal_disc_pose(z_rp: int, eccentricity: float, crank_angle):
+    """Conjugate (ideal) pose of the disc for a crank angle.
+
+    The crank angle chi [rad] is measured like the curve parameter (clockwise from
+    +y): the disc centre is at a (sin chi, cos chi) in the housing frame and the
+    disc is turned by chi / z_c counter-clockwise (``rotation = chi / z_c``): a
+    crank turning clockwise (increasing chi) turns the disc counter-clockwise at
+    1/z_c of its speed. With this pose every pin of the ideal pin circle lies on the
+    pin-centre curve :func:`center_curve` (derivation: R e(phi + t) - a e(z_rp phi + t)
+    + O = R e(psi_j) for all j requires phi = psi_j - t and O = a e(-z_c t), with
+    e(x) = (sin x, cos x) and t the clockwise disc angle, so t = -chi/z_c;
+    Litvin & Fuentes 2004, ch. 19).
+
+    Returns
+    -------
+    center : ndarray (..., 2)
+        Disc centre [m] in the housing frame.
+    rotation : ndarray (...)
+        Counter-clockwise disc rotation [rad] (housing <- disc).
+    """
+    chi = np.asarray(crank_angle, dtype=float)
+    center = eccentricity * np.stack([np.sin(chi), np.cos(chi)], axis=-1)
+    return center, chi / (z_rp - 1)
+
+
+def to_disc_frame(points, disc_center, disc_rotation):
+    """Express housing-frame points (..., 2) in the disc frame [m]:
+    x_disc = Rot(-rotation) (x - centre), rotation counter-clockwise [rad].
+    ``disc_center`` (..., 2) and ``disc_rotation`` (...) broadcast against the
+    points' leading dimensions."""
+    p = np.asarray(points, dtype=float) - np.asarray(disc_center, dtype=float)
+    c, s = np.cos(disc_rotation), np.sin(disc_rotation)
+    return np.stack([c * p[..., 0] + s * p[..., 1], -s * p[..., 0] + c * p[..., 1]], axis=-1)
+
+
+def _rotate(v, angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+# =========================================================================== signed pin gap
+def _outward_normal(d1):
+    """Unit outward normal (away from the disc centre) of the clockwise-traversed
+    pin-centre curve: the unit tangent rotated by +90 deg."""
+    t = d1 / np.linalg.norm(d1, axis=-1, keepdims=True)
+    return np.stack([-t[..., 1], t[..., 0]], axis=-1)
+
+
+def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
+            d_radius: float = 0.0, d_pin_radius: float = 0.0, d_rotation: float = 0.0, phi0=None,
+            tol: float = 1e-14, max_iter: int = 40):
+    """Exact signed gap between pins and the modified cycloid-disc profile.
+
+    The disc profile is the inward offset, by r_rp + dr_rp, of the pin-centre
+    epitrochoid C(phi) on the shift-modified pin circle R_p + dR_p, turned by the
+    rotation modification d_rotation (see module docstring). For a pin centre P the
+    closest profile point lies on the common normal of the profile and of C (offset
+    curves share normals), so with the foot point C(phi*) of P on C,
+
+        gap = s(P) + (r_rp + dr_rp) - r_rp = s(P) + dr_rp,
+
+    where s(P) = (P - C(phi*)) . n_out(phi*) is the signed distance of P from C
+    (> 0 outside, away from the disc centre). Valid while the profile has no
+    undercut (r_rp + dr_rp below the minimum convex curvature radius of C, which
+    the design model checks). Sources: Litvin & Fuentes 2004, ch. 19 (envelope /
+    offset of the pin-centre curve); closest point by Newton's method on
+    g(phi) = |P - C(phi)|^2 / 2 (g' = -(P - C).C', g'' = |C'|^2 - (P - C).C'').
+
+    Parameters
+    ----------
+    points : array_like (..., 2)
+        Pin centres [m] in the disc frame.
+    z_rp : int
+        Number of pins.
+    pin_circle_radius, pin_radius, eccentricity : float
+        R_p, r_rp (actual pin radius) and a [m].
+    d_radius, d_pin_radius, d_rotation : float
+        Shift dR_p [m], equidistant dr_rp [m] and rotation [rad, counter-clockwise]
+        modifications of the profile.
+    phi0 : array_like (...), optional
+        Warm start for the curve parameter (e.g. the ``phi`` of the previous call);
+        without it several starts around the pin's polar angle are used.
+
+    Returns
+    -------
+    gap : ndarray (...)
+        Signed gap [m]: > 0 open, < 0 penetration.
+    normal : ndarray (..., 2)
+        Unit vector (disc frame) from the profile towards the pin centre: the
+        direction of the contact force on the pin.
+    phi : ndarray (...)
+        Curve parameter of the closest point [rad].
+
+    Raises
+    ------
+    ConvergenceError
+        If the closest-point iteration does not converge.
+    """
+    from flexrv.errors import ConvergenceError, InputError
+
+    p = np.asarray(points, dtype=float)
+    if p.shape[-1] != 2:
+        raise InputError(f"points must have shape (..., 2), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise InputError("points must be finite")
+    if d_rotation:
+        p = _rotate(p, -d_rotation)
+    radius = pin_circle_radius + d_radius
+    lobe = 2.0 * np.pi / (z_rp - 1)
+    if phi0 is None:
+        theta = np.arctan2(p[..., 0], p[..., 1])
+        phi = theta[..., None] + lobe * np.linspace(-0.375, 0.375, 7)
+    else:
+        phi = np.asarray(phi0, dtype=float)[..., None] + np.zeros(1)
+        phi = np.broadcast_to(phi, p.shape[:-1] + (1,)).copy()
+    pp = p[..., None, :]
+    max_step = lobe / 8.0
+    scale = np.hypot(pin_circle_radius, 1.0)
+    converged = False
+    for _ in range(max_iter):
+        c, d1, d2 = center_curve(phi, z_rp, radius, eccentricity)
+        r = pp - c
+        g1 = -np.einsum("...k,...k->...", r, d1)
+        g2 = np.einsum("...k,...k->...", d1, d1) - np.einsum("...k,...k->...", r, d2)
+        step = np.where(g2 > 0, -g1 / np.where(g2 > 0, g2, 1.0), -np.sign(g1) * max_step)
+        step = np.clip(step, -max_step, max_step)
+        phi = phi + step
+        if np.max(np.abs(step), initial=0.0) < tol * scale:
+            converged = True
+            break
+    if not converged:
+        # accept if the first-order condition holds to round-off
+        c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
+        r = pp - c
+        res = np.abs(np.einsum("...k,...k->...", r, d1)) / np.linalg.norm(d1, axis=-1)
+        if np.max(res, initial=0.0) > 1e-12:
+            raise ConvergenceError(f"pin_gap: closest-point iteration did not converge in {max_iter} "
+                                   f"iterations (max residual {np.max(res):.3g} m)")
+    c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
+    dist2 = np.einsum("...k,...k->...", pp - c, pp - c)
+    best = np.argmin(dist2, axis=-1)[..., None]
+    phi = np.take_along_axis(phi, best, axis=-1)[..., 0]
+    c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
+    n_out = _outward_normal(d1)
+    signed = np.einsum("...k,...k->...", p - c, n_out)
+    gap = signed + d_pin_radius
+    if d_rotation:
+        n_out = _rotate(n_out, d_rotation)
+    return gap, n_out, phi
+
+
+# =========================================================================== curvature, arms, stiffness
+def profile_curvature_radius(phi, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
+                             d_radius: float = 0.0, d_pin_radius: float = 0.0):
+    """Signed radius of curvature [m] of the actual (modified) disc profile at
+    curve parameter phi: > 0 convex (tooth flank/tip bending towards the disc
+    centre), < 0 concave (tooth space).
+
+    rho_profile = 1/kappa_C - (r_rp + dr_rp), kappa_C the signed curvature of the
+    pin-centre curve (:func:`center_curve_curvature`); offset curves share centres
+    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of seed
+    004's rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an
+    unmodified profile.
+    """
+    kappa = center_curve_curvature(phi, z_rp, pin_circle_radius + d_radius, eccentricity)
+    with np.errstate(divide="ignore"):
+        return 1.0 / kappa - (pin_radius + d_pin_radius)
+
+
+def seed004_curvature_radius(theta, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float):
+    """Seed 004's curvature radius of the cycloid profile [m] (negative = convex):
+
+    rho = r_p (1 + K^2 - 2 K cos th)^(3/2) / (K (z_p + 1) cos th - (1 + z_p K^2)) + r_rp,
+    K = a z_p / r_p, th the meshing phase angle (= z_c phi in this module's
+    parametrisation; verified in tests/test_cycloid.py).
+    """
+    k = eccentricity * z_rp / pin_circle_radius
+    th = np.asarray(theta, dtype=float)
+    s3 = (1.0 + k * k - 2.0 * k * np.cos(th)) ** 1.5
+    return pin_circle_radius * s3 / (k * (z_rp + 1) * np.cos(th) - (1.0 + z_rp * k * k)) + pin_radius
+
+
+def moment_arm(phi_i, z_rp: int, pin_circle_radius: float, eccentricity: float):
+    """Moment arm l_i [m] of pin i's ideal contact normal about the disc centre
+    (seed 000; Chen et al., standard cycloid-drive force analysis):
+
+        l_i = r'_c sin(phi_i) / sqrt(1 + K^2 - 2 K cos(phi_i)),  r'_c = a z_c,
+        K = a z_rp / R_p,
+
+    phi_i [rad] being the angle of pin i from the eccentric (crank) direction,
+    measured about the pin-wheel centre. The ideal normal passes through the pitch
+    point, which lies at a z_c from the disc centre on the eccentric line.
+    l_i peaks at r'_c for cos(phi_i) = K.
+    """
+    k = eccentricity * z_rp / pin_circle_radius
+    phi_i = np.asarray(phi_i, dtype=float)
+    return eccentricity * (z_rp - 1) * np.sin(phi_i) / np.sqrt(1.0 + k * k - 2.0 * k * np.cos(phi_i))
+
+
+def pin_stiffness_seed000(width, e_eff):
+    """Seed 000's per-pin Hertz line-contact stiffness [N/m]:
+
+    k_n = pi b E rho_r rho_c / (4 (1 - mu^2)(rho_r + rho_c) rho_i), rho_i = rho_r rho_c/(rho_r + rho_c),
+
+    which SIMPLIFIES to pi b E / (4 (1 - mu^2)): the curvatures cancel. Written
+    with Hamrock's effective modulus E' (= E/(1 - mu^2) for equal materials) it is
+    pi b E' / 4, which also covers disc and pin of different steels. It is a
+    load- and curvature-independent linear surrogate; the physical 2-D Hertz
+    approach is nonlinear in the load (Palmgren: delta ~ Q^0.9, see
+    :func:`flexrv.contact.hertz.line_contact_stiffness`).
+
+    Parameters
+    ----------
+    width : disc width b [m]; e_eff : effective modulus E' [Pa].
+    """
+    return np.pi * np.asarray(width, dtype=float) * np.asarray(e_eff, dtype=float) / 4.0
+
+
+def pin_stiffness_seed004(rho, pin_radius: float, width, e_eff):
+    """Seed 004's per-pin stiffness K_cj [N/m] with rho from
+    :func:`seed004_curvature_radius` (rho < 0 convex):
+
+    K_cj = pi b E |rho| (rho - r_rp) / (4 rho (1 - mu^2)(r_rp + |rho|)), E/(1-mu^2) -> E'.
+
+    On the convex (working) flank this equals pi b E'/4 (seed 000); on the
+    concave part it is reduced by (rho - r_rp)/(rho + r_rp), and it vanishes
+    where the pin-centre curve has an inflection (rho = r_rp).
+    """
+    rho = np.asarray(rho, dtype=float)
+    return (np.pi * np.asarray(width) * np.asarray(e_eff) * np.abs(rho) * (rho - pin_radius)
+            / (4.0 * rho * (pin_radius + np.abs(rho))))
+
+
+def k34(pin_stiffness, arms, engaged=None):
+    """Torsional mesh stiffness of one disc about its centre [N m/rad] (seed 000):
+    k34 = sum over engaged pins of k_n,i l_i^2."""
+    k = np.asarray(pin_stiffness, dtype=float) * np.asarray(arms, dtype=float) ** 2
+    if engaged is not None:
+        k = np.where(engaged, k, 0.0)
+    return np.sum(k, axis=-1)

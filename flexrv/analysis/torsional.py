@@ -1,0 +1,269 @@
+"""Torsional stiffness of the RV reducer's second stage (seed 004 series model)
+and seed 004's meshing-zone identification from a measured stiffness.
+
+Model (seed 004): the output torque passes in series through
+(1) the needle (crank) bearings between the discs and the eccentrics and
+(2) the pin-disc contacts:
+
+    C_W = C_Hc C_c / (C_Hc + C_c),
+    C_Hc = n_discs sum_k K_Hc,k l_c^2       (seed: 2 (K_A + K_B + K_C) l_c^2),
+    C_c  = n_discs sum_j K_c,j L_j^2         (seed: 2 sum K_cj L_j^2),
+
+with the empirical needle-bearing radial stiffness
+K_Hc = 0.34e4 F_r^0.1 Z^0.9 l^0.8 cos(alpha)^1.9 [N/mm; F_r in N, l in mm].
+The first stage and the crank/carrier compliances are neglected (as in seed 004).
+
+Lever arm l_c: turning a disc by beta about its centre moves each crank hole by
+a_w beta tangentially (a_w = crank-circle radius = first-stage centre distance),
+so l_c = a_w. Seed 004's force split writes the couple term as F_t r'_c/(3a);
+moment balance of the disc about its centre requires the hole radius a_w in that
+denominator (with the eccentricity a = 1.3 mm the bearing forces of the RV-40E
+would be ~28x too large), so a_w is used (physics over seed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexrv.errors import InputError
+
+#: K_Hc [N/mm] = NEEDLE_COEFF * F^0.1 [N] * Z^0.9 * l^0.8 [mm] * cos^1.9 (seed 004).
+NEEDLE_COEFF = 0.34e4
+
+
+def needle_radial_stiffness(radial_force, roller_count, roller_length, contact_angle=0.0):
+    """Empirical radial stiffness of a needle/roller bearing [N/m] (seed 004):
+
+    K_Hc = 0.34e4 F_r^0.1 Z^0.9 l^0.8 cos(alpha)^1.9   in N/mm with F_r [N], l [mm].
+
+    SI conversion: K [N/m] = 1e3 * 0.34e4 * F_r^0.1 * Z^0.9 * (1e3 l[m])^0.8 cos^1.9
+    = 3.4e6 * 10^2.4 * F_r^0.1 Z^0.9 l^0.8 cos^1.9 = 8.541e8 F_r^0.1 Z^0.9 l[m]^0.8 cos^1.9.
+
+    Parameters
+    ----------
+    radial_force : bearing radial load F_r [N] (>= 0; F_r = 0 gives K = 0, the
+        formula's limit, so callers should not use it unloaded).
+    roller_count : Z [-]; roller_length : effective length l [m];
+    contact_angle : alpha [rad] (0 for needle bearings).
+    """
+    f = np.asarray(radial_force, dtype=float)
+    if np.any(~np.isfinite(f)) or np.any(f < 0):
+        raise InputError(f"radial_force must be finite and >= 0 N, got {radial_force!r}")
+    if np.any(np.asarray(roller_length) <= 0) or np.any(np.asarray(roller_count) <= 0):
+        raise InputError("roller_count and roller_length must be > 0")
+    l_mm = np.asarray(roller_length, dtype=float) * 1e3
+    k_n_per_mm = NEEDLE_COEFF * f**0.1 * np.asarray(roller_count, dtype=float) ** 0.9 * l_mm**0.8 \
+        * np.cos(contact_angle) ** 1.9
+    return k_n_per_mm * 1e3
+
+
+def crank_hole_angles(n_cranks: int, first: float = 0.0):
+    """Angles [rad] of the crank holes in the disc frame (math convention, ccw from +x):
+    first + 2 pi k / n."""
+    return first + 2.0 * np.pi * np.arange(n_cranks) / n_cranks
+
+
+def crank_bearing_forces(pin_resultant, disc_torque, crank_circle_radius, n_cranks: int = 3, first_angle=0.0):
+    """Forces [N] on the n crank bearings of one disc (seed 004's F_A/F_B/F_C,
+    generalised to n cranks), shape (..., n, 2):
+
+        F_k = F / n + T / (n a_w) t_k,   t_k = (-sin th_k, cos th_k),
+
+    the force the disc exerts on crank bearing k at hole angle th_k, with F the
+    resultant of the pin forces on the disc and T their moment about the disc
+    centre (= the disc torque). Equal sharing of the force and of the couple is
+    the statically determinate split of seed 004; it satisfies force and moment
+    balance of the disc exactly: sum_k F_k = F (the t_k sum to zero) and
+    sum_k a_w e_k x F_k = sum_k T/n = T (the F/n terms have no moment since
+    sum_k e_k = 0 for evenly spaced holes), e_k = (cos th_k, sin th_k).
+
+    Parameters
+    ----------
+    pin_resultant : (..., 2) resultant pin force on the disc [N].
+    disc_torque : (...) moment of the pin forces about the disc centre [N m].
+    crank_circle_radius : a_w [m]; n_cranks : number of cranks (>= 2);
+    first_angle : angle of the first hole [rad].
+    """
+    if n_cranks < 2:
+        raise InputError(f"n_cranks = {n_cranks} must be >= 2")
+    if crank_circle_radius <= 0:
+        raise InputError(f"crank_circle_radius = {crank_circle_radius} must be > 0")
+    th = crank_hole_angles(n_cranks, first_angle)
+    t = np.stack([-np.sin(th), np.cos(th)], axis=-1)
+    f = np.asarray(pin_resultant, dtype=float)[..., None, :] / n_cranks
+    couple = np.asarray(disc_torque, dtype=float)[..., None, None] / (n_cranks * crank_circle_radius) * t
+    return f + couple
+
+
+def bearing_torsional_stiffness(bearing_stiffness, lever_arm, n_discs: int = 2):
+    """C_Hc = n_discs sum_k K_Hc,k l_c^2 [N m/rad] (seed 004, n_discs = 2)."""
+    return n_discs * np.sum(np.asarray(bearing_stiffness, dtype=float), axis=-1) * lever_arm**2
+
+
+def mesh_torsional_stiffness(pin_stiffness, arms, n_discs: int = 2, engaged=None):
+    """C_c = n_discs sum_j K_c,j L_j^2 [N m/rad] over the engaged pins (seed 004)."""
+    c = np.asarray(pin_stiffness, dtype=float) * np.asarray(arms, dtype=float) ** 2
+    if engaged is not None:
+        c = np.where(engaged, c, 0.0)
+    return n_discs * np.sum(c, axis=-1)
+
+
+def series_stiffness(c1, c2):
+    """Two torsional springs in series: C = C1 C2 / (C1 + C2) [N m/rad] (seed 004's C_W)."""
+    c1, c2 = np.asarray(c1, dtype=float), np.asarray(c2, dtype=float)
+    return c1 * c2 / (c1 + c2)
+
+
+def required_mesh_stiffness(measured, bearing):
+    """Invert the series model: C_c = 1 / (1/C_W - 1/C_Hc) [N m/rad] (seed 004).
+
+    Raises InputError if C_W >= C_Hc (no positive mesh stiffness explains the
+    measurement)."""
+    if measured <= 0 or bearing <= measured:
+        raise InputError(f"measured stiffness {measured:.4g} N m/rad must be > 0 and below the bearing "
+                         f"stiffness C_Hc = {bearing:.4g} N m/rad")
+    return 1.0 / (1.0 / measured - 1.0 / bearing)
+
+
+@dataclass(frozen=True)
+class MeshingZone:
+    """Result of :func:`identify_meshing_zone` (pins numbered from 1 like seed 004).
+
+    target : required C_c [N m/rad]; first, last : best consecutive pin set;
+    n_pins; total : its summed stiffness; rel_error = (total - target)/target;
+    angles : phase angles of first/last pin [rad]; best_by_count : for every set
+    size n, (first, last, total) of the best n-pin set.
+    """
+
+    target: float
+    first: int
+    last: int
+    n_pins: int
+    total: float
+    rel_error: float
+    angles: tuple[float, float]
+    best_by_count: dict[int, tuple[int, int, float]]
+
+
+def identify_meshing_zone(contributions, target, phase_angles=None, n_pins: int | None = None) -> MeshingZone:
+    """Seed 004's meshing-zone identification: the consecutive set of pins whose
+    summed single-pin contributions KTC_j (= n_discs K_cj L_j^2) best match the
+    required mesh stiffness ``target`` (all consecutive sets are enumerated; with
+    ``n_pins`` only sets of that size).
+
+    Parameters
+    ----------
+    contributions : (m,) KTC_j [N m/rad] of pins 1..m (seed 004 Table: m = 21 over 0-180 deg).
+    target : required C_c [N m/rad]; phase_angles : (m,) [rad], optional.
+    """
+    c = np.asarray(contributions, dtype=float)
+    m = len(c)
+    cum = np.concatenate([[0.0], np.cumsum(c)])
+    i, j = np.triu_indices(m + 1, k=1)  # sets c[i:j]
+    totals = cum[j] - cum[i]
+    sizes = j - i
+    best_by = {}
+    for n in range(1, m + 1):
+        sel = np.flatnonzero(sizes == n)
+        b = sel[np.argmin(np.abs(totals[sel] - target))]
+        best_by[n] = (int(i[b]) + 1, int(j[b]), float(totals[b]))
+    cand = np.flatnonzero(sizes == n_pins) if n_pins else np.arange(len(totals))
+    b = cand[np.argmin(np.abs(totals[cand] - target))]
+    first, last = int(i[b]) + 1, int(j[b])
+    ang = (float("nan"), float("nan")) if phase_angles is None else (float(phase_angles[first - 1]),
+                                                                       float(phase_angles[last - 1]))
+    return MeshingZone(target=float(target), first=first, last=last, n_pins=last - first + 1, total=float(totals[b]),
+                       rel_error=float((totals[b] - target) / target), angles=ang, best_by_count=best_by)
+
+
+#: Seed 004 table: single-point equivalent torsional stiffness KTC_j [N mm/rad]
+#: of pins 1..21 at meshing phase 0, 9, ..., 180 deg (RV-40E, two discs).
+SEED004_KTC_NMM = np.array([0.0, 2.20e6, 1.97e7, 1.33e8, 1.84e8, 1.76e8, 1.66e8, 1.52e8, 1.38e8, 1.22e8, 1.06e8,
+                            8.93e7, 7.33e7, 5.79e7, 4.38e7, 3.12e7, 2.03e7, 1.16e7, 5.25e6, 1.33e6, 0.0])
+#: Seed 004: measured C_W = 3.06e8 N mm/rad and derived C_c = 6.24e8 N mm/rad.
+SEED004_CW_NMM = 3.06e8
+SEED004_CC_NMM = 6.24e8
+
+
+# --------------------------------------------------------------------------- design-level evaluation
+@dataclass(frozen=True)
+class SecondStageStiffness:
+    """Second-stage torsional stiffness of a design at one load and crank angle (SI).
+
+    bearing_forces : (n, 2) force on each crank bearing of one disc [N];
+    bearing_loads : (n,) their magnitudes [N]; bearing_stiffness : (n,) K_Hc [N/m];
+    lever_arm : l_c = a_w [m]; c_bearings : C_Hc [N m/rad];
+    c_mesh_seed : C_c with seed 004's K_cj over the loaded pins [N m/rad];
+    c_mesh_tangent : n_discs dT/dbeta of the Palmgren pin-load solution [N m/rad];
+    c_w_seed, c_w_tangent : series C_W with either mesh stiffness [N m/rad];
+    n_contact : loaded pins per disc.
+    """
+
+    bearing_forces: np.ndarray
+    bearing_loads: np.ndarray
+    bearing_stiffness: np.ndarray
+    lever_arm: float
+    c_bearings: float
+    c_mesh_seed: float
+    c_mesh_tangent: float
+    c_w_seed: float
+    c_w_tangent: float
+    n_contact: int
+
+
+def seed004_pin_contributions(reducer, n_pins: int | None = None):
+    """Single-pin equivalent torsional stiffness KTC_j = n_discs K_cj L_j^2 [N m/rad]
+    of pins j = 1..n at meshing phase (j - 1) 2 pi / z_rp (seed 004's table,
+    recomputed with the design's width and E'): K_cj from
+    :func:`flexrv.geometry.cycloid.pin_stiffness_seed004` with the profile radius
+    of :func:`flexrv.geometry.cycloid.seed004_curvature_radius` (seed 004 phase
+    theta = pin angle from the eccentric direction; the formula is even in theta),
+    L_j from :func:`flexrv.geometry.cycloid.moment_arm`.
+
+    Returns (phase angles [rad], KTC [N m/rad]); default n = z_rp/2 + 1 (0..180 deg)."""
+    from flexrv.analysis.pin_load import disc_effective_modulus
+    from flexrv.geometry.cycloid import moment_arm, pin_stiffness_seed004, seed004_curvature_radius
+
+    ss = reducer.second_stage
+    n = ss.pin_count // 2 + 1 if n_pins is None else n_pins
+    th = 2.0 * np.pi * np.arange(n) / ss.pin_count
+    rho = seed004_curvature_radius(th, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = pin_stiffness_seed004(rho, ss.pin_radius, ss.disc_width, disc_effective_modulus(reducer))
+    arms = moment_arm(th, ss.pin_count, ss.pin_circle_radius, ss.eccentricity)
+    return th, np.nan_to_num(ss.n_discs * k * arms**2)
+
+
+def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0.0,
+                           first_hole_angle: float = 0.0) -> SecondStageStiffness:
+    """Seed 004 series model evaluated for a design under ``output_torque`` [N m]:
+    pin loads (initial-clearance method, :mod:`flexrv.analysis.pin_load`) give the
+    pin resultant and the loaded pins; the crank-bearing forces
+    (:func:`crank_bearing_forces`) give K_Hc (:func:`needle_radial_stiffness`)."""
+    from flexrv.analysis.pin_load import disc_effective_modulus, reducer_pin_loads
+    from flexrv.geometry.cycloid import pin_stiffness_seed004, seed004_curvature_radius
+
+    ss, fs, nb = reducer.second_stage, reducer.first_stage, reducer.needle_bearing
+    if output_torque == 0:
+        raise InputError("output_torque must be non-zero for the load-dependent stiffness model")
+    res = reducer_pin_loads(reducer, output_torque, crank_angle)
+    t_disc = output_torque / ss.n_discs
+    a_w = fs.center_distance
+    forces = crank_bearing_forces(res.resultant, t_disc, a_w, fs.n_planets, first_hole_angle)
+    loads = np.linalg.norm(forces, axis=-1)
+    k_hc = needle_radial_stiffness(loads, nb.roller_count, nb.roller_length_mm * 1e-3)
+    c_hc = float(bearing_torsional_stiffness(k_hc, a_w, ss.n_discs))
+    # seed-004 pin stiffness at each loaded pin's phase angle (from its arm: |l| = r'_c sin/S)
+    psi = 2.0 * np.pi * np.arange(ss.pin_count) / ss.pin_count
+    phase = np.mod(psi - crank_angle + np.pi, 2 * np.pi) - np.pi
+    rho = seed004_curvature_radius(phase, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k_c = np.nan_to_num(pin_stiffness_seed004(rho, ss.pin_radius, ss.disc_width, disc_effective_modulus(reducer)))
+    c_c_seed = float(mesh_torsional_stiffness(k_c, res.arms, ss.n_discs, res.in_contact))
+    c_c_tan = ss.n_discs * res.torsional_stiffness
+    return SecondStageStiffness(bearing_forces=forces, bearing_loads=loads, bearing_stiffness=k_hc, lever_arm=a_w,
+                                c_bearings=c_hc, c_mesh_seed=c_c_seed, c_mesh_tangent=c_c_tan,
+                                c_w_seed=float(series_stiffness(c_hc, c_c_seed)),
+                                c_w_tangent=float(series_stiffness(c_hc, c_c_tan)), n_contact=res.n_contact)

@@ -1,0 +1,110 @@
+"""CLI: ``flexrv simulate PRESET`` and ``flexrv stiffness-test PRESET``."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import typer
+
+from flexrv.cli._common import JSON_HELP, console, emit, kv_table
+
+PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
+
+
+def _bar(enabled: bool):
+    """A rich progress callback on stderr (keeps stdout clean for --json)."""
+    if not enabled:
+        return False
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    bar = Progress(TextColumn("[bold]simulating[/]"), BarColumn(), TextColumn("{task.completed:.4f}/{task.total:.4f} s"),
+                   TimeElapsedColumn(), TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+    state = {"task": None}
+
+    def report(t, t_end):
+        if state["task"] is None:
+            bar.start()
+            state["task"] = bar.add_task("sim", total=t_end)
+        bar.update(state["task"], completed=t)
+        if t >= t_end * (1 - 1e-9):
+            bar.stop()
+
+    report.stop = bar.stop
+    return report
+
+
+def _default_out(preset: str, model: str, kind: str) -> Path:
+    stem = Path(preset).stem
+    return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
+             model: str = typer.Option("rigid", "--model", help="Model name (rigid)."),
+             t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
+             dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+             out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+             json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+    """Run the multibody model; write NetCDF, config, summary.md and PNGs."""
+    from flexrv.simulation import Simulation
+
+    out = out or _default_out(preset, model, "sim")
+    sim = Simulation(preset, model=model)
+    bar = _bar(not json)
+    try:
+        res = sim.run(t_end=t_end, dt=dt, progress=bar, save_to=out)
+    finally:
+        if bar:
+            bar.stop()
+    if res.attrs.get("status") != "interrupted":
+        res.save(out)
+    s = res.summary()
+    data = {"output_dir": str(out), "status": s["status"],
+            "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
+            "ratio_theoretical": s["ratio_theoretical"], "ratio_simulated": s["ratio_simulated"],
+            "te_min_arcsec": s["te_min_arcsec"], "te_max_arcsec": s["te_max_arcsec"], "te_pp_arcsec": s["te_pp_arcsec"],
+            "steady_window_s": s["steady_window_s"], "max_pin_force_N": s["max_pin_force_N"],
+            "pins_in_contact_mean": s["pins_in_contact_mean"], "pins_in_contact_max": s["pins_in_contact_max"],
+            "wall_time_s": sim.timing.get("solve_s")}
+
+    def render(d):
+        rows = [(k, v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}", "") for k, v in d.items()]
+        console.print(kv_table(f"simulate {preset} ({model})", rows))
+
+    emit(data, json, render)
+    if res.attrs.get("status") == "interrupted":
+        raise typer.Exit(130)
+
+
+def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
+                       model: str = typer.Option("rigid", "--model", help="Model name (rigid)."),
+                       quarter_time: float = typer.Option(0.02, "--quarter-time", help="Duration of each quarter of the torque loop [s]."),
+                       dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+                       out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+                       json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+    """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
+    torsional rigidity, lost motion, hysteresis loop PNG."""
+    from dataclasses import asdict
+
+    from flexrv.simulation import stiffness_test
+
+    out = out or _default_out(preset, model, "stiffness")
+    bar = _bar(not json)
+    try:
+        fig, _ = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out)
+    finally:
+        if bar:
+            bar.stop()
+    data = {"output_dir": str(out), **asdict(fig)}
+
+    def render(d):
+        console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, "") for k, v in d.items()]))
+
+    emit(data, json, render)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``simulate`` and ``stiffness-test`` to the app."""
+    app.command("simulate")(simulate)
+    app.command("stiffness-test")(stiffness_test_cmd)

@@ -1,0 +1,189 @@
+"""Precomputed central-film maps h_c(Q, u) of one point-contact geometry + lubricant.
+
+The numerical solver (:mod:`flexrv.ehl.solver`) is far too slow to call inside a
+dynamic simulation, so it is run once on a grid of loads x entrainment speeds and
+the result is stored as the *correction factor* to Hamrock–Dowson,
+
+    h_c(Q, u) = h_HD(Q, u) * exp(c(ln Q, ln u)),  c = ln(h_solver / h_HD),
+
+bilinear in (ln Q, ln u). Interpolating the ratio rather than h itself keeps the
+known power-law dependence exact between nodes, and outside the tabulated range
+the ratio is held at its edge value (constant extrapolation), so the map falls
+back to Hamrock–Dowson scaling there. Grid points where the solver fails (e.g. a
+film the grid cannot resolve at very high load, see the solver's limits) take the
+ratio of the nearest converged point; they are flagged in ``valid``.
+
+Maps are cached under ``flexrv.cache.cache_dir()/ehl_maps`` keyed by a content
+hash of all inputs, the solver settings and the library versions, and written
+atomically (.npz).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from flexrv.cache import atomic_path, cache_dir, content_hash, library_versions
+from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, hamrock_dowson
+from flexrv.ehl.solver import LubricantProperties, solve_point_contact
+from flexrv.errors import ConvergenceError, InputError
+
+#: Bump when the solver or the map layout changes (part of the cache key).
+MAP_SCHEMA = 1
+
+
+@dataclass(frozen=True)
+class FilmMap:
+    """Central-film correction table of one contact geometry + lubricant.
+
+    Attributes
+    ----------
+    rx, ry, e_eff : geometry [m] and effective modulus [Pa].
+    lubricant : the lubricant the map was computed for.
+    log_load, log_speed : uniform grids of ln Q [ln N] and ln u [ln(m/s)].
+    log_ratio : ln(h_solver / h_HD) at the nodes, shape (n_load, n_speed).
+    h_central : solver central film [m] at the nodes (NaN where it failed).
+    valid : nodes where the solver converged.
+    grid : solver grid used.
+    """
+
+    rx: float
+    ry: float
+    e_eff: float
+    lubricant: LubricantProperties
+    log_load: np.ndarray
+    log_speed: np.ndarray
+    log_ratio: np.ndarray
+    h_central: np.ndarray
+    valid: np.ndarray
+    grid: int
+
+    def log_correction(self, load, speed):
+        """c(ln Q, ln u) and dc/d ln Q (vectorised bilinear interpolation, edge-clamped)."""
+        lq = np.log(np.maximum(np.asarray(load, dtype=float), 1e-300))
+        lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
+        return _bilinear(self.log_ratio, self.log_load, self.log_speed, lq, lu)
+
+    def central_film(self, load, speed):
+        """h_c [m] and d ln h_c / d ln Q at (load [N], speed [m/s]) (arrays broadcast)."""
+        load = np.asarray(load, dtype=float)
+        speed = np.asarray(speed, dtype=float)
+        h_hd, _ = hamrock_dowson(load, speed, self.rx, self.ry, self.e_eff, self.lubricant.viscosity,
+                                 self.lubricant.pressure_viscosity)
+        c, dc = self.log_correction(load, speed)
+        return h_hd * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
+
+
+def _bilinear(table, gx, gy, x, y):
+    """Bilinear interpolation on uniform grids gx, gy (clamped), and d/dx."""
+    nx, ny = gx.size, gy.size
+    x, y = np.broadcast_arrays(x, y)
+    if nx > 1:
+        fx = np.clip((x - gx[0]) / (gx[1] - gx[0]), 0.0, nx - 1.0)
+        ix = np.minimum(fx.astype(int), nx - 2)
+        tx = fx - ix
+        inside_x = (x > gx[0]) & (x < gx[-1])
+    else:
+        ix = np.zeros(x.shape, dtype=int)
+        tx = np.zeros(x.shape)
+        inside_x = np.zeros(x.shape, dtype=bool)
+    if ny > 1:
+        fy = np.clip((y - gy[0]) / (gy[1] - gy[0]), 0.0, ny - 1.0)
+        iy = np.minimum(fy.astype(int), ny - 2)
+        ty = fy - iy
+    else:
+        iy = np.zeros(y.shape, dtype=int)
+        ty = np.zeros(y.shape)
+    ix1 = np.minimum(ix + 1, nx - 1)
+    iy1 = np.minimum(iy + 1, ny - 1)
+    f00, f10 = table[ix, iy], table[ix1, iy]
+    f01, f11 = table[ix, iy1], table[ix1, iy1]
+    val = (f00 * (1 - tx) + f10 * tx) * (1 - ty) + (f01 * (1 - tx) + f11 * tx) * ty
+    if nx > 1:
+        dval = ((f10 - f00) * (1 - ty) + (f11 - f01) * ty) / (gx[1] - gx[0])
+        dval = np.where(inside_x, dval, 0.0)
+    else:
+        dval = np.zeros(x.shape)
+    return val, dval
+
+
+def _check_range(name, lo, hi, n):
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
+        raise InputError(f"{name} range must satisfy 0 < min <= max, got ({lo!r}, {hi!r})")
+    if n < 1 or (lo == hi and n != 1):
+        raise InputError(f"{name} points must be >= 1 (1 when min == max), got {n}")
+
+
+def build_film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, speed_range, *,
+                   n_load: int = 6, n_speed: int = 4, grid: int = 65, **solver_kw) -> FilmMap:
+    """Run the solver over a log-spaced load x speed grid (no caching; see
+    :func:`film_map` for the cached version).
+
+    Parameters
+    ----------
+    rx, ry : effective radii [m]; e_eff : E' [Pa]; lubricant : LubricantProperties.
+    load_range : (Q_min, Q_max) [N]; speed_range : (u_min, u_max) [m/s].
+    n_load, n_speed : nodes per axis (log-spaced).
+    grid : solver grid (2^k + 1).
+    solver_kw : passed to :func:`flexrv.ehl.solver.solve_point_contact`.
+
+    Raises
+    ------
+    ConvergenceError
+        If the solver converges at no node at all.
+    """
+    _check_range("load", *load_range, n_load)
+    _check_range("speed", *speed_range, n_speed)
+    lubricant.check()
+    lq = np.linspace(np.log(load_range[0]), np.log(load_range[1]), n_load)
+    lu = np.linspace(np.log(speed_range[0]), np.log(speed_range[1]), n_speed)
+    h = np.full((n_load, n_speed), np.nan)
+    errors = []
+    for i, q in enumerate(np.exp(lq)):  # one solver run per node (each is a full 2-D solve)
+        for j, u in enumerate(np.exp(lu)):
+            try:
+                h[i, j] = solve_point_contact(q, u, rx, ry, e_eff, lubricant, grid=grid, **solver_kw).h_central
+            except ConvergenceError as exc:
+                errors.append(str(exc))
+    valid = np.isfinite(h)
+    if not valid.any():
+        raise ConvergenceError("EHL map: the solver converged at no node; first failure: " + errors[0])
+    qq, uu = np.meshgrid(np.exp(lq), np.exp(lu), indexing="ij")
+    h_hd, _ = hamrock_dowson(qq, uu, rx, ry, e_eff, lubricant.viscosity, lubricant.pressure_viscosity)
+    ratio = np.log(h / h_hd)
+    if not valid.all():  # nearest converged node in index space
+        vi, vj = np.nonzero(valid)
+        bi, bj = np.nonzero(~valid)
+        d = (bi[:, None] - vi[None, :]) ** 2 + (bj[:, None] - vj[None, :]) ** 2
+        k = np.argmin(d, axis=1)
+        ratio[bi, bj] = ratio[vi[k], vj[k]]
+    return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant, log_load=lq, log_speed=lu,
+                   log_ratio=ratio, h_central=h, valid=valid, grid=grid)
+
+
+def film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, speed_range, *, n_load: int = 6,
+             n_speed: int = 4, grid: int = 65, **solver_kw) -> FilmMap:
+    """Cached :func:`build_film_map`: loaded from ``cache_dir()/ehl_maps/<hash>.npz`` if present."""
+    key_inputs = dict(schema=MAP_SCHEMA, rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=asdict(lubricant),
+                      load_range=[float(v) for v in load_range], speed_range=[float(v) for v in speed_range],
+                      n_load=int(n_load), n_speed=int(n_speed), grid=int(grid), solver_kw=solver_kw,
+                      versions=library_versions("numpy", "scipy", "flexrv"))
+    key = content_hash(key_inputs)
+    path = cache_dir() / "ehl_maps" / f"film_map_{key}.npz"
+    if path.exists():
+        try:
+            with np.load(path) as data:
+                return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant,
+                               log_load=data["log_load"], log_speed=data["log_speed"], log_ratio=data["log_ratio"],
+                               h_central=data["h_central"], valid=data["valid"], grid=int(grid))
+        except (OSError, KeyError, ValueError):
+            pass  # unreadable cache entry: rebuild and overwrite
+    fmap = build_film_map(rx, ry, e_eff, lubricant, load_range, speed_range, n_load=n_load, n_speed=n_speed,
+                          grid=grid, **solver_kw)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, log_load=fmap.log_load, log_speed=fmap.log_speed, log_ratio=fmap.log_ratio,
+                     h_central=fmap.h_central, valid=fmap.valid, inputs=np.array(json.dumps(key_inputs, default=str)))
+    return fmap

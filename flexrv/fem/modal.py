@@ -1,0 +1,78 @@
+"""Eigenfrequencies (free-free, constrained) and the sparse factorisation they share.
+
+The generalized eigenproblem K x = w^2 M x is solved with
+``scipy.sparse.linalg.eigsh`` in shift-invert mode; the shifted matrix is
+factorised once with SuperLU using the MMD(A^T + A) column ordering and
+symmetric mode (measured on 100k DOF: 7.9 s and 65M factor entries vs 31 s and
+156M with SciPy's default COLAMD, which ``eigsh(sigma=...)`` would use).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+from flexrv.errors import ConvergenceError, InputError
+
+
+def factorize(A: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray]:
+    """Sparse LU of a symmetric (positive definite) matrix; returns ``solve(b)``
+    accepting (n,) or (n, k) right-hand sides."""
+    lu = sla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": True})
+
+    def solve(b: np.ndarray) -> np.ndarray:
+        return lu.solve(np.asarray(b, dtype=float))
+
+    return solve
+
+
+def free_dofs(n_dof: int, fixed_nodes: np.ndarray | None) -> np.ndarray:
+    """DOF indices (Exudyn node-wise order) not belonging to ``fixed_nodes``."""
+    if fixed_nodes is None or len(fixed_nodes) == 0:
+        return np.arange(n_dof)
+    mask = np.ones(n_dof, dtype=bool)
+    fixed = np.asarray(fixed_nodes, dtype=np.int64)
+    mask[(3 * fixed[:, None] + np.arange(3)).ravel()] = False
+    return np.flatnonzero(mask)
+
+
+def eigenmodes(K: sp.spmatrix, M: sp.spmatrix, n: int, fixed_nodes: np.ndarray | None = None,
+               shift_hz: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest ``n`` eigenpairs of K x = w^2 M x.
+
+    Parameters
+    ----------
+    K, M : stiffness [N/m] and mass [kg] (3N x 3N, node-wise DOFs).
+    n : number of modes (free-free: includes the 6 rigid-body modes).
+    fixed_nodes : nodes clamped in x, y, z (None: free-free).
+    shift_hz : shift sigma = -(2 pi shift_hz)^2; default -(2 pi 1 Hz)^2 which keeps
+        K - sigma M positive definite also for a free body.
+
+    Returns
+    -------
+    freq_hz : (n,) frequencies [Hz] (rigid-body modes ~0; tiny negative
+        round-off eigenvalues are clipped to 0).
+    modes : (3N, n) M-orthonormal mode shapes (zeros at fixed DOFs).
+    """
+    ndof = K.shape[0]
+    dofs = free_dofs(ndof, fixed_nodes)
+    if not 1 <= n < dofs.size - 1:
+        raise InputError(f"number of modes n = {n} must be in [1, {dofs.size - 2}]")
+    Kf = K[dofs][:, dofs]
+    Mf = M[dofs][:, dofs]
+    sigma = -(2.0 * np.pi * (1.0 if shift_hz is None else shift_hz)) ** 2
+    solve = factorize(Kf - sigma * Mf)
+    op = sla.LinearOperator(Kf.shape, matvec=solve, dtype=float)
+    try:
+        w2, vec = sla.eigsh(Kf, k=n, M=Mf, sigma=sigma, which="LM", OPinv=op, tol=1e-10)
+    except sla.ArpackNoConvergence as exc:  # pragma: no cover - rare
+        raise ConvergenceError(f"eigsh did not converge for {n} modes: {exc}") from None
+    order = np.argsort(w2)
+    w2, vec = w2[order], vec[:, order]
+    modes = np.zeros((ndof, n))
+    modes[dofs] = vec
+    return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * np.pi), modes

@@ -1,0 +1,130 @@
+"""Model factory: assemble a reducer model by name from member groups.
+
+``build_model(reducer, "rigid")`` creates the members (carrier, cranks with
+their planets, discs) and the force-element groups
+
+====================  =========================================  ==========================
+group                 members                                    module
+====================  =========================================  ==========================
+``gear_stage``        carrier, cranks (sun angle prescribed)     :mod:`.gear_stage`
+``crank_supports``    carrier, cranks                            :mod:`.cranks_discs`
+``needle_bearings``   cranks, discs                              :mod:`.cranks_discs`
+``pins``              discs                                      :mod:`.pins`
+``main_bearing``      carrier                                    :mod:`.main_bearing_rigid`
+``loads``             carrier                                    :mod:`.loads`
+====================  =========================================  ==========================
+
+A flexible variant registers a different builder in :data:`MODELS` that swaps
+single groups/members (e.g. ``main_bearing`` -> the ball-resolved flexible
+bearing) while keeping the others and their output names.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from flexrv.errors import ConfigError
+from flexrv.model.base import AssembledModel, Member
+
+
+def _members(p) -> dict[str, Member]:
+    mem: dict[str, Member] = {}
+    mc = np.diag([p.carrier_mass, p.carrier_mass, p.carrier_inertia, p.carrier_mass,
+                  0.5 * p.carrier_inertia, 0.5 * p.carrier_inertia])
+    mem["carrier"] = Member("carrier", mc, np.zeros(6), np.zeros(6), ("x", "y", "theta", "z", "rx", "ry"))
+    for j in range(p.n_cranks):
+        b = p.crank_angles[j]
+        q0 = np.array([p.center_distance * np.cos(b), p.center_distance * np.sin(b), 0.0])
+        mem[f"crank{j}"] = Member(f"crank{j}", np.diag([p.crank_mass, p.crank_mass, p.crank_inertia]), q0,
+                                  np.zeros(3), ("x", "y", "phi"))
+    for k in range(p.n_discs):
+        q0 = np.array([p.eccentricity * np.sin(p.chi0[k]), p.eccentricity * np.cos(p.chi0[k]), p.disc_rot0[k]])
+        mem[f"disc{k}"] = Member(f"disc{k}", np.diag([p.disc_mass, p.disc_mass, p.disc_inertia]), q0,
+                                 np.zeros(3), ("x", "y", "psi"))
+    return mem
+
+
+def empirical_needle_constant(reducer) -> float:
+    """Constant K [N/m^(10/9)] of the needle-bearing law F = K delta^(10/9) that
+    integrates seed 004's empirical stiffness dF/d(delta) = C F^0.1
+    (:func:`flexrv.analysis.torsional.needle_radial_stiffness`, C = its value at
+    F = 1 N): F^0.9 = 0.9 C delta, so K = (0.9 C)^(10/9)."""
+    from flexrv.analysis.torsional import needle_radial_stiffness
+
+    nb = reducer.needle_bearing
+    c = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * 1e-3))
+    return (0.9 * c) ** (10.0 / 9.0)
+
+
+def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None) -> AssembledModel:
+    """Rigid-body model with compliant contacts (see module docstring)."""
+    from flexrv.analysis.mesh_stiffness import involute_stage
+    from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
+    from flexrv.model.gear_stage import GearMeshes
+    from flexrv.model.loads import OutputLoads, locked_drive, ramp_drive, step_torque
+    from flexrv.model.main_bearing_rigid import RigidMainBearing
+    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.pins import PinContacts
+
+    p = rigid_parameters(reducer)
+    if drive == "ramp":
+        theta, omega = ramp_drive(p.input_speed, p.speed_ramp_time)
+    elif drive == "locked":
+        theta, omega = locked_drive()
+    else:
+        raise ConfigError(f"drive = {drive!r} is not allowed: choose 'ramp' or 'locked'")
+    if torque is None:
+        torque = step_torque(p.load_torque, *p.load_ramp)
+    nb_model = reducer.needle_bearing.model
+    k_emp = empirical_needle_constant(reducer) if nb_model == "empirical" else None
+    groups = [
+        GearMeshes(p, involute_stage(reducer), theta, omega),
+        CrankSupports(p),
+        NeedleBearings(p, nb_model, k_emp),
+        PinContacts(p),
+        RigidMainBearing(p),
+        OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment),
+    ]
+    model = AssembledModel(name="rigid", reducer=reducer, params=p, members=_members(p), groups=groups,
+                           input_angle=theta, input_speed=omega, load_torque=torque)
+    return assemble(model)
+
+
+def assemble(model: AssembledModel) -> AssembledModel:
+    """Create the Exudyn system: one NodeGenericODE2 + mass object per member, one
+    ObjectGenericODE2 per group."""
+    import exudyn as exu
+    from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2
+
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    offset = 0
+    for m in model.members.values():
+        m.node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * m.n, initialCoordinates=list(m.q0),
+                                             initialCoordinates_t=list(m.v0), numberOfODE2Coordinates=m.n))
+        mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix))
+        m.offset = offset
+        offset += m.n
+    for g in model.groups:
+        nodes = [model.members[name].node for name in g.members]
+        sizes = [model.members[name].n for name in g.members]
+        g.add_to(mbs, nodes, sizes)
+    mbs.Assemble()
+    model.mbs, model.sc, model.n = mbs, sc, offset
+    q = np.asarray(mbs.systemData.GetODE2Coordinates())
+    if q.shape != (offset,) or not np.allclose(q, model.q0):
+        raise RuntimeError("unexpected Exudyn coordinate ordering")
+    return model
+
+
+#: model name -> builder(reducer, drive=..., torque=...) -> AssembledModel
+MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid}
+
+
+def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
+    """Build the named model for a design (see :data:`MODELS`)."""
+    if model not in MODELS:
+        raise ConfigError(f"model = {model!r} is not allowed: choose one of {sorted(MODELS)}")
+    return MODELS[model](reducer, **kwargs)

@@ -1,0 +1,376 @@
+"""Main bearing as a multibody subsystem: rigid balls between (optionally flexible)
+rings, one vectorised Exudyn contact element per row.
+
+Members per row of the back-to-back pair:
+
+* the **inner ring** rides on a rigid frame node (``NodeRigidBodyRxyz``: the
+  carrier, or a frame rigidly joined to it). Its elastic raceway displacement is
+  ``Phi_i(psi) q_i`` in the frame's coordinates, with modal coordinates ``q_i`` on
+  their own ``NodeGenericODE2`` (reduced M, K). The inertia coupling between the
+  ring's slow frame rotation (carrier, ~0.7-1.6 rad/s) and its elastic modes is
+  neglected: centrifugal and Coriolis terms scale with omega_c^2 ~ 1 s^-2, eight
+  orders below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2;
+* the **outer ring** sits in the housing (fixed frame): plain modal coordinates
+  ``q_o`` (20x cheaper than an FFRF body, see the facts note);
+* **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`);
+* a kinematic **cage**: a tangential spring-damper pulls every ball towards its
+  pocket at theta_cage + 2 pi j / Z, theta_cage = cage_ratio * theta_frame (pure
+  rolling on a fixed outer ring). Without friction nothing else drives the balls
+  circumferentially; the cage's reaction torque (stiffness x the balls' tiny lag)
+  is carried by the kinematic constraint, not by the frame.
+
+Rings given as ``None`` are rigid (no modal node) — the stiff-ring limit.
+
+The contact element of a row is one ``ObjectGenericODE2`` over the nodes
+[frame, inner modes, outer modes, balls]: one Python call evaluates all ball
+contacts of the row with numpy (:func:`flexrv.contact.ball_raceway.raceway_contacts`)
+and an analytic Jacobian assembled from per-ball 3x3 blocks. The groove centre of
+ball j depends linearly on the element's ring coordinates x through
+c_j = c0_j + T_j x; the generalized reaction is -sum T_j^T f_j and the Jacobian
+blocks are K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j (geometric-stiffness terms
+of the frame rotation are dropped; the modified Newton iteration converges on the
+residual, which is exact).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from flexrv.contact.ball_raceway import NormalLaw, RowContactGeometry, hertz_law, raceway_contacts
+
+
+class RingModes(Protocol):
+    """What the bearing needs of a reduced flexible ring (one row's ring)."""
+
+    mass: np.ndarray  #: (m, m) reduced mass matrix [kg]
+    stiffness: np.ndarray  #: (m, m) reduced stiffness matrix [N/m]
+    damping: np.ndarray  #: (m, m) reduced damping matrix [N s/m]
+
+    def groove_basis(self, azimuth: np.ndarray) -> np.ndarray:
+        """(N, 3, m): groove-centre displacement (ring frame, Cartesian) per unit
+        modal coordinate at the given azimuths [rad]."""
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """Skew matrices [v]x of an (N,3) array -> (N,3,3)."""
+    out = np.zeros(v.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def rxyz_matrices(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation matrix A = Rx Ry Rz and G (omega_global = G phi_dot) of Tait–Bryan
+    xyz angles, as used by Exudyn's NodeRigidBodyRxyz."""
+    c0, s0 = np.cos(phi[0]), np.sin(phi[0])
+    c1, s1 = np.cos(phi[1]), np.sin(phi[1])
+    c2, s2 = np.cos(phi[2]), np.sin(phi[2])
+    rx = np.array([[1, 0, 0], [0, c0, -s0], [0, s0, c0]])
+    ry = np.array([[c1, 0, s1], [0, 1, 0], [-s1, 0, c1]])
+    rz = np.array([[c2, -s2, 0], [s2, c2, 0], [0, 0, 1]])
+    g = np.column_stack([[1.0, 0.0, 0.0], rx[:, 1], (rx @ ry)[:, 2]])
+    return rx @ ry @ rz, g
+
+
+@dataclass
+class RowModel:
+    """Everything one row's contact element needs (SI).
+
+    ``z`` is the axial position of the row's ball plane in the frame (and housing)
+    coordinates; ``row`` holds the groove-centre loci in row coordinates.
+    """
+
+    row: RowContactGeometry
+    z: float
+    ball_count: int
+    ball_mass: float
+    law_inner: NormalLaw
+    law_outer: NormalLaw
+    inner: RingModes | None = None
+    outer: RingModes | None = None
+    cage_stiffness: float = 1e5
+    cage_damping: float = 50.0
+    #: cage angle / frame (inner ring) angle for pure rolling with a fixed outer
+    #: ring: (1 - D cos a / d_m) / 2 (Harris & Kotzalas 2007, ch. 8)
+    cage_ratio: float = 0.5
+    #: weak radial/axial spring of each ball to its pocket [N/m]
+    pocket_stiffness: float = 1e3
+    #: reference ball centres (Z, 3) in global coordinates
+    ball_reference: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        psi = 2.0 * np.pi * np.arange(self.ball_count) / self.ball_count
+        rb = self.row.ball_radius_pitch
+        self.ball_reference = np.stack([rb * np.cos(psi), rb * np.sin(psi), np.full(self.ball_count, self.z)], -1)
+
+    @property
+    def m_inner(self) -> int:
+        return 0 if self.inner is None else self.inner.stiffness.shape[0]
+
+    @property
+    def m_outer(self) -> int:
+        return 0 if self.outer is None else self.outer.stiffness.shape[0]
+
+    @property
+    def n_coordinates(self) -> int:
+        return 6 + self.m_inner + self.m_outer + 3 * self.ball_count
+
+    def slices(self) -> tuple[slice, slice, slice, slice]:
+        """Coordinate slices of frame, inner modes, outer modes, balls in the element."""
+        a = 6 + self.m_inner
+        b = a + self.m_outer
+        return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + 3 * self.ball_count)
+
+
+@dataclass
+class RowEvaluation:
+    """Result of :func:`evaluate_row` (arrays over the row's balls)."""
+
+    inner: object  # ContactState
+    outer: object
+    force: np.ndarray  # (n,) generalized force vector of the element
+    jac_q: np.ndarray | None  # (n, n) d force / d q
+    jac_v: np.ndarray | None  # (n, n) d force / d q_t
+    ball_pos: np.ndarray
+    azimuth: np.ndarray
+    cage_force: np.ndarray
+
+
+def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool = True) -> RowEvaluation:
+    """Generalized forces (and Jacobians) of one row's contact element.
+
+    Parameters
+    ----------
+    q, q_t : element coordinates and velocities (displacements from the reference
+        configuration), ordered [frame(6), inner modes, outer modes, balls(3Z)].
+    """
+    sf, si, so, sb = model.slices()
+    z_count = model.ball_count
+    r, phi = q[0:3], q[3:6]
+    r_t, phi_t = q_t[0:3], q_t[3:6]
+    a_mat, g_mat = rxyz_matrices(phi)
+    omega = g_mat @ phi_t
+    balls = model.ball_reference + q[sb].reshape(z_count, 3)
+    balls_t = q_t[sb].reshape(z_count, 3)
+    row = model.row
+
+    # ---------------- inner ring (on the frame)
+    local = (balls - r) @ a_mat  # rows: A^T (b - r)
+    psi_i = np.arctan2(local[:, 1], local[:, 0])
+    p = row.groove_centers(psi_i, "inner")
+    p[:, 2] += model.z
+    nx_i = 6 + model.m_inner
+    t_i = np.zeros((z_count, 3, nx_i))
+    t_i[:, :, 0:3] = np.eye(3)
+    if model.inner is not None:
+        basis_i = model.inner.groove_basis(psi_i)  # (N,3,m)
+        p = p + np.einsum("nkm,m->nk", basis_i, q[si])
+        t_i[:, :, 6:] = np.einsum("jk,nkm->njm", a_mat, basis_i)
+    ap = p @ a_mat.T  # A p
+    t_i[:, :, 3:6] = -_skew(ap) @ g_mat
+    c_i = r + ap
+    x_i_t = np.concatenate([r_t, phi_t, q_t[si]]) if model.inner is not None else np.concatenate([r_t, phi_t])
+    c_i_t = np.einsum("njx,x->nj", t_i, x_i_t)
+    st_i = raceway_contacts(balls, balls_t, c_i, c_i_t, row.inner_offset, model.law_inner)
+
+    # ---------------- outer ring (housing)
+    psi_o = np.arctan2(balls[:, 1], balls[:, 0])
+    c_o = row.groove_centers(psi_o, "outer")
+    c_o[:, 2] += model.z
+    c_o_t = np.zeros_like(c_o)
+    t_o = None
+    if model.outer is not None:
+        basis_o = model.outer.groove_basis(psi_o)
+        c_o = c_o + np.einsum("nkm,m->nk", basis_o, q[so])
+        c_o_t = np.einsum("nkm,m->nk", basis_o, q_t[so])
+        t_o = basis_o
+    st_o = raceway_contacts(balls, balls_t, c_o, c_o_t, row.outer_offset, model.law_outer)
+
+    # ---------------- cage: tangential springs to the kinematic pockets
+    psi = np.arctan2(balls[:, 1], balls[:, 0])
+    cage_angle = model.cage_ratio * phi[2]
+    pockets = 2.0 * np.pi * np.arange(z_count) / z_count + cage_angle
+    dev = np.angle(np.exp(1j * (psi - pockets)))
+    e_t = np.stack([-np.sin(psi), np.cos(psi), np.zeros(z_count)], -1)
+    radius = np.hypot(balls[:, 0], balls[:, 1])
+    s_t = np.einsum("nk,nk->n", balls_t, e_t) - radius * model.cage_ratio * phi_t[2]
+    f_cage = -(model.cage_stiffness * radius * dev + model.cage_damping * s_t)[:, None] * e_t
+    # weak radial/axial pocket spring: keeps unloaded balls determinate (statics)
+    # while being 1e5 times softer than a loaded contact
+    e_r = np.stack([np.cos(psi), np.sin(psi), np.zeros(z_count)], -1)
+    pocket_dev = (radius - model.row.ball_radius_pitch)[:, None] * e_r
+    pocket_dev[:, 2] = balls[:, 2] - model.z
+    f_cage = f_cage - model.pocket_stiffness * pocket_dev
+
+    # ---------------- generalized forces
+    n = model.n_coordinates
+    force = np.zeros(n)
+    f_ball = st_i.force_ball + st_o.force_ball + f_cage
+    force[sb] = f_ball.ravel()
+    g_i = -np.einsum("njx,nj->x", t_i, st_i.force_ball)
+    force[0:6] = g_i[0:6]
+    if model.inner is not None:
+        force[si] = g_i[6:]
+    if t_o is not None:
+        force[so] = -np.einsum("njm,nj->m", t_o, st_o.force_ball)
+
+    jac_q = jac_v = None
+    if jacobian:
+        jac_q = np.zeros((n, n))
+        jac_v = np.zeros((n, n))
+        ball_idx = sb.start + 3 * np.arange(z_count)[:, None] + np.arange(3)[None, :]  # (N,3)
+        x_i_idx = np.concatenate([np.arange(6), np.arange(si.start, si.stop)])
+        cage_k = model.cage_stiffness * np.einsum("ni,nj->nij", e_t, e_t)
+        cage_c = model.cage_damping * np.einsum("ni,nj->nij", e_t, e_t)
+        for jac, blocks, extra in ((jac_q, (st_i.stiffness, st_o.stiffness), cage_k),
+                                   (jac_v, (st_i.damping, st_o.damping), cage_c)):
+            k_i, k_o = blocks
+            kb = k_i + k_o - extra
+            if jac is jac_q:
+                kb = kb - model.pocket_stiffness * (np.eye(3)[None] - np.einsum("ni,nj->nij", e_t, e_t))
+            for c in range(3):
+                for d in range(3):
+                    jac[ball_idx[:, c], ball_idx[:, d]] += kb[:, c, d]
+            # the kinematic cage angle follows the frame rotation phi_z
+            coef = (model.cage_stiffness if jac is jac_q else model.cage_damping) * radius * model.cage_ratio
+            for c in range(3):
+                jac[ball_idx[:, c], 5] += coef * e_t[:, c]
+            kt = np.einsum("nab,nbx->nax", k_i, t_i)  # K_j T_j
+            # d f_ball / d x = -K T ; d g / d b = -T^T K ; d g / d x = sum T^T K T
+            for c in range(3):
+                jac[np.ix_(ball_idx[:, c], x_i_idx)] -= kt[:, c, :]
+            ttk = np.einsum("nax,nab->nxb", t_i, k_i)
+            for d in range(3):
+                jac[np.ix_(x_i_idx, ball_idx[:, d])] -= ttk[:, :, d].T
+            jac[np.ix_(x_i_idx, x_i_idx)] += np.einsum("nax,nay->xy", t_i, kt)
+            if t_o is not None:
+                o_idx = np.arange(so.start, so.stop)
+                kto = np.einsum("nab,nbm->nam", k_o, t_o)
+                for c in range(3):
+                    jac[np.ix_(ball_idx[:, c], o_idx)] -= kto[:, c, :]
+                ttko = np.einsum("nam,nab->nmb", t_o, k_o)
+                for d in range(3):
+                    jac[np.ix_(o_idx, ball_idx[:, d])] -= ttko[:, :, d].T
+                jac[np.ix_(o_idx, o_idx)] += np.einsum("nam,nan->mn", t_o, kto)
+    return RowEvaluation(inner=st_i, outer=st_o, force=force, jac_q=jac_q, jac_v=jac_v, ball_pos=balls,
+                         azimuth=psi, cage_force=f_cage)
+
+
+# ---------------------------------------------------------------------------- Exudyn
+@dataclass
+class BearingHandle:
+    """Node/object indices of a bearing added to an Exudyn system."""
+
+    rows: list[RowModel]
+    frame_node: int
+    inner_nodes: list[int | None]
+    outer_nodes: list[int | None]
+    ball_nodes: list[list[int]]
+    contact_objects: list[int]
+
+    def element_coordinates(self, mbs, row_index: int, configuration=None) -> tuple[np.ndarray, np.ndarray]:
+        """Current (q, q_t) of a row's contact element read from the system."""
+        import exudyn as exu
+
+        cfg = configuration or exu.ConfigurationType.Current
+        nodes = [self.frame_node]
+        if self.inner_nodes[row_index] is not None:
+            nodes.append(self.inner_nodes[row_index])
+        if self.outer_nodes[row_index] is not None:
+            nodes.append(self.outer_nodes[row_index])
+        nodes += self.ball_nodes[row_index]
+        q = np.concatenate([np.asarray(mbs.GetNodeOutput(n, exu.OutputVariableType.Coordinates, cfg)) for n in nodes])
+        q_t = np.concatenate([np.asarray(mbs.GetNodeOutput(n, exu.OutputVariableType.Coordinates_t, cfg)) for n in nodes])
+        return q, q_t
+
+
+def initial_ball_displacements(model: RowModel) -> np.ndarray:
+    """Ball displacements (Z,3) that balance the contact forces with the frame and
+    rings in their reference configuration (preload equilibrium), so a static or
+    dynamic run starts without an artificial transient."""
+    from flexrv.contact.ball_raceway import solve_ball_positions
+
+    psi = 2.0 * np.pi * np.arange(model.ball_count) / model.ball_count
+    ci = model.row.groove_centers(psi, "inner")
+    co = model.row.groove_centers(psi, "outer")
+    ci[:, 2] += model.z
+    co[:, 2] += model.z
+    pos, st_i, st_o = solve_ball_positions(model.row, ci, co, model.law_inner, model.law_outer,
+                                           ball_pos0=model.ball_reference)
+    return pos - model.ball_reference
+
+
+def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ratio: float = 0.02) -> BearingHandle:
+    """Add balls, ring modal bodies and one contact element per row to ``mbs``.
+
+    ``frame_node`` must be a ``NodeRigidBodyRxyz`` at the origin (reference
+    position 0, reference rotation 0) carrying the inner rings.
+    """
+    import exudyn as exu
+    from exudyn.itemInterface import MassPoint, NodeGenericODE2, NodePoint, ObjectGenericODE2
+
+    inner_nodes, outer_nodes, ball_nodes, objects = [], [], [], []
+    for model in rows:
+        node_list = [frame_node]
+        for ring, store in ((model.inner, inner_nodes), (model.outer, outer_nodes)):
+            if ring is None:
+                store.append(None)
+                continue
+            m = ring.stiffness.shape[0]
+            node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
+                                               initialCoordinates_t=[0.0] * m, numberOfODE2Coordinates=m))
+            mbs.AddObject(ObjectGenericODE2(nodeNumbers=[node], massMatrix=ring.mass, stiffnessMatrix=ring.stiffness,
+                                            dampingMatrix=ring.damping))
+            store.append(node)
+            node_list.append(node)
+        balls = []
+        for ref, init in zip(model.ball_reference, initial_ball_displacements(model)):
+            nb = mbs.AddNode(NodePoint(referenceCoordinates=list(ref), initialCoordinates=list(init)))
+            mbs.AddObject(MassPoint(mass=model.ball_mass, nodeNumber=nb))
+            balls.append(nb)
+        ball_nodes.append(balls)
+        node_list += balls
+        n = model.n_coordinates
+
+        def force_fn(mbs_, t, item, q, q_t, model=model):
+            return evaluate_row(model, np.asarray(q), np.asarray(q_t), jacobian=False).force
+
+        def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, model=model):
+            ev = evaluate_row(model, np.asarray(q), np.asarray(q_t), jacobian=True)
+            return -(f_q * ev.jac_q + f_v * ev.jac_v)
+
+        obj = mbs.AddObject(ObjectGenericODE2(nodeNumbers=node_list, massMatrix=np.zeros((n, n)),
+                                              forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
+        objects.append(obj)
+    return BearingHandle(rows=rows, frame_node=frame_node, inner_nodes=inner_nodes, outer_nodes=outer_nodes,
+                         ball_nodes=ball_nodes, contact_objects=objects)
+
+
+def rows_from_design(reducer, inner=None, outer=None, law: str = "dry", c_max: float | None = None,
+                     depth: float = 1e-6) -> list[RowModel]:
+    """Row models of a design's main bearing (both rows, back-to-back).
+
+    ``inner``/``outer``: per-row lists of :class:`RingModes` (or None for rigid).
+    """
+    from flexrv.contact.hertz import effective_modulus
+    from flexrv.geometry.bearing import BallBearingGeometry
+
+    geom = BallBearingGeometry.from_design(reducer.main_bearing)
+    ring_mat, ball_mat = reducer.material("bearing_rings"), reducer.material("rolling_elements")
+    e_eff = effective_modulus(ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus,
+                              ball_mat.poisson_ratio)
+    c_max = reducer.main_bearing.ball_damping_Ns_per_m if c_max is None else c_max
+    rows = []
+    for k, (z, side) in enumerate(zip(geom.row_positions(), geom.row_sides())):
+        row = RowContactGeometry.from_bearing(geom, float(e_eff), side=float(side), preload=geom.axial_preload)
+        if law != "dry":
+            raise NotImplementedError("EHL laws are plugged in by the flexible reducer model")
+        rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count, cage_ratio=0.5 * (1.0 - geom.gamma),
+                             ball_mass=geom.ball_mass(ball_mat.density_kg_m3),
+                             law_inner=hertz_law(row.k_inner, c_max, depth), law_outer=hertz_law(row.k_outer, c_max, depth),
+                             inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
+    return rows

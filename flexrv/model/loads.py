@@ -1,0 +1,95 @@
+"""Drive and loads as in the seeds.
+
+* Input: speed-driven sun, omega_in(t) = omega_r step(t, 0, 0, t_r, 1) with the
+  cubic Adams STEP (seed 002: 0 -> 1215 r/min over 0.1 s). The angle is its exact
+  integral: with s = t/t_r, theta = omega_r t_r (s^3 - s^4/2) for t <= t_r and
+  omega_r (t - t_r/2) afterwards.
+* Output: load torque T_max step(t, t1, 0, t2, 1) on the carrier against the
+  rotation (seeds 000/002), plus optional constant external radial force (along
+  +x), axial force (+z) and tilting moment (about x) on the output flange.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flexrv.contact.laws import adams_step
+from flexrv.model.base import ForceGroup, Output
+
+
+def ramp_drive(speed: float, ramp_time: float):
+    """(theta(t), omega(t)) of the Adams-STEP speed ramp; vectorised in t."""
+
+    def omega(t):
+        t = np.asarray(t, dtype=float)
+        if ramp_time <= 0:
+            return np.full_like(t, speed)
+        return speed * adams_step(t, 0.0, 0.0, ramp_time, 1.0)
+
+    def theta(t):
+        t = np.asarray(t, dtype=float)
+        if ramp_time <= 0:
+            return speed * t
+        s = np.clip(t / ramp_time, 0.0, 1.0)
+        inside = speed * ramp_time * (s**3 - 0.5 * s**4)
+        return np.where(t <= ramp_time, inside, speed * (t - 0.5 * ramp_time))
+
+    return theta, omega
+
+
+def locked_drive():
+    """Input locked (stiffness test): theta = omega = 0."""
+
+    def zero(t):
+        return np.zeros_like(np.asarray(t, dtype=float))
+
+    return zero, zero
+
+
+def step_torque(t_max: float, t1: float, t2: float):
+    """T(t) = T_max step(t, t1, 0, t2, 1) (jump at t1 if t2 == t1)."""
+
+    def torque(t):
+        t = np.asarray(t, dtype=float)
+        if t2 <= t1:
+            return np.where(t >= t1, t_max, 0.0)
+        return t_max * adams_step(t, t1, 0.0, t2, 1.0)
+
+    return torque
+
+
+def piecewise_torque(times, values):
+    """Piecewise-linear torque program T(t) through (times, values) (stiffness test)."""
+    times = np.asarray(times, dtype=float)
+    values = np.asarray(values, dtype=float)
+
+    def torque(t):
+        return np.interp(np.asarray(t, dtype=float), times, values)
+
+    return torque
+
+
+class OutputLoads(ForceGroup):
+    """Load torque and external forces on the carrier (member ``carrier``:
+    x, y, theta, z, rx, ry)."""
+
+    name = "loads"
+    members = ("carrier",)
+    analytic_jacobian = True
+
+    def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0):
+        self.torque = torque
+        self.const = np.array([radial, 0.0, 0.0, axial, tilt, 0.0])
+
+    def evaluate(self, t, q, v, want_outputs: bool = False):
+        t = np.asarray(t, dtype=float)
+        f = np.broadcast_to(self.const, q.shape).copy()
+        f[..., 2] = -self.torque(t)
+        out = None
+        if want_outputs:
+            out = {"load_torque": Output(self.torque(t) + 0.0 * q[..., 0], ("time",), "N m", "load torque on the output")}
+        return f, out
+
+    def jacobian(self, t, q, v):
+        z = np.zeros((6, 6))
+        return z, z

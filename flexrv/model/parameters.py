@@ -1,0 +1,205 @@
+"""Derived parameters of the rigid multibody model (SI units).
+
+Everything the model's builders need that is not a field of the design is
+computed here once from a validated :class:`flexrv.design.Reducer`: member
+masses and inertias (from the modelled geometry, homogeneous steel cylinders),
+base radii of the first stage, nominal positions of cranks, eccentrics and disc
+holes, and the contact constants.
+
+Planar model (why): every force path that produces transmission error lies in
+the reducer's transverse plane (gear meshes along the line of action, pin–disc
+and needle contacts with normals in the plane, crank supports radial). Members
+therefore carry the planar coordinates (x, y, rotation) of their centre; the
+carrier additionally carries the out-of-plane coordinates (z, rx, ry) of the
+main bearing so that external axial force and tilting moment load it. With rigid
+members and frictionless contacts the out-of-plane motion is decoupled from the
+in-plane motion, so a 3-D rigid-body formulation would add twelve DOF per
+member group without changing TE, speeds or contact forces; the flexible-bearing
+model that tilts the carrier replaces the main-bearing element, not this choice.
+
+Sign conventions: all rotations counter-clockwise positive about +z (the input
+turns positive, so does the output). The crank's eccentric direction is written
+as in :mod:`flexrv.geometry.cycloid`: e (sin chi, cos chi) with the clockwise
+angle chi = chi0_k - phi_crank; disc k's profile frame is turned by its
+rotation coordinate psi_k, which starts at the conjugate value chi0_k / z_c
+(:func:`flexrv.geometry.cycloid.nominal_disc_pose`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
+from flexrv.geometry.kinematics import member_speeds, total_ratio
+
+
+@dataclass(frozen=True)
+class RigidParameters:
+    """All numbers of the rigid model (SI). Built by :func:`rigid_parameters`."""
+
+    # counts
+    n_cranks: int
+    n_discs: int
+    z_s: int
+    z_p: int
+    z_c: int
+    z_rp: int
+    ratio: float
+    # first stage
+    base_radius_sun: float
+    base_radius_planet: float
+    center_distance: float
+    working_pressure_angle: float
+    normal_backlash: float
+    crank_angles: np.ndarray  #: (N,) angular positions beta_j0 of the cranks on the carrier [rad]
+    # second stage
+    eccentricity: float
+    pin_circle_radius: float
+    pin_radius: float
+    d_radius: float
+    d_pin_radius: float
+    d_rotation: float
+    disc_width: float
+    pins: np.ndarray  #: (z_rp, 2) pin centres in the housing frame [m]
+    chi0: np.ndarray  #: (n_discs,) initial clockwise eccentric angle of each disc [rad]
+    disc_rot0: np.ndarray  #: (n_discs,) initial disc rotation psi_k0 = chi0_k / z_c [rad]
+    holes: np.ndarray  #: (n_discs, N, 2) crank-hole centres in each disc's frame [m]
+    # masses
+    crank_mass: float
+    crank_inertia: float
+    disc_mass: float
+    disc_inertia: float
+    carrier_mass: float
+    carrier_inertia: float
+    input_inertia: float
+    # compliances
+    support_stiffness: float  #: radial stiffness of one crank in the carrier (two bearings) [N/m]
+    support_damping: float
+    main_bearing_stiffness: np.ndarray  #: (5,) x, y, z, rx, ry [N/m, N m/rad]
+    main_bearing_damping: np.ndarray
+    pin_k: float  #: pin-contact constant [N/m^e]
+    pin_exponent: float
+    pin_c_max: float
+    contact_depth: float
+    needle_clearance: float
+    needle_roller_count: int
+    needle_roller_k: float  #: roller constant (inner + outer line contacts in series) [N/m^(10/9)]
+    needle_pitch_ratio: float  #: gamma = D / d_m of the needle bearing
+    needle_c_max: float
+    # drive and load
+    input_speed: float
+    speed_ramp_time: float
+    load_torque: float
+    load_ramp: tuple[float, float]
+    rated_torque: float
+    external_axial_force: float
+    external_radial_force: float
+    tilting_moment: float
+    extra: dict = field(default_factory=dict)
+
+
+def _cyl_mass(rho, d, length):
+    return rho * math.pi * 0.25 * d * d * length
+
+
+def rigid_parameters(reducer) -> RigidParameters:
+    """Derive :class:`RigidParameters` from a design.
+
+    Mass estimates (homogeneous cylinders, density of the part's material):
+    crank = planet gear (pitch-circle disc, face width b) + gear seat + two support
+    journals + two eccentric journals; disc = annulus between the centre hole and
+    the root circle R_p - r_rp - a minus the crank holes (J = m (R^2 + r^2)/2 of
+    the annulus, hole correction by parallel axes). Rigid main bearing: radial
+    stiffness 2e9 N/m, axial 1e9 N/m, tilting k_r (s/2)^2 with the row spacing s
+    (estimate typical of a preloaded thin-section pair of this size; the flexible
+    main-bearing model replaces it).
+    """
+    fs, ss, cs, nb = reducer.first_stage, reducer.second_stage, reducer.crankshaft, reducer.needle_bearing
+    op, ct = reducer.operating, reducer.contact
+    n = fs.n_planets
+    nd = ss.n_discs
+    z_s, z_p, z_c, z_rp = fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count
+    ratio = float(total_ratio(z_s, z_p, z_c, z_rp))
+    alpha = fs.pressure_angle
+    rb_s = 0.5 * fs.module * z_s * math.cos(alpha)
+    rb_p = 0.5 * fs.module * z_p * math.cos(alpha)
+    a_w = fs.center_distance
+    alpha_w = math.acos((rb_s + rb_p) / a_w)
+    beta = 2.0 * math.pi * np.arange(n) / n
+    # pins and discs
+    psi = 2.0 * np.pi * np.arange(z_rp) / z_rp
+    pins = ss.pin_circle_radius * np.stack([np.sin(psi), np.cos(psi)], axis=-1)
+    chi0 = 2.0 * np.pi * np.arange(nd) / nd
+    rot0 = chi0 / z_c
+    crank_pos = a_w * np.stack([np.cos(beta), np.sin(beta)], axis=-1)  # (N,2) housing frame at t=0
+    holes = np.empty((nd, n, 2))
+    for k in range(nd):
+        c, s = math.cos(rot0[k]), math.sin(rot0[k])
+        # hole centre (housing, t=0) = crank centre + eccentric vector; disc centre = eccentric vector
+        holes[k] = np.stack([c * crank_pos[:, 0] + s * crank_pos[:, 1], -s * crank_pos[:, 0] + c * crank_pos[:, 1]], -1)
+    # masses
+    rho_g = reducer.material("gears").density_kg_m3
+    rho_c = reducer.material("crankshaft").density_kg_m3
+    rho_d = reducer.material("cycloid_disc").density_kg_m3
+    r_pitch_p = 0.5 * fs.module * z_p
+    m_planet = rho_g * math.pi * r_pitch_p**2 * fs.face_width
+    parts = [(cs.gear_seat_diameter_mm, cs.gear_seat_length_mm, 1), (cs.support_journal_diameter_mm, cs.support_journal_length_mm, 2),
+             (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm, nd)]
+    m_shaft = sum(k * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) for d, l, k in parts)
+    crank_mass = m_planet + m_shaft
+    crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2
+                                                        for d, l, k in parts)
+    r_out = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
+    r_in = ss.center_hole_radius
+    r_h = reducer.crank_hole_radius
+    b = ss.disc_width
+    m_ann = rho_d * math.pi * (r_out**2 - r_in**2) * b
+    m_hole = rho_d * math.pi * r_h**2 * b
+    disc_mass = m_ann - n * m_hole
+    disc_inertia = 0.5 * m_ann * (r_out**2 + r_in**2) - n * m_hole * (0.5 * r_h**2 + a_w**2)
+    # contact constants
+    e_pin = effective_modulus(reducer.material("cycloid_disc").youngs_modulus, reducer.material("cycloid_disc").poisson_ratio,
+                              reducer.material("pins").youngs_modulus, reducer.material("pins").poisson_ratio)
+    k_line = float(line_contact_stiffness(b, e_pin))
+    depth = ct.impact_damping_depth_mm * 1e-3
+    if ct.pin_law == "hertz_line":
+        pin_k, pin_e = k_line, LINE_EXPONENT
+    else:  # impact law with the seeds' exponent, matched to the Hertz line law at penetration d
+        pin_e = ct.impact_exponent
+        pin_k = k_line * depth ** (LINE_EXPONENT - pin_e)
+    e_nb = effective_modulus(reducer.material("crankshaft").youngs_modulus, reducer.material("crankshaft").poisson_ratio,
+                             reducer.material("rolling_elements").youngs_modulus, reducer.material("rolling_elements").poisson_ratio)
+    k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
+    roller_k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
+    d_roll = nb.roller_diameter_mm * 1e-3
+    dm = cs.eccentric_journal_diameter_mm * 1e-3 + d_roll
+    k_r = 2.0e9
+    s = reducer.main_bearing.row_spacing_mm * 1e-3
+    kmb = np.array([k_r, k_r, 1.0e9, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
+    cmb = 2.0 * 0.05 * np.sqrt(kmb * np.array([reducer.inertia.carrier_mass_kg] * 3
+                                              + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2))
+    return RigidParameters(
+        n_cranks=n, n_discs=nd, z_s=z_s, z_p=z_p, z_c=z_c, z_rp=z_rp, ratio=ratio,
+        base_radius_sun=rb_s, base_radius_planet=rb_p, center_distance=a_w, working_pressure_angle=alpha_w,
+        normal_backlash=fs.backlash * math.cos(alpha_w), crank_angles=beta,
+        eccentricity=ss.eccentricity, pin_circle_radius=ss.pin_circle_radius, pin_radius=ss.pin_radius,
+        d_radius=ss.modification_shift, d_pin_radius=ss.modification_equidistant, d_rotation=ss.modification_rotation,
+        disc_width=b, pins=pins, chi0=chi0, disc_rot0=rot0, holes=holes,
+        crank_mass=crank_mass, crank_inertia=crank_inertia, disc_mass=disc_mass, disc_inertia=disc_inertia,
+        carrier_mass=reducer.inertia.carrier_mass_kg, carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
+        input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
+        support_stiffness=2.0 * cs.support_bearing_radial_stiffness_N_per_m,
+        support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
+        main_bearing_stiffness=kmb, main_bearing_damping=cmb,
+        pin_k=pin_k, pin_exponent=pin_e, pin_c_max=ct.pin_max_damping_Ns_per_m, contact_depth=depth,
+        needle_clearance=nb.radial_clearance_um * 1e-6, needle_roller_count=nb.roller_count, needle_roller_k=roller_k,
+        needle_pitch_ratio=d_roll / dm, needle_c_max=ct.pin_max_damping_Ns_per_m,
+        input_speed=op.input_speed, speed_ramp_time=op.speed_ramp_time_s, load_torque=op.load_torque_Nm,
+        load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s), rated_torque=op.rated_torque_Nm,
+        external_axial_force=op.external_axial_force_N, external_radial_force=op.external_radial_force_N,
+        tilting_moment=op.tilting_moment_Nm,
+        extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
+    )

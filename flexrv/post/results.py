@@ -1,0 +1,225 @@
+"""Simulation results on xarray: named, unit-tagged time series.
+
+Transmission error (seeds 000-003): TE(t) = theta_out(t) - theta_in(t) / i,
+reported in arcsec. Mechanism in the rigid-member model: the members are rigid,
+so TE comes only from the compliant elements and the clearances along the
+torque path sun -> planet meshes -> cranks -> needle bearings -> discs -> pins
+(and back through the crank supports to the carrier):
+
+* a *mean* wind-up under load, (load torque) / (torsional stiffness), mostly from
+  the pin–disc Hertz contacts and the needle bearings (seed 004's series model);
+* *fluctuations* at the first-stage mesh frequency (single/double tooth-pair
+  alternation of the involute mesh stiffness, divided by the second-stage ratio
+  z_rp as seen at the output) and at the cycloid mesh frequency z_c f_crank (the
+  number of loaded pins and their moment arms change as pins pass through the
+  meshing zone, so the second-stage stiffness varies with the crank angle), plus
+  crank-rotation harmonics from the needle bearing load cycle;
+* the *lost motion* of clearances (equidistant modification, needle clearance,
+  backlash) that must close before torque is transmitted.
+
+With ideal geometry (no modification, no clearance, no backlash) and no load,
+every element stays unloaded and the conjugate kinematics give TE = 0 up to the
+integration error; with load TE is the (varying) elastic wind-up.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+ARCSEC = 180.0 / np.pi * 3600.0  #: arcsec per radian
+
+
+class Results:
+    """Time series of one run (an :class:`xarray.Dataset` plus metadata).
+
+    ``res["te"]`` or ``res["TE [arcsec]"]`` return a DataArray with the ``time``
+    coordinate [s] and a ``units`` attribute; ``list(res)`` lists the labels.
+    """
+
+    def __init__(self, ds: xr.Dataset, reducer=None):
+        self.ds = ds
+        self.reducer = reducer
+
+    # ------------------------------------------------------------------ access
+    @property
+    def attrs(self) -> dict:
+        return self.ds.attrs
+
+    def labels(self) -> dict[str, str]:
+        """label "long name [units]" -> variable name."""
+        return {f"{v.attrs.get('long_name', k)} [{v.attrs.get('units', '')}]": k for k, v in self.ds.data_vars.items()}
+
+    def __iter__(self):
+        return iter(self.labels())
+
+    def __contains__(self, key) -> bool:
+        return key in self.ds.data_vars or key in self.labels()
+
+    def __getitem__(self, key: str) -> xr.DataArray:
+        if key in self.ds.data_vars:
+            return self.ds[key]
+        labels = self.labels()
+        if key in labels:
+            return self.ds[labels[key]]
+        raise KeyError(f"{key!r} is not a result; available: {sorted(labels)}")
+
+    @property
+    def time(self) -> np.ndarray:
+        return self.ds["time"].values
+
+    def steady_window(self) -> tuple[float, float]:
+        """(t0, t1) [s] of the steady-state window stored with the run."""
+        return float(self.attrs["steady_start_s"]), float(self.attrs["steady_end_s"])
+
+    def steady(self, key: str) -> xr.DataArray:
+        t0, t1 = self.steady_window()
+        return self[key].sel(time=slice(t0, t1))
+
+    # ------------------------------------------------------------------ summary
+    def summary(self) -> dict:
+        """Summary numbers over the steady window (ratio, TE statistics, forces)."""
+        from flexrv.post.stats import summary
+
+        return summary(self)
+
+    def save(self, directory: str | Path) -> Path:
+        from flexrv.post.io import save
+
+        return save(self, directory)
+
+    def plot(self, directory: str | Path | None = None) -> list[Path]:
+        """Write the standard PNGs (TE, speeds, pin forces, TE spectrum); returns paths."""
+        from flexrv.viz.plots import standard_plots
+
+        return standard_plots(self, directory)
+
+    @classmethod
+    def load(cls, directory: str | Path) -> "Results":
+        from flexrv.post.io import load_results
+
+        return load_results(directory)
+
+    def __repr__(self) -> str:
+        return f"Results({self.attrs.get('preset')}, model={self.attrs.get('model')}, {len(self.time)} samples, " \
+               f"status={self.attrs.get('status')})"
+
+
+def _var(values, dims, units, long_name):
+    return xr.Variable(dims, np.asarray(values), attrs={"units": units, "long_name": long_name})
+
+
+def steady_window_for(reducer, t_end: float, settle: float = 0.05) -> tuple[float, float]:
+    """Steady window: from the end of the speed and load ramps plus ``settle`` to
+    t_end; if that leaves less than 0.02 s, the last half of the run."""
+    op = reducer.operating
+    t0 = max(op.speed_ramp_time_s, op.load_ramp_end_s) + settle
+    if t_end - t0 < 0.02:
+        t0 = 0.5 * t_end
+    return t0, t_end
+
+
+def results_from_states(model, t, q, v, dt: float, status: str = "completed", timing: dict | None = None,
+                        chunk: int = 1000) -> Results:
+    """Build :class:`Results` from recorded states (T,), (T, n), (T, n)."""
+    from flexrv.geometry.kinematics import member_speeds
+
+    p = model.params
+    t = np.asarray(t, dtype=float)
+    if len(t) > 1:  # keep the last record of any repeated time (adaptive step reduction)
+        keep = np.r_[np.diff(t) > 0, True]
+        t, q, v = t[keep], q[keep], v[keep]
+    data: dict[str, xr.Variable] = {}
+    th_in = np.asarray(model.input_angle(t), dtype=float)
+    w_in = np.asarray(model.input_speed(t), dtype=float)
+    cs = model.slice("carrier")
+    th_out = q[:, cs][:, 2]
+    w_out = v[:, cs][:, 2]
+    data["theta_in"] = _var(th_in, ("time",), "rad", "input angle")
+    data["theta_out"] = _var(th_out, ("time",), "rad", "output angle")
+    data["omega_in"] = _var(w_in, ("time",), "rad/s", "input speed")
+    data["omega_out"] = _var(w_out, ("time",), "rad/s", "output speed")
+    data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC, ("time",), "arcsec", "TE")
+    crank = np.stack([q[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
+    crank_v = np.stack([v[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
+    disc = np.stack([q[:, model.slice(f"disc{k}")] for k in range(p.n_discs)], axis=1)
+    disc_v = np.stack([v[:, model.slice(f"disc{k}")] for k in range(p.n_discs)], axis=1)
+    data["crank_speed"] = _var(crank_v[..., 2], ("time", "crank"), "rad/s", "crank (planet) speed, absolute")
+    data["crank_speed_relative"] = _var(crank_v[..., 2] - w_out[:, None], ("time", "crank"), "rad/s",
+                                        "crank speed relative to the carrier")
+    data["crank_x"] = _var(crank[..., 0], ("time", "crank"), "m", "crank centre x")
+    data["crank_y"] = _var(crank[..., 1], ("time", "crank"), "m", "crank centre y")
+    data["disc_x"] = _var(disc[..., 0], ("time", "disc"), "m", "disc centre x")
+    data["disc_y"] = _var(disc[..., 1], ("time", "disc"), "m", "disc centre y")
+    data["disc_speed"] = _var(disc_v[..., 2], ("time", "disc"), "rad/s", "disc rotation speed")
+    data["carrier_x"] = _var(q[:, cs][:, 0], ("time",), "m", "carrier centre x")
+    data["carrier_y"] = _var(q[:, cs][:, 1], ("time",), "m", "carrier centre y")
+    # group outputs, evaluated on the time history in chunks
+    outs: dict[str, list] = {}
+    meta: dict[str, tuple] = {}
+    for g in model.groups:
+        qg_all = model.group_state(g, q)
+        vg_all = model.group_state(g, v)
+        for a in range(0, len(t), chunk):
+            b = min(a + chunk, len(t))
+            _, out = g.evaluate(t[a:b], qg_all[a:b], vg_all[a:b], want_outputs=True)
+            for name, o in (out or {}).items():
+                outs.setdefault(name, []).append(np.asarray(o.values))
+                meta[name] = (o.dims, o.units, o.long_name)
+    for name, parts in outs.items():
+        dims, units, long_name = meta[name]
+        values = np.concatenate(parts, axis=0) if len(t) else np.zeros((0,) + parts[0].shape[1:])
+        data[name] = _var(values, dims, units, long_name)
+    # torques and power
+    acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)
+    t_in = (data["sun_torque"].values if "sun_torque" in data else 0.0) + p.input_inertia * acc_in
+    data["input_torque"] = _var(t_in, ("time",), "N m", "input torque")
+    t_load = np.asarray(model.load_torque(t), dtype=float)
+    data["output_torque"] = _var(t_load, ("time",), "N m", "output (load) torque")
+    data["power_in"] = _var(t_in * w_in, ("time",), "W", "input power")
+    data["power_out"] = _var(t_load * w_out, ("time",), "W", "output power")
+    ke = np.zeros_like(t)
+    for m in model.members.values():
+        vm = v[:, model.slice(m.name)]
+        ke += 0.5 * np.einsum("ti,ij,tj->t", vm, m.mass_matrix, vm)
+    ke += 0.5 * p.input_inertia * w_in**2
+    data["kinetic_energy"] = _var(ke, ("time",), "J", "kinetic energy")
+    lz = np.zeros_like(t)
+    for m in model.members.values():  # planar members: coordinates x, y, rotation first
+        qm, vm = q[:, model.slice(m.name)], v[:, model.slice(m.name)]
+        lz += m.mass_matrix[2, 2] * vm[:, 2] + m.mass_matrix[0, 0] * (qm[:, 0] * vm[:, 1] - qm[:, 1] * vm[:, 0])
+    data["angular_momentum"] = _var(lz, ("time",), "N m s",
+                                    "angular momentum of carrier, cranks and discs about the axis")
+    ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
+    red = model.reducer
+    t_end = float(t[-1]) if len(t) else 0.0
+    s0, s1 = steady_window_for(red, t_end)
+    ks = member_speeds(1.0, p.z_s, p.z_p, p.z_c, p.z_rp)
+    ds.attrs.update({
+        "preset": red.name, "model": model.name, "status": status, "dt_s": dt, "ratio": p.ratio,
+        "rated_input_speed_rad_s": p.input_speed, "steady_start_s": s0, "steady_end_s": s1,
+        "crank_relative_per_input": float(ks.crank_relative), "crank_absolute_per_input": float(ks.crank_absolute),
+        "needle_model": red.needle_bearing.model, "pin_law": red.contact.pin_law,
+        "timing": json.dumps(_jsonable(timing or {})),
+    })
+    return Results(ds, reducer=red)
+
+
+def _jsonable(obj):
+    """Strict-JSON form of nested dicts/lists/numpy values (NaN/inf -> None)."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (np.integer, int)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if np.isfinite(obj) else None
+    return obj

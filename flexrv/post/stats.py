@@ -1,0 +1,83 @@
+"""Steady-window statistics and the kinematic validation table of a run."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def mean_speed(angle: np.ndarray, time: np.ndarray) -> float:
+    """Mean angular speed [rad/s] over a window: slope of the least-squares line
+    through angle(t) (insensitive to speed ripple and, unlike the end-point
+    increment, to the instantaneous TE at the window's ends)."""
+    if len(time) < 2 or time[-1] <= time[0]:
+        return float("nan")
+    tc = time - time.mean()
+    return float(np.dot(tc, angle - angle.mean()) / np.dot(tc, tc))
+
+
+def kinematic_table(res) -> list[dict]:
+    """Theory vs simulation of the mean member speeds over the steady window.
+
+    Theory: :func:`flexrv.geometry.kinematics.member_speeds` at the simulated mean
+    input speed. Rows: input, output, crank absolute, crank relative, disc
+    rotation, ratio. Errors in percent of the theoretical value."""
+    from flexrv.geometry.kinematics import member_speeds
+
+    t0, t1 = res.steady_window()
+    sel = res.ds.sel(time=slice(t0, t1))
+    t = sel["time"].values
+    red = res.reducer
+    fs, ss = red.first_stage, red.second_stage
+    w_in = mean_speed(sel["theta_in"].values, t)
+    w_out = mean_speed(sel["theta_out"].values, t)
+    th = member_speeds(w_in, fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
+    crank_abs = float(np.mean(sel["crank_speed"].values)) if len(t) else float("nan")
+    crank_rel = float(np.mean(sel["crank_speed_relative"].values)) if len(t) else float("nan")
+    disc = float(np.mean(sel["disc_speed"].values)) if len(t) else float("nan")
+    rows = [("input speed", "rad/s", float(th.input), w_in),
+            ("output speed", "rad/s", float(th.carrier), w_out),
+            ("crank speed, absolute", "rad/s", float(th.crank_absolute), crank_abs),
+            ("crank speed, relative to carrier", "rad/s", float(th.crank_relative), crank_rel),
+            ("disc rotation speed", "rad/s", float(th.disc_rotation), disc),
+            ("total ratio", "-", float(th.ratio), w_in / w_out if w_out else float("nan"))]
+    out = []
+    for name, unit, theory, sim in rows:
+        err = 100.0 * (sim - theory) / theory if theory else float("nan")
+        out.append({"quantity": name, "unit": unit, "theory": theory, "simulated": sim, "error_percent": err})
+    return out
+
+
+def summary(res) -> dict:
+    """Numbers of a run over its steady window (JSON-ready)."""
+    t0, t1 = res.steady_window()
+    sel = res.ds.sel(time=slice(t0, t1))
+    te = sel["te"].values
+    table = kinematic_table(res)
+    ratio_sim = table[-1]["simulated"]
+    pin = sel["pin_force"].values if "pin_force" in sel else np.zeros((len(te), 1, 1))
+    in_contact = sel["pins_in_contact"].values if "pins_in_contact" in sel else np.zeros((len(te), 1))
+    p_in = float(np.mean(sel["power_in"].values)) if len(te) else float("nan")
+    p_out = float(np.mean(sel["power_out"].values)) if len(te) else float("nan")
+    ke = sel["kinetic_energy"].values
+    dke = float((ke[-1] - ke[0]) / (t1 - t0)) if len(te) > 1 else 0.0
+    finite = len(te) > 0
+    return {
+        "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
+        "steady_window_s": [t0, t1],
+        "ratio_theoretical": float(res.attrs["ratio"]),
+        "ratio_simulated": ratio_sim,
+        "ratio_simulated_over_theoretical": ratio_sim / float(res.attrs["ratio"]),
+        "te_min_arcsec": float(te.min()) if finite else None,
+        "te_max_arcsec": float(te.max()) if finite else None,
+        "te_pp_arcsec": float(te.max() - te.min()) if finite else None,
+        "te_mean_arcsec": float(te.mean()) if finite else None,
+        "te_rms_fluctuation_arcsec": float(np.std(te)) if finite else None,
+        "max_pin_force_N": float(pin.max()) if finite else None,
+        "pins_in_contact_mean": float(np.mean(in_contact)) if finite else None,
+        "pins_in_contact_max": int(np.max(in_contact)) if finite else None,
+        "mean_input_power_W": p_in, "mean_output_power_W": p_out,
+        "mean_kinetic_energy_rate_W": dke,
+        "mean_dissipation_W": p_in - p_out - dke,
+        "kinematics": table,
+        "failure": res.attrs.get("failure"),
+    }

@@ -1,0 +1,130 @@
+"""Numerical EHL point-contact solver (flexrv.ehl.solver).
+
+References: Hertz pressure from flexrv.contact.hertz (Hamrock 1994 ch. 17);
+film formulas of Hamrock & Dowson (1977) and Nijenbanning, Venner & Moes (1994)
+from flexrv.ehl.film. Measured agreement (129^2 grid, first-order wedge term):
+
+case      M     L    lambda  h_c/HD  h_c/Moes  h_c(129)/h_c(65)-1  h_c(257)/h_c(129)-1
+circ260   260   11.4  1      1.101   1.038     +2.5 %              -2.2 %
+ell4      260   11.4  0.25   1.041   1.021     -1.8 %              -2.4 %
+circ31    31    13.6  1      1.047   1.052     -2.4 %              -1.7 %
+ell10     1300  11.4  0.1    1.018   0.994     +2.5 %
+rv221     720   6.6   0.036  1.135   1.228     -2.5 %              -2.5 %
+
+so the stated band is: h_c within 6 % of Moes and 11 % of Hamrock-Dowson for
+M = 30-1300, L = 11-14, lambda = 0.1-1; grid changes of h_c 1.7-2.5 % per
+refinement at 65-257 nodes (the 2 % target is met only for part of the cases).
+"""
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+from flexrv.contact.hertz import point_contact
+from flexrv.ehl.film import hamrock_dowson, moes_central
+from flexrv.ehl.solver import LubricantProperties, influence_kernel, solve_point_contact
+from flexrv.errors import ConvergenceError, InputError
+
+E = 2.2e11
+LUB = LubricantProperties(viscosity=0.05, pressure_viscosity=2e-8, roelands_z=0.67, roelands_p0=1.96e8,
+                          density=870.0)
+CASES = {"circ260": (100.0, 1.0, 0.01, 0.01), "ell4": (100.0, 1.0, 0.01, 0.04), "circ31": (20.0, 2.0, 0.01, 0.01)}
+
+
+@lru_cache(maxsize=None)
+def solve(case, grid):
+    q, u, rx, ry = CASES[case]
+    return solve_point_contact(q, u, rx, ry, E, LUB, grid=grid)
+
+
+def test_influence_kernel_uniform_square():
+    """Centre deflection of a uniformly loaded square 2c x 2c (unit pressure, E' = 1 Pa):
+    w = (2/pi) iint dA/r = (2/pi) 8 c asinh(1) (Love 1929; Johnson 1985, sec. 3.9), and a
+    far cell acts as a point load w = (2/pi) A / r."""
+    k = influence_kernel(1, 1, 2.0, 2.0)
+    np.testing.assert_allclose(k[0, 0], 2.0 / np.pi * 8.0 * np.arcsinh(1.0), rtol=1e-14)
+    # far field: a cell acts as a point load: w ~ (2/pi) A / r
+    kf = influence_kernel(60, 1, 1.0, 1.0)
+    np.testing.assert_allclose(kf[-1, 0], 2.0 / np.pi / 59.0, rtol=1e-4)
+
+
+def test_hertz_limit_pressure():
+    """Piezoviscous-elastic case (M = 260): the pressure follows the Hertz ellipse, p_max
+    within 3 % of p_H (the small excess is the pressure spike), and away from inlet and
+    spike (|x| < 0.6 b) within 5 % of p_H of the Hertz profile."""
+    res = solve("circ260", 65)
+    assert abs(res.p_max / res.hertz_pressure - 1.0) < 0.03
+    jc = np.argmin(np.abs(res.y))
+    xs = res.x / res.hertz_b
+    mask = np.abs(xs) < 0.6
+    hertz = res.hertz_pressure * np.sqrt(1.0 - xs[mask] ** 2)
+    assert np.max(np.abs(res.pressure[mask, jc] - hertz)) < 0.05 * res.hertz_pressure
+    pc = point_contact(100.0, 0.01, 0.01, E)
+    np.testing.assert_allclose(res.hertz_pressure, pc.p_max, rtol=1e-12)
+
+
+@pytest.mark.parametrize("case", ["circ260", "ell4"])
+def test_film_vs_formulas(case):
+    """h_c within 6 % of Moes and 11 % of Hamrock-Dowson; h_min between 0.4 h_c and h_c (129^2)."""
+    q, u, rx, ry = CASES[case]
+    res = solve(case, 129)
+    hc_hd, _ = hamrock_dowson(q, u, rx, ry, E, LUB.viscosity, LUB.pressure_viscosity)
+    hc_moes = moes_central(q, u, rx, ry, E, LUB.viscosity, LUB.pressure_viscosity)
+    assert abs(res.h_central / hc_moes - 1.0) < 0.06
+    assert abs(res.h_central / hc_hd - 1.0) < 0.11
+    assert 0.4 * res.h_central < res.h_min < res.h_central
+
+
+@pytest.mark.parametrize("case", ["circ260", "ell4"])
+def test_grid_convergence_and_load_balance(case):
+    """h_c changes < 3 % from 65^2 to the default 129^2 (measured 1.8-2.5 %); load balance
+    |int p - Q|/Q < 1e-3 (measured ~1e-12)."""
+    coarse, fine = solve(case, 65), solve(case, 129)
+    assert abs(fine.h_central / coarse.h_central - 1.0) < 0.03
+    assert fine.load_error < 1e-3 and coarse.load_error < 1e-3
+    q = CASES[case][0]
+    dx, dy = fine.x[1] - fine.x[0], fine.y[1] - fine.y[0]
+    np.testing.assert_allclose(fine.pressure.sum() * dx * dy, q, rtol=1e-3)
+    assert np.all(fine.pressure >= 0) and np.all(fine.film > 0)
+    assert fine.residual < 1e-6 and fine.residual_history[-1] == fine.residual
+
+
+def test_light_load_rigid_regime_converges():
+    """Light, slow contact (M ~ 8, rv221-like elongated geometry): converges, pressure spread
+    beyond the Hertz ellipse (p_max well below p_H), load balanced."""
+    lub = LubricantProperties(0.13, 2e-8, 0.68, 1.96e8, 870.0, 0.6e-9, 1.7e-9)
+    res = solve_point_contact(1.0, 0.05, 0.01389, 0.39, 2.2857e11, lub, grid=33)
+    assert res.p_max < 0.6 * res.hertz_pressure
+    assert res.load_error < 1e-3 and 1e-8 < res.h_central < 1e-6
+
+
+@pytest.mark.parametrize("bad,match", [(dict(load=0.0), "load"), (dict(speed=-1.0), "speed"), (dict(rx=0.0), "rx"),
+                                       (dict(ry=-0.01), "ry"), (dict(grid=100), "grid")])
+def test_bad_input(bad, match):
+    args = dict(load=100.0, speed=1.0, rx=0.01, ry=0.01, e_eff=E, lubricant=LUB, grid=33)
+    args.update(bad)
+    with pytest.raises(InputError, match=match):
+        solve_point_contact(**args)
+
+
+def test_missing_pressure_viscosity_data():
+    lub = LubricantProperties(0.05, 0.0, 0.67, 1.96e8, 870.0)
+    with pytest.raises(InputError, match="pressure_viscosity"):
+        solve_point_contact(100.0, 1.0, 0.01, 0.01, E, lub, grid=33)
+
+
+def test_non_convergence_is_reported():
+    with pytest.raises(ConvergenceError, match="residual reached .* after 1 Newton steps"):
+        solve_point_contact(100.0, 1.0, 0.01, 0.01, E, LUB, grid=33, max_iter=1, coarsest=33)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["circ260", "ell4", "circ31"])
+def test_fine_grid_257(case):
+    """257^2: h_c within 2.5 % of 129^2 and the film band of test_film_vs_formulas."""
+    q, u, rx, ry = CASES[case]
+    fine, mid = solve(case, 257), solve(case, 129)
+    assert abs(fine.h_central / mid.h_central - 1.0) < 0.025
+    hc_moes = moes_central(q, u, rx, ry, E, LUB.viscosity, LUB.pressure_viscosity)
+    assert abs(fine.h_central / hc_moes - 1.0) < 0.06
