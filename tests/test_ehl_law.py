@@ -71,7 +71,8 @@ def test_continuous_monotone_and_derivatives():
 def test_zero_speed_is_dry():
     law = EHLPointLaw(RX, RY, E, LUB, mode="hamrock_dowson")
     delta = np.linspace(1e-7, 1e-5, 10)
-    np.testing.assert_allclose(law(delta, 0 * delta, 0.0).force, EHLPointLaw(RX, RY, E, mode="dry")(delta, 0 * delta, 0.0).force)
+    dry = EHLPointLaw(RX, RY, E, mode="dry")
+    np.testing.assert_allclose(law(delta, 0 * delta, 0.0).force, dry(delta, 0 * delta, 0.0).force)
 
 
 def test_vectorised_52_contacts_fast():
@@ -153,3 +154,33 @@ def test_map_fills_failed_nodes(monkeypatch):
     fmap = build_film_map(RX, RY, E, LUB, (50.0, 200.0), (0.05, 0.05), n_load=2, n_speed=1, grid=17)
     assert fmap.valid.tolist() == [[True], [False]]
     assert fmap.log_ratio[1, 0] == fmap.log_ratio[0, 0]
+
+
+def test_from_design_rv221():
+    """Design-built law: E' of GCr15 on GCr15 (208 GPa, 0.3), mode from contact.ehl,
+    c_max = main_bearing.ball_damping_Ns_per_m."""
+    from flexrv.design import load
+
+    red = load("rv221")
+    law = EHLPointLaw.from_design(red, RX, RY)
+    np.testing.assert_allclose(law.e_eff, 208e9 / (1 - 0.3**2), rtol=1e-12)
+    assert law.mode == red.contact.ehl and law.c_max == red.main_bearing.ball_damping_Ns_per_m
+    with pytest.raises(InputError, match="scalar"):
+        EHLPointLaw.from_design(red, np.full(3, RX), RY, mode="map")
+
+
+def test_map_load_interpolant_matches_bilinear():
+    """The per-speed 1-D interpolant used in the Newton loop equals the 2-D bilinear table
+    lookup (including clamped extrapolation)."""
+    from flexrv.ehl.maps import FilmMap
+
+    rng = np.random.default_rng(1)
+    fmap = FilmMap(rx=RX, ry=RY, e_eff=E, lubricant=LUB, log_load=np.linspace(1, 6, 5),
+                   log_speed=np.linspace(-4, -1, 3), log_ratio=rng.normal(0, 0.1, (5, 3)),
+                   h_central=np.ones((5, 3)), valid=np.ones((5, 3), bool), grid=17)
+    q = np.exp(rng.uniform(0, 7, 52))
+    u = np.exp(rng.uniform(-5, 0, 52))
+    c2, d2 = fmap.log_correction(q, u)
+    c1, d1 = fmap.load_interpolant(u)(q)
+    np.testing.assert_allclose(c1, c2, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(d1, d2, rtol=1e-12, atol=1e-14)

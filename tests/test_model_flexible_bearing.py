@@ -21,7 +21,7 @@ def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None):
                                       MarkerNodeRigid, NodePointGround, NodeRigidBodyRxyz, ObjectRigidBody)
     from exudyn.utilities import RigidBodyInertia
 
-    rows = rows or rows_from_design(reducer)
+    rows = rows or rows_from_design(reducer, ehl="dry")
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     frame = mbs.AddNode(NodeRigidBodyRxyz(referenceCoordinates=[0.0] * 6))
@@ -95,7 +95,7 @@ def test_radial_load_balance_and_zone():
 def test_jacobian_vs_finite_difference():
     """Analytic Jacobian within 2 % of central differences (geometric-stiffness
     terms of the frame rotation are neglected by design)."""
-    rows = rows_from_design(load("rv221"))
+    rows = rows_from_design(load("rv221"), ehl="dry")
     m = rows[0]
     rng = np.random.default_rng(0)
     n = m.n_coordinates

@@ -133,25 +133,68 @@ def test_failure_is_reported_with_partial_results():
     assert res.attrs["status"] == "failed" and len(res.time) > 2
 
 
-@pytest.mark.slow
-def test_torsional_rigidity_vs_series_model():
+@pytest.mark.parametrize("name", ["rv40e", "rv221"])
+def test_torsional_rigidity_vs_series_model(name):
     """Virtual stiffness test (input locked, 0 -> +T_r -> -T_r -> 0) vs the seed 004
     series model C_W = C_Hc C_c / (C_Hc + C_c) (flexrv.analysis.torsional,
     tangent Palmgren pin stiffness at T_r), extended by the crank-support
     compliance in series, C_s = n_cranks k_s a_w^2 (the model's crank bearings in
     the carrier are elastic; seed 004 neglects them). Ideal geometry so that the
-    analytic zero-clearance assumptions hold. Tolerance 25 %: the analytic model
-    linearises at T_r while the test fits the secant over [T_r/2, T_r], and lets
-    neither the discs translate nor the torque split unevenly."""
+    analytic zero-clearance assumptions hold. Measured: -10 % (rv40e), -9 %
+    (rv221); tolerance 15 %: the analytic model linearises at T_r while the test
+    fits the secant over [T_r/2, T_r], and lets neither the discs translate nor
+    the torque split unevenly between the cranks."""
     from flexrv.analysis.torsional import second_stage_stiffness
     from flexrv.model.parameters import rigid_parameters
 
-    r = ideal(load("rv40e"))
+    r = ideal(load(name))
     fig, _ = stiffness_test(r, quarter_time=0.01)
     a = second_stage_stiffness(r, r.operating.rated_torque_Nm)
     p = rigid_parameters(r)
     c_s = p.n_cranks * p.support_stiffness * p.center_distance**2
     c_w = 1.0 / (1.0 / a.c_w_tangent + 1.0 / c_s)
     arcmin = np.pi / 180 / 60
-    assert fig.rigidity_Nm_per_arcmin == pytest.approx(c_w * arcmin, rel=0.25)
-    assert abs(fig.lost_motion_arcmin) < 0.5
+    assert fig.rigidity_Nm_per_arcmin == pytest.approx(c_w * arcmin, rel=0.15)
+    assert abs(fig.lost_motion_arcmin) < 0.2  # ideal geometry: no clearance to take up
+
+
+def test_roller_resolved_needle_bearing_option():
+    """needle_bearing.model = "rollers" (seed 003: per-roller Hertz line contacts
+    with clearance) vs "empirical" (seed 004 law): input locked, rated torque
+    412 N m: the output wind-up agrees within 15 % (two independent stiffness
+    models of the same bearing: Palmgren line contacts per roller, Harris &
+    Kotzalas 2007, vs the empirical law of seed 004); per-roller forces are
+    reported, every loaded bearing shares its load over >= 2 rollers and no
+    roller carries more than the bearing resultant."""
+    from flexrv.model.loads import piecewise_torque
+
+    te = {}
+    for model in ("empirical", "rollers"):
+        r = load("rv40e")
+        r = r.model_copy(update={"needle_bearing": r.needle_bearing.model_copy(update={"model": model})})
+        res = Simulation(r, drive="locked", torque=piecewise_torque([0, 0.01, 1], [0, 412.0, 412.0])).run(
+            t_end=0.013, dt=1e-4)
+        te[model] = float(res["te"].values[-1])
+        if model == "rollers":
+            rf = res["roller_force"]
+            assert rf.dims == ("time", "crank", "disc", "roller")
+            nf = res["needle_force"].values[-1]
+            assert np.all(rf.values[-1].max(axis=-1) < nf + 1e-9)
+            assert np.all((rf.values[-1] > 0).sum(axis=-1)[nf > 100] >= 2)
+    assert te["rollers"] == pytest.approx(te["empirical"], rel=0.15)
+
+
+def test_ctrl_c_keeps_partial_results(tmp_path):
+    """SIGINT during a run stops it cleanly: the results up to that time come back
+    with status "interrupted" and are saved when save_to is given."""
+    import os
+    import signal
+
+    def interrupt(t, t_end):
+        if t > 0.003:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    res = Simulation("rv40e").run(t_end=0.05, dt=1e-4, progress=interrupt, save_to=tmp_path / "partial")
+    assert res.attrs["status"] == "interrupted"
+    assert 0.003 < res.time[-1] < 0.05
+    assert (tmp_path / "partial" / "results.nc").is_file()

@@ -95,12 +95,13 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
 
 
 def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
-        load_n: Optional[float] = typer.Option(None, "--load-n", help="Normal load Q [N]."),
-        speed_m_s: Optional[float] = typer.Option(None, "--speed-m-s", help="Mean entrainment speed (u1+u2)/2 [m/s]."),
-        rx_m: Optional[float] = typer.Option(None, "--rx-m", help="Effective radius along the entrainment [m]."),
-        ry_m: Optional[float] = typer.Option(None, "--ry-m", help="Effective radius across the entrainment [m]."),
+        load_n: Optional[float] = typer.Option(None, "--load-n", help="Normal load Q (N)."),
+        speed_m_s: Optional[float] = typer.Option(None, "--speed-m-s", help="Mean entrainment speed (u1+u2)/2 (m/s)."),
+        rx_m: Optional[float] = typer.Option(None, "--rx-m", help="Effective radius along the entrainment (m)."),
+        ry_m: Optional[float] = typer.Option(None, "--ry-m", help="Effective radius across the entrainment (m)."),
         grid: int = typer.Option(129, "--grid", help="Nodes per direction, 2^k+1 (65, 129, 257)."),
-        png: Optional[str] = typer.Option(None, "--png", help="Write pressure/film centre lines and 2-D maps to this PNG."),
+        png: Optional[str] = typer.Option(None, "--png",
+                                          help="Write pressure/film centre lines and 2-D maps to this PNG."),
         json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Numerical EHL solution (Reynolds + Roelands + Dowson-Higginson + Boussinesq) of a
     ball-raceway contact, compared with Hamrock-Dowson and Moes."""

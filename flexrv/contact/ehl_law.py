@@ -180,6 +180,36 @@ class EHLPointLaw:
             h1, _ = hamrock_dowson(1.0, 1.0, self.rx, self.ry, self.e_eff, lub.viscosity, lub.pressure_viscosity)
             object.__setattr__(self, "_h_unit", np.asarray(h1))  # h_HD at Q = 1 N, u = 1 m/s
 
+    @classmethod
+    def from_design(cls, reducer, rx, ry, *, mode: Optional[str] = None, load_range=(5.0, 2000.0),
+                    speed_range=(0.005, 0.5), map_grid: int = 65) -> "EHLPointLaw":
+        """Law for the main-bearing ball contacts of a :class:`flexrv.design.model.Reducer`.
+
+        E' from the ``rolling_elements`` and ``bearing_rings`` materials, lubricant from
+        ``reducer.lubricant``, c_max = ``main_bearing.ball_damping_Ns_per_m``, damping depth
+        ``contact.impact_damping_depth_mm``, mode ``contact.ehl`` unless given. For
+        ``"map"`` (scalar rx, ry only) the solver map over ``load_range`` [N] x
+        ``speed_range`` [m/s] is built once and cached (:func:`flexrv.ehl.maps.film_map`).
+        """
+        from flexrv.contact.hertz import effective_modulus
+        from flexrv.ehl.solver import LubricantProperties
+
+        ball, ring = reducer.material("rolling_elements"), reducer.material("bearing_rings")
+        e_eff = float(effective_modulus(ball.youngs_modulus, ball.poisson_ratio, ring.youngs_modulus,
+                                        ring.poisson_ratio))
+        lub = LubricantProperties.from_design(reducer.lubricant)
+        mode = reducer.contact.ehl if mode is None else mode
+        fmap = None
+        if mode == "map":
+            if np.size(rx) != 1 or np.size(ry) != 1:
+                raise InputError("EHL mode 'map' needs one contact geometry (scalar rx, ry); "
+                                 f"got shapes {np.shape(rx)}, {np.shape(ry)}")
+            from flexrv.ehl.maps import film_map
+
+            fmap = film_map(float(rx), float(ry), e_eff, lub, load_range, speed_range, grid=map_grid)
+        return cls(rx, ry, e_eff, lub, mode=mode, film_map=fmap, c_max=reducer.main_bearing.ball_damping_Ns_per_m,
+                   damping_depth=reducer.contact.impact_damping_depth_mm * 1e-3)
+
     @property
     def stiffness(self):
         """Hertz constant K [N/m^1.5] of each contact."""
@@ -211,8 +241,13 @@ class EHLPointLaw:
             def film(q, hu=hu):
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT, HAMROCK_DOWSON_LOAD_EXPONENT
         elif self.mode == "map":
-            def film(q, speed=speed):
-                return self.film(q, speed)
+            hu = self._h_unit * speed**0.67
+            speed_b = np.broadcast_to(speed, np.broadcast(np.asarray(delta), speed).shape)
+            interp = self.film_map.load_interpolant(speed_b)
+
+            def film(q, hu=hu):
+                c, dc = interp(np.broadcast_to(q, speed_b.shape))
+                return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
         return _solve(delta, delta_rate, self._k, 1.5, film, self.load_floor, self.c_max,
                       self.damping_depth, self.iterations)
 

@@ -66,6 +66,42 @@ class FilmMap:
         lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
         return _bilinear(self.log_ratio, self.log_load, self.log_speed, lq, lu)
 
+    def load_interpolant(self, speed):
+        """Fix the speeds (array, one per contact) and return q -> (c, dc/d ln Q) that
+        interpolates only along ln Q (the contact law's Newton loop calls it repeatedly;
+        ``q`` must have the shape of ``speed``). Identical to :meth:`log_correction` at
+        those speeds."""
+        lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
+        shape = lu.shape
+        lu = lu.reshape(-1)
+        gy, ny = self.log_speed, self.log_speed.size
+        if ny > 1:
+            fy = np.clip((lu - gy[0]) / (gy[1] - gy[0]), 0.0, ny - 1.0)
+            iy = np.minimum(fy.astype(int), ny - 2)
+            ty = fy - iy
+            rows = self.log_ratio[:, iy] * (1 - ty) + self.log_ratio[:, iy + 1] * ty  # (n_load, contacts)
+        else:
+            rows = np.repeat(self.log_ratio[:, :1], lu.size, axis=1)
+        gx, nx = self.log_load, self.log_load.size
+        cols = np.arange(lu.size)
+        if nx == 1:
+            def interp(q):
+                return rows[0].reshape(shape), np.zeros(shape)
+            return interp
+        step = gx[1] - gx[0]
+        slopes = np.diff(rows, axis=0) / step  # (n_load - 1, contacts)
+
+        def interp(q):
+            lq = np.log(np.reshape(q, -1))
+            fx = np.clip((lq - gx[0]) / step, 0.0, nx - 1.0)
+            ix = np.minimum(fx.astype(int), nx - 2)
+            sl = slopes[ix, cols]
+            c = rows[ix, cols] + sl * step * (fx - ix)
+            dc = np.where((lq > gx[0]) & (lq < gx[-1]), sl, 0.0)
+            return c.reshape(shape), dc.reshape(shape)
+
+        return interp
+
     def central_film(self, load, speed):
         """h_c [m] and d ln h_c / d ln Q at (load [N], speed [m/s]) (arrays broadcast)."""
         load = np.asarray(load, dtype=float)

@@ -135,6 +135,21 @@ class ReducedBody:
         A = self.raceway_matrix(azimuth)
         return np.einsum("...im,...i->...m", A, np.asarray(force_vec, dtype=float))
 
+    def displacement(self, q_modal) -> np.ndarray:
+        """Nodal displacements (N, 3) [m] of modal coordinates q (m,)."""
+        return (self.modes @ np.asarray(q_modal, dtype=float)).reshape(-1, 3)
+
+    def von_mises(self, q_modal) -> np.ndarray:
+        """Nodal von Mises stress (N,) [Pa] of modal coordinates q (needs the body
+        built with ``stress=True``)."""
+        from flexrv.fem.stress import von_mises
+
+        if self.stress_modes is None:
+            raise InputError(f"reduced body {self.part!r} has no stress modes; rebuild it with stress=True")
+        q = np.asarray(q_modal, dtype=float)
+        comps = np.stack([self.stress_modes[:, c::6] @ q for c in range(6)], axis=-1)
+        return von_mises(comps)
+
     # ------------------------------------------------------------ Exudyn
     def add_modal_body(self, mbs, damping_ratio: float = 0.0, name: str = ""):
         """Add the body as plain modal coordinates (frame fixed in space):
@@ -328,3 +343,37 @@ def reduce_part(reducer, part: str, size: float | None = None, n_eig: int = 20, 
         rw = raceway_spec_for(spec_for(reducer, part), load_width, n_harmonics)
     return build_reduced_body(mres, material_dict(reducer, part), n_eig=n_eig, raceway=rw, stress=stress,
                               cache=cache)
+
+
+@dataclass
+class PartModes:
+    """Free-free and constrained (interfaces clamped) modes of a part's full FE model."""
+
+    part: str
+    mesh: object  # MeshData
+    free_hz: np.ndarray
+    free_modes: np.ndarray
+    constrained_hz: np.ndarray
+    constrained_modes: np.ndarray
+    interfaces: list
+
+
+def part_modes(reducer, part: str, n: int = 10, size: float | None = None, constrained: bool = True) -> PartModes:
+    """Lowest ``n`` elastic free-free modes (6 rigid-body modes dropped) and the
+    lowest ``n`` modes with the part's interfaces clamped (rings: fit surface;
+    crankshaft: support journals; disc: crank holes), from the full FE model."""
+    from flexrv.fem.modal import eigenmodes
+    from flexrv.meshing import build_mesh
+
+    if not 1 <= int(n) <= 200:
+        raise InputError(f"n = {n!r} modes must be in [1, 200]")
+    mres = build_mesh(reducer, part, size)
+    mesh = mres.data
+    fe = _assemble(mesh, material_dict(reducer, part))
+    f, v = eigenmodes(fe.K, fe.M, int(n) + 6)
+    groups = interface_groups(part, mesh.group_names)
+    fc, vc = np.zeros(0), np.zeros((fe.n_dof, 0))
+    if constrained:
+        fixed = np.unique(np.concatenate([mesh.node_set(g) for g in groups]))
+        fc, vc = eigenmodes(fe.K, fe.M, int(n), fixed_nodes=fixed)
+    return PartModes(part, mesh, f[6:], v[:, 6:], fc, vc, groups)

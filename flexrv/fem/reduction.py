@@ -23,7 +23,9 @@ truncation (c_k ~ exp(-(k b / 2 R_c)^2)). Static modes at discrete load points
 (the prototype of exudyn-facts.md) instead have an error that depends on where the
 ball is between load points. The patch width b (default D/4, of the order of the
 Hertz contact ellipse) is the length below which the ring deformation is left to
-the Hertz law; harmonics above K carry load coefficients < ``harmonic_tol``.
+the Hertz law; harmonics above K carry load coefficients c_K/c_0 < ``harmonic_tol``
+(default 0.2: on the rv221 outer ring, K = 57 and 115 raceway modes give < 0.5 %
+error of the deflection under the load at any azimuth; K = 40: -4 %, K = 20: -24 %).
 
 Finally the basis is replaced by its Ritz vectors (generalized eigenvectors of the
 projected K, M; near-dependent directions dropped), so the reduced mass is the
@@ -57,7 +59,7 @@ class RacewaySpec:
     n_harmonics: int
 
 
-def default_harmonics(r: float, b: float, harmonic_tol: float = 0.05) -> int:
+def default_harmonics(r: float, b: float, harmonic_tol: float = 0.2) -> int:
     """K such that the patch's Fourier coefficient c_K / c_0 = exp(-(K b/2R)^2)
     just falls below ``harmonic_tol``: K = ceil(2 R / b sqrt(ln(1/tol)))."""
     return int(math.ceil(2.0 * r / b * math.sqrt(math.log(1.0 / harmonic_tol))))
@@ -186,7 +188,7 @@ def hcb_basis(K: sp.csr_matrix, M: sp.csr_matrix, nodes: np.ndarray, interfaces:
     # 2. fixed-interface eigenmodes
     fi_hz = np.array([])
     if n_eig > 0:
-        fi_hz, E = eigenmodes(K, M, n_eig, fixed_nodes=bnodes)
+        fi_hz, E = eigenmodes(K, M, n_eig, fixed_nodes=bnodes, solve0=solve)
         cols.append(E)
     # 3. raceway attachment modes
     n_r = 0

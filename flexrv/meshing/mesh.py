@@ -184,8 +184,8 @@ def mesh_key(spec, size: float, local: float) -> str:
     return content_hash(P.spec_dict(spec), size, local, MESH_FORMAT_VERSION, library_versions("gmsh", "meshio"))
 
 
-def generate_mesh(spec, part: str, size: float | None = None, *, max_nodes: int | None = None,
-                  cache: bool = True, threads: int = 1) -> MeshResult:
+def generate_mesh(spec, part: str, size: float | None = None, *, local_size: float | None = None,
+                  max_nodes: int | None = None, cache: bool = True, threads: int = 1) -> MeshResult:
     """Mesh a part spec with Tet10 elements and cache the result.
 
     Parameters
@@ -193,6 +193,8 @@ def generate_mesh(spec, part: str, size: float | None = None, *, max_nodes: int 
     spec : a ``*Spec`` of :mod:`flexrv.meshing.parts` (SI).
     part : part name (file prefix).
     size : global mesh size [m]; the spec's ``default_size()`` if None.
+    local_size : mesh size on the raceway / tooth flanks [m] (default from the spec:
+        a third of the groove radius, an eighth of the tooth pitch); must be <= size.
     max_nodes : node-count limit (memory guard); :func:`default_max_nodes` if None.
     cache : reuse/write the cached files.
     threads : gmsh meshing threads.
@@ -206,6 +208,10 @@ def generate_mesh(spec, part: str, size: float | None = None, *, max_nodes: int 
 
     size = float(spec.default_size() if size is None else size)
     chk = P.check_size(spec, size, max_nodes or default_max_nodes())
+    if local_size is not None:
+        if not (0 < local_size <= size):
+            raise InputError(f"local mesh size = {local_size!r} m must be in (0, size = {size:g} m]")
+        chk["local_size"] = float(local_size)
     key = mesh_key(spec, size, chk["local_size"])
     folder = cache_dir()
     stem = f"{part}-{key}"

@@ -325,7 +325,8 @@ def build_crankshaft(gmsh, spec: CrankshaftSpec, size: float) -> dict[str, list[
         tags.append((3, occ.addCylinder(dx, 0, z, 0, 0, length, r)))
         spans.append((name, z, z + length, r, dx))
         z += length
-    occ.fuse(tags[:1], tags[1:])
+    if len(tags) > 1:
+        occ.fuse(tags[:1], tags[1:])
     occ.synchronize()
     vol = _single_volume(gmsh, "crankshaft")
     groups: dict[str, list[int]] = {name: [] for name, *_ in spans}

@@ -1,0 +1,19 @@
+"""Exudyn assembly of reducer models.
+
+``flexrv.model.factory.build_model(reducer, "rigid")`` assembles the rigid-member
+model with compliant contacts: members (carrier with its 5-DOF main-bearing
+element, cranks = planets, cycloid discs) as ``NodeGenericODE2`` nodes with
+constant mass matrices, and one vectorised ``ObjectGenericODE2`` per force group:
+
+* :mod:`.gear_stage` — sun–planet meshes along the line of action (time-varying
+  ISO 6336 stiffness, damping, backlash; the sun angle is prescribed by the drive);
+* :mod:`.cranks_discs` — crank support bearings in the carrier; needle bearings
+  (seed 004 empirical law or roller-resolved Hertz line contacts, seed 003);
+* :mod:`.pins` — every pin–disc contact (exact gap to the modified profile);
+* :mod:`.main_bearing_rigid` — linear carrier bearing (the flexible model
+  replaces it, :mod:`.flexible_bearing`);
+* :mod:`.loads` — seed drive (input speed step) and load torque step.
+
+Why TE appears and how it is built is explained in :mod:`flexrv.post.results`;
+the planar-DOF choice is justified in :mod:`.parameters`.
+"""

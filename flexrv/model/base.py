@@ -82,6 +82,10 @@ class ForceGroup:
     def new_step(self) -> None:
         """Hook called at the start of every time step (e.g. to drop caches)."""
 
+    def reset(self) -> None:
+        """Hook called before a run: forget all state of previous evaluations."""
+        self.new_step()
+
     # -------------------------------------------------------------- exudyn glue
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
         """Add the group's ObjectGenericODE2 to ``mbs``; return its object number."""

@@ -38,15 +38,6 @@ from flexrv.contact.laws import impact_force
 from flexrv.model.base import ForceGroup, Output
 
 
-def _rot(v, angle):
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
-
-
-def _cross2(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
 class CrankSupports(ForceGroup):
     """Crank centres in their carrier bores (members: carrier, crank0..N-1)."""
 
@@ -62,35 +53,34 @@ class CrankSupports(ForceGroup):
         self.c = p.support_damping
 
     def _kin(self, q, v):
-        n = self.n
-        cc, th = q[..., None, 0:2], q[..., 2:3]
-        vc, om = v[..., None, 0:2], v[..., 2:3]
-        qc = q[..., 6:].reshape(q.shape[:-1] + (n, 3))
-        vk = v[..., 6:].reshape(v.shape[:-1] + (n, 3))
-        r = _rot(self.local, th)  # (..., n, 2)
-        h = cc + r
-        hv = vc + om[..., None] * np.stack([-r[..., 1], r[..., 0]], axis=-1)
-        d = qc[..., :2] - h
-        dv = vk[..., :2] - hv
-        return r, d, dv
+        th, om = q[..., 2:3], v[..., 2:3]
+        c, s = np.cos(th), np.sin(th)
+        lx, ly = self.local[:, 0], self.local[:, 1]
+        rx, ry = c * lx - s * ly, s * lx + c * ly  # (..., n) bore offsets in the housing frame
+        dx = q[..., 6::3] - q[..., 0:1] - rx
+        dy = q[..., 7::3] - q[..., 1:2] - ry
+        dvx = v[..., 6::3] - v[..., 0:1] + om * ry
+        dvy = v[..., 7::3] - v[..., 1:2] - om * rx
+        return rx, ry, dx, dy, dvx, dvy
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
-        r, d, dv = self._kin(q, v)
-        f = -self.k * d - self.c * dv  # on the cranks
+        rx, ry, dx, dy, dvx, dvy = self._kin(q, v)
+        fx = -self.k * dx - self.c * dvx  # on the cranks
+        fy = -self.k * dy - self.c * dvy
         gen = np.zeros(q.shape)
-        gen[..., 0:2] = -f.sum(axis=-2)
-        gen[..., 2] = -_cross2(r, f).sum(axis=-1)
-        fk = np.zeros(q.shape[:-1] + (self.n, 3))
-        fk[..., :2] = f
-        gen[..., 6:] = fk.reshape(q.shape[:-1] + (3 * self.n,))
+        gen[..., 0] = -fx.sum(axis=-1)
+        gen[..., 1] = -fy.sum(axis=-1)
+        gen[..., 2] = -(rx * fy - ry * fx).sum(axis=-1)
+        gen[..., 6::3] = fx
+        gen[..., 7::3] = fy
         out = None
         if want_outputs:
-            out = {"crank_support_force": Output(np.hypot(f[..., 0], f[..., 1]), ("time", "crank"), "N",
+            out = {"crank_support_force": Output(np.hypot(fx, fy), ("time", "crank"), "N",
                                                  "radial force of the carrier on each crank (both support bearings)")}
         return gen, out
 
     def jacobian(self, t, q, v):
-        r, _, _ = self._kin(q, v)
+        rx, ry, _, _, _, _ = self._kin(q, v)
         n = q.shape[-1]
         dq = np.zeros((n, n))
         dv = np.zeros((n, n))
@@ -98,7 +88,7 @@ class CrankSupports(ForceGroup):
             b = np.zeros((2, n))  # d(d_j)/dq
             b[:, 6 + 3 * j:8 + 3 * j] = np.eye(2)
             b[:, 0:2] = -np.eye(2)
-            b[:, 2] = [r[j, 1], -r[j, 0]]
+            b[:, 2] = [ry[j], -rx[j]]
             bb = b.T @ b
             dq -= self.k * bb
             dv -= self.c * bb
@@ -118,7 +108,8 @@ class NeedleBearings(ForceGroup):
         self.model = model
         self.e = p.eccentricity
         self.chi0 = p.chi0  # (nd,)
-        self.holes = p.holes  # (nd, nc, 2)
+        self.hx = p.holes[..., 0].T  # (nc, nd) hole centres in the disc frames
+        self.hy = p.holes[..., 1].T
         self.clear = p.needle_clearance
         self.c_max = p.needle_c_max
         self.depth = p.contact_depth
@@ -131,101 +122,110 @@ class NeedleBearings(ForceGroup):
             self.k = p.needle_roller_k
             self.z = p.needle_roller_count
             self.g = p.needle_pitch_ratio
+            self.roller_angles = 2.0 * np.pi * np.arange(self.z) / self.z
         self.min_gap = np.inf
 
     def _kin(self, q, v):
-        nc, nd = self.nc, self.nd
-        lead = q.shape[:-1]
-        qc = q[..., :3 * nc].reshape(lead + (nc, 1, 3))
-        vc = v[..., :3 * nc].reshape(lead + (nc, 1, 3))
-        qd = q[..., 3 * nc:].reshape(lead + (1, nd, 3))
-        vd = v[..., 3 * nc:].reshape(lead + (1, nd, 3))
-        chi = self.chi0 - qc[..., 2]  # (..., nc, nd)
-        ecc = self.e * np.stack([np.sin(chi), np.cos(chi)], axis=-1)
-        e_phi = self.e * np.stack([-np.cos(chi), np.sin(chi)], axis=-1)  # dE/dphi
-        rh = _rot(np.swapaxes(self.holes, 0, 1), qd[..., 2])  # (..., nc, nd, 2)
-        h_psi = np.stack([-rh[..., 1], rh[..., 0]], axis=-1)
-        d = qc[..., :2] + ecc - qd[..., :2] - rh
-        dv = (vc[..., :2] + e_phi * vc[..., 2:3]) - (vd[..., :2] + h_psi * vd[..., 2:3])
-        return d, dv, e_phi, h_psi, rh, qc, qd
-
-    def _gen(self, q, grad_c, grad_d, f):
-        """Assemble Q = -sum f grad (grad_c: (..., nc, nd, 3), grad_d likewise)."""
-        lead = q.shape[:-1]
-        gc = -(f[..., None] * grad_c).sum(axis=-2)  # (..., nc, 3)
-        gd = -(f[..., None] * grad_d).sum(axis=-3)  # (..., nd, 3)
-        return np.concatenate([gc.reshape(lead + (3 * self.nc,)), gd.reshape(lead + (3 * self.nd,))], axis=-1)
+        """Journal offsets d = E - H and their rates, in components (..., nc, nd)."""
+        nc = self.nc
+        xc, yc, phc = q[..., 0:3 * nc:3, None], q[..., 1:3 * nc:3, None], q[..., 2:3 * nc:3, None]
+        vxc, vyc, vphc = v[..., 0:3 * nc:3, None], v[..., 1:3 * nc:3, None], v[..., 2:3 * nc:3, None]
+        xd, yd, psd = q[..., None, 3 * nc::3], q[..., None, 3 * nc + 1::3], q[..., None, 3 * nc + 2::3]
+        vxd, vyd, vpsd = v[..., None, 3 * nc::3], v[..., None, 3 * nc + 1::3], v[..., None, 3 * nc + 2::3]
+        chi = self.chi0 - phc
+        sc, cc = np.sin(chi), np.cos(chi)
+        epx, epy = -self.e * cc, self.e * sc  # dE/dphi
+        c, s = np.cos(psd), np.sin(psd)
+        rhx, rhy = c * self.hx - s * self.hy, s * self.hx + c * self.hy
+        hpx, hpy = -rhy, rhx  # dH/dpsi
+        dx = xc + self.e * sc - xd - rhx
+        dy = yc + self.e * cc - yd - rhy
+        dvx = vxc + epx * vphc - vxd - hpx * vpsd
+        dvy = vyc + epy * vphc - vyd - hpy * vpsd
+        return dx, dy, dvx, dvy, epx, epy, hpx, hpy, phc, psd
 
     def _contacts(self, q, v):
-        d, dv, e_phi, h_psi, rh, qc, qd = self._kin(q, v)
+        dx, dy, dvx, dvy, epx, epy, hpx, hpy, phc, psd = self._kin(q, v)
         if self.model == "empirical":
-            r = np.sqrt(np.einsum("...k,...k->...", d, d) + 1e-30)
-            u = d / r[..., None]  # (..., nc, nd, 2)
+            r = np.sqrt(dx * dx + dy * dy + 1e-30)
+            ux, uy = dx / r, dy / r
             delta = r - self.clear
-            rate = np.einsum("...k,...k->...", u, dv)
+            rate = ux * dvx + uy * dvy
         else:
-            gam_c = 0.5 * ((1.0 - self.g) * qc[..., 2] + (1.0 + self.g) * qd[..., 2])  # (..., nc, nd)
-            gam = gam_c[..., None] + 2.0 * np.pi * np.arange(self.z) / self.z
-            u = np.stack([np.cos(gam), np.sin(gam)], axis=-1)  # (..., nc, nd, z, 2)
-            delta = np.einsum("...k,...zk->...z", d, u) - self.clear
-            rate = np.einsum("...k,...zk->...z", dv, u)
-            e_phi, h_psi = e_phi[..., None, :], h_psi[..., None, :]
+            gam = (0.5 * ((1.0 - self.g) * phc + (1.0 + self.g) * psd))[..., None] + self.roller_angles
+            ux, uy = np.cos(gam), np.sin(gam)  # (..., nc, nd, z)
+            dx, dy, dvx, dvy = dx[..., None], dy[..., None], dvx[..., None], dvy[..., None]
+            epx, epy, hpx, hpy = epx[..., None], epy[..., None], hpx[..., None], hpy[..., None]
+            delta = dx * ux + dy * uy - self.clear
+            rate = dvx * ux + dvy * uy
         f, df, dfr = impact_force(-delta, -rate, self.k, self.exponent, self.c_max, self.depth)
-        gc = np.concatenate([u, np.einsum("...k,...k->...", u, e_phi)[..., None]], axis=-1)
-        gd = -np.concatenate([u, np.einsum("...k,...k->...", u, h_psi)[..., None]], axis=-1)
-        return delta, f, -df, -dfr, gc, gd, u
+        return dict(delta=delta, f=f, kq=-df, kv=-dfr, ux=ux, uy=uy,
+                    gc=(ux * epx + uy * epy), gd=(ux * hpx + uy * hpy), ep=(epx, epy), hp=(hpx, hpy))
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
-        delta, f, kq, kv, gc, gd, u = self._contacts(q, v)
-        if self.model == "empirical":
-            gen = self._gen(q, gc, gd, f)
-            vec = f[..., None] * u
-        else:
-            gen = self._gen(q, (f[..., None] * gc).sum(axis=-2), (f[..., None] * gd).sum(axis=-2), np.ones(f.shape[:-1]))
-            vec = (f[..., None] * u).sum(axis=-2)
-        self.min_gap = float(np.min(-delta)) if q.ndim == 1 else self.min_gap
+        c = self._contacts(q, v)
+        f, ux, uy = c["f"], c["ux"], c["uy"]
+        fx, fy, mc, md = f * ux, f * uy, f * c["gc"], f * c["gd"]
+        if self.model == "rollers":  # sum over the rollers of each bearing
+            fx, fy, mc, md = fx.sum(axis=-1), fy.sum(axis=-1), mc.sum(axis=-1), md.sum(axis=-1)
+        nc = self.nc
+        gen = np.empty(q.shape)
+        gen[..., 0:3 * nc:3] = -fx.sum(axis=-1)
+        gen[..., 1:3 * nc:3] = -fy.sum(axis=-1)
+        gen[..., 2:3 * nc:3] = -mc.sum(axis=-1)
+        gen[..., 3 * nc::3] = fx.sum(axis=-2)
+        gen[..., 3 * nc + 1::3] = fy.sum(axis=-2)
+        gen[..., 3 * nc + 2::3] = md.sum(axis=-2)
+        if q.ndim == 1:
+            self.min_gap = float(np.min(-c["delta"]))
         out = None
         if want_outputs:
             dims = ("time", "crank", "disc")
-            out = {"needle_force": Output(np.hypot(vec[..., 0], vec[..., 1]), dims, "N",
-                                          "needle-bearing force (journal on disc hole)"),
-                   "needle_force_x": Output(vec[..., 0], dims, "N", "needle-bearing force on the disc, x"),
-                   "needle_force_y": Output(vec[..., 1], dims, "N", "needle-bearing force on the disc, y")}
+            out = {"needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
+                   "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
+                   "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
             if self.model == "rollers":
                 out["roller_force"] = Output(f, dims + ("roller",), "N", "needle roller contact force")
         return gen, out
 
     def jacobian(self, t, q, v):
-        d, _, e_phi, h_psi, _, _, _ = self._kin(q, v)
-        delta, f, kq, kv, gc, gd, u = self._contacts(q, v)
+        c = self._contacts(q, v)
         n = q.shape[-1]
         dq = np.zeros((n, n))
         dv = np.zeros((n, n))
         nc = self.nc
         eye = np.eye(2)
+        epx, epy = c["ep"]
+        hpx, hpy = c["hp"]
         for j in range(nc):
             for k in range(self.nd):
                 idx = np.r_[3 * j:3 * j + 3, 3 * nc + 3 * k:3 * nc + 3 * k + 3]
                 b = np.zeros((2, 6))  # d(d)/d(local coordinates of crank j, disc k)
-                b[:, 0:2], b[:, 2] = eye, e_phi[j, k]
-                b[:, 3:5], b[:, 5] = -eye, -h_psi[j, k]
+                b[:, 0:2], b[:, 3:5] = eye, -eye
+                b[:, 2] = [np.ravel(epx[j, k])[0], np.ravel(epy[j, k])[0]]
+                b[:, 5] = [-np.ravel(hpx[j, k])[0], -np.ravel(hpy[j, k])[0]]
+                kq, kv, f = c["kq"][j, k], c["kv"][j, k], c["f"][j, k]
                 if self.model == "empirical":
-                    if f[j, k] <= 0 and kq[j, k] <= 0:
+                    if f <= 0 and kq <= 0:
                         continue
-                    uu = np.outer(u[j, k], u[j, k])
-                    r = delta[j, k] + self.clear
-                    stiff = kq[j, k] * uu + (f[j, k] / r) * (eye - uu)
-                    damp = kv[j, k] * uu
+                    u = np.array([c["ux"][j, k], c["uy"][j, k]])
+                    uu = np.outer(u, u)
+                    r = c["delta"][j, k] + self.clear
+                    stiff = kq * uu + (f / r) * (eye - uu)
+                    damp = kv * uu
                 else:
-                    act = kq[j, k] != 0
+                    act = kq != 0
                     if not np.any(act):
                         continue
-                    uj = u[j, k][act]  # (m, 2)
-                    stiff = (uj.T * kq[j, k][act]) @ uj
-                    damp = (uj.T * kv[j, k][act]) @ uj
+                    u = np.stack([c["ux"][j, k][act], c["uy"][j, k][act]], axis=-1)
+                    stiff = (u.T * kq[act]) @ u
+                    damp = (u.T * kv[act]) @ u
                 dq[np.ix_(idx, idx)] -= b.T @ stiff @ b
                 dv[np.ix_(idx, idx)] -= b.T @ damp @ b
         return dq, dv
+
+    def reset(self) -> None:
+        self.min_gap = np.inf
 
     def check(self) -> str | None:
         if self.min_gap < -max(20.0 * self.depth, 50e-6):

@@ -88,8 +88,8 @@ class RowModel:
     z: float
     ball_count: int
     ball_mass: float
-    law_inner: NormalLaw
-    law_outer: NormalLaw
+    law_inner: object  #: NormalLaw, or an EHL law with ``normal_law(speed)``
+    law_outer: object
     inner: RingModes | None = None
     outer: RingModes | None = None
     cage_stiffness: float = 1e5
@@ -99,6 +99,9 @@ class RowModel:
     cage_ratio: float = 0.5
     #: weak radial/axial spring of each ball to its pocket [N/m]
     pocket_stiffness: float = 1e3
+    #: entrainment speed per unit frame (inner ring) angular speed [m]:
+    #: u = (d_m/4)(1 - gamma^2)|omega| (Hamrock 1994, ch. 24)
+    speed_factor: float = 0.0
     #: reference ball centres (Z, 3) in global coordinates
     ball_reference: np.ndarray = field(init=False)
 
@@ -157,6 +160,9 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
     balls = model.ball_reference + q[sb].reshape(z_count, 3)
     balls_t = q_t[sb].reshape(z_count, 3)
     row = model.row
+    speed = model.speed_factor * abs(phi_t[2])
+    law_inner = model.law_inner.normal_law(speed) if hasattr(model.law_inner, "normal_law") else model.law_inner
+    law_outer = model.law_outer.normal_law(speed) if hasattr(model.law_outer, "normal_law") else model.law_outer
 
     # ---------------- inner ring (on the frame)
     local = (balls - r) @ a_mat  # rows: A^T (b - r)
@@ -175,7 +181,7 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
     c_i = r + ap
     x_i_t = np.concatenate([r_t, phi_t, q_t[si]]) if model.inner is not None else np.concatenate([r_t, phi_t])
     c_i_t = np.einsum("njx,x->nj", t_i, x_i_t)
-    st_i = raceway_contacts(balls, balls_t, c_i, c_i_t, row.inner_offset, model.law_inner)
+    st_i = raceway_contacts(balls, balls_t, c_i, c_i_t, row.inner_offset, law_inner)
 
     # ---------------- outer ring (housing)
     psi_o = np.arctan2(balls[:, 1], balls[:, 0])
@@ -188,7 +194,7 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
         c_o = c_o + np.einsum("nkm,m->nk", basis_o, q[so])
         c_o_t = np.einsum("nkm,m->nk", basis_o, q_t[so])
         t_o = basis_o
-    st_o = raceway_contacts(balls, balls_t, c_o, c_o_t, row.outer_offset, model.law_outer)
+    st_o = raceway_contacts(balls, balls_t, c_o, c_o_t, row.outer_offset, law_outer)
 
     # ---------------- cage: tangential springs to the kinematic pockets
     psi = np.arctan2(balls[:, 1], balls[:, 0])
@@ -299,8 +305,9 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     co = model.row.groove_centers(psi, "outer")
     ci[:, 2] += model.z
     co[:, 2] += model.z
-    pos, st_i, st_o = solve_ball_positions(model.row, ci, co, model.law_inner, model.law_outer,
-                                           ball_pos0=model.ball_reference)
+    law_i = model.law_inner.normal_law(0.0) if hasattr(model.law_inner, "normal_law") else model.law_inner
+    law_o = model.law_outer.normal_law(0.0) if hasattr(model.law_outer, "normal_law") else model.law_outer
+    pos, st_i, st_o = solve_ball_positions(model.row, ci, co, law_i, law_o, ball_pos0=model.ball_reference)
     return pos - model.ball_reference
 
 
@@ -350,27 +357,46 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
                          ball_nodes=ball_nodes, contact_objects=objects)
 
 
-def rows_from_design(reducer, inner=None, outer=None, law: str = "dry", c_max: float | None = None,
-                     depth: float = 1e-6) -> list[RowModel]:
+def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_max: float | None = None,
+                     depth: float | None = None) -> list[RowModel]:
     """Row models of a design's main bearing (both rows, back-to-back).
 
-    ``inner``/``outer``: per-row lists of :class:`RingModes` (or None for rigid).
+    Parameters
+    ----------
+    inner, outer : per-row lists of :class:`RingModes` (``None``: rigid rings).
+    ehl : ``"dry"``, ``"hamrock_dowson"`` or ``"map"`` (default: ``reducer.contact.ehl``);
+        the lubricated laws come from :class:`flexrv.contact.ehl_law.EHLPointLaw`
+        and use the entrainment speed of the frame's rotation.
+    c_max, depth : contact damping and its ramp depth (default: the design's).
     """
+    from flexrv.contact.ehl_law import EHLPointLaw
     from flexrv.contact.hertz import effective_modulus
     from flexrv.geometry.bearing import BallBearingGeometry
 
     geom = BallBearingGeometry.from_design(reducer.main_bearing)
     ring_mat, ball_mat = reducer.material("bearing_rings"), reducer.material("rolling_elements")
-    e_eff = effective_modulus(ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus,
-                              ball_mat.poisson_ratio)
+    e_eff = float(effective_modulus(ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus,
+                                    ball_mat.poisson_ratio))
     c_max = reducer.main_bearing.ball_damping_Ns_per_m if c_max is None else c_max
+    depth = reducer.contact.impact_damping_depth_mm * 1e-3 if depth is None else depth
+    ehl = reducer.contact.ehl if ehl is None else ehl
+    rx_i, ry_i, rx_o, ry_o = geom.contact_radii()
+    if ehl == "dry":
+        laws = None
+    else:
+        laws = [EHLPointLaw.from_design(reducer, float(rx), float(ry), mode=ehl) for rx, ry in ((rx_i, ry_i), (rx_o, ry_o))]
+        laws = [type(law)(law.rx, law.ry, law.e_eff, law.lubricant, mode=law.mode, film_map=law.film_map,
+                          c_max=c_max, damping_depth=depth) for law in laws]
+    speed_factor = 0.25 * geom.pitch_diameter * (1.0 - geom.gamma**2)
     rows = []
     for k, (z, side) in enumerate(zip(geom.row_positions(), geom.row_sides())):
-        row = RowContactGeometry.from_bearing(geom, float(e_eff), side=float(side), preload=geom.axial_preload)
-        if law != "dry":
-            raise NotImplementedError("EHL laws are plugged in by the flexible reducer model")
+        row = RowContactGeometry.from_bearing(geom, e_eff, side=float(side), preload=geom.axial_preload)
+        if laws is None:
+            law_i, law_o = hertz_law(row.k_inner, c_max, depth), hertz_law(row.k_outer, c_max, depth)
+        else:
+            law_i, law_o = laws
         rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count, cage_ratio=0.5 * (1.0 - geom.gamma),
-                             ball_mass=geom.ball_mass(ball_mat.density_kg_m3),
-                             law_inner=hertz_law(row.k_inner, c_max, depth), law_outer=hertz_law(row.k_outer, c_max, depth),
+                             ball_mass=geom.ball_mass(ball_mat.density_kg_m3), law_inner=law_i, law_outer=law_o,
+                             speed_factor=speed_factor,
                              inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
     return rows

@@ -34,6 +34,8 @@ import numpy as np
 
 from flexrv.model.base import ForceGroup, Output
 
+TWO_PI = 2.0 * np.pi
+
 
 class GearMeshes(ForceGroup):
     """All sun–planet meshes in one element (members: carrier, crank0..N-1)."""
@@ -63,14 +65,13 @@ class GearMeshes(ForceGroup):
 
     def _kin(self, t, q, v):
         n = self.n
-        qc = q[..., 6:].reshape(q.shape[:-1] + (n, 3))
-        vc = v[..., 6:].reshape(v.shape[:-1] + (n, 3))
-        x, y, phi = qc[..., 0], qc[..., 1], qc[..., 2]
+        x, y, phi = q[..., 6::3], q[..., 7::3], q[..., 8::3]
+        vx, vy, vphi = v[..., 6::3], v[..., 7::3], v[..., 8::3]
         th_c = q[..., 2:3]
         a2 = x * x + y * y
         a = np.sqrt(a2)
-        raw = np.arctan2(y, x) - th_c - self.beta0
-        rel = np.mod(raw + np.pi, 2.0 * np.pi) - np.pi
+        rel = np.arctan2(y, x) - th_c - self.beta0
+        rel -= TWO_PI * np.rint(rel / TWO_PI)
         beta = th_c + self.beta0 + rel
         ts = np.asarray(self.theta_s(t), dtype=float)[..., None]
         ws = np.asarray(self.omega_s(t), dtype=float)[..., None]
@@ -78,9 +79,8 @@ class GearMeshes(ForceGroup):
         delta = self.rbs * ts + self.rbp * phi - r * (beta - self.beta0) - self.sw * (a - self.aw)
         gx = r * y / a2 - self.sw * x / a
         gy = -r * x / a2 - self.sw * y / a
-        grad = np.stack([gx, gy, np.broadcast_to(self.rbp, gx.shape)], axis=-1)
-        ddelta = self.rbs * ws + np.einsum("...k,...k->...", grad, vc)
-        phase = self.zs * (ts - beta) / (2.0 * np.pi) - self.zs * self.beta0 / (2.0 * np.pi)
+        ddelta = self.rbs * ws + gx * vx + gy * vy + self.rbp * vphi
+        phase = (self.zs / TWO_PI) * (ts - beta - self.beta0)
         k = self._k_of(phase, self.k_single, self.eps, self.ramp)
         drive = delta > 0.0
         coast = delta < -self.bn
@@ -88,12 +88,14 @@ class GearMeshes(ForceGroup):
         f_coast = np.minimum(k * (delta + self.bn) + self.c * ddelta, 0.0)
         force = np.where(drive, f_drive, np.where(coast, f_coast, 0.0))
         active = (drive & (f_drive > 0)) | (coast & (f_coast < 0))
-        return delta, ddelta, force, grad, k, active
+        return delta, ddelta, force, (gx, gy), k, active
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
-        delta, ddelta, force, grad, k, active = self._kin(t, q, v)
+        delta, ddelta, force, (gx, gy), k, active = self._kin(t, q, v)
         gen = np.zeros(q.shape)
-        gen[..., 6:] = (-force[..., None] * grad).reshape(q.shape[:-1] + (3 * self.n,))
+        gen[..., 6::3] = -force * gx
+        gen[..., 7::3] = -force * gy
+        gen[..., 8::3] = -force * self.rbp
         out = None
         if want_outputs:
             out = {
@@ -105,7 +107,8 @@ class GearMeshes(ForceGroup):
         return gen, out
 
     def jacobian(self, t, q, v):
-        _, _, _, grad, k, active = self._kin(t, q, v)
+        _, _, _, (gx, gy), k, active = self._kin(t, q, v)
+        grad = np.stack([gx, gy, np.full_like(gx, self.rbp)], axis=-1)
         n = q.shape[-1]
         dq = np.zeros((n, n))
         dv = np.zeros((n, n))

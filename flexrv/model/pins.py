@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexrv.contact.laws import impact_force
+from flexrv.errors import ConvergenceError
 from flexrv.geometry.cycloid import pin_gap
 from flexrv.model.base import ForceGroup, Output
 
@@ -54,7 +55,7 @@ class PinContacts(ForceGroup):
         self.min_gap = np.inf
         self._cache = None
         #: max coordinate change [m, rad] before the gap is re-evaluated exactly within a step
-        self.relinearise = 2e-7
+        self.relinearise = 1e-6
 
     def _exact(self, q, phi0=None):
         """Exact gaps, housing normals and arms r = P - c at the discs' pose q;
@@ -65,7 +66,12 @@ class PinContacts(ForceGroup):
         r = self.pins - qd[..., :2]  # (..., nd, z, 2) housing frame, from disc centre to pin
         c, s = np.cos(psi), np.sin(psi)
         local = np.stack([c * r[..., 0] + s * r[..., 1], -s * r[..., 0] + c * r[..., 1]], axis=-1)
-        gap, n_loc, phi = pin_gap(local, phi0=phi0, **self.geo)
+        try:
+            gap, n_loc, phi = pin_gap(local, phi0=phi0, **self.geo)
+        except ConvergenceError:
+            if phi0 is None:
+                raise
+            gap, n_loc, phi = pin_gap(local, phi0=None, **self.geo)  # multi-start from the polar angle
         n = np.stack([c * n_loc[..., 0] - s * n_loc[..., 1], s * n_loc[..., 0] + c * n_loc[..., 1]], axis=-1)
         rxn = r[..., 0] * n[..., 1] - r[..., 1] * n[..., 0]
         grad = np.stack([-n[..., 0], -n[..., 1], -rxn], axis=-1)  # (..., nd, z, 3)
@@ -87,7 +93,7 @@ class PinContacts(ForceGroup):
             # Within one time step Newton moves the discs by far less than the contact
             # curvature radii: the gap is taken to first order about the first
             # (exact) evaluation of the step, g = g0 + grad0 . (q - q0), error
-            # O(|q - q0|^2 / rho) (< 1e-12 m for Newton corrections of 1e-7 m).
+            # O(|q - q0|^2 / rho) (< 2e-10 m within the 1e-6 re-evaluation threshold, rho > 3 mm).
             c = self._cache
             dqmax = np.inf if c is None else np.max(np.abs(q - c[0]))
             if c is None or dqmax > self.relinearise:
@@ -112,6 +118,12 @@ class PinContacts(ForceGroup):
     def new_step(self):
         """Force an exact evaluation at the next call (called at each step start)."""
         self._cache = None
+
+    def reset(self):
+        """Drop the linearisation cache and the closest-point warm start."""
+        self._cache = None
+        self.phi = None
+        self.min_gap = np.inf
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
         gap, f, _, _, grad, n, r = self._contacts(q, v)

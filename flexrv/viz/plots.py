@@ -116,6 +116,6 @@ def standard_plots(res, directory=None) -> list[Path]:
     paths = [plot_te(res, d / "te.png"), plot_speeds(res, d / "speeds.png")]
     if "pin_force" in res.ds:
         paths.append(plot_pin_forces(res, d / "pin_forces.png"))
-    if res.steady("te").size > 16:
+    if res.steady("te").size > 16 and float(abs(res["omega_in"]).max()) > 0:
         paths.append(plot_te_spectrum(res, d / "te_spectrum.png"))
     return paths

@@ -1,0 +1,107 @@
+"""Mode-shape views: off-screen PNG (pyvista, imported lazily) and VTU export.
+
+Headless rendering: VTK 9.x wheels render off-screen through EGL when
+``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow`` is set (done here with
+``setdefault`` when no ``DISPLAY`` exists); this needs the system EGL/Mesa
+libraries (Debian: ``libegl1 libegl-mesa0 libgl1-mesa-dri libglvnd0 libgl1``).
+Verified on this machine without ``DISPLAY``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from flexrv.cache import atomic_path
+
+
+def _pyvista():
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+
+    return pv
+
+
+def surface_polydata(nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray | None = None,
+                     scale: float = 1.0, scalars: np.ndarray | None = None, name: str = "|u|"):
+    """pyvista PolyData of the boundary (corner triangles of the Tri6 faces), nodes
+    moved by ``scale * displacement``; point scalars default to |displacement|."""
+    pv = _pyvista()
+    used = np.unique(tris6[:, :3])
+    remap = np.full(nodes.shape[0], -1, dtype=np.int64)
+    remap[used] = np.arange(used.size)
+    pts = nodes[used].copy()
+    if displacement is not None:
+        pts += scale * displacement[used]
+    faces = np.hstack([np.full((tris6.shape[0], 1), 3), remap[tris6[:, :3]]]).ravel()
+    poly = pv.PolyData(pts, faces)
+    if scalars is None and displacement is not None:
+        scalars = np.linalg.norm(displacement, axis=1)
+    if scalars is not None:
+        poly.point_data[name] = np.asarray(scalars)[used]
+    return poly
+
+
+def warp_scale(nodes: np.ndarray, displacement: np.ndarray, fraction: float = 0.08) -> float:
+    """Scale that makes the largest displacement ``fraction`` of the body size."""
+    umax = float(np.max(np.linalg.norm(displacement, axis=1)))
+    return 0.0 if umax == 0 else fraction * float(np.ptp(nodes, axis=0).max()) / umax
+
+
+def render_mode_png(path: str | os.PathLike, nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray,
+                    title: str = "", scalars: np.ndarray | None = None, scalar_name: str = "|u|",
+                    window_size=(900, 700)) -> Path:
+    """Render a mode shape (warped, coloured by |u| or ``scalars``, e.g. von Mises)
+    off-screen to a PNG, written atomically. Returns the path."""
+    pv = _pyvista()
+    scale = warp_scale(nodes, displacement)
+    poly = surface_polydata(nodes, tris6, displacement, scale, scalars, scalar_name)
+    ref = surface_polydata(nodes, tris6)
+    plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
+    try:
+        plotter.add_mesh(ref, style="wireframe", color="grey", opacity=0.15)
+        plotter.add_mesh(poly, scalars=scalar_name, cmap="viridis", show_edges=False)
+        if title:
+            plotter.add_text(title, font_size=10)
+        plotter.view_isometric()
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            plotter.screenshot(str(tmp))
+    finally:
+        plotter.close()
+    return path
+
+
+def show_mode(nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray, title: str = "") -> bool:
+    """Open an interactive window if a display exists; returns False (and does
+    nothing) when headless."""
+    if not os.environ.get("DISPLAY"):
+        return False
+    pv = _pyvista()
+    poly = surface_polydata(nodes, tris6, displacement, warp_scale(nodes, displacement))
+    plotter = pv.Plotter()
+    plotter.add_mesh(poly, scalars="|u|", cmap="viridis")
+    if title:
+        plotter.add_text(title, font_size=10)
+    plotter.show()
+    return True
+
+
+def export_modes_vtu(path: str | os.PathLike, nodes: np.ndarray, tets: np.ndarray, modes: np.ndarray,
+                     frequencies_hz=None, prefix: str = "mode") -> Path:
+    """Write the Tet10 mesh with each mode as a point vector ``mode_<k>_<f>Hz`` to a
+    VTU file for ParaView (meshio, atomic). ``modes`` is (3N, m) node-wise."""
+    import meshio
+
+    U = modes.reshape(nodes.shape[0], 3, -1)
+    data = {}
+    for k in range(U.shape[2]):
+        tag = f"{prefix}_{k + 1:02d}" + (f"_{frequencies_hz[k]:.1f}Hz" if frequencies_hz is not None else "")
+        data[tag] = U[:, :, k]
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        meshio.Mesh(nodes, [("tetra10", tets)], point_data=data).write(tmp, file_format="vtu")
+    return path

@@ -1,0 +1,56 @@
+"""`flexrv ehl` command (flexrv.cli.ehl)."""
+
+import json
+import math
+
+import numpy as np
+from typer.testing import CliRunner
+
+from flexrv.cli import app
+from flexrv.errors import InputError
+
+
+def test_ehl_preset_json(tmp_path):
+    """--preset rv221 --json: inputs are the most-loaded ball of the main bearing (checked
+    against ball_load_distribution) at the carrier speed 1500 r/min / 221 with
+    u = (d_m/4)(1 - g^2) w_c (Harris ch. 8); outputs within 35 % of Hamrock-Dowson on 33^2,
+    p_max near p_H, and a PNG is written."""
+    from flexrv.analysis.bearing_load import ball_load_distribution
+    from flexrv.contact.hertz import effective_modulus
+    from flexrv.design import load
+    from flexrv.geometry.bearing import BallBearingGeometry
+
+    png = tmp_path / "ehl.png"
+    res = CliRunner().invoke(app, ["ehl", "--preset", "rv221", "--grid", "33", "--json", "--png", str(png)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    inp, out = data["inputs"], data["outputs"]
+    red = load("rv221")
+    geom = BallBearingGeometry.from_design(red.main_bearing)
+    e_eff = effective_modulus(208e9, 0.3, 208e9, 0.3)  # GCr15 balls and rings (rv221.toml)
+    np.testing.assert_allclose(inp["reduced_modulus_Pa"], e_eff, rtol=1e-12)
+    q = ball_load_distribution(geom, float(e_eff)).max_load
+    np.testing.assert_allclose(inp["load_N"], q, rtol=1e-9)
+    w_c = 1500.0 * 2 * math.pi / 60.0 / 221.0
+    gam = geom.ball_diameter * math.cos(geom.contact_angle) / geom.pitch_diameter
+    np.testing.assert_allclose(inp["entrainment_speed_m_s"], 0.25 * geom.pitch_diameter * (1 - gam**2) * w_c,
+                               rtol=2e-3)  # loaded vs nominal contact angle
+    assert inp["grid"] == 33 and inp["viscosity_Pa_s"] == red.lubricant.viscosity_Pa_s
+    assert abs(out["h_central_m"] / out["hamrock_dowson_h_central_m"] - 1) < 0.35
+    assert 1e-8 < out["h_min_m"] < out["h_central_m"] < 1e-6  # EHL films: 0.01-1 um
+    assert abs(out["p_max_Pa"] / out["hertz_pressure_Pa"] - 1) < 0.1
+    assert out["load_error"] < 1e-3 and out["residual"] < 1e-6
+    assert png.exists() and png.stat().st_size > 10000
+
+
+def test_ehl_explicit_case_table():
+    res = CliRunner().invoke(app, ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.01", "--ry-m", "0.04",
+                                   "--grid", "33"])
+    assert res.exit_code == 0, res.output
+    assert "h_central_m" in res.output and "explicit" in res.output
+
+
+def test_ehl_incomplete_explicit_case():
+    res = CliRunner().invoke(app, ["ehl", "--load-n", "100", "--json"])
+    assert isinstance(res.exception, InputError)
+    assert "--speed-m-s" in str(res.exception)
