@@ -71,3 +71,21 @@ def test_npz_roundtrip(tmp_path):
     d.save_npz(tmp_path / "m.npz")
     e = MeshData.load_npz(tmp_path / "m.npz")
     assert np.array_equal(e.nodes, d.nodes) and e.group_names == d.group_names
+
+
+def test_self_intersecting_geometry_is_rejected():
+    """A groove deeper than the ring section, and a looped (non-star-shaped)
+    profile, are reported as self-intersecting before gmsh runs."""
+    import dataclasses
+
+    from flexrv.meshing.mesh import generate_mesh
+    from flexrv.meshing.parts import profile_is_simple
+
+    spec = spec_for(load("rv221"), "outer_ring")
+    deep = dataclasses.replace(spec, groove_radius=spec.r_outer - spec.groove_center_r + 1e-3)
+    with pytest.raises(InputError, match="self-intersects"):
+        generate_mesh(deep, "outer_ring", 0.01)
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    limacon = np.stack([(0.5 + np.cos(t)) * np.cos(t), (0.5 + np.cos(t)) * np.sin(t)], axis=1)  # inner loop
+    circle = np.stack([np.cos(t), np.sin(t)], axis=1)
+    assert not profile_is_simple(limacon) and profile_is_simple(circle)

@@ -13,7 +13,6 @@ swaps the last two (edges 32 and 31), which :func:`_extract` converts.
 
 from __future__ import annotations
 
-import math
 import os
 import time
 from dataclasses import dataclass, field

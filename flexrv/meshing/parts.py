@@ -15,7 +15,7 @@ the cycloid disc spans z in [-b/2, b/2] with its centre at the origin.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -23,8 +23,10 @@ from flexrv.errors import InputError
 
 PARTS = ("outer_ring", "inner_ring", "crankshaft", "cycloid_disc")
 
-#: Tet10 nodes per unit volume ~ C / h^3 (calibrated on gmsh 4.15 ring meshes:
-#: C = 12..14 measured; 16 is used as a conservative upper estimate).
+#: Tet10 nodes per unit volume ~ C / h^3 for the memory guard. gmsh 4.15 gives
+#: C = 10..14 on the ring meshes; with the refinement terms the estimate is
+#: 1.5-3x above the actual count (rv221 outer ring: 59k estimated, 33.5k meshed),
+#: deliberately conservative.
 NODE_DENSITY = 16.0
 
 
