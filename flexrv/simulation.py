@@ -16,9 +16,12 @@ interrupted run returns results with ``status = "interrupted"``.
 Newton tolerances (relative 1e-3, absolute 0.1 N residual per coordinate):
 tightening them to 1e-4/1e-2 changed the steady TE of rv40e by < 0.001 arcsec
 and doubled the Newton iterations. Cost (benchmarks/bench_rigid.py, 2 shared
-cores): ~3.7-4.7 Newton iterations per step at dt = 1e-4 s, ~1 ms per step, of
-which > 90 % is spent in the numpy force kernels (per-call overhead of a few
-hundred small array operations, not arithmetic): real-time factor ~30-50.
+cores): ~3.7-4.9 Newton iterations per step at dt = 1e-4 s, ~2.2-2.6 ms per step,
+~90 % of it in the Python force kernels (per-call overhead of small array
+operations, not arithmetic): real-time factor ~22-26. The Python groups share
+one Exudyn element (:func:`flexrv.model.base.add_merged`), and the closest-point
+iteration of the pin gap and the impact law run numba-compiled when numba is
+installed (same kernels, plain numpy otherwise).
 """
 
 from __future__ import annotations

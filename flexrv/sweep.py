@@ -163,7 +163,7 @@ def run_case(design: dict[str, Any], task: str, options: dict[str, Any]) -> dict
     Returns a record with ``status`` ("ok" or "failed"), ``result`` or ``error``,
     and the wall time.
     """
-    from flexrv.cli._common import to_jsonable
+    from flexrv.cache import to_jsonable
     from flexrv.design import from_dict
 
     start = time.perf_counter()

@@ -84,8 +84,9 @@ def test_radial_load_balance_and_zone():
     reducer = load("rv221")
     fr = 20000.0
     rows, evals, frame_q = _static_rig(reducer, (fr, 0.0, 0.0))
-    total = sum(-(ev.inner.force_ball).sum(axis=0) for ev in evals)
-    np.testing.assert_allclose(total, [fr, 0.0, 0.0], atol=1e-3 * fr)
+    # force of the balls on the inner ring (= frame) balances the external load
+    on_frame = sum(-(ev.inner.force_ball).sum(axis=0) for ev in evals)
+    np.testing.assert_allclose(on_frame, [-fr, 0.0, 0.0], atol=1e-6 * fr)
     for ev in evals:
         j = np.argmax(ev.inner.load)
         assert abs(np.angle(np.exp(1j * ev.azimuth[j]))) < 2 * np.pi / 26 + 1e-9

@@ -127,3 +127,32 @@ def test_roller_load_distribution_stribeck():
     c = np.clip(np.cos(psi), 0, None)
     assert rollers.max() == pytest.approx(f_r / np.sum(c ** (1 + 10 / 9)), rel=1e-9)
     assert rollers.max() == pytest.approx(4.08 * f_r / z, rel=0.10)
+
+
+def test_merged_force_element_matches_one_element_per_group(monkeypatch):
+    """The merged Exudyn element (flexrv.model.base.add_merged: all Python groups
+    in one ObjectGenericODE2) sums the same group kernels as one element per
+    group, so a short loaded run gives the same TE and pin forces up to
+    round-off (rel. 1e-7; a mis-scattered coordinate block would change them
+    at order 1) with fewer Exudyn objects."""
+    import functools
+
+    import flexrv.model.factory as factory
+    from flexrv.simulation import Simulation
+
+    r = load("rv40e")
+    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.002, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.002})
+    r = r.model_copy(update={"operating": op})
+    out = {}
+    orig = factory.assemble
+    for merge in (True, False):
+        monkeypatch.setattr(factory, "assemble", functools.partial(orig, merge=merge))
+        sim = Simulation(r)
+        model = sim.build()
+        res = sim.run(t_end=0.003, dt=1e-4)
+        out[merge] = (model.mbs.systemData.NumberOfObjects(), res["te"].values, res["pin_force"].values)
+    (n_m, te_m, pf_m), (n_s, te_s, pf_s) = out[True], out[False]
+    assert n_m < n_s
+    assert np.max(np.abs(pf_s)) > 10.0  # the pins are loaded
+    np.testing.assert_allclose(te_m, te_s, rtol=0, atol=1e-7 * np.max(np.abs(te_s)))
+    np.testing.assert_allclose(pf_m, pf_s, rtol=0, atol=1e-7 * np.max(np.abs(pf_s)))

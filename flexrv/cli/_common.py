@@ -4,40 +4,18 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from typing import Any, Callable
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from flexrv.cache import to_jsonable  # noqa: F401  (re-exported for the CLI modules)
+
 console = Console()
 
 JSON_HELP = "Print machine-readable JSON on stdout instead of a table."
-
-
-def to_jsonable(obj: Any) -> Any:
-    """Recursively convert numpy scalars/arrays and dataclasses to JSON types.
-
-    Non-finite floats become ``None`` so the output is strict JSON.
-    """
-    if hasattr(obj, "model_dump"):
-        return to_jsonable(obj.model_dump())
-    if hasattr(obj, "__dataclass_fields__"):
-        return {k: to_jsonable(getattr(obj, k)) for k in obj.__dataclass_fields__}
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.floating, float)):
-        value = float(obj)
-        return value if math.isfinite(value) else None
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
 
 
 def print_json(data: Any) -> None:
@@ -95,9 +73,23 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
         elif isinstance(value, list) and value and isinstance(value[0], dict):
             _render_records(key, value)
         else:
-            flat.append((key, _compact(value), ""))
+            label, unit = split_unit(key)
+            flat.append((label, _compact(value), unit))
     if flat:
         console.print(kv_table("", flat))
+
+
+_UNIT_HEAD = re.compile(r"_(N|Nm|Pa|GPa|MPa|Hz|W|J|m|mm|um|s|rad|rpm|deg|arcsec|arcmin|kg|m2|m3)(_|$)")
+
+
+def split_unit(key: str) -> tuple[str, str]:
+    """Split flexrv's unit-suffixed keys: ``"max_force_N"`` -> (``"max_force"``, ``"N"``),
+    ``"stiffness_Nm_per_rad"`` -> (``"stiffness"``, ``"Nm/rad"``)."""
+    match = _UNIT_HEAD.search(key)
+    if not match:
+        return key, ""
+    unit = key[match.start() + 1:].replace("_per_", "/").replace("_", " ")
+    return key[:match.start()], unit
 
 
 def _compact(value: Any) -> Any:
@@ -118,7 +110,8 @@ def _render_section(name: str, section: dict[str, Any], prefix: str = "") -> Non
         elif isinstance(value, list) and value and isinstance(value[0], dict):
             _render_records(f"{prefix}{name}.{key}", value)
         else:
-            rows.append((key, _compact(value), ""))
+            label, unit = split_unit(key)
+            rows.append((label, _compact(value), unit))
     if rows:
         console.print(kv_table(f"{prefix}{name}", rows))
     for key, value in nested:

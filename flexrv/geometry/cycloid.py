@@ -16,6 +16,17 @@ from __future__ import annotations
 
 import numpy as np
 
+try:  # optional accelerator for the closest-point iteration of pin_gap
+    from numba import njit as _njit
+except ImportError:  # pragma: no cover - numba absent: plain numpy
+    _njit = None
+
+
+def _jit(fn):
+    """numba-compiled ``fn`` (cached on disk) if numba is installed, else ``fn``:
+    the same kernel runs either way (one formula, two executors)."""
+    return _njit(cache=True)(fn) if _njit is not None else fn
+
 
 def center_curve(phi, z_rp: int, radius: float, eccentricity: float):
     """Pin-centre epitrochoid C(phi) and its first two derivatives.
@@ -25,12 +36,24 @@ def center_curve(phi, z_rp: int, radius: float, eccentricity: float):
     c, dc, ddc : ndarray, shape (..., 2)
         Position [m] and derivatives w.r.t. phi.
     """
-    phi = np.asarray(phi, dtype=float)
+    return _center_curve_kernel(np.asarray(phi, dtype=float), z_rp, radius, eccentricity)
+
+
+def _center_curve_kernel(phi, z_rp, radius, eccentricity):
+    """Body of :func:`center_curve` on a float array ``phi`` (numba-compilable)."""
     s, c = np.sin(phi), np.cos(phi)
-    sz, cz = np.sin(z_rp * phi), np.cos(z_rp * phi)
-    pos = np.stack([radius * s - eccentricity * sz, radius * c - eccentricity * cz], axis=-1)
-    d1 = np.stack([radius * c - eccentricity * z_rp * cz, -radius * s + eccentricity * z_rp * sz], axis=-1)
-    d2 = np.stack([-radius * s + eccentricity * z_rp**2 * sz, -radius * c + eccentricity * z_rp**2 * cz], axis=-1)
+    zphi = z_rp * phi
+    sz, cz = np.sin(zphi), np.cos(zphi)
+    rs, rc = radius * s, radius * c
+    out = np.empty((3,) + phi.shape + (2,))  # one allocation instead of three np.stack calls
+    pos, d1, d2 = out[0], out[1], out[2]
+    pos[..., 0] = rs - eccentricity * sz
+    pos[..., 1] = rc - eccentricity * cz
+    ez, ez2 = eccentricity * z_rp, eccentricity * z_rp**2
+    d1[..., 0] = rc - ez * cz
+    d1[..., 1] = -rs + ez * sz
+    d2[..., 0] = -rs + ez2 * sz
+    d2[..., 1] = -rc + ez2 * cz
     return pos, d1, d2
 
 
@@ -125,6 +148,38 @@ def _rotate(v, angle):
 
 
 # =========================================================================== signed pin gap
+def _dot2(a, b):
+    """Dot product over the last axis of length 2 (cheaper than einsum on small arrays)."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+_CURVE = _jit(_center_curve_kernel)
+_DOT2 = _jit(_dot2)
+
+
+def _closest_point_newton(pp, phi, z_rp, radius, eccentricity, max_step, tol, max_iter):
+    """Newton iteration of :func:`pin_gap` on g(phi) = |P - C(phi)|^2 / 2 from the
+    starts ``phi`` (..., S) for the points ``pp`` (..., 1, 2); steps clipped to
+    ``max_step``, a descent step where g'' <= 0. Returns (phi, converged) with
+    converged = max |step| < ``tol`` [rad]. numba-compilable."""
+    converged = False
+    for _ in range(max_iter):
+        c, d1, d2 = _CURVE(phi, z_rp, radius, eccentricity)
+        r = pp - c
+        g1 = -_DOT2(r, d1)
+        g2 = _DOT2(d1, d1) - _DOT2(r, d2)
+        step = np.where(g2 > 0, -g1 / np.where(g2 > 0, g2, 1.0), -np.sign(g1) * max_step)
+        step = np.clip(step, -max_step, max_step)
+        phi = phi + step
+        if np.max(np.abs(step)) < tol:
+            converged = True
+            break
+    return phi, converged
+
+
+_NEWTON = _jit(_closest_point_newton)
+
+
 def _outward_normal(d1):
     """Unit outward normal (away from the disc centre) of the clockwise-traversed
     pin-centre curve: the unit tangent rotated by +90 deg."""
@@ -202,33 +257,28 @@ def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, ecce
     pp = p[..., None, :]
     max_step = lobe / 8.0
     scale = np.hypot(pin_circle_radius, 1.0)
-    converged = False
-    for _ in range(max_iter):
-        c, d1, d2 = center_curve(phi, z_rp, radius, eccentricity)
-        r = pp - c
-        g1 = -np.einsum("...k,...k->...", r, d1)
-        g2 = np.einsum("...k,...k->...", d1, d1) - np.einsum("...k,...k->...", r, d2)
-        step = np.where(g2 > 0, -g1 / np.where(g2 > 0, g2, 1.0), -np.sign(g1) * max_step)
-        step = np.clip(step, -max_step, max_step)
-        phi = phi + step
-        if np.max(np.abs(step), initial=0.0) < tol * scale:
-            converged = True
-            break
+    if phi.size == 0:
+        converged = True
+    else:
+        phi, converged = _NEWTON(np.ascontiguousarray(pp), np.ascontiguousarray(phi), int(z_rp), float(radius),
+                                 float(eccentricity), float(max_step), float(tol * scale), int(max_iter))
     if not converged:
         # accept if the first-order condition holds to round-off
         c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
         r = pp - c
-        res = np.abs(np.einsum("...k,...k->...", r, d1)) / np.linalg.norm(d1, axis=-1)
+        res = np.abs(_dot2(r, d1)) / np.linalg.norm(d1, axis=-1)
         if np.max(res, initial=0.0) > 1e-12:
             raise ConvergenceError(f"pin_gap: closest-point iteration did not converge in {max_iter} "
                                    f"iterations (max residual {np.max(res):.3g} m)")
-    c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
-    dist2 = np.einsum("...k,...k->...", pp - c, pp - c)
-    best = np.argmin(dist2, axis=-1)[..., None]
-    phi = np.take_along_axis(phi, best, axis=-1)[..., 0]
+    if phi.shape[-1] > 1:  # several starts: keep the nearest foot point
+        c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
+        dist2 = _dot2(pp - c, pp - c)
+        best = np.argmin(dist2, axis=-1)[..., None]
+        phi = np.take_along_axis(phi, best, axis=-1)
+    phi = phi[..., 0]
     c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
     n_out = _outward_normal(d1)
-    signed = np.einsum("...k,...k->...", p - c, n_out)
+    signed = _dot2(p - c, n_out)
     gap = signed + d_pin_radius
     if d_rotation:
         n_out = _rotate(n_out, d_rotation)

@@ -6,7 +6,11 @@ absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
 *force group* couples several members through ONE ``ObjectGenericODE2`` whose
 Python force function evaluates every contact of the group at once with numpy
 (see the facts note: one user-function call costs ~18 us, so the number of
-groups, not the number of contacts, sets the overhead).
+groups, not the number of contacts, sets the overhead). On assembly each run
+of consecutive groups with the default glue shares ONE element
+(:func:`add_merged`): the rigid model makes two Python calls per residual
+(gear stage to pins, then loads, either side of the constant-matrix main
+bearing) instead of five.
 
 Each group's kernel ``evaluate(t, q, v)`` is written once and broadcasts over
 leading axes: the Exudyn callback calls it with one state (q of shape (n,)),
@@ -111,6 +115,15 @@ class ForceGroup:
                                                forceUserFunction=force_fn, **kwargs))
 
     @property
+    def mergeable(self) -> bool:
+        """True if the group can share a merged Python element
+        (:func:`add_merged`): default Exudyn glue and an analytic Jacobian. The
+        merged element's Jacobian is dense over ALL member coordinates, so a
+        model with many coordinates (e.g. modal ring members) should override
+        this to False for its groups or assemble with ``merge=False``."""
+        return type(self).add_to is ForceGroup.add_to and self.analytic_jacobian
+
+    @property
     def stats(self) -> list[int]:
         """[force calls, jacobian calls] (mutable counters)."""
         if not hasattr(self, "_stats"):
@@ -146,3 +159,54 @@ class AssembledModel:
     @property
     def q0(self) -> np.ndarray:
         return np.concatenate([m.q0 for m in self.members.values()])
+
+
+def group_index(offsets: list[int], sizes: list[int]):
+    """Indices of a group's local vector in a state vector: a slice if the
+    members are contiguous and in order, else an integer array."""
+    idx = np.concatenate([np.arange(o, o + n) for o, n in zip(offsets, sizes)])
+    if len(idx) and np.all(np.diff(idx) == 1):
+        return slice(int(idx[0]), int(idx[-1]) + 1)
+    return idx
+
+
+def add_merged(mbs, groups: list[ForceGroup], nodes: list[int], index: list, n: int) -> int:
+    """Add ONE ``ObjectGenericODE2`` over ``nodes`` whose force and Jacobian user
+    functions evaluate every group of ``groups`` and sum their contributions.
+
+    One Python call per residual instead of one per group: Exudyn's per-call cost
+    (argument lists, ``np.asarray``) is paid once. ``index[i]`` selects group i's
+    local coordinates in the merged vector of ``n`` coordinates (the nodes'
+    coordinates in order, see :func:`group_index`). Each group keeps
+    its own :meth:`ForceGroup.evaluate` kernel, outputs and call counters, so the
+    sum is the same generalized force as with one element per group.
+    """
+    from exudyn.itemInterface import ObjectGenericODE2
+
+    parts = [(g, ix, isinstance(ix, slice)) for g, ix in zip(groups, index)]
+
+    def force_fn(mbs_, t, item, q, q_t):
+        q = np.asarray(q)
+        v = np.asarray(q_t)
+        f = np.zeros(n)
+        for g, ix, _ in parts:
+            g.stats[0] += 1
+            fg, _ = g.evaluate(t, q[ix], v[ix])
+            f[ix] += fg
+        return f
+
+    def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
+        q = np.asarray(q)
+        v = np.asarray(q_t)
+        jac = np.zeros((n, n))
+        for g, ix, is_slice in parts:
+            g.stats[1] += 1
+            dq, dv = g.jacobian(t, q[ix], v[ix])
+            if is_slice:
+                jac[ix, ix] -= f_q * dq + f_v * dv
+            else:
+                jac[np.ix_(ix, ix)] -= f_q * dq + f_v * dv
+        return jac
+
+    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=np.zeros((n, n)),
+                                           forceUserFunction=force_fn, jacobianUserFunction=jac_fn))

@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from flexrv.errors import ConfigError
-from flexrv.model.base import AssembledModel, Member
+from flexrv.model.base import AssembledModel, Member, group_index, add_merged
 
 
 def _members(p) -> dict[str, Member]:
@@ -92,9 +92,17 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None) ->
     return assemble(model)
 
 
-def assemble(model: AssembledModel) -> AssembledModel:
-    """Create the Exudyn system: one NodeGenericODE2 + mass object per member, one
-    ObjectGenericODE2 per group."""
+def assemble(model: AssembledModel, merge: bool = True) -> AssembledModel:
+    """Create the Exudyn system: one NodeGenericODE2 + mass object per member and
+    the force elements: with ``merge`` (default) each run of consecutive groups
+    with the default glue and an analytic Jacobian shares ONE ObjectGenericODE2
+    (:func:`flexrv.model.base.add_merged`: one Python call per residual instead of
+    one per group); groups with their own
+    :meth:`~flexrv.model.base.ForceGroup.add_to` (e.g. constant matrices) get their
+    own object between the runs (group order kept). ``merge=False``: one object
+    per group. Both sum the same group kernels; they differ only in floating-point
+    summation order inside Exudyn (round-off, see
+    tests/test_model_groups.py::test_merged_force_element_matches_one_element_per_group)."""
     import exudyn as exu
     from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2
 
@@ -107,10 +115,20 @@ def assemble(model: AssembledModel) -> AssembledModel:
         mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix))
         m.offset = offset
         offset += m.n
-    for g in model.groups:
-        nodes = [model.members[name].node for name in g.members]
-        sizes = [model.members[name].n for name in g.members]
-        g.add_to(mbs, nodes, sizes)
+    all_nodes = [m.node for m in model.members.values()]
+    merged, index = [], []
+    for g in model.groups + [None]:
+        if g is not None and merge and g.mergeable:
+            merged.append(g)
+            index.append(group_index([model.members[name].offset for name in g.members],
+                                     [model.members[name].n for name in g.members]))
+            continue
+        if merged:  # close the run of consecutive mergeable groups (group order kept)
+            add_merged(mbs, merged, all_nodes, index, offset)
+            merged, index = [], []
+        if g is not None:
+            g.add_to(mbs, [model.members[name].node for name in g.members],
+                     [model.members[name].n for name in g.members])
     mbs.Assemble()
     model.mbs, model.sc, model.n = mbs, sc, offset
     q = np.asarray(mbs.systemData.GetODE2Coordinates())

@@ -54,6 +54,39 @@ class RingModes(Protocol):
         modal coordinate at the given azimuths [rad]."""
 
 
+@dataclass
+class ModalRing:
+    """:class:`RingModes` view of a reduced ring (:class:`flexrv.fem.body.ReducedBody`).
+
+    The meshed ring is the row with outer-contact side s = +1
+    (:meth:`flexrv.geometry.bearing.BallBearingGeometry.ring_section`); the other
+    row of the back-to-back pair is its mirror image z -> -z (``mirror=True``).
+    Modal damping ratio ``damping_ratio`` on the M-orthonormal basis.
+    """
+
+    body: object
+    damping_ratio: float = 0.02
+    mirror: bool = False
+
+    @property
+    def mass(self) -> np.ndarray:
+        return np.asarray(self.body.mass_matrix, dtype=float)
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        return np.asarray(self.body.stiffness_matrix, dtype=float)
+
+    @property
+    def damping(self) -> np.ndarray:
+        return np.diag(2.0 * self.damping_ratio * np.sqrt(np.asarray(self.body.omega2, dtype=float)))
+
+    def groove_basis(self, azimuth: np.ndarray) -> np.ndarray:
+        basis = np.array(self.body.raceway_matrix(azimuth), dtype=float)
+        if self.mirror:
+            basis[..., 2, :] *= -1.0
+        return basis
+
+
 def _skew(v: np.ndarray) -> np.ndarray:
     """Skew matrices [v]x of an (N,3) array -> (N,3,3)."""
     out = np.zeros(v.shape[:-1] + (3, 3))
@@ -196,12 +229,19 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
         t_o = basis_o
     st_o = raceway_contacts(balls, balls_t, c_o, c_o_t, row.outer_offset, law_outer)
 
-    # ---------------- cage: tangential springs to the kinematic pockets
+    # The groove centres follow the ball's azimuth, so a tangential ball motion
+    # does not rotate the contact normal: drop the geometric stiffness Q/L in the
+    # circumferential direction that raceway_contacts assigns for fixed centres.
     psi = np.arctan2(balls[:, 1], balls[:, 0])
+    e_t = np.stack([-np.sin(psi), np.cos(psi), np.zeros(z_count)], -1)
+    ett = np.einsum("ni,nj->nij", e_t, e_t)
+    for st, offset in ((st_i, row.inner_offset), (st_o, row.outer_offset)):
+        st.stiffness += (st.load / (st.approach + offset))[:, None, None] * ett
+
+    # ---------------- cage: tangential springs to the kinematic pockets
     cage_angle = model.cage_ratio * phi[2]
     pockets = 2.0 * np.pi * np.arange(z_count) / z_count + cage_angle
     dev = np.angle(np.exp(1j * (psi - pockets)))
-    e_t = np.stack([-np.sin(psi), np.cos(psi), np.zeros(z_count)], -1)
     radius = np.hypot(balls[:, 0], balls[:, 1])
     s_t = np.einsum("nk,nk->n", balls_t, e_t) - radius * model.cage_ratio * phi_t[2]
     f_cage = -(model.cage_stiffness * radius * dev + model.cage_damping * s_t)[:, None] * e_t

@@ -62,6 +62,24 @@ class GearMeshes(ForceGroup):
         self.c = stage.c12
         self.theta_s, self.omega_s = input_angle, input_speed
         self._k_of = time_varying_mesh_stiffness
+        self._drive_cache = None
+
+    def _drive(self, t):
+        """Sun angle and speed (..., 1) at t; cached for a scalar t (all Newton
+        iterations of a step evaluate the same time)."""
+        if np.ndim(t) == 0:
+            c = self._drive_cache
+            if c is not None and c[0] == t:
+                return c[1], c[2]
+        ts = np.asarray(self.theta_s(t), dtype=float)[..., None]
+        ws = np.asarray(self.omega_s(t), dtype=float)[..., None]
+        if np.ndim(t) == 0:
+            self._drive_cache = (float(t), ts, ws)
+        return ts, ws
+
+    def reset(self) -> None:
+        self._drive_cache = None
+        super().reset()
 
     def _kin(self, t, q, v):
         n = self.n
@@ -73,8 +91,7 @@ class GearMeshes(ForceGroup):
         rel = np.arctan2(y, x) - th_c - self.beta0
         rel -= TWO_PI * np.rint(rel / TWO_PI)
         beta = th_c + self.beta0 + rel
-        ts = np.asarray(self.theta_s(t), dtype=float)[..., None]
-        ws = np.asarray(self.omega_s(t), dtype=float)[..., None]
+        ts, ws = self._drive(t)
         r = self.rbs + self.rbp
         delta = self.rbs * ts + self.rbp * phi - r * (beta - self.beta0) - self.sw * (a - self.aw)
         gx = r * y / a2 - self.sw * x / a

@@ -80,15 +80,26 @@ class OutputLoads(ForceGroup):
     def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0):
         self.torque = torque
         self.const = np.array([radial, 0.0, 0.0, axial, tilt, 0.0])
+        self._cache = None
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
+        if q.ndim == 1:  # solver call: the load depends on t only (same t in all Newton iterations)
+            if self._cache is None or self._cache[0] != t:
+                f = self.const.copy()
+                f[2] = -self.torque(np.asarray(t, dtype=float))
+                self._cache = (t, f)
+            return self._cache[1].copy(), (self._outputs(np.asarray(t, dtype=float), q) if want_outputs else None)
         t = np.asarray(t, dtype=float)
         f = np.broadcast_to(self.const, q.shape).copy()
         f[..., 2] = -self.torque(t)
-        out = None
-        if want_outputs:
-            out = {"load_torque": Output(self.torque(t) + 0.0 * q[..., 0], ("time",), "N m", "load torque on the output")}
-        return f, out
+        return f, (self._outputs(t, q) if want_outputs else None)
+
+    def _outputs(self, t, q):
+        return {"load_torque": Output(self.torque(t) + 0.0 * q[..., 0], ("time",), "N m", "load torque on the output")}
+
+    def reset(self) -> None:
+        self._cache = None
+        super().reset()
 
     def jacobian(self, t, q, v):
         z = np.zeros((6, 6))

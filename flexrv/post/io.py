@@ -51,9 +51,9 @@ def save(res, directory) -> Path:
     if res.reducer is not None:
         atomic_write_text(d / "config.toml", to_toml(res.reducer))
     summ = res.summary()
-    from flexrv.post.results import _jsonable
+    from flexrv.cache import to_jsonable
 
-    atomic_write_text(d / "summary.json", json.dumps(_jsonable(summ), indent=2))
+    atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summ), indent=2))
     atomic_write_text(d / "summary.md", summary_markdown(res, summ))
     if len(res.time) > 1:
         res.plot(d)

@@ -28,6 +28,8 @@ import json
 from pathlib import Path
 
 import numpy as np
+
+from flexrv.cache import to_jsonable
 import xarray as xr
 
 ARCSEC = 180.0 / np.pi * 3600.0  #: arcsec per radian
@@ -203,23 +205,8 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         "rated_input_speed_rad_s": p.input_speed, "steady_start_s": s0, "steady_end_s": s1,
         "crank_relative_per_input": float(ks.crank_relative), "crank_absolute_per_input": float(ks.crank_absolute),
         "needle_model": red.needle_bearing.model, "pin_law": red.contact.pin_law,
-        "timing": json.dumps(_jsonable(timing or {})),
+        "timing": json.dumps(to_jsonable(timing or {})),
     })
     return Results(ds, reducer=red)
 
 
-def _jsonable(obj):
-    """Strict-JSON form of nested dicts/lists/numpy values (NaN/inf -> None)."""
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (np.integer, int)):
-        return int(obj)
-    if isinstance(obj, (np.floating, float)):
-        return float(obj) if np.isfinite(obj) else None
-    return obj
