@@ -18,10 +18,9 @@ tightening them to 1e-4/1e-2 changed the steady TE of rv40e by < 0.001 arcsec
 and doubled the Newton iterations. Cost (benchmarks/bench_rigid.py, 2 shared
 cores): ~3.7-4.9 Newton iterations per step at dt = 1e-4 s, ~2.2-2.6 ms per step,
 ~90 % of it in the Python force kernels (per-call overhead of small array
-operations, not arithmetic): real-time factor ~22-26. The Python groups share
-one Exudyn element (:func:`flexrv.model.base.add_merged`), and the closest-point
+operations, not arithmetic): real-time factor ~21-25. The closest-point
 iteration of the pin gap and the impact law run numba-compiled when numba is
-installed (same kernels, plain numpy otherwise).
+installed (same kernels and bit-identical results, plain numpy otherwise).
 """
 
 from __future__ import annotations

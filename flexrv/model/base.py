@@ -6,11 +6,11 @@ absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
 *force group* couples several members through ONE ``ObjectGenericODE2`` whose
 Python force function evaluates every contact of the group at once with numpy
 (see the facts note: one user-function call costs ~18 us, so the number of
-groups, not the number of contacts, sets the overhead). On assembly each run
-of consecutive groups with the default glue shares ONE element
-(:func:`add_merged`): the rigid model makes two Python calls per residual
-(gear stage to pins, then loads, either side of the constant-matrix main
-bearing) instead of five.
+groups, not the number of contacts, sets the overhead). Optionally
+(``assemble(model, merge=True)``) each run of consecutive groups with the
+default glue shares ONE element (:func:`add_merged`): the rigid model then
+makes two Python calls per residual instead of five (measured gain < 5 %,
+see :func:`flexrv.model.factory.assemble`).
 
 Each group's kernel ``evaluate(t, q, v)`` is written once and broadcasts over
 leading axes: the Exudyn callback calls it with one state (q of shape (n,)),

@@ -92,17 +92,21 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None) ->
     return assemble(model)
 
 
-def assemble(model: AssembledModel, merge: bool = True) -> AssembledModel:
+def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
     """Create the Exudyn system: one NodeGenericODE2 + mass object per member and
-    the force elements: with ``merge`` (default) each run of consecutive groups
+    the force elements. Default: one ObjectGenericODE2 per group. With ``merge``
+    each run of consecutive groups
     with the default glue and an analytic Jacobian shares ONE ObjectGenericODE2
     (:func:`flexrv.model.base.add_merged`: one Python call per residual instead of
     one per group); groups with their own
     :meth:`~flexrv.model.base.ForceGroup.add_to` (e.g. constant matrices) get their
-    own object between the runs (group order kept). ``merge=False``: one object
-    per group. Both sum the same group kernels; they differ only in floating-point
-    summation order inside Exudyn (round-off, see
-    tests/test_model_groups.py::test_merged_force_element_matches_one_element_per_group)."""
+    own object between the runs (group order kept). Both sum the same group
+    kernels and differ only in floating-point summation order inside Exudyn
+    (tests/test_model_groups.py::test_merged_force_element_matches_one_element_per_group).
+    Measured (benchmarks/bench_rigid.py): merging saves < 5 % (within the timing
+    noise) on the rigid model, while the changed round-off lets the modified-Newton
+    path of rv221 drift (TE differences up to 0.08 arcsec on a 5 arcsec ripple), so
+    it is off by default to keep results bit-reproducible."""
     import exudyn as exu
     from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2
 
