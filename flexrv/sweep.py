@@ -57,7 +57,8 @@ def simulate_task(reducer, model: str = "rigid", t_end: float = 0.5, dt: float |
     """Sweep task: run a dynamic simulation and return its summary numbers."""
     from flexrv.simulation import Simulation
 
-    results = Simulation(reducer, model=model).run(t_end=t_end, dt=dt, progress=False)
+    options = {} if dt is None else {"dt": dt}
+    results = Simulation(reducer, model=model).run(t_end=t_end, progress=False, **options)
     return results.summary()
 
 _SPEC_KEYS = {"name", "preset", "task", "outputs", "options", "grid", "cases", "description"}
