@@ -301,7 +301,7 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
                 ttko = np.einsum("nam,nab->nmb", t_o, k_o)
                 for d in range(3):
                     jac[np.ix_(o_idx, ball_idx[:, d])] -= ttko[:, :, d].T
-                jac[np.ix_(o_idx, o_idx)] += np.einsum("nam,nan->mn", t_o, kto)
+                jac[np.ix_(o_idx, o_idx)] += np.einsum("nam,nak->mk", t_o, kto)
     return RowEvaluation(inner=st_i, outer=st_o, force=force, jac_q=jac_q, jac_v=jac_v, ball_pos=balls,
                          azimuth=psi, cage_force=f_cage)
 
