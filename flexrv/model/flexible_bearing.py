@@ -97,16 +97,11 @@ def _skew(v: np.ndarray) -> np.ndarray:
 
 
 def rxyz_matrices(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrix A = Rx Ry Rz and G (omega_global = G phi_dot) of Tait–Bryan
-    xyz angles, as used by Exudyn's NodeRigidBodyRxyz."""
-    c0, s0 = np.cos(phi[0]), np.sin(phi[0])
-    c1, s1 = np.cos(phi[1]), np.sin(phi[1])
-    c2, s2 = np.cos(phi[2]), np.sin(phi[2])
-    rx = np.array([[1, 0, 0], [0, c0, -s0], [0, s0, c0]])
-    ry = np.array([[c1, 0, s1], [0, 1, 0], [-s1, 0, c1]])
-    rz = np.array([[c2, -s2, 0], [s2, c2, 0], [0, 0, 1]])
-    g = np.column_stack([[1.0, 0.0, 0.0], rx[:, 1], (rx @ ry)[:, 2]])
-    return rx @ ry @ rz, g
+    """Rotation matrix A = Rx Ry Rz and G (omega_global = G phi_dot) of the
+    Tait–Bryan xyz angles of Exudyn's NodeRigidBodyRxyz (Exudyn's own utilities)."""
+    from exudyn.rigidBodyUtilities import RotXYZ2G, RotXYZ2RotationMatrix
+
+    return np.asarray(RotXYZ2RotationMatrix(phi)), np.asarray(RotXYZ2G(phi))
 
 
 @dataclass
