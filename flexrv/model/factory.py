@@ -58,8 +58,12 @@ def empirical_needle_constant(reducer) -> float:
     return (0.9 * c) ** (10.0 / 9.0)
 
 
-def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None) -> AssembledModel:
-    """Rigid-body model with compliant contacts (see module docstring)."""
+def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid") -> AssembledModel:
+    """Rigid-body model with compliant contacts (see module docstring).
+
+    ``main_bearing``: ``"rigid"`` (linear 5-DOF element) or ``"balls"`` (the
+    ball-resolved bearing of :mod:`flexrv.model.flexible_bearing`: every ball a
+    point mass between rigid rings, Hertz/EHL contacts per the design)."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
@@ -84,11 +88,23 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None) ->
         CrankSupports(p),
         NeedleBearings(p, nb_model, k_emp),
         PinContacts(p),
-        RigidMainBearing(p),
         OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment),
     ]
-    model = AssembledModel(name="rigid", reducer=reducer, params=p, members=_members(p), groups=groups,
-                           input_angle=theta, input_speed=omega, load_torque=torque)
+    members = _members(p)
+    if main_bearing == "rigid":
+        groups.insert(4, RigidMainBearing(p))
+    elif main_bearing == "balls":
+        from flexrv.model.base import Member
+        from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
+
+        group = BallBearingGroup(rows_from_design(reducer))
+        for name, (mass, q0, v0) in group.member_states().items():
+            members[name] = Member(name, mass, q0, v0, tuple(f"{c}{j}" for j in range(len(q0) // 3) for c in "xyz"))
+        groups.insert(4, group)
+    else:
+        raise ConfigError(f"main_bearing = {main_bearing!r} is not allowed: choose 'rigid' or 'balls'")
+    model = AssembledModel(name="rigid" if main_bearing == "rigid" else "flexible", reducer=reducer, params=p,
+                           members=members, groups=groups, input_angle=theta, input_speed=omega, load_torque=torque)
     return assemble(model)
 
 
@@ -142,7 +158,14 @@ def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
 
 
 #: model name -> builder(reducer, drive=..., torque=...) -> AssembledModel
-MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid}
+def build_balls(reducer, **kwargs) -> AssembledModel:
+    """Rigid model with the ball-resolved main bearing (rigid rings): the carrier
+    is carried only by the balls of both rows (radial, axial and tilt compliance of
+    the Hertz/EHL contacts). The flexible-ring model builds on this."""
+    return build_rigid(reducer, main_bearing="balls", **kwargs)
+
+
+MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid, "balls": build_balls}
 
 
 def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:

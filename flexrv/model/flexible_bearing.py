@@ -40,6 +40,7 @@ from typing import Protocol
 import numpy as np
 
 from flexrv.contact.ball_raceway import NormalLaw, RowContactGeometry, hertz_law, raceway_contacts
+from flexrv.model.base import ForceGroup, Output
 
 
 class RingModes(Protocol):
@@ -435,3 +436,104 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
                              speed_factor=speed_factor,
                              inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
     return rows
+
+
+# ------------------------------------------------------------ reducer-model group
+#: carrier coordinates of the reducer model (x, y, theta, z, rx, ry) -> the row
+#: element's frame coordinates (x, y, z, phi_x, phi_y, phi_z): frame[i] = carrier[_PERM[i]]
+_PERM = np.array([0, 1, 3, 4, 5, 2])
+
+
+class BallBearingGroup(ForceGroup):
+    """The ball-resolved main bearing as a force group of the reducer model
+    (:mod:`flexrv.model.factory`), replacing the rigid model's 5-DOF element.
+
+    Members: ``carrier`` (x, y, theta, z, rx, ry — the tilts are small, so the
+    Tait–Bryan frame (rx, ry, theta) of the row elements is the carrier pose) and
+    one ``main_bearing_balls<k>`` member per row (absolute ball-centre positions,
+    3 Z coordinates). Rings are rigid here (the stiff-ring limit of
+    :class:`RowModel`); flexible rings enter through the rows' ``inner``/``outer``.
+    """
+
+    name = "main_bearing"
+    analytic_jacobian = True
+
+    def __init__(self, rows: list[RowModel]):
+        if any(r.inner is not None or r.outer is not None for r in rows):
+            raise NotImplementedError("flexible rings in the reducer model: use the standalone bearing for now")
+        self.rows = rows
+        self.members = ("carrier",) + tuple(f"main_bearing_balls{k}" for k in range(len(rows)))
+        self.sizes = [6] + [3 * r.ball_count for r in rows]
+
+    @property
+    def mergeable(self) -> bool:
+        return False
+
+    def member_states(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """(mass matrix, q0, v0) of the ball members (absolute positions, preload equilibrium)."""
+        out = {}
+        for k, row in enumerate(self.rows):
+            q0 = (row.ball_reference + initial_ball_displacements(row)).ravel()
+            out[f"main_bearing_balls{k}"] = (np.eye(q0.size) * row.ball_mass, q0, np.zeros(q0.size))
+        return out
+
+    def _element_state(self, q, v, k):
+        row = self.rows[k]
+        start = 6 + sum(self.sizes[1:k + 1])
+        balls = slice(start, start + 3 * row.ball_count)
+        qe = np.concatenate([q[_PERM], q[balls] - row.ball_reference.ravel()])
+        ve = np.concatenate([v[_PERM], v[balls]])
+        return qe, ve, balls
+
+    def _evaluate_one(self, q, v, jacobian: bool):
+        n = q.shape[-1]
+        f = np.zeros(n)
+        jq = np.zeros((n, n)) if jacobian else None
+        jv = np.zeros((n, n)) if jacobian else None
+        evals = []
+        for k, row in enumerate(self.rows):
+            qe, ve, balls = self._element_state(q, v, k)
+            ev = evaluate_row(row, qe, ve, jacobian=jacobian)
+            evals.append(ev)
+            idx = np.concatenate([_PERM, np.arange(balls.start, balls.stop)])
+            f[idx] += ev.force
+            if jacobian:
+                jq[np.ix_(idx, idx)] += ev.jac_q
+                jv[np.ix_(idx, idx)] += ev.jac_v
+        return f, jq, jv, evals
+
+    def evaluate(self, t, q, v, want_outputs: bool = False):
+        """Generalized forces for one state (n,) or a history (T, n)."""
+        q = np.asarray(q, dtype=float)
+        v = np.asarray(v, dtype=float)
+        if q.ndim == 1:
+            f, _, _, _ = self._evaluate_one(q, v, False)
+            return f, None
+        forces = np.zeros_like(q)
+        loads_i = np.zeros((q.shape[0], len(self.rows), self.rows[0].ball_count))
+        loads_o = np.zeros_like(loads_i)
+        angle = np.zeros_like(loads_i)
+        for i in range(q.shape[0]):
+            forces[i], _, _, evals = self._evaluate_one(q[i], v[i], False)
+            for k, ev in enumerate(evals):
+                loads_i[i, k], loads_o[i, k], angle[i, k] = ev.inner.load, ev.outer.load, ev.inner.contact_angle
+        out = None
+        if want_outputs:
+            fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
+            out = {"main_bearing_radial_force": Output(np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N",
+                                                       "radial reaction of the main bearing on the carrier"),
+                   "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
+                   "main_bearing_tilting_moment": Output(np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m",
+                                                         "tilting reaction moment on the carrier"),
+                   "ball_load_inner": Output(loads_i, ("time", "bearing_row", "ball"), "N",
+                                             "ball-inner raceway normal load"),
+                   "ball_load_outer": Output(loads_o, ("time", "bearing_row", "ball"), "N",
+                                             "ball-outer raceway normal load"),
+                   "ball_contact_angle": Output(np.degrees(angle), ("time", "bearing_row", "ball"), "deg",
+                                                "loaded inner contact angle")}
+        return forces, out
+
+    def jacobian(self, t, q, v):
+        _, jq, jv, _ = self._evaluate_one(np.asarray(q, dtype=float), np.asarray(v, dtype=float), True)
+        return jq, jv
+
