@@ -200,3 +200,16 @@ def test_reducer_with_ball_bearing_matches_rigid_model():
     assert abs(te_b - te_r) < 2.0
     assert balls.summary()["ratio_simulated_over_theoretical"] == pytest.approx(1.0, abs=2e-3)
     assert np.all(balls["ball_load_inner"].values >= 0)
+
+
+def test_reducer_with_ball_bearing_runs_and_balances():
+    """Short run of the reducer with the ball-resolved bearing (rv40e, 10 ms):
+    the bearing's ball loads are non-negative and the preloaded rows carry the
+    carrier (radial reaction finite, axial reaction ~0 without external load)."""
+    from flexrv.simulation import Simulation
+
+    res = Simulation("rv40e", model="balls").run(t_end=0.01)
+    loads = res["ball_load_inner"].values
+    assert loads.shape[1:] == (2, 38) and np.all(loads >= 0) and loads.max() > 0
+    assert np.all(np.isfinite(res["TE [arcsec]"].values))
+    assert abs(res["main_bearing_axial_force"].values[-1]) < 50.0

@@ -17,7 +17,7 @@ DEG = 180.0 / math.pi  #: deg per rad
 RPM = 60.0 / (2.0 * math.pi)  #: r/min per rad/s
 PRESETS = ("rv221", "rv40e")
 #: smoke settings: rv40e only, t_end after ramps (0.3 s = Simulation default for rv40e), coarse step
-SMOKE = {"presets": ("rv40e",), "t_end": None, "dt": 2e-4}
+SMOKE = {"presets": ("rv40e",), "t_end": None, "dt": None}
 
 
 def _simulate(preset: str, t_end, dt):

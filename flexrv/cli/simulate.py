@@ -41,7 +41,7 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
 
 
 def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
-             model: str = typer.Option("rigid", "--model", help="Model name (rigid)."),
+             model: str = typer.Option("rigid", "--model", help="Model name: rigid (5-DOF main-bearing element) or balls (ball-resolved main bearing)."),
              t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
              dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
              out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
@@ -78,7 +78,7 @@ def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
 
 
 def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
-                       model: str = typer.Option("rigid", "--model", help="Model name (rigid)."),
+                       model: str = typer.Option("rigid", "--model", help="Model name: rigid (5-DOF main-bearing element) or balls (ball-resolved main bearing)."),
                        quarter_time: float = typer.Option(0.02, "--quarter-time", help="Duration of each quarter of the torque loop [s]."),
                        dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
