@@ -1,0 +1,112 @@
+"""Smoke runs of the seed-study workflows (workflows/*.py) checked against closed
+forms and the seeds' numbers; and the ``flexrv workflow`` / ``flexrv report`` CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from flexrv.cli import app
+
+
+@pytest.fixture(scope="module")
+def results_root(tmp_path_factory):
+    return tmp_path_factory.mktemp("results")
+
+
+@pytest.fixture(scope="module")
+def kinematic(results_root):
+    from workflows.kinematic_validation import run
+
+    return run(results_root / "kinematic_validation", smoke=True)
+
+
+@pytest.fixture(scope="module")
+def torsional(results_root):
+    from workflows.torsional_stiffness import run
+
+    return run(results_root / "torsional_stiffness", smoke=True)
+
+
+@pytest.fixture(scope="module")
+def gallery(results_root):
+    from workflows.mode_gallery import run
+
+    return run(results_root / "mode_gallery", smoke=True)
+
+
+def _has_table(path):
+    text = path.read_text()
+    return "| quantity | unit | seed | flexrv | note |" in text
+
+
+def test_kinematic_validation(kinematic):
+    """Rigid rv40e run: steady-window ratio within 0.05 % of 1 + z_p z_rp/(z_s (z_rp - z_c)) = 81;
+    seed 002 Table 4 frequencies at 1215 r/min exact (closed form, 1e-9 relative); RV-221 planet
+    speed with the carrier held = 9000 z_s/z_p deg/s within 0.1 % of seed 001's 2452.3;
+    RV-221 ratio exactly 221 (seed 000's 221.02 = 9000/40.72, rounded simulated speed)."""
+    n = kinematic.numbers
+    assert n["rv40e"]["ratio_theory"] == pytest.approx(81.0, rel=1e-12)
+    assert abs(n["rv40e"]["ratio_simulated"] / n["rv40e"]["ratio_theory"] - 1) < 5e-4
+    seed = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
+            "cycloid_mesh": 390.0, "pin_passing": 400.0}
+    for key, val in seed.items():
+        assert n["rv40e_frequencies_hz"][key] == pytest.approx(val, rel=1e-9), key
+    planet = n["rv221_planet_deg_s"]
+    assert abs(planet["carrier_held"] / 2452.3 - 1) < 1e-3
+    assert abs(planet["relative"] / 2452.3 - 1) > 1e-3  # flexrv's relative speed differs from the seed
+    assert n["rv221_ratio_theory"] == pytest.approx(221.0, rel=1e-12)  # seed's 221.02 = 9000/40.72 (rounded)
+    out = kinematic.out_dir
+    assert _has_table(out / "summary.md")
+    assert (out / "speeds.png").stat().st_size > 1000 and (out / "speeds_rv40e.nc").exists()
+
+
+def test_torsional_stiffness(torsional):
+    """Seed 004 table with a four-pin zone and C_c = 6.24e8 N mm/rad -> pins 6-9 (sum 6.32e8,
+    +1.3 %); analytic and simulated contact both find more than four pins; the stiffness test
+    lies between the measured 89 N m/arcmin and the series model (the bench lacks compliances
+    of the real reducer but includes the contact)."""
+    n = torsional.numbers
+    assert n["zone_seed_4"] == [6, 9]
+    assert n["c_w_measured_Nm_per_arcmin"] == pytest.approx(3.06e5 / (180 * 60 / math.pi), rel=1e-9)
+    assert n["pins_in_contact_analytic"] >= 4 and n["pins_in_contact_sim"] >= 4
+    assert n["c_w_measured_Nm_per_arcmin"] < n["rigidity_test_Nm_per_arcmin"] < n["c_w_series_Nm_per_arcmin"]
+    assert _has_table(torsional.out_dir / "summary.md")
+    assert (torsional.out_dir / "stiffness.png").exists()
+
+
+def test_mode_gallery(gallery):
+    """Crankshaft rv40e: positive, ascending free-free frequencies; PNG renderings not blank
+    (more than one distinct colour) and embedded in summary.md."""
+    f = gallery.numbers["frequencies_hz"]["rv40e/crankshaft"]
+    assert len(f) == 2 and f[0] > 0 and f[1] >= f[0]
+    import matplotlib.image as mpimg
+
+    text = (gallery.out_dir / "summary.md").read_text()
+    for name in gallery.numbers["pngs"]:
+        img = mpimg.imread(gallery.out_dir / name)
+        assert np.unique(img.reshape(-1, img.shape[-1]), axis=0).shape[0] > 10
+        assert f"({name})" in text
+
+
+def test_cli_report(kinematic, torsional, gallery, results_root):
+    """``flexrv report --json`` collects the three summaries into README.md."""
+    r = CliRunner().invoke(app, ["report", "--results", str(results_root), "--json"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.output)
+    assert data["sections"] == ["kinematic_validation", "mode_gallery", "torsional_stiffness"]
+    readme = (results_root / "README.md").read_text()
+    assert "(mode_gallery/rv40e_crankshaft_mode01.png)" in readme and "| 6-9 |" in readme
+
+
+def test_cli_workflow(tmp_path):
+    """``flexrv workflow mode_gallery --smoke --json`` writes summary.md and reports the folder."""
+    r = CliRunner().invoke(app, ["workflow", "mode_gallery", "--smoke", "--out", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.output)
+    assert data["out_dir"] == str(tmp_path) and (tmp_path / "summary.md").exists()
+    assert data["numbers"]["frequencies_hz"]["rv40e/crankshaft"][0] > 0
