@@ -93,6 +93,17 @@ def test_radial_load_balance_and_zone():
     assert frame_q[0] > 0
 
 
+def _fd_jacobian(model, q, qt, h=1e-10):
+    """Central-difference d force / d q of a row element."""
+    n = q.size
+    jac = np.zeros((n, n))
+    for k in range(n):
+        dq = np.zeros(n)
+        dq[k] = h
+        jac[:, k] = (evaluate_row(model, q + dq, qt, False).force - evaluate_row(model, q - dq, qt, False).force) / (2 * h)
+    return jac
+
+
 def test_jacobian_vs_finite_difference():
     """Analytic Jacobian within 2 % of central differences (geometric-stiffness
     terms of the frame rotation are neglected by design)."""
@@ -104,12 +115,7 @@ def test_jacobian_vs_finite_difference():
     q[3:6] = rng.normal(scale=1e-5, size=3)
     qt = rng.normal(scale=1e-3, size=n)
     ev = evaluate_row(m, q, qt)
-    jac = np.zeros((n, n))
-    h = 1e-10
-    for k in range(n):
-        dq = np.zeros(n)
-        dq[k] = h
-        jac[:, k] = (evaluate_row(m, q + dq, qt, False).force - evaluate_row(m, q - dq, qt, False).force) / (2 * h)
+    jac = _fd_jacobian(m, q, qt)
     assert np.abs(jac - ev.jac_q).max() < 0.02 * np.abs(jac).max()
 
 
@@ -172,12 +178,7 @@ def test_jacobian_with_modal_rings_vs_finite_difference():
     q[3:6] = rng.normal(scale=1e-5, size=3)
     qt = rng.normal(scale=1e-3, size=n)
     ev = evaluate_row(m, q, qt)
-    jac = np.zeros((n, n))
-    h = 1e-10
-    for k in range(n):
-        dq = np.zeros(n)
-        dq[k] = h
-        jac[:, k] = (evaluate_row(m, q + dq, qt, False).force - evaluate_row(m, q - dq, qt, False).force) / (2 * h)
+    jac = _fd_jacobian(m, q, qt)
     assert np.abs(jac - ev.jac_q).max() < 0.02 * np.abs(jac).max()
     _, si, so, _ = m.slices()
     assert np.abs(jac[si, si]).max() > 0 and np.abs(jac[so, so]).max() > 0
