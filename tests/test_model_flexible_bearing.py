@@ -93,6 +93,15 @@ def test_radial_load_balance_and_zone():
     assert frame_q[0] > 0
 
 
+def _random_state(model, seed):
+    """A random element state near the reference: µm displacements, 1e-5 rad tilts."""
+    rng = np.random.default_rng(seed)
+    n = model.n_coordinates
+    q = rng.normal(scale=1e-6, size=n)
+    q[3:6] = rng.normal(scale=1e-5, size=3)
+    return q, rng.normal(scale=1e-3, size=n)
+
+
 def _fd_jacobian(model, q, qt, h=1e-10):
     """Central-difference d force / d q of a row element."""
     n = q.size
@@ -109,11 +118,7 @@ def test_jacobian_vs_finite_difference():
     terms of the frame rotation are neglected by design)."""
     rows = rows_from_design(load("rv221"), ehl="dry")
     m = rows[0]
-    rng = np.random.default_rng(0)
-    n = m.n_coordinates
-    q = rng.normal(scale=1e-6, size=n)
-    q[3:6] = rng.normal(scale=1e-5, size=3)
-    qt = rng.normal(scale=1e-3, size=n)
+    q, qt = _random_state(m, seed=0)
     ev = evaluate_row(m, q, qt)
     jac = _fd_jacobian(m, q, qt)
     assert np.abs(jac - ev.jac_q).max() < 0.02 * np.abs(jac).max()
@@ -172,11 +177,7 @@ def test_jacobian_with_modal_rings_vs_finite_difference():
     rows = rows_from_design(reducer, inner=[_FourierRing(), _FourierRing()], outer=[_FourierRing(), _FourierRing()],
                             ehl="dry")
     m = rows[0]
-    n = m.n_coordinates
-    rng = np.random.default_rng(2)
-    q = rng.normal(scale=1e-6, size=n)
-    q[3:6] = rng.normal(scale=1e-5, size=3)
-    qt = rng.normal(scale=1e-3, size=n)
+    q, qt = _random_state(m, seed=2)
     ev = evaluate_row(m, q, qt)
     jac = _fd_jacobian(m, q, qt)
     assert np.abs(jac - ev.jac_q).max() < 0.02 * np.abs(jac).max()

@@ -34,7 +34,7 @@ residual, which is exact).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -420,9 +420,8 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
     if ehl == "dry":
         laws = None
     else:
-        laws = [EHLPointLaw.from_design(reducer, float(rx), float(ry), mode=ehl) for rx, ry in ((rx_i, ry_i), (rx_o, ry_o))]
-        laws = [type(law)(law.rx, law.ry, law.e_eff, law.lubricant, mode=law.mode, film_map=law.film_map,
-                          c_max=c_max, damping_depth=depth) for law in laws]
+        laws = [replace(EHLPointLaw.from_design(reducer, float(rx), float(ry), mode=ehl),
+                                    c_max=c_max, damping_depth=depth) for rx, ry in ((rx_i, ry_i), (rx_o, ry_o))]
     speed_factor = 0.25 * geom.pitch_diameter * (1.0 - geom.gamma**2)
     rows = []
     for k, (z, side) in enumerate(zip(geom.row_positions(), geom.row_sides())):
