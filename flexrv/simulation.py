@@ -50,11 +50,16 @@ class Simulation:
     model : model name in :data:`flexrv.model.factory.MODELS` (``"rigid"``).
     drive : ``"ramp"`` (seed input-speed step) or ``"locked"`` (input held).
     torque : optional load-torque program T(t) [N m] replacing the seed step.
+    model_options : keyword options of the model builder, e.g. for ``"flexible"``
+        ``{"parts": ("main_bearing", "crankshaft"), "ring_options": {"harmonics": 24}}``
+        (:func:`flexrv.model.factory.build_flexible`).
     """
 
-    def __init__(self, preset_or_config, model: str = "rigid", drive: str = "ramp", torque: Callable | None = None):
+    def __init__(self, preset_or_config, model: str = "rigid", drive: str = "ramp", torque: Callable | None = None,
+                 model_options: dict | None = None):
         self.reducer = load(preset_or_config)
         self.model_name = model
+        self.model_options = dict(model_options or {})
         self.drive = drive
         self.torque = torque
         self.model = None
@@ -64,7 +69,8 @@ class Simulation:
         from flexrv.model.factory import build_model
 
         t0 = _time.perf_counter()
-        self.model = build_model(self.reducer, self.model_name, drive=self.drive, torque=self.torque)
+        self.model = build_model(self.reducer, self.model_name, drive=self.drive, torque=self.torque,
+                                 **self.model_options)
         self.timing["build_s"] = _time.perf_counter() - t0
         return self.model
 
@@ -140,7 +146,10 @@ class Simulation:
         ti.generalizedAlpha.spectralRadius = spectral_radius
         for key, value in (newton_options or {}).items():
             setattr(ti.newton, key, value)
-        ti.generalizedAlpha.computeInitialAccelerations = True
+        # massless (quasi-static) coordinates make M singular: start from rest with
+        # zero accelerations instead (every run starts at rest in equilibrium)
+        massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
+        ti.generalizedAlpha.computeInitialAccelerations = not massless
         ti.adaptiveStep = True
         ti.minimumStepSize = dt * 1e-3
         ss.solution.file.write = False

@@ -15,7 +15,10 @@ from flexrv.geometry.bearing import BallBearingGeometry
 from flexrv.model.flexible_bearing import add_main_bearing, evaluate_row, rows_from_design
 
 
-def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None):
+def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None, coordinates=False):
+    """Static equilibrium of the standalone bearing (frame on the balls, rotation
+    about z held) under a force and moment on the frame. Returns rows, row
+    evaluations, frame coordinates and, with ``coordinates``, each row element's q."""
     import exudyn as exu
     from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, LoadTorqueVector, MarkerNodeCoordinate,
                                       MarkerNodeRigid, NodePointGround, NodeRigidBodyRxyz, ObjectRigidBody)
@@ -40,11 +43,14 @@ def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None):
     settings.staticSolver.numberOfLoadSteps = 10
     settings.staticSolver.newton.absoluteTolerance = 1e-6
     exu.SolveStatic(mbs, settings)
-    evals = []
+    evals, qs = [], []
     for k in range(len(rows)):
         q, q_t = handle.element_coordinates(mbs, k)
         evals.append(evaluate_row(rows[k], q, q_t, jacobian=False))
+        qs.append(q)
     frame_q = np.asarray(mbs.GetNodeOutput(frame, exu.OutputVariableType.Coordinates))
+    if coordinates:
+        return rows, evals, frame_q, qs
     return rows, evals, frame_q
 
 

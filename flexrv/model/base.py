@@ -30,7 +30,15 @@ import numpy as np
 
 @dataclass
 class Member:
-    """A body of the model: ``n`` coordinates, constant mass matrix, initial state."""
+    """A body of the model: ``n`` coordinates, constant mass matrix, initial state.
+
+    ``kind`` says what the coordinates are (used by post-processing for kinetic
+    energy bookkeeping and angular momentum): ``"planar"`` (x, y, rotation about the
+    axis first, as carrier, cranks and discs), ``"points"`` (x, y, z of point masses,
+    e.g. the balls) or ``"modal"`` (elastic modal coordinates of a reduced body, with
+    constant ``stiffness_matrix`` and ``damping_matrix`` added to the member's own
+    Exudyn element).
+    """
 
     name: str
     mass_matrix: np.ndarray
@@ -39,6 +47,9 @@ class Member:
     labels: tuple[str, ...]
     node: int = -1  #: Exudyn node number (set on assembly)
     offset: int = -1  #: first index in the model's state vector
+    kind: str = "planar"
+    stiffness_matrix: np.ndarray | None = None  #: constant K [N/m] (modal members)
+    damping_matrix: np.ndarray | None = None  #: constant D [N s/m] (modal members)
 
     @property
     def n(self) -> int:

@@ -58,12 +58,16 @@ def empirical_needle_constant(reducer) -> float:
     return (0.9 * c) ** (10.0 / 9.0)
 
 
-def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid") -> AssembledModel:
+def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
+                crankshaft: str = "rigid", ring_options: dict | None = None, model_name: str = "rigid") -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
-    ``main_bearing``: ``"rigid"`` (linear 5-DOF element) or ``"balls"`` (the
+    ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
     ball-resolved bearing of :mod:`flexrv.model.flexible_bearing`: every ball a
-    point mass between rigid rings, Hertz/EHL contacts per the design)."""
+    point mass between rigid rings, Hertz/EHL contacts per the design) or
+    ``"flexible"`` (the same with reduced flexible rings, ``ring_options``);
+    ``crankshaft``: ``"rigid"`` or ``"flexible"``. ``model_name`` labels the
+    results of a non-rigid variant."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
@@ -91,20 +95,34 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment),
     ]
     members = _members(p)
+    info: dict = {}
     if main_bearing == "rigid":
         groups.insert(4, RigidMainBearing(p))
-    elif main_bearing == "balls":
-        from flexrv.model.base import Member
+    elif main_bearing in ("balls", "flexible"):
         from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
 
-        group = BallBearingGroup(rows_from_design(reducer))
-        for name, (mass, q0, v0) in group.member_states().items():
-            members[name] = Member(name, mass, q0, v0, tuple(f"{c}{j}" for j in range(len(q0) // 3) for c in "xyz"))
+        rings = {}
+        if main_bearing == "flexible":
+            from flexrv.model.flexible_bearing import flexible_rings
+
+            rings = flexible_rings(reducer, **(ring_options or {}))
+            info["flexible_bodies"] = rings["bodies"]
+            info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
+        group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer")))
+        members.update(group.new_members())
         groups.insert(4, group)
     else:
-        raise ConfigError(f"main_bearing = {main_bearing!r} is not allowed: choose 'rigid' or 'balls'")
-    model = AssembledModel(name="rigid" if main_bearing == "rigid" else "flexible", reducer=reducer, params=p,
-                           members=members, groups=groups, input_angle=theta, input_speed=omega, load_torque=torque)
+        raise ConfigError(f"main_bearing = {main_bearing!r} is not allowed: choose 'rigid', 'balls' or 'flexible'")
+    if crankshaft == "flexible":
+        from flexrv.model.flexible_crank import add_flexible_cranks
+
+        add_flexible_cranks(reducer, p, members, groups)
+    elif crankshaft != "rigid":
+        raise ConfigError(f"crankshaft = {crankshaft!r} is not allowed: choose 'rigid' or 'flexible'")
+    info.update(main_bearing=main_bearing, crankshaft=crankshaft)
+    name = "rigid" if (main_bearing, crankshaft) == ("rigid", "rigid") else model_name
+    model = AssembledModel(name=name, reducer=reducer, params=p, members=members, groups=groups, input_angle=theta,
+                           input_speed=omega, load_torque=torque, info=info)
     return assemble(model)
 
 
@@ -132,7 +150,12 @@ def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
     for m in model.members.values():
         m.node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * m.n, initialCoordinates=list(m.q0),
                                              initialCoordinates_t=list(m.v0), numberOfODE2Coordinates=m.n))
-        mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix))
+        extra = {}
+        if m.stiffness_matrix is not None:
+            extra["stiffnessMatrix"] = m.stiffness_matrix
+        if m.damping_matrix is not None:
+            extra["dampingMatrix"] = m.damping_matrix
+        mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix, **extra))
         m.offset = offset
         offset += m.n
     all_nodes = [m.node for m in model.members.values()]
@@ -157,15 +180,49 @@ def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
     return model
 
 
-#: model name -> builder(reducer, drive=..., torque=...) -> AssembledModel
 def build_balls(reducer, **kwargs) -> AssembledModel:
     """Rigid model with the ball-resolved main bearing (rigid rings): the carrier
     is carried only by the balls of both rows (radial, axial and tilt compliance of
     the Hertz/EHL contacts). The flexible-ring model builds on this."""
-    return build_rigid(reducer, main_bearing="balls", **kwargs)
+    return build_rigid(reducer, main_bearing="balls", model_name="balls", **kwargs)
 
 
-MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid, "balls": build_balls}
+#: parts that :func:`build_flexible` can make flexible
+FLEXIBLE_PARTS = ("main_bearing", "crankshaft")
+DEFAULT_FLEXIBLE_PARTS = ("main_bearing",)
+
+
+def parse_parts(parts) -> tuple[str, ...]:
+    """Validate a list (or comma-separated string) of flexible part names."""
+    if isinstance(parts, str):
+        parts = [p.strip() for p in parts.split(",") if p.strip()]
+    parts = tuple(parts)
+    bad = [p for p in parts if p not in FLEXIBLE_PARTS]
+    if bad or not parts:
+        raise ConfigError(f"parts = {','.join(parts) or '(empty)'} is not allowed: choose one or more of "
+                          f"{', '.join(FLEXIBLE_PARTS)}")
+    return parts
+
+
+def build_flexible(reducer, parts=DEFAULT_FLEXIBLE_PARTS, ring_options: dict | None = None,
+                   **kwargs) -> AssembledModel:
+    """Rigid model with the named parts flexible (:data:`FLEXIBLE_PARTS`):
+
+    * ``main_bearing`` — ball-resolved bearing with reduced flexible inner and
+      outer rings of both rows (:func:`flexrv.model.flexible_bearing.flexible_rings`,
+      options ``ring_options``: harmonics, n_eig, size, damping_ratio,
+      stiffness_scale);
+    * ``crankshaft`` — reduced flexible crankshafts (:mod:`flexrv.model.flexible_crank`).
+    """
+    parts = parse_parts(parts)
+    return build_rigid(reducer, main_bearing="flexible" if "main_bearing" in parts else "rigid",
+                       crankshaft="flexible" if "crankshaft" in parts else "rigid", ring_options=ring_options,
+                       model_name="flexible", **kwargs)
+
+
+#: model name -> builder(reducer, drive=..., torque=..., **options) -> AssembledModel
+MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid, "balls": build_balls,
+                                                    "flexible": build_flexible}
 
 
 def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:

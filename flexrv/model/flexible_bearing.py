@@ -39,6 +39,7 @@ from typing import Protocol
 
 import numpy as np
 
+from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import NormalLaw, RowContactGeometry, hertz_law, raceway_contacts
 from flexrv.model.base import ForceGroup, Output
 
@@ -62,24 +63,47 @@ class ModalRing:
     The meshed ring is the row with outer-contact side s = +1
     (:meth:`flexrv.geometry.bearing.BallBearingGeometry.ring_section`); the other
     row of the back-to-back pair is its mirror image z -> -z (``mirror=True``).
-    Modal damping ratio ``damping_ratio`` on the M-orthonormal basis.
+    ``stiffness_scale`` multiplies the ring's stiffness (a stiffened ring for the
+    stiff-ring consistency checks; 1 = the real ring).
+
+    ``quasi_static=True`` (default) drops the ring's inertia: the modal
+    coordinates become massless, K q = Q(contacts) holds at every instant (static
+    condensation of the ring onto its raceway loads, solved by the integrator's
+    Newton iteration together with the dynamics). Justification: with the fit
+    clamped (rigid housing / carrier) the lowest ring mode is 160-260 kHz for
+    rv40e (``frequencies_hz``; :func:`flexrv.model.flexible_bearing.flexible_rings`
+    records it), 2-3 orders above every excitation of the bearing (ball pass
+    < 1 kHz, first-stage mesh < 1 kHz), so the ring's dynamic amplification
+    (f/f_1)^2 < 1e-4 — while these stiff modes (omega dt ~ 100) make the modified
+    Newton iteration of the dynamic version take ~5x more iterations and ~100x
+    more Jacobians (measured: rv40e, 5 ms: 278 vs 88 Newton iterations, 96 vs 1
+    Jacobians). ``quasi_static=False`` keeps M = I and modal damping ``damping_ratio``.
     """
 
     body: object
     damping_ratio: float = 0.02
     mirror: bool = False
+    stiffness_scale: float = 1.0
+    quasi_static: bool = True
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.body.n_modes)
 
     @property
     def mass(self) -> np.ndarray:
-        return np.asarray(self.body.mass_matrix, dtype=float)
+        return (0.0 if self.quasi_static else 1.0) * np.asarray(self.body.mass_matrix, dtype=float)
 
     @property
     def stiffness(self) -> np.ndarray:
-        return np.asarray(self.body.stiffness_matrix, dtype=float)
+        return self.stiffness_scale * np.asarray(self.body.stiffness_matrix, dtype=float)
 
     @property
     def damping(self) -> np.ndarray:
-        return np.diag(2.0 * self.damping_ratio * np.sqrt(np.asarray(self.body.omega2, dtype=float)))
+        if self.quasi_static:
+            return np.zeros((self.n_modes, self.n_modes))
+        omega2 = self.stiffness_scale * np.asarray(self.body.omega2, dtype=float)
+        return np.diag(2.0 * self.damping_ratio * np.sqrt(omega2))
 
     def groove_basis(self, azimuth: np.ndarray) -> np.ndarray:
         basis = np.array(self.body.raceway_matrix(azimuth), dtype=float)
@@ -131,6 +155,10 @@ class RowModel:
     #: entrainment speed per unit frame (inner ring) angular speed [m]:
     #: u = (d_m/4)(1 - gamma^2)|omega| (Hamrock 1994, ch. 24)
     speed_factor: float = 0.0
+    #: effective radii (rx, ry) [m] of the inner contact and the effective modulus
+    #: E' [Pa] (for the Hertz pressure output; None: not reported)
+    inner_radii: tuple | None = None
+    e_eff: float = 0.0
     #: reference ball centres (Z, 3) in global coordinates
     ball_reference: np.ndarray = field(init=False)
 
@@ -432,9 +460,51 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
             law_i, law_o = laws
         rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count, cage_ratio=0.5 * (1.0 - geom.gamma),
                              ball_mass=geom.ball_mass(ball_mat.density_kg_m3), law_inner=law_i, law_outer=law_o,
-                             speed_factor=speed_factor,
+                             speed_factor=speed_factor, inner_radii=(float(rx_i), float(ry_i)), e_eff=e_eff,
                              inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
     return rows
+
+
+#: raceway Fourier harmonics K (None: the reduction's patch-width default,
+#: :func:`flexrv.fem.reduction.default_harmonics`) and fixed-interface
+#: eigenmodes of the rings in the dynamic model (see :func:`flexible_rings`)
+RING_HARMONICS = None
+RING_EIGENMODES = 12
+
+
+def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int = RING_EIGENMODES, size: float | None = None,
+                   damping_ratio: float = 0.02, stiffness_scale: float = 1.0, quasi_static: bool = True,
+                   rings: tuple[str, ...] = ("inner", "outer")) -> dict:
+    """Reduced flexible rings of a design's main bearing for both rows.
+
+    Returns ``{"inner": [row0, row1], "outer": [row0, row1], "bodies": {...}}`` with
+    :class:`ModalRing` views (row 1 mirrored) and, under ``"bodies"``, the
+    :func:`flexrv.fem.body.reduce_part` arguments that rebuild each body (cache hit)
+    for post-processing (:mod:`flexrv.viz.rings`).
+
+    Basis: HCB with the fit surface clamped (ring pressed into a rigid housing /
+    onto a rigid carrier), ``n_eig`` fixed-interface eigenmodes and 2K+1 Fourier
+    raceway load modes. K must exceed the ball count Z: Z equal ball loads excite
+    the harmonics 0, Z, 2Z, ... of the local dent under each ball, and a basis
+    without them misses it. Measured (rv221, Z = 26, seed 001's 20 kN radial +
+    15 kN axial, deflection at the loaded balls vs the full FE, see
+    tests/test_model_flexible_rings.py): K = 24/40/57/80 -> -42/2.7/0.08/0.04 %.
+    The default K is the reduction's patch-width rule (57 for rv221).
+    """
+    from flexrv.fem.body import reduce_part
+
+    out: dict = {"bodies": {}}
+    for label in rings:
+        if label not in ("inner", "outer"):
+            raise ConfigError(f"ring = {label!r} is not allowed: choose 'inner' or 'outer'")
+        part = f"{label}_ring"
+        settings = {"size": size, "n_eig": int(n_eig), "n_harmonics": None if harmonics is None else int(harmonics)}
+        body = reduce_part(reducer, part, **settings)
+        opts = dict(damping_ratio=damping_ratio, stiffness_scale=stiffness_scale, quasi_static=quasi_static)
+        out[label] = [ModalRing(body, **opts), ModalRing(body, mirror=True, **opts)]
+        out["bodies"][part] = settings
+        out.setdefault("lowest_mode_hz", {})[part] = float(np.sqrt(stiffness_scale) * body.frequencies_hz.min())
+    return out
 
 
 # ------------------------------------------------------------ reducer-model group
@@ -448,57 +518,86 @@ class BallBearingGroup(ForceGroup):
     (:mod:`flexrv.model.factory`), replacing the rigid model's 5-DOF element.
 
     Members: ``carrier`` (x, y, theta, z, rx, ry — the tilts are small, so the
-    Tait–Bryan frame (rx, ry, theta) of the row elements is the carrier pose) and
-    one ``main_bearing_balls<k>`` member per row (absolute ball-centre positions,
-    3 Z coordinates). Rings are rigid here (the stiff-ring limit of
-    :class:`RowModel`); flexible rings enter through the rows' ``inner``/``outer``.
+    Tait–Bryan frame (rx, ry, theta) of the row elements is the carrier pose) and,
+    per row k, ``main_bearing_inner<k>`` / ``main_bearing_outer<k>`` (modal
+    coordinates of a flexible ring, only if the row's ring is flexible; the inner
+    ring's modes live in the carrier frame, the outer ring's in the housing) and
+    ``main_bearing_balls<k>`` (absolute ball-centre positions, 3 Z coordinates).
+    Each row's contact element (:func:`evaluate_row`) sees the coordinates
+    [frame(6), inner modes, outer modes, balls]; the group scatters them.
     """
 
     name = "main_bearing"
     analytic_jacobian = True
 
     def __init__(self, rows: list[RowModel]):
-        if any(r.inner is not None or r.outer is not None for r in rows):
-            raise NotImplementedError("flexible rings in the reducer model: use the standalone bearing for now")
         self.rows = rows
-        self.members = ("carrier",) + tuple(f"main_bearing_balls{k}" for k in range(len(rows)))
-        self.sizes = [6] + [3 * r.ball_count for r in rows]
+        members, sizes, index = ["carrier"], [6], []
+        for k, row in enumerate(rows):
+            parts = [_PERM]
+            for label, m in (("inner", row.m_inner), ("outer", row.m_outer), ("balls", 3 * row.ball_count)):
+                if m == 0:
+                    continue
+                start = sum(sizes)
+                members.append(f"main_bearing_{label}{k}")
+                sizes.append(m)
+                parts.append(np.arange(start, start + m))
+            index.append(np.concatenate(parts))
+        self.members = tuple(members)
+        self.sizes = sizes
+        self._index = index  # per row: element coordinates in the group's local vector
+        self._n = int(sum(sizes))
 
     @property
     def mergeable(self) -> bool:
         return False
 
-    def member_states(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """(mass matrix, q0, v0) of the ball members (absolute positions, preload equilibrium)."""
+    @property
+    def flexible(self) -> bool:
+        return any(r.inner is not None or r.outer is not None for r in self.rows)
+
+    def new_members(self) -> dict:
+        """The group's own members (balls at the preload equilibrium, ring modes at
+        rest) as :class:`flexrv.model.base.Member` objects, in the group's order."""
+        from flexrv.model.base import Member
+
         out = {}
         for k, row in enumerate(self.rows):
+            for label, ring in (("inner", row.inner), ("outer", row.outer)):
+                if ring is None:
+                    continue
+                m = ring.stiffness.shape[0]
+                out[f"main_bearing_{label}{k}"] = Member(
+                    f"main_bearing_{label}{k}", np.asarray(ring.mass, dtype=float), np.zeros(m), np.zeros(m),
+                    tuple(f"mode{i}" for i in range(m)), kind="modal", stiffness_matrix=ring.stiffness,
+                    damping_matrix=ring.damping)
             q0 = (row.ball_reference + initial_ball_displacements(row)).ravel()
-            out[f"main_bearing_balls{k}"] = (np.eye(q0.size) * row.ball_mass, q0, np.zeros(q0.size))
+            out[f"main_bearing_balls{k}"] = Member(
+                f"main_bearing_balls{k}", np.eye(q0.size) * row.ball_mass, q0, np.zeros(q0.size),
+                tuple(f"{c}{j}" for j in range(row.ball_count) for c in "xyz"), kind="points")
         return out
 
     def _element_state(self, q, v, k):
         row = self.rows[k]
-        start = 6 + sum(self.sizes[1:k + 1])
-        balls = slice(start, start + 3 * row.ball_count)
-        qe = np.concatenate([q[_PERM], q[balls] - row.ball_reference.ravel()])
-        ve = np.concatenate([v[_PERM], v[balls]])
-        return qe, ve, balls
+        idx = self._index[k]
+        qe = q[..., idx].copy()
+        qe[..., -3 * row.ball_count:] -= row.ball_reference.ravel()
+        return qe, v[..., idx], idx
 
     def _evaluate_one(self, q, v, jacobian: bool):
-        n = q.shape[-1]
-        f = np.zeros(n)
-        jq = np.zeros((n, n)) if jacobian else None
-        jv = np.zeros((n, n)) if jacobian else None
+        f = np.zeros(self._n)
+        jq = np.zeros((self._n, self._n)) if jacobian else None
+        jv = np.zeros((self._n, self._n)) if jacobian else None
         evals = []
         for k, row in enumerate(self.rows):
-            qe, ve, balls = self._element_state(q, v, k)
+            qe, ve, idx = self._element_state(q, v, k)
             ev = evaluate_row(row, qe, ve, jacobian=jacobian)
             evals.append(ev)
-            idx = np.concatenate([_PERM, np.arange(balls.start, balls.stop)])
             f[idx] += ev.force
             if jacobian:
-                jq[np.ix_(idx, idx)] += ev.jac_q
-                jv[np.ix_(idx, idx)] += ev.jac_v
+                ix = np.ix_(idx, idx)
+                jq[ix] += ev.jac_q
+                jv[ix] += ev.jac_v
         return f, jq, jv, evals
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
@@ -509,30 +608,94 @@ class BallBearingGroup(ForceGroup):
             f, _, _, _ = self._evaluate_one(q, v, False)
             return f, None
         forces = np.zeros_like(q)
-        loads_i = np.zeros((q.shape[0], len(self.rows), self.rows[0].ball_count))
-        loads_o = np.zeros_like(loads_i)
-        angle = np.zeros_like(loads_i)
+        history = []
         for i in range(q.shape[0]):
             forces[i], _, _, evals = self._evaluate_one(q[i], v[i], False)
-            for k, ev in enumerate(evals):
-                loads_i[i, k], loads_o[i, k], angle[i, k] = ev.inner.load, ev.outer.load, ev.inner.contact_angle
-        out = None
-        if want_outputs:
-            fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
-            out = {"main_bearing_radial_force": Output(np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N",
-                                                       "radial reaction of the main bearing on the carrier"),
-                   "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
-                   "main_bearing_tilting_moment": Output(np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m",
-                                                         "tilting reaction moment on the carrier"),
-                   "ball_load_inner": Output(loads_i, ("time", "bearing_row", "ball"), "N",
-                                             "ball-inner raceway normal load"),
-                   "ball_load_outer": Output(loads_o, ("time", "bearing_row", "ball"), "N",
-                                             "ball-outer raceway normal load"),
-                   "ball_contact_angle": Output(np.degrees(angle), ("time", "bearing_row", "ball"), "deg",
-                                                "loaded inner contact angle")}
+            if want_outputs:
+                history.append(evals)
+        out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
 
     def jacobian(self, t, q, v):
         _, jq, jv, _ = self._evaluate_one(np.asarray(q, dtype=float), np.asarray(v, dtype=float), True)
         return jq, jv
 
+
+def _law_film(law, load, speed) -> np.ndarray:
+    """Central film h_c [m] of an EHL law at the given loads and speed (0 for dry laws)."""
+    if not hasattr(law, "film"):
+        return np.zeros_like(load)
+    h, _ = law.film(np.maximum(load, law.load_floor), speed)
+    return np.where(load > 0, h, 0.0)
+
+
+def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
+    """Named outputs of the bearing over a time history (see :class:`BallBearingGroup`).
+
+    Per ball (dims time, bearing_row, ball): inner/outer normal loads, loaded inner
+    contact angle, central film thickness and maximum Hertz pressure at the inner
+    contact (the more heavily stressed: convex–convex, smaller rx); per row: the
+    ring's raceway deflection at its most-loaded contact along the contact load
+    (positive: the raceway yields away from the ball), and the rings' modal
+    coordinates (for :mod:`flexrv.viz.rings`). The film is the quasi-static EHL
+    h_c(Q, u) of the contact law at the entrainment speed of the carrier's
+    rotation; the pressure is the Hertz p_max of the load (the EHL pressure spike
+    is not resolved by the law, see :mod:`flexrv.contact.ehl_law`).
+    """
+    from flexrv.contact.hertz import point_contact
+
+    rows = group.rows
+    n_t, n_r, n_b = q.shape[0], len(rows), rows[0].ball_count
+    shape = (n_t, n_r, n_b)
+    load_i, load_o, angle = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    film, p_max = np.zeros(shape), np.zeros(shape)
+    defl_i, defl_o = np.zeros((n_t, n_r)), np.zeros((n_t, n_r))
+    for i, evals in enumerate(history):
+        for k, (row, ev) in enumerate(zip(rows, evals)):
+            load_i[i, k], load_o[i, k], angle[i, k] = ev.inner.load, ev.outer.load, ev.inner.contact_angle
+            qe, _, _ = group._element_state(q[i], v[i], k)
+            _, si, so, _ = row.slices()
+            for ring, st, q_modal, store, frame in ((row.inner, ev.inner, qe[si], defl_i, True),
+                                                    (row.outer, ev.outer, qe[so], defl_o, False)):
+                if ring is None:
+                    continue
+                j = int(np.argmax(st.load))
+                local = ev.ball_pos[j] - qe[0:3] if frame else ev.ball_pos[j]
+                a_mat = rxyz_matrices(qe[3:6])[0] if frame else np.eye(3)
+                psi = float(np.arctan2(*(local @ a_mat)[[1, 0]]))
+                u = a_mat @ (ring.groove_basis(np.array([psi]))[0] @ q_modal)
+                store[i, k] = float(u @ st.normal[j])
+    carrier_speed = np.abs(v[:, 2])
+    for k, row in enumerate(rows):
+        speed = (row.speed_factor * carrier_speed)[:, None]
+        film[:, k] = _law_film(row.law_inner, load_i[:, k], speed)
+        if row.inner_radii is not None:
+            p_max[:, k] = point_contact(load_i[:, k], *row.inner_radii, row.e_eff).p_max
+    fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
+    dims = ("time", "bearing_row", "ball")
+    out = {"main_bearing_radial_force": Output(np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N",
+                                               "radial reaction of the main bearing on the carrier"),
+           "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
+           "main_bearing_tilting_moment": Output(np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m",
+                                                 "tilting reaction moment on the carrier"),
+           "ball_load_inner": Output(load_i, dims, "N", "ball-inner raceway normal load"),
+           "ball_load_outer": Output(load_o, dims, "N", "ball-outer raceway normal load"),
+           "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
+           "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
+           "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact")}
+    for label, store in (("inner", defl_i), ("outer", defl_o)):
+        ring_rows = [k for k, row in enumerate(rows) if getattr(row, label) is not None]
+        if not ring_rows:
+            continue
+        out[f"ring_deformation_{label}"] = Output(store, ("time", "bearing_row"), "m",
+                                                  f"{label} raceway deflection at the most-loaded contact")
+        modal = np.stack([q[:, group._index[k]][:, slice(*_modal_range(rows[k], label))] for k in range(n_r)], 1)
+        out[f"ring_modal_{label}"] = Output(modal, ("time", "bearing_row", f"mode_{label}"), "1",
+                                            f"modal coordinates of the {label} rings")
+    return out
+
+
+def _modal_range(row: RowModel, label: str) -> tuple[int, int]:
+    _, si, so, _ = row.slices()
+    s = si if label == "inner" else so
+    return s.start, s.stop

@@ -190,11 +190,17 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     ke += 0.5 * p.input_inertia * w_in**2
     data["kinetic_energy"] = _var(ke, ("time",), "J", "kinetic energy")
     lz = np.zeros_like(t)
-    for m in model.members.values():  # planar members: coordinates x, y, rotation first
+    for m in model.members.values():
         qm, vm = q[:, model.slice(m.name)], v[:, model.slice(m.name)]
-        lz += m.mass_matrix[2, 2] * vm[:, 2] + m.mass_matrix[0, 0] * (qm[:, 0] * vm[:, 1] - qm[:, 1] * vm[:, 0])
+        if m.kind == "planar":  # x, y, rotation first
+            lz += m.mass_matrix[2, 2] * vm[:, 2] + m.mass_matrix[0, 0] * (qm[:, 0] * vm[:, 1] - qm[:, 1] * vm[:, 0])
+        elif m.kind == "points":  # (x, y, z) per point, diagonal mass
+            mass = np.diag(m.mass_matrix)[0::3]
+            lz += ((qm[:, 0::3] * vm[:, 1::3] - qm[:, 1::3] * vm[:, 0::3]) * mass).sum(axis=-1)
+        # modal members: elastic vibration of the reduced bodies about their frames
+        # carries no net angular momentum about the axis to first order
     data["angular_momentum"] = _var(lz, ("time",), "N m s",
-                                    "angular momentum of carrier, cranks and discs about the axis")
+                                    "angular momentum of the rigid members and balls about the axis")
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
     red = model.reducer
     t_end = float(t[-1]) if len(t) else 0.0
@@ -207,6 +213,8 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         "needle_model": red.needle_bearing.model, "pin_law": red.contact.pin_law,
         "timing": json.dumps(to_jsonable(timing or {})),
     })
+    for key, value in model.info.items():  # e.g. flexible_bodies: how to rebuild the reduced bodies
+        ds.attrs[key] = value if isinstance(value, (str, int, float)) else json.dumps(to_jsonable(value))
     return Results(ds, reducer=red)
 
 
