@@ -37,6 +37,9 @@ from flexrv.design import load
 from flexrv.errors import InputError, SimulationError
 from flexrv.post.results import Results  # noqa: F401  (re-exported: flexrv.Results)
 
+#: systems with more coordinates than this use Exudyn's sparse linear solver
+SPARSE_ABOVE = 100
+
 #: default step [s]: ~25 steps per pin-mesh period of both presets at rated speed
 DEFAULT_DT = 1e-4
 
@@ -153,7 +156,10 @@ class Simulation:
         ti.adaptiveStep = True
         ti.minimumStepSize = dt * 1e-3
         ss.solution.file.write = False
-        ss.linearSolver.solverType = exu.LinearSolverType.EXUdense
+        # dense LU for the small rigid models; sparse for the ball/ring models, whose
+        # dense path costs 2-4x more in Exudyn (rv40e flexible: 10.2 -> 4.1 s per 10 ms)
+        ss.linearSolver.solverType = (exu.LinearSolverType.EXUdense if model.n <= SPARSE_ABOVE
+                                      else exu.LinearSolverType.EigenSparse)
 
         def on_sigint(signum, frame):
             state["stop"] = True
@@ -244,7 +250,7 @@ def _progress_callback(progress, t_end):
 
 def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = 0.02, settle: float = 0.005,
                    dt: float = DEFAULT_DT, torque: float | None = None, progress: bool | Callable = False,
-                   save_to: str | Path | None = None):
+                   save_to: str | Path | None = None, model_options: dict | None = None):
     """Virtual torsional-stiffness test bench (seed 004): input locked, output
     torque ramped 0 -> +T -> -T -> 0 (T = rated torque unless given), each
     quarter of the loop over ``quarter_time`` [s] (quasi-static: far longer than
@@ -264,7 +270,7 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
         raise InputError(f"quarter_time = {quarter_time!r} s is not allowed: must be > 20 dt = {20 * dt:g} s")
     times = np.array([0.0, settle, settle + quarter_time, settle + 3 * quarter_time, settle + 4 * quarter_time])
     program = piecewise_torque(times, [0.0, 0.0, t_r, -t_r, 0.0])
-    sim = Simulation(reducer, model=model, drive="locked", torque=program)
+    sim = Simulation(reducer, model=model, drive="locked", torque=program, model_options=model_options)
     res = sim.run(t_end=float(times[-1]), dt=dt, progress=progress)
     tq = res["output_torque"].values
     angle = -res["theta_out"].values  # the load torque acts against +theta: positive torque winds the output negative

@@ -30,7 +30,6 @@ the sweep table (NetCDF + CSV) and plots.
 
 from __future__ import annotations
 
-import copy
 import importlib
 import itertools
 import json
@@ -44,6 +43,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from flexrv.cache import atomic_write_text, content_hash
+from flexrv.design import apply_overrides
 from flexrv.errors import ConfigError, FlexrvError
 
 #: Built-in tasks: name -> "module:function" (imported lazily on the worker).
@@ -121,24 +121,6 @@ def load_spec(path: str | os.PathLike) -> SweepSpec:
 
 
 # ------------------------------------------------------------------ case logic
-def apply_overrides(base: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
-    """Return a copy of the design dict with dotted-path overrides applied.
-
-    Raises ConfigError for a path that does not exist in the design."""
-    data = copy.deepcopy(base)
-    for dotted, value in overrides.items():
-        keys = dotted.split(".")
-        node = data
-        for key in keys[:-1]:
-            if not isinstance(node, dict) or key not in node:
-                raise ConfigError(f"sweep parameter {dotted!r}: no field {key!r} in the design")
-            node = node[key]
-        if not isinstance(node, dict) or keys[-1] not in node:
-            raise ConfigError(f"sweep parameter {dotted!r}: no field {keys[-1]!r} in the design")
-        node[keys[-1]] = value
-    return data
-
-
 def resolve_task(name: str) -> Callable[..., dict]:
     """Import a task function from its registered name or 'module:function'."""
     target = TASKS.get(name, name)

@@ -35,22 +35,42 @@ def _bar(enabled: bool):
     return report
 
 
+MODEL_HELP = ("Model name: rigid (5-DOF main-bearing element), balls (ball-resolved main bearing, rigid rings) "
+              "or flexible (reduced flexible parts, see --parts).")
+PARTS_HELP = ("Flexible parts of --model flexible, comma-separated: main_bearing (flexible rings of both rows), "
+              "crankshaft. Default: main_bearing.")
+
+
+def model_options(model: str, parts: str | None) -> dict:
+    """Builder options of a model from the CLI's --parts (only for ``flexible``)."""
+    from flexrv.errors import InputError
+    from flexrv.model.factory import parse_parts
+
+    if parts is None:
+        return {}
+    if model != "flexible":
+        raise InputError(f"--parts {parts} is only allowed with --model flexible (got --model {model})")
+    return {"parts": parse_parts(parts)}
+
+
 def _default_out(preset: str, model: str, kind: str) -> Path:
     stem = Path(preset).stem
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
 def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
-             model: str = typer.Option("rigid", "--model", help="Model name: rigid (5-DOF main-bearing element) or balls (ball-resolved main bearing)."),
+             model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
              t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
              dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+             parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
              out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
              json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Run the multibody model; write NetCDF, config, summary.md and PNGs."""
     from flexrv.simulation import Simulation
 
+    options = model_options(model, parts)
     out = out or _default_out(preset, model, "sim")
-    sim = Simulation(preset, model=model)
+    sim = Simulation(preset, model=model, model_options=options)
     bar = _bar(not json)
     try:
         res = sim.run(t_end=t_end, dt=dt, progress=bar, save_to=out)
@@ -67,6 +87,9 @@ def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
             "steady_window_s": s["steady_window_s"], "max_pin_force_N": s["max_pin_force_N"],
             "pins_in_contact_mean": s["pins_in_contact_mean"], "pins_in_contact_max": s["pins_in_contact_max"],
             "wall_time_s": sim.timing.get("solve_s")}
+    for key in ("max_ball_load_N", "max_ring_deformation_m", "min_film_thickness_m"):
+        if key in s:
+            data[key] = s[key]
 
     def render(d):
         rows = [(k, v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}", "") for k, v in d.items()]
@@ -78,9 +101,10 @@ def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
 
 
 def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
-                       model: str = typer.Option("rigid", "--model", help="Model name: rigid (5-DOF main-bearing element) or balls (ball-resolved main bearing)."),
+                       model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
                        quarter_time: float = typer.Option(0.02, "--quarter-time", help="Duration of each quarter of the torque loop [s]."),
                        dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+                       parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
                        json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
@@ -89,10 +113,12 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
 
     from flexrv.simulation import stiffness_test
 
+    options = model_options(model, parts)
     out = out or _default_out(preset, model, "stiffness")
     bar = _bar(not json)
     try:
-        fig, _ = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out)
+        fig, _ = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out,
+                                model_options=options)
     finally:
         if bar:
             bar.stop()

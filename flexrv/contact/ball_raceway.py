@@ -40,14 +40,24 @@ from flexrv.contact.laws import impact_force
 NormalLaw = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 
-def hertz_law(k: float | np.ndarray, c_max: float = 0.0, depth: float = 1e-6) -> NormalLaw:
-    """Dry Hertz point contact Q = K delta^1.5 with the seeds' impact-law damping."""
+@dataclass(frozen=True)
+class HertzLaw:
+    """Dry Hertz point contact Q = K delta^1.5 with the seeds' impact-law damping
+    (a :data:`NormalLaw`; its parameters are readable, e.g. by the compiled row
+    kernel :mod:`flexrv.model.bearing_kernel`)."""
 
-    def law(delta, delta_rate):
-        q, dq_dgap, dq_drate = impact_force(-delta, -delta_rate, k, 1.5, c_max, depth)
+    k: float
+    c_max: float = 0.0
+    depth: float = 1e-6
+
+    def __call__(self, delta, delta_rate):
+        q, dq_dgap, dq_drate = impact_force(-delta, -delta_rate, self.k, 1.5, self.c_max, self.depth)
         return q, -dq_dgap, -dq_drate
 
-    return law
+
+def hertz_law(k: float | np.ndarray, c_max: float = 0.0, depth: float = 1e-6) -> NormalLaw:
+    """Dry Hertz point contact Q = K delta^1.5 with the seeds' impact-law damping."""
+    return HertzLaw(k, c_max, depth)
 
 
 @dataclass(frozen=True)

@@ -122,7 +122,7 @@ class ForceGroup:
                 return -(f_q * dq + f_v * dv)
 
             kwargs["jacobianUserFunction"] = jac_fn
-        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=np.zeros((n, n)),
+        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes,
                                                forceUserFunction=force_fn, **kwargs))
 
     @property
@@ -219,5 +219,5 @@ def add_merged(mbs, groups: list[ForceGroup], nodes: list[int], index: list, n: 
                 jac[np.ix_(ix, ix)] -= f_q * dq + f_v * dv
         return jac
 
-    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=np.zeros((n, n)),
+    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes,
                                            forceUserFunction=force_fn, jacobianUserFunction=jac_fn))

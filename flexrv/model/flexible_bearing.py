@@ -163,17 +163,18 @@ class RowModel:
     ball_reference: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
+        self._sizes = tuple(0 if r is None else r.stiffness.shape[0] for r in (self.inner, self.outer))
         psi = 2.0 * np.pi * np.arange(self.ball_count) / self.ball_count
         rb = self.row.ball_radius_pitch
         self.ball_reference = np.stack([rb * np.cos(psi), rb * np.sin(psi), np.full(self.ball_count, self.z)], -1)
 
     @property
     def m_inner(self) -> int:
-        return 0 if self.inner is None else self.inner.stiffness.shape[0]
+        return self._sizes[0]
 
     @property
     def m_outer(self) -> int:
-        return 0 if self.outer is None else self.outer.stiffness.shape[0]
+        return self._sizes[1]
 
     @property
     def n_coordinates(self) -> int:
@@ -184,6 +185,22 @@ class RowModel:
         a = 6 + self.m_inner
         b = a + self.m_outer
         return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + 3 * self.ball_count)
+
+
+def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+    """Generalized force of a row element (as ``evaluate_row(...).force``), from the
+    compiled kernel of :mod:`flexrv.model.bearing_kernel` when it covers the row's
+    rings and laws (inputs prepared once per row), else from :func:`evaluate_row`."""
+    inputs = getattr(model, "_kernel_inputs", False)
+    if inputs is False:
+        from flexrv.model.bearing_kernel import kernel_inputs
+
+        inputs = model._kernel_inputs = kernel_inputs(model)
+    if inputs is None:
+        return evaluate_row(model, q, q_t, jacobian=False).force
+    from flexrv.model.bearing_kernel import row_force_kernel
+
+    return row_force_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *inputs)
 
 
 @dataclass
@@ -408,13 +425,13 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
         n = model.n_coordinates
 
         def force_fn(mbs_, t, item, q, q_t, model=model):
-            return evaluate_row(model, np.asarray(q), np.asarray(q_t), jacobian=False).force
+            return row_force(model, np.asarray(q), np.asarray(q_t))
 
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, model=model):
             ev = evaluate_row(model, np.asarray(q), np.asarray(q_t), jacobian=True)
             return -(f_q * ev.jac_q + f_v * ev.jac_v)
 
-        obj = mbs.AddObject(ObjectGenericODE2(nodeNumbers=node_list, massMatrix=np.zeros((n, n)),
+        obj = mbs.AddObject(ObjectGenericODE2(nodeNumbers=node_list,
                                               forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
         objects.append(obj)
     return BearingHandle(rows=rows, frame_node=frame_node, inner_nodes=inner_nodes, outer_nodes=outer_nodes,
@@ -584,6 +601,14 @@ class BallBearingGroup(ForceGroup):
         qe[..., -3 * row.ball_count:] -= row.ball_reference.ravel()
         return qe, v[..., idx], idx
 
+    def _force(self, q, v) -> np.ndarray:
+        """Generalized force of one state (compiled row kernels where possible)."""
+        f = np.zeros(self._n)
+        for k in range(len(self.rows)):
+            qe, ve, idx = self._element_state(q, v, k)
+            f[idx] += row_force(self.rows[k], qe, ve)
+        return f
+
     def _evaluate_one(self, q, v, jacobian: bool):
         f = np.zeros(self._n)
         jq = np.zeros((self._n, self._n)) if jacobian else None
@@ -605,8 +630,7 @@ class BallBearingGroup(ForceGroup):
         q = np.asarray(q, dtype=float)
         v = np.asarray(v, dtype=float)
         if q.ndim == 1:
-            f, _, _, _ = self._evaluate_one(q, v, False)
-            return f, None
+            return self._force(q, v), None
         forces = np.zeros_like(q)
         history = []
         for i in range(q.shape[0]):

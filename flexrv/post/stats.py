@@ -80,4 +80,21 @@ def summary(res) -> dict:
         "mean_dissipation_W": p_in - p_out - dke,
         "kinematics": table,
         "failure": res.attrs.get("failure"),
+        **_bearing_summary(sel, finite),
     }
+
+
+def _bearing_summary(sel, finite: bool) -> dict:
+    """Steady-window extremes of the ball-resolved / flexible bearing outputs."""
+    out = {}
+    for key, var, fn in (("max_ball_load_N", "ball_load_inner", np.max),
+                         ("max_ring_deformation_m", "ring_deformation_outer", np.max),
+                         ("max_inner_ring_deformation_m", "ring_deformation_inner", np.max),
+                         ("max_ball_pressure_Pa", "ball_max_pressure", np.max)):
+        if var in sel and finite:
+            out[key] = float(fn(sel[var].values))
+    if "ball_film_thickness" in sel and finite:
+        h = sel["ball_film_thickness"].values
+        loaded = sel["ball_load_inner"].values > 0
+        out["min_film_thickness_m"] = float(h[loaded].min()) if loaded.any() else None
+    return out
