@@ -18,6 +18,8 @@ class Workflow(str, enum.Enum):
     kinematic_validation = "kinematic_validation"
     torsional_stiffness = "torsional_stiffness"
     mode_gallery = "mode_gallery"
+    ring_deformation = "ring_deformation"
+    lubrication = "lubrication"
 
 
 def _import(module: str):

@@ -5,8 +5,10 @@
   integral: with s = t/t_r, theta = omega_r t_r (s^3 - s^4/2) for t <= t_r and
   omega_r (t - t_r/2) afterwards.
 * Output: load torque T_max step(t, t1, 0, t2, 1) on the carrier against the
-  rotation (seeds 000/002), plus optional constant external radial force (along
-  +x), axial force (+z) and tilting moment (about x) on the output flange.
+  rotation (seeds 000/002), plus optional external radial force (along +x),
+  axial force (+z) and tilting moment (about x) on the output flange, ramped in
+  with the same STEP window as the torque (a sudden 30 kN at t = 0 would only add
+  a start-up transient of the bearing).
 """
 
 from __future__ import annotations
@@ -77,22 +79,29 @@ class OutputLoads(ForceGroup):
     members = ("carrier",)
     analytic_jacobian = True
 
-    def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0):
+    def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0,
+                 ramp: tuple[float, float] | None = None):
         self.torque = torque
         self.const = np.array([radial, 0.0, 0.0, axial, tilt, 0.0])
+        #: the external forces/moment ramp in with step(t, t1, 0, t2, 1) (None: from t = 0)
+        self.ramp = ramp
         self._cache = None
+
+    def _forces(self, t, shape):
+        f = np.broadcast_to(self.const, shape).copy()
+        if self.ramp is not None and self.ramp[1] > 0:
+            t1, t2 = self.ramp
+            f = f * np.asarray(adams_step(t, t1, 0.0, max(t2, t1 + 1e-12), 1.0))[..., None]
+        f[..., 2] = -self.torque(t)
+        return f
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
         if q.ndim == 1:  # solver call: the load depends on t only (same t in all Newton iterations)
             if self._cache is None or self._cache[0] != t:
-                f = self.const.copy()
-                f[2] = -self.torque(np.asarray(t, dtype=float))
-                self._cache = (t, f)
+                self._cache = (t, self._forces(np.asarray(t, dtype=float), (6,)))
             return self._cache[1].copy(), (self._outputs(np.asarray(t, dtype=float), q) if want_outputs else None)
         t = np.asarray(t, dtype=float)
-        f = np.broadcast_to(self.const, q.shape).copy()
-        f[..., 2] = -self.torque(t)
-        return f, (self._outputs(t, q) if want_outputs else None)
+        return self._forces(t, q.shape), (self._outputs(t, q) if want_outputs else None)
 
     def _outputs(self, t, q):
         return {"load_torque": Output(self.torque(t) + 0.0 * q[..., 0], ("time",), "N m", "load torque on the output")}
