@@ -159,6 +159,9 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     data["disc_speed"] = _var(disc_v[..., 2], ("time", "disc"), "rad/s", "disc rotation speed")
     data["carrier_x"] = _var(q[:, cs][:, 0], ("time",), "m", "carrier centre x")
     data["carrier_y"] = _var(q[:, cs][:, 1], ("time",), "m", "carrier centre y")
+    data["carrier_z"] = _var(q[:, cs][:, 3], ("time",), "m", "carrier axial displacement")
+    data["carrier_tilt"] = _var(np.hypot(q[:, cs][:, 4], q[:, cs][:, 5]), ("time",), "rad",
+                                "carrier tilt (magnitude of the rotations about x and y)")
     # group outputs, evaluated on the time history in chunks
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
