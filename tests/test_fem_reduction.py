@@ -30,10 +30,11 @@ def ring(tmp_path_factory):
     del os.environ["FLEXRV_CACHE"]
 
 
-def fe_patch_deflection(rv, mres, fe, az, forces):
-    """Full-FE patch-mean raceway displacement (n_az, 3) under patch loads."""
+def fe_patch_deflection(rv, mres, fe, az, forces, part="outer_ring"):
+    """Full-FE patch-mean raceway displacement (n_az, 3) [m] under patch loads
+    ``forces`` (n_az, 3) [N] at azimuths ``az``, ring clamped at its fit."""
     d = mres.data
-    rs = raceway_spec_for(spec_for(rv, "outer_ring"), None, 0)
+    rs = raceway_spec_for(spec_for(rv, part), None, 0)
     race = d.node_set("raceway")
     W = raceway_weights(d.nodes, race, nodal_areas(d.nodes, d.faces("raceway")), rs, az).toarray()
     f = np.zeros(fe.n_dof)

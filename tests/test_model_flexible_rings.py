@@ -13,11 +13,10 @@ import pytest
 
 from flexrv.design import load
 from flexrv.fem.body import _assemble, build_reduced_body, material_dict, raceway_spec_for
-from flexrv.fem.modal import factorize, free_dofs
-from flexrv.fem.reduction import nodal_areas, raceway_weights
 from flexrv.meshing import build_mesh, spec_for
 from flexrv.model.flexible_bearing import (RING_EIGENMODES, RING_HARMONICS, ModalRing, rows_from_design,
                                            rxyz_matrices)
+from tests.test_fem_reduction import fe_patch_deflection
 from tests.test_model_flexible_bearing import _static_rig
 
 SIZE, LOCAL = 0.015, 0.01  # coarse rv221 rings (as tests/test_fem_reduction.py)
@@ -42,22 +41,6 @@ def rings(tmp_path_factory):
         out[part] = (mres, fe, body)
     yield rv, out
     del os.environ["FLEXRV_CACHE"]
-
-
-def fe_contact_deflection(rv, part, mres, fe, azimuth, forces):
-    """Full-FE patch-mean raceway displacement (n, 3) [m] under patch loads
-    ``forces`` (n, 3) [N] at ``azimuth`` (n,), fit clamped."""
-    d = mres.data
-    rs = raceway_spec_for(spec_for(rv, part), None, 0)
-    race = d.node_set("raceway")
-    w = raceway_weights(d.nodes, race, nodal_areas(d.nodes, d.faces("raceway")), rs, azimuth).toarray()
-    f = np.zeros(fe.n_dof)
-    for c in range(3):
-        f[3 * race + c] = w.T @ forces[:, c]
-    idofs = free_dofs(fe.n_dof, d.node_set("fit"))
-    u = np.zeros(fe.n_dof)
-    u[idofs] = factorize(fe.K[idofs][:, idofs])(f[idofs])
-    return w @ u.reshape(-1, 3)[race]
 
 
 def _flexible_rows(rv, out, scale=1.0, rings=("inner", "outer")):
@@ -94,7 +77,7 @@ def test_ring_deflection_under_ball_loads_matches_full_fe(rings):
                 normal = st.normal[loaded]
             psi = np.arctan2(local[:, 1], local[:, 0])
             mirror = np.array([1.0, 1.0, -1.0 if k == 1 else 1.0])
-            ref = fe_contact_deflection(rv, f"{label}_ring", mres, fe, psi, load_on_ring * mirror) * mirror
+            ref = fe_patch_deflection(rv, mres, fe, psi, load_on_ring * mirror, part=f"{label}_ring") * mirror
             ring = getattr(row, label)
             _, si, so, _ = row.slices()
             q_modal = qs[k][si] if label == "inner" else qs[k][so]

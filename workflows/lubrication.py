@@ -133,10 +133,4 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
 
 
 if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--smoke", action="store_true")
-    args = parser.parse_args()
-    result = run(smoke=args.smoke)
-    print(result.out_dir)
+    print(run().out_dir)
