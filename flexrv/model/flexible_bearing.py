@@ -6,10 +6,13 @@ Members per row of the back-to-back pair:
 * the **inner ring** rides on a rigid frame node (``NodeRigidBodyRxyz``: the
   carrier, or a frame rigidly joined to it). Its elastic raceway displacement is
   ``Phi_i(psi) q_i`` in the frame's coordinates, with modal coordinates ``q_i`` on
-  their own ``NodeGenericODE2`` (reduced M, K). The inertia coupling between the
-  ring's slow frame rotation (carrier, ~0.7-1.6 rad/s) and its elastic modes is
-  neglected: centrifugal and Coriolis terms scale with omega_c^2 ~ 1 s^-2, eight
-  orders below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2;
+  their own ``NodeGenericODE2`` (reduced K; by default massless, see
+  :class:`ModalRing`: the fit-clamped ring's lowest mode is 47-167 kHz, so the
+  ring deforms quasi-statically). The inertia coupling between the ring's slow
+  frame rotation (carrier, ~0.7-1.6 rad/s) and its elastic modes is neglected:
+  centrifugal and Coriolis terms scale with omega_c^2 ~ 1 s^-2, eight orders
+  below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2 — so no FFRF
+  body is needed for the inner rings either;
 * the **outer ring** sits in the housing (fixed frame): plain modal coordinates
   ``q_o`` (20x cheaper than an FFRF body, see the facts note);
 * **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`);
@@ -23,8 +26,11 @@ Rings given as ``None`` are rigid (no modal node) — the stiff-ring limit.
 
 The contact element of a row is one ``ObjectGenericODE2`` over the nodes
 [frame, inner modes, outer modes, balls]: one Python call evaluates all ball
-contacts of the row with numpy (:func:`flexrv.contact.ball_raceway.raceway_contacts`)
-and an analytic Jacobian assembled from per-ball 3x3 blocks. The groove centre of
+contacts of the row — the force by the compiled kernel of
+:mod:`flexrv.model.bearing_kernel` (:func:`row_force`), the reference and the
+analytic Jacobian with numpy (:func:`evaluate_row`,
+:func:`flexrv.contact.ball_raceway.raceway_contacts`), assembled from per-ball
+3x3 blocks. The groove centre of
 ball j depends linearly on the element's ring coordinates x through
 c_j = c0_j + T_j x; the generalized reaction is -sum T_j^T f_j and the Jacobian
 blocks are K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j (geometric-stiffness terms
