@@ -193,12 +193,13 @@ def test_stiffened_flexible_reducer_matches_rigid_ring_reducer():
 @pytest.mark.parametrize("ehl", ["dry", "hamrock_dowson"])
 @pytest.mark.parametrize("flexible", [False, True])
 def test_compiled_row_kernel_matches_reference(rings, ehl, flexible):
-    """The compiled row force (:mod:`flexrv.model.bearing_kernel`) equals the
-    numpy reference :func:`evaluate_row` within 1e-9 of the largest force, for
+    """The compiled row force and Jacobians (:mod:`flexrv.model.bearing_kernel`)
+    equal the numpy reference :func:`evaluate_row` within 1e-9 of the largest
+    entry, for
     rigid and modal rings (row 1 mirrored), dry and Hamrock–Dowson laws, at a
     random state with um displacements, mrad tilts and a turning frame."""
     from flexrv.model.bearing_kernel import kernel_inputs
-    from flexrv.model.flexible_bearing import evaluate_row, row_force
+    from flexrv.model.flexible_bearing import evaluate_row, row_force, row_jacobian
 
     rv, out = rings
     if flexible:
@@ -219,7 +220,10 @@ def test_compiled_row_kernel_matches_reference(rings, ehl, flexible):
         q[so] *= 1e3
         qt = rng.normal(scale=1e-3, size=n)
         qt[5] = 1.2  # rad/s: entrainment for the EHL film
-        ref = evaluate_row(row, q, qt, jacobian=False).force
+        ev = evaluate_row(row, q, qt, jacobian=True)
         fast = row_force(row, q, qt)
-        assert np.abs(ref).max() > 100.0  # loaded contacts
-        np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+        assert np.abs(ev.force).max() > 100.0  # loaded contacts
+        np.testing.assert_allclose(fast, ev.force, rtol=0, atol=1e-9 * np.abs(ev.force).max())
+        jq, jv = row_jacobian(row, q, qt)
+        np.testing.assert_allclose(jq, ev.jac_q, rtol=0, atol=1e-9 * np.abs(ev.jac_q).max())
+        np.testing.assert_allclose(jv, ev.jac_v, rtol=0, atol=1e-9 * np.abs(ev.jac_v).max())

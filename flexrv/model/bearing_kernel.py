@@ -75,18 +75,13 @@ def kernel_inputs(model) -> tuple | None:
 
 
 @njit(cache=True)
-def _step(x, depth):
-    """Adams STEP(x, 0, 0, depth, 1) (flexrv.contact.laws)."""
-    s = min(max(x / depth, 0.0), 1.0)
-    return s * s * (3.0 - 2.0 * s)
-
-
-@njit(cache=True)
 def _normal_load(delta, rate, speed, law):
-    """Q of the EHL-corrected / dry law (flexrv.contact.ehl_law._solve, n = 3/2)."""
+    """(Q, dQ/d delta, dQ/d rate) of the EHL-corrected / dry law
+    (flexrv.contact.ehl_law._solve and flexrv.contact.laws.impact_force, n = 3/2)."""
     k, h_unit, lexp, sexp, floor, c_max, depth, iters = (law[0], law[1], law[2], law[3], law[4], law[5],
                                                          law[6], int(law[7]))
     hu = h_unit * speed**sexp if h_unit > 0.0 and speed > 0.0 else 0.0
+    dphi = 1.0
     if hu == 0.0:
         s = max(delta, 0.0)
     else:
@@ -102,11 +97,18 @@ def _normal_load(delta, rate, speed, law):
                 break
             s = max(s - (s - delta - h) / dphi, 0.0)
     if s <= 0.0:
-        return 0.0
+        return 0.0, 0.0, 0.0
     force = k * s**1.5
+    dforce = 1.5 * k * math.sqrt(s) / dphi
+    c = 0.0
     if c_max > 0.0:
-        force += c_max * _step(s, depth) * rate
-    return max(force, 0.0)
+        x = min(max(s / depth, 0.0), 1.0)
+        c = c_max * x * x * (3.0 - 2.0 * x)
+        force += c * rate
+        dforce += c_max * 6.0 * x * (1.0 - x) / depth / dphi * rate
+    if force <= 0.0:
+        return 0.0, 0.0, 0.0
+    return force, dforce, c
 
 
 @njit(cache=True)
@@ -136,9 +138,27 @@ def _basis(table, zsign, psi, out):
 
 
 @njit(cache=True)
-def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o):
-    """Generalized force (n,) of a row element, coordinates ordered
-    [frame(6), inner modes, outer modes, balls(3Z)] (see evaluate_row)."""
+def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
+    """d force_ball / d ball position and velocity (3x3) of one contact
+    (flexrv.contact.ball_raceway.raceway_contacts, plus the follower term Q/L
+    e_t e_t^T of evaluate_row: the groove centre follows the ball's azimuth)."""
+    n = (nx, ny, nz)
+    et = (etx, ety, 0.0)
+    ql = q_load / length
+    for a in range(3):
+        for b in range(3):
+            nn = n[a] * n[b]
+            eye = 1.0 if a == b else 0.0
+            stiff[a, b] = -(dq * nn + ql * (eye - nn)) + ql * et[a] * et[b]
+            damp[a, b] = -c * nn
+
+
+@njit(cache=True)
+def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, jacobian):
+    """Generalized force (n,) of a row element and, with ``jacobian``, its
+    derivatives d f / d q and d f / d q_t (n, n); coordinates ordered
+    [frame(6), inner modes, outer modes, balls(3Z)] (see evaluate_row, whose
+    Jacobian blocks K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j this assembles)."""
     z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (geometry[0], geometry[1], geometry[2], geometry[3],
                                                        geometry[4], geometry[5], geometry[6], geometry[7])
     speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (geometry[8], geometry[9], geometry[10], geometry[11],
@@ -148,7 +168,11 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     nz = ball_ref.shape[0]
     n = 6 + m_i + m_o + 3 * nz
     b0 = 6 + m_i + m_o
+    nx_i = 6 + m_i
     f = np.zeros(n)
+    nj = n if jacobian else 0
+    jq = np.zeros((nj, nj))
+    jv = np.zeros((nj, nj))
     ax, ay, az = q[3], q[4], q[5]
     sa, ca, sb, cb, sc, cc = math.sin(ax), math.cos(ax), math.sin(ay), math.cos(ay), math.sin(az), math.cos(az)
     # A = Rx(ax) Ry(ay) Rz(az); omega = G phi_t (Exudyn RotXYZ2RotationMatrix / RotXYZ2G)
@@ -161,12 +185,25 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     speed = speed_factor * abs(qt[5])
     bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
+    t_i = np.zeros((3, nx_i))
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
     two_pi = 2.0 * math.pi
+    nzj = nz if jacobian else 0
+    ti_all = np.zeros((3 * nzj, nx_i))
+    kti_q = np.zeros((3 * nzj, nx_i))
+    kti_v = np.zeros((3 * nzj, nx_i))
+    to_all = np.zeros((3 * nzj, m_o))
+    kto_q = np.zeros((3 * nzj, m_o))
+    kto_v = np.zeros((3 * nzj, m_o))
     for j in range(nz):
-        bx = ball_ref[j, 0] + q[b0 + 3 * j]
-        by = ball_ref[j, 1] + q[b0 + 3 * j + 1]
-        bz = ball_ref[j, 2] + q[b0 + 3 * j + 2]
-        vx, vy, vz = qt[b0 + 3 * j], qt[b0 + 3 * j + 1], qt[b0 + 3 * j + 2]
+        bj = b0 + 3 * j
+        bx = ball_ref[j, 0] + q[bj]
+        by = ball_ref[j, 1] + q[bj + 1]
+        bz = ball_ref[j, 2] + q[bj + 2]
+        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
         # ---- inner ring (frame)
         dx, dy, dz = bx - q[0], by - q[1], bz - q[2]
         lx = dx * a[0, 0] + dy * a[1, 0] + dz * a[2, 0]
@@ -185,11 +222,11 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
         cvy = qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1]
         cvz = qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2]
         ex, ey, ez = bx - cx, by - cy, bz - cz
-        length = math.sqrt(ex * ex + ey * ey + ez * ez)
-        nx, ny, nz_ = ex / length, ey / length, ez / length
-        rate = nx * (vx - cvx) + ny * (vy - cvy) + nz_ * (vz - cvz)
-        qi = _normal_load(length - off_i, rate, speed, law_i)
-        fix, fiy, fiz = -qi * nx, -qi * ny, -qi * nz_
+        len_i = math.sqrt(ex * ex + ey * ey + ez * ez)
+        nix, niy, niz = ex / len_i, ey / len_i, ez / len_i
+        rate = nix * (vx - cvx) + niy * (vy - cvy) + niz * (vz - cvz)
+        qi, dqi, cdi = _normal_load(len_i - off_i, rate, speed, law_i)
+        fix, fiy, fiz = -qi * nix, -qi * niy, -qi * niz
         # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
         f[0] -= fix
         f[1] -= fiy
@@ -221,11 +258,11 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
                 ovy += bas_o[1, k] * vk
                 ovz += bas_o[2, k] * vk
         ex, ey, ez = bx - ox, by - oy, bz - oz
-        length = math.sqrt(ex * ex + ey * ey + ez * ez)
-        nx, ny, nz_ = ex / length, ey / length, ez / length
-        rate = nx * (vx - ovx) + ny * (vy - ovy) + nz_ * (vz - ovz)
-        qo = _normal_load(length - off_o, rate, speed, law_o)
-        fox, foy, foz = -qo * nx, -qo * ny, -qo * nz_
+        len_o = math.sqrt(ex * ex + ey * ey + ez * ez)
+        nox, noy, noz = ex / len_o, ey / len_o, ez / len_o
+        rate = nox * (vx - ovx) + noy * (vy - ovy) + noz * (vz - ovz)
+        qo, dqo, cdo = _normal_load(len_o - off_o, rate, speed, law_o)
+        fox, foy, foz = -qo * nox, -qo * noy, -qo * noz
         if m_o > 0:
             for k in range(m_o):
                 f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
@@ -238,7 +275,56 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
         s_t = vx * etx + vy * ety - radius * cage_ratio * qt[5]
         fc = -(cage_k * radius * dev + cage_c * s_t)
         pr = radius - rb
-        f[b0 + 3 * j] = fix + fox + fc * etx - pocket_k * pr * cos_p
-        f[b0 + 3 * j + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
-        f[b0 + 3 * j + 2] = fiz + foz - pocket_k * (bz - z_row)
+        f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
+        f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
+        f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
+        if not jacobian:
+            continue
+        # ---- Jacobian blocks
+        _contact_blocks(qi, dqi, cdi, len_i, nix, niy, niz, etx, ety, k_i, d_i)
+        _contact_blocks(qo, dqo, cdo, len_o, nox, noy, noz, etx, ety, k_o, d_o)
+        et = (etx, ety, 0.0)
+        for c1 in range(3):
+            for c2 in range(3):
+                ee = et[c1] * et[c2]
+                eye = 1.0 if c1 == c2 else 0.0
+                jq[bj + c1, bj + c2] += k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
+                jv[bj + c1, bj + c2] += d_i[c1, c2] + d_o[c1, c2] - cage_c * ee
+            jq[bj + c1, 5] += cage_k * radius * cage_ratio * et[c1]
+            jv[bj + c1, 5] += cage_c * radius * cage_ratio * et[c1]
+        # T_i = [I | -[Ap]x G | A basis_i]; stacked over the balls for one product each at the end
+        rows3 = slice(3 * j, 3 * j + 3)
+        for r in range(3):
+            for c1 in range(3):
+                t_i[r, c1] = 1.0 if r == c1 else 0.0
+        skew = np.array([[0.0, -ap[2], ap[1]], [ap[2], 0.0, -ap[0]], [-ap[1], ap[0], 0.0]])
+        t_i[:, 3:6] = -(skew @ g)
+        if m_i > 0:
+            t_i[:, 6:] = a @ bas_i
+        ti_all[rows3] = t_i
+        kti_q[rows3] = k_i @ t_i
+        kti_v[rows3] = d_i @ t_i
+        if m_o > 0:
+            to_all[rows3] = bas_o
+            kto_q[rows3] = k_o @ bas_o
+            kto_v[rows3] = d_o @ bas_o
+    if jacobian:
+        # d f_ball/d x = -K T; d g/d b = -T^T K (K symmetric); d g/d x = sum T^T K T
+        ball = slice(b0, b0 + 3 * nz)
+        o = slice(6 + m_i, 6 + m_i + m_o)
+        for jac, kt, kto in ((jq, kti_q, kto_q), (jv, kti_v, kto_v)):
+            jac[ball, 0:nx_i] -= kt
+            jac[0:nx_i, ball] -= kt.T
+            jac[0:nx_i, 0:nx_i] += ti_all.T @ kt
+            if m_o > 0:
+                jac[ball, o] -= kto
+                jac[o, ball] -= kto.T
+                jac[o, o] += to_all.T @ kto
+    return f, jq, jv
+
+
+@njit(cache=True)
+def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o):
+    """Generalized force (n,) of a row element (see :func:`row_kernel`)."""
+    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, False)
     return f

@@ -193,20 +193,40 @@ class RowModel:
         return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + 3 * self.ball_count)
 
 
-def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
-    """Generalized force of a row element (as ``evaluate_row(...).force``), from the
-    compiled kernel of :mod:`flexrv.model.bearing_kernel` when it covers the row's
-    rings and laws (inputs prepared once per row), else from :func:`evaluate_row`."""
+def _kernel(model: RowModel):
+    """Inputs of the compiled row kernel (prepared once per row), or None."""
     inputs = getattr(model, "_kernel_inputs", False)
     if inputs is False:
         from flexrv.model.bearing_kernel import kernel_inputs
 
         inputs = model._kernel_inputs = kernel_inputs(model)
+    return inputs
+
+
+def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+    """Generalized force of a row element (as ``evaluate_row(...).force``), from the
+    compiled kernel of :mod:`flexrv.model.bearing_kernel` when it covers the row's
+    rings and laws, else from :func:`evaluate_row`."""
+    inputs = _kernel(model)
     if inputs is None:
         return evaluate_row(model, q, q_t, jacobian=False).force
     from flexrv.model.bearing_kernel import row_force_kernel
 
     return row_force_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *inputs)
+
+
+def row_jacobian(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(d force/d q, d force/d q_t) of a row element (as :func:`evaluate_row`), compiled
+    where :func:`row_force` is."""
+    inputs = _kernel(model)
+    if inputs is None:
+        ev = evaluate_row(model, q, q_t, jacobian=True)
+        return ev.jac_q, ev.jac_v
+    from flexrv.model.bearing_kernel import row_kernel
+
+    _, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *inputs,
+                           True)
+    return jq, jv
 
 
 @dataclass
@@ -434,8 +454,8 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
             return row_force(model, np.asarray(q), np.asarray(q_t))
 
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, model=model):
-            ev = evaluate_row(model, np.asarray(q), np.asarray(q_t), jacobian=True)
-            return -(f_q * ev.jac_q + f_v * ev.jac_v)
+            jq, jv = row_jacobian(model, np.asarray(q), np.asarray(q_t))
+            return -(f_q * jq + f_v * jv)
 
         obj = mbs.AddObject(ObjectGenericODE2(nodeNumbers=node_list,
                                               forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
@@ -605,8 +625,8 @@ class BallBearingGroup(ForceGroup):
             def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, row=row, element=element, inv=inv):
                 stats[1] += 1
                 qe, ve = element(q, q_t)
-                ev = evaluate_row(row, qe, ve, jacobian=True)
-                return -(f_q * ev.jac_q + f_v * ev.jac_v)[np.ix_(inv, inv)]
+                jq, jv = row_jacobian(row, qe, ve)
+                return -(f_q * jq + f_v * jv)[np.ix_(inv, inv)]
 
             objects.append(mbs.AddObject(ObjectGenericODE2(nodeNumbers=row_nodes, forceUserFunction=force_fn,
                                                            jacobianUserFunction=jac_fn)))
@@ -684,7 +704,16 @@ class BallBearingGroup(ForceGroup):
         return forces, out
 
     def jacobian(self, t, q, v):
-        _, jq, jv, _ = self._evaluate_one(np.asarray(q, dtype=float), np.asarray(v, dtype=float), True)
+        q = np.asarray(q, dtype=float)
+        v = np.asarray(v, dtype=float)
+        jq = np.zeros((self._n, self._n))
+        jv = np.zeros((self._n, self._n))
+        for k, row in enumerate(self.rows):
+            qe, ve, idx = self._element_state(q, v, k)
+            dq, dv = row_jacobian(row, qe, ve)
+            ix = np.ix_(idx, idx)
+            jq[ix] += dq
+            jv[ix] += dv
         return jq, jv
 
 
