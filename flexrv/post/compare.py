@@ -1,0 +1,168 @@
+"""Rigid vs flexible model on identical inputs (seeds 000/001's comparison).
+
+>>> from flexrv.post.compare import run_compare                      # doctest: +SKIP
+>>> cmp = run_compare("rv221", t_end=0.4, parts=("main_bearing",))    # doctest: +SKIP
+>>> cmp.numbers["flexible"]["te_pp_arcsec"]                         # doctest: +SKIP
+
+Both runs use the same design, drive, load program and step; they differ only in
+the model (``"rigid"``: 5-DOF main-bearing element, rigid crankshafts;
+``"flexible"``: the parts named in ``parts`` flexible, see
+:func:`flexrv.model.factory.build_flexible`). Written under ``out_dir``: the two
+result folders (``rigid/``, ``flexible/``: NetCDF, config, PNGs, summary.md),
+``te_overlay.png``, ``te_spectrum.png`` (characteristic frequencies marked),
+``ball_loads.png`` and ``ring_deformation.png`` (if the flexible model has a
+ball-resolved bearing), ``summary.md`` (rigid vs flexible table in the style of
+seeds 000/001) and ``compare.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from flexrv.cache import atomic_write_text, to_jsonable
+
+#: seeds 000/001: TE range [arcsec] and period [s] of the rigid and the flexible-bearing model
+SEED_TE = {"rigid": {"te_min_arcsec": -25.2, "te_max_arcsec": 21.6, "period_s": 0.15},
+           "flexible": {"te_min_arcsec": -43.2, "te_max_arcsec": 45.0, "period_s": 0.28}}
+
+
+@dataclass
+class CompareResult:
+    """Outputs of :func:`run_compare`."""
+
+    out_dir: Path
+    rigid: object  #: Results
+    flexible: object  #: Results
+    numbers: dict = field(default_factory=dict)
+    files: list = field(default_factory=list)
+
+
+def te_numbers(res) -> dict:
+    """TE statistics over the steady window, dominant TE frequency/period from the
+    amplitude spectrum, and the bearing extremes of one run (JSON-ready)."""
+    from flexrv.post.spectra import te_spectrum
+
+    s = res.summary()
+    freq, amp, marks = te_spectrum(res)
+    out = {key: s[key] for key in ("te_min_arcsec", "te_max_arcsec", "te_pp_arcsec", "te_mean_arcsec",
+                                   "te_rms_fluctuation_arcsec", "ratio_simulated_over_theoretical",
+                                   "steady_window_s")}
+    if len(freq) > 2:
+        k = 1 + int(np.argmax(amp[1:]))
+        out["dominant_frequency_hz"] = float(freq[k])
+        out["dominant_period_s"] = float(1.0 / freq[k]) if freq[k] > 0 else None
+        out["dominant_amplitude_arcsec"] = float(amp[k])
+    out["characteristic_frequencies_hz"] = marks
+    for key in ("max_ball_load_N", "max_ring_deformation_m", "max_inner_ring_deformation_m", "min_film_thickness_m",
+                "max_ball_pressure_Pa"):
+        if key in s:
+            out[key] = s[key]
+    te = res["te"].values
+    out["te_whole_run_min_arcsec"] = float(te.min())
+    out["te_whole_run_max_arcsec"] = float(te.max())
+    return out
+
+
+def compare_numbers(rigid, flexible) -> dict:
+    """Numbers of both runs and their differences."""
+    nr, nf = te_numbers(rigid), te_numbers(flexible)
+    return {"rigid": nr, "flexible": nf,
+            "difference": {"te_pp_arcsec": nf["te_pp_arcsec"] - nr["te_pp_arcsec"],
+                           "te_mean_arcsec": nf["te_mean_arcsec"] - nr["te_mean_arcsec"]},
+            "seed": SEED_TE}
+
+
+def summary_markdown(reducer, parts, numbers: dict, timing: dict) -> str:
+    """summary.md: rigid vs flexible table (seeds 000/001 style) and notes."""
+    nr, nf = numbers["rigid"], numbers["flexible"]
+
+    def f(x, fmt=".2f"):
+        return "–" if x is None else format(x, fmt)
+
+    lines = [f"# Rigid vs flexible model: {reducer.name}", "",
+             f"Flexible parts: {', '.join(parts)}. Identical design, drive, load program and step. "
+             f"Steady window: {nr['steady_window_s'][0]:.3f}-{nr['steady_window_s'][1]:.3f} s.", "",
+             "| model | TE min [arcsec] | TE max [arcsec] | TE p-p [arcsec] | TE mean [arcsec] | dominant period [s] |"
+             " seed 000/001 TE range [arcsec] | seed period [s] |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, n in (("rigid", nr), ("flexible", nf)):
+        seed = SEED_TE[name]
+        lines.append(f"| {name} | {f(n['te_min_arcsec'])} | {f(n['te_max_arcsec'])} | {f(n['te_pp_arcsec'])} | "
+                     f"{f(n['te_mean_arcsec'])} | {f(n.get('dominant_period_s'), '.4g')} | "
+                     f"{seed['te_min_arcsec']} .. {seed['te_max_arcsec']} | {seed['period_s']} |")
+    lines.append("")
+    if "max_ball_load_N" in nf:
+        lines += ["| flexible bearing (steady window) | value |", "|---|---|",
+                  f"| max ball load [N] | {f(nf['max_ball_load_N'], '.1f')} |"]
+        if "max_ring_deformation_m" in nf:
+            lines.append(f"| max outer-ring deflection at the most-loaded ball [um] | "
+                         f"{f(1e6 * nf['max_ring_deformation_m'], '.3f')} |")
+        if "max_inner_ring_deformation_m" in nf:
+            lines.append(f"| max inner-ring deflection at the most-loaded ball [um] | "
+                         f"{f(1e6 * nf['max_inner_ring_deformation_m'], '.3f')} |")
+        if nf.get("min_film_thickness_m") is not None:
+            lines.append(f"| min central EHL film of the loaded balls [um] | "
+                         f"{f(1e6 * nf['min_film_thickness_m'], '.3f')} |")
+        lines.append("")
+    marks = nr["characteristic_frequencies_hz"]
+    lines += ["Characteristic frequencies [Hz]: " + ", ".join(f"{k} {v:.4g}" for k, v in marks.items()) + ".", ""]
+    periods = {k: 1.0 / v for k, v in marks.items() if v > 0}
+    lines += [
+        "Seeds 000/001 report TE ranges of about +/-25 arcsec (rigid) and +/-45 arcsec (flexible main bearing), "
+        "symmetric about zero, with periods 0.15/0.28 s. In flexrv the loaded TE is the offset of the torque "
+        "path (clearances closed in the load direction plus the elastic wind-up; "
+        f"mean {f(nr['te_mean_arcsec'])} arcsec rigid, {f(nf['te_mean_arcsec'])} arcsec flexible) "
+        f"with a ripple of {f(nr['te_pp_arcsec'])} / {f(nf['te_pp_arcsec'])} arcsec peak-to-peak; the seeds' "
+        "periods match none of the drive's characteristic periods ("
+        + ", ".join(f"{k} {v:.4g} s" for k, v in periods.items())
+        + "), so flexrv does not reproduce them and reports what its verified models give. The flexible - rigid "
+        "difference comes from the ball-bearing compliance (carrier shift and tilt), the ring deflection under "
+        "the balls (local, ~1 um: the rings are clamped at their fits) and, if flexible, the crankshaft torsion.", "",
+        f"Wall time: rigid {timing.get('rigid_s', 0):.1f} s, flexible {timing.get('flexible_s', 0):.1f} s "
+        f"(including model build: meshing and CMS if not cached).", ""]
+    return "\n".join(lines)
+
+
+def run_compare(preset_or_reducer, t_end: float | None = None, parts=("main_bearing",), out_dir=None,
+                dt: float | None = None, progress=False, flexible_options: dict | None = None) -> CompareResult:
+    """Run the rigid and the flexible model on identical inputs; write plots,
+    summary.md and compare.json under ``out_dir`` (see module docstring).
+    ``flexible_options``: further builder options of the flexible model, e.g.
+    ``{"ring_options": {"size": 0.006}}`` (:func:`flexrv.model.factory.build_flexible`)."""
+    from flexrv.design import load
+    from flexrv.model.factory import parse_parts
+    from flexrv.simulation import DEFAULT_DT, Simulation
+    from flexrv.viz import compare_plots
+
+    reducer = load(preset_or_reducer)
+    parts = parse_parts(parts)
+    dt = DEFAULT_DT if dt is None else dt
+    out = Path(out_dir) if out_dir is not None else Path("results") / f"{reducer.name}_compare_{time.strftime('%Y%m%d-%H%M%S')}"
+    out.mkdir(parents=True, exist_ok=True)
+    runs, timing = {}, {}
+    flex_opts = {"parts": parts, **(flexible_options or {})}
+    for name, model, options in (("rigid", "rigid", {}), ("flexible", "flexible", flex_opts)):
+        t0 = time.perf_counter()
+        sim = Simulation(reducer, model=model, model_options=options)
+        res = sim.run(t_end=t_end, dt=dt, progress=progress, save_to=out / name)
+        res.save(out / name)
+        timing[f"{name}_s"] = time.perf_counter() - t0
+        runs[name] = res
+    numbers = compare_numbers(runs["rigid"], runs["flexible"])
+    numbers["parts"] = list(parts)
+    numbers["timing"] = timing
+    files = [compare_plots.plot_te_overlay(runs["rigid"], runs["flexible"], out / "te_overlay.png"),
+             compare_plots.plot_te_spectra(runs["rigid"], runs["flexible"], out / "te_spectrum.png")]
+    if "ball_load_inner" in runs["flexible"]:
+        files.append(compare_plots.plot_ball_loads(runs["flexible"], out / "ball_loads.png"))
+    if "ring_deformation_outer" in runs["flexible"]:
+        files.append(compare_plots.plot_ring_deformation(runs["flexible"], out / "ring_deformation.png"))
+    atomic_write_text(out / "summary.md", summary_markdown(reducer, parts, numbers, timing))
+    atomic_write_text(out / "compare.json", json.dumps(to_jsonable(numbers), indent=2))
+    files += [out / "summary.md", out / "compare.json"]
+    return CompareResult(out_dir=out, rigid=runs["rigid"], flexible=runs["flexible"], numbers=numbers, files=files)
