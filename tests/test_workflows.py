@@ -142,3 +142,20 @@ def test_lubrication_smoke(tmp_path):
     assert ratio == pytest.approx((1.5 / 0.05) ** 0.67, rel=0.1)
     assert len([c for c in r.comparisons if c.quantity.startswith("film")]) == 3
     assert (tmp_path / "lubrication" / "lubrication.png").exists()
+
+
+def test_rigid_vs_flexible_smoke(tmp_path):
+    """Workflow 2 (seeds 000/001) smoke: both models run on identical inputs; the
+    seeds' TE ranges and periods stand beside flexrv's; the TE difference flexible -
+    rigid is the difference of the two runs' statistics."""
+    from workflows.rigid_vs_flexible import run
+
+    r = run(tmp_path / "rigid_vs_flexible", smoke=True)
+    rows = {c.quantity: c for c in r.comparisons}
+    assert rows["TE range, rigid model"].seed == "-25.2 .. 21.6"
+    assert rows["TE range, flexible model"].seed == "-43.2 .. 45.0"
+    d = r.numbers["difference"]["te_pp_arcsec"]
+    assert d == pytest.approx(r.numbers["flexible"]["te_pp_arcsec"] - r.numbers["rigid"]["te_pp_arcsec"])
+    assert r.numbers["te_rms_difference_arcsec"] >= 0
+    text = (tmp_path / "rigid_vs_flexible" / "summary.md").read_text()
+    assert "te_overlay.png" in text and (tmp_path / "rigid_vs_flexible" / "te_overlay.png").exists()

@@ -18,6 +18,7 @@ class Workflow(str, enum.Enum):
     kinematic_validation = "kinematic_validation"
     torsional_stiffness = "torsional_stiffness"
     mode_gallery = "mode_gallery"
+    rigid_vs_flexible = "rigid_vs_flexible"
     ring_deformation = "ring_deformation"
     lubrication = "lubrication"
 
