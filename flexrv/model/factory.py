@@ -59,15 +59,17 @@ def empirical_needle_constant(reducer) -> float:
 
 
 def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
-                crankshaft: str = "rigid", ring_options: dict | None = None, model_name: str = "rigid") -> AssembledModel:
+                crankshaft: str = "rigid", ring_options: dict | None = None, crank_options: dict | None = None,
+                model_name: str = "rigid") -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
     ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
     ball-resolved bearing of :mod:`flexrv.model.flexible_bearing`: every ball a
     point mass between rigid rings, Hertz/EHL contacts per the design) or
     ``"flexible"`` (the same with reduced flexible rings, ``ring_options``);
-    ``crankshaft``: ``"rigid"`` or ``"flexible"``. ``model_name`` labels the
-    results of a non-rigid variant."""
+    ``crankshaft``: ``"rigid"`` or ``"flexible"`` (:mod:`flexrv.model.flexible_crank`,
+    options ``crank_options``). ``model_name`` labels the results of a non-rigid
+    variant."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
@@ -116,7 +118,7 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     if crankshaft == "flexible":
         from flexrv.model.flexible_crank import add_flexible_cranks
 
-        add_flexible_cranks(reducer, p, members, groups)
+        info.update(add_flexible_cranks(reducer, p, members, groups, **(crank_options or {})))
     elif crankshaft != "rigid":
         raise ConfigError(f"crankshaft = {crankshaft!r} is not allowed: choose 'rigid' or 'flexible'")
     info.update(main_bearing=main_bearing, crankshaft=crankshaft)
@@ -205,19 +207,20 @@ def parse_parts(parts) -> tuple[str, ...]:
 
 
 def build_flexible(reducer, parts=DEFAULT_FLEXIBLE_PARTS, ring_options: dict | None = None,
-                   **kwargs) -> AssembledModel:
+                   crank_options: dict | None = None, **kwargs) -> AssembledModel:
     """Rigid model with the named parts flexible (:data:`FLEXIBLE_PARTS`):
 
     * ``main_bearing`` — ball-resolved bearing with reduced flexible inner and
       outer rings of both rows (:func:`flexrv.model.flexible_bearing.flexible_rings`,
       options ``ring_options``: harmonics, n_eig, size, damping_ratio,
       stiffness_scale);
-    * ``crankshaft`` — reduced flexible crankshafts (:mod:`flexrv.model.flexible_crank`).
+    * ``crankshaft`` — flexible crankshafts (:mod:`flexrv.model.flexible_crank`,
+      options ``crank_options``: size, stiffness_scale, damping_ratio).
     """
     parts = parse_parts(parts)
     return build_rigid(reducer, main_bearing="flexible" if "main_bearing" in parts else "rigid",
                        crankshaft="flexible" if "crankshaft" in parts else "rigid", ring_options=ring_options,
-                       model_name="flexible", **kwargs)
+                       crank_options=crank_options, model_name="flexible", **kwargs)
 
 
 #: model name -> builder(reducer, drive=..., torque=..., **options) -> AssembledModel

@@ -70,6 +70,8 @@ class RigidParameters:
     # masses
     crank_mass: float
     crank_inertia: float
+    planet_mass: float  #: planet gear + gear seat (part of crank_mass) [kg]
+    planet_inertia: float  #: its inertia about the crank axis (part of crank_inertia) [kg m^2]
     disc_mass: float
     disc_inertia: float
     carrier_mass: float
@@ -152,6 +154,10 @@ def rigid_parameters(reducer) -> RigidParameters:
     crank_mass = m_planet + m_shaft
     crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2
                                                         for d, l, k in parts)
+    d_seat, l_seat = cs.gear_seat_diameter_mm * 1e-3, cs.gear_seat_length_mm * 1e-3
+    m_seat = _cyl_mass(rho_c, d_seat, l_seat)
+    planet_mass = m_planet + m_seat
+    planet_inertia = 0.5 * m_planet * r_pitch_p**2 + 0.5 * m_seat * (0.5 * d_seat) ** 2
     r_out = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
     r_in = ss.center_hole_radius
     r_h = reducer.crank_hole_radius
@@ -188,7 +194,8 @@ def rigid_parameters(reducer) -> RigidParameters:
         eccentricity=ss.eccentricity, pin_circle_radius=ss.pin_circle_radius, pin_radius=ss.pin_radius,
         d_radius=ss.modification_shift, d_pin_radius=ss.modification_equidistant, d_rotation=ss.modification_rotation,
         disc_width=b, pins=pins, chi0=chi0, disc_rot0=rot0, holes=holes,
-        crank_mass=crank_mass, crank_inertia=crank_inertia, disc_mass=disc_mass, disc_inertia=disc_inertia,
+        crank_mass=crank_mass, crank_inertia=crank_inertia, planet_mass=planet_mass, planet_inertia=planet_inertia,
+        disc_mass=disc_mass, disc_inertia=disc_inertia,
         carrier_mass=reducer.inertia.carrier_mass_kg, carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
         input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
         support_stiffness=2.0 * cs.support_bearing_radial_stiffness_N_per_m,
