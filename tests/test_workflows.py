@@ -159,3 +159,18 @@ def test_rigid_vs_flexible_smoke(tmp_path):
     assert r.numbers["te_rms_difference_arcsec"] >= 0
     text = (tmp_path / "rigid_vs_flexible" / "summary.md").read_text()
     assert "te_overlay.png" in text and (tmp_path / "rigid_vs_flexible" / "te_overlay.png").exists()
+
+
+def test_crankshaft_flexibility_smoke(tmp_path):
+    """Workflow 5 (seed 002) smoke: Table 4 frequencies from the kinematics equal the
+    seed's at 1215 r/min (20.25 / 10 / 0.25 / 320 / 390 Hz, 1e-3); the spectral table
+    lists the crank harmonics and mesh lines for both models."""
+    from workflows.crankshaft_flexibility import SEED_TABLE4, run
+
+    r = run(tmp_path / "crankshaft_flexibility", smoke=True)
+    for c in r.comparisons:
+        if c.quantity.endswith("frequency"):
+            assert c.flexrv == pytest.approx(SEED_TABLE4[c.quantity[:-len(" frequency")]], rel=1e-3)
+    labels = [row["line"] for row in r.numbers["lines"]]
+    assert "3 x crank rotation" in labels and "cycloid mesh" in labels
+    assert (tmp_path / "crankshaft_flexibility" / "te_spectra_table4.png").exists()

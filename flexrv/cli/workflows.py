@@ -21,6 +21,7 @@ class Workflow(str, enum.Enum):
     rigid_vs_flexible = "rigid_vs_flexible"
     ring_deformation = "ring_deformation"
     lubrication = "lubrication"
+    crankshaft_flexibility = "crankshaft_flexibility"
 
 
 def _import(module: str):
