@@ -103,3 +103,35 @@ def system_life(lives, exponent: float = 10.0 / 9.0):
     with np.errstate(divide="ignore"):
         inv = np.sum(np.where(np.isfinite(lv), lv, np.inf) ** -exponent)
     return float("inf") if inv == 0 else float(inv ** (-1.0 / exponent))
+
+
+def line_contact_fc(gamma, lambda_nu: float = 0.83):
+    """Factor f_c of the basic dynamic radial load rating of roller bearings (line
+    contact), ISO 281:2007 eq. (Lundberg–Palmgren):
+    f_c = 207.9 lambda nu gamma^(2/9) (1 - gamma)^(29/27) (1 + gamma)^(-1/4)
+    {1 + [1.04 ((1 - gamma)/(1 + gamma))^(143/108)]^(9/2)}^(-2/9), gamma = D cos(a)/D_pw,
+    lambda nu = 0.83 (the value behind ISO 281's Table 7)."""
+    g = np.asarray(gamma, dtype=float)
+    if np.any((g <= 0) | (g >= 1)):
+        raise InputError(f"gamma = {gamma!r} must lie in (0, 1)")
+    ratio = (1.0 - g) / (1.0 + g)
+    return (207.9 * lambda_nu * g ** (2.0 / 9.0) * (1.0 - g) ** (29.0 / 27.0) * (1.0 + g) ** -0.25
+            * (1.0 + (1.04 * ratio ** (143.0 / 108.0)) ** 4.5) ** (-2.0 / 9.0))
+
+
+def roller_dynamic_rating(roller_diameter: float, roller_length: float, roller_count: int, pitch_diameter: float,
+                          rows: int = 1, contact_angle: float = 0.0, b_m: float = 1.1) -> float:
+    """Basic dynamic radial load rating C_r [N] of a roller (needle) bearing,
+    ISO 281:2007: C_r = b_m f_c (i L_we cos a)^(7/9) Z^(3/4) D_we^(29/27) with lengths
+    in mm; b_m = 1.1 (needle roller bearings with machined raceways; the crank's
+    eccentric and the disc's bore are the raceways). Inputs in SI [m]."""
+    for name, v in (("roller_diameter", roller_diameter), ("roller_length", roller_length),
+                    ("pitch_diameter", pitch_diameter)):
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name} = {v!r} m must be > 0")
+    if roller_count < 1 or rows < 1:
+        raise InputError(f"roller_count = {roller_count!r} and rows = {rows!r} must be >= 1")
+    d_mm, l_mm = 1e3 * roller_diameter, 1e3 * roller_length
+    c = math.cos(contact_angle)
+    fc = float(line_contact_fc(roller_diameter * c / pitch_diameter))
+    return b_m * fc * (rows * l_mm * c) ** (7.0 / 9.0) * roller_count ** 0.75 * d_mm ** (29.0 / 27.0)

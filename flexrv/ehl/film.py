@@ -121,43 +121,83 @@ def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, el
     return h_c, h_m
 
 
-def moes_central(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity):
-    """Central film thickness [m] from the Moes / Nijenbanning–Venner–Moes formula.
+def moes_asymptotes(moes_m, moes_l, curvature_ratio):
+    """The four asymptotic central films of Nijenbanning, Venner & Moes (1994) (dimensionless).
 
-    Nijenbanning, Venner & Moes, "Film thickness in elastohydrodynamically lubricated
-    elliptic contacts", Wear 176 (1994) 217-229, with lambda = rx/ry (the circular
-    contact of Moes 1992 / Venner & Lubrecht 2000 for lambda = 1):
+    With lambda = rx/ry (<= 1 for entrainment along the minor axis of the contact ellipse),
+    H = h_c/rx (2U)^-1/2, M = W (2U)^-3/4, L = G (2U)^1/4 (U, W, G of Hamrock, 2U uses the
+    sum speed u1 + u2), Nijenbanning, Venner & Moes, Wear 176 (1994) 217-229, eqs. (5)-(8):
 
-    H = h_c/rx (2U)^-1/2,  M = W (2U)^-3/4,  L = G (2U)^1/4,
-    H_RI = 145 (1 + 0.796 l^(14/15))^(-15/7) l^-1 M^-2,
-    H_EI = 3.18 (1 + 0.006 ln l + 0.63 l^(4/7))^(-14/25) l^(-1/15) M^(-2/15),
-    H_RP = 1.29 (1 + 0.691 l)^(-2/3) L^(2/3),
-    H_EP = 1.48 (1 + 0.006 ln l + 0.63 l^(4/7))^(-7/20) l^(-1/24) M^(-1/12) L^(3/4),
-    s = 1.5 (1 + exp(-1.2 H_EI/H_RI)),
-    H = [ (H_RI^(3/2) + (H_EI^-4 + 0.1^-4)^(-3/8))^(2s/3) + (H_RP^-8 + H_EP^-8)^(-s/8) ]^(1/s).
+    * rigid-isoviscous     H_RI = 145 (1 + 0.796 lambda^(14/15))^(-15/7) lambda^-1 M^-2,
+    * elastic-isoviscous   H_EI = 3.18 (1 + 0.006 ln lambda + 0.63 lambda^(4/7))^(-14/25) lambda^(-1/15) M^(-2/15),
+    * rigid-piezoviscous   H_RP = 1.29 (1 + 0.691 lambda)^(-2/3) L^(2/3),
+    * elastic-piezoviscous H_EP = 1.48 (1 + 0.006 ln lambda + 0.63 lambda^(4/7))^(-7/20) lambda^(-1/24)
+      M^(-1/12) L^(3/4).
 
-    Unlike Hamrock–Dowson it bridges all four regimes (rigid/elastic x
-    isoviscous/piezoviscous) for circular contacts. Verification status (tests in
-    tests/test_ehl_film.py and tests/test_ehl_solver.py): for lambda = 1 and
-    lambda >= 0.1 in the piezoviscous-elastic regime (M >= 100, L ~ 4-15) it agrees
-    with Hamrock–Dowson within ~15 % and with the numerical solver within ~5 %.
-    For very elongated contacts (lambda < 0.1) at light load (M < ~50) the elliptic
-    correction terms as implemented here give unphysically thick films (e.g. mm
-    instead of 0.1 um at M = 8, lambda = 0.036): do not use it there — use the
-    numerical solver (:func:`flexrv.ehl.solver.solve_point_contact`).
+    Parameters
+    ----------
+    moes_m, moes_l : Moes load and material parameters M, L [-] (> 0, L >= 0).
+    curvature_ratio : lambda = rx/ry [-] (> 0).
+
+    Returns
+    -------
+    h_ri, h_ei, h_rp, h_ep : ndarray (dimensionless, Moes scaling)
     """
-    grp = dimensionless_groups(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity)
-    lam = np.asarray(rx, dtype=float) / np.asarray(ry, dtype=float)
-    m, el = grp.moes_m, grp.moes_l
+    m = np.asarray(moes_m, dtype=float)
+    el = np.asarray(moes_l, dtype=float)
+    lam = np.asarray(curvature_ratio, dtype=float)
     shape = 1.0 + 0.006 * np.log(lam) + 0.63 * lam ** (4.0 / 7.0)
     h_ri = 145.0 * (1.0 + 0.796 * lam ** (14.0 / 15.0)) ** (-15.0 / 7.0) / lam * m**-2.0
     h_ei = 3.18 * shape ** (-14.0 / 25.0) * lam ** (-1.0 / 15.0) * m ** (-2.0 / 15.0)
     h_rp = 1.29 * (1.0 + 0.691 * lam) ** (-2.0 / 3.0) * el ** (2.0 / 3.0)
     h_ep = 1.48 * shape ** (-7.0 / 20.0) * lam ** (-1.0 / 24.0) * m ** (-1.0 / 12.0) * el**0.75
-    s = 1.5 * (1.0 + np.exp(-1.2 * h_ei / h_ri))
-    iso = (h_ri**1.5 + (h_ei**-4.0 + 0.1**-4.0) ** -0.375) ** (2.0 * s / 3.0)
-    piezo = (h_rp**-8.0 + h_ep**-8.0) ** (-s / 8.0)
-    h = (iso + piezo) ** (1.0 / s)
+    return h_ri, h_ei, h_rp, h_ep
+
+
+def moes_dimensionless(moes_m, moes_l, curvature_ratio):
+    """Dimensionless central film H = h_c/rx (2U)^-1/2 of Nijenbanning, Venner & Moes (1994).
+
+    Blend of the asymptotes of :func:`moes_asymptotes` (Nijenbanning, Venner & Moes,
+    Wear 176 (1994) 217-229, eqs. (9)-(10)):
+
+        H = { [H_RI^(3/2) + (H_EI^-4 + H_00^-4)^(-3/8)]^(2s/3) + (H_RP^-8 + H_EP^-8)^(-s/8) }^(1/s),
+        s = 1.5 (1 + exp(-1.2 H_EI/H_RI)),   H_00 = 1.8 lambda^-1.
+
+    Limits (tests/test_ehl_film.py): L -> 0 gives (H_RI^(3/2) + H_EI^(3/2))^(2/3) (H_RI at light
+    load, H_EI at heavy load); large L gives min(H_RP, H_EP) (H_RP at light, H_EP at heavy load).
+    H_00 = 1.8/lambda only caps H_EI at extremely light loads. (Earlier flexrv versions used
+    0.1^-4 in place of H_00^-4, which capped the isoviscous branch at H = 0.1 and made the
+    elastic-isoviscous asymptote unreachable — up to +7 % on h_c at M ~ 260 once corrected.)
+    """
+    h_ri, h_ei, h_rp, h_ep = moes_asymptotes(moes_m, moes_l, curvature_ratio)
+    lam = np.asarray(curvature_ratio, dtype=float)
+    h_00 = 1.8 / lam
+    with np.errstate(divide="ignore", over="ignore"):
+        s = 1.5 * (1.0 + np.exp(-1.2 * h_ei / h_ri))
+        iso = (h_ri**1.5 + (h_ei**-4.0 + h_00**-4.0) ** -0.375) ** (2.0 * s / 3.0)
+        piezo = (h_rp**-8.0 + h_ep**-8.0) ** (-s / 8.0)
+    return (iso + piezo) ** (1.0 / s)
+
+
+def moes_central(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity):
+    """Central film thickness [m] from the Nijenbanning–Venner–Moes (1994) formula.
+
+    h_c = H(M, L, lambda) rx (2U)^(1/2) with H of :func:`moes_dimensionless`,
+    lambda = rx/ry (Nijenbanning, Venner & Moes, "Film thickness in elastohydrodynamically
+    lubricated elliptic contacts", Wear 176 (1994) 217-229; the circular case lambda = 1 is
+    the point-contact formula quoted in Venner & Lubrecht 2000).
+
+    Unlike Hamrock–Dowson it bridges all four regimes (rigid/elastic x
+    isoviscous/piezoviscous). Verification status (tests/test_ehl_film.py,
+    tests/test_ehl_solver.py): asymptotic limits exact; in the piezoviscous-elastic
+    regime (M >= 30, L ~ 6-14, lambda = 0.036-1) within ~15 % of Hamrock–Dowson and
+    ~10 % of the numerical solver. For very elongated contacts (lambda < 0.1) the fit is
+    an extrapolation (the paper's data cover lambda >= ~0.1); prefer the numerical
+    solver (:func:`flexrv.ehl.solver.solve_point_contact`) there.
+    """
+    grp = dimensionless_groups(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity)
+    lam = np.asarray(rx, dtype=float) / np.asarray(ry, dtype=float)
+    h = moes_dimensionless(grp.moes_m, grp.moes_l, lam)
     return h * np.asarray(rx, dtype=float) * np.sqrt(2.0 * grp.speed_u)
 
 

@@ -186,6 +186,8 @@ class NeedleBearings(ForceGroup):
                    "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
             if self.model == "rollers":
                 out["roller_force"] = Output(f, dims + ("roller",), "N", "needle roller contact force")
+                out["roller_angle"] = Output(np.arctan2(uy, ux), dims + ("roller",), "rad",
+                                             "direction of each roller's contact force on the disc (housing frame)")
         return gen, out
 
     def jacobian(self, t, q, v):
