@@ -95,6 +95,14 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         "flexible/rigid per line). The crank harmonics in flexrv's TE come from the needle-bearing and pin "
         "load cycle that both models share; the first-stage mesh line is present in both. Seed 002's Table 4 "
         "frequencies are reproduced exactly by the kinematics.")
+    finite = [row for row in rows if np.isfinite(row["rigid [arcsec]"])]
+    if finite:
+        top = max(finite, key=lambda row: row["rigid [arcsec]"])
+        r.text.append(f"Dominant line in both models: {top['line']} ({top['frequency [Hz]']:.4g} Hz), "
+                      f"{top['rigid [arcsec]']:.3g} arcsec rigid vs {top['flexible crank [arcsec]']:.3g} arcsec with "
+                      "flexible crankshafts — the pins entering and leaving the load zone, which the crank twist does "
+                      "not change; seed 002's rigid model shows mainly the first-stage mesh, flexrv's the cycloid "
+                      "mesh (its involute mesh ripple is filtered by the second-stage ratio).")
     r.numbers = {"rigid": nr, "flexible": nf, "lines": rows}
     f_r, a_r = spectra["rigid"]
     f_f, a_f = spectra["flexible"]
