@@ -174,3 +174,42 @@ def test_crankshaft_flexibility_smoke(tmp_path):
     labels = [row["line"] for row in r.numbers["lines"]]
     assert "3 x crank rotation" in labels and "cycloid mesh" in labels
     assert (tmp_path / "crankshaft_flexibility" / "te_spectra_table4.png").exists()
+
+
+def test_crank_bearing_forces_smoke(tmp_path):
+    """Workflow 6 (seed 003) smoke: the FE load resultant equals the sum of the
+    roller forces of crank 0 (both bearings, equilibrium of the spread loads); the
+    Hertz pressure equals sqrt(F E' / (2 pi R L)) (Johnson 1985, eq. 4.45, an
+    independent form of p0 = 2F/(pi b L)); invalid eccentricities of the seed's
+    sweep are reported, not simulated; the roller-load period is one crank
+    revolution relative to the carrier."""
+    from flexrv.contact.hertz import effective_modulus
+    from flexrv.design import load
+    from workflows.crank_bearing_forces import run
+
+    r = run(tmp_path / "crank_bearing_forces", smoke=True)
+    rows = next(iter(r.tables.values()))
+    fmax = max(row["resultant [N]"] for row in rows)
+    red = load("rv40e")
+    nb, cs = red.needle_bearing, red.crankshaft
+    reff = 1.0 / (2.0 / (nb.roller_diameter_mm * 1e-3) + 2.0 / (cs.eccentric_journal_diameter_mm * 1e-3))
+    mat = red.material("crankshaft")
+    e_eff = float(effective_modulus(mat.youngs_modulus, mat.poisson_ratio, mat.youngs_modulus, mat.poisson_ratio))
+    p0 = np.sqrt(fmax * e_eff / (2 * np.pi * reff * nb.roller_length_mm * 1e-3))
+    assert r.numbers["hertz_life"]["hertz_p_max_Pa"] == pytest.approx(p0, rel=1e-9)
+    assert r.numbers["stress"]["von_mises_max_Pa"] > 0
+    assert r.numbers["sweep"][0]["valid"]
+    period = next(c for c in r.comparisons if c.quantity == "roller-load period")
+    assert period.flexrv == pytest.approx(1 / (2000 / 60 * 16 / 32), rel=1e-9)  # crank at z_s/z_p of the input
+    assert (tmp_path / "crank_bearing_forces" / "roller_forces.png").exists()
+
+
+def test_crank_bearing_sweep_reports_invalid_eccentricities():
+    """The seed's 2.0 mm on the RV-40E (R_p = 64 mm, 40 pins) makes K1 = 1.25 > 1:
+    the workflow's design step rejects it with the physics reason."""
+    from flexrv.errors import ConfigError
+    from workflows.crank_bearing_forces import _design
+    from flexrv.design import load
+
+    with pytest.raises(ConfigError, match="K1"):
+        _design(load("rv40e"), 2.0)

@@ -22,6 +22,7 @@ class Workflow(str, enum.Enum):
     ring_deformation = "ring_deformation"
     lubrication = "lubrication"
     crankshaft_flexibility = "crankshaft_flexibility"
+    crank_bearing_forces = "crank_bearing_forces"
 
 
 def _import(module: str):

@@ -152,6 +152,7 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     data["crank_speed"] = _var(crank_v[..., 2], ("time", "crank"), "rad/s", "crank (planet) speed, absolute")
     data["crank_speed_relative"] = _var(crank_v[..., 2] - w_out[:, None], ("time", "crank"), "rad/s",
                                         "crank speed relative to the carrier")
+    data["crank_angle"] = _var(crank[..., 2], ("time", "crank"), "rad", "crank (planet) angle, absolute")
     data["crank_x"] = _var(crank[..., 0], ("time", "crank"), "m", "crank centre x")
     data["crank_y"] = _var(crank[..., 1], ("time", "crank"), "m", "crank centre y")
     data["disc_x"] = _var(disc[..., 0], ("time", "disc"), "m", "disc centre x")
