@@ -176,8 +176,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
               f"(C/P)^(10/3) with C = 5000 N, P = 3500 N gives {hl['seed_L10_with_its_C_and_P_Mrev']:.2f} x 10^6 "
               "rev, not 1.5e7 cycles")
     r.compare("roller-load period", "s", SEED["period_s"], 2.0 * np.pi / abs(crank_rel),
-              "one crank revolution relative to the carrier (crank at z_s/z_p of the input, not half of it for "
-              "the RV-40E's 16/32 first stage: that is exactly 1/2 here)")
+              "one crank revolution relative to the carrier, (omega_in - omega_out) z_s/z_p (Willis); the seed's "
+              "'half the input speed' would give 0.060 s, its 0.075 s matches neither")
     # ---- eccentricity sweep
     sweep_rows = []
     for ecc in (SMOKE["sweep"] if smoke else (sweep or SWEEP)):
