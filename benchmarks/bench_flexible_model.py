@@ -6,7 +6,7 @@ steps, Newton iterations and Jacobians per step, and the time of the model build
 (meshing + CMS of the four rings; ``--cold`` builds them in an empty cache).
 
     python benchmarks/bench_flexible_model.py [--preset rv221] [--t-end 0.05] [--cold]
-        [--models rigid,balls,flexible] [--harmonics K]
+        [--models rigid,balls,flexible] [--harmonics K] [--parts main_bearing,crankshaft]
 
 Goal of the flexible-bearing issue: <= 60 s wall per simulated second.
 """
@@ -40,6 +40,7 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=0.05)
     parser.add_argument("--models", default="rigid,balls,flexible")
     parser.add_argument("--harmonics", type=int, default=None, help="raceway harmonics K of the rings")
+    parser.add_argument("--parts", default="main_bearing", help="flexible parts of the flexible model")
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
     args = parser.parse_args()
     if args.cold:
@@ -49,8 +50,10 @@ def main() -> None:
           f"{'Newton/step':>11s} {'Jacobians':>9s}")
     for model in args.models.split(","):
         opts = {}
-        if model == "flexible" and args.harmonics is not None:
-            opts = {"ring_options": {"harmonics": args.harmonics}}
+        if model == "flexible":
+            opts["parts"] = args.parts.split(",")
+            if args.harmonics is not None:
+                opts["ring_options"] = {"harmonics": args.harmonics}
         r = run(args.preset, model, args.t_end, opts)
         print(f"{r['model']:10s} {r['coordinates']:5d} {r['build_s']:8.2f} {r['solve_s']:8.2f} "
               f"{r['wall_per_sim_s']:8.1f} {r['ms_per_step']:8.2f} {r['newton_per_step']:11.2f} {r['jacobians']:9d}")
