@@ -96,7 +96,13 @@ def crank_stress(reducer, res, i: int, crank: int = 0, size: float | None = None
     for name, _, length, _ in spec_for(reducer, "crankshaft").segments:
         spans[name] = (zc, zc + length)
         zc += length
-    where = next((n for n, (a, b) in spans.items() if a - 1e-9 <= z_node <= b + 1e-9), "?")
+    names = list(spans)
+    bounds = [spans[n][1] for n in names[:-1]]
+    k_b = int(np.argmin(np.abs(np.array(bounds) - z_node)))
+    if abs(bounds[k_b] - z_node) < 0.5e-3:  # a sharp shoulder: the stress concentration of the step
+        where = f"shoulder {names[k_b]}/{names[k_b + 1]}"
+    else:
+        where = next((n for n, (a, b) in spans.items() if a - 1e-9 <= z_node <= b + 1e-9), "?")
     return {"von_mises_max_Pa": float(vm[k_max]), "location": where, "z_m": float(z_node),
             "resultant_N": float(np.linalg.norm(forces.sum(axis=0))), "n_nodes": int(mesh.n_nodes),
             "max_displacement_m": float(np.linalg.norm(u, axis=1).max())}
@@ -162,7 +168,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
               "loaded bearing with clearance cannot do: only the rollers facing the load carry it)")
     r.compare("crankshaft von Mises max", "MPa", SEED["von_mises_MPa"], 1e-6 * stress["von_mises_max_Pa"],
               f"at the {stress['location']} (z = {1e3 * stress['z_m']:.1f} mm), supports clamped as in the seed; "
-              "nodal-averaged FE stress, the Hertz contact stress itself is local (below)")
+              "nodal-averaged FE stress at a sharp (unfilleted) shoulder, so mesh-dependent; the Hertz contact "
+              "stress itself is local (below)")
     r.compare("Hertz max pressure, most-loaded roller on the journal", "MPa", SEED["hertz_MPa"],
               1e-6 * hl["hertz_p_max_Pa"],
               f"contact half-width b = {1e6 * hl['hertz_half_width_m']:.1f} um from the geometry (Johnson 1985); "
