@@ -20,11 +20,12 @@ ETA, ALPHA = 0.05, 2e-8
 @pytest.mark.parametrize("load,speed,ry", [(100.0, 1.0, 0.01), (1000.0, 1.0, 0.01), (100.0, 1.0, 0.04),
                                            (500.0, 1.0, 0.1), (50.0, 0.1, 0.01)])
 def test_hamrock_dowson_vs_moes_piezoviscous_elastic(load, speed, ry):
-    """HD and Moes h_c agree within 15 % for M = 100-3000, L = 6-12, lambda = 0.1-1."""
+    """HD and Moes h_c agree within 20 % for M = 100-3000, L = 6-12, lambda = 0.1-1 (measured Moes/HD =
+    1.08-1.18: the two fits use different load exponents, W^-0.067 against M^-1/12)."""
     g = dimensionless_groups(load, speed, 0.01, ry, E, ETA, ALPHA)
     assert 100 <= g.moes_m <= 3000 and 5 <= g.moes_l <= 15
     hc, hmin = hamrock_dowson(load, speed, 0.01, ry, E, ETA, ALPHA)
-    assert abs(moes_central(load, speed, 0.01, ry, E, ETA, ALPHA) / hc - 1.0) < 0.15
+    assert abs(moes_central(load, speed, 0.01, ry, E, ETA, ALPHA) / hc - 1.0) < 0.20
     assert 0.4 * hc < hmin < hc  # minimum film below the central film
 
 
@@ -63,3 +64,44 @@ def test_bad_input(bad):
     args.update(bad)
     with pytest.raises(InputError, match=next(iter(bad))):
         hamrock_dowson(**args)
+
+
+# ---------------------------------------------------------------- Nijenbanning–Venner–Moes (1994)
+from flexrv.ehl.film import moes_asymptotes, moes_dimensionless  # noqa: E402
+
+
+@pytest.mark.parametrize("lam", [1.0, 0.25, 0.036])
+def test_moes_blend_reduces_to_its_asymptotes(lam):
+    """Nijenbanning, Venner & Moes (1994), eqs. (5)-(10): the blend must return each asymptote in
+    its own regime — L -> 0: H_RI at light load (M -> 0), H_EI at heavy load; large L: H_RP at
+    light load (M = 1, L = 1e8), H_EP at heavy load (tolerance 2 %). The former 0.1^-4 cap failed the H_EI limit
+    by an order of magnitude."""
+    tiny_l = 1e-6
+    cases = [(1e-3 / lam, tiny_l, 0), (1e4, tiny_l, 1), (1.0, 1e8, 2), (1e12, 1e4, 3)]
+    for m, el, which in cases:
+        expected = moes_asymptotes(m, el, lam)[which]
+        np.testing.assert_allclose(moes_dimensionless(m, el, lam), expected, rtol=0.02,
+                                   err_msg=f"M={m}, L={el}, lambda={lam}, asymptote {which}")
+
+
+def test_moes_circular_coefficients():
+    """lambda = 1 coefficients of the elliptic formula (Nijenbanning et al. 1994 with lambda = 1):
+    H_RI = 145 * 1.796^(-15/7) M^-2 = 41.3 M^-2, H_EI = 3.18 * 1.63^(-14/25) M^(-2/15) = 2.42 M^(-2/15),
+    H_RP = 1.29 * 1.691^(-2/3) L^(2/3) = 0.909 L^(2/3), H_EP = 1.48 * 1.63^(-7/20) = 1.25 M^(-1/12) L^(3/4)
+    (hand evaluation, 3 digits)."""
+    h_ri, h_ei, h_rp, h_ep = moes_asymptotes(1.0, 1.0, 1.0)
+    np.testing.assert_allclose([h_ri, h_ei, h_rp, h_ep], [41.3, 2.42, 0.909, 1.25], rtol=4e-3)
+
+
+def test_moes_isoviscous_elastic_vs_hamrock_dowson_1978():
+    """Isoviscous-elastic point contact (alpha -> 0): Hamrock & Dowson (1978; Hamrock 1994,
+    eq. 22.28) H_c,IE = 11.15 g_E^0.67 (1 - 0.72 exp(-0.28 k)), H~ = (h/rx)(W/U)^2,
+    g_E = W^(8/3)/U^2 — an independent fit; the NVM blend agrees within 20 % (M = 26 and 260,
+    circular). The old 0.1^-4 cap gave a film ~10x too thin here."""
+    for load in (10.0, 100.0):
+        g = dimensionless_groups(load, 1.0, 0.01, 0.01, E, ETA, 1e-13)
+        assert g.moes_l < 1e-3
+        u, w, k = g.speed_u, g.load_w, g.ellipticity
+        h_hd = 11.15 * (w ** (8.0 / 3.0) / u**2) ** 0.67 * (1.0 - 0.72 * np.exp(-0.28 * k)) * (u / w) ** 2 * 0.01
+        h_moes = moes_central(load, 1.0, 0.01, 0.01, E, ETA, 1e-13)
+        assert abs(h_moes / h_hd - 1.0) < 0.20, (load, h_moes, h_hd)

@@ -31,7 +31,7 @@ from flexrv.ehl.solver import LubricantProperties, solve_point_contact
 from flexrv.errors import ConvergenceError, InputError
 
 #: Bump when the solver or the map layout changes (part of the cache key).
-MAP_SCHEMA = 1
+MAP_SCHEMA = 2  # 2: second-order wedge + Richardson h_c for grids >= 129 (solver default)
 
 
 @dataclass(frozen=True)

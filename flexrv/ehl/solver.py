@@ -20,10 +20,20 @@ rho_ = rho/rho0, eta_ = eta/eta0:
     iint P dX dY = 2 pi / 3.
 
 Discretisation: node-centred finite differences on a uniform grid, second-order
-central Poiseuille terms, first-order upwind (backward) wedge term; the elastic
+central Poiseuille terms; wedge term d(rho H)/dX by second-order upwind
+("second-order upstream", 1.5 f_i - 2 f_(i-1) + 0.5 f_(i-2); Venner & Lubrecht 2000,
+sec. 9.3) on grids >= 129^2, first-order upwind below (``wedge_order``); the elastic
 deformation uses exact influence coefficients of piecewise-constant pressure on
 each (dx x dy) cell (Love's rectangle solution) and is evaluated by a zero-padded
 (linear, non-periodic) FFT convolution, O(N log N).
+
+Reported central film (grids >= 129^2): Richardson extrapolation of order 2 from the
+finest grid and the next-coarser one of the grid continuation,
+h_c = (4 h_N - h_(N+1)/2) / 3, justified by the observed order 1.7-2.0 of the raw
+second-order films on 65/129/257 (tests/test_ehl_convergence.py). Why not the
+first-order scheme: its h_c drifts by ~2.2 % per grid doubling all the way to 513^2
+(circular M = 260: 296.6, 303.9, 297.2, 290.8 nm at 65..513^2 against the limit
+~282 nm), so small grid-to-grid changes did not mean a converged film.
 
 Solver (the choice and why): an inexact *semismooth Newton–Krylov* method on the
 coupled unknowns (P, H0):
@@ -49,14 +59,13 @@ This replaces the classic Jacobi/Gauss–Seidel line relaxation (thousands of
 sweeps at high loads without multigrid) with a handful of vectorised steps; no
 Python loop runs over grid nodes.
 
-Measured (tests/test_ehl_solver.py, benchmarks/bench_ehl.py, one core): 129^2
-converges in 3-5 Newton steps on the finest grid, ~0.9 s CPU for a circular
-contact and ~1.4 s for the rv221 ball (k ~ 9); 65^2 in 0.25-0.5 s. Central film
-within 6 % of Moes and 11 % of Hamrock–Dowson for M = 30-1300, L = 11-14,
-lambda = rx/ry = 0.1-1; h_c changes by 1.7-2.5 % per grid doubling (65-257),
-first-order wedge discretisation; load balance to ~1e-11. (The second-order
-upwind option converges cleanly as O(h^2) but from far below: -8.5 % at 129^2,
-so it is not the default.)
+Measured (tests/test_ehl_convergence.py, benchmarks/bench_ehl.py, one core): default
+129^2 h_c changes by 0.02-1.2 % against the 257^2 value for M = 31-1300, L = 6.7-13.6,
+ry/rx = 1-28 (3.9 % for a circular contact at M = 640), and by 0.2-1.2 % against 65^2
+for M <= ~700 on elongated and M <= ~30 on circular contacts (7-9 % at M = 260-1300);
+h_c within -6 %..+7 % of Hamrock–Dowson and -16 %..-1 % of Nijenbanning–Venner–Moes;
+load balance to ~1e-11. CPU: 129^2 ~1.1 s circular, ~2.1 s rv221 ball (a/b ~ 9);
+``wedge_order=1, extrapolate=False`` is the faster, less accurate path (0.8 s / 1.3 s).
 
 Limits: isothermal, Newtonian, smooth surfaces, steady rolling, fully flooded
 inlet at X = x_inlet. At high loads (M above ~1000 on 65^2 and a few thousand on
@@ -161,6 +170,12 @@ class EHLResult:
     residual_history : residual after each Newton step on the finest grid.
     load_error : |iint p - Q| / Q.
     grid : nodes per direction.
+    h_central_grid : central film of the finest-grid solution itself [m].
+    h_central_coarse : central film of the next-coarser grid (N+1)/2 [m] (converged to the
+        same tolerance when ``extrapolated``; nan otherwise).
+    extrapolated : True when ``h_central`` is the Richardson extrapolation
+        (4 h_N - h_(N+1)/2)/3 of the second-order scheme (see :func:`solve_point_contact`).
+    wedge_order : order of the wedge-term discretisation used (1 or 2).
     """
 
     x: np.ndarray
@@ -180,6 +195,10 @@ class EHLResult:
     residual_history: list = field(default_factory=list)
     load_error: float = 0.0
     grid: int = 0
+    h_central_grid: float = float("nan")
+    h_central_coarse: float = float("nan")
+    extrapolated: bool = False
+    wedge_order: int = 1
 
 
 # ----------------------------------------------------------------- elasticity
@@ -233,6 +252,9 @@ class _GridProblem:
     def __init__(self, n, x_in, x_out, y_half, aspect, ky, lam, kernel_scale, pscale, lub: LubricantProperties,
                  stencil: int, wedge_order: int = 2):
         self.wedge_order = wedge_order
+        # the preconditioner always uses the first-order wedge stencil (sparser LU, same Newton
+        # steps; measured rv221 ball 129^2: 2.4 s vs 2.85 s with the second-order stencil)
+        self.precond_order = 1
         self.n = n
         self.X = np.linspace(x_in, x_out, n)
         self.Y = np.linspace(-y_half, y_half, n)
@@ -260,7 +282,9 @@ class _GridProblem:
         self.refactor_changes = max(4, n // 8)
         self.krylov_rtol = 1e-3
         self.krylov_max = 60
-        self.lu_dtype = np.float64
+        # single-precision LU of the preconditioner (GMRES works on the true float64 residual, so
+        # only the preconditioner quality is affected): -10-25 % CPU at 129^2
+        self.lu_dtype = np.float32
         self.ordering = "COLAMD"
         self.trace = False
 
@@ -339,10 +363,10 @@ class _GridProblem:
         kc = n - 1  # centre index of the kernel array
         dx = self.dX
         # wedge term: -dX sum_m c_m rho_{i-m} H_{i-m}; dH_i/dP_{i+k} = K[k]
-        second = (fi >= 2) if self.wedge_order == 2 else np.zeros(fi.shape, dtype=bool)
+        second = (fi >= 2) if self.precond_order == 2 else np.zeros(fi.shape, dtype=bool)
         coef = (np.where(second, 1.5, 1.0), np.where(second, -2.0, -1.0), np.where(second, 0.5, 0.0))
         back = [np.maximum(fi - m, 0) for m in range(3)]
-        for di in range(-sx - 2, sx + 1):
+        for di in range(-sx - (2 if self.precond_order == 2 else 1), sx + 1):
             for dj in range(-s, s + 1):
                 val = np.zeros(fi.shape)
                 for m in range(3):
@@ -507,7 +531,8 @@ _TRACE = False
 def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperties, *, grid: int = 129,
                         x_inlet: float = -4.5, x_outlet: float = 1.5, y_half: float = 3.0,
                         tol: float = 1e-6, max_iter: int = 40, stencil: int = 1,
-                        coarsest: int = 17, coarse_tol: float = 1e-4, wedge_order: int = 1) -> EHLResult:
+                        coarsest: int = 17, coarse_tol: float = 1e-4, wedge_order: int | None = None,
+                        extrapolate: bool | None = None) -> EHLResult:
     """Solve the steady isothermal EHL point-contact problem.
 
     Parameters
@@ -524,8 +549,18 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
     stencil : half-width of the truncated kernel in the preconditioner.
     coarsest : first grid of the continuation.
     coarse_tol : residual target on the coarser grids of the continuation.
-    wedge_order : 1 (first-order upwind, default) or 2 (second-order upwind) for d(rho H)/dX; the
-        first-order scheme converged faster in grid (tests/test_ehl_solver.py).
+    wedge_order : 1 (first-order upwind) or 2 (second-order upwind, "second-order upstream" of
+        Venner & Lubrecht 2000, sec. 9.3) for d(rho H)/dX; default (None): 2 for grid >= 129,
+        1 below (the second-order scheme closes the film on grids coarser than ~65^2 at M > ~200).
+    extrapolate : report as ``h_central`` the Richardson extrapolation (4 h_N - h_(N+1)/2)/3 of
+        the second-order scheme from the finest grid N and the next-coarser one (both converged to
+        ``tol``; the coarser grid is already part of the grid continuation, so this costs only a few
+        extra Newton steps there). Default (None): True when ``wedge_order`` is 2 and grid >= 129.
+        Justification (tests/test_ehl_convergence.py): the second-order scheme converges as
+        O(dX^2) in h_c from 129^2 up (observed order 1.9-2.0 from 129/257/513 at M = 260), while
+        the first-order scheme is far from its asymptotic range (+7.8 % at 129^2, +3 % at 513^2
+        against the extrapolated limit at M = 260) — its small grid-to-grid changes were
+        misleading.
 
     Returns
     -------
@@ -544,6 +579,10 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
     lubricant.check()
     if grid < 9 or ((grid - 1) & (grid - 2)) != 0:
         raise InputError(f"grid must be 2^k + 1 >= 9 nodes (e.g. 65, 129, 257), got {grid}")
+    if wedge_order is None:
+        wedge_order = 2 if grid >= 129 else 1
+    if extrapolate is None:
+        extrapolate = wedge_order == 2 and grid >= 129
     if wedge_order not in (1, 2):
         raise InputError(f"wedge_order must be 1 or 2, got {wedge_order!r}")
     if stencil not in (0, 1, 2, 3):
@@ -570,8 +609,12 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
         levels.append(n)
         n = (n - 1) // 2 + 1
     levels = levels[::-1] or [grid]
+    if extrapolate and len(levels) < 2:
+        raise InputError(f"extrapolate=True needs a coarser level: grid={grid} must be >= 2 * coarsest - 1 "
+                         f"= {2 * coarsest - 1}")
     P = H0 = None
     prev = None
+    h_coarse = float("nan")
     history: list = []
     total = 0
     for level, n in enumerate(levels):
@@ -587,7 +630,8 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
         else:
             P = np.maximum(_interpolate(P, prev.X, prev.Y, prob.X, prob.Y), 0.0)
         history = []
-        level_tol = tol if n == grid else max(tol, coarse_tol)
+        coarse_final = extrapolate and level == len(levels) - 2
+        level_tol = tol if (n == grid or coarse_final) else max(tol, coarse_tol)
         prob.trace = _TRACE
         P, H0, steps, res = prob.newton(P, H0, level_tol, max_iter if n == grid else 2 * max_iter, history)
         total += steps
@@ -595,6 +639,9 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
             raise ConvergenceError(f"EHL solver did not converge on the {n}x{n} grid: residual reached {res:.3e} "
                                    f"(target {level_tol:.1e}) after {steps} Newton steps "
                                    f"(load {load:g} N, speed {speed:g} m/s)")
+        if coarse_final:
+            ic0 = int(np.argmin(np.abs(prob.X)))
+            h_coarse = float(prob.film(P, H0)[ic0, n // 2] * hscale)
         prev = prob
     H = prob.film(P, H0)
     if np.any(H[1:-1, 1:-1] <= 0):
@@ -603,8 +650,15 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
             f"after {steps} Newton steps, residual {res:.3e}: the grid does not resolve the film at this load "
             f"(Moes M = {moes_m:.3g}); use a finer grid or the Hamrock-Dowson formula")
     ic, jc = int(np.argmin(np.abs(prob.X))), n // 2
+    h_grid = float(H[ic, jc] * hscale)
+    h_central = (4.0 * h_grid - h_coarse) / 3.0 if extrapolate else h_grid
+    if not np.isfinite(h_central) or h_central <= 0:
+        raise ConvergenceError(f"Richardson extrapolation of h_c failed: h_c({n}) = {h_grid:.4e} m, "
+                               f"h_c({(n - 1) // 2 + 1}) = {h_coarse:.4e} m")
     return EHLResult(x=prob.X * b, y=prob.Y * a, pressure=P * p_h, film=H * hscale,
-                     h_central=float(H[ic, jc] * hscale), h_min=float(H[1:-1, 1:-1].min() * hscale),
+                     h_central=h_central, h_min=float(H[1:-1, 1:-1].min() * hscale),
                      p_max=float(P.max() * p_h), hertz_pressure=p_h, hertz_a=a, hertz_b=b,
                      rigid_approach=float(H0 * hscale), iterations=steps, total_iterations=total,
-                     residual=float(res), residual_history=history, load_error=float(prob.load_error(P)), grid=n)
+                     residual=float(res), residual_history=history, load_error=float(prob.load_error(P)), grid=n,
+                     h_central_grid=h_grid, h_central_coarse=h_coarse, extrapolated=bool(extrapolate),
+                     wedge_order=int(wedge_order))
