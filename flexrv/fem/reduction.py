@@ -87,6 +87,30 @@ def rbe2_mapping(nodes: np.ndarray, node_set: np.ndarray) -> np.ndarray:
     return T.reshape(3 * n, 6)
 
 
+def interface_dofs(n_dof: int, interfaces: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(boundary DOFs in interface order, interior DOFs) of disjoint interface node sets."""
+    bnodes = np.concatenate([np.asarray(s, dtype=np.int64) for s in interfaces])
+    if np.unique(bnodes).size != bnodes.size:
+        raise InputError("interface node sets overlap; every interface node may belong to one interface only")
+    bdofs = (3 * bnodes[:, None] + np.arange(3)).ravel()
+    mask = np.ones(n_dof, dtype=bool)
+    mask[bdofs] = False
+    return bdofs, np.flatnonzero(mask)
+
+
+def rbe2_block(nodes: np.ndarray, interfaces: list[np.ndarray]) -> np.ndarray:
+    """(boundary DOFs, 6 n_if) block-diagonal RBE2 mapping of all interfaces
+    (rows in the order of :func:`interface_dofs`)."""
+    rows = 3 * sum(len(s) for s in interfaces)
+    T = np.zeros((rows, 6 * len(interfaces)))
+    start = 0
+    for k, s in enumerate(interfaces):
+        t = rbe2_mapping(nodes, np.asarray(s))
+        T[start:start + t.shape[0], 6 * k:6 * k + 6] = t
+        start += t.shape[0]
+    return T
+
+
 def raceway_weights(nodes: np.ndarray, race_nodes: np.ndarray, areas: np.ndarray, spec: RacewaySpec,
                     azimuths: np.ndarray, cutoff: float = 4.0) -> sp.csr_matrix:
     """Sparse (n_az, n_race) patch weights w_j(theta) (rows sum to 1); see module doc."""
@@ -161,24 +185,14 @@ def hcb_basis(K: sp.csr_matrix, M: sp.csr_matrix, nodes: np.ndarray, interfaces:
     from flexrv.fem.modal import eigenmodes
 
     n = K.shape[0]
-    bnodes = np.concatenate([np.asarray(s, dtype=np.int64) for s in interfaces])
-    if np.unique(bnodes).size != bnodes.size:
-        raise InputError("interface node sets overlap; every interface node may belong to one interface only")
-    bdofs = (3 * bnodes[:, None] + np.arange(3)).ravel()
-    mask = np.ones(n, dtype=bool)
-    mask[bdofs] = False
-    idofs = np.flatnonzero(mask)
+    bdofs, idofs = interface_dofs(n, interfaces)
+    bnodes = bdofs[::3] // 3
     Kii = K[idofs][:, idofs]
     solve = factorize(Kii)
     cols = []
-    # 1. RBE2 interface static modes (interfaces 2..)
+    # 1. RBE2 interface static modes (interfaces 2..; the first is the body frame)
     if len(interfaces) > 1:
-        Tall = np.zeros((bdofs.size, 6 * (len(interfaces) - 1)))
-        start = 3 * len(interfaces[0])
-        for k, s in enumerate(interfaces[1:]):
-            T = rbe2_mapping(nodes, np.asarray(s))
-            Tall[start:start + T.shape[0], 6 * k:6 * k + 6] = T
-            start += T.shape[0]
+        Tall = rbe2_block(nodes, interfaces)[:, 6:]
         Kib = K[idofs][:, bdofs]
         S = np.zeros((n, Tall.shape[1]))
         S[bdofs] = Tall
@@ -224,20 +238,8 @@ def interface_stiffness(K: sp.csr_matrix, nodes: np.ndarray, interfaces: list[np
     """
     from flexrv.fem.modal import factorize
 
-    n = K.shape[0]
-    bnodes = np.concatenate([np.asarray(s, dtype=np.int64) for s in interfaces])
-    if np.unique(bnodes).size != bnodes.size:
-        raise InputError("interface node sets overlap; every interface node may belong to one interface only")
-    bdofs = (3 * bnodes[:, None] + np.arange(3)).ravel()
-    mask = np.ones(n, dtype=bool)
-    mask[bdofs] = False
-    idofs = np.flatnonzero(mask)
-    T = np.zeros((bdofs.size, 6 * len(interfaces)))
-    start = 0
-    for k, s in enumerate(interfaces):
-        t = rbe2_mapping(nodes, np.asarray(s))
-        T[start:start + t.shape[0], 6 * k:6 * k + 6] = t
-        start += t.shape[0]
+    bdofs, idofs = interface_dofs(K.shape[0], interfaces)
+    T = rbe2_block(nodes, interfaces)
     K = sp.csr_matrix(K)
     kib_t = np.asarray(K[idofs][:, bdofs] @ T)
     s_i = -factorize(K[idofs][:, idofs])(kib_t)

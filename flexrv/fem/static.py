@@ -14,8 +14,23 @@ from flexrv.errors import InputError
 
 
 def solve_static(K, fixed_nodes: np.ndarray, forces: np.ndarray) -> np.ndarray:
-    """Displacements (N, 3) [m] of K u = f with the nodes ``fixed_nodes`` clamped;
-    ``forces`` (N, 3) [N] nodal forces (those on clamped nodes go to the support)."""
+    """Linear static displacements of a clamped FE model, K u = f (Zienkiewicz &
+    Taylor, The Finite Element Method, vol. 1, ch. 2).
+
+    Parameters
+    ----------
+    K : sparse (3N, 3N) stiffness matrix [N/m] (e.g. ``flexrv.fem.assembly.assemble(...).K``).
+    fixed_nodes : indices of clamped nodes (all three DOFs zero).
+    forces : (N, 3) nodal forces [N]; those on clamped nodes go straight to the support.
+
+    Returns
+    -------
+    (N, 3) displacements [m].
+
+    Raises
+    ------
+    InputError : wrong force size, or no clamped node (a free body is singular).
+    """
     from flexrv.fem.modal import factorize, free_dofs
 
     f = np.asarray(forces, dtype=float).reshape(-1)
@@ -38,14 +53,21 @@ def sector_loads(nodes: np.ndarray, surface_nodes: np.ndarray, center_xy, angles
     line load along a cylindrical raceway. The resultant of every load is exact."""
     nodes = np.asarray(nodes, dtype=float)
     surface_nodes = np.asarray(surface_nodes)
-    out = np.zeros_like(nodes)
+    angles = np.atleast_1d(np.asarray(angles, dtype=float))
+    forces = np.atleast_2d(np.asarray(forces, dtype=float))
+    if forces.shape != (angles.size, 3):
+        raise InputError(f"forces have shape {forces.shape}, expected ({angles.size}, 3) for {angles.size} angles")
+    if not 0.0 < half_width <= np.pi:
+        raise InputError(f"half_width = {half_width!r} rad must be in (0, pi]")
     p = nodes[surface_nodes, :2] - np.asarray(center_xy, dtype=float)
     theta = np.arctan2(p[:, 1], p[:, 0])
-    for a, f in zip(np.atleast_1d(angles), np.atleast_2d(forces)):
-        sel = np.abs(np.angle(np.exp(1j * (theta - a)))) <= half_width
-        if not sel.any():
-            raise InputError(f"no surface node within {np.degrees(half_width):.3g} deg of {np.degrees(a):.4g} deg")
-        np.add.at(out, surface_nodes[sel], f / sel.sum())
+    sel = np.abs(np.angle(np.exp(1j * (theta[None, :] - angles[:, None])))) <= half_width  # (loads, surface)
+    count = sel.sum(axis=1)
+    if np.any(count == 0):
+        a = angles[np.argmin(count)]
+        raise InputError(f"no surface node within {np.degrees(half_width):.3g} deg of {np.degrees(a):.4g} deg")
+    out = np.zeros_like(nodes)
+    np.add.at(out, surface_nodes, (sel / count[:, None]).T @ forces)
     return out
 
 

@@ -66,12 +66,17 @@ def render_mode_png(path: str | os.PathLike, nodes: np.ndarray, tris6: np.ndarra
         plotter.add_mesh(poly, scalars=scalar_name, cmap="viridis", show_edges=False)
         if title:
             plotter.add_text(title, font_size=10)
-        plotter.view_isometric()
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            plotter.screenshot(str(tmp))
+        return save_screenshot(plotter, path)
     finally:
         plotter.close()
+
+
+def save_screenshot(plotter, path) -> Path:
+    """Isometric view of an off-screen plotter written atomically to a PNG."""
+    plotter.view_isometric()
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        plotter.screenshot(str(tmp))
     return path
 
 

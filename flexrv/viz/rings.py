@@ -22,7 +22,7 @@ import numpy as np
 
 from flexrv.cache import atomic_path, atomic_write_text
 from flexrv.errors import InputError
-from flexrv.viz.modes import _pyvista, surface_polydata
+from flexrv.viz.modes import _pyvista, save_screenshot, surface_polydata
 
 FIELDS = ("displacement", "von_mises")
 
@@ -121,13 +121,9 @@ def render_rings_png(res, path, time: float | None = None, scale: float | None =
         i = len(t) - 1 if time is None else int(np.argmin(np.abs(t - time)))
         plotter.add_text(f"{res.attrs.get('preset')} main-bearing rings, t = {t[i]:.4f} s, scale x{scale:.3g}",
                          font_size=10)
-        plotter.view_isometric()
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            plotter.screenshot(str(tmp))
+        return save_screenshot(plotter, path)
     finally:
         plotter.close()
-    return path
 
 
 def show_rings(res, time: float | None = None, scale: float | None = None, field: str = "displacement") -> bool:
