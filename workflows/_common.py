@@ -121,6 +121,9 @@ def collect_report(results_root: Path = RESULTS_ROOT) -> Path:
              "What do main-bearing flexibility and lubrication do to an RV reducer's transmission error?",
              "Each section below is one workflow's summary (seed numbers beside flexrv's, with the",
              "reason for every difference). Regenerate with `flexrv report`.", ""]
+    answer = answer_section(results_root)
+    if answer:
+        parts += answer
     found = sorted(p for p in results_root.glob("*/summary.md"))
     for path in found:
         folder = path.parent.name
@@ -131,3 +134,59 @@ def collect_report(results_root: Path = RESULTS_ROOT) -> Path:
     if not found:
         parts.append("No workflow results yet: run `flexrv workflow NAME` (or the workflows' modules) first.")
     return atomic_write_text(results_root / "README.md", "\n".join(parts) + "\n")
+
+
+def answer_section(results_root: Path = RESULTS_ROOT) -> list[str]:
+    """The report's short answer, computed from the saved workflow outputs that
+    exist (rigid_vs_flexible/compare.json, ring_deformation.nc, lubrication_*.nc,
+    crankshaft_flexibility/compare.json); empty if none does."""
+    import json
+
+    import numpy as np
+
+    lines: list[str] = []
+    cmp = results_root / "rigid_vs_flexible" / "compare.json"
+    if cmp.exists():
+        n = json.loads(cmp.read_text())
+        r, f = n["rigid"], n["flexible"]
+        lines.append(f"* **Main-bearing flexibility** (rv221, seeds 000/001, 20 N m): steady TE "
+                     f"{r['te_min_arcsec']:.2f} .. {r['te_max_arcsec']:.2f} arcsec with the rigid model, "
+                     f"{f['te_min_arcsec']:.2f} .. {f['te_max_arcsec']:.2f} arcsec with flexible rings and "
+                     f"ball-resolved EHL contacts — a change of {f['te_mean_arcsec'] - r['te_mean_arcsec']:+.2f} arcsec "
+                     f"in the mean and {f['te_pp_arcsec'] - r['te_pp_arcsec']:+.2f} arcsec in the ripple, not the "
+                     "seeds' near-doubling: clamped at their fits the rings deform only locally (~1 um under a "
+                     "ball).")
+    ring = results_root / "ring_deformation" / "ring_deformation.nc"
+    if ring.exists():
+        import xarray as xr
+
+        ds = xr.load_dataset(ring, engine="h5netcdf")
+        loaded = ds.where(ds["radial [kN]"] > 0, drop=True)
+        if loaded.sizes.get("case", 0):
+            lines.append(
+                f"* **External load** (seed 001's 15/20 .. 25/30 kN): ring deflection "
+                f"{float(loaded['outer ring deflection [um]'].min()):.2f} .. "
+                f"{float(loaded['outer ring deflection [um]'].max()):.2f} um (seed 0.35 .. 0.65 um); what moves TE is "
+                "the carrier's radial shift in the ball bearing (tens of um): the TE range moves to "
+                f"{float(loaded['TE min, flexible [arcsec]'].min()):.2f} .. "
+                f"{float(loaded['TE max, flexible [arcsec]'].max()):.2f} arcsec, with rigid and flexible rings alike.")
+    film = results_root / "lubrication" / "lubrication_film.nc"
+    if film.exists():
+        import xarray as xr
+
+        ds = xr.load_dataset(film, engine="h5netcdf")
+        te = ds["TE mean [arcsec]"].values
+        h = ds["min central film [um]"].values
+        h = h[h > 0] if np.any(h > 0) else np.array([0.0])
+        lines.append(f"* **Lubrication**: EHL films of {h.min():.3g} .. {h.max():.3g} um (viscosity "
+                     f"0.01 .. 1.5 Pa s) change the TE mean by {te.max() - te.min():.3f} arcsec: negligible. The "
+                     "seeds' mm-scale 'films' are not EHL films.")
+    crank = results_root / "crankshaft_flexibility" / "compare.json"
+    if crank.exists():
+        n = json.loads(crank.read_text())
+        lines.append(f"* **Crankshaft torsion** (rv40e, 412 N m): shifts TE by "
+                     f"{n['flexible']['te_mean_arcsec'] - n['rigid']['te_mean_arcsec']:+.2f} arcsec (twist / z_c), "
+                     "the ripple is unchanged.")
+    if not lines:
+        return []
+    return ["## Answer", "", *lines, ""]
