@@ -214,3 +214,17 @@ def test_crank_bearing_sweep_reports_invalid_eccentricities():
 
     with pytest.raises(ConfigError, match="K1"):
         _design(load("rv40e"), 2.0)
+
+
+def test_report_answer_is_computed_from_saved_outputs(tmp_path):
+    """The report's Answer section quotes the numbers of the saved comparison
+    (rigid_vs_flexible/compare.json), not fixed text: changing the file changes it."""
+    from workflows._common import answer_section
+
+    (tmp_path / "rigid_vs_flexible").mkdir()
+    stats = {"te_min_arcsec": -1.5, "te_max_arcsec": 2.25, "te_mean_arcsec": 0.5, "te_pp_arcsec": 3.75}
+    flex = dict(stats, te_mean_arcsec=0.75, te_pp_arcsec=4.0)
+    (tmp_path / "rigid_vs_flexible" / "compare.json").write_text(json.dumps({"rigid": stats, "flexible": flex}))
+    text = "\n".join(answer_section(tmp_path))
+    assert "-1.50 .. 2.25" in text and "+0.25 arcsec in the mean" in text and "+0.25 arcsec in the ripple" in text
+    assert answer_section(tmp_path / "missing") == []
