@@ -112,6 +112,16 @@ def _normal_load(delta, rate, speed, law):
 
 
 @njit(cache=True)
+def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
+    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w
+    (flexrv.contact.ball_raceway.raceway_contacts): (|e|, unit normal, Q, dQ/ddelta, dQ/drate)."""
+    length = math.sqrt(ex * ex + ey * ey + ez * ez)
+    nx, ny, nz = ex / length, ey / length, ez / length
+    q, dq, c = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
+    return length, nx, ny, nz, q, dq, c
+
+
+@njit(cache=True)
 def _basis(table, zsign, psi, out):
     """Cartesian raceway displacement per modal coordinate at azimuth psi -> out (3, m)
     (Catmull–Rom periodic cubic of the cylindrical table, flexrv.fem.reduction.periodic_cubic)."""
@@ -221,11 +231,8 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         cvx = qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0]
         cvy = qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1]
         cvz = qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2]
-        ex, ey, ez = bx - cx, by - cy, bz - cz
-        len_i = math.sqrt(ex * ex + ey * ey + ez * ez)
-        nix, niy, niz = ex / len_i, ey / len_i, ez / len_i
-        rate = nix * (vx - cvx) + niy * (vy - cvy) + niz * (vz - cvz)
-        qi, dqi, cdi = _normal_load(len_i - off_i, rate, speed, law_i)
+        len_i, nix, niy, niz, qi, dqi, cdi = _contact(bx - cx, by - cy, bz - cz, vx - cvx, vy - cvy, vz - cvz,
+                                                      off_i, speed, law_i)
         fix, fiy, fiz = -qi * nix, -qi * niy, -qi * niz
         # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
         f[0] -= fix
@@ -257,11 +264,8 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
                 ovx += bas_o[0, k] * vk
                 ovy += bas_o[1, k] * vk
                 ovz += bas_o[2, k] * vk
-        ex, ey, ez = bx - ox, by - oy, bz - oz
-        len_o = math.sqrt(ex * ex + ey * ey + ez * ez)
-        nox, noy, noz = ex / len_o, ey / len_o, ez / len_o
-        rate = nox * (vx - ovx) + noy * (vy - ovy) + noz * (vz - ovz)
-        qo, dqo, cdo = _normal_load(len_o - off_o, rate, speed, law_o)
+        len_o, nox, noy, noz, qo, dqo, cdo = _contact(bx - ox, by - oy, bz - oz, vx - ovx, vy - ovy, vz - ovz,
+                                                      off_o, speed, law_o)
         fox, foy, foz = -qo * nox, -qo * noy, -qo * noz
         if m_o > 0:
             for k in range(m_o):
