@@ -215,10 +215,12 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                                "seed stress [MPa]": seed_s, "seed TE [arcsec]": seed_te,
                                "note": str(exc).split("\n")[-1].strip()})
             continue
-        res_e = res if abs(ecc - red.second_stage.eccentricity_mm) < 1e-12 else \
-            Simulation(red_e, model="rigid").run(t_end=t_end)
-        ie, ke, _ = max_load_instant(res_e)
-        st = crank_stress(red_e, res_e, ie, size=size)
+        if abs(ecc - red.second_stage.eccentricity_mm) < 1e-12:  # the study's own case: reuse run and FE solve
+            res_e, (ie, ke, _), st = res, (i, k, j), stress
+        else:
+            res_e = Simulation(red_e, model="rigid").run(t_end=t_end)
+            ie, ke, _ = max_load_instant(res_e)
+            st = crank_stress(red_e, res_e, ie, size=size)
         te = res_e.steady("te").values
         sweep_rows.append({"eccentricity [mm]": ecc, "valid": True,
                            "max roller force [N]": float(res_e["roller_force"].values[ie, 0, ke].max()),

@@ -672,21 +672,16 @@ class BallBearingGroup(ForceGroup):
             f[idx] += row_force(self.rows[k], qe, ve)
         return f
 
-    def _evaluate_one(self, q, v, jacobian: bool):
+    def _evaluate_rows(self, q, v):
+        """Generalized force and the full row evaluations (numpy reference) of one state."""
         f = np.zeros(self._n)
-        jq = np.zeros((self._n, self._n)) if jacobian else None
-        jv = np.zeros((self._n, self._n)) if jacobian else None
         evals = []
         for k, row in enumerate(self.rows):
             qe, ve, idx = self._element_state(q, v, k)
-            ev = evaluate_row(row, qe, ve, jacobian=jacobian)
+            ev = evaluate_row(row, qe, ve, jacobian=False)
             evals.append(ev)
             f[idx] += ev.force
-            if jacobian:
-                ix = np.ix_(idx, idx)
-                jq[ix] += ev.jac_q
-                jv[ix] += ev.jac_v
-        return f, jq, jv, evals
+        return f, evals
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
         """Generalized forces for one state (n,) or a history (T, n)."""
@@ -697,7 +692,7 @@ class BallBearingGroup(ForceGroup):
         forces = np.zeros_like(q)
         history = []
         for i in range(q.shape[0]):
-            forces[i], _, _, evals = self._evaluate_one(q[i], v[i], False)
+            forces[i], evals = self._evaluate_rows(q[i], v[i])
             if want_outputs:
                 history.append(evals)
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
