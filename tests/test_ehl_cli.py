@@ -54,3 +54,19 @@ def test_ehl_incomplete_explicit_case():
     res = CliRunner().invoke(app, ["ehl", "--load-n", "100", "--json"])
     assert isinstance(res.exception, InputError)
     assert "--speed-m-s" in str(res.exception)
+
+
+def test_ehl_grid_refinement_reported():
+    """The JSON reports the grid actually used, the change of h_c from the next-coarser grid and
+    whether it met --grid-tol; a tolerance the capped refinement cannot meet is reported as a
+    warning, not an error."""
+    args = ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.01", "--ry-m", "0.04", "--json"]
+    res = CliRunner().invoke(app, args + ["--grid-tol", "0.001", "--max-grid", "129"])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    out = data["outputs"]
+    assert out["grid_used"] == 129 and not out["grid_converged"] and out["grid_change"] > 0.001
+    assert data["inputs"]["grid_tol"] == 0.001 and "not grid-converged" in data["warnings"][0]
+    res = CliRunner().invoke(app, args)
+    out = json.loads(res.output)["outputs"]
+    assert out["grid_converged"] and out["grid_change"] < 0.02 and out["grid_used"] >= 129

@@ -113,10 +113,12 @@ def test_law_bad_input(kwargs, match):
 def test_map_mode(tmp_path, monkeypatch):
     """mode 'map': at a map node the film equals the solver's h_c (same grid); between nodes
     it stays within 25 % of Hamrock-Dowson (solver/HD ratio at 33^2: 1.12-1.20); the map is
-    cached on disk and reloaded identically."""
+    cached on disk and reloaded identically. The 33^2 map grid (for speed) is too coarse for
+    the 2 % grid tolerance, which the build reports as one warning."""
     monkeypatch.setenv("FLEXRV_CACHE", str(tmp_path))
     kw = dict(n_load=2, n_speed=2, grid=33)
-    fmap = film_map(RX, RY, E, LUB, (20.0, 100.0), (0.05, 0.15), **kw)
+    with pytest.warns(RuntimeWarning, match="EHL map: at [1-4] of 4 nodes"):
+        fmap = film_map(RX, RY, E, LUB, (20.0, 100.0), (0.05, 0.15), **kw)
     assert fmap.valid.all()
     files = list((tmp_path / "ehl_maps").glob("*.npz"))
     assert len(files) == 1
@@ -138,6 +140,7 @@ def test_map_mode(tmp_path, monkeypatch):
     np.testing.assert_allclose(out.elastic_approach[on] - np.linspace(-1e-7, 5e-6, 52)[on], hm, rtol=1e-8)
 
 
+@pytest.mark.filterwarnings("ignore:EHL map")
 def test_map_fills_failed_nodes(monkeypatch):
     """A node where the solver fails takes the nearest converged ratio (flagged invalid)."""
     import flexrv.ehl.maps as maps

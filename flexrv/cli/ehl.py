@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any, Optional
 
 import typer
@@ -50,7 +51,8 @@ def _reduced_modulus(reducer, effective_modulus) -> float:
 
 
 def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: Optional[float] = None,
-             rx_m: Optional[float] = None, ry_m: Optional[float] = None, grid: int = 129):
+             rx_m: Optional[float] = None, ry_m: Optional[float] = None, grid: int = 129,
+             grid_tol: Optional[float] = 0.02, max_grid: Optional[int] = None):
     """Solve one case; returns (report dict, EHLResult)."""
     from flexrv.contact.hertz import effective_modulus
     from flexrv.design import load as load_design
@@ -73,7 +75,10 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
                   f"(carrier {case['carrier_speed_rad_s']:.4g} rad/s, ratio {case['ratio']:.4g})")
     lub = LubricantProperties.from_design(reducer.lubricant)
     t0 = time.perf_counter()
-    res = solve_point_contact(case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub, grid=grid)
+    with warnings.catch_warnings(record=True) as caught:  # grid not converged: reported, not printed twice
+        warnings.simplefilter("always", RuntimeWarning)
+        res = solve_point_contact(case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub, grid=grid,
+                                  grid_tol=grid_tol, max_grid=max_grid)
     elapsed = time.perf_counter() - t0
     args = (case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub.viscosity, lub.pressure_viscosity)
     hd_c, hd_min = hamrock_dowson(*args)
@@ -84,9 +89,10 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
                    "pressure_viscosity_1_Pa": lub.pressure_viscosity, "roelands_z": lub.roelands_z,
                    "roelands_p0_Pa": lub.roelands_p0, "density_kg_m3": lub.density,
                    "dowson_higginson_a_1_Pa": lub.dh_a, "dowson_higginson_b_1_Pa": lub.dh_b, "grid": grid,
-                   "wedge_order": res.wedge_order},
+                   "grid_tol": grid_tol, "max_grid": max_grid, "wedge_order": res.wedge_order},
         "outputs": {"h_central_m": res.h_central, "h_central_grid_m": res.h_central_grid,
                     "h_central_coarse_grid_m": res.h_central_coarse, "extrapolated": res.extrapolated,
+                    "grid_used": res.grid, "grid_change": res.grid_change, "grid_converged": res.grid_converged,
                     "h_min_m": res.h_min, "p_max_Pa": res.p_max,
                     "hertz_pressure_Pa": res.hertz_pressure, "hertz_a_m": res.hertz_a, "hertz_b_m": res.hertz_b,
                     "hamrock_dowson_h_central_m": float(hd_c), "hamrock_dowson_h_min_m": float(hd_min),
@@ -94,6 +100,8 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
                     "total_iterations": res.total_iterations, "residual": res.residual,
                     "load_error": res.load_error, "solve_time_s": elapsed},
     }
+    if caught:
+        report["warnings"] = [str(w.message) for w in caught if "EHL" in str(w.message)]
     return report, res
 
 
@@ -102,13 +110,18 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         speed_m_s: Optional[float] = typer.Option(None, "--speed-m-s", help="Mean entrainment speed (u1+u2)/2 (m/s)."),
         rx_m: Optional[float] = typer.Option(None, "--rx-m", help="Effective radius along the entrainment (m)."),
         ry_m: Optional[float] = typer.Option(None, "--ry-m", help="Effective radius across the entrainment (m)."),
-        grid: int = typer.Option(129, "--grid", help="Nodes per direction, 2^k+1 (65, 129, 257)."),
+        grid: int = typer.Option(129, "--grid", help="Nodes per direction, 2^k+1 (65, 129, 257); the first grid of "
+                                 "the adaptive refinement at >= 129."),
+        grid_tol: float = typer.Option(0.02, "--grid-tol", help="Refine the grid until h_c changes by less than this "
+                                       "fraction from the next-coarser grid (0.02 = 2 %)."),
+        max_grid: Optional[int] = typer.Option(None, "--max-grid", help="Finest grid of the refinement (default 513 "
+                                               "at grid >= 129; = --grid below, i.e. no refinement)."),
         png: Optional[str] = typer.Option(None, "--png",
                                           help="Write pressure/film centre lines and 2-D maps to this PNG."),
         json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Numerical EHL solution (Reynolds + Roelands + Dowson-Higginson + Boussinesq) of a
     ball-raceway contact, compared with Hamrock-Dowson and Moes."""
-    report, res = ehl_case(preset, load_n, speed_m_s, rx_m, ry_m, grid)
+    report, res = ehl_case(preset, load_n, speed_m_s, rx_m, ry_m, grid, grid_tol, max_grid)
     if png:
         from flexrv.viz.ehl_plots import plot_ehl_solution
 
@@ -127,6 +140,8 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
 
         for section in ("inputs", "outputs"):
             console.print(kv_table(section, [(k, v, unit(k)) for k, v in data[section].items()]))
+        for message in data.get("warnings", []):
+            console.print(f"[yellow]warning:[/] {message}")
         if "png" in data:
             console.print(f"plot: {data['png']}")
 

@@ -182,7 +182,7 @@ class EHLPointLaw:
 
     @classmethod
     def from_design(cls, reducer, rx, ry, *, mode: Optional[str] = None, load_range=(5.0, 2000.0),
-                    speed_range=(0.005, 0.5), map_grid: int = 65) -> "EHLPointLaw":
+                    speed_range=(0.005, 0.5), map_grid: int = 129) -> "EHLPointLaw":
         """Law for the main-bearing ball contacts of a :class:`flexrv.design.model.Reducer`.
 
         E' from the ``rolling_elements`` and ``bearing_rings`` materials, lubricant from
