@@ -36,6 +36,8 @@ def test_ehl_preset_json(tmp_path):
     np.testing.assert_allclose(inp["entrainment_speed_m_s"], 0.25 * geom.pitch_diameter * (1 - gam**2) * w_c,
                                rtol=2e-3)  # loaded vs nominal contact angle
     assert inp["grid"] == 33 and inp["viscosity_Pa_s"] == red.lubricant.viscosity_Pa_s
+    np.testing.assert_allclose(inp["roelands_pressure_viscosity_1_Pa"], 0.68 * (math.log(0.13) + 9.67) / 1.96e8,
+                               rtol=1e-12)  # Roelands 1966 slope at p -> 0
     assert abs(out["h_central_m"] / out["hamrock_dowson_h_central_m"] - 1) < 0.35
     assert 1e-8 < out["h_min_m"] < out["h_central_m"] < 1e-6  # EHL films: 0.01-1 um
     assert abs(out["p_max_Pa"] / out["hertz_pressure_Pa"] - 1) < 0.1

@@ -121,3 +121,13 @@ def test_missing_pressure_viscosity_data():
 def test_non_convergence_is_reported():
     with pytest.raises(ConvergenceError, match="residual reached .* after 1 Newton steps"):
         solve_point_contact(100.0, 1.0, 0.01, 0.01, E, LUB, grid=33, max_iter=1, coarsest=33)
+
+
+def test_roelands_alpha():
+    """alpha* = z (ln eta0 + 9.67)/p0 (Roelands 1966): 0.67 (ln 0.05 + 9.67)/1.96e8 = 2.2815e-8 1/Pa,
+    and it is the p -> 0 slope of ln(eta) (central difference, 1e-6)."""
+    assert LUB.roelands_alpha == pytest.approx(0.67 * (np.log(0.05) + 9.67) / 1.96e8, rel=1e-12)
+    assert LUB.roelands_alpha == pytest.approx(2.2815e-8, rel=1e-4)
+    dp = 1e3
+    slope = (np.log(LUB.roelands_viscosity_ratio(dp)) - np.log(LUB.roelands_viscosity_ratio(-dp))) / (2 * dp)
+    assert slope == pytest.approx(LUB.roelands_alpha, rel=1e-6)
