@@ -76,7 +76,7 @@ def test_default_solve_is_grid_converged(case):
 
 
 def test_refinement_where_129_is_too_coarse():
-    """Circular M = 260: the 65^2 grid is too coarse for its extrapolation (7.9 % change from
+    """Circular M = 260: the 65^2 grid is too coarse for its extrapolation (8.6 % change from
     65^2 to 129^2), so the solver refines to 257^2; capped at max_grid = 129 it returns the
     129^2 film, flags it as not grid-converged and warns."""
     assert solve("circ260").grid == 257

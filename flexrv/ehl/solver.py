@@ -821,7 +821,7 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
             continue
         closed = bool(np.any(H[1:-1, 1:-1] <= 0))
         change = abs(reported(k) / reported(k - 1) - 1.0) if k >= (2 if extrapolate else 1) else float("nan")
-        converged = (not closed) and np.isfinite(change) and change <= grid_tol if grid_tol is not None else True
+        converged = True if grid_tol is None else bool((not closed) and np.isfinite(change) and change <= grid_tol)
         if converged or n >= max_grid:
             break
         levels.append(2 * n - 1)  # refine: one more level of the continuation
