@@ -123,7 +123,7 @@ def test_nested_dissection_lu(shape):
     coo = A.tocoo()
     Ap = sp.csc_matrix((coo.data, (pos[coo.row], pos[coo.col])), shape=A.shape)
     b = rng.standard_normal(n)
-    x = _PermutedLU(Ap, perm, "NATURAL").solve(b)
+    x = _PermutedLU(Ap, perm).solve(b)
     np.testing.assert_allclose(x, sp.linalg.spsolve(A, b), rtol=1e-10, atol=1e-12)
 
 

@@ -143,6 +143,7 @@ def answer_section(results_root: Path = RESULTS_ROOT) -> list[str]:
     import json
 
     import numpy as np
+    import xarray as xr
 
     lines: list[str] = []
     cmp = results_root / "rigid_vs_flexible" / "compare.json"
@@ -158,8 +159,6 @@ def answer_section(results_root: Path = RESULTS_ROOT) -> list[str]:
                      "ball).")
     ring = results_root / "ring_deformation" / "ring_deformation.nc"
     if ring.exists():
-        import xarray as xr
-
         ds = xr.load_dataset(ring, engine="h5netcdf")
         loaded = ds.where(ds["radial [kN]"] > 0, drop=True)
         if loaded.sizes.get("case", 0):
@@ -172,8 +171,6 @@ def answer_section(results_root: Path = RESULTS_ROOT) -> list[str]:
                 f"{float(loaded['TE max, flexible [arcsec]'].max()):.2f} arcsec, with rigid and flexible rings alike.")
     film = results_root / "lubrication" / "lubrication_film.nc"
     if film.exists():
-        import xarray as xr
-
         ds = xr.load_dataset(film, engine="h5netcdf")
         te = ds["TE mean [arcsec]"].values
         h = ds["min central film [um]"].values

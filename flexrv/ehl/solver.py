@@ -204,8 +204,8 @@ class EHLResult:
     load_error : |iint p - Q| / Q.
     grid : nodes per direction of the grid used (may exceed the requested one, see ``grid_tol``).
     h_central_grid : central film of the finest-grid solution itself [m].
-    h_central_coarse : central film of the next-coarser grid (N+1)/2 [m] (converged to the
-        same tolerance when ``extrapolated``; nan otherwise).
+    h_central_coarse : central film of the next-coarser level (N+1)/2 of the continuation [m]
+        (nan when there is none).
     extrapolated : True when ``h_central`` is the Richardson extrapolation
         (4 h_N - h_(N+1)/2)/3 of the second-order scheme (see :func:`solve_point_contact`).
     wedge_order : order of the wedge-term discretisation used (1 or 2).
@@ -292,9 +292,6 @@ class _GridProblem:
     def __init__(self, n, x_in, x_out, y_half, aspect, ky, lam, kernel_scale, pscale, lub: LubricantProperties,
                  stencil: int, wedge_order: int = 2, symmetric: bool = True):
         self.wedge_order = wedge_order
-        # the preconditioner always uses the first-order wedge stencil (sparser LU, same Newton
-        # steps; measured rv221 ball 129^2: 2.4 s vs 2.85 s with the second-order stencil)
-        self.precond_order = 1
         self.n = n
         self.X = np.linspace(x_in, x_out, n)
         self.Y = np.linspace(-y_half, y_half, n)
@@ -325,7 +322,6 @@ class _GridProblem:
         # single-precision LU of the preconditioner (GMRES works on the true float64 residual, so
         # only the preconditioner quality is affected): -10-25 % CPU at 129^2
         self.lu_dtype = np.float32
-        self.ordering = "nested_dissection"  # or a SuperLU permc_spec such as "COLAMD"
         self.trace = False
         # symmetry about Y = 0 (module docstring): unknowns P[i, j] for j >= jc only
         self.symmetric = symmetric
@@ -432,14 +428,15 @@ class _GridProblem:
         rows_list, cols_list, vals_list = [], [], []
         kc = n - 1  # centre index of the kernel array
         dx = self.dX
-        # wedge term: -dX sum_m c_m rho_{i-m} H_{i-m}; dH_i/dP_{i+k} = K[k]
-        second = (fi >= 2) if self.precond_order == 2 else np.zeros(fi.shape, dtype=bool)
-        coef = (np.where(second, 1.5, 1.0), np.where(second, -2.0, -1.0), np.where(second, 0.5, 0.0))
-        back = [np.maximum(fi - m, 0) for m in range(3)]
-        for di in range(-sx - (2 if self.precond_order == 2 else 1), sx + 1):
+        # wedge term, first-order upwind whatever the residual's order (sparser LU, same Newton
+        # steps; measured rv221 ball 129^2: 2.4 s vs 2.85 s with the second-order stencil):
+        # -dX (rho_i H_i - rho_(i-1) H_(i-1)); dH_i/dP_(i+k) = K[k]
+        coef = (1.0, -1.0)
+        back = (fi, fi - 1)  # free nodes are interior: fi >= 1
+        for di in range(-sx - 1, sx + 1):
             for dj in range(-s, s + 1):
                 val = np.zeros(fi.shape)
-                for m in range(3):
+                for m in range(2):
                     if abs(di + m) <= sx:
                         val = val - dx * coef[m] * rho[back[m], fj] * self.kernel[kc + di + m, kc + dj]
                 ti, tj = fi + di, fj + dj
@@ -448,7 +445,7 @@ class _GridProblem:
                 cols_list.append(idx[ti[ok], tj[ok]])
                 vals_list.append(val[ok])
         # density derivative part of the wedge term
-        for m in range(3):
+        for m in range(2):
             rows_list.append(idx[fi, fj])
             cols_list.append(idx[back[m], fj])
             vals_list.append(-dx * coef[m] * H[back[m], fj] * drho[back[m], fj])
@@ -468,14 +465,12 @@ class _GridProblem:
         cols_list.append(idx[ci, cj])
         vals_list.append(np.ones(ci.shape))
         nu = n * self.m
-        rows, cols = np.concatenate(rows_list), np.concatenate(cols_list)
-        if self.ordering == "nested_dissection":  # assemble directly in the dissection order
-            rows, cols = self.pos[rows], self.pos[cols]
+        rows, cols = self.pos[np.concatenate(rows_list)], self.pos[np.concatenate(cols_list)]  # dissection order
         A = sp.csc_matrix((np.concatenate(vals_list), (rows, cols)), shape=(nu, nu))
         # H0 column: wedge term (vanishes for an incompressible film, where d(rho H)/dX does not
         # see a uniform shift) plus the Poiseuille term through d eps/dH = 3 eps/H
         col = np.zeros((n, n))
-        col[fi, fj] = -dx * sum(coef[m] * rho[back[m], fj] for m in range(3))
+        col[fi, fj] = -dx * (rho[fi, fj] - rho[fi - 1, fj])
         deps = 3.0 * eps / np.maximum(H, 1e-12)
         dex_p = 0.5 * (deps[fi, fj] + deps[fi + 1, fj])
         dex_m = 0.5 * (deps[fi, fj] + deps[fi - 1, fj])
@@ -508,8 +503,7 @@ class _GridProblem:
                 free_lu = free
                 A, col = self.precond_matrix(self.expand(z[:-1].reshape(n, self.m)), z[-1], free)
                 try:
-                    lu = _PermutedLU(A.astype(self.lu_dtype), self.perm if self.ordering == "nested_dissection"
-                                     else None, self.ordering)
+                    lu = _PermutedLU(A.astype(self.lu_dtype), self.perm)
                 except RuntimeError as exc:  # singular preconditioner
                     raise ConvergenceError(f"EHL Newton step {steps}: singular preconditioner ({exc}); "
                                            f"residual reached {res:.3e}") from exc
@@ -554,17 +548,16 @@ class _GridProblem:
 
 
 class _PermutedLU:
-    """Sparse LU (SuperLU) of a matrix assembled in the order ``perm`` (new -> old index);
-    ``solve`` takes and returns vectors in the original order (float64)."""
+    """Sparse LU (SuperLU, no further column ordering) of a matrix assembled in the order
+    ``perm`` (new -> old index); ``solve`` takes and returns float64 vectors in the original
+    order."""
 
-    def __init__(self, A, perm, ordering):
+    def __init__(self, A, perm):
         self.perm = perm
         self.dtype = A.dtype
-        self.lu = spla.splu(A, permc_spec="NATURAL" if perm is not None else ordering)
+        self.lu = spla.splu(A, permc_spec="NATURAL")
 
     def solve(self, r):
-        if self.perm is None:
-            return self.lu.solve(r.astype(self.dtype)).astype(float)
         out = np.empty(r.shape)
         out[self.perm] = self.lu.solve(r[self.perm].astype(self.dtype))
         return out

@@ -46,7 +46,7 @@ from typing import Protocol
 import numpy as np
 
 from flexrv.errors import ConfigError
-from flexrv.contact.ball_raceway import NormalLaw, RowContactGeometry, hertz_law, raceway_contacts
+from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law, raceway_contacts
 from flexrv.model.base import ForceGroup, Output
 
 
@@ -256,7 +256,6 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
     r, phi = q[0:3], q[3:6]
     r_t, phi_t = q_t[0:3], q_t[3:6]
     a_mat, g_mat = rxyz_matrices(phi)
-    omega = g_mat @ phi_t
     balls = model.ball_reference + q[sb].reshape(z_count, 3)
     balls_t = q_t[sb].reshape(z_count, 3)
     row = model.row
@@ -424,7 +423,6 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
     ``frame_node`` must be a ``NodeRigidBodyRxyz`` at the origin (reference
     position 0, reference rotation 0) carrying the inner rings.
     """
-    import exudyn as exu
     from exudyn.itemInterface import MassPoint, NodeGenericODE2, NodePoint, ObjectGenericODE2
 
     inner_nodes, outer_nodes, ball_nodes, objects = [], [], [], []
@@ -448,7 +446,6 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
             balls.append(nb)
         ball_nodes.append(balls)
         node_list += balls
-        n = model.n_coordinates
 
         def force_fn(mbs_, t, item, q, q_t, model=model):
             return row_force(model, np.asarray(q), np.asarray(q_t))
