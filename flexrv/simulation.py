@@ -36,6 +36,7 @@ import numpy as np
 from flexrv.design import load
 from flexrv.errors import InputError, SimulationError
 from flexrv.post.results import Results  # noqa: F401  (re-exported: flexrv.Results)
+from flexrv.units import ARCMIN_PER_RAD
 
 #: systems with more coordinates than this use Exudyn's sparse linear solver
 SPARSE_ABOVE = 100
@@ -278,11 +279,10 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     res.attrs["stiffness_test"] = str(figures)
     if save_to is not None:
         from flexrv.viz.plots import plot_hysteresis
-        from flexrv.post.stiffness import ARCMIN
 
         d = Path(save_to)
         d.mkdir(parents=True, exist_ok=True)
         res.save(d)
-        plot_hysteresis(angle * ARCMIN, tq, d / "hysteresis.png",
+        plot_hysteresis(angle * ARCMIN_PER_RAD, tq, d / "hysteresis.png",
                         title=f"{reducer.name}: {figures.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
     return figures, res

@@ -7,9 +7,9 @@ import pytest
 
 from flexrv.design import load
 from flexrv.errors import InputError
+from flexrv.units import RAD_S_PER_RPM
 from flexrv.geometry.kinematics import characteristic_frequencies, harmonics, member_speeds, reducer_kinematics, total_ratio
 
-RPM = 2 * math.pi / 60
 
 
 def test_ratios_exact():
@@ -25,12 +25,12 @@ def test_seed002_table4_frequencies():
     carrier 0.25, first-stage mesh 320, cycloid mesh 390, pin gear 400 Hz (rel. 1e-12).
     Seed 002's text quotes the crank at 585 r/min: that is the absolute speed
     (600 r/min relative to the carrier minus the 15 r/min carrier speed)."""
-    kin = reducer_kinematics(load("rv40e"), 1215 * RPM)
+    kin = reducer_kinematics(load("rv40e"), 1215 * RAD_S_PER_RPM)
     f = kin.frequencies
     got = [f.input, f.crank_rotation, f.carrier, f.first_stage_mesh, f.cycloid_mesh, f.pin_passing]
     assert np.allclose(got, [20.25, 10.0, 0.25, 320.0, 390.0, 400.0], rtol=1e-12)
-    assert np.isclose(abs(kin.speeds.crank_absolute) / RPM, 585.0, rtol=1e-12)
-    assert np.isclose(kin.speeds.carrier / RPM, 15.0, rtol=1e-12)
+    assert np.isclose(abs(kin.speeds.crank_absolute) / RAD_S_PER_RPM, 585.0, rtol=1e-12)
+    assert np.isclose(kin.speeds.carrier / RAD_S_PER_RPM, 15.0, rtol=1e-12)
     assert kin.speeds.crank_relative < 0 < kin.speeds.carrier  # crank turns against the input
 
 

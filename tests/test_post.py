@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from flexrv.post.spectra import amplitude_spectrum
-from flexrv.post.stiffness import ARCMIN, evaluate_stiffness_test
+from flexrv.post.stiffness import evaluate_stiffness_test
+from flexrv.units import ARCMIN_PER_RAD
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +67,7 @@ def test_stiffness_loop_evaluation_closed_form():
     times = (0.0, 1.0, 3.0, 4.0)
     t = np.linspace(0, 4, 4001)
     torque = np.interp(t, [0, 1, 3, 4], [0, tr, -tr, 0])
-    angle = (torque / k + np.sign(torque) * b) / ARCMIN
+    angle = (torque / k + np.sign(torque) * b) / ARCMIN_PER_RAD
     fig = evaluate_stiffness_test(t, torque, angle, times)
     assert fig.rigidity_Nm_per_arcmin == pytest.approx(k, rel=1e-6)
     assert fig.lost_motion_arcmin == pytest.approx(2 * b + 2 * 0.03 * tr / k, rel=1e-3)

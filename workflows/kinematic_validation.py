@@ -10,11 +10,11 @@ import math
 
 import numpy as np
 
+from flexrv.units import DEG_PER_RAD, RAD_PER_DEG, RAD_S_PER_RPM, RPM_PER_RAD_S
+
 from workflows._common import WorkflowResult, new_figure
 
 NAME = "kinematic_validation"
-DEG = 180.0 / math.pi  #: deg per rad
-RPM = 60.0 / (2.0 * math.pi)  #: r/min per rad/s
 PRESETS = ("rv221", "rv40e")
 #: smoke settings: rv40e only, 0.3 s (0.1 s steady window after the 0.2 s ramps)
 SMOKE = {"presets": ("rv40e",), "t_end": 0.3, "dt": None}
@@ -75,10 +75,10 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
 
     # ---- seed 000 / 001: RV-221 at 9000 deg/s
     red = load("rv221")
-    k = reducer_kinematics(red, 9000.0 / DEG)
+    k = reducer_kinematics(red, 9000.0 * RAD_PER_DEG)
     s = k.speeds
-    out_deg = float(s.carrier) * DEG
-    r.compare("RV-221 input speed", "deg/s", 9000.0, float(s.input) * DEG,
+    out_deg = float(s.carrier) * DEG_PER_RAD
+    r.compare("RV-221 input speed", "deg/s", 9000.0, float(s.input) * DEG_PER_RAD,
               "seed 000 also writes '150 RPM': 9000 deg/s = 1500 r/min (a slip in the seed)")
     r.compare("RV-221 output speed, theory", "deg/s", "40.724", _g(out_deg), "9000/ratio")
     r.numbers["rv221_ratio_theory"] = float(s.ratio)
@@ -94,21 +94,21 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
                   "residual from contact compliance/clearance oscillation in the window")
     fs = red.first_stage
     held = 9000.0 * fs.sun_teeth / fs.planet_teeth
-    r.compare("RV-221 planet (crank) speed", "deg/s", "2452.3", _g(abs(float(s.crank_relative)) * DEG, 5),
-              f"flexrv: relative to the carrier {abs(float(s.crank_relative)) * DEG:.1f}, absolute "
-              f"{abs(float(s.crank_absolute)) * DEG:.1f} deg/s; seed 001's 2452.3 is within "
+    r.compare("RV-221 planet (crank) speed", "deg/s", "2452.3", _g(abs(float(s.crank_relative)) * DEG_PER_RAD, 5),
+              f"flexrv: relative to the carrier {abs(float(s.crank_relative)) * DEG_PER_RAD:.1f}, absolute "
+              f"{abs(float(s.crank_absolute)) * DEG_PER_RAD:.1f} deg/s; seed 001's 2452.3 is within "
               f"{abs(2452.3 / held - 1) * 100:.2f} % of 9000 z_s/z_p = {held:.1f} deg/s, the planet speed with the "
               "carrier HELD (sun speed not reduced by the carrier's rotation)")
-    r.numbers["rv221_planet_deg_s"] = {"relative": abs(float(s.crank_relative)) * DEG,
-                                       "absolute": abs(float(s.crank_absolute)) * DEG, "carrier_held": held}
+    r.numbers["rv221_planet_deg_s"] = {"relative": abs(float(s.crank_relative)) * DEG_PER_RAD,
+                                       "absolute": abs(float(s.crank_absolute)) * DEG_PER_RAD, "carrier_held": held}
 
     # ---- seed 002: RV-40E at 1215 r/min
     red40 = load("rv40e")
-    k40 = reducer_kinematics(red40, 1215.0 / RPM)
+    k40 = reducer_kinematics(red40, 1215.0 * RAD_S_PER_RPM)
     s40, f40 = k40.speeds, k40.frequencies
-    r.compare("RV-40E crank speed, absolute", "r/min", 585.0, abs(float(s40.crank_absolute)) * RPM, "")
-    r.compare("RV-40E crank speed, relative", "r/min", 600.0, abs(float(s40.crank_relative)) * RPM, "= 10 Hz")
-    r.compare("RV-40E output speed", "r/min", 15.0, abs(float(s40.carrier)) * RPM, "1215/81")
+    r.compare("RV-40E crank speed, absolute", "r/min", 585.0, abs(float(s40.crank_absolute)) * RPM_PER_RAD_S, "")
+    r.compare("RV-40E crank speed, relative", "r/min", 600.0, abs(float(s40.crank_relative)) * RPM_PER_RAD_S, "= 10 Hz")
+    r.compare("RV-40E output speed", "r/min", 15.0, abs(float(s40.carrier)) * RPM_PER_RAD_S, "1215/81")
     seed_f = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
               "cycloid_mesh": 390.0, "pin_passing": 400.0}
     freqs = {}
@@ -131,7 +131,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         ds = r.datasets[f"speeds_{p}"]
         t = ds["time"].values
         for key in ds.data_vars:
-            y = ds[key].values.reshape(len(t), -1) * RPM
+            y = ds[key].values.reshape(len(t), -1) * RPM_PER_RAD_S
             ax.plot(t, y, lw=0.8, label=[key] + ["_"] * (y.shape[1] - 1))
         ax.axvspan(ds.attrs["steady_start_s"], ds.attrs["steady_end_s"], color="0.9")
         ax.set_title(f"{p}: member speeds (grey: steady window)")

@@ -36,7 +36,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
                                            required_mesh_stiffness, second_stage_stiffness,
                                            seed004_pin_contributions)
     from flexrv.design import load
-    from flexrv.post.stiffness import ARCMIN
+    from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
     from flexrv.simulation import stiffness_test
 
     red = load(preset)
@@ -99,7 +99,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
               "rigid multibody with penalty pin contacts (per disc, maximum over discs)")
 
     # ---- stiffness
-    to_am = 1.0 / ARCMIN
+    to_am = RAD_PER_ARCMIN
     r.compare("torsional stiffness, measured vs series model", "N m/arcmin", c_w * to_am, ss_st.c_w_seed * to_am,
               f"series C_Hc ({ss_st.c_bearings * to_am:.4g}) with C_c from seed-type K_cj over the loaded pins "
               f"({ss_st.c_mesh_seed * to_am:.4g}); {ss_st.c_w_seed / c_w:.3g}x the measurement")
@@ -121,7 +121,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
                       "rigidity_test_Nm_per_arcmin": st.rigidity_Nm_per_arcmin,
                       "lost_motion_arcmin": st.lost_motion_arcmin, "hysteresis_arcmin": st.hysteresis_arcmin})
 
-    ang = -res["theta_out"].values * ARCMIN
+    ang = -res["theta_out"].values * ARCMIN_PER_RAD
     r.datasets["per_pin"] = xr.Dataset(
         {"ktc_flexrv": ("phase", ktc[:n], {"units": "N m/rad"}), "ktc_seed": ("phase", seed_ktc[:n], {"units": "N m/rad"})},
         coords={"phase": ("phase", np.degrees(th[:n]), {"units": "deg"})})

@@ -17,9 +17,8 @@ import math
 
 import numpy as np
 
-ARCMIN = math.pi / (180.0 * 60.0)
-ARCSEC = ARCMIN / 60.0
-RPM = 2.0 * math.pi / 60.0
+from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN, RPM_PER_RAD_S
+
 
 #: Measured torsional stiffness of the RV-40E (seed 004): 3.06e8 N mm/rad.
 SEED004_MEASURED_CW = 3.06e5  # N m/rad
@@ -38,7 +37,7 @@ def _kinematics(reducer) -> dict:
                                              "disc_rotation", "disc_orbit", "disc_orbit_relative")}
     return {"ratio": s.ratio,
             "speeds_rad_s": speeds,
-            "speeds_rpm": {k: v / RPM for k, v in speeds.items()},
+            "speeds_rpm": {k: v * RPM_PER_RAD_S for k, v in speeds.items()},
             "frequencies_Hz": {k: _f(getattr(f, k)) for k in ("input", "crank_rotation", "carrier", "crank_absolute",
                                                               "first_stage_mesh", "cycloid_mesh", "pin_passing")}}
 
@@ -63,7 +62,7 @@ def _pin_case(reducer, torque: float, law: str = "palmgren", d_pin_radius=None) 
     return {"output_torque_Nm": torque, "disc_torque_Nm": res.torque, "law": res.law,
             "pins_in_contact": res.n_contact, "loaded_pins": [int(i) for i in np.flatnonzero(res.in_contact)],
             "max_pin_force_N": res.max_force, "max_hertz_pressure_Pa": res.max_pressure,
-            "disc_rotation_rad": res.rotation, "lost_motion_arcsec": res.backlash_rotation / ARCSEC,
+            "disc_rotation_rad": res.rotation, "lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD,
             "torsional_stiffness_per_disc_Nm_per_rad": res.torsional_stiffness,
             "torsional_stiffness_all_discs_Nm_per_rad": n_discs * res.torsional_stiffness,
             "pin_resultant_N": float(np.linalg.norm(res.resultant)),
@@ -105,7 +104,7 @@ def _modification_sweep(reducer, torque: float) -> dict:
     for dr_um in (0.0, 1.0, 2.0, 5.0, 10.0, 20.0):
         res = reducer_pin_loads(reducer, torque, d_pin_radius=dr_um * 1e-6)
         out[f"{dr_um:g}um"] = {"pins_in_contact": res.n_contact, "max_pin_force_N": res.max_force,
-                               "lost_motion_arcsec": res.backlash_rotation / ARCSEC}
+                               "lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD}
     return out
 
 
@@ -128,8 +127,8 @@ def _torsional(reducer) -> dict:
             "C_c_palmgren_tangent_Nm_per_rad": first.c_mesh_tangent,
             "C_W_seed004_Nm_per_rad": first.c_w_seed,
             "C_W_palmgren_Nm_per_rad": first.c_w_tangent,
-            "C_W_seed004_Nm_per_arcmin": first.c_w_seed * ARCMIN,
-            "C_W_palmgren_Nm_per_arcmin": first.c_w_tangent * ARCMIN,
+            "C_W_seed004_Nm_per_arcmin": first.c_w_seed * RAD_PER_ARCMIN,
+            "C_W_palmgren_Nm_per_arcmin": first.c_w_tangent * RAD_PER_ARCMIN,
             "C_W_palmgren_over_crank_angle_Nm_per_rad": {"min": float(cw_tan.min()), "max": float(cw_tan.max())},
             "C_W_seed004_over_crank_angle_Nm_per_rad": {"min": float(cw_seed.min()), "max": float(cw_seed.max())},
             "pins_in_contact": first.n_contact,

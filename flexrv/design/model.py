@@ -17,7 +17,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-DEG = math.pi / 180.0
+from flexrv.units import RAD_PER_DEG
+
 
 
 class _Strict(BaseModel):
@@ -58,7 +59,7 @@ class FirstStage(_Strict):
     @property
     def pressure_angle(self) -> float:
         """Pressure angle [rad]."""
-        return self.pressure_angle_deg * DEG
+        return self.pressure_angle_deg * RAD_PER_DEG
 
     @property
     def face_width(self) -> float:
@@ -128,7 +129,7 @@ class SecondStage(_Strict):
 
     @property
     def modification_rotation(self) -> float:
-        return self.modification_rotation_deg * DEG
+        return self.modification_rotation_deg * RAD_PER_DEG
 
     @property
     def center_hole_radius(self) -> float:
@@ -222,7 +223,7 @@ class MainBearing(_Strict):
         min_wall = 0.1 * d
         if not bore < dm < od:
             raise _bad("main_bearing.pitch_diameter_mm", dm, f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm")
-        ca = math.cos(self.contact_angle_deg * DEG)
+        ca = math.cos(self.contact_angle_deg * RAD_PER_DEG)
         # groove bottoms (torus of radius f D about the curvature centres, flexrv.geometry.bearing)
         bottom_i = dm / 2 + (self.inner_conformity - 0.5) * d * ca - self.inner_conformity * d
         bottom_o = dm / 2 - (self.outer_conformity - 0.5) * d * ca + self.outer_conformity * d
@@ -234,7 +235,7 @@ class MainBearing(_Strict):
             raise _bad("main_bearing.ball_diameter_mm", d,
                        f"too large for the outer ring section: the wall under the groove is {od / 2 - bottom_o:.4g} mm, "
                        f"must be >= 0.1 D = {min_wall:.4g} mm", "ball larger than the ring section")
-        half_contact = 0.5 * d * math.sin(self.contact_angle_deg * DEG)
+        half_contact = 0.5 * d * math.sin(self.contact_angle_deg * RAD_PER_DEG)
         if self.ring_width_mm < 2.2 * half_contact:
             raise _bad("main_bearing.ring_width_mm", self.ring_width_mm,
                        f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} mm) lies on the raceway")
@@ -255,7 +256,7 @@ class MainBearing(_Strict):
 
     @property
     def contact_angle(self) -> float:
-        return self.contact_angle_deg * DEG
+        return self.contact_angle_deg * RAD_PER_DEG
 
 
 class Material(_Strict):

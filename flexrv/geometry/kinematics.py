@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexrv.errors import InputError
+from flexrv.units import TWO_PI
 
-TWO_PI = 2.0 * np.pi
 
 
 def total_ratio(z_s, z_p, z_c, z_rp):

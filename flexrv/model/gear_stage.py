@@ -33,8 +33,8 @@ from __future__ import annotations
 import numpy as np
 
 from flexrv.model.base import ForceGroup, Output
+from flexrv.units import TWO_PI
 
-TWO_PI = 2.0 * np.pi
 
 
 class GearMeshes(ForceGroup):

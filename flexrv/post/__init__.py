@@ -1,3 +1,3 @@
 """Post-processing: the Results object (xarray), save/load, TE, spectra, statistics."""
 
-from flexrv.post.results import ARCSEC, Results  # noqa: F401
+from flexrv.post.results import Results  # noqa: F401

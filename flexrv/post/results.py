@@ -32,7 +32,8 @@ import numpy as np
 from flexrv.cache import to_jsonable
 import xarray as xr
 
-ARCSEC = 180.0 / np.pi * 3600.0  #: arcsec per radian
+from flexrv.units import ARCSEC_PER_RAD
+
 
 
 class Results:
@@ -144,7 +145,7 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     data["theta_out"] = _var(th_out, ("time",), "rad", "output angle")
     data["omega_in"] = _var(w_in, ("time",), "rad/s", "input speed")
     data["omega_out"] = _var(w_out, ("time",), "rad/s", "output speed")
-    data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC, ("time",), "arcsec", "TE")
+    data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC_PER_RAD, ("time",), "arcsec", "TE")
     crank = np.stack([q[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
     crank_v = np.stack([v[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
     disc = np.stack([q[:, model.slice(f"disc{k}")] for k in range(p.n_discs)], axis=1)

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-ARCMIN = 180.0 / np.pi * 60.0  #: arcmin per radian
+from flexrv.units import ARCMIN_PER_RAD
+
 
 
 @dataclass(frozen=True)
@@ -52,7 +53,7 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
     ramps 0 -> +T_r on [t_start, t_pos], +T_r -> -T_r on [t_pos, t_neg] and
     -T_r -> 0 on [t_neg, t_end]; ``angle`` is the output rotation [rad]."""
     time, torque, angle = (np.asarray(a, dtype=float) for a in (time, torque, angle))
-    a = angle * ARCMIN
+    a = angle * ARCMIN_PER_RAD
     t0, tp, tn, te = times
     rated = float(np.max(np.abs(torque)))
     up = (time >= t0) & (time <= tp)
