@@ -60,7 +60,7 @@ def empirical_needle_constant(reducer) -> float:
 
 def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
                 crankshaft: str = "rigid", ring_options: dict | None = None, crank_options: dict | None = None,
-                model_name: str = "rigid") -> AssembledModel:
+                model_name: str = "rigid", exudyn: bool = True) -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
     ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
@@ -69,11 +69,12 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     ``"flexible"`` (the same with reduced flexible rings, ``ring_options``);
     ``crankshaft``: ``"rigid"`` or ``"flexible"`` (:mod:`flexrv.model.flexible_crank`,
     options ``crank_options``). ``model_name`` labels the results of a non-rigid
-    variant."""
+    variant. ``exudyn=False`` returns the members and force groups without an Exudyn
+    system (the quasi-static solver evaluates the same groups directly)."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
-    from flexrv.model.loads import OutputLoads, locked_drive, ramp_drive, step_torque
+    from flexrv.model.loads import OutputLoads, locked_drive, position_drive, ramp_drive, step_torque
     from flexrv.model.main_bearing_rigid import RigidMainBearing
     from flexrv.model.parameters import rigid_parameters
     from flexrv.model.pins import PinContacts
@@ -83,8 +84,10 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         theta, omega = ramp_drive(p.input_speed, p.speed_ramp_time)
     elif drive == "locked":
         theta, omega = locked_drive()
+    elif drive == "position":  # quasi-static: the 'time' argument is the input angle itself
+        theta, omega = position_drive()
     else:
-        raise ConfigError(f"drive = {drive!r} is not allowed: choose 'ramp' or 'locked'")
+        raise ConfigError(f"drive = {drive!r} is not allowed: choose 'ramp', 'locked' or 'position'")
     if torque is None:
         torque = step_torque(p.load_torque, *p.load_ramp)
     nb_model = reducer.needle_bearing.model
@@ -125,6 +128,13 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     name = "rigid" if (main_bearing, crankshaft) == ("rigid", "rigid") else model_name
     model = AssembledModel(name=name, reducer=reducer, params=p, members=members, groups=groups, input_angle=theta,
                            input_speed=omega, load_torque=torque, info=info)
+    if not exudyn:
+        offset = 0
+        for m in members.values():
+            m.offset = offset
+            offset += m.n
+        model.n = offset
+        return model
     return assemble(model)
 
 

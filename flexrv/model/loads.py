@@ -48,6 +48,19 @@ def locked_drive():
     return zero, zero
 
 
+def position_drive():
+    """Quasi-static drive: the model's 'time' argument is the input angle [rad]
+    (theta(t) = t) and every speed is zero."""
+
+    def theta(t):
+        return np.asarray(t, dtype=float)
+
+    def omega(t):
+        return np.zeros_like(np.asarray(t, dtype=float))
+
+    return theta, omega
+
+
 def step_torque(t_max: float, t1: float, t2: float):
     """T(t) = T_max step(t, t1, 0, t2, 1) (jump at t1 if t2 == t1)."""
 

@@ -100,6 +100,22 @@ class RigidParameters:
     external_axial_force: float
     external_radial_force: float
     tilting_moment: float
+    # ---- actual (as-built) geometry, one entry per element. Nominal values for an ideal
+    # design; manufacturing and assembly errors (design ``[errors]``) enter only here, so
+    # every model (analytic, dynamic, quasi-static) reads the same as-built geometry.
+    pin_radii: np.ndarray  #: (z_rp,) actual pin radii [m] (pins: actual centres)
+    disc_profile: np.ndarray  #: (n_discs, 3) actual (d_radius [m], d_pin_radius [m], d_rotation [rad]) per disc
+    profile_harmonics: np.ndarray  #: (n_discs, H, 3) (order [-], amplitude [m], phase [rad]): material added
+    #: along the profile normal, delta(phi) = sum A cos(order phi + phase), phi the curve parameter;
+    #: it reduces the pin gap by delta(phi*) at the contact's foot point
+    eccentricities: np.ndarray  #: (N, n_discs) eccentric radius of crank j under disc k [m]
+    eccentric_phase_errors: np.ndarray  #: (N, n_discs) added to chi0_k: chi = chi0_k + err_jk - phi_j [rad]
+    crank_bores: np.ndarray  #: (N, 2) crank-bore centres in the carrier frame [m]
+    needle_clearances: np.ndarray  #: (N, n_discs) radial clearance of each needle bearing [m]
+    support_clearances: np.ndarray  #: (N,) radial clearance of each crank's support bearings [m]
+    sun_runout: np.ndarray  #: (2,) amplitude [m] along the lines of action, phase [rad]
+    planet_runout: np.ndarray  #: (N, 2) amplitude [m], phase [rad]
+    planet_phase_errors: np.ndarray  #: (N,) assembly phase error of each planet on its crank [rad]
     extra: dict = field(default_factory=dict)
 
 
@@ -208,5 +224,12 @@ def rigid_parameters(reducer) -> RigidParameters:
         load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s), rated_torque=op.rated_torque_Nm,
         external_axial_force=op.external_axial_force_N, external_radial_force=op.external_radial_force_N,
         tilting_moment=op.tilting_moment_Nm,
+        pin_radii=np.full(z_rp, ss.pin_radius),
+        disc_profile=np.tile([ss.modification_shift, ss.modification_equidistant, ss.modification_rotation], (nd, 1)),
+        profile_harmonics=np.zeros((nd, 0, 3)),
+        eccentricities=np.full((n, nd), ss.eccentricity), eccentric_phase_errors=np.zeros((n, nd)),
+        crank_bores=crank_pos.copy(), needle_clearances=np.full((n, nd), nb.radial_clearance_um * 1e-6),
+        support_clearances=np.zeros(n), sun_runout=np.zeros(2), planet_runout=np.zeros((n, 2)),
+        planet_phase_errors=np.zeros(n),
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
     )
