@@ -171,6 +171,31 @@ class AssembledModel:
     def q0(self) -> np.ndarray:
         return np.concatenate([m.q0 for m in self.members.values()])
 
+    def generalized_forces(self, t, q: np.ndarray, v: np.ndarray, jacobian: bool = True):
+        """Sum of every group's generalized force at one state, and its Jacobians.
+
+        Returns ``(f, dfdq, dfdv)`` with f of shape (n,) and the Jacobians (n, n)
+        (``None`` if ``jacobian`` is False). The same group kernels as the Exudyn
+        elements; every call is an exact evaluation (no within-step
+        linearisation), so a static solver can iterate on it.
+        """
+        n = self.n
+        f = np.zeros(n)
+        dq = np.zeros((n, n)) if jacobian else None
+        dv = np.zeros((n, n)) if jacobian else None
+        for g in self.groups:
+            idx = group_index([self.members[m].offset for m in g.members], [self.members[m].n for m in g.members])
+            g.new_step()
+            qg, vg = q[idx], v[idx]
+            fg, _ = g.evaluate(t, qg, vg)
+            f[idx] += fg
+            if jacobian:
+                jq, jv = g.jacobian(t, qg, vg)
+                ix = np.ix_(np.arange(n)[idx], np.arange(n)[idx])
+                dq[ix] += jq
+                dv[ix] += jv
+        return f, dq, dv
+
 
 def group_index(offsets: list[int], sizes: list[int]):
     """Indices of a group's local vector in a state vector: a slice if the

@@ -38,6 +38,9 @@ class RigidMainBearing(ForceGroup):
                                                          "tilting reaction moment on the carrier")}
         return f, out
 
+    def jacobian(self, t, q, v):
+        return -self.k, -self.c
+
     def add_to(self, mbs, nodes, sizes):
         from exudyn.itemInterface import ObjectGenericODE2
 
