@@ -97,7 +97,8 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         CrankSupports(p),
         NeedleBearings(p, nb_model, k_emp),
         PinContacts(p),
-        OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment, ramp=p.load_ramp),
+        OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment,
+                    ramp=None if drive == "position" else p.load_ramp),
     ]
     members = _members(p)
     info: dict = {}

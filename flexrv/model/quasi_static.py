@@ -1,0 +1,424 @@
+"""Quasi-static loaded transmission error: static equilibrium of the reducer at a
+sequence of input positions.
+
+For every input angle theta_in the coordinates q of the carrier, the cranks
+(with their planets) and the discs are found such that every generalized force
+of the model's force groups sums to zero,
+
+    R(q; theta_in, T) = sum_groups Q_g(q, v = 0; theta_in) = 0,
+
+with the output torque T on the carrier (the ``loads`` group) and the sun's
+angle prescribed. The groups are the SAME objects as in the dynamic model
+(:func:`flexrv.model.factory.build_rigid` with ``exudyn=False`` and the
+``position`` drive, in which the model's "time" argument is the input angle): the
+same pin gaps, Hertz/Palmgren laws, needle bearings, crank supports, gear meshes
+and main bearing, read from the same as-built parameters
+(:func:`flexrv.model.parameters.rigid_parameters`). At zero velocity the
+damping terms vanish, so this is the dynamic model's equilibrium manifold.
+
+Solver: Newton's method on R with the groups' analytic Jacobians
+(:meth:`flexrv.model.base.AssembledModel.generalized_forces`), globalised by
+pseudo-transient continuation (Kelley & Keyes 1998 :cite:`kelley1998ptc`): each
+step solves (s M - J) dq = R with the members' mass matrix M as the metric and
+s shrinking with the residual ("switched evolution relaxation", s_k = s_{k-1}
+|R_k| / |R_{k-1}|), so a step through a clearance, where J is singular,
+becomes an over-damped motion towards contact, and near the solution the
+iteration is Newton's. Successive positions are warm-started by linear
+extrapolation of the two previous solutions.
+
+Transmission error TE = theta_out - theta_in / i. Definitions used for the
+catalog quantities (Nabtesco-style catalogs define lost motion at +-3 % of the
+rated torque):
+
+* no-load (kinematic) TE: the TE curve at a vanishing torque, evaluated at
+  ``no_load_fraction`` (default 1e-3) of the rated torque, where the contacts are
+  just closed (its elastic part is below 1e-3 of the loaded wind-up);
+* backlash: output rotation between +T0 and -T0 at T0 = ``no_load_fraction`` of
+  rated torque, input locked;
+* lost motion: output rotation between +3 % and -3 % of rated torque, input locked;
+* torsional rigidity at the operating torque: the tangent dT/dtheta_out from the
+  condensed Jacobian, mean over the positions; catalog-style secant slope between
+  50 % and 100 % rated torque at the lost-motion positions.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flexrv.errors import ConvergenceError, InputError
+from flexrv.units import ARCSEC_PER_RAD, ARCMIN_PER_RAD
+
+
+@dataclass(frozen=True)
+class StaticOptions:
+    """Options of the static equilibrium iteration (unknown keys are rejected by
+    :meth:`from_dict`).
+
+    force_tol : residual tolerance [N] on force coordinates, relative to the
+        characteristic force T_ref / a_w (T_ref: rated torque, a_w: crank circle).
+    step_tol : coordinate-step tolerance [m, rad].
+    max_iter : iterations per position before giving up.
+    """
+
+    force_tol: float = 1e-7
+    step_tol: float = 1e-12
+    max_iter: int = 60
+
+    @classmethod
+    def from_dict(cls, options: dict | None) -> "StaticOptions":
+        options = dict(options or {})
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(options) - known)
+        if unknown:
+            raise InputError(f"unknown static-solver option(s) {unknown}: allowed {sorted(known)}")
+        out = cls(**options)
+        if not (0 < out.force_tol < 1e-2 and 0 < out.step_tol < 1e-6 and 1 <= out.max_iter <= 1000):
+            raise InputError(f"static-solver options {out} out of range: 0 < force_tol < 1e-2, "
+                             "0 < step_tol < 1e-6, 1 <= max_iter <= 1000")
+        return out
+
+
+class StaticModel:
+    """The reducer's force groups without inertia, for static equilibria.
+
+    ``torque`` [N m] is the load torque on the output (positive against the
+    input's direction of rotation, as in the dynamic model)."""
+
+    def __init__(self, reducer, options: StaticOptions | dict | None = None):
+        from flexrv.model.factory import build_model
+
+        self.reducer = reducer
+        self.options = options if isinstance(options, StaticOptions) else StaticOptions.from_dict(options)
+        self._torque = [0.0]
+        self.model = build_model(reducer, "rigid", drive="position", exudyn=False,
+                                 torque=lambda t: np.full(np.shape(t), self._torque[0]))
+        m = self.model
+        self.p = m.params
+        self.n = m.n
+        self.mass = np.concatenate([np.diag(mem.mass_matrix) for mem in m.members.values()])
+        cs = m.slice("carrier")
+        self.i_theta = cs.start + 2  # the carrier's rotation = output angle
+        self.t_ref = max(abs(reducer.operating.rated_torque_Nm), 1.0)
+        self.f_ref = self.t_ref / self.p.center_distance
+        # residual scale per coordinate: forces [N] and moments [N m] -> comparable numbers
+        lengths = np.ones(self.n)
+        for mem in m.members.values():
+            sl = m.slice(mem.name)
+            for k, lab in enumerate(mem.labels):
+                if lab in ("theta", "phi", "psi", "rx", "ry"):
+                    lengths[sl.start + k] = self.p.center_distance
+        self.arm = lengths  # moment = force * arm
+        #: largest coordinate step per iteration [m on the crank circle]
+        self.max_step = 50e-6
+        self.calls = 0
+
+    @property
+    def torque(self) -> float:
+        return self._torque[0]
+
+    @torque.setter
+    def torque(self, value: float) -> None:
+        self._torque[0] = float(value)
+        for g in self.model.groups:  # the loads group caches its force per 'time' (= input angle here)
+            if g.name == "loads":
+                g.reset()
+
+    def residual(self, theta_in: float, q: np.ndarray, jacobian: bool = True):
+        """Generalized force sum R(q) and dR/dq at input angle ``theta_in``."""
+        self.calls += 1
+        f, dq, _ = self.model.generalized_forces(theta_in, q, np.zeros(self.n), jacobian=jacobian)
+        return f, dq
+
+    def kinematic_pose(self, theta_in) -> np.ndarray:
+        """Nominal (conjugate, unloaded) coordinates at input angle(s) [rad], shape
+        (..., n): carrier at theta_in / i, each crank carried by the carrier and
+        turned by the first stage's relative ratio, discs in the conjugate pose of
+        their eccentrics (:func:`flexrv.geometry.cycloid.nominal_disc_pose`:
+        centre a (sin chi, cos chi), rotation psi_0 + (chi - chi_0) / z_c)."""
+        from flexrv.geometry.kinematics import member_speeds
+
+        p, m = self.p, self.model
+        th = np.asarray(theta_in, dtype=float)
+        s = member_speeds(1.0, p.z_s, p.z_p, p.z_c, p.z_rp)
+        q = np.broadcast_to(m.q0, th.shape + (self.n,)).copy()
+        th_c = th * float(s.carrier)
+        phi = th_c + th * float(s.crank_relative)  # absolute crank angle
+        c, s_ = np.cos(th_c), np.sin(th_c)
+        q[..., m.slice("carrier").start + 2] = th_c
+        for j in range(p.n_cranks):
+            o = m.slice(f"crank{j}").start
+            x0, y0 = m.members[f"crank{j}"].q0[:2]
+            q[..., o], q[..., o + 1], q[..., o + 2] = c * x0 - s_ * y0, s_ * x0 + c * y0, phi
+        for k in range(p.n_discs):
+            o = m.slice(f"disc{k}").start
+            chi = p.chi0[k] - phi
+            q[..., o], q[..., o + 1] = p.eccentricity * np.sin(chi), p.eccentricity * np.cos(chi)
+            q[..., o + 2] = p.disc_rot0[k] + (chi - p.chi0[k]) / p.z_c
+        return q
+
+    def solve(self, theta_in: float, q_start: np.ndarray) -> tuple[np.ndarray, int]:
+        """Static equilibrium at ``theta_in`` from ``q_start``; returns (q, iterations).
+
+        Each iteration solves (s M - J) dq = R. With s = 0 this is Newton's step;
+        a step is accepted only if it lowers the scaled residual norm |R_i / l_i|_2
+        (l_i = 1 for forces, the crank-circle radius for moments), otherwise s is
+        raised (x10) and the step retried, and after an accepted step s is lowered
+        (x0.1, down to a floor of 1e-8 of its start value, which changes the step, never the solution). A coordinate whose contacts are
+        all open (a crank inside its clearances at a vanishing torque) has a
+        singular Newton step; the s M term keeps its step finite and, its force
+        being zero, leaves it where it is. Steps are limited to ``max_step``
+        (50 um on the crank circle) so a contact set cannot jump across a
+        clearance in one step. Raises :class:`flexrv.errors.ConvergenceError` if the
+        residual does not reach the tolerance within ``max_iter`` iterations.
+        """
+        o = self.options
+        q = q_start.copy()
+        tol = o.force_tol * self.f_ref
+        for g in self.model.groups:  # forget warm starts (closest-point parameters) of rejected trial steps
+            g.reset()
+        f, jac = self.residual(theta_in, q)
+        r, merit = np.max(np.abs(f / self.arm)), np.linalg.norm(f / self.arm)
+        s0 = self._initial_shift(jac)
+        stalls = 0
+        shift = 1e-8 * s0  # floor: keeps the step finite for a coordinate whose contacts are all open
+        diag_m = np.diag(self.mass)
+        for it in range(1, o.max_iter + 1):
+            if r < tol:
+                return q, it - 1
+            try:
+                dq = np.linalg.solve(shift * diag_m - jac, f)
+            except np.linalg.LinAlgError:
+                dq = None
+            if dq is not None and np.all(np.isfinite(dq)):
+                big = np.max(np.abs(dq) * self.arm) / self.max_step
+                if big > 1.0:
+                    dq = dq / big
+                q_new = q + dq
+                f_new, jac_new = self.residual(theta_in, q_new)
+                merit_new = np.linalg.norm(f_new / self.arm)
+                if np.isfinite(merit_new) and merit_new < merit:
+                    q, f, jac, merit = q_new, f_new, jac_new, merit_new
+                    r = np.max(np.abs(f / self.arm))
+                    shift = max(0.1 * shift, 1e-8 * s0)
+                    if np.max(np.abs(dq)) < o.step_tol and r < 1e3 * tol:
+                        return q, it
+                    continue
+            shift = max(10.0 * shift, s0)
+            if shift > 1e6 * s0:
+                # stalled at a non-zero local minimum of the residual norm (e.g. a planet inside
+                # its backlash, whose free rotation first raises the residual elsewhere):
+                # relax along the over-damped motion (s M - J) dq = R, accepting every step
+                stalls += 1
+                if stalls > 5:
+                    break
+                for _ in range(20):
+                    dq = np.linalg.solve(s0 * diag_m - jac, f)
+                    big = np.max(np.abs(dq) * self.arm) / self.max_step
+                    q = q + (dq / big if big > 1.0 else dq)
+                    f, jac = self.residual(theta_in, q)
+                merit, r = np.linalg.norm(f / self.arm), np.max(np.abs(f / self.arm))
+                shift = 1e-8 * s0
+        raise ConvergenceError(f"static equilibrium at input angle {theta_in:.6g} rad not found in {o.max_iter} "
+                               f"iterations (residual {r:.3g} N, tolerance {tol:.3g} N)")
+
+    def _initial_shift(self, jac) -> float:
+        """Pseudo-time weight whose mass term is 1e-3 of the largest stiffness per mass."""
+        kmax = np.max(np.abs(np.diag(jac)) / self.mass)
+        return 1e-3 * max(kmax, 1e6)
+
+    def tangent_rigidity(self, theta_in: float, q: np.ndarray) -> float:
+        """Torsional rigidity dT/d(theta_out) [N m/rad] at an equilibrium, input
+        locked: the carrier-rotation entry of the inverse (negated) Jacobian."""
+        _, jac = self.residual(theta_in, q)
+        e = np.zeros(self.n)
+        e[self.i_theta] = 1.0
+        compliance = np.linalg.solve(-jac, e)[self.i_theta]
+        return 1.0 / compliance
+
+
+@dataclass
+class LoadedTE:
+    """Result of :func:`loaded_te` (SI; outputs declared with units in ``outputs``)."""
+
+    input_angle: np.ndarray  #: (P,) [rad]
+    output_angle: np.ndarray  #: (P,) [rad]
+    te: np.ndarray  #: (P,) loaded TE [rad]
+    te_no_load: np.ndarray  #: (P,) [rad]
+    torque: float
+    ratio: float
+    outputs: dict  #: name -> flexrv.model.base.Output over the positions (dims start with "position")
+    catalog: dict  #: lost motion, backlash, rigidities (SI)
+    iterations: np.ndarray
+    solve_time_s: float
+    orders: dict = field(default_factory=dict)  #: characteristic orders per output revolution
+
+    def summary(self) -> dict:
+        """Headline numbers in engineering units (keys name their unit)."""
+        te = self.te * ARCSEC_PER_RAD
+        nl = self.te_no_load * ARCSEC_PER_RAD
+        c = self.catalog
+        return {
+            "te_pp_arcsec": float(np.ptp(te)) if te.size else float("nan"),
+            "te_mean_arcsec": float(np.mean(te)) if te.size else float("nan"),
+            "no_load_te_pp_arcsec": float(np.ptp(nl)) if nl.size else float("nan"),
+            "lost_motion_arcmin": c["lost_motion_rad"] * ARCMIN_PER_RAD,
+            "backlash_arcmin": c["backlash_rad"] * ARCMIN_PER_RAD,
+            "torsional_rigidity_Nm_per_arcmin": c["rigidity_tangent_Nm_per_rad"] / ARCMIN_PER_RAD,
+            "catalog_rigidity_Nm_per_arcmin": c["rigidity_secant_Nm_per_rad"] / ARCMIN_PER_RAD,
+            "torque_Nm": self.torque,
+            "positions": int(self.te.size),
+            "solve_time_s": self.solve_time_s,
+            "mean_iterations": float(np.mean(self.iterations)) if self.iterations.size else 0.0,
+        }
+
+
+def characteristic_orders(reducer) -> dict[str, float]:
+    """Orders (cycles per output revolution) of the reducer's characteristic
+    frequencies (:func:`flexrv.geometry.kinematics.characteristic_frequencies`
+    divided by the output frequency)."""
+    from flexrv.geometry.kinematics import characteristic_frequencies
+
+    fs, ss = reducer.first_stage, reducer.second_stage
+    f = characteristic_frequencies(1.0, fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
+    out = float(f.carrier)
+    return {"crank rotation": float(f.crank_rotation) / out, "crank, absolute": float(f.crank_absolute) / out,
+            "cycloid mesh": float(f.cycloid_mesh) / out, "first-stage mesh": float(f.first_stage_mesh) / out,
+            "input rotation": float(f.input) / out}
+
+
+def positions_for(reducer, output_revolutions: float | None = None, crank_revolutions: float | None = None,
+                  points_per_mesh: int = 8) -> np.ndarray:
+    """Input angles [rad] covering the requested range with ``points_per_mesh``
+    points per cycloid-mesh period (the pin-mesh period of the TE ripple).
+    ``crank_revolutions`` counts crank revolutions relative to the carrier."""
+    if points_per_mesh < 2 or points_per_mesh > 1000:
+        raise InputError(f"points_per_mesh = {points_per_mesh} is not allowed: must lie in [2, 1000]")
+    orders = characteristic_orders(reducer)
+    if (output_revolutions is None) == (crank_revolutions is None):
+        if output_revolutions is None:
+            output_revolutions = 1.0
+        else:
+            raise InputError("give either output_revolutions or crank_revolutions, not both")
+    if crank_revolutions is not None:
+        if not (math.isfinite(crank_revolutions) and 0 < crank_revolutions <= 1e4):
+            raise InputError(f"crank_revolutions = {crank_revolutions!r} is not allowed: must lie in (0, 1e4]")
+        output_revolutions = crank_revolutions / orders["crank rotation"]
+    if not (math.isfinite(output_revolutions) and 0 < output_revolutions <= 100):
+        raise InputError(f"output_revolutions = {output_revolutions!r} is not allowed: must lie in (0, 100]")
+    n = int(round(output_revolutions * orders["cycloid mesh"] * points_per_mesh))
+    n = max(n, 2)
+    ratio = orders["input rotation"]
+    span = output_revolutions * 2.0 * math.pi * ratio
+    return np.arange(n) * (span / n)
+
+
+def _sweep(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray):
+    """Solve every position; each is warm-started from the previous solution
+    advanced by the nominal kinematic increment (measured: 2 Newton iterations
+    per position against 3 with secant extrapolation, and 2 against 8 at a
+    vanishing torque, where the contact set changes between positions).
+    Returns (Q (P, n), iterations (P,))."""
+    qs = np.empty((len(angles), sm.n))
+    its = np.empty(len(angles), dtype=int)
+    kin = sm.kinematic_pose(angles)
+    guess = q_start
+    for k, th in enumerate(angles):
+        if k:
+            guess = qs[k - 1] + (kin[k] - kin[k - 1])
+        qs[k], its[k] = sm.solve(th, guess)
+    return qs, its
+
+
+def _ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, steps: int = 4) -> np.ndarray:
+    """Equilibrium at ``torque`` reached by continuation from the current torque."""
+    t0 = sm.torque
+    for a in np.linspace(0.0, 1.0, steps + 1)[1:]:
+        sm.torque = t0 + a * (torque - t0)
+        q, _ = sm.solve(theta_in, q)
+    return q
+
+
+def loaded_te(reducer, torque: float | None = None, output_revolutions: float | None = None,
+              crank_revolutions: float | None = None, points_per_mesh: int = 8, no_load_fraction: float = 1e-2,
+              catalog_positions: int = 6, options: dict | None = None, progress=None) -> LoadedTE:
+    """Loaded and no-load TE over the requested input range, catalog lost motion,
+    backlash and rigidity (see module docstring).
+
+    ``torque`` [N m] defaults to the design's rated torque; it must be positive and
+    at most 3x the rated torque (beyond that the Hertz laws leave their range).
+    """
+    from flexrv.model.base import Output
+
+    op = reducer.operating
+    rated = op.rated_torque_Nm
+    if torque is None:
+        torque = rated
+    if not (math.isfinite(torque) and 0 < torque <= 3.0 * rated):
+        raise InputError(f"torque = {torque!r} N m is not allowed: must lie in (0, 3 x rated = {3 * rated:g}] N m")
+    if not (0 < no_load_fraction <= 0.03):
+        raise InputError(f"no_load_fraction = {no_load_fraction!r} is not allowed: must lie in (0, 0.03]")
+    angles = positions_for(reducer, output_revolutions, crank_revolutions, points_per_mesh)
+    sm = StaticModel(reducer, options)
+    t_start = _time.perf_counter()
+    q0 = sm.kinematic_pose(angles[0])
+    # first position: torque continuation from the kinematic pose
+    sm.torque = 0.0
+    q_load = _ramp_to(sm, angles[0], q0, torque)
+    qs, its = _sweep(sm, angles, q_load)
+    # no-load curve
+    t_small = no_load_fraction * rated
+    sm.torque = torque
+    q_small = _ramp_to(sm, angles[0], qs[0], t_small)
+    qs_nl, its_nl = _sweep(sm, angles, q_small)
+    ratio = sm.p.ratio
+    th_out = qs[:, sm.i_theta]
+    te = th_out - angles / ratio
+    te_nl = qs_nl[:, sm.i_theta] - angles / ratio
+    # outputs declared by the groups, over the positions (at the loaded curve's torque)
+    sm.torque = torque
+    outs = {}
+    z = np.zeros_like(qs)
+    for g in sm.model.groups:
+        qg = sm.model.group_state(g, qs)
+        vg = sm.model.group_state(g, z)
+        g.reset()
+        _, o = g.evaluate(angles, qg, vg, want_outputs=True)
+        for name, val in (o or {}).items():
+            outs[name] = Output(np.asarray(val.values), ("position",) + tuple(val.dims[1:]), val.units, val.long_name)
+    # catalog quantities at a few positions spread over one crank revolution
+    cat_idx = np.unique(np.linspace(0, len(angles) - 1, max(1, min(catalog_positions, len(angles)))).astype(int))
+    lm, bl, k_sec, k_tan = [], [], [], []
+    for i in cat_idx:
+        th = angles[i]
+        levels = {}
+        q = qs[i]
+        sm.torque = torque
+        for name, level in (("rated", rated), ("half", 0.5 * rated), ("plus3", 0.03 * rated), ("plus0", t_small)):
+            q = _ramp_to(sm, th, q, level, steps=2)
+            levels[name] = q[sm.i_theta]
+        # the reversed load: start from the mirror image of the +T0 pose about the kinematic
+        # pose (symmetric clearances give exactly that) instead of creeping through the clearances
+        q_kin = sm.kinematic_pose(th)
+        sm.torque = -t_small
+        q, _ = sm.solve(th, 2.0 * q_kin - q)
+        levels["minus0"] = q[sm.i_theta]
+        q = _ramp_to(sm, th, q, -0.03 * rated, steps=2)
+        levels["minus3"] = q[sm.i_theta]
+        # output angle under positive load is smaller (the load acts against +theta)
+        lm.append(levels["minus3"] - levels["plus3"])
+        bl.append(levels["minus0"] - levels["plus0"])
+        k_sec.append(0.5 * rated / (levels["half"] - levels["rated"]))
+        sm.torque = torque
+        k_tan.append(sm.tangent_rigidity(th, qs[i]))
+    wall = _time.perf_counter() - t_start
+    catalog = {"lost_motion_rad": float(np.max(lm)), "backlash_rad": float(np.max(bl)),
+               "lost_motion_positions_rad": np.asarray(lm), "backlash_positions_rad": np.asarray(bl),
+               "rigidity_secant_Nm_per_rad": float(np.mean(k_sec)),
+               "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)), "catalog_input_angles": angles[cat_idx]}
+    return LoadedTE(input_angle=angles, output_angle=th_out, te=te, te_no_load=te_nl, torque=float(torque),
+                    ratio=ratio, outputs=outs, catalog=catalog, iterations=np.r_[its, its_nl],
+                    solve_time_s=wall, orders=characteristic_orders(reducer))

@@ -1,0 +1,161 @@
+"""Quasi-static loaded TE results (:func:`flexrv.model.quasi_static.loaded_te`)
+as an xarray Dataset with units, its order spectrum with labelled lines, the
+summary numbers and the run directory (NetCDF, config, JSON, summary.md).
+
+Everything here reads the result by output name; it never knows the model's
+state layout.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from flexrv.cache import atomic_path, atomic_write_text, to_jsonable
+from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+
+def te_dataset(result, reducer) -> xr.Dataset:
+    """Dataset over the ``position`` dimension (coordinate: input angle [rad]).
+
+    Variables: ``te`` and ``te_no_load`` [arcsec], ``output_angle`` [rad],
+    ``output_revolutions`` [-] and every output the force groups declared
+    (pin, needle, support and mesh forces, pins in contact, ...), with their
+    units and long names. Catalog numbers and the solver figures are attributes.
+    """
+    data = {
+        "te": (("position",), result.te * ARCSEC_PER_RAD, {"units": "arcsec", "long_name": "loaded TE"}),
+        "te_no_load": (("position",), result.te_no_load * ARCSEC_PER_RAD,
+                       {"units": "arcsec", "long_name": "no-load (kinematic) TE"}),
+        "output_angle": (("position",), result.output_angle, {"units": "rad", "long_name": "output angle"}),
+        "output_revolutions": (("position",), result.input_angle / result.ratio / (2.0 * np.pi),
+                               {"units": "1", "long_name": "nominal output revolutions"}),
+    }
+    for name, o in result.outputs.items():
+        data[name] = (o.dims, np.asarray(o.values), {"units": o.units, "long_name": o.long_name})
+    ds = xr.Dataset(data, coords={"position": ("position", result.input_angle,
+                                               {"units": "rad", "long_name": "input angle"})})
+    s = result.summary()
+    ds.attrs.update({"preset": reducer.name, "kind": "quasi-static loaded TE", "ratio": result.ratio,
+                     "torque_Nm": result.torque, "orders": json.dumps(result.orders),
+                     "summary": json.dumps(to_jsonable(s))})
+    return ds
+
+
+def order_spectrum(te_arcsec: np.ndarray, output_revolutions: float):
+    """Amplitude spectrum of TE sampled uniformly over ``output_revolutions``.
+
+    Returns (order [cycles per output revolution], amplitude [arcsec]). A whole
+    number of revolutions is one period of every error (pins fixed in the
+    housing, discs turning with the output, cranks z_c times per revolution), so
+    the plain DFT is exact there (a sine of amplitude A and integer order shows
+    A); otherwise a Hann window (amplitude-corrected) limits the leakage.
+    """
+    x = np.asarray(te_arcsec, dtype=float)
+    n = len(x)
+    if n < 8:
+        return np.zeros(0), np.zeros(0)
+    x = x - x.mean()
+    whole = abs(output_revolutions - round(output_revolutions)) < 1e-9 and round(output_revolutions) >= 1
+    w = np.ones(n) if whole else np.hanning(n)
+    amp = 2.0 * np.abs(np.fft.rfft(x * w)) / w.sum()
+    order = np.fft.rfftfreq(n, d=output_revolutions / n)
+    return order, amp
+
+
+def spectrum_lines(order, amp, orders: dict[str, float], count: int = 8, harmonics: int = 12) -> list[dict]:
+    """The ``count`` largest spectral lines (local maxima), each labelled with the
+    characteristic order or harmonic ``h x name`` (h <= ``harmonics``) nearest to
+    it within half a bin; ``-`` where none is (e.g. sidebands)."""
+    if len(order) < 2:
+        return []
+    df = order[1] - order[0]
+    a = amp.copy()
+    a[0] = 0.0
+    peaks = [i for i in range(1, len(a) - 1) if a[i] >= a[i - 1] and a[i] >= a[i + 1] and a[i] > 0]
+    peaks.sort(key=lambda i: -a[i])
+    out = []
+    for i in peaks[:count]:
+        best = None
+        for name, o in orders.items():
+            h = int(round(order[i] / o))
+            if 1 <= h <= harmonics:
+                d = abs(order[i] - h * o)
+                if d <= 0.5 * df + 1e-9 and (best is None or (d, h) < best[:2]):
+                    best = (d, h, name if h == 1 else f"{h} x {name}")
+        out.append({"order": float(order[i]), "amplitude_arcsec": float(a[i]), "label": best[2] if best else "-"})
+    return out
+
+
+def te_summary(ds: xr.Dataset) -> dict:
+    """The numbers ``flexrv te --json`` prints (keys name their unit)."""
+    s = json.loads(ds.attrs["summary"])
+    revs = float(ds["output_revolutions"].values[-1] - ds["output_revolutions"].values[0])
+    n = ds.sizes["position"]
+    revs = revs * n / max(n - 1, 1)  # the positions span [0, revs) with n uniform points
+    order, amp = order_spectrum(ds["te"].values, revs)
+    s["spectrum_lines"] = spectrum_lines(order, amp, json.loads(ds.attrs["orders"]))
+    s["spectral_resolution_orders"] = float(order[1] - order[0]) if len(order) > 1 else None
+    s["output_revolutions"] = revs
+    for name, key in (("pin_force", "max_pin_force_N"), ("needle_force", "max_needle_force_N"),
+                      ("crank_support_force", "max_support_force_N"), ("mesh_force", "max_mesh_force_N")):
+        if name in ds:
+            s[key] = float(np.max(ds[name].values))
+    if "pins_in_contact" in ds:
+        pic = ds["pins_in_contact"].values
+        s["pins_in_contact_min"], s["pins_in_contact_max"] = int(pic.min()), int(pic.max())
+    return s
+
+
+def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
+    """summary.md of a ``flexrv te`` run, every number from ``summary``."""
+    s = summary
+    rows = [("loaded TE, peak to peak", s["te_pp_arcsec"], "arcsec"),
+            ("loaded TE, mean (wind-up)", s["te_mean_arcsec"], "arcsec"),
+            ("no-load TE, peak to peak", s["no_load_te_pp_arcsec"], "arcsec"),
+            ("lost motion (±3 % rated torque)", s["lost_motion_arcmin"], "arcmin"),
+            ("backlash (±1 % rated torque)", s["backlash_arcmin"], "arcmin"),
+            ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+            ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+            ("max pin force", s.get("max_pin_force_N"), "N"),
+            ("max needle-bearing force", s.get("max_needle_force_N"), "N"),
+            ("max crank-support force", s.get("max_support_force_N"), "N"),
+            ("pins in contact per disc", f"{s.get('pins_in_contact_min')}–{s.get('pins_in_contact_max')}", "-")]
+    lines = [f"# Quasi-static loaded TE: {reducer.name}", "",
+             f"Output torque {s['torque_Nm']:.6g} N m, {s['positions']} positions over "
+             f"{s['output_revolutions']:.4g} output revolutions, solved in {s['solve_time_s']:.3g} s "
+             f"({s['mean_iterations']:.2f} Newton iterations per position).", ""]
+    if errors_note:
+        lines += [errors_note, ""]
+    lines += ["| quantity | value | unit |", "|---|---|---|"]
+    for name, value, unit in rows:
+        v = f"{value:.4g}" if isinstance(value, float) else str(value)
+        lines.append(f"| {name} | {v} | {unit} |")
+    lines += ["", "## Largest TE spectrum lines (orders of the output rotation)", "",
+              f"Resolution {s['spectral_resolution_orders']:.3g} orders.", "",
+              "| order | amplitude [arcsec] | nearest characteristic order |", "|---|---|---|"]
+    for line in s["spectrum_lines"]:
+        lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
+    lines += ["", "Definitions: TE = theta_out - theta_in / i; no-load TE at 1 % of the rated torque; lost motion "
+              "and backlash are the output rotations between the reversed loads at ±3 % and ±1 % of the rated "
+              "torque with the input locked (largest over the evaluated positions); rigidity in "
+              f"N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad)."]
+    return "\n".join(lines) + "\n"
+
+
+def save_te(ds: xr.Dataset, summary: dict, reducer, directory, errors_note: str = "") -> Path:
+    """Write ``results.nc``, ``config.toml``, ``summary.json`` and ``summary.md``
+    atomically into ``directory``; returns its path."""
+    from flexrv.design import to_toml
+
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    with atomic_path(d / "results.nc") as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    atomic_write_text(d / "config.toml", to_toml(reducer))
+    atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summary), indent=2))
+    atomic_write_text(d / "summary.md", te_summary_markdown(summary, reducer, errors_note))
+    return d
