@@ -316,7 +316,7 @@ def positions_for(reducer, output_revolutions: float | None = None, crank_revolu
     return np.arange(n) * (span / n)
 
 
-def _sweep(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray):
+def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray):
     """Solve every position; each is warm-started from the previous solution
     advanced by the nominal kinematic increment (measured: 2 Newton iterations
     per position against 3 with secant extrapolation, and 2 against 8 at a
@@ -333,7 +333,7 @@ def _sweep(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray):
     return qs, its
 
 
-def _ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, steps: int = 4) -> np.ndarray:
+def ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, steps: int = 4) -> np.ndarray:
     """Equilibrium at ``torque`` reached by continuation from the current torque."""
     t0 = sm.torque
     for a in np.linspace(0.0, 1.0, steps + 1)[1:]:
@@ -367,13 +367,13 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
     q0 = sm.kinematic_pose(angles[0])
     # first position: torque continuation from the kinematic pose
     sm.torque = 0.0
-    q_load = _ramp_to(sm, angles[0], q0, torque)
-    qs, its = _sweep(sm, angles, q_load)
+    q_load = ramp_to(sm, angles[0], q0, torque)
+    qs, its = equilibrium_path(sm, angles, q_load)
     # no-load curve
     t_small = no_load_fraction * rated
     sm.torque = torque
-    q_small = _ramp_to(sm, angles[0], qs[0], t_small)
-    qs_nl, its_nl = _sweep(sm, angles, q_small)
+    q_small = ramp_to(sm, angles[0], qs[0], t_small)
+    qs_nl, its_nl = equilibrium_path(sm, angles, q_small)
     ratio = sm.p.ratio
     th_out = qs[:, sm.i_theta]
     te = th_out - angles / ratio
@@ -398,7 +398,7 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
         q = qs[i]
         sm.torque = torque
         for name, level in (("rated", rated), ("half", 0.5 * rated), ("plus3", 0.03 * rated), ("plus0", t_small)):
-            q = _ramp_to(sm, th, q, level, steps=2)
+            q = ramp_to(sm, th, q, level, steps=2)
             levels[name] = q[sm.i_theta]
         # the reversed load: start from the mirror image of the +T0 pose about the kinematic
         # pose (symmetric clearances give exactly that) instead of creeping through the clearances
@@ -406,7 +406,7 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
         sm.torque = -t_small
         q, _ = sm.solve(th, 2.0 * q_kin - q)
         levels["minus0"] = q[sm.i_theta]
-        q = _ramp_to(sm, th, q, -0.03 * rated, steps=2)
+        q = ramp_to(sm, th, q, -0.03 * rated, steps=2)
         levels["minus3"] = q[sm.i_theta]
         # output angle under positive load is smaller (the load acts against +theta)
         lm.append(levels["minus3"] - levels["plus3"])
