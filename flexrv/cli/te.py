@@ -55,6 +55,8 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
                 ("max pin force", d.get("max_pin_force_N"), "N"), ("positions", d["positions"], "-"),
                 ("solve time", d["solve_time_s"], "s"), ("output", d["output_dir"], "")]
         console.print(kv_table(f"quasi-static TE {reducer.name} at {d['torque_Nm']:.6g} N m", rows))
+        budget = sorted(d.get("compliance_budget_percent", {}).items(), key=lambda kv: -kv[1])
+        console.print(kv_table("compliance budget", [(k.replace("_", " "), v, "%") for k, v in budget]))
         lines = [(f"{x['label']}", x["amplitude_arcsec"], f"order {x['order']:.4g}") for x in d["spectrum_lines"]]
         console.print(kv_table("largest TE lines [arcsec]", lines))
 

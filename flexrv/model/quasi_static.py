@@ -38,7 +38,9 @@ rated torque):
 * lost motion: output rotation between +3 % and -3 % of rated torque, input locked;
 * torsional rigidity at the operating torque: the tangent dT/dtheta_out from the
   condensed Jacobian, mean over the positions; catalog-style secant slope between
-  50 % and 100 % rated torque at the lost-motion positions.
+  50 % and 100 % rated torque at the lost-motion positions;
+* compliance budget: each force group's share of the torsional compliance at the
+  operating torque (strain-energy fractions, :meth:`StaticModel.compliance_budget`).
 """
 
 from __future__ import annotations
@@ -239,6 +241,34 @@ class StaticModel:
         compliance = np.linalg.solve(-jac, e)[self.i_theta]
         return 1.0 / compliance
 
+    def compliance_budget(self, theta_in: float, q: np.ndarray) -> dict[str, float]:
+        """Share of each force group in the torsional compliance at an equilibrium
+        (input locked): with the tangent stiffness K = -dR/dq = sum_g K_g and the
+        displacement u = K^-1 e_theta under a unit output torque, the compliance is
+        C = e_theta . u = u . K u and group g's share is its strain energy
+        u . K_g u / C. The shares sum to 1; for elements in series each share is the
+        element's part of the total compliance (Castigliano)."""
+        from flexrv.model.base import group_index
+
+        m = self.model
+        k_total = np.zeros((self.n, self.n))
+        parts = {}
+        zero = np.zeros(self.n)
+        for g in m.groups:
+            idx = np.arange(self.n)[group_index([m.members[x].offset for x in g.members],
+                                                [m.members[x].n for x in g.members])]
+            g.new_step()
+            jq, _ = g.jacobian(theta_in, q[idx], zero[idx])
+            k = np.zeros((self.n, self.n))
+            k[np.ix_(idx, idx)] = -jq
+            parts[g.name] = k
+            k_total += k
+        e = np.zeros(self.n)
+        e[self.i_theta] = 1.0
+        u = np.linalg.solve(k_total, e)
+        c = float(u[self.i_theta])
+        return {name: float(u @ k @ u) / c for name, k in parts.items()}
+
 
 @dataclass
 class LoadedTE:
@@ -269,6 +299,7 @@ class LoadedTE:
             "backlash_arcmin": c["backlash_rad"] * ARCMIN_PER_RAD,
             "torsional_rigidity_Nm_per_arcmin": c["rigidity_tangent_Nm_per_rad"] / ARCMIN_PER_RAD,
             "catalog_rigidity_Nm_per_arcmin": c["rigidity_secant_Nm_per_rad"] / ARCMIN_PER_RAD,
+            "compliance_budget_percent": {g: 100.0 * v for g, v in c["compliance_budget"].items() if v > 1e-6},
             "torque_Nm": self.torque,
             "positions": int(self.te.size),
             "solve_time_s": self.solve_time_s,
@@ -391,7 +422,7 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
             outs[name] = Output(np.asarray(val.values), ("position",) + tuple(val.dims[1:]), val.units, val.long_name)
     # catalog quantities at a few positions spread over one crank revolution
     cat_idx = np.unique(np.linspace(0, len(angles) - 1, max(1, min(catalog_positions, len(angles)))).astype(int))
-    lm, bl, k_sec, k_tan = [], [], [], []
+    lm, bl, k_sec, k_tan, budgets = [], [], [], [], []
     for i in cat_idx:
         th = angles[i]
         levels = {}
@@ -414,11 +445,13 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
         k_sec.append(0.5 * rated / (levels["half"] - levels["rated"]))
         sm.torque = torque
         k_tan.append(sm.tangent_rigidity(th, qs[i]))
+        budgets.append(sm.compliance_budget(th, qs[i]))
     wall = _time.perf_counter() - t_start
     catalog = {"lost_motion_rad": float(np.max(lm)), "backlash_rad": float(np.max(bl)),
                "lost_motion_positions_rad": np.asarray(lm), "backlash_positions_rad": np.asarray(bl),
                "rigidity_secant_Nm_per_rad": float(np.mean(k_sec)),
-               "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)), "catalog_input_angles": angles[cat_idx]}
+               "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)), "catalog_input_angles": angles[cat_idx],
+               "compliance_budget": {g: float(np.mean([b_[g] for b_ in budgets])) for g in budgets[0]}}
     return LoadedTE(input_angle=angles, output_angle=th_out, te=te, te_no_load=te_nl, torque=float(torque),
                     ratio=ratio, outputs=outs, catalog=catalog, iterations=np.r_[its, its_nl],
                     solve_time_s=wall, orders=characteristic_orders(reducer))

@@ -134,6 +134,12 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
     for name, value, unit in rows:
         v = f"{value:.4g}" if isinstance(value, float) else str(value)
         lines.append(f"| {name} | {v} | {unit} |")
+    budget = s.get("compliance_budget_percent") or {}
+    if budget:
+        lines += ["", "## Compliance budget at the operating torque (share of the torsional compliance)", "",
+                  "| element | share [%] |", "|---|---|"]
+        for name, share in sorted(budget.items(), key=lambda kv: -kv[1]):
+            lines.append(f"| {name.replace('_', ' ')} | {share:.1f} |")
     lines += ["", "## Largest TE spectrum lines (orders of the output rotation)", "",
               f"Resolution {s['spectral_resolution_orders']:.3g} orders.", "",
               "| order | amplitude [arcsec] | nearest characteristic order |", "|---|---|---|"]
