@@ -64,8 +64,8 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
             console.print("errors: none (ideal geometry)")
             return
         table = Table(title="errors (manufacturing and assembly, non-zero only)", title_justify="left")
-        table.add_column("field", overflow="fold")
-        table.add_column("value", justify="right")
+        table.add_column("field", no_wrap=True, min_width=max(len(key) for key, _ in errors))
+        table.add_column("value", justify="right", overflow="fold")
         for key, value in errors:
             table.add_row(escape(key), escape(", ".join(fmt(v) for v in value) if isinstance(value, list) else fmt(value)))
         console.print(table)
