@@ -332,15 +332,24 @@ def test_show_prints_nonzero_errors(tmp_path):
     assert "errors: none" in CliRunner().invoke(app, ["show", "rv40e"]).stdout
 
 
-def test_example_error_set_loads():
-    """The example grade-5 error set validates on rv40e: every group non-zero, within
-    the assembly limit, and the pin loads of both discs read it."""
-    assert "iso_grade5_rv40e" in error_set_names()
-    r = with_errors("rv40e", load_error_set("iso_grade5_rv40e"))
+@pytest.mark.parametrize("name", ["rv40e", "rv221"])
+def test_example_error_sets_load(name):
+    """The example grade-5 error sets validate on their presets: every group that
+    the file sets is non-zero, the assembly penetration stays within the limit, the
+    file is exactly what `python -m workflows._error_sets` writes, and the pin loads
+    of both discs read it."""
+    from workflows._error_sets import iso_grade5_toml
+
+    from flexrv.design.manufacturing import error_set_path
+
+    assert f"iso_grade5_{name}" in error_set_names()
+    assert error_set_path(f"iso_grade5_{name}").read_text() == iso_grade5_toml(name)
+    r = with_errors(name, load_error_set(f"iso_grade5_{name}"))
     groups = {path.split(".")[1].split("[")[0] for path, _ in r.errors.nonzero_items()}
     assert groups == {"pins", "discs", "cranks", "first_stage"}
     assert assembly_penetration(r)[0] < ASSEMBLY_PENETRATION_LIMIT_UM * M_PER_UM
-    nominal = reducer_pin_loads(load("rv40e"), 412.0)
-    assert reducer_pin_loads(r, 412.0, disc=1).max_force != nominal.max_force
+    nominal = reducer_pin_loads(load(name), r.operating.rated_torque_Nm)
+    assert reducer_pin_loads(r, r.operating.rated_torque_Nm, disc=1).max_force != nominal.max_force
+    other = "rv221" if name == "rv40e" else "rv40e"
     with pytest.raises(ConfigError):
-        with_errors("rv221", load_error_set("iso_grade5_rv40e"))  # 40 pin values on a 60-pin design
+        with_errors(other, load_error_set(f"iso_grade5_{name}"))  # wrong pin count for the other design

@@ -346,21 +346,25 @@ def error_set_names() -> list[str]:
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
+def error_set_path(name: str):
+    """Path of a built-in example error set."""
+    from importlib import resources
+    from pathlib import Path
+
+    return Path(str(resources.files("flexrv.design.presets") / "errors" / f"{name}.toml"))
+
+
 def load_error_set(name_or_path: str) -> dict[str, Any]:
     """The ``[errors]`` table of a built-in example error set (by name, see
     :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
     plain dict (validate it with :func:`with_errors`)."""
     import tomllib
-    from importlib import resources
     from pathlib import Path
 
     from flexrv.errors import ConfigError
 
     text_name = str(name_or_path)
-    if text_name in error_set_names():
-        path = Path(str(resources.files("flexrv.design.presets") / "errors" / f"{text_name}.toml"))
-    else:
-        path = Path(text_name)
+    path = error_set_path(text_name) if text_name in error_set_names() else Path(text_name)
     if not path.is_file():
         raise ConfigError(f"unknown error set {text_name!r}: choose one of {error_set_names()} or give a TOML file")
     try:
