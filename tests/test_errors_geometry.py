@@ -256,8 +256,8 @@ BAD = [
      "errors.clearances.needle_extra_clearance_um[1][0]", "total needle clearance"),
     ({"clearances": {"support_clearance_um": -1.0}}, "errors.clearances.support_clearance_um", "0..500 um"),
     ({"pins": {"pin_size_um": 1.0}}, "errors.pins.pin_size_um", "unknown field"),
-    ({"pins": {"pin_radius_um": 30.0}}, "errors.pins", "penetrates disc"),
-    ({"discs": [{"rotation_arcmin": 10.0}, {}]}, "errors.discs", "penetrates disc"),
+    ({"pins": {"pin_radius_um": 30.0}}, "errors.pins:", "penetrates disc"),
+    ({"discs": [{"rotation_arcmin": 10.0}, {}]}, "errors.discs:", "penetrates disc"),
 ]
 
 
@@ -279,7 +279,7 @@ def test_interference_message_names_the_group():
     with pytest.raises(ConfigError) as info:
         _with({"pins": {"pin_radius_um": 30.0}})
     msg = str(info.value)
-    assert "errors = 'errors.pins'" in msg and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg and "25 um" in msg
+    assert "errors.pins: the as-built parts interfere" in msg and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg and "errors.pins alone: 25 um interference" in msg
     assert assembly_penetration(_with({"pins": {"pin_radius_um": 24.0}}))[0] == pytest.approx(19e-6, abs=1e-12)
 
 

@@ -328,13 +328,15 @@ class ManufacturingErrors(_Strict):
             if not sub.is_zero():
                 alone.append((assembly_penetration(reducer, sub)[0] * UM_PER_M, f"errors.{group}"))
         alone.sort(reverse=True)
-        detail = ", ".join(f"{name} alone {p:.3g} um" for p, name in alone)
+        detail = ", ".join(f"{name} alone: " + (f"{p:.3g} um interference" if p > 0 else f"{-p:.3g} um clearance")
+                           for p, name in alone)
         culprit = alone[0][1] if alone and alone[0][0] > max(nominal * UM_PER_M, 0.0) + 1e-3 else "the combination of errors"
-        raise _bad("errors", culprit,
-                   f"the as-built pins must not penetrate the discs at assembly by more than "
-                   f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um (what the pin contact law can carry)",
-                   f"pin {pin} penetrates disc {disc} by {pen * UM_PER_M:.3g} um at the best common disc rotation; "
-                   f"nominal design {max(nominal, 0.0) * UM_PER_M:.3g} um; {detail}; reduce {culprit}")
+        nominal_text = (f"{nominal * UM_PER_M:.3g} um" if nominal > 0 else "none")
+        raise ValueError(f"{culprit}: the as-built parts interfere at assembly: pin {pin} penetrates disc {disc} by "
+                         f"{pen * UM_PER_M:.3g} um at the best common disc rotation, more than the "
+                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um the pin contact law can carry (allowed: <= "
+                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um; nominal design's interference: {nominal_text}; {detail}); "
+                         f"reduce {culprit}")
 
 
 # --------------------------------------------------------------------------- example error sets
