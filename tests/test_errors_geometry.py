@@ -353,3 +353,14 @@ def test_example_error_sets_load(name):
     other = "rv221" if name == "rv40e" else "rv40e"
     with pytest.raises(ConfigError):
         with_errors(other, load_error_set(f"iso_grade5_{name}"))  # wrong pin count for the other design
+
+
+def test_dotted_override_reaches_the_errors():
+    """Sweeps and tolerance studies set errors by dotted path like any other field
+    (flexrv.design.override), with the same validation."""
+    from flexrv.design import override
+
+    r = override("rv40e", {"errors.pins.pin_radius_um": 2.0})
+    np.testing.assert_array_equal(as_built(r).pin_radii, np.full(Z, r.second_stage.pin_radius + 2e-6))
+    with pytest.raises(ConfigError, match=r"errors\.pins\.pin_radius_um"):
+        override("rv40e", {"errors.pins.pin_radius_um": 501.0})
