@@ -163,9 +163,15 @@ def _rotate(v, angle):
 def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol, max_iter):
     """Newton iteration of :func:`pin_gap` on g(phi) = |P - C(phi)|^2 / 2 for one
     point P = (px, py) from the start ``phi``; steps clipped to ``max_step``, a
-    descent step where g'' <= 0. Returns (phi, converged) with converged =
-    |last step| < ``tol`` [rad]. The single implementation (numba-compiled): the
-    pin-contact kernel and :func:`pin_gap` call it."""
+    descent step where g'' <= 0. The single implementation (numba-compiled): the
+    pin-contact kernel and :func:`pin_gap` call it.
+
+    Returns (phi, converged, residual, s, nx, ny, dist2) at the LAST EVALUATED
+    parameter phi (the next Newton step from it is below ``tol`` [rad] when
+    converged, so phi is the foot point to O(tol)): the first-order residual
+    |(P - C).C'|/|C'| [m], the signed distance s(P) = (P - C).n_out (> 0 outside,
+    away from the disc centre) with the unit outward normal n_out = C'/|C'| turned
+    by +90 deg (clockwise traversal), and |P - C|^2."""
     for _ in range(max_iter):
         cx, cy, d1x, d1y, d2x, d2y = _POINT(phi, z_rp, radius, eccentricity)
         rx, ry = px - cx, py - cy
@@ -176,10 +182,17 @@ def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol
         else:
             step = -np.sign(g1) * max_step
         step = min(max(step, -max_step), max_step)
-        phi = phi + step
         if abs(step) < tol:
-            return phi, True
-    return phi, False
+            break
+        phi = phi + step
+    else:
+        cx, cy, d1x, d1y, _, _ = _POINT(phi, z_rp, radius, eccentricity)
+        rx, ry = px - cx, py - cy
+        step = np.inf
+    inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
+    nx, ny = -d1y * inv, d1x * inv
+    residual = abs(rx * d1x + ry * d1y) * inv
+    return phi, abs(step) < tol, residual, rx * nx + ry * ny, nx, ny, rx * rx + ry * ry
 
 
 _NEWTON = _jit(_closest_point_newton)
@@ -189,49 +202,28 @@ _COLD_STARTS = np.linspace(-0.375, 0.375, 7)
 
 
 def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter):
-    """Curve parameter of the foot point of P = (px, py) on C: Newton from the warm
-    start ``phi0`` if it is finite, else (or if that fails) from seven starts
-    across the lobe around P's polar angle, keeping the nearest converged foot
-    point. A start counts as converged when the step fell below ``tol`` or the
-    first-order condition |(P - C).C'|/|C'| holds to 1e-12 m. Returns (phi, ok)."""
+    """Foot point of P = (px, py) on C: Newton from the warm start ``phi0`` if it is
+    finite, else (or if that fails) from seven starts across the lobe around P's
+    polar angle, keeping the nearest converged foot point. A start counts as
+    converged when the step fell below ``tol`` or the first-order residual is below
+    1e-12 m. Returns (phi, ok, s, nx, ny) (see :func:`_closest_point_newton`)."""
     if np.isfinite(phi0):
-        phi, conv = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
-        if conv or _first_order_residual(px, py, phi, z_rp, radius, eccentricity) <= 1e-12:
-            return phi, True
+        phi, conv, res, sd, nx, ny, _ = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
+        if conv or res <= 1e-12:
+            return phi, True, sd, nx, ny
     lobe = 2.0 * np.pi / (z_rp - 1)
     theta = np.arctan2(px, py)
-    best, best_d2, ok = theta, np.inf, False
+    best = (theta, False, np.nan, np.nan, np.nan)
+    best_d2 = np.inf
     for k in range(_COLD_STARTS.shape[0]):
-        phi, conv = _NEWTON(px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius, eccentricity, max_step, tol,
-                            max_iter)
-        if not conv and _first_order_residual(px, py, phi, z_rp, radius, eccentricity) > 1e-12:
-            continue
-        cx, cy, _, _, _, _ = _POINT(phi, z_rp, radius, eccentricity)
-        d2 = (px - cx) ** 2 + (py - cy) ** 2
-        if d2 < best_d2:
-            best, best_d2, ok = phi, d2, True
-    return best, ok
+        phi, conv, res, sd, nx, ny, d2 = _NEWTON(px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius,
+                                                 eccentricity, max_step, tol, max_iter)
+        if (conv or res <= 1e-12) and d2 < best_d2:
+            best, best_d2 = (phi, True, sd, nx, ny), d2
+    return best
 
 
-def _first_order_residual(px, py, phi, z_rp, radius, eccentricity):
-    """|(P - C(phi)).C'(phi)| / |C'(phi)| [m]: zero at a foot point."""
-    cx, cy, d1x, d1y, _, _ = _POINT(phi, z_rp, radius, eccentricity)
-    return abs((px - cx) * d1x + (py - cy) * d1y) / np.sqrt(d1x * d1x + d1y * d1y)
-
-
-def _signed_distance(px, py, phi, z_rp, radius, eccentricity):
-    """Signed distance s(P) = (P - C(phi*)).n_out of P from C at its foot point
-    phi* (> 0 outside, away from the disc centre) and the unit outward normal
-    (nx, ny): the tangent C'/|C'| turned by +90 deg (clockwise traversal)."""
-    cx, cy, d1x, d1y, _, _ = _POINT(phi, z_rp, radius, eccentricity)
-    inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
-    nx, ny = -d1y * inv, d1x * inv
-    return (px - cx) * nx + (py - cy) * ny, nx, ny
-
-
-_first_order_residual = _jit(_first_order_residual)
 _FOOT = _jit(_foot_point)
-_SIGNED = _jit(_signed_distance)
 
 
 def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter, out):
@@ -239,9 +231,9 @@ def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max
     arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
     failed = 0
     for i in range(px.shape[0]):
-        phi, ok = _FOOT(px[i], py[i], phi0[i], z_rp, radius, eccentricity, max_step, tol, max_iter)
+        phi, ok, out[0, i], out[1, i], out[2, i] = _FOOT(px[i], py[i], phi0[i], z_rp, radius, eccentricity,
+                                                         max_step, tol, max_iter)
         failed += not ok
-        out[0, i], out[1, i], out[2, i] = _SIGNED(px[i], py[i], phi, z_rp, radius, eccentricity)
         out[3, i] = phi
     return failed
 

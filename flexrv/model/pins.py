@@ -43,7 +43,7 @@ from numba import njit
 
 from flexrv.contact.laws import _impact_one
 from flexrv.errors import ConvergenceError
-from flexrv.geometry.cycloid import _FOOT, _SIGNED, closest_point_settings
+from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output
 
 
@@ -53,11 +53,19 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
     the output arrays; phi is the closest-point warm start (updated; NaN: cold
     start). ctr[0] counts calls (a cold restart every ctr[1] calls), ctr[2] counts
-    closest-point failures."""
-    (idx, sc, pins, radii, profile, harm, phi, out_gap, out_f, out_nx, out_ny, out_rxn, ctr) = pack
+    closest-point failures; ctr[3] = 1 allows skipping pins that are provably open.
+
+    Skipping (exact for the forces): the gap is 1-Lipschitz in the pin's position
+    relative to the disc (distance to a curve) up to the harmonics' variation, so
+    with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
+    pin whose bound is positive carries no force (and no Jacobian); its closest
+    point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
+    P0y) of the last exact evaluation."""
+    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, ctr) = pack
     z_rp, R_p, r_nom, ecc, k, expo, c_max, depth = int(sc[0]), sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
     max_step, tol, max_iter = sc[8], sc[9], int(sc[10])
     cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0
+    skip = ctr[3] > 0
     ctr[0] += 1
     for kd in range(profile.shape[0]):
         ix, iy, ip = idx[3 * kd], idx[3 * kd + 1], idx[3 * kd + 2]
@@ -66,6 +74,9 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         d_r, d_rp, d_rot = profile[kd, 0], profile[kd, 1], profile[kd, 2]
         cr, sr = np.cos(d_rot), np.sin(d_rot)
         radius = R_p + d_r
+        margin = 0.0
+        for h in range(harm.shape[1]):
+            margin += 2.0 * abs(harm[kd, h, 1])
         gxx = gxy = gxp = gyy = gyp = gpp = 0.0
         hxx = hxy = hxp = hyy = hyp = hpp = 0.0
         fx = fy = fp = 0.0
@@ -73,15 +84,20 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
             lx, ly = c * rx + s * ry, -s * rx + c * ry  # disc frame
             px, py = cr * lx + sr * ly, -sr * lx + cr * ly  # profile frame (rotation modification removed)
+            if skip and not cold:
+                bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
+                if bound > 0.0:  # provably open (NaN: never skipped)
+                    out_gap[kd, i], out_f[kd, i] = bound, 0.0
+                    continue
             start = np.nan if cold else phi[kd, i]
-            ph, ok = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
+            ph, ok, dist, nlx, nly = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
             if not ok:
                 ctr[2] += 1
             phi[kd, i] = ph
-            dist, nlx, nly = _SIGNED(px, py, ph, z_rp, radius, ecc)
             gap = dist + r_nom + d_rp - radii[i]
             for h in range(harm.shape[1]):
                 gap -= harm[kd, h, 1] * np.cos(harm[kd, h, 0] * ph + harm[kd, h, 2])
+            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2] = gap, px, py
             mx, my = cr * nlx - sr * nly, sr * nlx + cr * nly  # disc frame
             nx, ny = c * mx - s * my, s * mx + c * my  # housing frame
             rxn = rx * ny - ry * nx
@@ -153,20 +169,23 @@ class PinContacts(KernelGroup):
         self.phi = np.full((self.nd, z), np.nan)
         self.gap, self.force = np.zeros((self.nd, z)), np.zeros((self.nd, z))
         self.nx, self.ny, self.rxn = np.zeros((self.nd, z)), np.zeros((self.nd, z)), np.zeros((self.nd, z))
-        self.ctr = np.array([0, restart_every, 0], dtype=np.int64)
+        self.last = np.full((self.nd, z, 3), np.nan)
+        #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
+        self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
 
     def pack(self, idx, history=False):
-        phi, ctr = self.phi, self.ctr
-        if history:  # post-processing: cold start at the first sample, then warm
-            phi, ctr = np.full_like(self.phi, np.nan), np.array([1, 0, 0], dtype=np.int64)
-        return (idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, self.gap, self.force,
+        phi, last, ctr = self.phi, self.last, self.ctr
+        if history:  # post-processing: cold start at the first sample, then warm; every gap exact
+            phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
+            ctr = np.array([1, 0, 0, 0], dtype=np.int64)
+        return (idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
                 self.nx, self.ny, self.rxn, ctr)
 
     @staticmethod
     def empty_pack():
         z2 = np.zeros((0, 0))
         return (np.zeros(0, np.int64), np.zeros(11), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
-                np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, np.array([1, 0, 0], dtype=np.int64))
+                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, np.array([1, 0, 0, 0], dtype=np.int64))
 
     def run(self, t, q, v, f, jq, jv, jac, pack):
         ctr = pack[-1]
@@ -198,6 +217,7 @@ class PinContacts(KernelGroup):
     def reset(self):
         """Forget the closest-point warm start and the call counter."""
         self.phi[:] = np.nan
+        self.last[:] = np.nan
         self.ctr[0] = 0
         self.gap[:] = 0.0
 
