@@ -7,7 +7,12 @@ rv40e and rv221, each with both needle-bearing models, and stores the
 generalized forces, the analytic Jacobians and the output dictionaries
 (evaluated on the 20 states as one history) in tests/data/force_reference.npz.
 
-Run from the repository root:  python tests/data/make_force_reference.py
+With ``--te`` it instead runs a short rigid rv40e simulation (speed and load
+ramps shortened to 5 ms, t_end 0.05 s, dt 1e-4, default Newton tolerance) and
+writes the TE statistics over t > 0.02 s to tests/data/te_reference.json.
+Both files were written with the code before issue 15 (commit 5cab5cb).
+
+Run from the repository root:  python tests/data/make_force_reference.py [--te]
 """
 
 from __future__ import annotations
@@ -18,6 +23,27 @@ import numpy as np
 
 N_STATES = 20
 PATH = Path(__file__).with_name("force_reference.npz")
+TE_PATH = Path(__file__).with_name("te_reference.json")
+
+
+def short_run_reducer(name: str = "rv40e"):
+    """Preset with speed and load ramps shortened to 5 ms (steady after ~0.02 s)."""
+    from flexrv.design import load
+
+    r = load(name)
+    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
+    return r.model_copy(update={"operating": op})
+
+
+def te_statistics(name: str = "rv40e", t_end: float = 0.05, dt: float = 1e-4) -> dict:
+    """TE mean and peak-to-peak [arcsec] over t > 0.02 s of a short rigid run."""
+    from flexrv.simulation import Simulation
+
+    res = Simulation(short_run_reducer(name)).run(t_end=t_end, dt=dt)
+    te = res["te"]
+    sel = te.values[te["time"].values > 0.02]
+    return {"preset": name, "t_end": t_end, "dt": dt, "te_mean_arcsec": float(np.mean(sel)),
+            "te_pp_arcsec": float(np.ptp(sel)), "samples": int(len(sel))}
 
 
 def variant(name: str, needle: str):
@@ -98,4 +124,11 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    import json
+    import sys
+
+    if "--te" in sys.argv:
+        TE_PATH.write_text(json.dumps(te_statistics(), indent=1) + "\n")
+        print(TE_PATH.read_text())
+    else:
+        main()
