@@ -203,16 +203,20 @@ _COLD_STARTS = np.linspace(-0.375, 0.375, 7)
 
 def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter):
     """Foot point of P = (px, py) on C: Newton from the warm start ``phi0`` if it is
-    finite, else (or if that fails) from seven starts across the lobe around P's
-    polar angle, keeping the nearest converged foot point. A start counts as
+    finite, else (or if that fails or lands more than half a lobe from P's polar
+    angle theta: a warm start from a far-away state, e.g. a diverging Newton trial,
+    can reach another lobe's local minimum) from seven starts across the lobe
+    around theta, keeping the nearest converged foot point. A start counts as
     converged when the step fell below ``tol`` or the first-order residual is below
     1e-12 m. Returns (phi, ok, s, nx, ny) (see :func:`_closest_point_newton`)."""
-    if np.isfinite(phi0):
-        phi, conv, res, sd, nx, ny, _ = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
-        if conv or res <= 1e-12:
-            return phi, True, sd, nx, ny
     lobe = 2.0 * np.pi / (z_rp - 1)
     theta = np.arctan2(px, py)
+    if np.isfinite(phi0):
+        phi, conv, res, sd, nx, ny, _ = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
+        off = phi - theta
+        off -= 2.0 * np.pi * np.rint(off / (2.0 * np.pi))
+        if (conv or res <= 1e-12) and abs(off) <= 0.5 * lobe:
+            return phi, True, sd, nx, ny
     best = (theta, False, np.nan, np.nan, np.nan)
     best_d2 = np.inf
     for k in range(_COLD_STARTS.shape[0]):
