@@ -3,21 +3,20 @@ groups and the assembled model.
 
 A *member* is a body with its own Exudyn ``NodeGenericODE2`` (coordinates are
 absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
-*force group* couples several members through ONE ``ObjectGenericODE2`` whose
-Python force function evaluates every contact of the group at once with numpy
-(see the facts note: one user-function call costs ~18 us, so the number of
-groups, not the number of contacts, sets the overhead). Optionally
-(``assemble(model, merge=True)``) each run of consecutive groups with the
-default glue shares ONE element (:func:`add_merged`): the rigid model then
-makes two Python calls per residual instead of five (measured gain < 5 %,
-see :func:`flexrv.model.factory.assemble`).
+*force group* couples several members. The rigid reducer's groups (gear stage,
+crank supports, needle bearings, pins, rigid main bearing, loads) are
+:class:`KernelGroup` s: their physics is one numba-compiled kernel each, and the
+model evaluates all of them in ONE compiled call from ONE ``ObjectGenericODE2``
+(:class:`flexrv.model.kernels.FusedForces`; issue 15: 95 % of a step was Python
+overhead with one numpy element per group). Other groups (ball-resolved bearing,
+flexible crank) keep one element each with a Python force function, optionally
+merged (``assemble(model, merge=True)``, :func:`add_merged`).
 
-Each group's kernel ``evaluate(t, q, v)`` is written once and broadcasts over
-leading axes: the Exudyn callback calls it with one state (q of shape (n,)),
-post-processing calls it with a whole time history (shape (T, n)) to recover
-every contact force as a named output. Replacing a member group by a flexible
-one (flexible-bearing issue) means registering another group under the same
-output names.
+A group's ``evaluate(t, q, v)`` accepts one state (q of shape (n,), the solver
+path) or a whole time history (shape (T, n)), from which post-processing
+recovers every contact force as a named output. Replacing a member group by a
+flexible one (flexible-bearing issue) means registering another group under the
+same output names.
 """
 
 from __future__ import annotations
@@ -176,8 +175,14 @@ class KernelGroup(ForceGroup):
         """Time-dependent kernel inputs at scalar t (drive angle, loads)."""
         return ()
 
-    def run(self, t, q, v, f, jq, jv, jac: bool, pack: tuple) -> None:
-        """Call the compiled kernel: add forces into f (and Jacobians into jq, jv)."""
+    def time_inputs_many(self, ts: np.ndarray):
+        """Time-dependent inputs for every sample of a history (vectorised; row i is
+        passed to :meth:`run` as ``inputs``), or None."""
+        return None
+
+    def run(self, t, q, v, f, jq, jv, jac: bool, pack: tuple, inputs=None) -> None:
+        """Call the compiled kernel: add forces into f (and Jacobians into jq, jv);
+        ``inputs``: precomputed time inputs at t (else :meth:`time_inputs`)."""
         raise NotImplementedError
 
     def record(self) -> dict:
@@ -208,8 +213,10 @@ class KernelGroup(ForceGroup):
         pack = self.pack(idx, history=True)
         f = np.zeros(qf.shape)
         recs = []
+        inputs = self.time_inputs_many(ts)
         for i in range(qf.shape[0]):
-            self.run(float(ts[i]), qf[i], vf[i], f[i], _NO_JACOBIAN, _NO_JACOBIAN, False, pack)
+            self.run(float(ts[i]), qf[i], vf[i], f[i], _NO_JACOBIAN, _NO_JACOBIAN, False, pack,
+                     None if inputs is None else inputs[i])
             if want_outputs:
                 recs.append(self.record())
         out = None

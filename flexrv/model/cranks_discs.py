@@ -144,7 +144,7 @@ class CrankSupports(KernelGroup):
         z = np.zeros(0)
         return (np.zeros(6, np.int64), np.zeros(2), np.zeros((0, 2)), z, z, z)
 
-    def run(self, t, q, v, f, jq, jv, jac, pack):
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         crank_support_kernel(q, v, f, jq, jv, jac, pack)
 
     def record(self):
@@ -286,7 +286,7 @@ class NeedleBearings(KernelGroup):
         z1, z2, z3 = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0, 0))
         return (np.zeros(0, np.int64), np.zeros(7), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, np.zeros(1))
 
-    def run(self, t, q, v, f, jq, jv, jac, pack):
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         needle_kernel(q, v, f, jq, jv, jac, pack)
 
     @property

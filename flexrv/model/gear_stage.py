@@ -146,8 +146,12 @@ class GearMeshes(KernelGroup):
             c = self._drive_cache = (t, float(self.theta_s(t)), float(self.omega_s(t)))
         return c[1], c[2]
 
-    def run(self, t, q, v, f, jq, jv, jac, pack):
-        ts, ws = self.time_inputs(t)
+    def time_inputs_many(self, ts):
+        return np.stack([np.broadcast_to(np.asarray(self.theta_s(ts), dtype=float), ts.shape),
+                         np.broadcast_to(np.asarray(self.omega_s(ts), dtype=float), ts.shape)], axis=-1)
+
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        ts, ws = self.time_inputs(t) if inputs is None else inputs
         gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack)
 
     def record(self):

@@ -52,7 +52,7 @@ class RigidMainBearing(KernelGroup):
     def empty_pack():
         return (np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0))
 
-    def run(self, t, q, v, f, jq, jv, jac, pack):
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         main_bearing_kernel(q, v, f, jq, jv, jac, pack)
 
     def record(self):

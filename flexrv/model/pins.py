@@ -187,7 +187,7 @@ class PinContacts(KernelGroup):
         return (np.zeros(0, np.int64), np.zeros(11), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
                 np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, np.array([1, 0, 0, 0], dtype=np.int64))
 
-    def run(self, t, q, v, f, jq, jv, jac, pack):
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ctr = pack[-1]
         before = ctr[2]
         pin_kernel(q, v, f, jq, jv, jac, pack)
