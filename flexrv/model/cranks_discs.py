@@ -56,6 +56,7 @@ from numba import njit
 from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _impact_one
 from flexrv.model.base import KernelGroup, Output
+from flexrv.units import DEG_PER_RAD
 
 
 @njit(cache=True)
@@ -324,5 +325,5 @@ class NeedleBearings(KernelGroup):
         if np.any(np.abs(dep) > limit):
             k = int(np.nanargmax(np.abs(dep)))
             return (f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
-                    f"{np.degrees(dep[k]):.3g} deg (more than half a pin pitch, {np.degrees(limit):.3g} deg)")
+                    f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)")
         return None

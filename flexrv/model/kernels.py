@@ -50,8 +50,7 @@ def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, ma
     if jac:
         jq[:, :] = 0.0
         jv[:, :] = 0.0
-    if gear[1].shape[0] > 0 and gear[2].shape[0] > 0:
-        gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, gear)
+    gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, gear)
     crank_support_kernel(q, v, f, jq, jv, jac, supports)
     needle_kernel(q, v, f, jq, jv, jac, needles)
     pin_kernel(q, v, f, jq, jv, jac, pins)
