@@ -365,3 +365,28 @@ def test_short_rigid_run_same_te():
     assert new["samples"] == ref["samples"]
     assert new["te_mean_arcsec"] == pytest.approx(ref["te_mean_arcsec"], abs=1e-3)
     assert new["te_pp_arcsec"] == pytest.approx(ref["te_pp_arcsec"], abs=1e-3)
+
+
+def test_fused_element_coexists_with_ball_bearing():
+    """Ball-resolved main bearing (its own element): the fused element covers only
+    the kernel groups' members (carrier, cranks, discs; no rigid main bearing) and
+    generalized_forces = fused part scattered into the model vector + the ball
+    group, equal to the sum of every group's evaluate/jacobian (1e-9 rel.)."""
+    from flexrv.model.base import group_index
+
+    m = build_model(_variant("rv40e", "empirical"), "balls", exudyn=False)
+    q, v = _loaded(m)
+    f, dq, dv = m.generalized_forces(0.002, q, v)
+    assert not m.fused.is_full and m.fused.n < m.n
+    assert "main_bearing" not in [g.kind for g in m.fused.groups]
+    fr, dqr, dvr = np.zeros(m.n), np.zeros((m.n, m.n)), np.zeros((m.n, m.n))
+    for g in m.groups:
+        ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])]
+        g.new_step()
+        fr[ix] += g.evaluate(0.002, q[ix], v[ix])[0]
+        jq, jv = g.jacobian(0.002, q[ix], v[ix])
+        dqr[np.ix_(ix, ix)] += jq
+        dvr[np.ix_(ix, ix)] += jv
+    _close(f, fr, what="force")
+    _close(dq, dqr, what="jac_q")
+    _close(dv, dvr, what="jac_v")
