@@ -287,7 +287,7 @@ class AssembledModel:
         q = np.ascontiguousarray(q, dtype=float)
         v = np.ascontiguousarray(v, dtype=float)
         f, dq, dv = fused.full(t, q, v, jacobian)
-        others = [g for g in self.groups if g not in fused.groups]
+        others = fused.others
         if others:
             from flexrv.model.kernels import single_thread_blas
 

@@ -97,6 +97,8 @@ class FusedForces:
                 raise ValueError(f"two kernel groups of kind {g.kind!r} in one fused element")
             by_kind[g.kind] = g
         self.groups = list(groups)
+        #: the model's groups outside this element (own elements; added by generalized_forces)
+        self.others = [g for g in model.groups if g not in self.groups]
         names = [name for name in model.members if any(name in g.members for g in groups)]
         self.member_names = names
         local, pos = {}, 0
