@@ -34,6 +34,11 @@ force -F n acts on the disc along the line through the pin centre), so
 modification clearance, separation and the number of pins in mesh emerge from
 the contact physics. The pins are rigidly fixed in the housing (their own
 bending and the pin-housing contact are not modelled).
+
+One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
+evaluate/jacobian and the model's fused element call it. Solver calls skip pins
+that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
+time histories (outputs) evaluate every gap exactly.
 """
 
 from __future__ import annotations
