@@ -176,8 +176,11 @@ class Simulation:
         solver = exu.MainSolverImplicitSecondOrder()
         t0 = _time.perf_counter()
         error = None
+        from flexrv.model.kernels import single_thread_blas
+
         try:
-            ok = solver.SolveSystem(mbs, ss)
+            with single_thread_blas():  # one BLAS thread unless FLEXRV_BLAS_THREADS is set (issue 15)
+                ok = solver.SolveSystem(mbs, ss)
         except Exception as exc:  # exudyn raises on Newton failure / user-function errors
             ok, error = False, exc
         finally:

@@ -141,8 +141,11 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
 
 def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
     """Create the Exudyn system: one NodeGenericODE2 + mass object per member and
-    the force elements. Default: one ObjectGenericODE2 per group. With ``merge``
-    each run of consecutive groups
+    the force elements. The compiled kernel groups (:class:`flexrv.model.base.KernelGroup`:
+    gear stage, crank supports, needle bearings, pins, rigid main bearing, loads)
+    share ONE ObjectGenericODE2 (:class:`flexrv.model.kernels.FusedForces`, one
+    compiled call per residual). Other groups: one ObjectGenericODE2 per group; with ``merge``
+    each run of consecutive such groups
     with the default glue and an analytic Jacobian shares ONE ObjectGenericODE2
     (:func:`flexrv.model.base.add_merged`: one Python call per residual instead of
     one per group); groups with their own
@@ -171,9 +174,18 @@ def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
         mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix, **extra))
         m.offset = offset
         offset += m.n
+    from flexrv.model.base import KernelGroup
+    from flexrv.model.kernels import FusedForces
+
+    kernel_groups = [g for g in model.groups if isinstance(g, KernelGroup)]
+    if kernel_groups:  # ONE element for every compiled group (issue 15)
+        model.fused = FusedForces(model, kernel_groups)
+        for g in kernel_groups:
+            g._stats = model.fused.stats  # the groups report the fused element's call counts
+        model.fused.add_to(mbs, [model.members[name].node for name in model.fused.member_names])
     all_nodes = [m.node for m in model.members.values()]
     merged, index = [], []
-    for g in model.groups + [None]:
+    for g in [g for g in model.groups if not isinstance(g, KernelGroup)] + [None]:
         if g is not None and merge and g.mergeable:
             merged.append(g)
             index.append(group_index([model.members[name].offset for name in g.members],
