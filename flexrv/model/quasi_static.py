@@ -208,8 +208,6 @@ class StaticModel:
         o = self.options
         q = q_start.copy()
         tol = o.force_tol * self.f_ref
-        for g in self.model.groups:  # forget warm starts (closest-point parameters) of rejected trial steps
-            g.reset()
         f, jac = self.residual(theta_in, q)
         r, merit = np.max(np.abs(f / self.arm)), np.linalg.norm(f / self.arm)
         s0 = self._initial_shift(jac)
