@@ -13,7 +13,9 @@ from rich.table import Table
 
 from flexrv.cache import to_jsonable  # noqa: F401  (re-exported for the CLI modules)
 
-console = Console()
+#: stdout console; markup off: paths, names and values are printed literally
+#: (``[/x].toml`` is a valid file name, ``[s]`` a unit), styles are passed explicitly
+console = Console(markup=False)
 
 JSON_HELP = "Print machine-readable JSON on stdout instead of a table."
 
@@ -65,7 +67,7 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
     convention used throughout flexrv (``max_force_N``, ``stiffness_Nm_per_rad``).
     Lists of numbers are shown compactly; lists of dicts as sub-tables.
     """
-    console.print(f"[bold]{title}[/]")
+    console.print(title, style="bold")
     flat: list[tuple[str, Any, str]] = []
     for key, value in data.items():
         if isinstance(value, dict):

@@ -45,7 +45,7 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
 
     def render(r) -> None:
         data = r.model_dump()
-        console.print(f"[bold]{r.name}[/] — {r.description}")
+        console.print(f"{r.name} — {r.description}", style="bold")
         for section, values in data.items():
             if not isinstance(values, dict) or section == "provenance":
                 continue
@@ -68,10 +68,34 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
     loads, Hertz, film thickness, life)."""
     from flexrv.analysis.report import design_report
+    from flexrv.errors import ConvergenceError
 
     reducer = load(preset)
-    report = design_report(reducer)
+    check_design_report_range(reducer)
+    try:
+        report = design_report(reducer)
+    except ConvergenceError as exc:
+        mb = reducer.main_bearing
+        if mb.axial_preload_um < 0:
+            raise ConvergenceError(
+                f"main_bearing.axial_preload_um = {mb.axial_preload_um:g} um (axial clearance) is not supported by "
+                f"flexrv design: the quasi-static ball loads are indeterminate in the clearance at this load "
+                f"({exc}); use a preload >= 0 for the design report (simulate models the clearance)") from None
+        raise
     emit(report, json, lambda rep: render_nested(f"Design report: {reducer.name}", rep))
+
+
+def check_design_report_range(reducer) -> None:
+    """Refuse, naming the field, a design whose main-bearing contact angle lies
+    outside the ISO 281 table that the life rating of the design report uses."""
+    from flexrv.analysis.life import _ISO281_XY
+    from flexrv.errors import InputError
+
+    lo, hi = float(_ISO281_XY[0, 0]), float(_ISO281_XY[-1, 0])
+    angle = reducer.main_bearing.contact_angle_deg
+    if not lo <= angle <= hi:
+        raise InputError(f"main_bearing.contact_angle_deg = {angle:g} is not allowed for flexrv design: must lie in "
+                         f"{lo:g} <= value <= {hi:g} deg (the ISO 281 X/Y table of the bearing life rating)")
 
 
 def register(app: typer.Typer) -> None:

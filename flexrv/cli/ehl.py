@@ -129,7 +129,7 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         report["png"] = str(plot_ehl_solution(res, png))
 
     def render(data: dict[str, Any]) -> None:
-        console.print(f"[bold]EHL point contact[/] — {data['case']}")
+        console.print(f"EHL point contact — {data['case']}", style="bold")
         units = {"_N": "N", "_m_s": "m/s", "_m": "m", "_Pa": "Pa", "_Pa_s": "Pa s", "_1_Pa": "1/Pa",
                  "_kg_m3": "kg/m^3", "_s": "s"}
 
@@ -142,7 +142,7 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         for section in ("inputs", "outputs"):
             console.print(kv_table(section, [(k, v, unit(k)) for k, v in data[section].items()]))
         for message in data.get("warnings", []):
-            console.print(f"[yellow]warning:[/] {message}")
+            console.print(f"warning: {message}", style="yellow")
         if "png" in data:
             console.print(f"plot: {data['png']}")
 
