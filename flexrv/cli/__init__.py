@@ -137,6 +137,10 @@ def main(argv: list[str] | None = None) -> None:
     except FlexrvError as exc:
         print_error(str(exc))
         sys.exit(USAGE_EXIT)
+    except OSError as exc:  # a file the user named cannot be read or written
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print_error(f"{exc.strerror or exc}:{where}" if where else f"{exc.strerror or exc}")
+        sys.exit(USAGE_EXIT)
     except (typer.Exit, *click_exit) as exc:
         sys.exit(exc.exit_code)
     except (typer.Abort, *click_abort, KeyboardInterrupt):
