@@ -21,15 +21,25 @@ import math
 
 import numpy as np
 
-#: Root of the mesh / reduced-body / EHL-map cache (``meshes/`` at the repo top
-#: level, overridable with the environment variable ``FLEXRV_CACHE``).
+#: environment variable overriding the cache location (``FLEXRV_CACHE`` is the
+#: older name, still honoured)
+CACHE_ENV = "FLEXRV_CACHE_DIR"
+
+
 def cache_dir() -> Path:
-    """Directory of cached meshes and reduced bodies (created on demand)."""
-    root = os.environ.get("FLEXRV_CACHE")
+    """Directory of cached meshes, reduced bodies and EHL maps (created on demand):
+    ``$FLEXRV_CACHE_DIR`` (or ``$FLEXRV_CACHE``) if set, else the user cache
+    directory of the platform (``~/.cache/flexrv`` on Linux, via platformdirs)."""
+    root = os.environ.get(CACHE_ENV) or os.environ.get("FLEXRV_CACHE")
     if root:
         path = Path(root)
     else:
-        path = Path(__file__).resolve().parent.parent / "meshes"
+        try:
+            from platformdirs import user_cache_dir
+
+            path = Path(user_cache_dir("flexrv", appauthor=False))
+        except ImportError:  # platformdirs missing: the XDG default
+            path = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "flexrv"
     path.mkdir(parents=True, exist_ok=True)
     return path
 
@@ -52,12 +62,22 @@ def _canonical(obj: Any) -> Any:
     return obj
 
 
+def flexrv_version() -> str:
+    """flexrv's own version (part of every cache key and sweep case id)."""
+    from flexrv import __version__
+
+    return __version__
+
+
 def library_versions(*names: str) -> dict[str, str]:
-    """Installed versions of the named distributions (part of every cache key)."""
+    """Installed versions of the named distributions, and always flexrv's own
+    version (part of every cache key: a new flexrv never serves an old entry)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    out = {}
+    out = {"flexrv": flexrv_version()}
     for name in names:
+        if name == "flexrv":
+            continue
         try:
             out[name] = version(name)
         except PackageNotFoundError:
@@ -181,3 +201,120 @@ def to_jsonable(obj: Any) -> Any:
     if isinstance(obj, np.bool_):
         return bool(obj)
     return obj
+
+
+# ------------------------------------------------------------------ verified cache entries
+#: suffix of the stamp written next to every cached file: its key, size and sha256
+STAMP_SUFFIX = ".stamp.json"
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _stamp_path(path: Path) -> Path:
+    return path.with_name(path.name + STAMP_SUFFIX)
+
+
+def stamp_entry(paths, key: str) -> None:
+    """Record, next to each file of a freshly written cache entry, the entry's key
+    and the file's size and sha256 (read back by :func:`entry_problem`)."""
+    for path in map(Path, paths):
+        stamp = {"key": key, "size": path.stat().st_size, "sha256": _sha256(path), "flexrv": flexrv_version()}
+        atomic_write_text(_stamp_path(path), json.dumps(stamp))
+
+
+def entry_problem(paths, key: str) -> str | None:
+    """None if every file of a cache entry exists and matches its stamp (same key,
+    size and sha256); otherwise why not ("missing" if no file exists at all)."""
+    paths = [Path(p) for p in paths]
+    if not any(p.exists() for p in paths):
+        return "missing"
+    for path in paths:
+        if not path.exists():
+            return f"{path.name} is missing"
+        stamp_file = _stamp_path(path)
+        try:
+            stamp = json.loads(stamp_file.read_text())
+        except (OSError, ValueError):
+            return f"{path.name} has no valid stamp (written by an older flexrv or interrupted)"
+        if stamp.get("key") != key:
+            return f"{path.name} belongs to another key ({stamp.get('key')!r})"
+        size = path.stat().st_size
+        if size != stamp.get("size"):
+            return f"{path.name} is truncated or altered ({size} bytes, {stamp.get('size')} expected)"
+        if _sha256(path) != stamp.get("sha256"):
+            return f"{path.name} content does not match its hash"
+    return None
+
+
+def cache_notice(path, reason: str) -> None:
+    """The one-line notice of a cache entry that is rebuilt."""
+    import sys
+
+    print(f"flexrv: cache entry {Path(path).name}: {reason}; rebuilding it", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def build_lock(path, enabled: bool = True) -> Iterator[None]:
+    """Exclusive lock of one cache entry while it is built (``<path>.lock``, fcntl),
+    so concurrent builders of the same entry do the work once: the second waits,
+    then finds the entry valid. No-op where fcntl is unavailable or ``enabled`` is False."""
+    if not enabled:
+        yield
+        return
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        yield
+        return
+    lock_path = Path(path).with_name(Path(path).name + ".lock")
+    lock_path.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock_path, "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
+def cached_entry(paths, key: str, load, build, enabled: bool = True):
+    """Load a verified cache entry, or build it once under its lock.
+
+    ``paths``: the entry's files; ``load()`` reads them (called only when every
+    file matches its stamp); ``build()`` computes the value and writes the files
+    (atomically) and returns the value; the files are then stamped. A corrupt,
+    truncated, foreign or unreadable entry is rebuilt with a one-line notice on
+    stderr. Returns (value, cached: bool)."""
+    paths = [Path(p) for p in paths]
+    if not enabled:  # no reuse; what is written is still stamped for later runs
+        value = build()
+        if all(p.exists() for p in paths):
+            stamp_entry(paths, key)
+        return value, False
+
+    def try_load():
+        problem = entry_problem(paths, key)
+        if problem is None:
+            try:
+                return load(), None
+            except Exception as exc:  # unreadable although stamped (foreign writer): rebuild
+                problem = f"unreadable ({type(exc).__name__}: {exc})"
+        return None, problem
+
+    value, problem = try_load()
+    if problem is None:
+        return value, True
+    with build_lock(paths[0]):
+        value, problem2 = try_load()  # built by another process while we waited
+        if problem2 is None:
+            return value, True
+        if problem != "missing":
+            cache_notice(paths[0], problem)
+        value = build()
+        stamp_entry(paths, key)
+    return value, False
