@@ -60,9 +60,16 @@ def modes(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART
           vtu: Optional[Path] = typer.Option(None, "--vtu", help="Write the modes as VTU for ParaView to this folder.")
           ) -> None:
     """Free-free and constrained (interfaces clamped) eigenfrequencies [Hz] of a part."""
+    from flexrv.cli._common import check_output_dir
     from flexrv.design import load
+    from flexrv.errors import InputError
     from flexrv.fem.body import part_modes
 
+    if n < 1:
+        raise InputError(f"--n {n}: must be >= 1")
+    for opt, folder in (("--png", png), ("--vtu", vtu)):
+        if folder is not None:
+            check_output_dir(folder, opt, allow_existing=True)
     pm = part_modes(load(preset), part.value, n=n, size=_size_m(size))
     m = pm.mesh
     files = []
