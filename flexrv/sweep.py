@@ -343,6 +343,8 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
     cases = build_cases(spec)
     output_keys = known_outputs(spec, load(spec.preset))
     check_outputs(spec, output_keys)
+    if scheduler:  # reachable? (before anything is written)
+        connect_scheduler(scheduler).close()
     out.mkdir(parents=True, exist_ok=True)
     spec_json = json.dumps(spec.__dict__, indent=1, default=str)
     spec_path = out / "spec.json"
