@@ -322,6 +322,8 @@ class Simulation:
 
         ck = load_checkpoint(directory)
         meta = ck["meta"]
+        if float(ck["t"][-1]) >= meta["t_end"] - 0.5 * meta["dt"]:
+            raise InputError(f"--resume {directory}: the run is already complete (t_end = {meta['t_end']:g} s)")
         options = dict(meta.get("model_options") or {})
         if "parts" in options:
             options["parts"] = tuple(options["parts"])
