@@ -134,7 +134,6 @@ class Simulation:
         ``initial_records``: (t, q, v) arrays of an earlier part of this run (a
         checkpoint); the run continues from their last state at its time.
         """
-        import exudyn as exu
 
         op = self.reducer.operating
         if t_end is None:
@@ -151,6 +150,8 @@ class Simulation:
             if not t_start < t_end:
                 raise InputError(f"t_end = {t_end:g} s is not allowed: must be > the checkpoint time {t_start:g} s")
         check_step_count(t_end, dt, output_every, t_start=t_start)
+        import exudyn as exu
+
         model = self.model if self.model is not None else self.build()
         mbs = model.mbs
         n_steps = check_step_count(t_end, dt, output_every, model.n, t_start=t_start)
@@ -289,13 +290,20 @@ class Simulation:
         if checkpoint is not None and k > 1:  # the complete record, so a resume of a finished run is a no-op
             checkpoint.write_states(ts[:k], qs[:k], vs[:k], state.get("a_last"))
         if status == "failed":
-            t_fail, cause = state["fail"] if state["fail"] is not None else (t_fin, f"Newton iteration failed ({error})")
+            detail = " ".join(str(error).split())[:200] if error is not None else ""
+            t_fail, cause = state["fail"] if state["fail"] is not None else (t_fin, f"Newton iteration failed ({detail})")
             res.attrs["failure"] = f"t = {t_fail:.6g} s: {cause}"
             path = None
             if save_to is not None and k > 1:
                 path = res.save(save_to)
-            msg = (f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: reduce the step (dt = {dt:g} s -> "
-                   f"{dt / 2:g} s) or increase contact damping (contact.pin_max_damping_Ns_per_m)"
+            if t_fail <= t_start + 2 * dt:  # at the very start: the assembled design, not the step
+                advice = ("the design cannot start from rest: check the profile modifications and clearances "
+                          "(second_stage.modification_*, needle_bearing.radial_clearance_um, first_stage.backlash_um) "
+                          "for interference at assembly")
+            else:
+                advice = (f"reduce the step (dt = {dt:g} s -> {dt / 2:g} s) or increase contact damping "
+                          "(contact.pin_max_damping_Ns_per_m)")
+            msg = (f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: {advice}"
                    + (f"; partial results saved to {path}" if path else "; partial results in exc.results"))
             err = SimulationError(msg)
             err.results = res

@@ -4,7 +4,7 @@ message naming the option/field (and, where there is one, the value), and no
 traceback. Covers usage errors, undecodable files, markup-like text, strict types,
 infeasible designs, step bounds, output paths checked before work, and sweep specs.
 
-The cases run four at a time (each is a fresh interpreter, ~1 s) so the table stays
+The cases run six at a time (each is a fresh interpreter, ~1 s) so the table stays
 well under a minute; only the unreachable-scheduler case waits for its 5 s timeout.
 """
 
@@ -152,7 +152,7 @@ def _run(argv: list[str], cwd: Path) -> subprocess.CompletedProcess:
 def outcomes(tmp_path_factory):
     d = tmp_path_factory.mktemp("fuzz")
     cases = _cases(d / "inputs")
-    with ThreadPoolExecutor(max_workers=4) as pool:
+    with ThreadPoolExecutor(max_workers=6) as pool:
         futures = {cid: pool.submit(_run, argv, d) for cid, argv, _ in cases}
         return {cid: (argv, must, futures[cid].result()) for cid, argv, must in cases}, d
 
