@@ -56,7 +56,8 @@ def load(preset_or_path: str | Path | Reducer) -> Reducer:
     elif not (path.suffix == ".toml" or path.exists()):
         raise ConfigError(f"unknown preset {text_name!r}: choose one of {list_presets()} or give a path to a .toml file")
     if not path.is_file():
-        raise ConfigError(f"design file {str(path)!r} does not exist")
+        what = "is not a regular file" if path.exists() else "does not exist"
+        raise ConfigError(f"design file {str(path)!r} {what}")
     return loads(read_text_file(path, "design file"), source=str(path))
 
 
