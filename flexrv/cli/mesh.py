@@ -31,7 +31,7 @@ def _size_m(size_mm: Optional[float]) -> Optional[float]:
 
 def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
          size: Optional[float] = SIZE_OPT, json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
-    """Mesh a part with second-order tetrahedra (cached under meshes/): files and counts."""
+    """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
     from flexrv.meshing import build_mesh
 

@@ -124,6 +124,8 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
                 bar.stop()
     if res.attrs.get("status") != "interrupted":
         res.save(out)
+        if res.attrs.get("status") == "completed":  # saved in full: the resume data is no longer needed
+            (Path(out) / "checkpoint.npz").unlink(missing_ok=True)
     s = res.summary()
     data = {"output_dir": str(out), "status": s["status"],
             "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
