@@ -137,36 +137,26 @@ RUN_FILES = ("results.nc", "config.toml", "summary.json", "summary.md", "checkpo
 
 
 def _probe_writable(directory: Path, option: str) -> None:
-    """Create ``directory`` (and parents) and a probe file in it; InputError naming
-    the option if that fails. Directories created only for the probe are removed."""
+    """InputError naming the option unless ``directory`` can be created and written:
+    its nearest existing ancestor must be a directory in which a probe file can be
+    created (and is removed again). Nothing else is created, so concurrent runs
+    probing the same new path do not race."""
     import os
     import tempfile
 
     from flexrv.errors import InputError
 
-    created = []
-    d = directory
-    while not d.exists():
-        created.append(d)
-        if d.parent == d:
-            break
+    d = Path(directory)
+    while not d.exists() and d.parent != d:
         d = d.parent
     if not d.is_dir():
         raise InputError(f"{option} {directory}: {d} exists and is not a directory")
     try:
-        for c in reversed(created):
-            c.mkdir()
-        fd, probe = tempfile.mkstemp(prefix=".flexrv-probe.", dir=directory)
+        fd, probe = tempfile.mkstemp(prefix=".flexrv-probe.", dir=d)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise InputError(f"{option} {directory}: not writable ({exc.strerror or exc})") from None
-    finally:
-        for c in created:
-            try:
-                c.rmdir()
-            except OSError:
-                pass
+        raise InputError(f"{option} {directory}: not writable ({d}: {exc.strerror or exc})") from None
 
 
 def check_output_dir(path: Path, option: str = "--out", overwrite: bool = False, allow_existing: bool = False) -> Path:

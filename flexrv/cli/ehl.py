@@ -17,8 +17,9 @@ PRESET_HELP = ("Preset name or design TOML. Without explicit --load-n/--speed-m-
                "the preset (default rv221) supplies only the materials (balls, rings) and the lubricant.")
 
 
-#: largest contact semi-axis / radius of curvature for which the Hertz half-space
-#: assumption is accepted without a warning (Johnson, Contact Mechanics, sec. 4.1: a << R)
+#: largest contact semi-axis / radius of curvature (same direction) for which the
+#: Hertz half-space assumption is accepted without a warning (Johnson, Contact
+#: Mechanics, sec. 4.1: a << R)
 HERTZ_SIZE_LIMIT = 0.1
 
 
@@ -121,12 +122,17 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
     }
     warn = [str(w.message) for w in caught if "EHL" in str(w.message)]
     # Hertz (and the half-space of the film solver) assume contact semi-axes small
-    # against the radii of curvature: flag a/Rx or b/Ry above 0.1
-    ratio = max(res.hertz_a / case["rx"], res.hertz_b / case["ry"])
-    if ratio > HERTZ_SIZE_LIMIT:
-        warn.append(f"contact semi-axes a = {res.hertz_a:.3g} m, b = {res.hertz_b:.3g} m reach {ratio:.3g} x the radius "
-                    f"of curvature (> {HERTZ_SIZE_LIMIT:g}): outside the Hertz/half-space assumptions, results are "
-                    "not physical")
+    # against the radii of curvature: flag a/Ry or b/Rx above HERTZ_SIZE_LIMIT (a is
+    # the semi-axis along y, b along x), and any semi-axis beyond the smaller radius
+    # (a contact larger than the curvature of the bodies that carry it)
+    a, b = res.hertz_a, res.hertz_b
+    paired = max(a / case["ry"], b / case["rx"])
+    overall = max(a, b) / min(case["rx"], case["ry"])
+    if paired > HERTZ_SIZE_LIMIT or overall > 1.0:
+        warn.append(f"contact semi-axes a = {a:.3g} m (along y), b = {b:.3g} m (along x) with rx = {case['rx']:.3g} m, "
+                    f"ry = {case['ry']:.3g} m: semi-axis/radius = {max(paired, overall):.3g}, outside the "
+                    f"Hertz/half-space assumptions (a/ry, b/rx <= {HERTZ_SIZE_LIMIT:g}, semi-axes <= min(rx, ry)); "
+                    "results are not physical")
     if warn:
         report["warnings"] = warn
     return report, res
