@@ -275,3 +275,18 @@ def test_geometric_feasibility(name):
               ball_diameter_mm=6.0, ball_count=20, ring_width_mm=8.0, row_spacing_mm=max(mb["row_spacing_mm"], 8.0))
     with pytest.raises(ConfigError, match="main_bearing.pitch_diameter_mm.*crank-hole circle"):
         from_dict(d)
+
+
+def test_design_report_load_sanity_warnings():
+    """Contact pressures above the ISO 76 static limits (4.2 GPa ball, 4.0 GPa line)
+    are flagged by name; the presets at their operating points are not."""
+    from flexrv.analysis.report import design_report
+    from flexrv.cli.design import load_sanity_warnings
+
+    fake = {"main_bearing": {"external": {"hertz_max_ball": {"inner_p_max_Pa": 4.3e9, "outer_p_max_Pa": 4.1e9}}},
+            "pin_loads": {"rated_torque": {"max_hertz_pressure_Pa": 4.05e9}}}
+    warnings = load_sanity_warnings(fake)
+    assert len(warnings) == 2
+    assert warnings[0].startswith("main_bearing.external.hertz_max_ball.inner_p_max_Pa = 4.3 GPa")
+    assert warnings[1].startswith("pin_loads.rated_torque.max_hertz_pressure_Pa = 4.05 GPa")
+    assert load_sanity_warnings(design_report(load("rv40e"))) == []

@@ -82,7 +82,42 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
                 f"flexrv design: the quasi-static ball loads are indeterminate in the clearance at this load "
                 f"({exc}); use a preload >= 0 for the design report (simulate models the clearance)") from None
         raise
-    emit(report, json, lambda rep: render_nested(f"Design report: {reducer.name}", rep))
+    warnings = load_sanity_warnings(report)
+    if warnings:
+        report["warnings"] = warnings
+
+    def render(rep):
+        render_nested(f"Design report: {reducer.name}", {k: v for k, v in rep.items() if k != "warnings"})
+        for message in rep.get("warnings", []):
+            console.print(f"warning: {message}", style="yellow")
+
+    emit(report, json, render)
+
+
+#: ISO 76:2006 static load rating: the contact pressure at the static rating is
+#: 4200 MPa for ball bearings and 4000 MPa for roller bearings (line contacts, also
+#: used here for the pin-disc contact). Above it the contact deforms permanently and
+#: the elastic (Hertz) results of the report no longer hold.
+ISO76_BALL_PA = 4.2e9
+ISO76_LINE_PA = 4.0e9
+
+
+def load_sanity_warnings(report: dict, prefix: str = "") -> list[str]:
+    """Warnings for every contact pressure of the design report above the ISO 76
+    static limit (ball contacts: keys ``*_p_max_Pa``; line contacts: ``max_hertz_pressure_Pa``)."""
+    out = []
+    for key, value in report.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out += load_sanity_warnings(value, f"{path}.")
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            limit = ISO76_BALL_PA if key.endswith("_p_max_Pa") else ISO76_LINE_PA if key.endswith(
+                "max_hertz_pressure_Pa") else None
+            if limit is not None and value > limit:
+                out.append(f"{path} = {value / 1e9:.3g} GPa exceeds the ISO 76 static limit {limit / 1e9:g} GPa: "
+                           "the contact yields, the elastic (Hertz) results do not hold; check the loads "
+                           "(operating.*) and the contact geometry")
+    return out
 
 
 def check_design_report_range(reducer) -> None:
