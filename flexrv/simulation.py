@@ -375,7 +375,7 @@ class _Checkpointer:
             res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=self.meta["dt"], status="running",
                                       timing=self.sim.timing)
             save_partial(res, self.directory)
-        except OSError as exc:  # a full disk must not kill the run; the next checkpoint tries again
+        except Exception as exc:  # a full disk (or any save error) must not kill the run; the next one retries
             import warnings
 
             warnings.warn(f"checkpoint to {self.directory} failed: {exc}", RuntimeWarning, stacklevel=2)
