@@ -16,6 +16,7 @@ def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
                                       help="Flexible parts, comma-separated: main_bearing, crankshaft."),
             dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
             out: Path = typer.Option(None, "--out", help="Output directory (default results/<preset>_compare_<time>/)."),
+            overwrite: bool = typer.Option(False, "--overwrite", help="Allow an existing non-empty --out directory."),
             json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Run the rigid and the flexible model on identical inputs: TE overlay, TE spectra with the
     characteristic frequencies, ball loads, ring deflection, summary.md and compare.json."""
@@ -23,6 +24,10 @@ def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
     from flexrv.post.compare import run_compare
 
     part_list = parse_parts(parts)
+    if out is not None:
+        from flexrv.cli._common import check_output_dir
+
+        check_output_dir(out, "--out", overwrite=overwrite)
     cmp = run_compare(preset, t_end=t_end, parts=part_list, out_dir=out, dt=dt, progress=not json)
     nr, nf = cmp.numbers["rigid"], cmp.numbers["flexible"]
     data = {"output_dir": str(cmp.out_dir), "parts": list(part_list), "rigid": nr, "flexible": nf,

@@ -47,6 +47,10 @@ def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_
              out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default: results/NAME)."),
              json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Run a seed-study workflow: seed-vs-flexrv table, NetCDF, PNGs and summary.md."""
+    if out is not None:  # a workflow regenerates its folder: existing content is expected
+        from flexrv.cli._common import check_output_dir
+
+        check_output_dir(out, "--out", allow_existing=True)
     mod = _import(f"workflows.{name.value}")
     res = mod.run(out_dir=out, smoke=smoke)
     data = {"workflow": name.value, "out_dir": str(res.out_dir), "numbers": res.numbers,
