@@ -29,7 +29,7 @@ def _f(x) -> float:
 
 
 def _kinematics(reducer) -> dict:
-    from flexrv.geometry.kinematics import reducer_kinematics
+    from flexrv.geometry.kinematics import FREQUENCY_NAMES, reducer_kinematics
 
     kin = reducer_kinematics(reducer)
     s, f = kin.speeds, kin.frequencies
@@ -38,8 +38,8 @@ def _kinematics(reducer) -> dict:
     return {"ratio": s.ratio,
             "speeds_rad_s": speeds,
             "speeds_rpm": {k: v * RPM_PER_RAD_S for k, v in speeds.items()},
-            "frequencies_Hz": {k: _f(getattr(f, k)) for k in ("input", "crank_rotation", "carrier", "crank_absolute",
-                                                              "first_stage_mesh", "cycloid_mesh", "pin_passing")}}
+            # names and meanings: flexrv.geometry.kinematics.CharacteristicFrequencies
+            "frequencies_Hz": {k: _f(getattr(f, k)) for k in FREQUENCY_NAMES}}
 
 
 def _involute(reducer) -> dict:

@@ -44,7 +44,7 @@ class DimensionlessGroups:
     load_w : W = Q / (E' rx^2).
     moes_m : M = W (2U)^(-3/4) (Moes; 2U uses the sum speed u1 + u2).
     moes_l : L = G (2U)^(1/4).
-    ellipticity : k = 1.0339 (ry/rx)^0.636 (Hamrock & Brewe 1983 fit).
+    ellipticity : k = a/b, exact (elliptic integrals, :func:`ellipticity`); 1 for ry = rx.
     """
 
     speed_u: np.ndarray
@@ -55,11 +55,28 @@ class DimensionlessGroups:
     ellipticity: np.ndarray
 
 
+def ellipticity(rx, ry):
+    """Exact Hertz ellipticity k = a/b [-] of the contact of principal radii rx (along the
+    entrainment) and ry (across), from the complete elliptic integrals (one executor:
+    :func:`flexrv.contact.hertz.point_contact`, whose ellipticity does not depend on load or
+    modulus). k = 1 for a circular contact (ry = rx); k < 1 for rx > ry.
+
+    This is the k of the Hamrock–Dowson formulas: their own curve fit k ~ 1.0339 (ry/rx)^0.636
+    (:func:`ellipticity_approx`) gives 1.0339 for a circular contact, +1.0 % on h_c and +2.3 %
+    on h_min there (issue 17 (2)).
+    """
+    from flexrv.contact.hertz import point_contact
+
+    rx = np.asarray(rx, dtype=float)
+    ry = np.asarray(ry, dtype=float)
+    return np.asarray(point_contact(np.ones(np.broadcast(rx, ry).shape), rx, ry, 1.0).ellipticity, dtype=float)
+
+
 def ellipticity_approx(rx, ry):
     """Ellipticity k = a/b ~ 1.0339 (ry/rx)^0.636 (Hamrock & Brewe 1983; Hamrock 1994, eq. 17.17).
 
-    Within 3.4 % of the exact value for 1 <= ry/rx <= 30 (6 % at 100); :func:`flexrv.contact.hertz.point_contact`
-    gives the exact value.
+    Within 3.4 % of the exact value for 1 <= ry/rx <= 30 (6 % at 100), but 1.0339 instead of 1 for
+    a circular contact; flexrv uses the exact :func:`ellipticity` (kept for comparison only).
     """
     return 1.0339 * (np.asarray(ry, dtype=float) / np.asarray(rx, dtype=float)) ** 0.636
 
@@ -87,7 +104,7 @@ def dimensionless_groups(load, speed, rx, ry, e_eff, viscosity, pressure_viscosi
     g = alpha * e_eff
     w = load / (e_eff * rx**2)
     return DimensionlessGroups(speed_u=u, material_g=g, load_w=w, moes_m=w * (2.0 * u) ** -0.75,
-                               moes_l=g * (2.0 * u) ** 0.25, ellipticity=ellipticity_approx(rx, ry))
+                               moes_l=g * (2.0 * u) ** 0.25, ellipticity=ellipticity(rx, ry))
 
 
 def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, ellipticity=None):
@@ -106,7 +123,11 @@ def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, el
     load, speed, rx, ry, e_eff, viscosity, pressure_viscosity :
         as in :func:`dimensionless_groups`.
     ellipticity : array_like, optional
-        k = a/b; default the Hamrock–Brewe fit 1.0339 (ry/rx)^0.636.
+        k = a/b; default the exact Hertz ellipticity (:func:`ellipticity`; k = 1 for ry = rx).
+        Hamrock & Dowson evaluate k from a curve fit, 1.03 (ry/rx)^0.64, which is 1.03 instead
+        of 1 for a circular contact; with the exact k the circular films are
+        h_c = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^-0.73) rx and
+        h_min = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^-0.68) rx (tests/test_ehl_film.py).
 
     Returns
     -------
