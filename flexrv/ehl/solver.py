@@ -1,13 +1,12 @@
 """Steady isothermal EHL of an elliptical point contact (numerical solution).
 
-Model (Hamrock 1994, ch. 22; Venner & Lubrecht, *Multilevel Methods in
-Lubrication*, 2000, ch. 9; seeds 000/001):
+Model (:cite:`hamrock1994`, ch. 22; :cite:`venner2000`, ch. 9; :cite:`seed000,seed001`):
 
 * Reynolds:  d/dx(rho h^3/(12 eta) dp/dx) + d/dy(rho h^3/(12 eta) dp/dy) = u d(rho h)/dx,
   u = mean entrainment speed (u1 + u2)/2, cavitation by p >= 0 (Reynolds
   condition, written as the complementarity problem p >= 0, R(p) <= 0, p R = 0);
-* Roelands viscosity eta = eta0 exp{(ln eta0 + 9.67)[(1 + p/p0)^z - 1]};
-* Dowson–Higginson density rho = rho0 (1 + a p / (1 + b p));
+* Roelands viscosity :cite:`roelands1966` eta = eta0 exp{(ln eta0 + 9.67)[(1 + p/p0)^z - 1]};
+* Dowson–Higginson density :cite:`dowson1966` rho = rho0 (1 + a p / (1 + b p));
 * film h = h0 + x^2/(2 rx) + y^2/(2 ry) + (2/(pi E')) iint p / r  (Boussinesq);
 * load balance iint p dx dy = Q, closed by the rigid approach h0.
 
@@ -21,10 +20,10 @@ rho_ = rho/rho0, eta_ = eta/eta0:
 
 Discretisation: node-centred finite differences on a uniform grid, second-order
 central Poiseuille terms; wedge term d(rho H)/dX by second-order upwind
-("second-order upstream", 1.5 f_i - 2 f_(i-1) + 0.5 f_(i-2); Venner & Lubrecht 2000,
+("second-order upstream", 1.5 f_i - 2 f_(i-1) + 0.5 f_(i-2); :cite:`venner2000`,
 sec. 9.3) on grids >= 129^2, first-order upwind below (``wedge_order``); the elastic
 deformation uses exact influence coefficients of piecewise-constant pressure on
-each (dx x dy) cell (Love's rectangle solution) and is evaluated by a zero-padded
+each (dx x dy) cell (Love's rectangle solution, :cite:`love1929`) and is evaluated by a zero-padded
 (linear, non-periodic) FFT convolution, O(N log N).
 
 Reported central film (grids >= 129^2): Richardson extrapolation of order 2 from the
@@ -70,7 +69,7 @@ coupled unknowns (P, H0):
   the H0 column and the load row are added by a Schur complement (two LU solves);
   the LU is reused while GMRES needs few iterations and the active set is unchanged;
   it is factorised in single precision in a geometric nested-dissection order
-  (George 1973) with separators as wide as the stencil (2.4x faster than COLAMD);
+  (:cite:`george1973`) with separators as wide as the stencil (2.4x faster than COLAMD);
 * symmetry: rolling along x with no spin makes the problem symmetric about Y = 0; the
   unknowns are the half Y >= 0 (the residual is evaluated on the full grid from the
   mirror image, the preconditioner's columns of mirrored nodes are folded), which halves
@@ -167,14 +166,14 @@ class LubricantProperties:
     @property
     def roelands_alpha(self) -> float:
         """Pressure-viscosity coefficient of the Roelands law at p -> 0 [1/Pa]:
-        d ln(eta)/dp = z (ln eta0 + 9.67)/p0 (Roelands 1966; the alpha with which Venner &
-        Lubrecht 2000 and Nijenbanning, Venner & Moes 1994 define L). It differs from the Barus
+        d ln(eta)/dp = z (ln eta0 + 9.67)/p0 (:cite:`roelands1966`; the alpha with which
+        :cite:`venner2000` and :cite:`nijenbanning1994` define L). It differs from the Barus
         ``pressure_viscosity`` when the two are estimated separately (rv221/rv40e oil:
         26.5/GPa against 20/GPa)."""
         return self.roelands_z * (math.log(self.viscosity) + 9.67) / self.roelands_p0
 
     def roelands_viscosity_ratio(self, p):
-        """eta/eta0 = exp{(ln eta0 + 9.67)[(1 + p/p0)^z - 1]} (Roelands 1966), p [Pa] >= 0.
+        """eta/eta0 = exp{(ln eta0 + 9.67)[(1 + p/p0)^z - 1]} (:cite:`roelands1966`), p [Pa] >= 0.
 
         Overflows to inf at extreme pressures, which the solver reads as eps = 0 (no
         pressure flow), the correct limit."""
@@ -183,7 +182,7 @@ class LubricantProperties:
                           * ((1.0 + p / self.roelands_p0) ** self.roelands_z - 1.0))
 
     def density_ratio(self, p):
-        """rho/rho0 = 1 + a p/(1 + b p) (Dowson & Higginson 1966)."""
+        """rho/rho0 = 1 + a p/(1 + b p) (:cite:`dowson1966`)."""
         return 1.0 + self.dh_a * p / (1.0 + self.dh_b * p)
 
     def density_ratio_derivative(self, p):
@@ -270,8 +269,8 @@ def influence_kernel(nx: int, ny: int, dx: float, dy: float):
     both bodies, E' = 1 Pa) at offset (k dx, l dy) from a cell of uniform unit pressure
     of size dx x dy, k in [-(nx-1), nx-1], l in [-(ny-1), ny-1].
 
-    w = (2/(pi E')) iint p/r ds dt (Johnson 1985, eq. 3.96 with E' = 2E*),
-    rectangle integral of Love (1929): sum over the four corners of
+    w = (2/(pi E')) iint p/r ds dt (:cite:`johnson1985`, eq. 3.96 with E' = 2E*),
+    rectangle integral of Love :cite:`love1929`: sum over the four corners of
     u asinh(v/|u|) + v asinh(u/|v|).
     """
     k = np.arange(-(nx - 1), nx)[:, None] * dx
@@ -583,7 +582,7 @@ class _PermutedLU:
 def _nested_dissection(ni, nj, wx, wy, leaf=64):
     """Geometric nested-dissection order of an ni x nj node grid (row-major index i*nj + j):
     split the longer side (in units of its separator width) by a separator of wx rows
-    (or wy columns), order both halves recursively, the separator last (George 1973).
+    (or wy columns), order both halves recursively, the separator last (:cite:`george1973`).
     Returns the permutation new -> old index (int64)."""
     out = []
 
@@ -613,7 +612,7 @@ def _nested_dissection(ni, nj, wx, wy, leaf=64):
 
 
 def _gmres_right(matvec, prec, b, rtol, max_iter):
-    """Right-preconditioned GMRES without restart (Saad 2003, alg. 9.5), classical
+    """Right-preconditioned GMRES without restart (:cite:`saad2003`, alg. 9.5), classical
     Gram–Schmidt with one re-orthogonalisation done as matrix–vector products.
 
     Solves A x = b to ||b - A x|| <= rtol ||b|| (true residual, because the
@@ -717,7 +716,7 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
     coarsest : first grid of the continuation.
     coarse_tol : residual target on the coarser grids of the continuation.
     wedge_order : 1 (first-order upwind) or 2 (second-order upwind, "second-order upstream" of
-        Venner & Lubrecht 2000, sec. 9.3) for d(rho H)/dX; default (None): 2 for grid >= 129,
+        :cite:`venner2000`, sec. 9.3) for d(rho H)/dX; default (None): 2 for grid >= 129,
         1 below (the second-order scheme closes the film on grids coarser than ~65^2 at M > ~200).
     grid_tol : adaptive grid: refine (one more level of the continuation, up to ``max_grid``)
         until the reported h_c and h_min both change by less than this fraction from the values

@@ -1,13 +1,13 @@
 """Kinematics of the RV reducer (two-stage: involute planetary + cycloid-pin).
 
-Arrangement (as in seeds 000-004): the input shaft carries the sun (z_s); each of
+Arrangement (as in :cite:`seed000,seed001,seed002,seed003,seed004`): the input shaft carries the sun (z_s); each of
 the n planets (z_p) is fixed to a crankshaft borne in the carrier; the cranks'
 eccentrics (eccentricity a) drive the cycloid discs (z_c teeth) inside the fixed
 pin housing (z_rp pins); the carrier is the output. Angular speeds are signed
 (same positive sense for all members), SI [rad/s]; frequencies in Hz.
 
-Derivation (Willis' equation for each stage, e.g. Müller, *Epicyclic Drive
-Trains* (1982); Blagojevic et al., Mech. Mach. Theory 2011 for the RV drive):
+Derivation (Willis' equation for each stage, e.g. :cite:`muller1982`;
+:cite:`blagojevic2011` for the RV drive):
 
 * first stage, relative to the carrier H:
   w_crank - w_H = -(z_s / z_p)(w_in - w_H);
@@ -31,7 +31,7 @@ from flexrv.units import TWO_PI
 
 
 def total_ratio(z_s, z_p, z_c, z_rp):
-    """Total ratio i = w_in / w_out = 1 + z_p z_rp / (z_s (z_rp - z_c)) (seeds 000/001).
+    """Total ratio i = w_in / w_out = 1 + z_p z_rp / (z_s (z_rp - z_c)) (:cite:`seed000,seed001`).
 
     Parameters
     ----------
@@ -53,8 +53,8 @@ class MemberSpeeds:
     input : input shaft = sun.
     sun_relative : sun relative to the carrier, w_in - w_H.
     carrier : carrier = output.
-    crank_absolute : planet = crankshaft, absolute (seed 002's "585 r/min").
-    crank_relative : planet = crankshaft relative to the carrier (seed 002's 10 Hz).
+    crank_absolute : planet = crankshaft, absolute (:cite:`seed002`'s "585 r/min").
+    crank_relative : planet = crankshaft relative to the carrier (:cite:`seed002`'s 10 Hz).
     disc_rotation : cycloid disc spin, absolute (= carrier).
     disc_orbit : angular speed of the disc centre about the reducer axis
         (= crank_absolute: all eccentrics are parallel).
@@ -96,7 +96,7 @@ class CharacteristicFrequencies:
     crank (eccentric, disc-centre orbit) speed, and z_c (w_H - w_e) = -z_rp w_e (Willis, module
     docstring):
 
-    input : input shaft rotation |w_in|/2pi (seed 002 Table 4: 20.25 Hz).
+    input : input shaft rotation |w_in|/2pi (:cite:`seed002` Table 4: 20.25 Hz).
     crank_rotation : crank rotation relative to the carrier |w_rel|/2pi (Table 4: 10 Hz).
     carrier : carrier (output) rotation = crank revolution |w_H|/2pi (Table 4: 0.25 Hz).
     crank_absolute : crank rotation in the housing frame |w_e|/2pi.
@@ -110,7 +110,7 @@ class CharacteristicFrequencies:
     disc_tooth_pin_passing : pins passed by one disc tooth, z_rp |w_H| / 2pi = (z_rp - z_c)
         |w_rel| / 2pi (the disc turns past the fixed pins with the carrier; 10 Hz for RV-40E).
     pins_x_crank_rotation : z_rp |w_rel| / 2pi, the pin count times the crank rotation relative
-        to the carrier: seed 002 Table 4's "cycloidal gear" and "pin gear" 400 Hz. It is not a
+        to the carrier: :cite:`seed002` Table 4's "cycloidal gear" and "pin gear" 400 Hz. It is not a
         mesh frequency of the RV arrangement (that is ``cycloid_mesh``, 10 Hz lower for RV-40E)
         and no TE line is expected there; kept to reproduce the seed's table. (Named
         ``pin_passing`` before; its docstring "pins passed by one disc tooth" described
@@ -134,7 +134,7 @@ FREQUENCY_NAMES = ("input", "crank_rotation", "carrier", "crank_absolute", "firs
 
 def characteristic_frequencies(input_speed, z_s: int, z_p: int, z_c: int, z_rp: int) -> CharacteristicFrequencies:
     """Characteristic frequencies [Hz] for an input speed [rad/s] (see
-    :class:`CharacteristicFrequencies`). For the RV-40E at 1215 r/min, seed 002 Table 4 lists
+    :class:`CharacteristicFrequencies`). For the RV-40E at 1215 r/min, :cite:`seed002` Table 4 lists
     20.25 (input), 10 (crank rotation), 0.25 (carrier), 320 (first-stage mesh), 390
     (cycloid mesh) and 400 Hz (``pins_x_crank_rotation``)."""
     s = member_speeds(input_speed, z_s, z_p, z_c, z_rp)
