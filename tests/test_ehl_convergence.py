@@ -73,7 +73,8 @@ def test_default_solve_is_grid_converged(case):
     coarse = solve(case, (fine.grid - 1) // 2 + 1, refine=False)
     change = abs(fine.h_central / coarse.h_central - 1.0)
     assert change < 0.02
-    assert change == pytest.approx(fine.grid_change, abs=2e-3)
+    assert change == pytest.approx(fine.grid_change_central, abs=2e-3)
+    assert fine.grid_change == max(fine.grid_change_central, fine.grid_change_min)
     assert fine.load_error < 1e-3 and coarse.load_error < 1e-3
     hd, _ = hamrock_dowson(q, u, rx, ry, e, lub.viscosity, lub.pressure_viscosity)
     assert abs(fine.h_central / hd - 1.0) < 0.08
@@ -177,16 +178,27 @@ def test_incompressible_film_vs_nvm_with_roelands_alpha(case, measured):
 @pytest.mark.parametrize("moes_m", [10.0, 50.0, 200.0, 1000.0])
 def test_robust_over_the_ehl_map(moes_m, moes_l, ratio):
     """Robustness sweep, M = 10-1000, L = 5-20, ry/rx = 1-20 (36 cases; speed and load chosen
-    from L = G (2U)^(1/4), M = W (2U)^(-3/4)): the default solve converges and meets the 2 %
-    grid tolerance everywhere (measured 0.0-1.7 %, stopping at 129^2 to 513^2, 0.2-13 s);
+    from L = G (2U)^(1/4), M = W (2U)^(-3/4)): the default solve converges and h_c meets the 2 %
+    grid tolerance everywhere (measured 0.0-1.7 %, stopping at 129^2 to 513^2, 0.2-19 s); h_min
+    meets it everywhere except at M = 1000, L = 10, circular (6.5 % at 513^2, flagged);
     h_c within 12 % of Hamrock-Dowson for M >= 50 (measured 0.90-1.10; at M = 10 it
     reads 0.76-0.98, outside the formula's piezoviscous-elastic range)."""
     lub, e, rx = LUB, E, 0.01
     two_u = (moes_l / (lub.pressure_viscosity * e)) ** 4
     u = two_u / 2.0 * e * rx / lub.viscosity
     q = moes_m * two_u**0.75 * e * rx**2
-    res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
-    assert res.grid_converged and res.grid_change < 0.02 and res.load_error < 1e-3
+    if (moes_m, moes_l, ratio) == (1000.0, 10.0, 1.0):
+        # the one case where h_min is not grid-converged at 513^2: it changes by 6.5 % from the
+        # 257^2 value (narrow side lobes of a heavily loaded circular contact), h_c by 0.9 %;
+        # reported as not converged, with a warning naming both changes
+        with pytest.warns(RuntimeWarning, match="h_min by 6"):
+            res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
+        assert not res.grid_converged and res.grid == 513
+        assert res.grid_change_central < 0.02 and 0.04 < res.grid_change_min < 0.09
+    else:
+        res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
+        assert res.grid_converged and res.grid_change < 0.02
+    assert res.load_error < 1e-3
     if moes_m >= 50:
         hd, _ = hamrock_dowson(q, u, rx, ratio * rx, e, lub.viscosity, lub.pressure_viscosity)
         assert abs(res.h_central / hd - 1.0) < 0.12
