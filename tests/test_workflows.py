@@ -53,7 +53,7 @@ def test_kinematic_validation(kinematic):
     assert n["rv40e"]["ratio_theory"] == pytest.approx(81.0, rel=1e-12)
     assert abs(n["rv40e"]["ratio_simulated"] / n["rv40e"]["ratio_theory"] - 1) < 5e-4
     seed = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
-            "cycloid_mesh": 390.0, "pin_passing": 400.0}
+            "cycloid_mesh": 390.0, "pins_x_crank_rotation": 400.0}
     for key, val in seed.items():
         assert n["rv40e_frequencies_hz"][key] == pytest.approx(val, rel=1e-9), key
     planet = n["rv221_planet_deg_s"]

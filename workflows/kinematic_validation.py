@@ -110,7 +110,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
     r.compare("RV-40E crank speed, relative", "r/min", 600.0, abs(float(s40.crank_relative)) * RPM_PER_RAD_S, "= 10 Hz")
     r.compare("RV-40E output speed", "r/min", 15.0, abs(float(s40.carrier)) * RPM_PER_RAD_S, "1215/81")
     seed_f = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
-              "cycloid_mesh": 390.0, "pin_passing": 400.0}
+              "cycloid_mesh": 390.0, "pins_x_crank_rotation": 400.0}
     freqs = {}
     for key, val in seed_f.items():
         got = float(getattr(f40, key))

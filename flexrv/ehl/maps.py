@@ -32,7 +32,10 @@ from flexrv.ehl.solver import LubricantProperties, solve_point_contact
 from flexrv.errors import ConvergenceError, InputError
 
 #: Bump when the solver or the map layout changes (part of the cache key).
-MAP_SCHEMA = 3  # 3: fixed map grid (no adaptive refinement), half-domain solver; 2: second-order + Richardson
+#: 4: the maps store the ratio to Hamrock–Dowson, whose ellipticity is now the exact Hertz k
+#: (1.0 for circular contacts); 3: fixed map grid (no adaptive refinement), half-domain solver;
+#: 2: second-order + Richardson
+MAP_SCHEMA = 4
 
 
 @dataclass(frozen=True)
