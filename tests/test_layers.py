@@ -33,6 +33,8 @@ ALLOWED_UPWARD = {
         "design validation checks profile feasibility (undercut) with the cycloid geometry",
     ("flexrv.design.model", "flexrv.geometry.involute"):
         "design validation checks the involute contact ratio with the gear geometry",
+    ("flexrv.design.manufacturing", "flexrv.geometry.as_built"):
+        "design validation rejects an error set whose as-built parts interfere at assembly",
     ("flexrv.post.compare", "flexrv.simulation"):
         "compare builds and runs simulations: orchestration belongs above simulation (issue 16)",
     ("flexrv.post.compare", "flexrv.viz.compare_plots"):
