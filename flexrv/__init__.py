@@ -6,7 +6,7 @@ Pipeline: design (validated presets) -> geometry -> meshing -> fem/cms -> contac
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from flexrv._version import __version__  # noqa: F401
 
 #: Layer order of the package, lowest first: a module may import from its own layer and the
 #: layers below it, never from a layer above (tests/test_layers.py checks every import,
@@ -14,7 +14,7 @@ __version__ = "0.1.0"
 #: top-level modules or subpackages of ``flexrv`` in that layer; the package root
 #: (``flexrv/__init__.py``, a facade) and ``flexrv/__main__.py`` (-> cli) are outside the order.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("units", "errors", "cache", "references"),  # base utilities, no flexrv imports
+    ("units", "errors", "cache", "references", "_version"),  # base utilities, no flexrv imports
     ("design",),  # validated design model and presets
     ("geometry",),  # kinematics, involute, cycloid and bearing geometry
     ("contact",),  # contact laws (Hertz, EHL-corrected laws)

@@ -64,7 +64,7 @@ def _canonical(obj: Any) -> Any:
 
 def flexrv_version() -> str:
     """flexrv's own version (part of every cache key and sweep case id)."""
-    from flexrv import __version__
+    from flexrv._version import __version__
 
     return __version__
 

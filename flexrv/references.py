@@ -23,6 +23,8 @@ import re
 #: section title -> {key: citation (Markdown)}
 SECTIONS: dict[str, dict[str, str]] = {
     "Seed studies (texts in the project's seed collection; no authors, venue or year given)": {
+        "kelley1998ptc": "Kelley, C. T., Keyes, D. E. (1998). Convergence analysis of pseudo-transient "
+                         "continuation. *SIAM Journal on Numerical Analysis* 35(2), 508-523.",
         "seed000": "Seed study 000: transmission error of a rotary vector (RV) reducer with flexible, "
                    "lubricated main bearings: a multi-physics dynamic model coupling the elastic deformation "
                    "of the thin-walled angular-contact ball main bearings and their elastohydrodynamic (EHL) "
@@ -57,6 +59,9 @@ SECTIONS: dict[str, dict[str, str]] = {
                       "of Roller and Gear Lubrication*. Pergamon Press, Oxford.",
         "george1973": "George, A. (1973). Nested dissection of a regular finite element mesh. "
                       "*SIAM Journal on Numerical Analysis* 10(2), 345-363.",
+        "grippo1986nonmonotone": "Grippo, L., Lampariello, F., Lucidi, S. (1986). A nonmonotone line search "
+                                 "technique for Newton's method. *SIAM Journal on Numerical Analysis* 23(4), "
+                                 "707-716.",
         "guyan1965": "Guyan, R. J. (1965). Reduction of stiffness and mass matrices. *AIAA Journal* 3(2), 380.",
         "hamrock1977": "Hamrock, B. J., Dowson, D. (1977). Isothermal elastohydrodynamic lubrication of point "
                        "contacts, Part III: fully flooded results. *ASME Journal of Lubrication Technology* "

@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 from flexrv.analysis.pin_load import disc_effective_modulus, pin_load_distribution, reducer_pin_loads
 from flexrv.cli import app
 from flexrv.design import from_dict, load, loads, to_toml
-from flexrv.design.manufacturing import (ASSEMBLY_PENETRATION_LIMIT_UM, ManufacturingErrors, error_set_names,
-                                         load_error_set, with_errors)
+from flexrv.design import error_set_names, load_error_set, with_errors
+from flexrv.design.manufacturing import ASSEMBLY_PENETRATION_LIMIT_UM, ManufacturingErrors
 from flexrv.errors import ConfigError
 from flexrv.geometry.as_built import (as_built, as_built_pin_gap, assembly_disc_poses, assembly_penetration,
                                       profile_deviation)
@@ -340,7 +340,7 @@ def test_example_error_sets_load(name):
     of both discs read it."""
     from workflows._error_sets import iso_grade5_toml
 
-    from flexrv.design.manufacturing import error_set_path
+    from flexrv.design import error_set_path
 
     assert f"iso_grade5_{name}" in error_set_names()
     assert error_set_path(f"iso_grade5_{name}").read_text() == iso_grade5_toml(name)

@@ -75,7 +75,7 @@ def test_groups_match_reference(ref, name, needle):
 def test_fused_generalized_forces_match_reference(ref, name, needle):
     """AssembledModel.generalized_forces (ONE call of the fused compiled kernel)
     equals the sum of the reference groups' forces and Jacobians (1e-9 rel.)."""
-    from flexrv.model.base import group_index
+    from flexrv.model.assembled import group_index
 
     key = f"{name}-{needle}"
     m = build_model(_variant(name, needle), exudyn=False)
@@ -372,7 +372,7 @@ def test_fused_element_coexists_with_ball_bearing():
     the kernel groups' members (carrier, cranks, discs; no rigid main bearing) and
     generalized_forces = fused part scattered into the model vector + the ball
     group, equal to the sum of every group's evaluate/jacobian (1e-9 rel.)."""
-    from flexrv.model.base import group_index
+    from flexrv.model.assembled import group_index
 
     m = build_model(_variant("rv40e", "empirical"), "balls", exudyn=False)
     q, v = _loaded(m)

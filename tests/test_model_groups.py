@@ -136,7 +136,7 @@ def test_fused_force_element_matches_the_groups():
     residual at loaded states after a short run equals the sum of the groups' own
     evaluate() (same kernels on the group's local vectors) to round-off (1e-9 of
     the largest force; a mis-scattered coordinate block would differ at order 1)."""
-    from flexrv.model.base import group_index
+    from flexrv.model.assembled import group_index
     from flexrv.simulation import Simulation
 
     r = load("rv40e")

@@ -89,7 +89,7 @@ def iso_grade5_toml(preset: str, seed: int = 2026) -> str:
 # (numpy.random.default_rng({seed}), rounded to 0.01 um / 0.01 arcmin / 0.1 deg). Nothing is tuned
 # to any transmission-error target. Written by `python -m workflows._error_sets` (sources and
 # assumptions in its docstring). Load it with
-#     flexrv.design.manufacturing.with_errors("{preset}", load_error_set("iso_grade5_{preset}"))
+#     flexrv.design.with_errors("{preset}", load_error_set("iso_grade5_{preset}"))
 # ISO 1328-1:1995 grade 5 of the pin ring / disc teeth (m = 2 R_p / z_rp = {m_pin:.3g} mm, d = {d_pin:g} mm):
 #   f_pt = {g['f_pt']:.2f} um, F_p = {g['F_p']:.2f} um, f_falpha = {g['f_falpha']:.2f} um.
 

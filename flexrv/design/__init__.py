@@ -221,3 +221,52 @@ def format_validation_error(exc: ValidationError, source: str) -> str:
                 text += f" (allowed: {rng})"
             lines.append(text)
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- example error sets
+def error_set_names() -> list[str]:
+    """Names of the built-in example error sets (``flexrv/design/presets/errors/*.toml``)."""
+    from importlib import resources
+
+    folder = resources.files("flexrv.design.presets") / "errors"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def error_set_path(name: str):
+    """Path of a built-in example error set."""
+    from importlib import resources
+    from pathlib import Path
+
+    return Path(str(resources.files("flexrv.design.presets") / "errors" / f"{name}.toml"))
+
+
+def load_error_set(name_or_path: str) -> dict[str, Any]:
+    """The ``[errors]`` table of a built-in example error set (by name, see
+    :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
+    plain dict (validate it with :func:`with_errors`)."""
+    import tomllib
+    from pathlib import Path
+
+    text_name = str(name_or_path)
+    path = error_set_path(text_name) if text_name in error_set_names() else Path(text_name)
+    if not path.is_file():
+        raise ConfigError(f"unknown error set {text_name!r}: choose one of {error_set_names()} or give a TOML file")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"cannot read error set {str(path)!r}: {exc}") from None
+    if not isinstance(data.get("errors"), dict):
+        raise ConfigError(f"error set {str(path)!r} has no [errors] table")
+    return data["errors"]
+
+
+def with_errors(reducer, errors):
+    """A validated copy of a design (or preset name / path) whose ``[errors]``
+    table is replaced by ``errors``; every check applies (ConfigError naming the
+    field otherwise)."""
+    from flexrv.design.manufacturing import ManufacturingErrors
+
+    base = load(reducer)
+    data = base.model_dump()
+    data["errors"] = errors.model_dump() if isinstance(errors, ManufacturingErrors) else errors
+    return from_dict(data, source=f"{base.name} + errors")

@@ -17,17 +17,10 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from flexrv.design._base import _bad, _Strict
+
 from flexrv.units import RAD_PER_DEG
 
-
-
-class _Strict(BaseModel):
-    """Base: unknown fields and non-finite numbers are errors, values are frozen,
-    types are strict: a string (``"12.0"``) or a boolean (``true``) is never coerced
-    into a number, a float never into an integer; an integer is accepted for a float
-    field (TOML ``12`` for ``12.0``)."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True, validate_default=True, strict=True)
 
 
 #: allowed transverse contact ratio of the first stage: below 1 the mesh loses
@@ -35,14 +28,6 @@ class _Strict(BaseModel):
 #: (an RV first stage runs at 1.2-1.8). A mesh outside this range made ``simulate``
 #: fail at t = 0 instead of being refused here.
 CONTACT_RATIO_RANGE = (1.0, 2.5)
-
-
-def _bad(field: str, value, allowed: str, why: str = "") -> ValueError:
-    """Build the uniform cross-field error message."""
-    msg = f"{field} = {value!r} is not allowed: {allowed}"
-    if why:
-        msg += f" ({why})"
-    return ValueError(msg)
 
 
 # --------------------------------------------------------------------------- stages
@@ -392,7 +377,7 @@ class OperatingPoint(_Strict):
 
 
 # --------------------------------------------------------------------------- reducer
-from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402  (needs _Strict, defined above)
+from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
 
 
 class Reducer(_Strict):

@@ -9,8 +9,9 @@ crank supports, needle bearings, pins, rigid main bearing, loads) are
 model evaluates all of them in ONE compiled call from ONE ``ObjectGenericODE2``
 (:class:`flexrv.model.kernels.FusedForces`; issue 15: 95 % of a step was Python
 overhead with one numpy element per group). Other groups (ball-resolved bearing,
-flexible crank) keep one element each with a Python force function, optionally
-merged (``assemble(model, merge=True)``, :func:`add_merged`).
+flexible crank) keep one element each with a Python force function.
+The assembled model (:class:`flexrv.model.assembled.AssembledModel`) lives in its
+own module, above the kernels it calls.
 
 A group's ``evaluate(t, q, v)`` accepts one state (q of shape (n,), the solver
 path) or a whole time history (shape (T, n)), from which post-processing
@@ -125,15 +126,6 @@ class ForceGroup:
                                                forceUserFunction=force_fn, **kwargs))
 
     @property
-    def mergeable(self) -> bool:
-        """True if the group can share a merged Python element
-        (:func:`add_merged`): default Exudyn glue and an analytic Jacobian. The
-        merged element's Jacobian is dense over ALL member coordinates, so a
-        model with many coordinates (e.g. modal ring members) should override
-        this to False for its groups or assemble with ``merge=False``."""
-        return type(self).add_to is ForceGroup.add_to and self.analytic_jacobian
-
-    @property
     def stats(self) -> list[int]:
         """[force calls, jacobian calls] (mutable counters)."""
         if not hasattr(self, "_stats"):
@@ -233,126 +225,3 @@ class KernelGroup(ForceGroup):
         dq, dv = np.zeros((n, n)), np.zeros((n, n))
         self.run(float(t), q, v, f, dq, dv, True, self.pack(np.arange(n, dtype=np.int64)))
         return dq, dv
-
-
-@dataclass
-class AssembledModel:
-    """A model ready to simulate: Exudyn system, members, groups, drive."""
-
-    name: str
-    reducer: object
-    params: object
-    members: dict[str, Member]
-    groups: list[ForceGroup]
-    input_angle: Callable  #: theta_in(t) [rad], vectorised
-    input_speed: Callable  #: omega_in(t) [rad/s]
-    load_torque: Callable  #: T_load(t) [N m] acting against the output rotation
-    mbs: object = None
-    sc: object = None
-    n: int = 0
-    info: dict = field(default_factory=dict)
-    #: the fused compiled element of the kernel groups (:class:`flexrv.model.kernels.FusedForces`)
-    fused: object = None
-
-    def slice(self, member: str) -> slice:
-        m = self.members[member]
-        return slice(m.offset, m.offset + m.n)
-
-    def group_state(self, group: ForceGroup, q: np.ndarray) -> np.ndarray:
-        """Local coordinates of ``group`` from full states (..., n_total)."""
-        return np.concatenate([q[..., self.slice(name)] for name in group.members], axis=-1)
-
-    @property
-    def q0(self) -> np.ndarray:
-        return np.concatenate([m.q0 for m in self.members.values()])
-
-    def generalized_forces(self, t, q: np.ndarray, v: np.ndarray, jacobian: bool = True):
-        """Sum of every group's generalized force at one state, and its Jacobians.
-
-        Returns ``(f, dfdq, dfdv)`` with f of shape (n,) and the Jacobians (n, n)
-        (``None`` if ``jacobian`` is False). The compiled groups run in ONE call of
-        the fused kernel (:class:`flexrv.model.kernels.FusedForces`, the same as the
-        Exudyn element); other groups (ball bearing, flexible crank) add their own
-        evaluate/jacobian. Every call is an exact evaluation, so a static solver
-        can iterate on it. BLAS is pinned to one thread
-        (:func:`flexrv.model.kernels.single_thread_blas`) around the numpy work of
-        the other groups.
-        """
-        from flexrv.model.kernels import FusedForces
-
-        n = self.n
-        fused = self.fused
-        if fused is None:
-            fused = self.fused = FusedForces(self)
-        q = np.ascontiguousarray(q, dtype=float)
-        v = np.ascontiguousarray(v, dtype=float)
-        f, dq, dv = fused.full(t, q, v, jacobian)
-        others = fused.others
-        if others:
-            from flexrv.model.kernels import single_thread_blas
-
-            with single_thread_blas():
-                for g in others:
-                    idx = group_index([self.members[m].offset for m in g.members],
-                                      [self.members[m].n for m in g.members])
-                    g.new_step()
-                    qg, vg = q[idx], v[idx]
-                    fg, _ = g.evaluate(t, qg, vg)
-                    f[idx] += fg
-                    if jacobian:
-                        jq, jv = g.jacobian(t, qg, vg)
-                        ix = np.ix_(np.arange(n)[idx], np.arange(n)[idx])
-                        dq[ix] += jq
-                        dv[ix] += jv
-        return f, dq, dv
-
-
-def group_index(offsets: list[int], sizes: list[int]):
-    """Indices of a group's local vector in a state vector: a slice if the
-    members are contiguous and in order, else an integer array."""
-    idx = np.concatenate([np.arange(o, o + n) for o, n in zip(offsets, sizes)])
-    if len(idx) and np.all(np.diff(idx) == 1):
-        return slice(int(idx[0]), int(idx[-1]) + 1)
-    return idx
-
-
-def add_merged(mbs, groups: list[ForceGroup], nodes: list[int], index: list, n: int) -> int:
-    """Add ONE ``ObjectGenericODE2`` over ``nodes`` whose force and Jacobian user
-    functions evaluate every group of ``groups`` and sum their contributions.
-
-    One Python call per residual instead of one per group: Exudyn's per-call cost
-    (argument lists, ``np.asarray``) is paid once. ``index[i]`` selects group i's
-    local coordinates in the merged vector of ``n`` coordinates (the nodes'
-    coordinates in order, see :func:`group_index`). Each group keeps
-    its own :meth:`ForceGroup.evaluate` kernel, outputs and call counters, so the
-    sum is the same generalized force as with one element per group.
-    """
-    from exudyn.itemInterface import ObjectGenericODE2
-
-    parts = [(g, ix, isinstance(ix, slice)) for g, ix in zip(groups, index)]
-
-    def force_fn(mbs_, t, item, q, q_t):
-        q = np.asarray(q)
-        v = np.asarray(q_t)
-        f = np.zeros(n)
-        for g, ix, _ in parts:
-            g.stats[0] += 1
-            fg, _ = g.evaluate(t, q[ix], v[ix])
-            f[ix] += fg
-        return f
-
-    def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-        q = np.asarray(q)
-        v = np.asarray(q_t)
-        jac = np.zeros((n, n))
-        for g, ix, is_slice in parts:
-            g.stats[1] += 1
-            dq, dv = g.jacobian(t, q[ix], v[ix])
-            if is_slice:
-                jac[ix, ix] -= f_q * dq + f_v * dv
-            else:
-                jac[np.ix_(ix, ix)] -= f_q * dq + f_v * dv
-        return jac
-
-    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes,
-                                           forceUserFunction=force_fn, jacobianUserFunction=jac_fn))

@@ -6,7 +6,7 @@ loads — in ONE call of :func:`fused_kernel`, a numba function that calls the
 groups' own compiled kernels (the physics stays in the groups' modules: one
 formula, one executor) on the model's coordinate vector. It backs both the single
 Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
-:meth:`FusedForces.add_to`) and :meth:`flexrv.model.base.AssembledModel.generalized_forces`.
+:meth:`FusedForces.add_to`) and :meth:`flexrv.model.assembled.AssembledModel.generalized_forces`.
 Groups of other kinds (ball bearing, flexible crank) keep their own elements.
 
 Python work per call: Exudyn's argument lists to arrays (``np.asarray``), the

@@ -17,7 +17,7 @@ and main bearing, read from the same as-built parameters
 damping terms vanish, so this is the dynamic model's equilibrium manifold.
 
 Solver: Newton's method on R with the groups' analytic Jacobians
-(:meth:`flexrv.model.base.AssembledModel.generalized_forces`), globalised by
+(:meth:`flexrv.model.assembled.AssembledModel.generalized_forces`), globalised by
 pseudo-transient continuation (Kelley & Keyes 1998 :cite:`kelley1998ptc`): each
 step solves (s M - J) dq = R with the members' mass matrix M as the metric and
 s shrinking with the residual ("switched evolution relaxation", s_k = s_{k-1}
@@ -320,7 +320,7 @@ class StaticModel:
         C = e_theta . u = u . K u and group g's share is its strain energy
         u . K_g u / C. The shares sum to 1; for elements in series each share is the
         element's part of the total compliance (Castigliano)."""
-        from flexrv.model.base import group_index
+        from flexrv.model.assembled import group_index
 
         m = self.model
         k_total = np.zeros((self.n, self.n))
