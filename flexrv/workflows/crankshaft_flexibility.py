@@ -9,14 +9,14 @@ the first-stage mesh. flexrv runs :func:`flexrv.post.compare.run_compare` with t
 crankshafts flexible (:mod:`flexrv.model.flexible_crank`: FE-condensed torsion and
 gear-seat bending) and compares the spectra at the Table 4 frequencies.
 
-Run: ``python -m workflows.crankshaft_flexibility`` or ``flexrv workflow crankshaft_flexibility``.
+Run: ``python -m flexrv.workflows.crankshaft_flexibility`` or ``flexrv workflow crankshaft_flexibility``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "crankshaft_flexibility"
 PRESET = "rv40e"
@@ -43,17 +43,17 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     from flexrv.geometry.kinematics import reducer_kinematics
     from flexrv.post.compare import run_compare
     from flexrv.post.spectra import te_spectrum
-    from workflows._common import RESULTS_ROOT
+    from flexrv.workflows._common import default_out
 
     red = load(preset)
-    out = RESULTS_ROOT / NAME if out_dir is None else out_dir
+    out = default_out(NAME, smoke) if out_dir is None else out_dir
     t_end = (SMOKE["t_end"] if smoke else T_END) if t_end is None else t_end
     options = {"crank_options": SMOKE["crank_options"]} if smoke else None
     cmp = run_compare(red, t_end=t_end, parts=("crankshaft",), out_dir=out, flexible_options=options)
     kin = reducer_kinematics(red)
     cf = kin.frequencies
     r = WorkflowResult(NAME, f"Crankshaft flexibility and the TE spectrum ({red.name})",
-                       ["002 (RV-40E rigid-flexible coupling, Table 4, TE spectrum)"])
+                       ["002 (RV-40E rigid-flexible coupling, Table 4, TE spectrum)"], smoke=smoke)
     ours = {"input shaft": float(cf.input), "crank rotation": float(cf.crank_rotation),
             "carrier (crank revolution)": float(cf.carrier), "first-stage mesh": float(cf.first_stage_mesh),
             "cycloid mesh": float(cf.cycloid_mesh)}

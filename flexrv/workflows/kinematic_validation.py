@@ -1,7 +1,7 @@
 """Kinematic validation (seeds 000, 001, 002): rigid multibody runs of both presets
 against the closed-form kinematics of :mod:`flexrv.geometry.kinematics`.
 
-Run: ``python -m workflows.kinematic_validation`` or ``flexrv workflow kinematic_validation``.
+Run: ``python -m flexrv.workflows.kinematic_validation`` or ``flexrv workflow kinematic_validation``.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import numpy as np
 
 from flexrv.units import DEG_PER_RAD, RAD_PER_DEG, RAD_S_PER_RPM, RPM_PER_RAD_S
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "kinematic_validation"
 PRESETS = ("rv221", "rv40e")
@@ -60,7 +60,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         t_end = t_end or SMOKE["t_end"]
     presets = tuple(presets or PRESETS)
     r = WorkflowResult(NAME, "Kinematic validation: rigid multibody vs closed-form kinematics",
-                       ["000 (RV-221 Adams)", "001 (RV-221 planets)", "002 (RV-40E frequencies)"])
+                       ["000 (RV-221 Adams)", "001 (RV-221 planets)", "002 (RV-40E frequencies)"], smoke=smoke)
     sims = {}
     for p in presets:
         res, summ = _simulate(p, t_end, dt)

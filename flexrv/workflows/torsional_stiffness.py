@@ -3,14 +3,14 @@ torsional stiffness vs meshing phase, meshing-zone identification from the measu
 3.06e8 N mm/rad, pins in contact (analytic pin-load distribution and contact
 simulation) and the stiffness-test bench.
 
-Run: ``python -m workflows.torsional_stiffness`` or ``flexrv workflow torsional_stiffness``.
+Run: ``python -m flexrv.workflows.torsional_stiffness`` or ``flexrv workflow torsional_stiffness``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "torsional_stiffness"
 PRESET = "rv40e"
@@ -42,7 +42,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     red = load(preset)
     ss = red.second_stage
     t_rated = red.operating.rated_torque_Nm
-    r = WorkflowResult(NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"])
+    r = WorkflowResult(NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke)
 
     # ---- per-pin contributions
     th, ktc = seed004_pin_contributions(red)
