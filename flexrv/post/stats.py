@@ -107,8 +107,9 @@ def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01) -
         note = "power balance not available"
     elif abs(d) <= tol * scale:
         note = (f"power balance closes: P_in {p_in:.4g} W = P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W "
-                f"+ dissipation {d:.3g} W (|dissipation| <= {100 * tol:.0f} % of the power: the contacts are "
-                "nearly lossless in this model)")
+                f"+ remainder {d:.3g} W; the remainder is within {100 * tol:.0f} % of the power, the accuracy of "
+                "the window means (P_in uses the numerically differentiated input speed): the contact damping "
+                "dissipates less than that")
     elif d > 0:
         note = (f"power balance: P_in {p_in:.4g} W - P_out {p_out:.4g} W - dE_kin/dt {dke_dt:.3g} W = "
                 f"{d:.4g} W dissipated (contact damping), efficiency P_out/P_in = {p_out / p_in:.4f}"
