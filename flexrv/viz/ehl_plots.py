@@ -19,12 +19,24 @@ def plot_ehl_solution(result, path, title: str = "") -> Path:
     path : output PNG file (written atomically).
     title : optional figure title.
     """
+    import matplotlib.pyplot as plt
+
+    from flexrv.cache import atomic_path
+
+    fig = ehl_figure(result, title)
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
+
+
+def ehl_figure(result, title: str = ""):
+    """The matplotlib figure of :func:`plot_ehl_solution` (not saved)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from flexrv.cache import atomic_path
 
     x, y = result.x * 1e3, result.y * 1e3  # mm
     p, h = result.pressure * 1e-9, result.film * 1e6  # GPa, um
@@ -66,8 +78,4 @@ def plot_ehl_solution(result, path, title: str = "") -> Path:
     fig.suptitle(title or f"EHL: h_c = {result.h_central * 1e9:.1f} nm, h_min = {result.h_min * 1e9:.1f} nm, "
                  f"p_max = {result.p_max * 1e-9:.3f} GPa (p_H = {result.hertz_pressure * 1e-9:.3f} GPa)")
     fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
+    return fig

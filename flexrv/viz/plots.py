@@ -119,7 +119,7 @@ def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None
         if not (ax.get_xlim()[0] <= f0 <= ax.get_xlim()[1]):
             continue
         ax.axvline(f0, ls="--", lw=0.6, color="0.5")
-        level = sum(1 for p in placed if abs(p - f0) < 0.06 * span)  # stagger close labels
+        level = sum(1 for p in placed if f0 - p < 0.25 * span)  # stagger: a label is ~1/4 of the axis wide
         placed.append(f0)
         ax.annotate(f"{FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz", (f0, y_top),
                     xytext=(3, -4 - 11 * level), textcoords="offset points", rotation=0, va="top", ha="left",
