@@ -115,14 +115,20 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                                            "amplitude_flexible": ("frequency_flexible", a_f)},
                                           coords={"frequency_rigid": f_r, "frequency_flexible": f_f})
     fig, ax = new_figure(figsize=(10, 4))
+    top = max([float(a[1:].max()) for a in (a_r, a_f) if len(a) > 1] or [1.0])
+    floor = top * 1e-4  # four decades below the largest line: the meaningful range
     if len(f_r) > 1:
-        ax.semilogy(f_r[1:], np.maximum(a_r[1:], 1e-9), lw=0.8, label="rigid")
+        ax.semilogy(f_r[1:], np.maximum(a_r[1:], floor), lw=0.8, label="rigid")
     if len(f_f) > 1:
-        ax.semilogy(f_f[1:], np.maximum(a_f[1:], 1e-9), lw=0.8, label="flexible crankshafts")
+        ax.semilogy(f_f[1:], np.maximum(a_f[1:], floor), lw=0.8, label="flexible crankshafts")
+    ax.set_ylim(floor, 3 * top)
     for label, f0 in lines:
         ax.axvline(f0, ls="--", lw=0.6, color="0.4")
         ax.text(f0, 1.0, f" {label}", rotation=90, va="top", fontsize=7, transform=ax.get_xaxis_transform())
     ax.set_xlim(0, 1.3 * max(cf.cycloid_mesh, 2 * cf.first_stage_mesh))
+    window = float(np.diff(cmp.rigid.steady_window())[0])
+    ax.set_title(f"TE spectra: steady window {window:.3g} s, resolution "
+                 f"{(f_r[1] - f_r[0]) if len(f_r) > 1 else float('nan'):.3g} Hz (Hann)", fontsize=9)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("TE amplitude [arcsec]")
     ax.legend(loc="lower left")

@@ -125,7 +125,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                    label="flexrv (TE mean, min..max)")
     ax[0].axhline(film_rows[0]["TE mean [arcsec]"], color="k", ls=":", label="dry Hertz")
     ax[0].set_xscale("log")
-    ax[0].set_xlabel("minimum central film h_c [um]")
+    ax[0].set_xlabel("minimum central film h_c [µm]")
     ax[0].set_ylabel("TE [arcsec]")
     ax[0].legend(fontsize=8)
     ax[1].errorbar([row["max contact pressure [GPa]"] for row in pressure_rows],

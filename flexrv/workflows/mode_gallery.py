@@ -67,7 +67,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
     fig, ax = new_figure(figsize=(8, 3.5))
     for j, c in enumerate(freq):
         ax.plot(np.arange(1, n_modes + 1), freq[c], "o-", label=c)
-    ax.set_xlabel("mode"), ax.set_ylabel("free-free frequency [Hz]"), ax.set_yscale("log"), ax.legend(fontsize=7)
+    ax.set_xlabel("mode number"), ax.set_ylabel("free-free frequency [Hz]"), ax.set_yscale("log"), ax.legend(fontsize=7)
+    ax.set_xticks(np.arange(1, n_modes + 1))  # whole mode numbers only
     fig.tight_layout()
     r.figures["frequencies"] = fig
     r.save(out)
