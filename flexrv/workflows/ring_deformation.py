@@ -121,8 +121,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     r.datasets["ring_deformation"] = ds
     fig, ax = new_figure(1, 2, figsize=(11, 4))
     x = np.arange(len(rows))
-    ax[0].bar(x - 0.2, [row["outer ring deflection [µm]"] for row in rows], 0.4, label="flexrv outer ring")
-    ax[0].bar(x + 0.2, [row["seed deformation [µm]"] or 0.0 for row in rows], 0.4, label="seed 001")
+    ax[0].bar(x - 0.2, [row["outer ring deflection [um]"] for row in rows], 0.4, label="flexrv outer ring")
+    ax[0].bar(x + 0.2, [row["seed deformation [um]"] or 0.0 for row in rows], 0.4, label="seed 001")
     ax[0].set_xticks(x, [f"{row['axial [kN]']:.0f}/{row['radial [kN]']:.0f}" for row in rows])
     ax[0].set_xlabel("axial/radial load [kN]")
     ax[0].set_ylabel("ring deformation [µm]")
