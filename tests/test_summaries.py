@@ -131,3 +131,30 @@ def test_stiffness_test_saves_its_numbers(tmp_path):
     assert (tmp_path / "hysteresis.png").stat().st_size > 5000 and not (tmp_path / "te.png").exists()
     assert fig.fit_range_low_Nm == pytest.approx(0.5 * fig.rated_torque)
     assert fig.lost_motion_positive_arcmin - fig.lost_motion_negative_arcmin == pytest.approx(fig.lost_motion_arcmin)
+
+
+# ----------------------------------------------------------------------------- tables: units
+@pytest.mark.parametrize("key, label, unit", [
+    ("C_W_seed004_Nm_per_rad", "C_W_seed004", "N m/rad"), ("entrainment_speed", "entrainment_speed", ""),
+    ("entrainment_speed_m_s", "entrainment_speed", "m/s"), ("max_force_N", "max_force", "N"),
+    ("c12_N_s_per_m", "c12", "N s/m"), ("density_kg_m3", "density", "kg/m³"),
+    ("planet_inertia_estimate_kg_m2", "planet_inertia_estimate", "kg m²"), ("pins_in_contact_max",
+                                                                             "pins_in_contact_max", "")])
+def test_design_report_unit_column(key, label, unit):
+    """The issue's cases: 'C_W_seed004_Nm_per_rad' was read as 'W seed004 Nm/rad' and
+    'entrainment_speed_m_s' as 'm s'."""
+    from flexrv.cli._common import split_unit
+
+    assert split_unit(key) == (label, unit)
+
+
+def test_summary_units_come_from_the_results_attrs():
+    """The summary's units are the variables' declared units: change the attribute and the
+    summary's unit follows (no parsing of 'te_pp_arcsec')."""
+    from flexrv.simulation import Simulation
+
+    res = Simulation("rv40e").run(t_end=0.004, dt=1e-4)
+    u = res.summary()["units"]
+    assert u["te_pp_arcsec"] == "arcsec" and u["max_pin_force_N"] == "N" and u["mean_input_power_W"] == "W"
+    res.ds["te"].attrs["units"] = "test-unit"
+    assert res.summary()["units"]["te_pp_arcsec"] == "test-unit"

@@ -66,7 +66,7 @@ def summary(res) -> dict:
     finite = len(te) > 0
     steady = bool(int(res.attrs.get("steady", 1)))
     balance = power_balance(p_in, p_out, dke)
-    return {
+    out = {
         "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
         "steady_window_s": [t0, t1],
         "steady_state": steady,
@@ -92,6 +92,33 @@ def summary(res) -> dict:
         "failure": res.attrs.get("failure"),
         **_bearing_summary(sel, finite),
     }
+    out["units"] = summary_units(res, out)
+    return out
+
+
+#: summary key -> the result variable whose ``units`` attribute it carries
+_UNIT_SOURCE = {"te_min_arcsec": "te", "te_max_arcsec": "te", "te_pp_arcsec": "te", "te_mean_arcsec": "te",
+                "te_rms_fluctuation_arcsec": "te", "max_pin_force_N": "pin_force", "mean_input_power_W": "power_in",
+                "mean_output_power_W": "power_out", "mean_dissipation_W": "power_in",
+                "mean_kinetic_energy_rate_W": "power_in", "max_ball_load_N": "ball_load_inner",
+                "max_ring_deformation_m": "ring_deformation_outer", "max_inner_ring_deformation_m":
+                "ring_deformation_inner", "max_ball_pressure_Pa": "ball_max_pressure",
+                "min_film_thickness_m": "ball_film_thickness", "pins_in_contact_mean": "pins_in_contact",
+                "pins_in_contact_max": "pins_in_contact"}
+
+
+def summary_units(res, summ: dict) -> dict:
+    """Units of the summary's numbers, carried from the result variables' ``units``
+    attributes (the model's declared outputs), not parsed from the key names; the steady
+    window in the time coordinate's units, ratios dimensionless ("-")."""
+    units = {}
+    for key, var in _UNIT_SOURCE.items():
+        if key in summ and var in res.ds:
+            units[key] = str(res.ds[var].attrs.get("units", ""))
+    units["steady_window_s"] = str(res.ds["time"].attrs.get("units", "s"))
+    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical"):
+        units[key] = "-"
+    return units
 
 
 def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01) -> dict:
