@@ -158,3 +158,22 @@ def test_summary_units_come_from_the_results_attrs():
     assert u["te_pp_arcsec"] == "arcsec" and u["max_pin_force_N"] == "N" and u["mean_input_power_W"] == "W"
     res.ds["te"].attrs["units"] = "test-unit"
     assert res.summary()["units"]["te_pp_arcsec"] == "test-unit"
+
+
+# ----------------------------------------------------------------------------- first run
+def test_first_compile_notice(tmp_path):
+    """The notice names the kernels whose numba cache index is missing and disappears once
+    the index exists (fake dispatchers: no compilation in the test)."""
+    import io
+    from types import SimpleNamespace
+
+    from flexrv.model.kernel_cache import announce_compile, uncached_kernels
+
+    index = tmp_path / "cycloid._closest_point_newton-1.py311.nbi"
+    disp = SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace(_index_path=str(index))))
+    modules = {"flexrv.geometry.cycloid": SimpleNamespace(_NEWTON=disp)}
+    assert uncached_kernels(modules) == ["cycloid._NEWTON"]
+    out = io.StringIO()
+    assert announce_compile(out, modules) and "compiling numba kernels (once, ~" in out.getvalue()
+    index.write_bytes(b"")
+    assert uncached_kernels(modules) == [] and not announce_compile(io.StringIO(), modules)

@@ -11,10 +11,10 @@ from flexrv.cli.design import PRESET_HELP
 
 
 def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
-            t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
+            t_end: float = typer.Option(None, "--t-end", help="End time in s (default: end of the speed and load ramps + 0.2 s)."),
             parts: str = typer.Option("main_bearing", "--parts",
                                       help="Flexible parts, comma-separated: main_bearing, crankshaft."),
-            dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+            dt: float = typer.Option(1e-4, "--dt", help="Time step in s."),
             out: Path = typer.Option(None, "--out", help="Output directory (default results/<preset>_compare_<time>/)."),
             json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Run the rigid and the flexible model on identical inputs: TE overlay, TE spectra with the

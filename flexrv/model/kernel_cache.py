@@ -49,10 +49,10 @@ def cache_dir() -> str:
     return os.environ.get("NUMBA_CACHE_DIR") or str(Path(__file__).resolve().parents[1] / "**" / "__pycache__")
 
 
-def announce_compile(stream=None) -> bool:
+def announce_compile(stream=None, modules: dict | None = None) -> bool:
     """Print ``flexrv: compiling numba kernels (once, ~90 s) ...`` on stderr if any kernel
     the run uses is not cached yet; returns whether it printed."""
-    missing = uncached_kernels()
+    missing = uncached_kernels(modules)
     if not missing:
         return False
     stream = sys.stderr if stream is None else stream
