@@ -1,0 +1,47 @@
+"""A plain (non-editable) install runs the workflows and ``simulate`` from any directory:
+the workflows are part of the installed package, outputs go to ./results of the current
+directory (issue 18). Slow: builds and installs a wheel into a temporary venv and
+compiles the numba kernels there once."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.slow
+def test_non_editable_install_runs_workflow_and_simulate_from_another_directory(tmp_path):
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation", str(ROOT)],
+                   check=True, cwd=tmp_path)
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    env = {**os.environ, "MPLBACKEND": "Agg", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+           "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "PYTHONPATH": ""}
+    where = subprocess.run([str(py), "-c", "import flexrv.workflows, flexrv; print(flexrv.__file__)"],
+                           cwd=work, env=env, capture_output=True, text=True, check=True).stdout.strip()
+    assert str(venv) in where, where  # the installed copy, not the source tree
+    r = subprocess.run([str(py), "-m", "flexrv", "workflow", "kinematic_validation", "--smoke", "--json"],
+                       cwd=work, env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = Path(json.loads(r.stdout)["out_dir"])
+    assert out == work / "results" / "kinematic_validation-smoke"
+    assert (out / "summary.md").read_text().startswith("# Kinematic validation")
+    assert "SMOKE RUN" in (out / "summary.md").read_text().splitlines()[0]
+    r = subprocess.run([str(py), "-m", "flexrv", "simulate", "rv40e", "--t-end", "0.004", "--json",
+                        "--out", "results/sim"], cwd=work, env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert (work / "results" / "sim" / "results.nc").exists()
+    r = subprocess.run([str(py), "-m", "flexrv", "report", "--smoke", "--json"], cwd=work, env=env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert Path(json.loads(r.stdout)["path"]) == work / "results" / "REPORT-smoke.md"
