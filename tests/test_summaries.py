@@ -177,3 +177,8 @@ def test_first_compile_notice(tmp_path):
     assert announce_compile(out, modules) and "compiling numba kernels (once, ~" in out.getvalue()
     index.write_bytes(b"")
     assert uncached_kernels(modules) == [] and not announce_compile(io.StringIO(), modules)
+
+
+def test_power_balance_not_steady_says_storage():
+    b = power_balance(323.9, 323.0, 0.0046, steady=False)
+    assert "NOT steady" in b["note"] and "stored elastically" in b["note"]

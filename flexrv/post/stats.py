@@ -65,7 +65,7 @@ def summary(res) -> dict:
     dke = float((ke[-1] - ke[0]) / (tw[-1] - tw[0])) if len(te) > 1 and tw[-1] > tw[0] else 0.0
     finite = len(te) > 0
     steady = bool(int(res.attrs.get("steady", 1)))
-    balance = power_balance(p_in, p_out, dke)
+    balance = power_balance(p_in, p_out, dke, steady=steady)
     out = {
         "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
         "steady_window_s": [t0, t1],
@@ -121,7 +121,7 @@ def summary_units(res, summ: dict) -> dict:
     return units
 
 
-def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01) -> dict:
+def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True) -> dict:
     """Mean power balance over a window: dissipation D = P_in - P_out - dE_kin/dt [W]
     (every term the window mean; dE_kin/dt = (E_kin(t1) - E_kin(t0)) / (t1 - t0) is exactly
     the mean of the rate). ``note`` says in words what the numbers mean: D < 0 beyond
@@ -146,6 +146,9 @@ def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01) -
                 f"{-d:.4g} W: not a negative dissipation but energy released from elastic storage (contact "
                 "and mesh deflections, not counted in E_kin) — the window is not in steady state (ramps) or "
                 "too short")
+    if not steady:
+        note += ("; the window is NOT steady: energy stored elastically in the contacts while the load ramps "
+                 "is not part of E_kin, so the balance above is not a dissipation measurement")
     return {"dissipation_W": float(d), "note": note}
 
 

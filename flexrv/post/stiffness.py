@@ -88,7 +88,7 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
 #: (variable, StiffnessTest field, units, long name) of the saved figures
 _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the loop"),
             ("torsional_rigidity", "rigidity_Nm_per_arcmin", "N m/arcmin",
-             "torsional rigidity, mean of the +T_r and -T_r branch slopes over |T| in [T_r/2, T_r]"),
+             "torsional rigidity, mean of the +T_r and -T_r branch slopes over T_r/2 <= abs(T) <= T_r"),
             ("torsional_rigidity_positive", "rigidity_positive_Nm_per_arcmin", "N m/arcmin",
              "slope of the +T_r loading branch over T in [T_r/2, T_r]"),
             ("torsional_rigidity_negative", "rigidity_negative_Nm_per_arcmin", "N m/arcmin",
@@ -97,7 +97,7 @@ _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the 
              "lost motion: rotation between +3 % and -3 % of T_r on the mean curve"),
             ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
             ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
-            ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range |T|"),
+            ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
             ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
             ("lost_motion_negative_angle", "lost_motion_negative_arcmin", "arcmin", "mean-curve angle at -3 % T_r"),
             ("lost_motion_positive_angle", "lost_motion_positive_arcmin", "arcmin", "mean-curve angle at +3 % T_r"),
@@ -144,7 +144,7 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
              "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
     for name, field, units, long in _FIGURES[:7]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
-    lines += ["", f"Rigidity fit range: |T| = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
+    lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
               f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
               f"{f.lost_motion_positive_arcmin:.4g} arcmin); hysteresis at T = 0 ({f.hysteresis_returning_arcmin:.4g}"
               f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
