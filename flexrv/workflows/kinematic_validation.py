@@ -132,7 +132,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         t = ds["time"].values
         for key in ds.data_vars:
             y = ds[key].values.reshape(len(t), -1) * RPM_PER_RAD_S
-            ax.plot(t, y, lw=0.8, label=[key] + ["_"] * (y.shape[1] - 1))
+            ax.plot(t, y, lw=0.8, label=[ds[key].attrs.get("long_name", key.replace("_", " "))]
+                    + ["_"] * (y.shape[1] - 1))
         ax.axvspan(ds.attrs["steady_start_s"], ds.attrs["steady_end_s"], color="0.9")
         ax.set_title(f"{p}: member speeds (grey: steady window)")
         ax.set_ylabel("speed [r/min]")
