@@ -129,8 +129,9 @@ class WorkflowResult:
 
 
 def _fmt(value: Any) -> str:
-    """A table cell: floats (numpy included) with 4 significant figures, exponent
-    notation outside 1e-3 .. 1e5 (never ``6214726455202.804``), lists element-wise."""
+    """A table cell: floats (numpy included) with 4 significant figures below 1000, whole
+    numbers from 1000 to 1e5, exponent notation outside 1e-3 .. 1e5 (never
+    ``6214726455202.804``), lists element-wise."""
     import numpy as np
 
     if value is None:
@@ -145,7 +146,9 @@ def _fmt(value: Any) -> str:
             return str(v)
         if v == 0:
             return "0"
-        if 1e-3 <= abs(v) < 1e5:
+        if 1e3 <= abs(v) < 1e5:
+            return f"{v:.0f}"  # whole units: 17138, not 1.714e+04
+        if 1e-3 <= abs(v) < 1e3:
             return f"{v:.4g}"
         return f"{v:.3e}"
     if isinstance(value, (list, tuple)):
