@@ -82,13 +82,15 @@ def test_report_is_generated_full_and_smoke_kept_apart(tmp_path):
 
     _result(False).save(tmp_path / "demo")
     _result(True).save(tmp_path / "demo-smoke")
+    (tmp_path / "rv40e_rigid_sim_20261123").mkdir()  # a `flexrv simulate` run in the same ./results
+    (tmp_path / "rv40e_rigid_sim_20261123" / "summary.md").write_text("# Simulation rv40e\n")
     _compare_json(tmp_path / "rigid_vs_flexible-smoke", 3.0, 3.0)
     r = CliRunner().invoke(app, ["report", "--results", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
     assert json.loads(r.output)["sections"] == ["demo"]
     full = (tmp_path / "REPORT.md").read_text()
     assert "SMOKE" not in full and "## Answer" not in full and "Demo workflow" in full
-    assert full.count("## References") == 1
+    assert full.count("## References") == 1 and "Simulation rv40e" not in full
     r = CliRunner().invoke(app, ["report", "--results", str(tmp_path), "--smoke", "--json"])
     assert json.loads(r.output)["sections"] == ["demo-smoke"]  # the compare.json folder has no summary
     smoke = (tmp_path / "REPORT-smoke.md").read_text()

@@ -65,13 +65,13 @@ def report(results: Optional[Path] = typer.Option(None, "--results",
            json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Collect the workflow summaries into the generated results/REPORT.md (full runs only;
     --smoke: results/REPORT-smoke.md from the smoke runs)."""
-    from flexrv.workflows._common import SMOKE_SUFFIX, collect_report, results_root
+    from flexrv.workflows._common import SMOKE_SUFFIX, collect_report, is_workflow_summary, results_root
 
     root = Path(results) if results else results_root()
     path = collect_report(root, smoke=smoke)
     data = {"path": str(path), "smoke": smoke,
             "sections": sorted(p.parent.name for p in root.glob("*/summary.md")
-                               if p.parent.name.endswith(SMOKE_SUFFIX) == smoke)}
+                               if p.parent.name.endswith(SMOKE_SUFFIX) == smoke and is_workflow_summary(p))}
 
     def render(d):
         console.print(f"wrote {d['path']} ({', '.join(d['sections']) or 'no workflow results yet'})")

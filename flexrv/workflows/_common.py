@@ -35,6 +35,16 @@ REFERENCES = ("## References", "",
               "seed 004 = `seed004` (full citations there).", "")
 
 
+#: invisible marker closing every workflow summary: ``flexrv report`` collects only these
+#: (not the ``flexrv simulate`` / ``compare`` runs that share ./results)
+WORKFLOW_MARK = "<!-- flexrv workflow: {name} -->"
+
+
+def is_workflow_summary(path: Path) -> bool:
+    """True if ``path`` is a summary.md written by :meth:`WorkflowResult.save`."""
+    return "<!-- flexrv workflow: " in path.read_text()
+
+
 def results_root() -> Path:
     """``./results`` of the current directory (the default parent of every output, as for
     ``flexrv simulate``)."""
@@ -106,6 +116,7 @@ class WorkflowResult:
                 lines.append(f"![{name}]({name}.png)")
             lines.append("")
         lines += list(REFERENCES)
+        lines += [WORKFLOW_MARK.format(name=self.name), ""]
         return "\n".join(lines)
 
     def save(self, out_dir: str | Path | None = None) -> Path:
@@ -189,13 +200,14 @@ def collect_report(results_root: Path | None = None, smoke: bool = False) -> Pat
     answer = answer_section(root, smoke=smoke)
     if answer:
         parts += answer
-    found = sorted(p for p in root.glob("*/summary.md") if _is_smoke_folder(p.parent) == smoke)
+    found = sorted(p for p in root.glob("*/summary.md")
+                   if _is_smoke_folder(p.parent) == smoke and is_workflow_summary(p))
     for path in found:
         folder = path.parent.name
         text = path.read_text()
         text = text.replace("](", f"]({folder}/").replace(f"]({folder}/http", "](http")
         # drop each summary's own References section: the report has one at its end
-        text = text.split("\n## References\n")[0]
+        text = text.split("\n## References\n")[0].split("<!-- flexrv workflow: ")[0]
         text = "\n".join(("#" + line) if line.startswith("#") else line for line in text.splitlines())
         parts += [text, ""]
     if not found:
