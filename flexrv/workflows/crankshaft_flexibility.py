@@ -73,6 +73,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                      "flexible/rigid": a_f / a_r if a_r and np.isfinite(a_r) and a_r > 0 else None})
     r.tables["TE amplitude at the characteristic frequencies (steady window)"] = rows
     nr, nf = cmp.numbers["rigid"], cmp.numbers["flexible"]
+    if not nr.get("steady_state", True):
+        r.text.append(f"**{nr['steady_note']}: the spectra below are not steady-state spectra.**")
     twist = cmp.flexible.steady("crank_twist").values
     r.compare("TE, rigid model (steady)", "arcsec", "periodic, smaller",
               f"{nr['te_min_arcsec']:.2f} .. {nr['te_max_arcsec']:.2f}", "seed 002 gives no numbers, only plots")

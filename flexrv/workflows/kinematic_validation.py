@@ -67,6 +67,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         sims[p] = (res, summ)
         r.datasets[f"speeds_{p}"] = _speeds_dataset(res)
         tab = summ["kinematics"]
+        if not summ.get("steady_state", True):
+            r.text.append(f"**{p}: {summ['steady_note']}.**")
         r.tables[f"{p}: steady-window speeds (simulated vs theory at the simulated input speed)"] = tab
         ratio = _row(tab, "total ratio")
         r.numbers[p] = {"ratio_theory": ratio["theory"], "ratio_simulated": ratio["simulated"],
