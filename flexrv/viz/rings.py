@@ -173,6 +173,8 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> P
     for i in range(0, len(t), every):
         for st in ring_states(res, float(t[i]), stress=field == "von_mises", bodies=bodies):
             poly = _polydata(st, 0.0, field)
+            for name in list(poly.point_data.keys()):  # ASCII array names in files for other tools
+                poly.point_data[name.replace("µm", "um")] = poly.point_data.pop(name)
             used = np.unique(st.tris[:, :3])
             poly.point_data["displacement"] = st.displacement[used]
             fname = f"{st.label}_row{st.row}_{i:06d}.vtu"
