@@ -20,9 +20,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.slow
 def test_non_editable_install_runs_workflow_and_simulate_from_another_directory(tmp_path):
+    import shutil
+
+    src = tmp_path / "src"  # a copy, so that the build leaves nothing in the source tree
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(".git", "meshes", "results", "build", "*.egg-info",
+                                                              ".pytest_cache", "__pycache__", ".benchmarks"))
     target = tmp_path / "site"
     r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target),
-                        str(ROOT)], cwd=tmp_path, capture_output=True, text=True)
+                        str(src)], cwd=tmp_path, capture_output=True, text=True)
     if r.returncode != 0 and ("Could not find a version" in r.stderr or "NewConnectionError" in r.stderr):
         pytest.skip("no package index reachable to build the wheel")
     assert r.returncode == 0, r.stderr[-2000:]
