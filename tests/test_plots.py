@@ -35,8 +35,6 @@ def captured(monkeypatch):
 
     def keep(fig, path):
         figs.append(fig)
-        import matplotlib.pyplot as plt
-
         from flexrv.cache import atomic_path
 
         with atomic_path(path) as tmp:
