@@ -6,8 +6,6 @@ Run: ``python -m flexrv.workflows.kinematic_validation`` or ``flexrv workflow ki
 
 from __future__ import annotations
 
-
-
 from flexrv.units import DEG_PER_RAD, RAD_PER_DEG, RAD_S_PER_RPM, RPM_PER_RAD_S
 
 from flexrv.workflows._common import WorkflowResult, new_figure
