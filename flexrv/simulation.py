@@ -153,6 +153,9 @@ class Simulation:
         import exudyn as exu
 
         model = self.model if self.model is not None else self.build()
+        from flexrv.model.kernel_cache import announce_compile
+
+        announce_compile()  # one line on stderr if the numba kernels compile now (first run)
         mbs = model.mbs
         n_steps = check_step_count(t_end, dt, output_every, model.n, t_start=t_start)
         k0 = 0 if initial_records is None else len(initial_records[0])
@@ -426,11 +429,16 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     quarter of the loop over ``quarter_time`` [s] (quasi-static: far longer than
     the output's torsional period, ~1 ms for both presets).
 
-    Returns (:class:`flexrv.post.stiffness.StiffnessTest`, Results). The PNG of the
-    hysteresis loop is written to ``save_to`` if given.
+    Returns (:class:`flexrv.post.stiffness.StiffnessTest`, Results); the Results'
+    dataset carries the figures as scalar variables with units (rigidity, lost motion,
+    hysteresis, ...) and the loop (``loop_torque``, ``loop_angle``). Written to
+    ``save_to`` if given: ``results.nc`` (that dataset), ``stiffness.json``,
+    ``config.toml``, the test's own ``summary.md`` and ``hysteresis.png`` (loop with the
+    rigidity fit range, lost motion and hysteresis marked).
     """
     from flexrv.model.loads import piecewise_torque
-    from flexrv.post.stiffness import evaluate_stiffness_test
+    from flexrv.post.stiffness import (evaluate_stiffness_test, stiffness_dataset, stiffness_json,
+                                       stiffness_summary_markdown)
 
     reducer = load(preset_or_config)
     t_r = reducer.operating.rated_torque_Nm if torque is None else float(torque)
@@ -445,13 +453,24 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     tq = res["output_torque"].values
     angle = -res["theta_out"].values  # the load torque acts against +theta: positive torque winds the output negative
     figures = evaluate_stiffness_test(res.time, tq, angle, times[1:])
-    res.attrs["stiffness_test"] = str(figures)
+    res.ds = stiffness_dataset(figures, res.time, tq, angle * ARCMIN_PER_RAD, base=res.ds)
     if save_to is not None:
+        import json
+
+        from flexrv.cache import atomic_path, atomic_write_text
+        from flexrv.design import to_toml
         from flexrv.viz.plots import plot_hysteresis
 
         d = Path(save_to)
         d.mkdir(parents=True, exist_ok=True)
-        res.save(d)
-        plot_hysteresis(angle * ARCMIN_PER_RAD, tq, d / "hysteresis.png",
-                        title=f"{reducer.name}: {figures.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
+        with atomic_path(d / "results.nc") as tmp:
+            res.ds.to_netcdf(tmp, engine="h5netcdf")
+        atomic_write_text(d / "config.toml", to_toml(reducer))
+        atomic_write_text(d / "stiffness.json", json.dumps(
+            {"preset": reducer.name, "model": model, "quarter_time_s": quarter_time, "dt_s": dt,
+             "figures": stiffness_json(figures)}, indent=2))
+        plot_hysteresis(angle * ARCMIN_PER_RAD, tq, d / "hysteresis.png", figures=figures,
+                        title=f"{reducer.name} stiffness test ({model} model)")
+        atomic_write_text(d / "summary.md", stiffness_summary_markdown(figures, reducer.name, model,
+                                                                       quarter_time, dt))
     return figures, res

@@ -336,9 +336,9 @@ def test_show_prints_nonzero_errors(tmp_path):
 def test_example_error_sets_load(name):
     """The example grade-5 error sets validate on their presets: every group that
     the file sets is non-zero, the assembly penetration stays within the limit, the
-    file is exactly what `python -m workflows._error_sets` writes, and the pin loads
+    file is exactly what `python -m flexrv.workflows._error_sets` writes, and the pin loads
     of both discs read it."""
-    from workflows._error_sets import iso_grade5_toml
+    from flexrv.workflows._error_sets import iso_grade5_toml
 
     from flexrv.design import error_set_path
 

@@ -82,17 +82,35 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
         console.print(kv_table("", flat))
 
 
-_UNIT_HEAD = re.compile(r"_(N|Nm|Pa|GPa|MPa|Hz|W|J|m|mm|um|s|rad|rpm|deg|arcsec|arcmin|kg|m2|m3)(_|$)")
+#: unit tokens of flexrv's unit-suffixed keys (``max_force_N``, ``C_W_seed004_Nm_per_rad``)
+_UNIT_TOKENS = {"N", "Nm", "Pa", "kPa", "MPa", "GPa", "Hz", "W", "J", "m", "mm", "um", "nm", "s", "ms", "rad",
+                "rpm", "deg", "arcsec", "arcmin", "kg", "m2", "m3", "percent"}
+#: suffixes whose plain reading (tokens joined by spaces) is wrong
+_UNIT_SPECIAL = {("m", "s"): "m/s", ("rad", "s"): "rad/s", ("kg", "m3"): "kg/m³", ("mm", "s"): "mm/s"}
+_UNIT_PRETTY = {"Nm": "N m", "um": "µm", "m2": "m²", "m3": "m³", "percent": "%"}
 
 
 def split_unit(key: str) -> tuple[str, str]:
-    """Split flexrv's unit-suffixed keys: ``"max_force_N"`` -> (``"max_force"``, ``"N"``),
-    ``"stiffness_Nm_per_rad"`` -> (``"stiffness"``, ``"Nm/rad"``)."""
-    match = _UNIT_HEAD.search(key)
-    if not match:
+    """Split flexrv's unit-suffixed keys into (label, unit): the unit is the longest run
+    of unit tokens (and ``per``) at the END of the key, leaving at least one label token:
+    ``"max_force_N"`` -> (``"max_force"``, ``"N"``), ``"C_W_seed004_Nm_per_rad"`` ->
+    (``"C_W_seed004"``, ``"N m/rad"``), ``"entrainment_speed_m_s"`` -> (``"entrainment_speed"``,
+    ``"m/s"``), ``"entrainment_speed"`` -> (``"entrainment_speed"``, ``""``)."""
+    tokens = key.split("_")
+    k = len(tokens)
+    while k > 1 and (tokens[k - 1] in _UNIT_TOKENS or (tokens[k - 1] == "per" and k < len(tokens))):
+        k -= 1
+    while k < len(tokens) and tokens[k] == "per":  # a unit cannot start with "per"
+        k += 1
+    unit_tokens = tokens[k:]
+    if not unit_tokens:
         return key, ""
-    unit = key[match.start() + 1:].replace("_per_", "/").replace("_", " ")
-    return key[:match.start()], unit
+    label = "_".join(tokens[:k])
+    special = _UNIT_SPECIAL.get(tuple(unit_tokens))
+    if special:
+        return label, special
+    unit = " ".join(_UNIT_PRETTY.get(t, t) for t in unit_tokens).replace(" per ", "/")
+    return label, unit
 
 
 def _compact(value: Any) -> Any:

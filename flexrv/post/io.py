@@ -31,6 +31,7 @@ def summary_markdown(res, summ: dict) -> str:
              f"steady window: {summ['steady_window_s'][0]:.4g} – {summ['steady_window_s'][1]:.4g} s, "
              f"dt = {res.attrs.get('dt_s')} s, needle model {res.attrs.get('needle_model')}, "
              f"pin law {res.attrs.get('pin_law')}", "",
+             *[f"> {note}\n" for note in summ.get("notes", [])],
              "## Kinematic validation (mean over the steady window)", "",
              "| quantity | unit | theory | simulated | error [%] |", "|---|---|---|---|---|"]
     for row in summ["kinematics"]:

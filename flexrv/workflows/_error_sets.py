@@ -1,6 +1,6 @@
 """Example manufacturing-error sets drawn from ISO tolerance grades (one sample reducer each).
 
-``python -m workflows._error_sets`` (re)writes ``flexrv/design/presets/errors/iso_grade5_<preset>.toml``
+``python -m flexrv.workflows._error_sets`` (re)writes ``flexrv/design/presets/errors/iso_grade5_<preset>.toml``
 for rv40e and rv221. Every deviation is drawn ONCE, uniformly within its tolerance zone, from
 ``numpy.random.default_rng(seed)``; the tolerance of each field is derived from the design's
 geometry with the standard formulas below and written beside it in the file. Nothing is tuned to
@@ -87,7 +87,7 @@ def iso_grade5_toml(preset: str, seed: int = 2026) -> str:
     text = f"""# Example manufacturing and assembly error set for the {preset} preset (z_rp = {z}, N = {n} cranks,
 # {nd} discs): ONE sample reducer, every deviation drawn once, uniformly within its tolerance zone
 # (numpy.random.default_rng({seed}), rounded to 0.01 um / 0.01 arcmin / 0.1 deg). Nothing is tuned
-# to any transmission-error target. Written by `python -m workflows._error_sets` (sources and
+# to any transmission-error target. Written by `python -m flexrv.workflows._error_sets` (sources and
 # assumptions in its docstring). Load it with
 #     flexrv.design.with_errors("{preset}", load_error_set("iso_grade5_{preset}"))
 # ISO 1328-1:1995 grade 5 of the pin ring / disc teeth (m = 2 R_p / z_rp = {m_pin:.3g} mm, d = {d_pin:g} mm):
@@ -149,7 +149,7 @@ support_clearance_um = 0.0
 
 
 def main() -> None:
-    folder = Path(__file__).resolve().parent.parent / "flexrv" / "design" / "presets" / "errors"
+    folder = Path(__file__).resolve().parent.parent / "design" / "presets" / "errors"
     for preset in ("rv40e", "rv221"):
         path = folder / f"iso_grade5_{preset}.toml"
         path.write_text(iso_grade5_toml(preset))
