@@ -88,8 +88,8 @@ def test_pin_loads_vs_analytic_distribution():
 
 
 def test_ideal_geometry_no_load_te_vanishes_and_loaded_does_not():
-    """Ideal geometry: the no-load TE (extrapolated to zero torque) has no
-    kinematic part, p-p below 2 % of the loaded p-p and below 0.01 arcsec (the kinematics are
+    """Ideal geometry: the no-load TE (1 % of rated torque) is the elastic part
+    only, p-p below 2 % of the loaded p-p and below 0.01 arcsec (the kinematics are
     exact: conjugate profile, no clearance); the loaded TE winds up by more than
     10 arcsec."""
     r = loaded_te(ideal("rv40e"), crank_revolutions=0.25, points_per_mesh=8, catalog_positions=1)
@@ -97,11 +97,10 @@ def test_ideal_geometry_no_load_te_vanishes_and_loaded_does_not():
     assert s["no_load_te_pp_arcsec"] < 0.01
     assert s["no_load_te_pp_arcsec"] < 0.02 * s["te_pp_arcsec"]
     assert s["te_mean_arcsec"] < -10.0
-    # no clearance anywhere: the backlash is only the elastic twist between +-1 % of the rated torque,
-    # and the extrapolated no-load wind-up nearly vanishes: measured 7.5 % of the +1 % wind-up (the
-    # T^0.9 extrapolation leaves 15 % of the linear crank supports' share); required below 10 %
+    # no clearance anywhere: the backlash is the elastic twist between +-1 % of the rated torque, i.e.
+    # twice the no-load wind-up (the ideal reducer is symmetric under load reversal)
+    assert s["backlash_arcmin"] == pytest.approx(2 * abs(r.te_no_load[0]) * ARCMIN_PER_RAD, rel=1e-3)
     assert s["backlash_arcmin"] < 0.05
-    assert abs(r.te_no_load[0]) * ARCMIN_PER_RAD < 0.10 * 0.5 * s["backlash_arcmin"]
 
 
 def test_mean_wind_up_equals_integrated_tangent_compliance():
@@ -145,13 +144,13 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
         r = loaded_te(red, crank_revolutions=crank, points_per_mesh=k, catalog_positions=1)
         assert len(r.te) == 4 * k
         pp[k] = r.summary()["te_pp_arcsec"]
-    assert pp[8] <= pp[16] + 1e-7 and pp[16] <= pp[32] + 1e-7 and pp[32] <= pp[64] + 1e-7  # nested, up to solver tolerance
+    assert pp[8] <= pp[16] + 1e-5 and pp[16] <= pp[32] + 1e-5 and pp[32] <= pp[64] + 1e-5  # nested, up to solver tolerance
     err = {k: (pp[64] - pp[k]) / pp[64] for k in (8, 16, 32)}
     assert err[8] >= err[16] >= err[32] - 1e-9
     assert err[8] < 0.05 and err[32] < 0.005
     a = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1)
     b = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1,
-                  options={"force_tol": 1e-9})
+                  options={"force_tol": 1e-8})
     assert np.max(np.abs(a.te - b.te)) * ARCSEC_PER_RAD < 1e-4
 
 
@@ -268,24 +267,25 @@ def test_uniform_tangential_pin_error_is_an_exact_offset():
 def test_single_pin_tangential_error_bump_height():
     """One pin moved tangentially by t = 2 um (towards its loaded flank): its gap
     falls by t l_j / R_p (l_j its moment arm), so while it is the first contact the
-    disc turns t / R_p earlier and TE rises by t / R_p (1 - 1/i) = 6.366 arcsec
-    (closed form, independent of l_j). The no-load TE, extrapolated to zero torque
-    from paths at 1 % and 2 % of the rated torque, shows it +3.6 % (the load
-    moves between pins as it grows, which the T^0.9 extrapolation does not know;
-    +2.8 % and +1.2 % from 0.5 % and 0.25 %; one path at 1 % alone shows 76 %);
-    required within 5 %. Moved the other way, the pin only opens its gap:
-    no bump (< 0.2 arcsec)."""
+    disc turns t / R_p earlier and the kinematic TE rises by t / R_p (1 - 1/i) =
+    6.366 arcsec (closed form, independent of l_j). The no-load curve holds the
+    elastic part at its torque, which falls like T^0.9: measured 76 % of the
+    closed form at 1 % of the rated torque and 97.5 % at 0.1 %; required >= 70 %
+    and within 4 % respectively. Moved the other way, the pin only opens its
+    gap: no bump (< 0.2 arcsec)."""
     base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
     z = base.second_stage.pin_count
-    kw = dict(crank_revolutions=1.1, points_per_mesh=8, catalog_positions=1)
-    r0 = loaded_te(base, **kw)
-    expected = 2e-6 / base.second_stage.pin_circle_radius * (1.0 - 1.0 / r0.ratio)
-    for sign in (1.0, -1.0):
+    expected = None
+    for frac, sign, check in ((1e-2, 1.0, "default"), (1e-3, 1.0, "small"), (1e-2, -1.0, "away")):
+        kw = dict(crank_revolutions=1.1, points_per_mesh=8, catalog_positions=1, no_load_fraction=frac)
+        r0 = loaded_te(base, **kw)
+        expected = 2e-6 / base.second_stage.pin_circle_radius * (1.0 - 1.0 / r0.ratio)
         t = [0.0] * z
         t[5] = 2.0 * sign
-        r1 = loaded_te(_pins(base, "pin_tangential_position_um", t), **kw)
-        d = r1.te_no_load - r0.te_no_load
-        if sign > 0:
-            assert d.max() == pytest.approx(expected, rel=0.05)
+        d = loaded_te(_pins(base, "pin_tangential_position_um", t), **kw).te_no_load - r0.te_no_load
+        if check == "default":
+            assert 0.70 * expected < d.max() < expected
+        elif check == "small":
+            assert d.max() == pytest.approx(expected, rel=0.04)
         else:
             assert np.max(np.abs(d)) * ARCSEC_PER_RAD < 0.2

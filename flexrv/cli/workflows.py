@@ -26,6 +26,7 @@ class Workflow(str, enum.Enum):
     lubrication = "lubrication"
     crankshaft_flexibility = "crankshaft_flexibility"
     crank_bearing_forces = "crank_bearing_forces"
+    te_errors = "te_errors"
 
 
 def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_sensitive=True),
