@@ -151,6 +151,9 @@ def _render_records(name: str, records: list[dict[str, Any]]) -> None:
 
 # ------------------------------------------------------------ output paths, before any work
 #: files a run writes into its output directory (removed by --overwrite)
+OVERWRITE_HELP = "Allow an existing non-empty --out directory (the files of the earlier run are removed)."
+
+#: files of an earlier run that --overwrite removes
 RUN_FILES = ("results.nc", "config.toml", "summary.json", "summary.md", "checkpoint.npz")
 
 

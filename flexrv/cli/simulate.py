@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from flexrv.cli._common import JSON_HELP, check_output_dir, console, emit, kv_table
+from flexrv.cli._common import OVERWRITE_HELP
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -62,7 +63,6 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-OVERWRITE_HELP = "Allow an existing non-empty --out directory (the files of the earlier run are removed)."
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, console, emit, kv_table
+from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -21,6 +21,7 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
        points_per_mesh: int = typer.Option(8, "--points-per-mesh",
                                            help="Positions per cycloid-mesh (pin-mesh) period, 2-1000."),
        out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
+       overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
        json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
     output torque: loaded and no-load TE, lost motion, backlash, torsional rigidity, contact forces,
@@ -34,9 +35,8 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     if output_revolutions is not None and crank_revolutions is not None:
         raise InputError("--output-revolutions and --crank-revolutions exclude each other: give one")
     reducer = load(preset)
-    out = out or Path("results") / f"{Path(preset).stem}_te_{time.strftime('%Y%m%d-%H%M%S')}"
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out} is an existing file: give a directory")
+    out = check_output_dir(out or Path("results") / f"{Path(preset).stem}_te_{time.strftime('%Y%m%d-%H%M%S')}",
+                           "--out", overwrite=overwrite)
     result = loaded_te(reducer, torque=torque_nm, output_revolutions=output_revolutions,
                        crank_revolutions=crank_revolutions, points_per_mesh=points_per_mesh)
     ds = te_dataset(result, reducer)
