@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from flexrv.cache import to_jsonable  # noqa: F401  (re-exported for the CLI modules)
+from flexrv.post.format import fmt  # noqa: F401  (one number format for every table)
 
 #: stdout console; markup off: paths, names and values are printed literally
 #: (``[/x].toml`` is a valid file name, ``[s]`` a unit), styles are passed explicitly
@@ -43,22 +44,6 @@ def kv_table(title: str, rows: list[tuple[str, Any, str]]) -> Table:
     for name, value, unit in rows:
         table.add_row(name, fmt(value), unit)
     return table
-
-
-def fmt(value: Any) -> str:
-    """Compact engineering formatting of a number (or ``str(value)``)."""
-    if isinstance(value, (bool, np.bool_)):
-        return str(bool(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        if v == 0 or not math.isfinite(v):
-            return f"{v:g}"
-        if 1e-3 <= abs(v) < 1e5:
-            return f"{v:.5g}"
-        return f"{v:.4e}"
-    return str(value)
 
 
 def render_nested(title: str, data: dict[str, Any]) -> None:

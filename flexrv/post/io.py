@@ -14,14 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from flexrv.cache import atomic_path, atomic_write_text
-
-
-def _fmt(v) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, float):
-        return f"{v:.6g}"
-    return str(v)
+from flexrv.post.format import fmt as _fmt
 
 
 def summary_markdown(res, summ: dict) -> str:

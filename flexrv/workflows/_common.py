@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from flexrv.cache import atomic_path, atomic_write_text
+from flexrv.post.format import fmt as _fmt
 
 #: smoke outputs go to ``results/<name><SMOKE_SUFFIX>``
 SMOKE_SUFFIX = "-smoke"
@@ -137,34 +138,6 @@ class WorkflowResult:
                     atomic_write_text(path, SMOKE_BANNER + "\n\n" + text)
         self.out_dir = out
         return out
-
-
-def _fmt(value: Any) -> str:
-    """A table cell: floats (numpy included) with 4 significant figures below 1000, whole
-    numbers from 1000 to 1e5, exponent notation outside 1e-3 .. 1e5 (never
-    ``6214726455202.804``), lists element-wise."""
-    import numpy as np
-
-    if value is None:
-        return "–"
-    if isinstance(value, (bool, np.bool_)):
-        return str(bool(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        if not math.isfinite(v):
-            return str(v)
-        if v == 0:
-            return "0"
-        if 1e3 <= abs(v) < 1e5:
-            return f"{v:.0f}"  # whole units: 17138, not 1.714e+04
-        if 1e-3 <= abs(v) < 1e3:
-            return f"{v:.4g}"
-        return f"{v:.3e}"
-    if isinstance(value, (list, tuple)):
-        return ", ".join(_fmt(v) for v in value)
-    return str(value)
 
 
 def new_figure(*args, **kwargs):
