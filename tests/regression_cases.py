@@ -1,0 +1,61 @@
+"""Short runs of every model whose headline numbers are pinned in
+``tests/reference_values.py`` (the pattern of Exudyn's TestModels reference-value
+table): each function returns {quantity: value}."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+#: short ramps so that a short run reaches the loaded state: speed 0 -> rated and load 0 -> rated
+#: over the first 20 ms
+FAST = {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0, "operating.load_ramp_end_s": 0.02}
+
+
+def _dynamic(preset: str, model: str, t_end: float) -> dict:
+    from flexrv.design import override
+    from flexrv.simulation import Simulation
+
+    res = Simulation(override(preset, FAST), model=model).run(t_end=t_end, dt=1e-4)
+    sel = res.ds.sel(time=slice(0.5 * t_end, None))
+    out = {"te_mean_arcsec": float(sel["te"].mean()), "te_pp_arcsec": float(np.ptp(sel["te"].values)),
+           "max_pin_force_N": float(sel["pin_force"].max())}
+    if "ball_load_inner" in sel:
+        out["max_ball_load_N"] = float(sel["ball_load_inner"].max())
+    return out
+
+
+def rigid_rv40e() -> dict:
+    """Rigid model, rv40e, 0.06 s from rest (20 ms ramps), second half."""
+    return _dynamic("rv40e", "rigid", 0.06)
+
+
+def balls_rv40e() -> dict:
+    """Ball-resolved main bearing (rigid rings), rv40e, 0.05 s, second half."""
+    return _dynamic("rv40e", "balls", 0.05)
+
+
+def flexible_rv221() -> dict:
+    """Flexible main-bearing rings, rv221, 0.04 s, second half (meshing and CMS on a cold cache)."""
+    return _dynamic("rv221", "flexible", 0.04)
+
+
+def quasi_static_rv40e() -> dict:
+    """`flexrv te` on rv40e over a quarter crank revolution at 8 points per mesh period."""
+    from flexrv.design import load
+    from flexrv.model.quasi_static import loaded_te
+
+    s = loaded_te(load("rv40e"), crank_revolutions=0.25, points_per_mesh=8, catalog_positions=2).summary()
+    return {k: s[k] for k in ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motion_arcmin",
+                              "torsional_rigidity_Nm_per_arcmin")}
+
+
+def quasi_static_rv40e_grade5() -> dict:
+    """`flexrv te` on rv40e with the ISO grade-5 example error set, one crank revolution,
+    2 points per mesh period."""
+    from flexrv.design import load_error_set, with_errors
+    from flexrv.model.quasi_static import loaded_te
+
+    red = with_errors("rv40e", load_error_set("iso_grade5_rv40e"))
+    s = loaded_te(red, crank_revolutions=1.0, points_per_mesh=2, catalog_positions=2).summary()
+    return {k: s[k] for k in ("te_pp_arcsec", "te_mean_arcsec", "lost_motion_arcmin")}
