@@ -176,28 +176,32 @@ class StaticModel:
     def solve(self, theta_in: float, q_start: np.ndarray) -> tuple[np.ndarray, int]:
         """Static equilibrium at ``theta_in`` from ``q_start``; returns (q, iterations).
 
-        Each iteration solves (s M - J) dq = R. With s = 0 this is Newton's step;
-        a step is accepted only if it lowers the scaled residual norm |R_i / l_i|_2
-        (an exact Newton step also if the norm stays below twice the largest of its
-        last four values)
-        (l_i = 1 for forces, the crank-circle radius for moments), otherwise s is
-        raised (x10) and the step retried, and after an accepted step s is lowered
-        (x0.1, down to a floor of 1e-8 of its start value, which changes the step, never the solution). A coordinate whose contacts are
-        all open (a crank inside its clearances at a vanishing torque) has a
-        singular Newton step; the s M term keeps its step finite and, its force
-        being zero, leaves it where it is. After 12 iterations, two rejected steps in
-        a row, or a stall, the
-        iteration continues with the finite-difference Jacobian (:meth:`fd_jacobian`);
-        then an exact Newton step shorter than ``position_tol`` (0.1 nm on the crank
-        circle) also ends it, since at a kink of a contact law (a contact exactly at
-        its onset, common at a vanishing torque) the residual norm can stall above
-        the force tolerance while the position is already located; for the same reason
-        a residual that stagnates below 10x the tolerance over eight exact iterations
-        is accepted.
-        Steps are limited to ``max_step``
-        (50 um on the crank circle) so a contact set cannot jump across a
-        clearance in one step. Raises :class:`flexrv.errors.ConvergenceError` if the
-        residual does not reach the tolerance within ``max_iter`` iterations.
+        Each iteration solves (s M - J) dq = R (M the members' masses, J = dR/dq):
+        Newton's step for s -> 0, an over-damped pseudo-time step for larger s.
+
+        * Acceptance: a step must lower the scaled residual norm |R_i / l_i|_2
+          (l_i = 1 for forces, the crank-circle radius a_w for moments); rejected,
+          s rises x10 and the step is retried; accepted, s falls x0.1 down to a floor
+          of 1e-8 of its start value (which changes steps, never the solution: a
+          coordinate whose contacts are all open, e.g. a crank inside its clearances
+          at a vanishing torque, keeps a finite step and, its force being zero, stays).
+        * Steps are limited to ``max_step`` (50 um on the crank circle), so a contact
+          set cannot jump across a clearance in one step.
+        * After 12 iterations, two rejections in a row, or a stall (s beyond 1e6 of
+          its start: 20 accepted over-damped steps are then taken), the iteration
+          continues with the finite-difference Jacobian (:meth:`fd_jacobian`; the
+          analytic ones omit the pins' curvature and the mesh stiffness' change with
+          the planet's position, which matter where a contact is barely loaded), and
+          exact Newton steps may raise the norm below twice its largest of the last
+          four values (non-monotone, :cite:`grippo1986nonmonotone`), halved after such
+          a rise so that a 2-cycle across a contact's onset kink contracts.
+        * Convergence: max |R_i / l_i| below ``force_tol`` times T_rated / a_w; or an
+          exact Newton step below ``position_tol`` (0.1 nm on the crank circle); or, at
+          such a kink, a residual that stagnates, or a best iterate, below 10x the
+          tolerance (0.11 N on rv40e: an output-angle error of about 0.11 N x a_w /
+          k_t = 4e-12 rad with k_t ~ 1e6 N m/rad).
+
+        Raises :class:`flexrv.errors.ConvergenceError` otherwise.
         """
         o = self.options
         q = q_start.copy()
@@ -282,7 +286,7 @@ class StaticModel:
                 shift = 1e-8 * s0
         if best[0] < 10.0 * tol:
             # cycling across a contact's onset kink within 10x the force tolerance: the best
-            # iterate locates the equilibrium (its TE error is below 1e-3 arcsec, see class doc)
+            # iterate locates the equilibrium (see the docstring for the output-angle error)
             return best[1], o.max_iter
         raise ConvergenceError(f"static equilibrium at input angle {theta_in:.6g} rad not found in {o.max_iter} "
                                f"iterations (residual {min(r, best[0]):.3g} N, tolerance {tol:.3g} N)")
