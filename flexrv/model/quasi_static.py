@@ -199,7 +199,7 @@ class StaticModel:
           exact Newton step below ``position_tol`` (0.1 nm on the crank circle); or, at
           such a kink, a residual that stagnates, or a best iterate, below 10x the
           tolerance (0.11 N on rv40e: an output-angle error of about 0.11 N x a_w /
-          k_t = 4e-12 rad with k_t ~ 1e6 N m/rad).
+          k_t = 4e-9 rad = 0.0008 arcsec with k_t ~ 1e6 N m/rad).
 
         Raises :class:`flexrv.errors.ConvergenceError` otherwise.
         """
