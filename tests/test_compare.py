@@ -77,8 +77,14 @@ def test_view_png_and_pvd_match_the_reduced_bodies(compared, tmp_path):
     img = mpimg.imread(png)
     assert (np.abs(img[..., :3] - img[0, 0, :3]).sum(axis=-1) > 0.1).mean() > 0.02  # rings drawn
     every = 7
-    pvd = write_pvd(res, tmp_path / "vtu", every=every)
+    seen = []
+    pvd = write_pvd(res, tmp_path / "vtu", every=every, notice=lambda frames, size: seen.append((frames, size)))
     n_frames = len(range(0, len(res.time), every))
+    # the size estimate (uncompressed first frame x frames) is announced once and bounds the
+    # written (compressed) size from above, within a factor 4
+    written = sum(f.stat().st_size for f in (tmp_path / "vtu").glob("*.vtu"))
+    assert len(seen) == 1 and seen[0][0] == n_frames
+    assert written <= seen[0][1] <= 4 * written
     assert pvd.read_text().count("<DataSet") == 4 * n_frames  # 2 rings x 2 rows per frame
     bodies = ring_bodies(res)
     i = (n_frames - 1) * every
@@ -96,3 +102,12 @@ def test_view_cli_on_rigid_result_says_why(compared):
     r = CliRunner().invoke(app, ["view", str(compared.out_dir / "rigid")])
     assert r.exit_code != 0
     assert "--model flexible" in str(r.exception)
+
+
+def test_view_time_beyond_the_run_is_an_error(compared):
+    """`view --time` outside the recorded interval names the option and the run's span (exit 2
+    through the CLI's error handling)."""
+    from flexrv.errors import InputError
+
+    r = CliRunner().invoke(app, ["view", str(compared.out_dir / "flexible"), "--time", "5"])
+    assert isinstance(r.exception, InputError) and "--time 5" in str(r.exception)

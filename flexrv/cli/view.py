@@ -15,7 +15,8 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
          field: str = typer.Option("displacement", "--field", help="Colour: displacement or von_mises."),
          png: Path = typer.Option(None, "--png", help="Write an off-screen PNG (default <result>/rings.png)."),
          vtu: Path = typer.Option(None, "--vtu", help="Also write a PVD time series (VTU per frame) to this folder."),
-         every: int = typer.Option(10, "--every", help="With --vtu: every k-th record."),
+         every: int = typer.Option(10, "--every", help="With --vtu: every k-th record (the stride; the size "
+                                                        "of the series is printed after its first frame)."),
          show: bool = typer.Option(False, "--show", help="Open an interactive window (needs a display)."),
          json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Deformed rings (scaled) coloured by displacement or von Mises stress: PNG off-screen,
@@ -35,6 +36,10 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
     if every < 1:
         raise InputError(f"--every {every}: must be >= 1")
     res = load_results(result_dir)
+    t = res.time
+    if time is not None and not (len(t) and t[0] - 1e-12 <= time <= t[-1] + 1e-12):
+        raise InputError(f"--time {time:g} s is not allowed: the run covers {t[0]:g} .. {t[-1]:g} s"
+                         if len(t) else f"--time {time:g} s: the run has no records")
     data = {"result_dir": str(result_dir)}
     if show:
         data["interactive"] = show_rings(res, time, scale, field)
@@ -43,7 +48,15 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
     if not data.get("interactive"):
         data["png"] = str(render_rings_png(res, png or result_dir / "rings.png", time, scale, field))
     if vtu is not None:
-        data["pvd"] = str(write_pvd(res, vtu, every=every, field=field))
+        def notice(frames, size):
+            from rich.console import Console
+
+            Console(stderr=True, markup=False, highlight=False).print(
+                f"writing {frames} frames of the rings to {vtu}: at most {size / 1e6:.3g} MB "
+                f"(--every {every}; a larger --every writes fewer)")
+            data["vtu_frames"], data["vtu_bytes_estimate"] = frames, size
+
+        data["pvd"] = str(write_pvd(res, vtu, every=every, field=field, notice=notice))
 
     def render(d):
         console.print(kv_table("view", [(k, v, "") for k, v in d.items()]))

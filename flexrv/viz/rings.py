@@ -159,10 +159,14 @@ def show_rings(res, time: float | None = None, scale: float | None = None, field
     return True
 
 
-def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> Path:
+def write_pvd(res, directory, every: int = 10, field: str = "displacement", notice=None) -> Path:
     """Write the ring surfaces of every ``every``-th record as VTU files (point data
     ``displacement`` [m] and |u| [µm], undeformed coordinates: warp in ParaView) and a
-    ParaView PVD collection ``rings.pvd`` with the simulation times. Atomic writes."""
+    ParaView PVD collection ``rings.pvd`` with the simulation times. Atomic writes.
+    ``notice(frames, bytes_estimate)`` is called once, after the first frame, with
+    the number of frames and an upper bound of the series' size: the first frame's
+    uncompressed arrays (points, point data, cells) times the frames; the files
+    are zlib-compressed VTU, so they come out smaller."""
     if every < 1:
         raise InputError(f"every = {every!r} must be >= 1")
     d = Path(directory)
@@ -170,7 +174,11 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> P
     bodies = ring_bodies(res, stress=field == "von_mises")
     t = res.time
     entries = []
-    for i in range(0, len(t), every):
+    frames = range(0, len(t), every)
+    frame_bytes = 0
+    for i in frames:
+        if notice is not None and i == every:
+            notice(len(frames), len(frames) * frame_bytes)
         for st in ring_states(res, float(t[i]), stress=field == "von_mises", bodies=bodies):
             poly = _polydata(st, 0.0, field)
             for name in list(poly.point_data.keys()):  # ASCII array names in files for other tools
@@ -178,8 +186,12 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> P
             used = np.unique(st.tris[:, :3])
             poly.point_data["displacement"] = st.displacement[used]
             fname = f"{st.label}_row{st.row}_{i:06d}.vtu"
+            grid = poly.cast_to_unstructured_grid()
+            if i == 0:
+                frame_bytes += (grid.points.nbytes + sum(grid.point_data[k].nbytes for k in grid.point_data.keys())
+                                + grid.cells.nbytes + grid.celltypes.nbytes + grid.offset.nbytes)
             with atomic_path(d / fname) as tmp:
-                poly.cast_to_unstructured_grid().save(str(tmp), binary=True)
+                grid.save(str(tmp), binary=True)
             entries.append((float(t[i]), f"{st.label}_row{st.row}", fname))
     parts = sorted({e[1] for e in entries})
     lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
