@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from flexrv.cli._common import JSON_HELP, console, emit, fmt, render_nested
@@ -47,7 +48,7 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
         data = r.model_dump()
         console.print(f"[bold]{r.name}[/] — {r.description}")
         for section, values in data.items():
-            if not isinstance(values, dict) or section == "provenance":
+            if not isinstance(values, dict) or section in ("provenance", "errors"):
                 continue
             table = Table(title=section, title_justify="left")
             table.add_column("field")
@@ -58,6 +59,16 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
                     value = ", ".join(f"{k}={fmt(v)}" for k, v in value.items())
                 table.add_row(key, fmt(value), r.provenance.get(f"{section}.{key}", ""))
             console.print(table)
+        errors = r.errors.nonzero_items()
+        if not errors:
+            console.print("errors: none (ideal geometry)")
+            return
+        table = Table(title="errors (manufacturing and assembly, non-zero only)", title_justify="left")
+        table.add_column("field", no_wrap=True, min_width=max(len(key) for key, _ in errors))
+        table.add_column("value", justify="right", overflow="fold")
+        for key, value in errors:
+            table.add_row(escape(key), escape(", ".join(fmt(v) for v in value) if isinstance(value, list) else fmt(value)))
+        console.print(table)
 
     emit(reducer, json, render)
 

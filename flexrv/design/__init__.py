@@ -111,6 +111,9 @@ def override(reducer: Reducer | str | Path, overrides: dict[str, Any]) -> Reduce
 def to_toml(reducer: Reducer) -> str:
     """Serialise a design to TOML that :func:`loads` reads back unchanged."""
     data = reducer.model_dump(mode="python")
+    data.pop("errors", None)
+    if not reducer.errors.is_zero():  # the [errors] table only when there are errors, non-zero fields only
+        data["errors"] = reducer.errors.model_dump(mode="python", exclude_defaults=True)
     head = {k: data.pop(k) for k in ("name", "description", "sources")}
     provenance = data.pop("provenance")
     ordered = {**head, **data, "provenance": provenance}

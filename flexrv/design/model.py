@@ -358,6 +358,9 @@ class OperatingPoint(_Strict):
 
 
 # --------------------------------------------------------------------------- reducer
+from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402  (needs _Strict, defined above)
+
+
 class Reducer(_Strict):
     """A complete RV reducer design. Load one with :func:`flexrv.design.load`."""
 
@@ -376,6 +379,8 @@ class Reducer(_Strict):
     inertia: Inertia
     contact: ContactSettings
     operating: OperatingPoint
+    errors: ManufacturingErrors = Field(default_factory=ManufacturingErrors,
+                                        description="Manufacturing and assembly errors (all zero: ideal reducer)")
 
     def material(self, part: str) -> Material:
         """Material of a part (``gears``, ``crankshaft``, ``cycloid_disc``, ...)."""
@@ -414,4 +419,5 @@ class Reducer(_Strict):
         if self.crankshaft.eccentric_journal_diameter_mm / 2.0 <= ss.eccentricity_mm:
             raise _bad("crankshaft.eccentric_journal_diameter_mm", self.crankshaft.eccentric_journal_diameter_mm,
                        f"must be > 2 a = {2 * ss.eccentricity_mm:g} mm")
+        self.errors.validate_for(self)  # list lengths vs z_rp / N / n_discs, clearances, assembly interference
         return self

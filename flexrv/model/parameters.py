@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
+from flexrv.geometry.as_built import as_built
 from flexrv.geometry.kinematics import member_speeds, total_ratio
 
 
@@ -147,17 +148,8 @@ def rigid_parameters(reducer) -> RigidParameters:
     a_w = fs.center_distance
     alpha_w = math.acos((rb_s + rb_p) / a_w)
     beta = 2.0 * math.pi * np.arange(n) / n
-    # pins and discs
-    psi = 2.0 * np.pi * np.arange(z_rp) / z_rp
-    pins = ss.pin_circle_radius * np.stack([np.sin(psi), np.cos(psi)], axis=-1)
-    chi0 = 2.0 * np.pi * np.arange(nd) / nd
-    rot0 = chi0 / z_c
-    crank_pos = a_w * np.stack([np.cos(beta), np.sin(beta)], axis=-1)  # (N,2) housing frame at t=0
-    holes = np.empty((nd, n, 2))
-    for k in range(nd):
-        c, s = math.cos(rot0[k]), math.sin(rot0[k])
-        # hole centre (housing, t=0) = crank centre + eccentric vector; disc centre = eccentric vector
-        holes[k] = np.stack([c * crank_pos[:, 0] + s * crank_pos[:, 1], -s * crank_pos[:, 0] + c * crank_pos[:, 1]], -1)
+    # pins, discs, cranks: the as-built geometry (nominal + the design's [errors]), one place
+    ab = as_built(reducer)
     # masses
     rho_g = reducer.material("gears").density_kg_m3
     rho_c = reducer.material("crankshaft").density_kg_m3
@@ -209,7 +201,7 @@ def rigid_parameters(reducer) -> RigidParameters:
         normal_backlash=fs.backlash * math.cos(alpha_w), crank_angles=beta,
         eccentricity=ss.eccentricity, pin_circle_radius=ss.pin_circle_radius, pin_radius=ss.pin_radius,
         d_radius=ss.modification_shift, d_pin_radius=ss.modification_equidistant, d_rotation=ss.modification_rotation,
-        disc_width=b, pins=pins, chi0=chi0, disc_rot0=rot0, holes=holes,
+        disc_width=b, pins=ab.pins, chi0=ab.chi0, disc_rot0=ab.disc_rot0, holes=ab.holes,
         crank_mass=crank_mass, crank_inertia=crank_inertia, planet_mass=planet_mass, planet_inertia=planet_inertia,
         disc_mass=disc_mass, disc_inertia=disc_inertia,
         carrier_mass=reducer.inertia.carrier_mass_kg, carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
@@ -224,12 +216,10 @@ def rigid_parameters(reducer) -> RigidParameters:
         load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s), rated_torque=op.rated_torque_Nm,
         external_axial_force=op.external_axial_force_N, external_radial_force=op.external_radial_force_N,
         tilting_moment=op.tilting_moment_Nm,
-        pin_radii=np.full(z_rp, ss.pin_radius),
-        disc_profile=np.tile([ss.modification_shift, ss.modification_equidistant, ss.modification_rotation], (nd, 1)),
-        profile_harmonics=np.zeros((nd, 0, 3)),
-        eccentricities=np.full((n, nd), ss.eccentricity), eccentric_phase_errors=np.zeros((n, nd)),
-        crank_bores=crank_pos.copy(), needle_clearances=np.full((n, nd), nb.radial_clearance_um * 1e-6),
-        support_clearances=np.zeros(n), sun_runout=np.zeros(2), planet_runout=np.zeros((n, 2)),
-        planet_phase_errors=np.zeros(n),
+        pin_radii=ab.pin_radii, disc_profile=ab.disc_profile, profile_harmonics=ab.profile_harmonics,
+        eccentricities=ab.eccentricities, eccentric_phase_errors=ab.eccentric_phase_errors,
+        crank_bores=ab.crank_bores, needle_clearances=ab.needle_clearances,
+        support_clearances=ab.support_clearances, sun_runout=ab.sun_runout, planet_runout=ab.planet_runout,
+        planet_phase_errors=ab.planet_phase_errors,
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
     )
