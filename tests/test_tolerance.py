@@ -162,13 +162,19 @@ def test_marginals_and_correlation(rv40e):
 
 
 def test_yield_clopper_pearson():
-    """Exact binomial interval: 0 of 10 failing -> upper... ; 45 of 50 -> known values (R binom.test)."""
-    y = {"te_pp_arcsec": np.r_[np.full(45, 10.0), np.full(5, 100.0)]}
+    """Yield 45/50 and its exact interval against the Clopper-Pearson closed form in beta
+    quantiles (lower = B^-1(0.025; k, n-k+1), upper = B^-1(0.975; k+1, n-k)), computed here
+    independently of scipy's binomtest root finding; 1e-7."""
+    from scipy.stats import beta
+
+    y = {"te_pp_arcsec": np.r_[np.full(45, 10.0), np.full(5, 100.0), np.nan],
+         "lost_motion_arcmin": np.r_[1.5, np.full(50, 0.5)]}
     res = yield_estimate(y, [parse_spec("te_pp_arcsec<=60")])
-    assert res["passed"] == 45 and res["n"] == 50 and res["yield"] == 0.9
-    # binom.test(45, 50): 95 % CI 0.7818746 .. 0.9667213
-    assert res["ci_low"] == pytest.approx(0.7818746, abs=1e-6)
-    assert res["ci_high"] == pytest.approx(0.9667213, abs=1e-6)
+    assert res["passed"] == 45 and res["n"] == 50 and res["yield"] == 0.9  # the NaN sample is not counted
+    assert res["ci_low"] == pytest.approx(beta.ppf(0.025, 45, 6), abs=1e-7)
+    assert res["ci_high"] == pytest.approx(beta.ppf(0.975, 46, 5), abs=1e-7)
+    both = yield_estimate(y, [parse_spec("te_pp_arcsec<=60"), parse_spec("lost_motion_arcmin<1")])
+    assert both["passed"] == 44  # sample 0 fails the lost-motion spec only
 
 
 def test_sobol_indices_additive(rv40e):

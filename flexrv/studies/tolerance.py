@@ -93,7 +93,7 @@ OUTPUTS = ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motio
 DEFAULT_RESOLUTION = {"crank_revolutions": 1.0, "output_revolutions": None, "points_per_mesh": 2,
                       "force_tol": 1e-6, "max_iter": 200, "torque": None}
 
-_SPEC = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+0-9.eE]+)\s*$")
+_SPEC = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+0-9.eEinfINFaA]+)\s*$")
 
 
 # ----------------------------------------------------------------------------- evaluation task
