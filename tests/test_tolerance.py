@@ -360,3 +360,50 @@ def test_real_dask_scheduler_and_workers(local_run, tmp_path):
             except ProcessLookupError:
                 pass
             p.wait(timeout=30)
+
+
+def test_src_linear_function(rv40e):
+    """SRC^2 on the 'variables' basis of a linear function of the sampled errors equals the
+    analytic variance shares a_i^2 sigma_i^2 / sum (R^2 = 1): bores 3 x (a=1, sigma 1), sun
+    runout 2 x (a=2, sigma 0.5), pin radius per reducer (a=0.5, sigma 2) -> 3/6, 2/6, 1/6; 0.02."""
+    from flexrv.studies.tolerance import src_indices
+
+    table = {"cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 1.0},
+             "first_stage.sun_runout_um": {"distribution": "normal", "sigma_um": 0.5},
+             "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 2.0, "scope": "per_reducer"}}
+    plan = TolerancePlan.build(rv40e, parse_tolerances(table, rv40e), 2)
+    x = plan.values(plan.unit_samples(4000, "random"))
+    a = np.r_[1.0, 1.0, 1.0, 2.0, 2.0, 0.5]
+    res = src_indices(x, x @ a, plan)
+    assert res["best"] == "variables" and res["variables"]["r2"] == pytest.approx(1.0, abs=1e-9)
+    got = res["variables"]["indices"]
+    assert got["cranks.bore_radial_um"] == pytest.approx(3 / 6, abs=0.02)
+    assert got["first_stage.sun_runout_um"] == pytest.approx(2 / 6, abs=0.02)
+    assert got["pins.pin_radius_um"] == pytest.approx(1 / 6, abs=0.02)
+
+
+@pytest.mark.slow
+def test_study_sobol_and_what_if(tmp_path):
+    """--sobol (Saltelli, N = 2 base samples, 2 tolerances -> 8 evaluations, its A and B rows the 4
+    plain samples) and a what-if table on 1 sample (2 tolerances x 2 factors): every evaluation is
+    run once, Sobol' indices and the what-if rows are reported; the halved tolerance's stored
+    error values are exactly half the plain sample's."""
+    tol = tmp_path / "tol.toml"
+    tol.write_text('[tolerances."cranks.bore_tangential_um"]\ndistribution = "band"\nband_um = 3.0\n'
+                   '[tolerances."pins.pin_radius_um"]\ndistribution = "normal"\nsigma_um = 0.4\n')
+    out = tmp_path / "s"
+    res = _cli("rv40e", "--tolerances", str(tol), "--samples", "2", "--sobol", "--what-if-samples", "1",
+               "--workers", "1", "--spec", "lost_motion_arcmin<=1.5", *SMOKE, "--out", str(out), "--json")
+    assert res.returncode == 0, res.stderr
+    data = json.loads(res.stdout)
+    assert data["samples"] == 4 and data["evaluations"] == 8 + 4
+    assert data["yield"]["n"] >= 3
+    summary = json.loads((out / "summary.json").read_text())
+    sob = summary["sensitivity_sobol"]["te_mean_arcsec"]
+    assert set(sob) == {"cranks.bore_tangential_um", "pins.pin_radius_um"}
+    assert all(math.isfinite(v["ST"]) for v in sob.values())
+    assert {r["tolerance"] for r in data["what_if"]["rows"]} == set(sob)
+    records = [json.loads(p.read_text()) for p in (out / "runs" / "cases").glob("*.json")]
+    bores = [r["overrides"]["errors"]["cranks"]["bore_tangential_um"] for r in records]
+    x0 = np.asarray(_table(out)["x"][0][:3])
+    assert any(np.allclose(b, 0.5 * x0, rtol=0, atol=1e-12) for b in bores if isinstance(b, list))

@@ -33,12 +33,15 @@ see :data:`DEFAULT_RESOLUTION` and :func:`resolution_accuracy_note`.
 
 Sensitivities
 -------------
-* Standardised regression coefficients (SRC) on the plain samples: a linear
-  least-squares fit of the standardised output on all D standardised variables;
-  an entry's share is the sum of its variables' SRC^2 (for independent inputs
-  the fraction of the output variance the linear model attributes to it); the
-  fit's R^2 says how much of the variance is linear at all (TE p-p, a
-  max-minus-min, is not: use ``--sobol`` for it).
+* Standardised regression coefficients (SRC) on the plain samples, on two
+  bases (:func:`src_indices`): a linear least-squares fit of the standardised
+  output on all D standardised variables (an entry's share is the sum of its
+  variables' SRC^2: for independent inputs the fraction of the output variance
+  the linear model attributes to it; needs N >= D + 3), and a fit on one
+  feature per entry, the RMS of its standardised deviations in each reducer
+  (what a max-minus-min such as TE p-p responds to; needs N >= G + 3). The
+  ranking uses the basis with the higher adjusted R^2, which is reported: a low
+  R^2 means the output is not explained linearly (use ``--sobol``).
 * With ``--sobol``: first-order and total Sobol' indices per tolerance entry
   (SALib, grouped variables) on a Saltelli design of N (G + 2) evaluations, G =
   number of entries; its A and B blocks (2N quasi-random samples) are the plain
@@ -383,25 +386,51 @@ def yield_estimate(ys: dict[str, np.ndarray], specs: list[Spec], confidence: flo
             "confidence": confidence, "specs": [str(s) for s in specs]}
 
 
-def src_indices(x: np.ndarray, y: np.ndarray, groups: list[str], entries: list[str]) -> dict[str, Any]:
-    """Standardised regression coefficients of y on the columns of x, summed as
-    SRC^2 per entry (see module docstring); R^2 of the linear fit."""
-    ok = np.isfinite(y)
-    x, y = x[ok], y[ok]
-    n = len(y)
-    if n < 3 or np.std(y) == 0.0:
-        return {"r2": None, "n": n, "indices": {}}
-    sx = np.std(x, axis=0)
+def _src(features: np.ndarray, names: list[str], y: np.ndarray, entries: list[str]) -> dict[str, Any] | None:
+    """Least-squares SRCs of y on the feature columns, SRC^2 summed per entry,
+    R^2 and adjusted R^2; None if there are too few samples for the fit."""
+    sx = np.std(features, axis=0)
     keep = sx > 0
-    xs = (x[:, keep] - x[:, keep].mean(axis=0)) / sx[keep]
+    n, p = len(y), int(keep.sum())
+    if n < p + 3 or p == 0:
+        return None
+    xs = (features[:, keep] - features[:, keep].mean(axis=0)) / sx[keep]
     ys = (y - y.mean()) / np.std(y)
     beta, *_ = np.linalg.lstsq(xs, ys, rcond=None)
     resid = ys - xs @ beta
     r2 = 1.0 - float(resid @ resid) / float(ys @ ys)
-    kept_groups = [g for g, k in zip(groups, keep) if k]
-    share = {e: float(sum(b * b for g, b in zip(kept_groups, beta) if g == e)) for e in entries}
-    return {"r2": r2, "n": n, "underdetermined": bool(n <= xs.shape[1] + 1),
+    kept = [g for g, k in zip(names, keep) if k]
+    share = {e: float(sum(b * b for g, b in zip(kept, beta) if g == e)) for e in entries}
+    return {"r2": r2, "r2_adjusted": 1.0 - (1.0 - r2) * (n - 1) / (n - p - 1), "features": p,
             "indices": dict(sorted(share.items(), key=lambda kv: -kv[1]))}
+
+
+def src_indices(x: np.ndarray, y: np.ndarray, plan: "TolerancePlan") -> dict[str, Any]:
+    """Standardised regression coefficients of an output on two bases (see the
+    module docstring): ``variables`` (every sampled variable, SRC^2 summed per
+    entry; needs N >= D + 3) and ``magnitudes`` (one feature per entry: the RMS
+    of its standardised deviations in that reducer, what a max-minus-min such as
+    TE p-p responds to; needs N >= G + 3). ``best`` names the basis with the
+    higher adjusted R^2 (the ranking uses it)."""
+    ok = np.isfinite(y)
+    x, y = x[ok], y[ok]
+    out: dict[str, Any] = {"n": int(len(y)), "best": None}
+    if len(y) < 3 or np.std(y) == 0.0:
+        return out
+    entries = plan.groups
+    cols = [c.entry for c in plan.columns]
+    out["variables"] = _src(x, cols, y, entries)
+    z = np.empty((len(y), len(entries)))
+    for i, e in enumerate(entries):
+        xe = x[:, plan.slices[e]]
+        sd = np.std(xe, axis=0)
+        sd[sd == 0] = 1.0
+        z[:, i] = np.sqrt(np.mean(((xe - xe.mean(axis=0)) / sd) ** 2, axis=1))
+    out["magnitudes"] = _src(z, entries, y, entries)
+    fits = [(v["r2_adjusted"], k) for k in ("variables", "magnitudes") if (v := out.get(k))]
+    if fits:
+        out["best"] = max(fits)[1]
+    return out
 
 
 def sobol_indices(problem: dict[str, Any], y: np.ndarray, seed: int = 0) -> dict[str, Any]:
@@ -582,8 +611,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
         "percentiles": {k: percentiles(ys[k]) for k in OUTPUTS},
         "yield": yield_estimate(ys, specs),
     }
-    groups = [c.entry for c in plan.columns]
-    result["sensitivity_src"] = {k: src_indices(parts["x"], ys[k], groups, plan.groups)
+    result["sensitivity_src"] = {k: src_indices(parts["x"], ys[k], plan)
                                  for k in ("te_pp_arcsec", "te_mean_arcsec", "lost_motion_arcmin")} if plan.dim else {}
     if cfg.sobol and plan.dim:
         n_salt = len(parts["saltelli_x"])
@@ -640,14 +668,19 @@ def _what_if(parts, kinds, y, n_plain, specs) -> dict[str, Any]:
 
 
 def _ranking(result) -> dict[str, list[dict[str, Any]]]:
-    """Ranked sensitivities per output: Sobol' ST if computed, else SRC^2."""
+    """Ranked sensitivities per output: Sobol' ST if computed, else SRC^2 of the
+    better-fitting basis (empty if too few samples for either)."""
     out = {}
     sob = result.get("sensitivity_sobol", {})
     for k, v in result.get("sensitivity_src", {}).items():
         if k in sob and "error" not in sob[k]:
             out[k] = [{"tolerance": e, "ST": s["ST"], "S1": s["S1"], "method": "sobol"} for e, s in sob[k].items()]
+        elif v.get("best"):
+            fit = v[v["best"]]
+            out[k] = [{"tolerance": e, "src2": s, "method": f"src ({v['best']})", "r2": fit["r2"]}
+                      for e, s in fit["indices"].items()]
         else:
-            out[k] = [{"tolerance": e, "src2": s, "method": "src", "r2": v["r2"]} for e, s in v["indices"].items()]
+            out[k] = []
     return out
 
 
@@ -764,7 +797,7 @@ def _markdown(r: dict[str, Any]) -> str:
     lines += ["", "## Ranked sensitivities of TE p-p", ""]
     for row in r["ranked_sensitivities"].get("te_pp_arcsec", [])[:10]:
         val = f"ST {row['ST']:.3f}, S1 {row['S1']:.3f}" if row["method"] == "sobol" else \
-            f"SRC^2 {row['src2']:.3f} (R^2 {row['r2']:.2f})"
+            f"SRC^2 {row['src2']:.3f} ({row['method']}, R^2 {row['r2']:.2f})"
         lines.append(f"- {row['tolerance']}: {val}")
     w = r["what_if"]
     if w["rows"]:
