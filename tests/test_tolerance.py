@@ -113,6 +113,24 @@ def test_cli_bad_inputs_exit_2_quickly(tmp_path):
         assert wall < 20.0, (args, wall)
 
 
+def test_tolerances_inside_design_toml(tmp_path):
+    """A [tolerances] table inside the design TOML is read; the design itself validates as before;
+    --tolerances FILE takes precedence; a design without either is a ConfigError naming the fix."""
+    from flexrv.design import preset_path
+    from flexrv.studies.tolerance import load_design_and_tolerances
+
+    text = preset_path("rv40e").read_text()
+    path = tmp_path / "d.toml"
+    path.write_text(text + '\n[tolerances."cranks.bore_radial_um"]\ndistribution = "uniform"\nband_um = 2.0\n')
+    reducer, tol, data = load_design_and_tolerances(str(path), None)
+    assert list(tol.entries) == ["cranks.bore_radial_um"] and tol.entries["cranks.bore_radial_um"].band == 2.0
+    assert reducer.model_dump() == load("rv40e").model_dump() and "tolerances" not in data
+    _, tol2, _ = load_design_and_tolerances(str(path), "rv40e")
+    assert "pins.pin_radius_um" in tol2.entries
+    with pytest.raises(ConfigError, match="--tolerances"):
+        load_design_and_tolerances("rv40e", None)
+
+
 # --------------------------------------------------------------------------- sampling
 @pytest.mark.parametrize("sampler", ["random", "sobol", "lhs"])
 def test_same_seed_identical_samples(rv40e, sampler):
@@ -202,17 +220,18 @@ def test_sobol_indices_additive(rv40e):
 def test_first_order_propagation_mean_te(rv40e):
     """Small errors: the loaded mean TE is linear in them, so its Monte Carlo variance equals the
     first-order propagation sum_i (dy/dx_i)^2 sigma_i^2 from central finite differences
-    (step = sigma). Checked two ways on N = 24 samples at 0.1 crank revolution, 2 points per mesh:
+    (step = sigma) of the 7 variables (crank-hole tangential positions of 2 discs x 3 holes, a
+    common tangential pin-ring offset). Checked two ways on N = 20 samples at 0.1 crank revolution,
+    2 points per mesh:
     (1) the predicted variance lies inside the 99.9 % chi-square interval of the sample variance
     (sampling error); (2) sample by sample the linear prediction y0 + J (x - mean) matches the
-    computed mean TE within 3 % of its standard deviation (tight: fails for a wrong sensitivity)."""
+    computed mean TE within 5 % of its standard deviation (fails for a wrong sensitivity)."""
     from scipy.stats import chi2
 
     from flexrv.design.manufacturing import with_errors
 
-    table = {"cranks.bore_tangential_um": {"distribution": "normal", "sigma_um": 0.5},
-             "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 0.3, "scope": "per_reducer"},
-             "discs.rotation_arcmin": {"distribution": "normal", "sigma_arcmin": 0.5}}
+    table = {"discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 0.3},
+             "pins.pin_tangential_position_um": {"distribution": "normal", "sigma_um": 0.5, "scope": "per_reducer"}}
     tol = parse_tolerances(table, rv40e)
     plan = TolerancePlan.build(rv40e, tol, 5)
     res = {"crank_revolutions": 0.1, "points_per_mesh": 2}
@@ -229,14 +248,15 @@ def test_first_order_propagation_mean_te(rv40e):
         e[i] = sig[i]
         jac[i] = (mean_te(e) - mean_te(-e)) / (2 * sig[i])
     var_pred = float(np.sum(jac ** 2 * sig ** 2))
-    n = 24
+    n = 20
     x = plan.values(plan.unit_samples(n, "random"))
     y = np.array([mean_te(row) for row in x])
     s2 = float(np.var(y, ddof=1))
     lo, hi = s2 * (n - 1) / chi2.ppf(0.9995, n - 1), s2 * (n - 1) / chi2.ppf(0.0005, n - 1)
     assert lo <= var_pred <= hi, (var_pred, s2, lo, hi)
     y_lin = y0 + x @ jac
-    assert np.max(np.abs(y - y_lin)) < 0.03 * math.sqrt(s2), (y, y_lin)
+    assert s2 > 0.1  # arcsec^2: the errors do move the mean TE
+    assert np.max(np.abs(y - y_lin)) < 0.05 * math.sqrt(s2), (y, y_lin)
 
 
 # --------------------------------------------------------------------------- studies (dask)
