@@ -242,14 +242,17 @@ class TolerancePlan:
             return np.random.default_rng(self.seed).random((n, d))
         from scipy.stats import qmc
 
-        if sampler == "sobol":
+        engines = {"sobol": qmc.Sobol, "lhs": qmc.LatinHypercube}
+        if sampler in engines:
             import warnings
 
+            try:  # scipy >= 1.15 names the seed 'rng'
+                engine = engines[sampler](d, scramble=True, rng=self.seed)
+            except TypeError:
+                engine = engines[sampler](d, scramble=True, seed=self.seed)
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # balance warning for n not a power of 2
-                return qmc.Sobol(d, scramble=True, rng=self.seed).random(n)
-        if sampler == "lhs":
-            return qmc.LatinHypercube(d, rng=self.seed).random(n)
+                warnings.simplefilter("ignore")  # Sobol' balance warning for n not a power of 2
+                return engine.random(n)
         raise InputError(f"--sampler {sampler!r}: allowed random, sobol, lhs")
 
     def saltelli(self, n: int) -> np.ndarray:
