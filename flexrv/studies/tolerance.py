@@ -610,7 +610,6 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
         status.append(r.get("status", "missing"))
         if r.get("status") == "ok":
             y[i] = [np.nan if r["result"].get(k) is None else float(r["result"][k]) for k in OUTPUTS]
-    kinds = [c[0] for c in parts["cases"]]
     n_plain = len(parts["x"])
     y_plain = y[:n_plain]
     ys = {k: y_plain[:, j] for j, k in enumerate(OUTPUTS)}
@@ -639,7 +638,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
             else:
                 sob[k] = {"error": f"{int(np.sum(~np.isfinite(col)))} failed evaluations: Sobol' indices need all"}
         result["sensitivity_sobol"] = sob
-    result["what_if"] = _what_if(parts, kinds, y, n_plain, specs)
+    result["what_if"] = _what_if(parts, y, specs)
     result["ranked_sensitivities"] = _ranking(result)
     _write_outputs(out, cfg, plan, parts, y_plain, status[:n_plain], ids[:n_plain], specs, result)
     result["output_dir"] = str(out)
@@ -647,7 +646,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     return result
 
 
-def _what_if(parts, kinds, y, n_plain, specs) -> dict[str, Any]:
+def _what_if(parts, y, specs) -> dict[str, Any]:
     m = parts["what_if_m"]
     if m == 0:
         return {"samples": 0, "rows": []}
