@@ -1,21 +1,36 @@
-"""Benchmark of the rigid reducer model: wall time per simulated second (real-time
-factor), steps/s, Newton iterations and the share of time spent in the Python
-force-element groups, for each preset at the default step.
+"""Benchmark of the rigid reducer model: force residual and Jacobian cost per call,
+real-time factor and the TE statistics (so speed never buys a different answer).
 
-Run:  python benchmarks/bench_rigid.py [--t-end 0.05] [--dt 1e-4] [--profile]
+Run:  python benchmarks/bench_rigid.py [--t-end 0.05] [--dt 1e-4] [--presets rv40e rv221]
 
-The run starts at rated speed (ramps shortened to 5 ms) so the timing measures
-steady operation under the preset's load torque. Every group is evaluated once
-before the timed run, so the one-time load of the numba-compiled kernels
-(printed as warm-up) is not counted in the solve time.
+The run starts at rated speed (speed and load ramps shortened to 5 ms) so the
+timing measures steady operation under the preset's load torque. Printed per preset:
+
+* ``residual`` / ``jacobian``: wall µs per call of the Python force user
+  function(s) and Jacobian user function(s) during the run (all groups of one
+  residual together);
+* ``generalized_forces``: µs per call of ``AssembledModel.generalized_forces`` with
+  the Jacobian at a loaded state (the quasi-static solver's path);
+* real-time factor = solve wall s per simulated s, and post-processing wall s
+  (outputs of every group recomputed from the recorded states; one-time imports
+  excluded);
+* TE mean and peak-to-peak over t > 0.02 s [arcsec].
+
+It runs unchanged on the code before issue 15 (one Python element per group) and
+after (one fused compiled element), so both sides of a comparison come from the
+same script. One-time numba compilation/loading is done before timing.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def _fast(name: str):
@@ -27,92 +42,110 @@ def _fast(name: str):
 
 
 def _instrument(model):
-    """Wrap each group's evaluate/jacobian to accumulate wall time."""
-    acc = {}
-    for g in model.groups:
-        acc[g.name] = [0.0, 0.0]
-        ev, jac = g.evaluate, getattr(g, "jacobian", None)
+    """Accumulate wall time and calls of the Python force/Jacobian user functions:
+    the fused element (``model.fused``) if present, else every group's
+    evaluate/jacobian (one residual = one call of every group)."""
+    acc = {"res": [0.0, 0], "jac": [0.0, 0]}
 
-        def timed_ev(t, q, v, want_outputs=False, _ev=ev, _a=acc[g.name]):
-            if np.ndim(q) != 1:  # post-processing of the time history: not solver time
-                return _ev(t, q, v, want_outputs)
+    def wrap(obj, attr, key, count=True, single_state_only=False):
+        fn = getattr(obj, attr)
+
+        def timed(*args, **kw):
+            if single_state_only and np.ndim(args[1]) != 1:  # post-processing, not solver time
+                return fn(*args, **kw)
             t0 = time.perf_counter()
-            r = _ev(t, q, v, want_outputs)
-            _a[0] += time.perf_counter() - t0
+            r = fn(*args, **kw)
+            acc[key][0] += time.perf_counter() - t0
+            acc[key][1] += count
             return r
 
-        def timed_jac(t, q, v, _jac=jac, _a=acc[g.name]):
-            t0 = time.perf_counter()
-            r = _jac(t, q, v)
-            _a[1] += time.perf_counter() - t0
-            return r
+        setattr(obj, attr, timed)
 
-        g.evaluate = timed_ev
-        if jac is not None:
-            g.jacobian = timed_jac
+    fused = getattr(model, "fused", None)
+    if fused is not None:
+        wrap(fused, "residual", "res")
+        wrap(fused, "jacobian", "jac")
+    else:
+        python_groups = [g for g in model.groups if type(g).__name__ != "RigidMainBearing"]
+        for i, g in enumerate(python_groups):
+            wrap(g, "evaluate", "res", count=(i == 0), single_state_only=True)
+            if g.analytic_jacobian:
+                wrap(g, "jacobian", "jac", count=(i == 0))
     return acc
 
 
-def _warm_up(model) -> float:
-    """Evaluate every group once at the initial state (loads the numba-compiled
-    kernels, a one-time cost per process of ~1 s, ~40 s on the very first run
-    while numba compiles and caches them); return its wall time [s]."""
+def _loaded_state(model):
+    """A state with the discs turned into the pins and the drive flanks loaded."""
+    q = model.q0.copy()
+    for k in range(model.params.n_discs):
+        q[model.slice(f"disc{k}").start + 2] += 1.5e-4
+    for j in range(model.params.n_cranks):
+        q[model.slice(f"crank{j}").start + 2] += 5e-5
+    return q
+
+
+def _gf_time(model, reps: int = 300) -> float:
+    """µs per call of generalized_forces(t, q, v) with the Jacobian."""
+    q, v = _loaded_state(model), np.zeros(model.n)
+    model.generalized_forces(0.0, q, v)
     t0 = time.perf_counter()
-    q0, v0 = model.q0, np.zeros(model.n)
-    for g in model.groups:
-        g.evaluate(0.0, model.group_state(g, q0), model.group_state(g, v0))
-        if g.analytic_jacobian:
-            g.jacobian(0.0, model.group_state(g, q0), model.group_state(g, v0))
-        g.reset()
-    return time.perf_counter() - t0
+    for i in range(reps):
+        model.generalized_forces(0.0, q + 1e-9 * (i % 7), v)
+    return (time.perf_counter() - t0) / reps * 1e6
 
 
-def bench(name: str, t_end: float, dt: float, profile: bool = False) -> dict:
+def bench(name: str, t_end: float, dt: float) -> dict:
     from flexrv.simulation import Simulation
 
     sim = Simulation(_fast(name))
     model = sim.build()
-    t_warm = _warm_up(model)
+    t0 = time.perf_counter()
+    gf_us = _gf_time(model, reps=3)  # loads/compiles the kernels
+    import xarray as xr
+
+    xr.Variable(("t",), np.zeros(3))  # one-time imports of the results path (~0.4 s), not post-processing cost
+    t_warm = time.perf_counter() - t0
+    gf_us = _gf_time(model)
     acc = _instrument(model)
     t0 = time.perf_counter()
-    if profile:
-        import cProfile
-        import pstats
-
-        pr = cProfile.Profile()
-        pr.enable()
-    sim.run(t_end=t_end, dt=dt)
-    if profile:
-        pr.disable()
-        pstats.Stats(pr).sort_stats("tottime").print_stats(15)
+    res = sim.run(t_end=t_end, dt=dt)
     total = time.perf_counter() - t0
     tm = sim.timing
     solve = tm["solve_s"]
-    py = sum(a[0] + a[1] for a in acc.values())
+    te = res["te"]
+    sel = te.values[te["time"].values > 0.02]
     return {"preset": name, "dt_s": dt, "simulated_s": tm["simulated_s"], "solve_wall_s": solve,
             "post_wall_s": total - solve, "real_time_factor": solve / tm["simulated_s"],
-            "steps": tm["steps"], "steps_per_s": tm["steps"] / solve,
-            "newton_iterations_per_step": tm["newton_iterations"] / max(tm["steps"], 1),
+            "steps": tm["steps"], "newton_iterations_per_step": tm["newton_iterations"] / max(tm["steps"], 1),
             "jacobian_updates": tm["jacobians"], "warm_up_s": t_warm,
-            "user_function_share": py / solve,
-            "group_time_s": {k: round(a[0] + a[1], 3) for k, a in acc.items()}}
+            "residual_us": acc["res"][0] / max(acc["res"][1], 1) * 1e6, "residual_calls": acc["res"][1],
+            "jacobian_us": acc["jac"][0] / max(acc["jac"][1], 1) * 1e6, "jacobian_calls": acc["jac"][1],
+            "user_function_share": (acc["res"][0] + acc["jac"][0]) / solve, "generalized_forces_us": gf_us,
+            "te_mean_arcsec": float(np.mean(sel)), "te_pp_arcsec": float(np.ptp(sel)),
+            "status": res.attrs.get("status", "?") if hasattr(res, "attrs") else "?"}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=0.05)
     ap.add_argument("--dt", type=float, default=1e-4)
-    ap.add_argument("--profile", action="store_true")
     ap.add_argument("--presets", nargs="*", default=["rv40e", "rv221"])
     a = ap.parse_args()
+    import flexrv
+
+    print(f"flexrv from {os.path.dirname(flexrv.__file__)}")
     for name in a.presets:
-        r = bench(name, a.t_end, a.dt, a.profile)
+        r = bench(name, a.t_end, a.dt)
         print(f"{r['preset']}: dt = {r['dt_s']:g} s, {r['steps']} steps for {r['simulated_s']:.3g} s simulated")
-        print(f"  solve wall {r['solve_wall_s']:.2f} s  -> real-time factor {r['real_time_factor']:.1f} "
-              f"(wall s per simulated s), {r['steps_per_s']:.0f} steps/s")
-        print(f"  Newton iterations/step {r['newton_iterations_per_step']:.2f}, Jacobian updates {r['jacobian_updates']}")
-        print(f"  Python force-element share of solve time {100 * r['user_function_share']:.0f} %: {r['group_time_s']}")
-        print(f"  post-processing {r['post_wall_s']:.2f} s; warm-up before timing (numba load) {r['warm_up_s']:.2f} s")
+        print(f"  residual {r['residual_us']:.1f} us/call ({r['residual_calls']} calls), "
+              f"jacobian {r['jacobian_us']:.1f} us/call ({r['jacobian_calls']} calls), "
+              f"user functions {100 * r['user_function_share']:.0f} % of solve")
+        print(f"  generalized_forces with Jacobian {r['generalized_forces_us']:.1f} us/call")
+        print(f"  solve wall {r['solve_wall_s']:.2f} s -> real-time factor {r['real_time_factor']:.2f}; "
+              f"post-processing {r['post_wall_s']:.2f} s; Newton iterations/step "
+              f"{r['newton_iterations_per_step']:.2f}, Jacobian updates {r['jacobian_updates']}")
+        print(f"  TE (t > 0.02 s): mean {r['te_mean_arcsec']:.4f} arcsec, p-p {r['te_pp_arcsec']:.4f} arcsec")
+        print(f"  warm-up (numba load/compile) {r['warm_up_s']:.2f} s")
 
 
 if __name__ == "__main__":

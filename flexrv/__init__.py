@@ -6,7 +6,29 @@ Pipeline: design (validated presets) -> geometry -> meshing -> fem/cms -> contac
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from flexrv._version import __version__  # noqa: F401
+
+#: Layer order of the package, lowest first: a module may import from its own layer and the
+#: layers below it, never from a layer above (tests/test_layers.py checks every import,
+#: including those inside functions, and that modules import no cycle). Each entry names the
+#: top-level modules or subpackages of ``flexrv`` in that layer; the package root
+#: (``flexrv/__init__.py``, a facade) and ``flexrv/__main__.py`` (-> cli) are outside the order.
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("units", "errors", "cache", "references", "_version"),  # base utilities, no flexrv imports
+    ("design",),  # validated design model and presets
+    ("geometry",),  # kinematics, involute, cycloid and bearing geometry
+    ("contact",),  # contact laws (Hertz, EHL-corrected laws)
+    ("ehl",),  # closed-form films, numerical EHL solver, solver maps
+    ("analysis",),  # analytic design calculations (pin loads, stiffness, life, report)
+    ("meshing",),  # gmsh part meshes
+    ("fem",),  # FE assembly, modes, reduction
+    ("model",),  # Exudyn multibody model: members and force groups
+    ("post",),  # results, statistics, spectra, I/O
+    ("viz",),  # plots and 3-D views
+    ("simulation",),  # Simulation: build, run, save
+    ("sweep", "studies", "workflows"),  # orchestration of many runs
+    ("cli",),  # command line
+)
 
 from flexrv.design import list_presets, load  # noqa: F401
 

@@ -12,6 +12,7 @@ import contextlib
 import hashlib
 import json
 import os
+import re
 import tempfile
 from pathlib import Path
 from typing import Any, Iterator
@@ -20,15 +21,25 @@ import math
 
 import numpy as np
 
-#: Root of the mesh / reduced-body / EHL-map cache (``meshes/`` at the repo top
-#: level, overridable with the environment variable ``FLEXRV_CACHE``).
+#: environment variable overriding the cache location (``FLEXRV_CACHE`` is the
+#: older name, still honoured)
+CACHE_ENV = "FLEXRV_CACHE_DIR"
+
+
 def cache_dir() -> Path:
-    """Directory of cached meshes and reduced bodies (created on demand)."""
-    root = os.environ.get("FLEXRV_CACHE")
+    """Directory of cached meshes, reduced bodies and EHL maps (created on demand):
+    ``$FLEXRV_CACHE_DIR`` (or ``$FLEXRV_CACHE``) if set, else the user cache
+    directory of the platform (``~/.cache/flexrv`` on Linux, via platformdirs)."""
+    root = os.environ.get(CACHE_ENV) or os.environ.get("FLEXRV_CACHE")
     if root:
         path = Path(root)
     else:
-        path = Path(__file__).resolve().parent.parent / "meshes"
+        try:
+            from platformdirs import user_cache_dir
+
+            path = Path(user_cache_dir("flexrv", appauthor=False))
+        except ImportError:  # platformdirs missing: the XDG default
+            path = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "flexrv"
     path.mkdir(parents=True, exist_ok=True)
     return path
 
@@ -51,12 +62,22 @@ def _canonical(obj: Any) -> Any:
     return obj
 
 
+def flexrv_version() -> str:
+    """flexrv's own version (part of every cache key and sweep case id)."""
+    from flexrv._version import __version__
+
+    return __version__
+
+
 def library_versions(*names: str) -> dict[str, str]:
-    """Installed versions of the named distributions (part of every cache key)."""
+    """Installed versions of the named distributions, and always flexrv's own
+    version (part of every cache key: a new flexrv never serves an old entry)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    out = {}
+    out = {"flexrv": flexrv_version()}
     for name in names:
+        if name == "flexrv":
+            continue
         try:
             out[name] = version(name)
         except PackageNotFoundError:
@@ -70,10 +91,56 @@ def content_hash(*parts: Any, length: int = 16) -> str:
     return hashlib.sha256(payload.encode()).hexdigest()[:length]
 
 
+_TMP_RE = re.compile(r"^\.(?P<name>.+)\.(?P<pid>\d+)\.[A-Za-z0-9_]+\.tmp")
+
+
+def _umask() -> int:
+    """The process umask (read by setting and restoring it)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, another user's
+        return True
+    return True
+
+
+def remove_stale_temp_files(directory: str | os.PathLike) -> list[Path]:
+    """Delete the temporary files of atomic writes that were killed before their
+    rename (``.<name>.<pid>.<random>.tmp<suffix>``) in ``directory``: those of
+    processes that no longer exist. Returns the removed paths."""
+    removed = []
+    d = Path(directory)
+    if not d.is_dir():
+        return removed
+    for path in d.glob(".*.tmp*"):
+        match = _TMP_RE.match(path.name)
+        if match is None:
+            continue
+        pid = int(match["pid"])
+        if pid == os.getpid() or _pid_alive(pid):
+            continue
+        with contextlib.suppress(OSError):
+            path.unlink()
+            removed.append(path)
+    return removed
+
+
 @contextlib.contextmanager
 def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path next to ``target``; rename it onto ``target`` on
     success, delete it on failure.
+
+    The file gets the mode of an ordinary new file (0666 minus the umask, not
+    the 0600 of a temporary file). The temporary name carries the writer's pid,
+    so the leftovers of a writer that was killed mid-save are deleted by the next
+    save into the same directory (:func:`remove_stale_temp_files`).
 
     Examples
     --------
@@ -82,11 +149,14 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
     """
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + target.suffix, dir=target.parent)
+    remove_stale_temp_files(target.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp" + target.suffix,
+                               dir=target.parent)
     os.close(fd)
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        os.chmod(tmp_path, 0o666 & ~_umask())
         os.replace(tmp_path, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -131,3 +201,120 @@ def to_jsonable(obj: Any) -> Any:
     if isinstance(obj, np.bool_):
         return bool(obj)
     return obj
+
+
+# ------------------------------------------------------------------ verified cache entries
+#: suffix of the stamp written next to every cached file: its key, size and sha256
+STAMP_SUFFIX = ".stamp.json"
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _stamp_path(path: Path) -> Path:
+    return path.with_name(path.name + STAMP_SUFFIX)
+
+
+def stamp_entry(paths, key: str) -> None:
+    """Record, next to each file of a freshly written cache entry, the entry's key
+    and the file's size and sha256 (read back by :func:`entry_problem`)."""
+    for path in map(Path, paths):
+        stamp = {"key": key, "size": path.stat().st_size, "sha256": _sha256(path), "flexrv": flexrv_version()}
+        atomic_write_text(_stamp_path(path), json.dumps(stamp))
+
+
+def entry_problem(paths, key: str) -> str | None:
+    """None if every file of a cache entry exists and matches its stamp (same key,
+    size and sha256); otherwise why not ("missing" if no file exists at all)."""
+    paths = [Path(p) for p in paths]
+    if not any(p.exists() for p in paths):
+        return "missing"
+    for path in paths:
+        if not path.exists():
+            return f"{path.name} is missing"
+        stamp_file = _stamp_path(path)
+        try:
+            stamp = json.loads(stamp_file.read_text())
+        except (OSError, ValueError):
+            return f"{path.name} has no valid stamp (written by an older flexrv or interrupted)"
+        if stamp.get("key") != key:
+            return f"{path.name} belongs to another key ({stamp.get('key')!r})"
+        size = path.stat().st_size
+        if size != stamp.get("size"):
+            return f"{path.name} is truncated or altered ({size} bytes, {stamp.get('size')} expected)"
+        if _sha256(path) != stamp.get("sha256"):
+            return f"{path.name} content does not match its hash"
+    return None
+
+
+def cache_notice(path, reason: str) -> None:
+    """The one-line notice of a cache entry that is rebuilt."""
+    import sys
+
+    print(f"flexrv: cache entry {Path(path).name}: {reason}; rebuilding it", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def build_lock(path, enabled: bool = True) -> Iterator[None]:
+    """Exclusive lock of one cache entry while it is built (``<path>.lock``, fcntl),
+    so concurrent builders of the same entry do the work once: the second waits,
+    then finds the entry valid. No-op where fcntl is unavailable or ``enabled`` is False."""
+    if not enabled:
+        yield
+        return
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        yield
+        return
+    lock_path = Path(path).with_name(Path(path).name + ".lock")
+    lock_path.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock_path, "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
+def cached_entry(paths, key: str, load, build, enabled: bool = True):
+    """Load a verified cache entry, or build it once under its lock.
+
+    ``paths``: the entry's files; ``load()`` reads them (called only when every
+    file matches its stamp); ``build()`` computes the value and writes the files
+    (atomically) and returns the value; the files are then stamped. A corrupt,
+    truncated, foreign or unreadable entry is rebuilt with a one-line notice on
+    stderr. Returns (value, cached: bool)."""
+    paths = [Path(p) for p in paths]
+    if not enabled:  # no reuse; what is written is still stamped for later runs
+        value = build()
+        if all(p.exists() for p in paths):
+            stamp_entry(paths, key)
+        return value, False
+
+    def try_load():
+        problem = entry_problem(paths, key)
+        if problem is None:
+            try:
+                return load(), None
+            except Exception as exc:  # unreadable although stamped (foreign writer): rebuild
+                problem = f"unreadable ({type(exc).__name__}: {exc})"
+        return None, problem
+
+    value, problem = try_load()
+    if problem is None:
+        return value, True
+    with build_lock(paths[0]):
+        value, problem2 = try_load()  # built by another process while we waited
+        if problem2 is None:
+            return value, True
+        if problem != "missing":
+            cache_notice(paths[0], problem)
+        value = build()
+        stamp_entry(paths, key)
+    return value, False

@@ -35,6 +35,7 @@ import itertools
 import json
 import math
 import os
+import re
 import time
 import tomllib
 import traceback
@@ -88,13 +89,25 @@ class SweepSpec:
         return out
 
 
+#: a sweep name: one path component of letters, digits, ``._-`` (results/<name>/)
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
+
+
+def _require(cond: bool, path, key: str, message: str) -> None:
+    if not cond:
+        raise ConfigError(f"{path}: {key}: {message}")
+
+
 def load_spec(path: str | os.PathLike) -> SweepSpec:
-    """Read and validate a sweep spec TOML; :class:`ConfigError` names the problem."""
+    """Read and validate a sweep spec TOML completely (before any case runs);
+    :class:`ConfigError` names the key, the value and what is allowed."""
+    from flexrv.design import read_text_file
+
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"sweep spec {str(path)!r} does not exist")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_text_file(path, "sweep spec"))
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: invalid TOML: {exc}") from None
     unknown = set(data) - _SPEC_KEYS
@@ -103,21 +116,102 @@ def load_spec(path: str | os.PathLike) -> SweepSpec:
     for key in ("name", "preset", "task", "outputs"):
         if key not in data:
             raise ConfigError(f"{path}: missing required sweep field {key!r}")
-    if not isinstance(data["outputs"], list) or not all(isinstance(o, str) for o in data["outputs"]):
-        raise ConfigError(f"{path}: 'outputs' must be a list of dotted result keys")
+    for key in ("name", "preset", "task", "description"):
+        if key in data:
+            _require(isinstance(data[key], str), path, key, f"must be a string, got {data[key]!r}")
+    name = data["name"]
+    _require(bool(_NAME_RE.match(name)) and ".." not in name, path, "name",
+             f"{name!r} is not allowed: one folder name of letters, digits and ._- (no path separators, no '..'), "
+             "the sweep writes to results/<name>/")
+    if not isinstance(data["outputs"], list) or not all(isinstance(o, str) and o for o in data["outputs"]):
+        raise ConfigError(f"{path}: outputs: must be a list of dotted result keys (strings), got {data['outputs']!r}")
+    _require(len(set(data["outputs"])) == len(data["outputs"]), path, "outputs", "duplicate keys")
+    options = data.get("options", {})
+    _require(isinstance(options, dict), path, "options",
+             f"must be a table of keyword arguments of the task ([options]), got {options!r}")
     grid = data.get("grid", {})
+    _require(isinstance(grid, dict), path, "grid",
+             f"must be a table of dotted design fields -> lists of values ([grid]), got {grid!r}")
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
-            raise ConfigError(f"{path}: grid.{key} must be a non-empty list of values")
+            raise ConfigError(f"{path}: grid.{key} must be a non-empty list of values, got {values!r}")
+        for v in values:
+            _require(not isinstance(v, (dict, list)), path, f"grid.{key}", f"values must be scalars, got {v!r}")
     cases = data.get("cases", [])
+    _require(isinstance(cases, list) and all(isinstance(c, dict) for c in cases), path, "cases",
+             f"must be an array of tables ([[cases]]) of dotted design fields -> values, got {cases!r}")
+    for i, case in enumerate(cases):
+        _require(bool(case), path, f"cases[{i}]", "is empty")
     if not grid and not cases:
         raise ConfigError(f"{path}: a sweep needs a [grid] or [[cases]]")
-    spec = SweepSpec(name=str(data["name"]), preset=str(data["preset"]), task=str(data["task"]),
-                     outputs=list(data["outputs"]), options=dict(data.get("options", {})), grid=dict(grid),
+    spec = SweepSpec(name=name, preset=data["preset"], task=data["task"],
+                     outputs=list(data["outputs"]), options=dict(options), grid=dict(grid),
                      cases=list(cases), description=str(data.get("description", "")))
     if spec.task not in TASKS and ":" not in spec.task:
         raise ConfigError(f"{path}: task {spec.task!r} is neither a built-in task {sorted(TASKS)} nor 'module:function'")
     return spec
+
+
+def check_task(spec: SweepSpec) -> Callable[..., dict]:
+    """Import the spec's task and check its options against its signature (before
+    any case runs); ConfigError naming the task or option otherwise."""
+    import inspect
+
+    try:
+        func = resolve_task(spec.task)
+    except (ImportError, AttributeError, ValueError) as exc:
+        raise ConfigError(f"task {spec.task!r} cannot be imported: {type(exc).__name__}: {exc}") from None
+    if not callable(func):
+        raise ConfigError(f"task {spec.task!r} is not a function")
+    try:
+        sig = inspect.signature(func)
+    except (TypeError, ValueError):
+        return func
+    params = list(sig.parameters.values())[1:]
+    if not any(p.kind is p.VAR_KEYWORD for p in params):
+        allowed = [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+        bad = sorted(set(spec.options) - set(allowed))
+        if bad:
+            raise ConfigError(f"options.{bad[0]}: not an option of task {spec.task!r}; allowed: {allowed}")
+    return func
+
+
+def known_outputs(spec: SweepSpec, base) -> set[str] | None:
+    """Dotted output keys the task produces, if knowable before running: a task
+    function's ``outputs`` attribute, or (built-in ``design``) the keys of the
+    design report of the base design. None if unknown (checked after the run)."""
+    func = check_task(spec)
+    declared = getattr(func, "outputs", None)
+    if declared is not None:
+        return set(declared)
+    if spec.task == "design":
+        from flexrv.cache import to_jsonable
+
+        return set(_dotted_keys(to_jsonable(func(base, **spec.options))))
+    return None
+
+
+def _dotted_keys(node: Any, prefix: str = "") -> list[str]:
+    out = []
+    if isinstance(node, dict):
+        for k, v in node.items():
+            out += _dotted_keys(v, f"{prefix}{k}.")
+    else:
+        out.append(prefix[:-1])
+    return out
+
+
+def check_outputs(spec: SweepSpec, keys: set[str] | None) -> None:
+    """ConfigError for an output key the task does not produce."""
+    if keys is None:
+        return
+    for o in spec.outputs:
+        if o not in keys:
+            import difflib
+
+            close = difflib.get_close_matches(o, sorted(keys), n=3)
+            hint = f"; did you mean {', '.join(close)}?" if close else ""
+            raise ConfigError(f"outputs: {o!r} is not an output of task {spec.task!r}{hint}")
 
 
 # ------------------------------------------------------------------ case logic
@@ -176,11 +270,13 @@ def build_cases(spec: SweepSpec) -> list[Case]:
     """Expand the spec into cases with stable ids (hash of design, task, options)."""
     from flexrv.design import load
 
+    from flexrv.cache import flexrv_version
+
     base = load(spec.preset).model_dump(mode="python")
     cases = []
     for overrides in spec.variations():
         design = apply_overrides(base, overrides)
-        cid = content_hash(design, spec.task, spec.options, length=12)
+        cid = content_hash(design, spec.task, spec.options, flexrv_version(), length=12)
         cases.append(Case(case_id=cid, overrides=overrides, design=design))
     return cases
 
@@ -238,16 +334,32 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
     """
     from dask.distributed import Client, LocalCluster, as_completed
 
+    from flexrv.design import load
+
+    if n_workers is not None and (isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1):
+        raise ConfigError(f"--workers {n_workers!r}: must be an integer >= 1")
     out = Path(out_dir) if out_dir else Path("results") / spec.name
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / "spec.json", json.dumps(spec.__dict__, indent=1, default=str))
+    # everything checked before any case runs: design overrides, task, options, outputs
     cases = build_cases(spec)
+    output_keys = known_outputs(spec, load(spec.preset))
+    check_outputs(spec, output_keys)
+    if scheduler:  # reachable? (before anything is written)
+        connect_scheduler(scheduler).close()
+    out.mkdir(parents=True, exist_ok=True)
+    spec_json = json.dumps(spec.__dict__, indent=1, default=str)
+    spec_path = out / "spec.json"
+    changed = spec_path.exists() and spec_path.read_text() != spec_json
+    atomic_write_text(spec_path, spec_json)
+    if changed or not (out / "table.csv").exists():
+        # the table always matches spec.json: rebuilt now (pending cases marked "missing"),
+        # so a rerun killed before its end never leaves the table of an older spec
+        write_table(spec, cases, out)
     todo = pending_cases(out, cases, retry_failed)
     failed = 0
     if todo:
         cluster = None
         if scheduler:
-            client = Client(scheduler)
+            client = connect_scheduler(scheduler)
         else:
             workers = n_workers or os.cpu_count() or 1
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
@@ -274,8 +386,38 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
                 cluster.close()
     csv_path, nc_path, plots = write_table(spec, cases, out)
     total_failed = sum(json.loads(case_file(out, c).read_text()).get("status") != "ok" for c in cases)
+    if output_keys is None:
+        _check_outputs_after(spec, cases, out)
     return SweepSummary(out_dir=out, total=len(cases), computed=len(todo), skipped=len(cases) - len(todo),
                         failed=total_failed, table_csv=csv_path, table_nc=nc_path, plots=plots)
+
+
+def connect_scheduler(address: str, timeout_s: float = 5.0):
+    """A dask Client of the scheduler at ``address``; ConfigError within
+    ``timeout_s`` if it cannot be reached."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout=timeout_s)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        raise ConfigError(f"--scheduler {address}: cannot connect within {timeout_s:g} s "
+                          f"({type(exc).__name__}: {' '.join(str(exc).split())[:160]})") from None
+
+
+def _check_outputs_after(spec: SweepSpec, cases: list[Case], out: Path) -> None:
+    """Output keys of a task whose outputs are not declared: ConfigError naming a
+    key that none of the successful cases produced (the table column is all NaN)."""
+    results = []
+    for c in cases:
+        path = case_file(out, c)
+        if path.exists():
+            record = json.loads(path.read_text())
+            if record.get("status") == "ok":
+                results.append(record.get("result", {}))
+    if not results:
+        return
+    keys = set().union(*(_dotted_keys(r) for r in results))
+    check_outputs(spec, keys)
 
 
 def _progress(enabled: bool, total: int, done: int):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 
 import pytest
@@ -192,3 +193,100 @@ def test_reducer_is_frozen():
     with pytest.raises(Exception):
         r.name = "x"  # type: ignore[misc]
     assert isinstance(r, Reducer)
+
+
+def _dump(name):
+    return copy.deepcopy(load(name).model_dump(mode="python"))
+
+
+@pytest.mark.parametrize("name", list_presets())
+def test_strict_types(name):
+    """No string or boolean is coerced into a number, no float into an integer;
+    an integer (TOML ``12``) still loads into a float field, numpy scalars too."""
+    import numpy as np
+
+    data = _dump(name)
+    data["second_stage"]["disc_width_mm"] = int(data["second_stage"]["disc_width_mm"])
+    assert isinstance(from_dict(data).second_stage.disc_width_mm, float)
+    for section, field, bad in (("second_stage", "disc_width_mm", "12.0"),
+                                ("inertia", "input_shaft_inertia_kg_m2", True),
+                                ("second_stage", "disc_teeth", float(data["second_stage"]["disc_teeth"])),
+                                ("first_stage", "sun_teeth", "[/x]")):
+        d = _dump(name)
+        d[section][field] = bad
+        with pytest.raises(ConfigError, match=rf"{section}\.{field} = {re.escape(repr(bad))}"):
+            from_dict(d)
+    d = _dump(name)
+    d["second_stage"]["n_discs"] = np.int64(d["second_stage"]["n_discs"])
+    d["second_stage"]["disc_width_mm"] = np.float64(d["second_stage"]["disc_width_mm"])
+    assert from_dict(d) == load(name)
+
+
+@pytest.mark.parametrize("name", list_presets())
+def test_first_stage_contact_ratio(name):
+    """eps_alpha of the design model is the involute helper's value, and designs
+    outside 1 < eps_alpha < 2.5 are refused naming the profile shift. For the
+    unshifted rv40e pair (z 16/32, m 1.5, 20 deg, standard addendum) the textbook
+    formula eps = [sqrt(ra1^2-rb1^2) + sqrt(ra2^2-rb2^2) - a sin(alpha)] / (pi m cos(alpha))
+    gives 1.583 (computed independently below)."""
+    from flexrv.geometry.involute import contact_ratio
+
+    r = load(name)
+    fs = r.first_stage
+    assert fs.contact_ratio == pytest.approx(float(contact_ratio(fs.sun_teeth, fs.planet_teeth, fs.module,
+                                                                 fs.pressure_angle, fs.sun_profile_shift,
+                                                                 fs.planet_profile_shift)), rel=1e-12)
+    if name == "rv40e":
+        m, al = 1.5, math.radians(20.0)
+        ra1, ra2 = m * (16 + 2) / 2, m * (32 + 2) / 2
+        rb1, rb2 = m * 16 / 2 * math.cos(al), m * 32 / 2 * math.cos(al)
+        eps = (math.sqrt(ra1**2 - rb1**2) + math.sqrt(ra2**2 - rb2**2) - m * 24 * math.sin(al)) / (math.pi * m * math.cos(al))
+        assert fs.contact_ratio == pytest.approx(eps, rel=1e-9)
+        assert eps == pytest.approx(1.583, abs=1e-3)
+    for shifts in ((1.5, 1.5), (-1.0, -1.0)):
+        d = _dump(name)
+        d["first_stage"]["sun_profile_shift"], d["first_stage"]["planet_profile_shift"] = shifts
+        with pytest.raises(ConfigError, match="first_stage.sun_profile_shift.*eps_alpha"):
+            from_dict(d)
+
+
+@pytest.mark.parametrize("name", list_presets())
+def test_geometric_feasibility(name):
+    """Needles that do not fit on their pitch circle, needles longer than the disc,
+    a main bearing inside the crank-hole circle: refused naming the field."""
+    base = load(name)
+    nb, cs = base.needle_bearing, base.crankshaft
+    n_max = int(math.pi * (cs.eccentric_journal_diameter_mm + nb.roller_diameter_mm) / nb.roller_diameter_mm)
+    d = _dump(name)
+    d["needle_bearing"]["roller_count"] = n_max
+    from_dict(d)  # the limit itself fits
+    d["needle_bearing"]["roller_count"] = n_max + 1
+    with pytest.raises(ConfigError, match=rf"needle_bearing.roller_count = {n_max + 1} .*<= {n_max}"):
+        from_dict(d)
+    d = _dump(name)
+    d["needle_bearing"]["roller_length_mm"] = base.second_stage.disc_width_mm + 0.5
+    with pytest.raises(ConfigError, match="needle_bearing.roller_length_mm"):
+        from_dict(d)
+    r_out = (base.first_stage.center_distance + base.crank_hole_radius) * 1e3
+    d = _dump(name)
+    mb = d["main_bearing"]
+    dm = 2 * r_out - 4.0
+    mb.update(pitch_diameter_mm=dm, inner_ring_bore_diameter_mm=dm - 20.0, outer_ring_outer_diameter_mm=dm + 20.0,
+              ball_diameter_mm=6.0, ball_count=20, ring_width_mm=8.0, row_spacing_mm=max(mb["row_spacing_mm"], 8.0))
+    with pytest.raises(ConfigError, match="main_bearing.pitch_diameter_mm.*crank-hole circle"):
+        from_dict(d)
+
+
+def test_design_report_load_sanity_warnings():
+    """Contact pressures above the ISO 76 static limits (4.2 GPa ball, 4.0 GPa line)
+    are flagged by name; the presets at their operating points are not."""
+    from flexrv.analysis.report import design_report
+    from flexrv.cli.design import load_sanity_warnings
+
+    fake = {"main_bearing": {"external": {"hertz_max_ball": {"inner_p_max_Pa": 4.3e9, "outer_p_max_Pa": 4.1e9}}},
+            "pin_loads": {"rated_torque": {"max_hertz_pressure_Pa": 4.05e9}}}
+    warnings = load_sanity_warnings(fake)
+    assert len(warnings) == 2
+    assert warnings[0].startswith("main_bearing.external.hertz_max_ball.inner_p_max_Pa = 4.3 GPa")
+    assert warnings[1].startswith("pin_loads.rated_torque.max_hertz_pressure_Pa = 4.05 GPa")
+    assert load_sanity_warnings(design_report(load("rv40e"))) == []

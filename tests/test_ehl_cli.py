@@ -4,6 +4,7 @@ import json
 import math
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from flexrv.cli import app
@@ -72,3 +73,21 @@ def test_ehl_grid_refinement_reported():
     res = CliRunner().invoke(app, args)
     out = json.loads(res.output)["outputs"]
     assert out["grid_converged"] and out["grid_change"] < 0.02 and out["grid_used"] >= 129
+
+
+def test_explicit_case_outside_the_model_is_flagged():
+    """A contact whose Hertz semi-axis reaches the radius of curvature (ry -> 1e30 m:
+    a = 34.7 m on rx = 5 mm) is reported with a warning naming the assumption; a
+    speed the solver cannot handle is one InputError naming the inputs, not a LinAlgError."""
+    from flexrv.cli.ehl import HERTZ_SIZE_LIMIT, ehl_case
+    from flexrv.errors import InputError
+
+    report, res = ehl_case("rv221", load_n=1000.0, speed_m_s=1.0, rx_m=0.005, ry_m=1e30, grid=65, grid_tol=None)
+    assert res.hertz_a > 0.005 and HERTZ_SIZE_LIMIT < 1
+    assert any("Hertz" in w for w in report["warnings"])
+    report, _ = ehl_case("rv221", load_n=1000.0, speed_m_s=1.0, rx_m=0.005, ry_m=0.05, grid=65, grid_tol=None)
+    assert not any("Hertz" in w for w in report.get("warnings", []))
+    with pytest.raises(InputError, match="--speed-m-s"):
+        ehl_case("rv221", load_n=1000.0, speed_m_s=1e-30, rx_m=0.005, ry_m=0.05, grid=65, grid_tol=None)
+    with pytest.raises(InputError, match="--load-n"):
+        ehl_case("rv221", load_n=-1.0, speed_m_s=1.0, rx_m=0.005, ry_m=0.05, grid=65, grid_tol=None)

@@ -13,15 +13,19 @@ less than ``grid_tol`` = 2 % from the next-coarser grid. Measured (one core):
 ====================  ======  =====  ===========  ===========  =========
 case                  Moes M  grid   change [%]   vs HD [%]    CPU [s]
 ====================  ======  =====  ===========  ===========  =========
-circ31                31      129    0.19         +0.7         0.6
+circ31                31      129    0.19         +1.7         0.6
 ell4 (ry/rx = 4)      260     129    1.23         -2.0         0.6
 rv221 ball (a/b 9)    720     129    0.66         +6.9         0.8
-circ260               260     257    0.75         +2.2         2.7
+circ260               260     257    0.75         +3.2         2.7
 ell10 (ry/rx = 10)    1300    257    0.68         -5.4         6.6
-circ640               640     513    0.31         +1.3         12.5
+circ640               640     513    0.31         +2.3         12.5
 ====================  ======  =====  ===========  ===========  =========
 
-Cases span Moes M = 31-1300, L = 6.7-13.6, ry/rx = 1-28.
+Cases span Moes M = 31-1300, L = 6.7-13.6, ry/rx = 1-28. "vs HD" uses the exact Hertz
+ellipticity (k = 1 for the circular cases, +1.0 % on the ratio against the earlier fitted
+k = 1.0339). "change" is that of h_c; the grid refinement now also requires h_min's change
+< 2 % (measured circ31 0.20 %, ell4 1.30 %, rv221 0.37 %, circ260 0.17 %), which did not
+change any grid chosen here.
 """
 
 import warnings
@@ -69,7 +73,8 @@ def test_default_solve_is_grid_converged(case):
     coarse = solve(case, (fine.grid - 1) // 2 + 1, refine=False)
     change = abs(fine.h_central / coarse.h_central - 1.0)
     assert change < 0.02
-    assert change == pytest.approx(fine.grid_change, abs=2e-3)
+    assert change == pytest.approx(fine.grid_change_central, abs=2e-3)
+    assert fine.grid_change == max(fine.grid_change_central, fine.grid_change_min)
     assert fine.load_error < 1e-3 and coarse.load_error < 1e-3
     hd, _ = hamrock_dowson(q, u, rx, ry, e, lub.viscosity, lub.pressure_viscosity)
     assert abs(fine.h_central / hd - 1.0) < 0.08
@@ -173,16 +178,58 @@ def test_incompressible_film_vs_nvm_with_roelands_alpha(case, measured):
 @pytest.mark.parametrize("moes_m", [10.0, 50.0, 200.0, 1000.0])
 def test_robust_over_the_ehl_map(moes_m, moes_l, ratio):
     """Robustness sweep, M = 10-1000, L = 5-20, ry/rx = 1-20 (36 cases; speed and load chosen
-    from L = G (2U)^(1/4), M = W (2U)^(-3/4)): the default solve converges and meets the 2 %
-    grid tolerance everywhere (measured 0.0-1.7 %, stopping at 129^2 to 513^2, 0.2-13 s);
+    from L = G (2U)^(1/4), M = W (2U)^(-3/4)): the default solve converges and h_c meets the 2 %
+    grid tolerance everywhere (measured 0.0-1.7 %, stopping at 129^2 to 513^2, 0.2-19 s); h_min
+    meets it everywhere except at M = 1000, L = 10, circular (6.5 % at 513^2, flagged);
     h_c within 12 % of Hamrock-Dowson for M >= 50 (measured 0.90-1.10; at M = 10 it
     reads 0.76-0.98, outside the formula's piezoviscous-elastic range)."""
     lub, e, rx = LUB, E, 0.01
     two_u = (moes_l / (lub.pressure_viscosity * e)) ** 4
     u = two_u / 2.0 * e * rx / lub.viscosity
     q = moes_m * two_u**0.75 * e * rx**2
-    res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
-    assert res.grid_converged and res.grid_change < 0.02 and res.load_error < 1e-3
+    if (moes_m, moes_l, ratio) == (1000.0, 10.0, 1.0):
+        # the one case where h_min is not grid-converged at 513^2: it changes by 6.5 % from the
+        # 257^2 value (narrow side lobes of a heavily loaded circular contact), h_c by 0.9 %;
+        # reported as not converged, with a warning naming both changes
+        with pytest.warns(RuntimeWarning, match="h_min by 6"):
+            res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
+        assert not res.grid_converged and res.grid == 513
+        assert res.grid_change_central < 0.02 and 0.04 < res.grid_change_min < 0.09
+    else:
+        res = solve_point_contact(q, u, rx, ratio * rx, e, lub)
+        assert res.grid_converged and res.grid_change < 0.02
+    assert res.load_error < 1e-3
     if moes_m >= 50:
         hd, _ = hamrock_dowson(q, u, rx, ratio * rx, e, lub.viscosity, lub.pressure_viscosity)
         assert abs(res.h_central / hd - 1.0) < 0.12
+
+
+@pytest.mark.parametrize("case", ["circ31", "rv221"])
+def test_h_min_at_the_accuracy_of_h_c(case):
+    """Issue 17 (1): the default solve's h_min is extrapolated like h_c (sub-grid minimum of
+    each level, order-2 Richardson) and takes part in the grid refinement. Checked against the
+    solver's own finer-grid value (257^2, extrapolated, no refinement): within 0.5 % (measured
+    circ31 +0.13 %, rv221 ball +0.05 % against 513^2). The previous default (the finest grid's
+    raw node minimum, kept as ``h_min_grid``) is 0.9-3.7 % low against 513^2; it must stay
+    further from the reference than 0.8 % here, so this test fails if h_min reverts to it."""
+    fine = solve(case, 257, refine=False)
+    default = solve(case)
+    assert default.grid == 129  # both cases stop at 129^2
+    assert abs(default.h_min / fine.h_min - 1.0) < 0.005
+    assert default.h_min_grid / fine.h_min - 1.0 < -0.008
+    # the reported value is the extrapolation of the two finest levels, and it is what converged
+    assert default.grid_change == max(default.grid_change_central, default.grid_change_min)
+    assert default.grid_change_min < 0.02
+    assert default.h_min < default.h_central
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case,measured", [("circ31", 0.0013), ("ell4", -0.0025), ("rv221", 0.0005),
+                                           ("circ260", -0.0008)])
+def test_h_min_vs_513(case, measured):
+    """The default h_min against the solver's 513^2 extrapolation: within 0.5 % (measured
+    +0.13, -0.25, +0.05, -0.08 %); the old raw node minimum read -0.94, -3.71, -2.30, -2.82 %."""
+    ref = solve(case, 513, refine=False)
+    default = solve(case)
+    assert default.h_min / ref.h_min - 1.0 == pytest.approx(measured, abs=0.002)
+    assert default.h_min_grid / ref.h_min - 1.0 < -0.008

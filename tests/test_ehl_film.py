@@ -49,6 +49,32 @@ def test_ellipticity_fit_matches_exact():
     assert np.max(np.abs(ellipticity_approx(0.01, 0.01 * ratio) / exact - 1.0)) < 0.035
 
 
+def test_circular_contact_ellipticity_is_one():
+    """Issue 17 (2): for a circular contact (ry = rx) the Hamrock-Dowson films use k = 1 (the
+    exact Hertz ellipticity; the fit 1.0339 (ry/rx)^0.636 gives 1.0339). Closed form written out
+    independently from Hamrock & Dowson (1977) / Hamrock (1994) eqs. 22.18-22.19 with k = 1;
+    rtol 1e-12. The fitted k would raise h_c by 1.0 % and h_min by 2.3 %: checked exactly as
+    (1 - 0.61 e^(-0.73 k)) and (1 - e^(-0.68 k)) ratios (1e-12)."""
+    rx = ry = 0.01
+    q, u = 100.0, 1.0
+    g = dimensionless_groups(q, u, rx, ry, E, ETA, ALPHA)
+    assert float(g.ellipticity) == 1.0
+    hc, hmin = hamrock_dowson(q, u, rx, ry, E, ETA, ALPHA)
+    uu, gg, ww = ETA * u / (E * rx), ALPHA * E, q / (E * rx**2)
+    assert hc == pytest.approx(2.69 * uu**0.67 * gg**0.53 * ww**-0.067 * (1 - 0.61 * np.exp(-0.73)) * rx, rel=1e-12)
+    assert hmin == pytest.approx(3.63 * uu**0.68 * gg**0.49 * ww**-0.073 * (1 - np.exp(-0.68)) * rx, rel=1e-12)
+    k_fit = float(ellipticity_approx(rx, ry))
+    assert k_fit == pytest.approx(1.0339, rel=1e-12)
+    hc_fit, hmin_fit = hamrock_dowson(q, u, rx, ry, E, ETA, ALPHA, ellipticity=k_fit)
+    assert hc_fit / hc - 1 == pytest.approx(0.0102, abs=5e-4)
+    assert hmin_fit / hmin - 1 == pytest.approx(0.0234, abs=5e-4)
+    # elliptical contacts: the exact k of the Hertz solution, also when rx > ry (k < 1)
+    for rx_, ry_ in ((0.01, 0.04), (0.04, 0.01)):
+        k = float(dimensionless_groups(q, u, rx_, ry_, E, ETA, ALPHA).ellipticity)
+        pc = point_contact(q, rx_, ry_, E)
+        assert k == pytest.approx(float(pc.a / pc.b), rel=1e-12)
+
+
 def test_pan_hamrock_line_scaling():
     """Line contact: h_c ~ (w/L)^-0.166 u^0.692 (Pan & Hamrock 1989); 1 m/s, 1 kN over 10 mm
     of R = 10 mm steel gives a film in the 0.1-1 um range."""

@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 from flexrv.analysis.pin_load import disc_effective_modulus, pin_load_distribution, reducer_pin_loads
 from flexrv.cli import app
 from flexrv.design import from_dict, load, loads, to_toml
-from flexrv.design.manufacturing import (ASSEMBLY_PENETRATION_LIMIT_UM, ManufacturingErrors, error_set_names,
-                                         load_error_set, with_errors)
+from flexrv.design import error_set_names, load_error_set, with_errors
+from flexrv.design.manufacturing import ASSEMBLY_PENETRATION_LIMIT_UM, ManufacturingErrors
 from flexrv.errors import ConfigError
 from flexrv.geometry.as_built import (as_built, as_built_pin_gap, assembly_disc_poses, assembly_penetration,
                                       profile_deviation)
@@ -256,8 +256,8 @@ BAD = [
      "errors.clearances.needle_extra_clearance_um[1][0]", "total needle clearance"),
     ({"clearances": {"support_clearance_um": -1.0}}, "errors.clearances.support_clearance_um", "0..500 um"),
     ({"pins": {"pin_size_um": 1.0}}, "errors.pins.pin_size_um", "unknown field"),
-    ({"pins": {"pin_radius_um": 30.0}}, "errors.pins", "penetrates disc"),
-    ({"discs": [{"rotation_arcmin": 10.0}, {}]}, "errors.discs", "penetrates disc"),
+    ({"pins": {"pin_radius_um": 30.0}}, "errors.pins:", "penetrates disc"),
+    ({"discs": [{"rotation_arcmin": 10.0}, {}]}, "errors.discs:", "penetrates disc"),
 ]
 
 
@@ -279,7 +279,7 @@ def test_interference_message_names_the_group():
     with pytest.raises(ConfigError) as info:
         _with({"pins": {"pin_radius_um": 30.0}})
     msg = str(info.value)
-    assert "errors = 'errors.pins'" in msg and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg and "25 um" in msg
+    assert "errors.pins: the as-built parts interfere" in msg and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg and "errors.pins alone: 25 um interference" in msg
     assert assembly_penetration(_with({"pins": {"pin_radius_um": 24.0}}))[0] == pytest.approx(19e-6, abs=1e-12)
 
 
@@ -332,15 +332,35 @@ def test_show_prints_nonzero_errors(tmp_path):
     assert "errors: none" in CliRunner().invoke(app, ["show", "rv40e"]).stdout
 
 
-def test_example_error_set_loads():
-    """The example grade-5 error set validates on rv40e: every group non-zero, within
-    the assembly limit, and the pin loads of both discs read it."""
-    assert "iso_grade5_rv40e" in error_set_names()
-    r = with_errors("rv40e", load_error_set("iso_grade5_rv40e"))
+@pytest.mark.parametrize("name", ["rv40e", "rv221"])
+def test_example_error_sets_load(name):
+    """The example grade-5 error sets validate on their presets: every group that
+    the file sets is non-zero, the assembly penetration stays within the limit, the
+    file is exactly what `python -m flexrv.workflows._error_sets` writes, and the pin loads
+    of both discs read it."""
+    from flexrv.workflows._error_sets import iso_grade5_toml
+
+    from flexrv.design import error_set_path
+
+    assert f"iso_grade5_{name}" in error_set_names()
+    assert error_set_path(f"iso_grade5_{name}").read_text() == iso_grade5_toml(name)
+    r = with_errors(name, load_error_set(f"iso_grade5_{name}"))
     groups = {path.split(".")[1].split("[")[0] for path, _ in r.errors.nonzero_items()}
     assert groups == {"pins", "discs", "cranks", "first_stage"}
     assert assembly_penetration(r)[0] < ASSEMBLY_PENETRATION_LIMIT_UM * M_PER_UM
-    nominal = reducer_pin_loads(load("rv40e"), 412.0)
-    assert reducer_pin_loads(r, 412.0, disc=1).max_force != nominal.max_force
+    nominal = reducer_pin_loads(load(name), r.operating.rated_torque_Nm)
+    assert reducer_pin_loads(r, r.operating.rated_torque_Nm, disc=1).max_force != nominal.max_force
+    other = "rv221" if name == "rv40e" else "rv40e"
     with pytest.raises(ConfigError):
-        with_errors("rv221", load_error_set("iso_grade5_rv40e"))  # 40 pin values on a 60-pin design
+        with_errors(other, load_error_set(f"iso_grade5_{name}"))  # wrong pin count for the other design
+
+
+def test_dotted_override_reaches_the_errors():
+    """Sweeps and tolerance studies set errors by dotted path like any other field
+    (flexrv.design.override), with the same validation."""
+    from flexrv.design import override
+
+    r = override("rv40e", {"errors.pins.pin_radius_um": 2.0})
+    np.testing.assert_array_equal(as_built(r).pin_radii, np.full(Z, r.second_stage.pin_radius + 2e-6))
+    with pytest.raises(ConfigError, match=r"errors\.pins\.pin_radius_um"):
+        override("rv40e", {"errors.pins.pin_radius_um": 501.0})

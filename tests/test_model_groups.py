@@ -32,8 +32,9 @@ def test_nominal_pose_is_conjugate(ideal_model):
     m = ideal_model
     q, v = m.q0, np.zeros(m.n)
     pins = next(g for g in m.groups if g.name == "pins")
-    gap, *_ = pins._exact(m.group_state(pins, q))
-    assert np.max(np.abs(gap)) < 1e-9
+    pins.reset()
+    pins.evaluate(0.0, m.group_state(pins, q), m.group_state(pins, v))
+    assert np.max(np.abs(pins.gap)) < 1e-9
     for g in m.groups:
         f, _ = g.evaluate(0.0, m.group_state(g, q), m.group_state(g, v))
         assert np.max(np.abs(f)) < 1e-3, g.name
@@ -129,30 +130,31 @@ def test_roller_load_distribution_stribeck():
     assert rollers.max() == pytest.approx(4.08 * f_r / z, rel=0.10)
 
 
-def test_merged_force_element_matches_one_element_per_group(monkeypatch):
-    """The merged Exudyn element (flexrv.model.base.add_merged: all Python groups
-    in one ObjectGenericODE2) sums the same group kernels as one element per
-    group, so a short loaded run gives the same TE and pin forces up to
-    round-off (rel. 1e-7; a mis-scattered coordinate block would change them
-    at order 1) with fewer Exudyn objects."""
-    import functools
-
-    import flexrv.model.factory as factory
+def test_fused_force_element_matches_the_groups():
+    """The rigid model's compiled groups share ONE Exudyn element
+    (flexrv.model.kernels.FusedForces: members' mass objects + 1 object), and its
+    residual at loaded states after a short run equals the sum of the groups' own
+    evaluate() (same kernels on the group's local vectors) to round-off (1e-9 of
+    the largest force; a mis-scattered coordinate block would differ at order 1)."""
+    from flexrv.model.assembled import group_index
     from flexrv.simulation import Simulation
 
     r = load("rv40e")
     op = r.operating.model_copy(update={"speed_ramp_time_s": 0.002, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.002})
-    r = r.model_copy(update={"operating": op})
-    out = {}
-    orig = factory.assemble
-    for merge in (True, False):
-        monkeypatch.setattr(factory, "assemble", functools.partial(orig, merge=merge))
-        sim = Simulation(r)
-        model = sim.build()
-        res = sim.run(t_end=0.003, dt=1e-4)
-        out[merge] = (model.mbs.systemData.NumberOfObjects(), res["te"].values, res["pin_force"].values)
-    (n_m, te_m, pf_m), (n_s, te_s, pf_s) = out[True], out[False]
-    assert n_m < n_s
-    assert np.max(np.abs(pf_s)) > 10.0  # the pins are loaded
-    np.testing.assert_allclose(te_m, te_s, rtol=0, atol=1e-7 * np.max(np.abs(te_s)))
-    np.testing.assert_allclose(pf_m, pf_s, rtol=0, atol=1e-7 * np.max(np.abs(pf_s)))
+    sim = Simulation(r.model_copy(update={"operating": op}))
+    model = sim.build()
+    assert model.mbs.systemData.NumberOfObjects() == len(model.members) + 1
+    res = sim.run(t_end=0.003, dt=1e-4)
+    assert np.max(np.abs(res["pin_force"].values)) > 10.0  # the pins are loaded
+    rng = np.random.default_rng(3)
+    for i in range(5):
+        q = model.q0.copy()
+        q[model.slice("disc0").start + 2] += 1e-4 * (i + 1)
+        q += rng.normal(scale=1e-7, size=q.shape)
+        v = rng.normal(scale=1e-3, size=q.shape)
+        f = model.fused.residual(0.001 * i, q, v).copy()
+        total = np.zeros(model.n)
+        for g in model.groups:
+            ix = group_index([model.members[n].offset for n in g.members], [model.members[n].n for n in g.members])
+            total[ix] += g.evaluate(0.001 * i, q[ix], v[ix])[0]
+        np.testing.assert_allclose(f, total, rtol=0, atol=1e-9 * np.abs(total).max())

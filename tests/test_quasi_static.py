@@ -88,8 +88,8 @@ def test_pin_loads_vs_analytic_distribution():
 
 
 def test_ideal_geometry_no_load_te_vanishes_and_loaded_does_not():
-    """Ideal geometry: the no-load TE (1 % of rated torque) is the elastic part
-    only, p-p below 2 % of the loaded p-p and below 0.01 arcsec (the kinematics are
+    """Ideal geometry: the no-load TE (extrapolated to zero torque) has no
+    kinematic part, p-p below 2 % of the loaded p-p and below 0.01 arcsec (the kinematics are
     exact: conjugate profile, no clearance); the loaded TE winds up by more than
     10 arcsec."""
     r = loaded_te(ideal("rv40e"), crank_revolutions=0.25, points_per_mesh=8, catalog_positions=1)
@@ -97,10 +97,11 @@ def test_ideal_geometry_no_load_te_vanishes_and_loaded_does_not():
     assert s["no_load_te_pp_arcsec"] < 0.01
     assert s["no_load_te_pp_arcsec"] < 0.02 * s["te_pp_arcsec"]
     assert s["te_mean_arcsec"] < -10.0
-    # no clearance anywhere: the backlash is the elastic twist between +-1 % of the rated torque, i.e.
-    # twice the no-load wind-up (the ideal reducer is symmetric under load reversal)
-    assert s["backlash_arcmin"] == pytest.approx(2 * abs(r.te_no_load[0]) * ARCMIN_PER_RAD, rel=1e-4)
+    # no clearance anywhere: the backlash is only the elastic twist between +-1 % of the rated torque,
+    # and the extrapolated no-load wind-up nearly vanishes: measured 7.5 % of the +1 % wind-up (the
+    # T^0.9 extrapolation leaves 15 % of the linear crank supports' share); required below 10 %
     assert s["backlash_arcmin"] < 0.05
+    assert abs(r.te_no_load[0]) * ARCMIN_PER_RAD < 0.10 * 0.5 * s["backlash_arcmin"]
 
 
 def test_mean_wind_up_equals_integrated_tangent_compliance():
@@ -242,3 +243,49 @@ def test_compliance_budget_predicts_a_stiffer_support():
     k = red.crankshaft.support_bearing_radial_stiffness_N_per_m
     c1, _ = compliance(override(red, {"crankshaft.support_bearing_radial_stiffness_N_per_m": 2 * k}))
     assert c1 == pytest.approx(c0 * (1 - budget["crank_supports"] / 2), abs=0.01 * c0)
+
+
+def _pins(red, field, values):
+    return override(red, {f"errors.pins.{field}": values})
+
+
+def test_uniform_tangential_pin_error_is_an_exact_offset():
+    """All pins moved tangentially by t = 2 um: the pin ring turned by
+    alpha = t / R_p. With the input held, the relative kinematics give
+    theta_out - alpha = (theta_in - alpha) / i, so TE rises by alpha (1 - 1/i)
+    at every position, loaded and unloaded (closed form; 6.366 arcsec for rv40e).
+    Tolerance 1e-3 relative; the TE ripple is unchanged to 1e-3 arcsec."""
+    base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
+    kw = dict(crank_revolutions=0.2, points_per_mesh=8, catalog_positions=1)
+    r0 = loaded_te(base, **kw)
+    r1 = loaded_te(_pins(base, "pin_tangential_position_um", 2.0), **kw)
+    alpha = 2e-6 / base.second_stage.pin_circle_radius * (1.0 - 1.0 / r0.ratio)
+    for d in (r1.te - r0.te, r1.te_no_load - r0.te_no_load):
+        assert d.mean() == pytest.approx(alpha, rel=1e-3)
+        assert np.ptp(d) * ARCSEC_PER_RAD < 1e-3
+
+
+def test_single_pin_tangential_error_bump_height():
+    """One pin moved tangentially by t = 2 um (towards its loaded flank): its gap
+    falls by t l_j / R_p (l_j its moment arm), so while it is the first contact the
+    disc turns t / R_p earlier and TE rises by t / R_p (1 - 1/i) = 6.366 arcsec
+    (closed form, independent of l_j). The no-load TE, extrapolated to zero torque
+    from paths at 1 % and 2 % of the rated torque, shows it +3.6 % (the load
+    moves between pins as it grows, which the T^0.9 extrapolation does not know;
+    +2.8 % and +1.2 % from 0.5 % and 0.25 %; one path at 1 % alone shows 76 %);
+    required within 5 %. Moved the other way, the pin only opens its gap:
+    no bump (< 0.2 arcsec)."""
+    base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
+    z = base.second_stage.pin_count
+    kw = dict(crank_revolutions=1.1, points_per_mesh=8, catalog_positions=1)
+    r0 = loaded_te(base, **kw)
+    expected = 2e-6 / base.second_stage.pin_circle_radius * (1.0 - 1.0 / r0.ratio)
+    for sign in (1.0, -1.0):
+        t = [0.0] * z
+        t[5] = 2.0 * sign
+        r1 = loaded_te(_pins(base, "pin_tangential_position_um", t), **kw)
+        d = r1.te_no_load - r0.te_no_load
+        if sign > 0:
+            assert d.max() == pytest.approx(expected, rel=0.05)
+        else:
+            assert np.max(np.abs(d)) * ARCSEC_PER_RAD < 0.2

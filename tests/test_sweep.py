@@ -99,3 +99,57 @@ def test_sweep_killed_and_resumed(tmp_path):
     # a second run computes nothing
     again = run_sweep(load_spec(spec_path), out_dir=out, n_workers=2, progress=False)
     assert again.computed == 0 and again.skipped == total
+
+
+def test_table_follows_a_changed_spec(tmp_path, monkeypatch):
+    """A rerun with a grown spec that is killed before its first case finishes
+    leaves a table.csv of the new spec (new cases marked missing), never the old one."""
+    import flexrv.sweep as sw
+
+    sys.path.insert(0, str(ROOT))
+    spec_path = tmp_path / "s.toml"
+    body = ('name = "grow"\npreset = "rv40e"\ntask = "tests.sweep_tasks:slow_ratio"\noutputs = ["kinematics.ratio"]\n'
+            '[grid]\n"second_stage.eccentricity_mm" = {values}\n')
+    spec_path.write_text(body.format(values="[1.0]"))
+    out = tmp_path / "out"
+    summary = run_sweep(load_spec(spec_path), out_dir=out, n_workers=1, progress=False)
+    assert summary.failed == 0
+    assert (out / "table.csv").read_text().count("\n") == 2
+
+    spec_path.write_text(body.format(values="[1.0, 1.1, 1.2]"))
+
+    def killed(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sw, "pending_cases", killed)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(load_spec(spec_path), out_dir=out, n_workers=1, progress=False)
+    rows = (out / "table.csv").read_text().strip().splitlines()[1:]
+    assert len(rows) == 3
+    assert sum('"ok"' in r for r in rows) == 1 and sum('"missing"' in r for r in rows) == 2
+
+
+def test_spec_validated_before_running(tmp_path):
+    head = 'name = "v"\npreset = "rv40e"\ntask = "design"\noutputs = ["kinematics.ratio"]\n'
+    grid = '[grid]\n"second_stage.eccentricity_mm" = [1.0]\n'
+    bad = tmp_path / "bad.toml"
+    for body, key in ((head + "grid = 5\n", "grid"), (head + "cases = 5\n", "cases"),
+                      (head + 'options = "x"\n' + grid, "options"),
+                      (head.replace('"v"', '"../v"') + grid, "name"),
+                      (head.replace('"v"', '"a/b"') + grid, "name")):
+        bad.write_text(body)
+        with pytest.raises(ConfigError, match=key):
+            load_spec(bad)
+    bad.write_text(head.replace("kinematics.ratio", "kinematics.ratioo") + grid)
+    with pytest.raises(ConfigError, match="kinematics.ratioo"):
+        run_sweep(load_spec(bad), out_dir=tmp_path / "o", progress=False)
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(ConfigError, match="--workers"):
+        run_sweep(load_spec(spec_path_ok(tmp_path, head + grid)), out_dir=tmp_path / "o", n_workers=0,
+                  progress=False)
+
+
+def spec_path_ok(tmp_path, body):
+    path = tmp_path / "ok.toml"
+    path.write_text(body)
+    return path

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from workflows.crank_bearing_forces import SMOKE, _design, crank_stress, hertz_and_life, max_load_instant
+from flexrv.workflows.crank_bearing_forces import SMOKE, _design, crank_stress, hertz_and_life, max_load_instant
 
 
 @pytest.fixture(scope="module")
@@ -104,7 +104,7 @@ def test_full_run_bearing_load_against_the_carrier_moment_balance(tmp_path):
     smaller); the most-loaded roller carries less than the whole bearing force and
     more than the Stribeck share 4.08 F / Z (Harris & Kotzalas, line contact,
     zero clearance); the Hertz pressure stays below 4 GPa (ISO 76)."""
-    from workflows.crank_bearing_forces import run
+    from flexrv.workflows.crank_bearing_forces import run
 
     r = run(tmp_path / "cbf", sweep=(1.3,))
     chk = r.numbers["bearing_load_check"]

@@ -15,7 +15,7 @@ def test_amplitude_at_recovers_sine_amplitudes():
     :func:`flexrv.post.spectra.amplitude_spectrum` a bin-centred sine shows its
     amplitude: both within 1 %; a line above the Nyquist band is NaN, not 0."""
     from flexrv.post.spectra import amplitude_spectrum
-    from workflows.crankshaft_flexibility import amplitude_at
+    from flexrv.workflows.crankshaft_flexibility import amplitude_at
 
     t = np.arange(0.0, 0.6, 1e-4)
     te = 2.0 * np.sin(2 * np.pi * 30.0 * t) + 0.5 * np.sin(2 * np.pi * 320.0 * t + 0.3) + 7.0
@@ -31,7 +31,7 @@ def test_table4_frequencies_follow_from_the_kinematics():
     (f_in - f_out) z_s / z_p = 10 Hz; carrier f_in / 81 = 0.25 Hz; first-stage mesh
     z_s (f_in - f_out) = 320 Hz; cycloid mesh z_c (f_crank) = 390 Hz (Willis; seed
     002 rounds). The workflow's table of seed numbers agrees to 1 % with these."""
-    from workflows.crankshaft_flexibility import SEED_TABLE4
+    from flexrv.workflows.crankshaft_flexibility import SEED_TABLE4
 
     f_in = 1215.0 / 60.0
     f_out = f_in / 81.0

@@ -1,4 +1,4 @@
-"""Smoke runs of the seed-study workflows (workflows/*.py) checked against closed
+"""Smoke runs of the seed-study workflows (flexrv/workflows/*.py) checked against closed
 forms and the seeds' numbers; and the ``flexrv workflow`` / ``flexrv report`` CLI."""
 
 from __future__ import annotations
@@ -20,21 +20,21 @@ def results_root(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def kinematic(results_root):
-    from workflows.kinematic_validation import run
+    from flexrv.workflows.kinematic_validation import run
 
     return run(results_root / "kinematic_validation", smoke=True)
 
 
 @pytest.fixture(scope="module")
 def torsional(results_root):
-    from workflows.torsional_stiffness import run
+    from flexrv.workflows.torsional_stiffness import run
 
     return run(results_root / "torsional_stiffness", smoke=True)
 
 
 @pytest.fixture(scope="module")
 def gallery(results_root):
-    from workflows.mode_gallery import run
+    from flexrv.workflows.mode_gallery import run
 
     return run(results_root / "mode_gallery", smoke=True)
 
@@ -53,7 +53,7 @@ def test_kinematic_validation(kinematic):
     assert n["rv40e"]["ratio_theory"] == pytest.approx(81.0, rel=1e-12)
     assert abs(n["rv40e"]["ratio_simulated"] / n["rv40e"]["ratio_theory"] - 1) < 5e-4
     seed = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
-            "cycloid_mesh": 390.0, "pin_passing": 400.0}
+            "cycloid_mesh": 390.0, "pins_x_crank_rotation": 400.0}
     for key, val in seed.items():
         assert n["rv40e_frequencies_hz"][key] == pytest.approx(val, rel=1e-9), key
     planet = n["rv221_planet_deg_s"]
@@ -94,13 +94,16 @@ def test_mode_gallery(gallery):
 
 
 def test_cli_report(kinematic, torsional, gallery, results_root):
-    """``flexrv report --json`` collects the three summaries into README.md."""
+    """``flexrv report --json`` collects the three summaries into the generated REPORT.md
+    (never README.md); the smoke runs' banner is carried into the report."""
     r = CliRunner().invoke(app, ["report", "--results", str(results_root), "--json"])
     assert r.exit_code == 0, r.output
     data = json.loads(r.output)
     assert data["sections"] == ["kinematic_validation", "mode_gallery", "torsional_stiffness"]
-    readme = (results_root / "README.md").read_text()
-    assert "(mode_gallery/rv40e_crankshaft_mode01.png)" in readme and "| 6-9 |" in readme
+    assert data["path"].endswith("REPORT.md") and not (results_root / "README.md").exists()
+    report = (results_root / "REPORT.md").read_text()
+    assert "(mode_gallery/rv40e_crankshaft_mode01.png)" in report and "| 6-9 |" in report
+    assert "SMOKE RUN" in report and "## References" in report
 
 
 def test_cli_workflow(tmp_path):
@@ -117,7 +120,7 @@ def test_ring_deformation_smoke(tmp_path):
     flexible rings deflect (> 0) under the preload and the start of the load
     ramp, the rigid-ring run has no ring deflection column to compare but the
     same TE to < 0.1 arcsec this early; the seed's numbers are listed beside."""
-    from workflows.ring_deformation import SEED_DEFORMATION_UM, run
+    from flexrv.workflows.ring_deformation import SEED_DEFORMATION_UM, run
 
     r = run(tmp_path / "ring_deformation", smoke=True)
     row = r.numbers["cases"][0]
@@ -133,7 +136,7 @@ def test_lubrication_smoke(tmp_path):
     eta0^0.67 (Hamrock 1994, eq. 22.18: same load and speed -> ratio
     (1.5/0.05)^0.67 within 10 %, loads differ slightly), the dry case has no film,
     and the seed's table is listed beside flexrv's numbers."""
-    from workflows.lubrication import run
+    from flexrv.workflows.lubrication import run
 
     r = run(tmp_path / "lubrication", smoke=True)
     dry, low, high = r.numbers["film"]
@@ -148,7 +151,7 @@ def test_rigid_vs_flexible_smoke(tmp_path):
     """Workflow 2 (seeds 000/001) smoke: both models run on identical inputs; the
     seeds' TE ranges and periods stand beside flexrv's; the TE difference flexible -
     rigid is the difference of the two runs' statistics."""
-    from workflows.rigid_vs_flexible import run
+    from flexrv.workflows.rigid_vs_flexible import run
 
     r = run(tmp_path / "rigid_vs_flexible", smoke=True)
     rows = {c.quantity: c for c in r.comparisons}
@@ -165,7 +168,7 @@ def test_crankshaft_flexibility_smoke(tmp_path):
     """Workflow 5 (seed 002) smoke: Table 4 frequencies from the kinematics equal the
     seed's at 1215 r/min (20.25 / 10 / 0.25 / 320 / 390 Hz, 1e-3); the spectral table
     lists the crank harmonics and mesh lines for both models."""
-    from workflows.crankshaft_flexibility import SEED_TABLE4, run
+    from flexrv.workflows.crankshaft_flexibility import SEED_TABLE4, run
 
     r = run(tmp_path / "crankshaft_flexibility", smoke=True)
     for c in r.comparisons:
@@ -185,7 +188,7 @@ def test_crank_bearing_forces_smoke(tmp_path):
     revolution relative to the carrier."""
     from flexrv.contact.hertz import effective_modulus
     from flexrv.design import load
-    from workflows.crank_bearing_forces import run
+    from flexrv.workflows.crank_bearing_forces import run
 
     r = run(tmp_path / "crank_bearing_forces", smoke=True)
     rows = next(iter(r.tables.values()))
@@ -209,7 +212,7 @@ def test_crank_bearing_sweep_reports_invalid_eccentricities():
     """The seed's 2.0 mm on the RV-40E (R_p = 64 mm, 40 pins) makes K1 = 1.25 > 1:
     the workflow's design step rejects it with the physics reason."""
     from flexrv.errors import ConfigError
-    from workflows.crank_bearing_forces import _design
+    from flexrv.workflows.crank_bearing_forces import _design
     from flexrv.design import load
 
     with pytest.raises(ConfigError, match="K1"):
@@ -219,7 +222,7 @@ def test_crank_bearing_sweep_reports_invalid_eccentricities():
 def test_report_answer_is_computed_from_saved_outputs(tmp_path):
     """The report's Answer section quotes the numbers of the saved comparison
     (rigid_vs_flexible/compare.json), not fixed text: changing the file changes it."""
-    from workflows._common import answer_section
+    from flexrv.workflows._common import answer_section
 
     (tmp_path / "rigid_vs_flexible").mkdir()
     stats = {"te_min_arcsec": -1.5, "te_max_arcsec": 2.25, "te_mean_arcsec": 0.5, "te_pp_arcsec": 3.75}

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from flexrv.errors import InputError
 from flexrv.geometry.involute import base_radius, contact_ratio, tooth_pair_count, working_center_distance
@@ -120,15 +121,34 @@ def time_varying_mesh_stiffness(phase, k_single, eps_alpha, ramp: float = 0.0):
     if ramp == 0.0:
         pairs = tooth_pair_count(ph, eps)
         return np.where(pairs == 2, 1.75, 1.0) * k_single
-    # box-filtered square wave: level = (F(ph + h) - F(ph - h)) / ramp with F the
-    # cumulative length of double-contact zone, F(x) = floor(x) w1 + clip(frac(x), 0, w1)
+    flat = np.ascontiguousarray(ph).ravel()
+    return _RAMPED_ARRAY(flat, float(k_single), eps, float(ramp)).reshape(ph.shape)
+
+
+def _mesh_stiffness_ramped(phase, k_single, eps_alpha, ramp):
+    """k(phase) of :func:`time_varying_mesh_stiffness` with ramps (ramp > 0) at one
+    phase (numba-compiled; the gear-stage kernel calls it per mesh): the
+    box-filtered square wave, level = (F(ph + h) - F(ph - h)) / ramp with h =
+    ramp/2 and F the cumulative length of double-contact zone, F(x) = floor(x) w1
+    + clip(frac(x), 0, w1), w1 = eps_alpha - 1; k = k_single (1 + 0.75 level)."""
+    w1 = eps_alpha - 1.0
+    ph = phase % 1.0
     h = 0.5 * ramp
+    hi, lo = ph + h, ph - h
+    f_hi = np.floor(hi) * w1 + min(max(hi - np.floor(hi), 0.0), w1)
+    f_lo = np.floor(lo) * w1 + min(max(lo - np.floor(lo), 0.0), w1)
+    return k_single * (1.0 + 0.75 * (f_hi - f_lo) / ramp)
 
-    def cum(x):
-        return np.floor(x) * w1 + np.clip(x - np.floor(x), 0.0, w1)
 
-    level = (cum(ph + h) - cum(ph - h)) / ramp
-    return k_single * (1.0 + 0.75 * level)
+def _ramped_array(phase, k_single, eps_alpha, ramp):
+    out = np.empty(phase.shape[0])
+    for i in range(phase.shape[0]):
+        out[i] = mesh_stiffness_ramped(phase[i], k_single, eps_alpha, ramp)
+    return out
+
+
+mesh_stiffness_ramped = njit(cache=True)(_mesh_stiffness_ramped)
+_RAMPED_ARRAY = njit(cache=True)(_ramped_array)
 
 
 def mesh_phase(sun_angle_relative, z_sun: int, phase0: float = 0.0):

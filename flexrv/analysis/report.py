@@ -3,7 +3,7 @@
 Collects kinematics (:mod:`flexrv.geometry.kinematics`), the involute stage
 (:mod:`flexrv.analysis.mesh_stiffness`), the cycloid stage
 (:mod:`flexrv.geometry.cycloid`), the pin load distribution
-(:mod:`flexrv.analysis.pin_load`), the seed 004 torsional model and meshing-zone
+(:mod:`flexrv.analysis.pin_load`), the :cite:`seed004` torsional model and meshing-zone
 identification (:mod:`flexrv.analysis.torsional`), the main-bearing ball loads
 (:mod:`flexrv.analysis.bearing_load`), Hertz and Hamrock–Dowson film of the
 most loaded ball and the L10 life (:mod:`flexrv.analysis.life`). All values are
@@ -20,7 +20,7 @@ import numpy as np
 from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN, RPM_PER_RAD_S
 
 
-#: Measured torsional stiffness of the RV-40E (seed 004): 3.06e8 N mm/rad.
+#: Measured torsional stiffness of the RV-40E (:cite:`seed004`): 3.06e8 N mm/rad.
 SEED004_MEASURED_CW = 3.06e5  # N m/rad
 
 
@@ -29,7 +29,7 @@ def _f(x) -> float:
 
 
 def _kinematics(reducer) -> dict:
-    from flexrv.geometry.kinematics import reducer_kinematics
+    from flexrv.geometry.kinematics import FREQUENCY_NAMES, reducer_kinematics
 
     kin = reducer_kinematics(reducer)
     s, f = kin.speeds, kin.frequencies
@@ -38,8 +38,8 @@ def _kinematics(reducer) -> dict:
     return {"ratio": s.ratio,
             "speeds_rad_s": speeds,
             "speeds_rpm": {k: v * RPM_PER_RAD_S for k, v in speeds.items()},
-            "frequencies_Hz": {k: _f(getattr(f, k)) for k in ("input", "crank_rotation", "carrier", "crank_absolute",
-                                                              "first_stage_mesh", "cycloid_mesh", "pin_passing")}}
+            # names and meanings: flexrv.geometry.kinematics.CharacteristicFrequencies
+            "frequencies_Hz": {k: _f(getattr(f, k)) for k in FREQUENCY_NAMES}}
 
 
 def _involute(reducer) -> dict:
@@ -249,8 +249,8 @@ def design_report(reducer) -> dict:
     operating point (nested dict of floats/ints/lists/str, SI; keys with
     non-SI-obvious units carry a suffix). Sections: kinematics, involute_stage,
     cycloid_stage, pin_loads (load and rated torque, ideal profile), modification
-    sweep, torsional_stiffness (seed 004 model), meshing_zone (vs the measured
-    3.06e5 N m/rad of seed 004), main_bearing (ball loads, contact angles, Hertz,
+    sweep, torsional_stiffness (:cite:`seed004` model), meshing_zone (vs the measured
+    3.06e5 N m/rad of :cite:`seed004`), main_bearing (ball loads, contact angles, Hertz,
     Hamrock–Dowson film, L10)."""
     op = reducer.operating
     report: dict = {"name": reducer.name, "kinematics": _kinematics(reducer), "involute_stage": _involute(reducer),

@@ -3,8 +3,11 @@
 Each command group lives in its own module under :mod:`flexrv.cli` and exposes
 ``register(app)``; commands are thin wrappers around library functions. Every
 command accepts ``--json`` (machine-readable output on stdout) and prints a rich
-table by default. Any :class:`flexrv.errors.FlexrvError` becomes one clear message
-on stderr and exit code 2 — never a traceback.
+table by default. Any :class:`flexrv.errors.FlexrvError` and every usage error
+(unknown option or command, a value of the wrong type, a missing argument)
+becomes one clear message on stderr and exit code 2 — never a traceback. A bare
+``flexrv`` (or a command that needs arguments, given none) prints the help on
+stderr and exits 2, like any other usage error. Ctrl-C / SIGTERM exit 130.
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # plain help texts: rich markup would eat the units in square brackets ("End time [s]")
+    rich_markup_mode=None,
 )
 
 #: Command modules; each defines ``register(app)``. A module that is not present
@@ -37,26 +42,122 @@ for _name in _COMMAND_MODULES:
         continue
     _mod.register(app)
 
+#: exit code of a usage or input error
+USAGE_EXIT = 2
 
-def main() -> None:
-    """Console-script entry point: run the app, map user errors to exit code 2."""
+
+def _click_modules() -> list:
+    """The click exception modules in use: typer >= 0.2x vendors its own click
+    (``typer._click``), older typer uses the ``click`` package; both are checked."""
+    mods = []
+    for name in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            mods.append(importlib.import_module(name))
+        except ImportError:
+            continue
+    return mods
+
+
+def _types(attr: str) -> tuple[type, ...]:
+    return tuple(getattr(m, attr) for m in _click_modules() if hasattr(m, attr))
+
+
+def print_error(message: str) -> None:
+    """One error message on stderr, printed literally (no rich markup parsing)."""
+    from rich.console import Console
+    from rich.text import Text
+
+    Console(stderr=True, highlight=False, soft_wrap=True).print(Text("error: ", style="bold red") + Text(str(message)))
+
+
+def _argv_value(opts, argv: list[str]) -> str | None:
+    """The raw command-line text given for an option (``--dt abc`` or ``--dt=abc``)."""
+    for i, arg in enumerate(argv):
+        for opt in opts:
+            if arg == opt and i + 1 < len(argv):
+                return argv[i + 1]
+            if arg.startswith(opt + "="):
+                return arg[len(opt) + 1:]
+    return None
+
+
+def _param_name(param) -> str:
+    name = getattr(param, "human_readable_name", None) or getattr(param, "name", None) or "?"
+    return str(name).upper()
+
+
+def usage_message(exc, argv: list[str]) -> str:
+    """One line for a click usage error: the command, the option or argument,
+    the value given and what is allowed."""
+    ctx = getattr(exc, "ctx", None)
+    command = ctx.command_path if ctx is not None else "flexrv"
+    command = "flexrv" + command[command.find(" "):] if " " in command else "flexrv"
+    kind = type(exc).__name__
+    param = getattr(exc, "param", None)
+    msg = exc.format_message() if hasattr(exc, "format_message") else str(exc)
+    msg = " ".join(str(msg).split())
+    if kind == "NoSuchOption":
+        opt = getattr(exc, "option_name", "?")
+        allowed = []
+        if ctx is not None:
+            for p in ctx.command.params:
+                allowed += [o for o in getattr(p, "opts", []) if o.startswith("-")]
+        return f"{command}: unknown option {opt}; allowed options: {', '.join(allowed + ['--help'])}"
+    if kind == "BadParameter" and param is not None:
+        opts = [o for o in getattr(param, "opts", []) if o.startswith("-")]
+        name = opts[0] if opts else _param_name(param)
+        value = _argv_value(opts, argv) if opts else None
+        reason = str(getattr(exc, "message", msg)).removeprefix("Value error, ")
+        reason = " ".join(reason.split())
+        expected = getattr(getattr(param, "type", None), "name", None)
+        shown = f" {value!r}" if value is not None else ""
+        tail = f" (expected: {expected})" if expected and expected not in reason.lower() else ""
+        return f"{command}: invalid value{shown} for {name}: {reason}{tail}"
+    if kind == "MissingParameter" and param is not None:
+        opts = [o for o in getattr(param, "opts", []) if o.startswith("-")]
+        name = opts[0] if opts else _param_name(param)
+        what = "option" if opts else "argument"
+        usage = " ".join(ctx.get_usage().split()) if ctx is not None else ""
+        return f"{command}: missing required {what} {name}" + (f" ({usage})" if usage else "")
+    if kind == "UsageError" and ctx is not None and "command" in msg.lower() and hasattr(ctx.command, "commands"):
+        return f"{msg} Available commands: {', '.join(sorted(ctx.command.commands))}"
+    return f"{command}: {msg}"
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point: run the app, map user errors to exit code 2,
+    Ctrl-C to 130; the exit code of a command (``typer.Exit``) is passed on."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    no_args = _types("NoArgsIsHelpError")
+    click_exc = _types("ClickException")
+    click_exit = _types("Exit")
+    click_abort = _types("Abort")
     try:
-        app(standalone_mode=False)
+        rv = app(args=args, prog_name="flexrv", standalone_mode=False)
     except FlexrvError as exc:
-        from rich.console import Console
-
-        Console(stderr=True).print(f"[bold red]error:[/] {exc}", highlight=False, markup=True)
-        sys.exit(2)
-    except typer.Exit as exc:
+        print_error(str(exc))
+        sys.exit(USAGE_EXIT)
+    except OSError as exc:  # a file the user named cannot be read or written
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print_error(f"{exc.strerror or exc}:{where}" if where else f"{exc.strerror or exc}")
+        sys.exit(USAGE_EXIT)
+    except (typer.Exit, *click_exit) as exc:
         sys.exit(exc.exit_code)
-    except typer.Abort:
+    except (typer.Abort, *click_abort, KeyboardInterrupt):
         sys.exit(130)
-    except KeyboardInterrupt:
-        sys.exit(130)
-    except Exception as exc:  # click usage errors
-        import click
-
-        if isinstance(exc, click.exceptions.ClickException):
-            exc.show()
-            sys.exit(2)
-        raise
+    except no_args as exc:  # bare `flexrv` / a command given no arguments: help, usage exit code
+        print(exc.format_message(), file=sys.stderr)
+        sys.exit(USAGE_EXIT)
+    except click_exc as exc:
+        if type(exc).__name__ in ("BadParameter", "MissingParameter", "NoSuchOption", "UsageError",
+                                  "BadOptionUsage", "BadArgumentUsage"):
+            try:
+                text = usage_message(exc, args)
+            except Exception:  # never a traceback for a usage error
+                text = " ".join(str(exc.format_message()).split())
+            print_error(text)
+            sys.exit(USAGE_EXIT)
+        print_error(" ".join(str(exc.format_message()).split()))
+        sys.exit(exc.exit_code if exc.exit_code else USAGE_EXIT)
+    if isinstance(rv, int) and not isinstance(rv, bool):
+        sys.exit(rv)

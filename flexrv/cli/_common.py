@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
@@ -13,7 +14,9 @@ from rich.table import Table
 
 from flexrv.cache import to_jsonable  # noqa: F401  (re-exported for the CLI modules)
 
-console = Console()
+#: stdout console; markup off: paths, names and values are printed literally
+#: (``[/x].toml`` is a valid file name, ``[s]`` a unit), styles are passed explicitly
+console = Console(markup=False)
 
 JSON_HELP = "Print machine-readable JSON on stdout instead of a table."
 
@@ -65,7 +68,7 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
     convention used throughout flexrv (``max_force_N``, ``stiffness_Nm_per_rad``).
     Lists of numbers are shown compactly; lists of dicts as sub-tables.
     """
-    console.print(f"[bold]{title}[/]")
+    console.print(title, style="bold")
     flat: list[tuple[str, Any, str]] = []
     for key, value in data.items():
         if isinstance(value, dict):
@@ -79,17 +82,35 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
         console.print(kv_table("", flat))
 
 
-_UNIT_HEAD = re.compile(r"_(N|Nm|Pa|GPa|MPa|Hz|W|J|m|mm|um|s|rad|rpm|deg|arcsec|arcmin|kg|m2|m3)(_|$)")
+#: unit tokens of flexrv's unit-suffixed keys (``max_force_N``, ``C_W_seed004_Nm_per_rad``)
+_UNIT_TOKENS = {"N", "Nm", "Pa", "kPa", "MPa", "GPa", "Hz", "W", "J", "m", "mm", "um", "nm", "s", "ms", "rad",
+                "rpm", "deg", "arcsec", "arcmin", "kg", "m2", "m3", "percent"}
+#: suffixes whose plain reading (tokens joined by spaces) is wrong
+_UNIT_SPECIAL = {("m", "s"): "m/s", ("rad", "s"): "rad/s", ("kg", "m3"): "kg/m³", ("mm", "s"): "mm/s"}
+_UNIT_PRETTY = {"Nm": "N m", "um": "µm", "m2": "m²", "m3": "m³", "percent": "%"}
 
 
 def split_unit(key: str) -> tuple[str, str]:
-    """Split flexrv's unit-suffixed keys: ``"max_force_N"`` -> (``"max_force"``, ``"N"``),
-    ``"stiffness_Nm_per_rad"`` -> (``"stiffness"``, ``"Nm/rad"``)."""
-    match = _UNIT_HEAD.search(key)
-    if not match:
+    """Split flexrv's unit-suffixed keys into (label, unit): the unit is the longest run
+    of unit tokens (and ``per``) at the END of the key, leaving at least one label token:
+    ``"max_force_N"`` -> (``"max_force"``, ``"N"``), ``"C_W_seed004_Nm_per_rad"`` ->
+    (``"C_W_seed004"``, ``"N m/rad"``), ``"entrainment_speed_m_s"`` -> (``"entrainment_speed"``,
+    ``"m/s"``), ``"entrainment_speed"`` -> (``"entrainment_speed"``, ``""``)."""
+    tokens = key.split("_")
+    k = len(tokens)
+    while k > 1 and (tokens[k - 1] in _UNIT_TOKENS or (tokens[k - 1] == "per" and k < len(tokens))):
+        k -= 1
+    while k < len(tokens) and tokens[k] == "per":  # a unit cannot start with "per"
+        k += 1
+    unit_tokens = tokens[k:]
+    if not unit_tokens:
         return key, ""
-    unit = key[match.start() + 1:].replace("_per_", "/").replace("_", " ")
-    return key[:match.start()], unit
+    label = "_".join(tokens[:k])
+    special = _UNIT_SPECIAL.get(tuple(unit_tokens))
+    if special:
+        return label, special
+    unit = " ".join(_UNIT_PRETTY.get(t, t) for t in unit_tokens).replace(" per ", "/")
+    return label, unit
 
 
 def _compact(value: Any) -> Any:
@@ -126,3 +147,68 @@ def _render_records(name: str, records: list[dict[str, Any]]) -> None:
     for rec in records[:60]:
         table.add_row(*(fmt(_compact(rec.get(c))) for c in columns))
     console.print(table)
+
+
+# ------------------------------------------------------------ output paths, before any work
+#: files a run writes into its output directory (removed by --overwrite)
+RUN_FILES = ("results.nc", "config.toml", "summary.json", "summary.md", "checkpoint.npz")
+
+
+def _probe_writable(directory: Path, option: str) -> None:
+    """InputError naming the option unless ``directory`` can be created and written:
+    its nearest existing ancestor must be a directory in which a probe file can be
+    created (and is removed again). Nothing else is created, so concurrent runs
+    probing the same new path do not race."""
+    import os
+    import tempfile
+
+    from flexrv.errors import InputError
+
+    d = Path(directory)
+    while not d.exists() and d.parent != d:
+        d = d.parent
+    if not d.is_dir():
+        raise InputError(f"{option} {directory}: {d} exists and is not a directory")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".flexrv-probe.", dir=d)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise InputError(f"{option} {directory}: not writable ({d}: {exc.strerror or exc})") from None
+
+
+def check_output_dir(path: Path, option: str = "--out", overwrite: bool = False, allow_existing: bool = False) -> Path:
+    """Check an output directory before any work: it must be a directory (or not
+    exist) and be writable; an existing non-empty directory is refused unless
+    ``overwrite`` (then the files of an earlier run are removed) or
+    ``allow_existing`` (e.g. a resumable sweep). Raises InputError naming the option."""
+    from flexrv.errors import InputError
+
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} {path}: exists and is not a directory")
+    if path.is_dir() and any(path.iterdir()) and not allow_existing:
+        if not overwrite:
+            raise InputError(f"{option} {path}: directory exists and is not empty; choose another directory or "
+                             "pass --overwrite")
+        for name in RUN_FILES:
+            (path / name).unlink(missing_ok=True)
+        for png in path.glob("*.png"):
+            png.unlink()
+    _probe_writable(path, option)
+    return path
+
+
+def check_output_file(path: Path, option: str, suffixes: tuple[str, ...] = ()) -> Path:
+    """Check an output file path before any work: not a directory, its folder
+    writable, the suffix one of ``suffixes`` (if given). InputError naming the option."""
+    from flexrv.errors import InputError
+
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{option} {path}: is a directory; give a file name" +
+                         (f" ending in {'/'.join(suffixes)}" if suffixes else ""))
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise InputError(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
+    _probe_writable(path.parent if str(path.parent) else Path("."), option)
+    return path

@@ -46,7 +46,7 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
 
     def render(r) -> None:
         data = r.model_dump()
-        console.print(f"[bold]{r.name}[/] — {r.description}")
+        console.print(f"{r.name} — {r.description}", style="bold")
         for section, values in data.items():
             if not isinstance(values, dict) or section in ("provenance", "errors"):
                 continue
@@ -79,10 +79,69 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
     loads, Hertz, film thickness, life)."""
     from flexrv.analysis.report import design_report
+    from flexrv.errors import ConvergenceError
 
     reducer = load(preset)
-    report = design_report(reducer)
-    emit(report, json, lambda rep: render_nested(f"Design report: {reducer.name}", rep))
+    check_design_report_range(reducer)
+    try:
+        report = design_report(reducer)
+    except ConvergenceError as exc:
+        mb = reducer.main_bearing
+        if mb.axial_preload_um < 0:
+            raise ConvergenceError(
+                f"main_bearing.axial_preload_um = {mb.axial_preload_um:g} um (axial clearance) is not supported by "
+                f"flexrv design: the quasi-static ball loads are indeterminate in the clearance at this load "
+                f"({exc}); use a preload >= 0 for the design report (simulate models the clearance)") from None
+        raise
+    warnings = load_sanity_warnings(report)
+    if warnings:
+        report["warnings"] = warnings
+
+    def render(rep):
+        render_nested(f"Design report: {reducer.name}", {k: v for k, v in rep.items() if k != "warnings"})
+        for message in rep.get("warnings", []):
+            console.print(f"warning: {message}", style="yellow")
+
+    emit(report, json, render)
+
+
+#: ISO 76:2006 static load rating: the contact pressure at the static rating is
+#: 4200 MPa for ball bearings and 4000 MPa for roller bearings (line contacts, also
+#: used here for the pin-disc contact). Above it the contact deforms permanently and
+#: the elastic (Hertz) results of the report no longer hold.
+ISO76_BALL_PA = 4.2e9
+ISO76_LINE_PA = 4.0e9
+
+
+def load_sanity_warnings(report: dict, prefix: str = "") -> list[str]:
+    """Warnings for every contact pressure of the design report above the ISO 76
+    static limit (ball contacts: keys ``*_p_max_Pa``; line contacts: ``max_hertz_pressure_Pa``)."""
+    out = []
+    for key, value in report.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out += load_sanity_warnings(value, f"{path}.")
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            limit = ISO76_BALL_PA if key.endswith("_p_max_Pa") else ISO76_LINE_PA if key.endswith(
+                "max_hertz_pressure_Pa") else None
+            if limit is not None and value > limit:
+                out.append(f"{path} = {value / 1e9:.3g} GPa exceeds the ISO 76 static limit {limit / 1e9:g} GPa: "
+                           "the contact yields, the elastic (Hertz) results do not hold; check the loads "
+                           "(operating.*) and the contact geometry")
+    return out
+
+
+def check_design_report_range(reducer) -> None:
+    """Refuse, naming the field, a design whose main-bearing contact angle lies
+    outside the ISO 281 table that the life rating of the design report uses."""
+    from flexrv.analysis.life import _ISO281_XY
+    from flexrv.errors import InputError
+
+    lo, hi = float(_ISO281_XY[0, 0]), float(_ISO281_XY[-1, 0])
+    angle = reducer.main_bearing.contact_angle_deg
+    if not lo <= angle <= hi:
+        raise InputError(f"main_bearing.contact_angle_deg = {angle:g} is not allowed for flexrv design: must lie in "
+                         f"{lo:g} <= value <= {hi:g} deg (the ISO 281 X/Y table of the bearing life rating)")
 
 
 def register(app: typer.Typer) -> None:

@@ -4,16 +4,23 @@ from __future__ import annotations
 
 import time
 import warnings
+from pathlib import Path
 from typing import Any, Optional
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, console, emit, kv_table
+from flexrv.cli._common import JSON_HELP, check_output_file, console, emit, kv_table
 from flexrv.errors import InputError
 
 PRESET_HELP = ("Preset name or design TOML. Without explicit --load-n/--speed-m-s/--rx-m/--ry-m: the main "
                "bearing's most-loaded ball (inner-race contact) at the preset's operating point. With them: "
                "the preset (default rv221) supplies only the materials (balls, rings) and the lubricant.")
+
+
+#: largest contact semi-axis / radius of curvature (same direction) for which the
+#: Hertz half-space assumption is accepted without a warning (Johnson, Contact
+#: Mechanics, sec. 4.1: a << R)
+HERTZ_SIZE_LIMIT = 0.1
 
 
 def operating_contact(reducer) -> dict[str, Any]:
@@ -66,6 +73,11 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
         missing = [k for k, v in explicit.items() if v is None]
         raise InputError(f"explicit case needs all of --load-n --speed-m-s --rx-m --ry-m; missing {', '.join(missing)}")
     if given:
+        import math
+
+        for opt, value in explicit.items():
+            if not (math.isfinite(value) and value > 0):
+                raise InputError(f"{opt} {value!r}: must be a finite number > 0")
         case = {"load": load_n, "speed": speed_m_s, "rx": rx_m, "ry": ry_m,
                 "e_eff": _reduced_modulus(reducer, effective_modulus)}
         source = f"explicit; materials and lubricant from preset {preset}"
@@ -77,8 +89,15 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:  # grid not converged: reported, not printed twice
         warnings.simplefilter("always", RuntimeWarning)
-        res = solve_point_contact(case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub, grid=grid,
-                                  grid_tol=grid_tol, max_grid=max_grid)
+        import numpy as np
+
+        try:
+            res = solve_point_contact(case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub,
+                                      grid=grid, grid_tol=grid_tol, max_grid=max_grid)
+        except (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError) as exc:
+            raise InputError(f"EHL solve failed for load {case['load']:g} N, speed {case['speed']:g} m/s, "
+                             f"rx {case['rx']:g} m, ry {case['ry']:g} m ({type(exc).__name__}: {exc}); the case is "
+                             "outside the solver's range (check --load-n/--speed-m-s/--rx-m/--ry-m)") from None
     elapsed = time.perf_counter() - t0
     args = (case["load"], case["speed"], case["rx"], case["ry"], case["e_eff"], lub.viscosity, lub.pressure_viscosity)
     hd_c, hd_min = hamrock_dowson(*args)
@@ -101,8 +120,21 @@ def ehl_case(preset: str = "rv221", load_n: Optional[float] = None, speed_m_s: O
                     "total_iterations": res.total_iterations, "residual": res.residual,
                     "load_error": res.load_error, "solve_time_s": elapsed},
     }
-    if caught:
-        report["warnings"] = [str(w.message) for w in caught if "EHL" in str(w.message)]
+    warn = [str(w.message) for w in caught if "EHL" in str(w.message)]
+    # Hertz (and the half-space of the film solver) assume contact semi-axes small
+    # against the radii of curvature: flag a/Ry or b/Rx above HERTZ_SIZE_LIMIT (a is
+    # the semi-axis along y, b along x), and any semi-axis beyond the smaller radius
+    # (a contact larger than the curvature of the bodies that carry it)
+    a, b = res.hertz_a, res.hertz_b
+    paired = max(a / case["ry"], b / case["rx"])
+    overall = max(a, b) / min(case["rx"], case["ry"])
+    if paired > HERTZ_SIZE_LIMIT or overall > 1.0:
+        warn.append(f"contact semi-axes a = {a:.3g} m (along y), b = {b:.3g} m (along x) with rx = {case['rx']:.3g} m, "
+                    f"ry = {case['ry']:.3g} m: semi-axis/radius = {max(paired, overall):.3g}, outside the "
+                    f"Hertz/half-space assumptions (a/ry, b/rx <= {HERTZ_SIZE_LIMIT:g}, semi-axes <= min(rx, ry)); "
+                    "results are not physical")
+    if warn:
+        report["warnings"] = warn
     return report, res
 
 
@@ -122,6 +154,8 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Numerical EHL solution (Reynolds + Roelands + Dowson-Higginson + Boussinesq) of a
     ball-raceway contact, compared with Hamrock-Dowson and Moes."""
+    if png:
+        check_output_file(Path(png), "--png", (".png",))
     report, res = ehl_case(preset, load_n, speed_m_s, rx_m, ry_m, grid, grid_tol, max_grid)
     if png:
         from flexrv.viz.ehl_plots import plot_ehl_solution
@@ -129,7 +163,7 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         report["png"] = str(plot_ehl_solution(res, png))
 
     def render(data: dict[str, Any]) -> None:
-        console.print(f"[bold]EHL point contact[/] — {data['case']}")
+        console.print(f"EHL point contact — {data['case']}", style="bold")
         units = {"_N": "N", "_m_s": "m/s", "_m": "m", "_Pa": "Pa", "_Pa_s": "Pa s", "_1_Pa": "1/Pa",
                  "_kg_m3": "kg/m^3", "_s": "s"}
 
@@ -142,7 +176,7 @@ def ehl(preset: str = typer.Option("rv221", "--preset", help=PRESET_HELP),
         for section in ("inputs", "outputs"):
             console.print(kv_table(section, [(k, v, unit(k)) for k, v in data[section].items()]))
         for message in data.get("warnings", []):
-            console.print(f"[yellow]warning:[/] {message}")
+            console.print(f"warning: {message}", style="yellow")
         if "png" in data:
             console.print(f"plot: {data['png']}")
 

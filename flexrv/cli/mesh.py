@@ -31,7 +31,7 @@ def _size_m(size_mm: Optional[float]) -> Optional[float]:
 
 def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
          size: Optional[float] = SIZE_OPT, json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
-    """Mesh a part with second-order tetrahedra (cached under meshes/): files and counts."""
+    """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
     from flexrv.meshing import build_mesh
 
@@ -60,9 +60,16 @@ def modes(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART
           vtu: Optional[Path] = typer.Option(None, "--vtu", help="Write the modes as VTU for ParaView to this folder.")
           ) -> None:
     """Free-free and constrained (interfaces clamped) eigenfrequencies [Hz] of a part."""
+    from flexrv.cli._common import check_output_dir
     from flexrv.design import load
+    from flexrv.errors import InputError
     from flexrv.fem.body import part_modes
 
+    if n < 1:
+        raise InputError(f"--n {n}: must be >= 1")
+    for opt, folder in (("--png", png), ("--vtu", vtu)):
+        if folder is not None:
+            check_output_dir(folder, opt, allow_existing=True)
     pm = part_modes(load(preset), part.value, n=n, size=_size_m(size))
     m = pm.mesh
     files = []

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, console, emit, kv_table
+from flexrv.cli._common import JSON_HELP, check_output_dir, console, emit, kv_table
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -31,7 +31,11 @@ def _bar(enabled: bool):
         if t >= t_end * (1 - 1e-9):
             bar.stop()
 
-    report.stop = bar.stop
+    def stop():
+        if state["task"] is not None:
+            bar.stop()
+
+    report.stop = stop
     return report
 
 
@@ -58,27 +62,70 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
+OVERWRITE_HELP = "Allow an existing non-empty --out directory (the files of the earlier run are removed)."
+CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
+
+
+def _exit_code(res) -> int:
+    """128 + signal number for a run stopped by a signal (130 Ctrl-C, 143 SIGTERM), else 0."""
+    import signal
+
+    if res.attrs.get("status") != "interrupted":
+        return 0
+    name = res.attrs.get("signal", "SIGINT")
+    return 128 + int(getattr(signal, name, signal.SIGINT))
+
+
+def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --resume."),
              model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
              t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
              dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
              parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
              out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+             overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+             resume: Path = typer.Option(None, "--resume", help="Continue a killed run from the last checkpoint in this output directory."),
+             checkpoint: float = typer.Option(10.0, "--checkpoint-s", help=CHECKPOINT_HELP),
              json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
-    """Run the multibody model; write NetCDF, config, summary.md and PNGs."""
+    """Run the multibody model; write NetCDF, config, summary.md and PNGs.
+    Checkpoints into --out while running; Ctrl-C or SIGTERM keeps the partial results
+    (exit 130 / 143); --resume DIR continues a killed run."""
+    import math
+
+    from flexrv.errors import InputError
     from flexrv.simulation import Simulation
 
-    options = model_options(model, parts)
-    out = out or _default_out(preset, model, "sim")
-    sim = Simulation(preset, model=model, model_options=options)
+    if not (math.isfinite(checkpoint) and checkpoint >= 0):
+        raise InputError(f"--checkpoint-s {checkpoint}: must be a finite number >= 0 s")
     bar = _bar(not json)
-    try:
-        res = sim.run(t_end=t_end, dt=dt, progress=bar, save_to=out)
-    finally:
-        if bar:
-            bar.stop()
+    if resume is not None:
+        if preset is not None or out is not None:
+            raise InputError("--resume DIR continues the run in DIR with its own design and options: "
+                             "give no PRESET and no --out")
+        if not resume.is_dir():
+            raise InputError(f"--resume {resume}: not a directory")
+        check_output_dir(resume, "--resume", allow_existing=True)
+        out = resume
+        try:
+            sim, res = Simulation.resume(resume, progress=bar, checkpoint_s=checkpoint or None)
+        finally:
+            if bar:
+                bar.stop()
+        preset, model = res.attrs.get("preset", str(resume)), sim.model_name
+    else:
+        if preset is None:
+            raise InputError("flexrv simulate: missing argument PRESET (a preset name or design TOML), or --resume DIR")
+        options = model_options(model, parts)
+        out = check_output_dir(out or _default_out(preset, model, "sim"), "--out", overwrite=overwrite)
+        sim = Simulation(preset, model=model, model_options=options)
+        try:
+            res = sim.run(t_end=t_end, dt=dt, progress=bar, save_to=out, checkpoint_s=checkpoint or None)
+        finally:
+            if bar:
+                bar.stop()
     if res.attrs.get("status") != "interrupted":
         res.save(out)
+        if res.attrs.get("status") == "completed":  # saved in full: the resume data is no longer needed
+            (Path(out) / "checkpoint.npz").unlink(missing_ok=True)
     s = res.summary()
     data = {"output_dir": str(out), "status": s["status"],
             "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
@@ -96,8 +143,9 @@ def simulate(preset: str = typer.Argument(..., help=PRESET_HELP),
         console.print(kv_table(f"simulate {preset} ({model})", rows))
 
     emit(data, json, render)
-    if res.attrs.get("status") == "interrupted":
-        raise typer.Exit(130)
+    code = _exit_code(res)
+    if code:
+        raise typer.Exit(code)
 
 
 def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
@@ -106,6 +154,7 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
                        dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
                        parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+                       overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
                        json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
     torsional rigidity, lost motion, hysteresis loop PNG."""
@@ -114,7 +163,7 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     from flexrv.simulation import stiffness_test
 
     options = model_options(model, parts)
-    out = out or _default_out(preset, model, "stiffness")
+    out = check_output_dir(out or _default_out(preset, model, "stiffness"), "--out", overwrite=overwrite)
     bar = _bar(not json)
     try:
         fig, _ = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out,

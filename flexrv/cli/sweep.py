@@ -13,13 +13,18 @@ from flexrv.cli._common import JSON_HELP, console, emit, kv_table
 def sweep(spec: Path = typer.Argument(..., help="Sweep specification TOML (see flexrv.sweep)."),
           out: Optional[Path] = typer.Option(None, "--out", help="Results directory (default results/<name>)."),
           scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing dask scheduler (default: a LocalCluster)."),
-          workers: Optional[int] = typer.Option(None, "--workers", help="LocalCluster worker processes (default: CPU count)."),
+          workers: Optional[int] = typer.Option(None, "--workers", min=1, help="LocalCluster worker processes, >= 1 (default: CPU count)."),
           retry_failed: bool = typer.Option(False, "--retry-failed", help="Recompute cases recorded as failed."),
           json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
-    """Run a grid/list of design variations of a task; killed sweeps resume where they stopped."""
+    """Run a grid/list of design variations of a task; killed sweeps resume where they stopped.
+    Exit code 1 if any case failed (recorded in table.csv with its error)."""
+    from flexrv.cli._common import check_output_dir
     from flexrv.sweep import load_spec, run_sweep
 
-    summary = run_sweep(load_spec(spec), out_dir=out, scheduler=scheduler, n_workers=workers,
+    sweep_spec = load_spec(spec)
+    target = out if out is not None else Path("results") / sweep_spec.name
+    check_output_dir(target, "--out", allow_existing=True)  # an existing sweep directory is resumed
+    summary = run_sweep(sweep_spec, out_dir=target, scheduler=scheduler, n_workers=workers,
                         retry_failed=retry_failed, progress=not json)
     data = {"out_dir": str(summary.out_dir), "cases": summary.total, "computed": summary.computed,
             "skipped_existing": summary.skipped, "failed": summary.failed,
@@ -30,6 +35,11 @@ def sweep(spec: Path = typer.Argument(..., help="Sweep specification TOML (see f
         console.print(kv_table("sweep", [(k, v, "") for k, v in d.items() if k != "plots"]))
 
     emit(data, json, render)
+    if summary.failed:
+        from flexrv.cli import print_error
+
+        print_error(f"{summary.failed} of {summary.total} cases failed (see the error column of {summary.table_csv})")
+        raise typer.Exit(1)
 
 
 def register(app: typer.Typer) -> None:

@@ -24,8 +24,16 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
     from flexrv.post.io import load_results
     from flexrv.viz.rings import render_rings_png, show_rings, write_pvd
 
+    from flexrv.cli._common import check_output_dir, check_output_file
+
     if not (result_dir / "results.nc").exists():
         raise InputError(f"{result_dir} is not a result folder (no results.nc)")
+    if png is not None:
+        check_output_file(png, "--png", (".png",))
+    if vtu is not None:
+        check_output_dir(vtu, "--vtu", allow_existing=True)
+    if every < 1:
+        raise InputError(f"--every {every}: must be >= 1")
     res = load_results(result_dir)
     data = {"result_dir": str(result_dir)}
     if show:

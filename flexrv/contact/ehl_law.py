@@ -19,9 +19,9 @@ continuous and monotone in delta, and dQ/ddelta = n K s^(n-1) / phi'(s).
 
 Film h_c(Q, u) by ``mode``:
 
-* ``"dry"`` — h_c = 0 (plain Hertz, Harris & Kotzalas 2007 eq. 6.42);
-* ``"hamrock_dowson"`` — Hamrock & Dowson (1977) central film for point contacts,
-  Pan & Hamrock (1989) for line contacts (:mod:`flexrv.ehl.film`);
+* ``"dry"`` — h_c = 0 (plain Hertz, :cite:`harris2007` eq. 6.42);
+* ``"hamrock_dowson"`` — Hamrock & Dowson :cite:`hamrock1977` central film for point contacts,
+  Pan & Hamrock :cite:`pan1989` for line contacts (:mod:`flexrv.ehl.film`);
 * ``"map"`` — the numerical solver's h_c(Q, u) table (:mod:`flexrv.ehl.maps`),
   interpolated in log space (point contacts only).
 
@@ -38,7 +38,7 @@ equation.
 
 Limits: quasi-static film (the steady EHL h_c at the instantaneous load and speed,
 no squeeze-film history), isothermal, fully flooded, smooth surfaces. Real EHL
-films are 0.01-1 um; the "oil film 0.01-0.18 mm" of seeds 000/001 is not an EHL
+films are 0.01-1 um; the "oil film 0.01-0.18 mm" of :cite:`seed000,seed001` is not an EHL
 film and is not used. The film offset matters for the bearing's stiffness and
 clearance at the 0.1 um level, not for its load capacity.
 """
@@ -267,7 +267,7 @@ class EHLLineLaw:
     """EHL-corrected line-contact law (rollers, pins): Q = K s^(10/9), s = delta + h_c.
 
     K from Palmgren's line-contact law (:func:`flexrv.contact.hertz.line_contact_stiffness`),
-    h_c from Pan & Hamrock (1989). Modes ``"dry"`` and ``"hamrock_dowson"`` (the latter
+    h_c from Pan & Hamrock :cite:`pan1989`. Modes ``"dry"`` and ``"hamrock_dowson"`` (the latter
     meaning the Pan–Hamrock line-contact formula here); no solver map for line contacts.
 
     Parameters

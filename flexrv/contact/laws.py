@@ -15,11 +15,9 @@ and clipped at F >= 0 (a contact cannot pull). All functions return the force an
 its partial derivatives so that Exudyn user functions can supply analytic
 Jacobians.
 
-Speed: the Exudyn force functions call :func:`impact_force` several times per
-Newton iteration on a few dozen contacts, where numpy's per-operation overhead
-dominates. If numba is installed, the same kernel (:func:`_impact_kernel`) is
-compiled with ``numba.njit`` and used for float arrays; without numba it runs
-as plain numpy. Both give the same numbers (one formula, two executors).
+One formula: the law at one contact is :func:`_impact_scalar` (numba-compiled);
+the force groups' compiled kernels call it per contact and :func:`impact_force`
+loops it over (broadcast) arrays.
 """
 
 from __future__ import annotations
@@ -60,21 +58,34 @@ def adams_step_derivative(x, x0, h0, x1, h1):
     return _step_and_slope(np.asarray(x, dtype=float), x0, h0, x1, h1)[1]
 
 
-def _impact_kernel(gap, gap_rate, k, exponent, c_max, depth):
-    """Body of :func:`impact_force` on float arrays (numba-compilable)."""
-    delta = np.maximum(-gap, 0.0)
-    spring = k * delta**exponent
-    dspring = k * exponent * delta ** (exponent - 1.0)  # used only where delta > 0
+def _impact_scalar(gap, gap_rate, k, exponent, c_max, depth):
+    """The impact law at one contact (the single implementation: compiled
+    kernels of the force groups call it directly, :func:`impact_force` loops it
+    over arrays). Returns (force, dforce_dgap, dforce_dgap_rate); all zero where
+    the contact is open or the damped force would pull."""
+    delta = max(-gap, 0.0)
+    if not delta > 0.0:
+        return 0.0, 0.0, 0.0
     step, dstep = _STEP(delta, 0.0, 0.0, depth, 1.0)
     c = c_max * step
-    force = spring - c * gap_rate
-    inactive = ~((delta > 0) & (force > 0))  # open or pulling: no force
-    dforce_dgap = np.where(inactive, 0.0, (c_max * dstep) * gap_rate - dspring)  # d/dgap = -d/ddelta
-    dforce_dgap_rate = np.where(inactive, 0.0, -c)
-    return np.where(inactive, 0.0, force), dforce_dgap, dforce_dgap_rate
+    force = k * delta**exponent - c * gap_rate
+    if not force > 0.0:  # pulling: no force
+        return 0.0, 0.0, 0.0
+    dspring = k * exponent * delta ** (exponent - 1.0)
+    return force, (c_max * dstep) * gap_rate - dspring, -c  # d/dgap = -d/ddelta
 
 
-_impact_jit = _njit(cache=True)(_impact_kernel) if _njit is not None else None
+_impact_one = _njit(cache=True)(_impact_scalar) if _njit is not None else _impact_scalar
+
+
+def _impact_kernel(gap, gap_rate, k, exponent, c_max, depth, force, dgap, drate):
+    """:func:`_impact_scalar` over flat float arrays of equal length (gap, rate,
+    k, c_max), results into ``force``, ``dgap``, ``drate``."""
+    for i in range(gap.shape[0]):
+        force[i], dgap[i], drate[i] = _impact_one(gap[i], gap_rate[i], k[i], exponent, c_max[i], depth)
+
+
+_impact_jit = _njit(cache=True)(_impact_kernel) if _njit is not None else _impact_kernel
 
 
 def impact_force(gap, gap_rate, k, exponent, c_max, depth):
@@ -100,9 +111,9 @@ def impact_force(gap, gap_rate, k, exponent, c_max, depth):
     force, dforce_dgap, dforce_dgap_rate : ndarray
         Compressive normal force [N] (>= 0) and its partial derivatives.
     """
-    gap = np.asarray(gap, dtype=float)
-    gap_rate = np.asarray(gap_rate, dtype=float)
-    if (_impact_jit is not None and gap.ndim >= 1 and gap.shape == gap_rate.shape and np.ndim(k) == 0
-            and np.ndim(c_max) == 0):
-        return _impact_jit(gap, gap_rate, float(k), float(exponent), float(c_max), float(depth))
-    return _impact_kernel(gap, gap_rate, k, exponent, c_max, depth)
+    gap, gap_rate, k, c_max = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (gap, gap_rate, k, c_max)))
+    shape = gap.shape
+    flat = [np.ascontiguousarray(a).ravel() for a in (gap, gap_rate, k, c_max)]
+    out = np.empty((3, flat[0].size))
+    _impact_jit(flat[0], flat[1], flat[2], float(exponent), flat[3], float(depth), out[0], out[1], out[2])
+    return out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape)

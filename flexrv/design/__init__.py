@@ -22,7 +22,7 @@ from flexrv.design.model import Reducer
 from flexrv.errors import ConfigError
 
 __all__ = ["Reducer", "load", "loads", "from_dict", "list_presets", "to_toml", "preset_path", "override",
-           "apply_overrides"]
+           "apply_overrides", "read_text_file"]
 
 _PRESET_PACKAGE = "flexrv.design.presets"
 
@@ -56,12 +56,29 @@ def load(preset_or_path: str | Path | Reducer) -> Reducer:
     elif not (path.suffix == ".toml" or path.exists()):
         raise ConfigError(f"unknown preset {text_name!r}: choose one of {list_presets()} or give a path to a .toml file")
     if not path.is_file():
-        raise ConfigError(f"design file {str(path)!r} does not exist")
+        what = "is not a regular file" if path.exists() else "does not exist"
+        raise ConfigError(f"design file {str(path)!r} {what}")
+    return loads(read_text_file(path, "design file"), source=str(path))
+
+
+def read_text_file(path: str | Path, what: str) -> str:
+    """The text of a UTF-8 file (a UTF-8 byte-order mark is allowed).
+
+    Raises ConfigError naming the file if it cannot be read, is not UTF-8
+    (e.g. UTF-16 or Latin-1) or is binary (contains NUL bytes)."""
+    path = Path(path)
     try:
-        text = path.read_text()
+        raw = path.read_bytes()
     except OSError as exc:
-        raise ConfigError(f"cannot read design file {str(path)!r}: {exc}") from None
-    return loads(text, source=str(path))
+        raise ConfigError(f"cannot read {what} {str(path)!r}: {exc.strerror or exc}") from None
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ConfigError(f"{what} {str(path)!r} is UTF-16 encoded: save it as UTF-8")
+    if b"\x00" in raw:
+        raise ConfigError(f"{what} {str(path)!r} is not a text file (binary content): a UTF-8 TOML file is required")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{what} {str(path)!r} is not valid UTF-8 (byte {exc.start}): save it as UTF-8") from None
 
 
 def loads(text: str, source: str = "<string>") -> Reducer:
@@ -76,9 +93,22 @@ def loads(text: str, source: str = "<string>") -> Reducer:
 def from_dict(data: dict[str, Any], source: str = "<dict>") -> Reducer:
     """Validate a nested dict (as read from TOML) into a :class:`Reducer`."""
     try:
-        return Reducer.model_validate(data)
+        return Reducer.model_validate(_plain(data))
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, source)) from None
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars -> the Python number they hold (the strict model accepts
+    ``np.float64`` but not ``np.int64``); a numpy bool stays a (rejected) bool."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    item = getattr(value, "item", None)
+    if item is not None and type(value).__module__ == "numpy" and getattr(value, "ndim", None) == 0:
+        return item()
+    return value
 
 
 def apply_overrides(base: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
@@ -191,3 +221,52 @@ def format_validation_error(exc: ValidationError, source: str) -> str:
                 text += f" (allowed: {rng})"
             lines.append(text)
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- example error sets
+def error_set_names() -> list[str]:
+    """Names of the built-in example error sets (``flexrv/design/presets/errors/*.toml``)."""
+    from importlib import resources
+
+    folder = resources.files("flexrv.design.presets") / "errors"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def error_set_path(name: str):
+    """Path of a built-in example error set."""
+    from importlib import resources
+    from pathlib import Path
+
+    return Path(str(resources.files("flexrv.design.presets") / "errors" / f"{name}.toml"))
+
+
+def load_error_set(name_or_path: str) -> dict[str, Any]:
+    """The ``[errors]`` table of a built-in example error set (by name, see
+    :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
+    plain dict (validate it with :func:`with_errors`)."""
+    import tomllib
+    from pathlib import Path
+
+    text_name = str(name_or_path)
+    path = error_set_path(text_name) if text_name in error_set_names() else Path(text_name)
+    if not path.is_file():
+        raise ConfigError(f"unknown error set {text_name!r}: choose one of {error_set_names()} or give a TOML file")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"cannot read error set {str(path)!r}: {exc}") from None
+    if not isinstance(data.get("errors"), dict):
+        raise ConfigError(f"error set {str(path)!r} has no [errors] table")
+    return data["errors"]
+
+
+def with_errors(reducer, errors):
+    """A validated copy of a design (or preset name / path) whose ``[errors]``
+    table is replaced by ``errors``; every check applies (ConfigError naming the
+    field otherwise)."""
+    from flexrv.design.manufacturing import ManufacturingErrors
+
+    base = load(reducer)
+    data = base.model_dump()
+    data["errors"] = errors.model_dump() if isinstance(errors, ManufacturingErrors) else errors
+    return from_dict(data, source=f"{base.name} + errors")

@@ -40,7 +40,7 @@ from typing import Any
 
 from pydantic import BaseModel, Field, model_validator
 
-from flexrv.design.model import _bad, _Strict
+from flexrv.design._base import _bad, _Strict
 
 #: Largest pin penetration into a disc at assembly [um] accepted from an error set.
 #: Why 20 um: the pin contact law (Palmgren line contact, rv40e's 12 mm wide steel
@@ -328,57 +328,12 @@ class ManufacturingErrors(_Strict):
             if not sub.is_zero():
                 alone.append((assembly_penetration(reducer, sub)[0] * UM_PER_M, f"errors.{group}"))
         alone.sort(reverse=True)
-        detail = ", ".join(f"{name} alone {p:.3g} um" for p, name in alone)
+        detail = ", ".join(f"{name} alone: " + (f"{p:.3g} um interference" if p > 0 else f"{-p:.3g} um clearance")
+                           for p, name in alone)
         culprit = alone[0][1] if alone and alone[0][0] > max(nominal * UM_PER_M, 0.0) + 1e-3 else "the combination of errors"
-        raise _bad("errors", culprit,
-                   f"the as-built pins must not penetrate the discs at assembly by more than "
-                   f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um (what the pin contact law can carry)",
-                   f"pin {pin} penetrates disc {disc} by {pen * UM_PER_M:.3g} um at the best common disc rotation; "
-                   f"nominal design {max(nominal, 0.0) * UM_PER_M:.3g} um; {detail}; reduce {culprit}")
-
-
-# --------------------------------------------------------------------------- example error sets
-def error_set_names() -> list[str]:
-    """Names of the built-in example error sets (``flexrv/design/presets/errors/*.toml``)."""
-    from importlib import resources
-
-    folder = resources.files("flexrv.design.presets") / "errors"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
-def load_error_set(name_or_path: str) -> dict[str, Any]:
-    """The ``[errors]`` table of a built-in example error set (by name, see
-    :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
-    plain dict (validate it with :func:`with_errors`)."""
-    import tomllib
-    from importlib import resources
-    from pathlib import Path
-
-    from flexrv.errors import ConfigError
-
-    text_name = str(name_or_path)
-    if text_name in error_set_names():
-        path = Path(str(resources.files("flexrv.design.presets") / "errors" / f"{text_name}.toml"))
-    else:
-        path = Path(text_name)
-    if not path.is_file():
-        raise ConfigError(f"unknown error set {text_name!r}: choose one of {error_set_names()} or give a TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot read error set {str(path)!r}: {exc}") from None
-    if not isinstance(data.get("errors"), dict):
-        raise ConfigError(f"error set {str(path)!r} has no [errors] table")
-    return data["errors"]
-
-
-def with_errors(reducer, errors: dict[str, Any] | ManufacturingErrors):
-    """A validated copy of a design (or preset name / path) whose ``[errors]``
-    table is replaced by ``errors``; every check applies (ConfigError naming the
-    field otherwise)."""
-    from flexrv.design import from_dict, load
-
-    base = load(reducer)
-    data = base.model_dump()
-    data["errors"] = errors.model_dump() if isinstance(errors, ManufacturingErrors) else errors
-    return from_dict(data, source=f"{base.name} + errors")
+        nominal_text = (f"{nominal * UM_PER_M:.3g} um" if nominal > 0 else "none")
+        raise ValueError(f"{culprit}: the as-built parts interfere at assembly: pin {pin} penetrates disc {disc} by "
+                         f"{pen * UM_PER_M:.3g} um at the best common disc rotation, more than the "
+                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um the pin contact law can carry (allowed: <= "
+                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um; nominal design's interference: {nominal_text}; {detail}); "
+                         f"reduce {culprit}")

@@ -17,22 +17,17 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from flexrv.design._base import _bad, _Strict
+
 from flexrv.units import RAD_PER_DEG
 
 
 
-class _Strict(BaseModel):
-    """Base: unknown fields and non-finite numbers are errors, values are frozen."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True, validate_default=True)
-
-
-def _bad(field: str, value, allowed: str, why: str = "") -> ValueError:
-    """Build the uniform cross-field error message."""
-    msg = f"{field} = {value!r} is not allowed: {allowed}"
-    if why:
-        msg += f" ({why})"
-    return ValueError(msg)
+#: allowed transverse contact ratio of the first stage: below 1 the mesh loses
+#: contact between pairs; above 2.5 a spur pair needs unusually long addenda
+#: (an RV first stage runs at 1.2-1.8). A mesh outside this range made ``simulate``
+#: fail at t = 0 instead of being refused here.
+CONTACT_RATIO_RANGE = (1.0, 2.5)
 
 
 # --------------------------------------------------------------------------- stages
@@ -83,6 +78,30 @@ class FirstStage(_Strict):
         return float(working_center_distance(self.sun_teeth, self.planet_teeth, self.module,
                                              self.pressure_angle, self.sun_profile_shift,
                                              self.planet_profile_shift))
+
+    @property
+    def contact_ratio(self) -> float:
+        """Transverse contact ratio eps_alpha of the sun-planet mesh [-]
+        (:func:`flexrv.geometry.involute.contact_ratio`)."""
+        import numpy as np
+
+        from flexrv.geometry.involute import contact_ratio
+
+        with np.errstate(invalid="ignore"):  # tips that miss the line of action: NaN, refused by the validator
+            return float(contact_ratio(self.sun_teeth, self.planet_teeth, self.module, self.pressure_angle,
+                                       self.sun_profile_shift, self.planet_profile_shift))
+
+    @model_validator(mode="after")
+    def _mesh(self) -> "FirstStage":
+        lo, hi = CONTACT_RATIO_RANGE
+        eps = self.contact_ratio
+        if not (math.isfinite(eps) and lo < eps < hi):
+            shown = f"{eps:.3g}" if math.isfinite(eps) else "undefined (tips do not reach the line of action)"
+            raise _bad("first_stage.sun_profile_shift", self.sun_profile_shift,
+                       f"the transverse contact ratio eps_alpha = {shown} of sun_teeth = {self.sun_teeth}, "
+                       f"planet_teeth = {self.planet_teeth}, planet_profile_shift = {self.planet_profile_shift:g} "
+                       f"must lie in {lo:g} < eps_alpha < {hi:g}", "change the profile shifts or tooth numbers")
+        return self
 
 
 class SecondStage(_Strict):
@@ -358,7 +377,7 @@ class OperatingPoint(_Strict):
 
 
 # --------------------------------------------------------------------------- reducer
-from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402  (needs _Strict, defined above)
+from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
 
 
 class Reducer(_Strict):
@@ -419,5 +438,24 @@ class Reducer(_Strict):
         if self.crankshaft.eccentric_journal_diameter_mm / 2.0 <= ss.eccentricity_mm:
             raise _bad("crankshaft.eccentric_journal_diameter_mm", self.crankshaft.eccentric_journal_diameter_mm,
                        f"must be > 2 a = {2 * ss.eccentricity_mm:g} mm")
+        nb, cs, mb = self.needle_bearing, self.crankshaft, self.main_bearing
+        # needles side by side on their pitch circle (journal diameter + one roller diameter)
+        d_j, d_r = cs.eccentric_journal_diameter_mm, nb.roller_diameter_mm
+        n_max = int(math.pi * (d_j + d_r) / d_r)
+        if nb.roller_count > n_max:
+            raise _bad("needle_bearing.roller_count", nb.roller_count,
+                       f"must be <= {n_max}: {nb.roller_count} rollers of {d_r:g} mm need "
+                       f"{nb.roller_count * d_r:.4g} mm > pi (d_journal + d_roller) = {math.pi * (d_j + d_r):.4g} mm "
+                       f"on the {d_j:g} mm journal", "the needles would overlap")
+        if nb.roller_length_mm > ss.disc_width_mm:
+            raise _bad("needle_bearing.roller_length_mm", nb.roller_length_mm,
+                       f"must be <= second_stage.disc_width_mm = {ss.disc_width_mm:g} mm",
+                       "the needles run in the disc's crank hole")
+        r_crank_out = (a_w + r_hole) * 1e3
+        if mb.pitch_diameter_mm / 2.0 <= r_crank_out:
+            raise _bad("main_bearing.pitch_diameter_mm", mb.pitch_diameter_mm,
+                       f"must be > {2 * r_crank_out:.4g} mm: the main-bearing pitch circle must lie outside the "
+                       f"crank-hole circle (crank circle radius {a_w * 1e3:.4g} mm + crank hole radius "
+                       f"{r_hole * 1e3:.4g} mm)", "the main bearing would sit inside the crank circle")
         self.errors.validate_for(self)  # list lengths vs z_rp / N / n_discs, clearances, assembly interference
         return self

@@ -1,8 +1,7 @@
 """Closed-form film-thickness formulas of isothermal, fully flooded EHL point contacts.
 
 All functions are vectorised over numpy arrays and use SI units. Conventions
-(Hamrock, *Fundamentals of Fluid Film Lubrication*, 1994, ch. 22; Hamrock &
-Dowson, *Ball Bearing Lubrication*, 1981):
+(:cite:`hamrock1994`, ch. 22; :cite:`hamrock1981`):
 
 * x is the entrainment (rolling) direction, ``rx`` the effective radius in x and
   ``ry`` in y; the formulas are fitted for ry >= rx (entrainment along the minor
@@ -12,7 +11,7 @@ Dowson, *Ball Bearing Lubrication*, 1981):
   :func:`flexrv.contact.hertz.effective_modulus`).
 
 Orders of magnitude: EHL films of rolling bearings are 0.01-1 um. The
-"film thickness 0.01-0.18 mm" quoted in seeds 000/001 is not an EHL film (it is
+"film thickness 0.01-0.18 mm" quoted in :cite:`seed000,seed001` is not an EHL film (it is
 three orders of magnitude too large for a loaded ball-raceway contact); it is not
 used anywhere in flexrv.
 """
@@ -44,7 +43,7 @@ class DimensionlessGroups:
     load_w : W = Q / (E' rx^2).
     moes_m : M = W (2U)^(-3/4) (Moes; 2U uses the sum speed u1 + u2).
     moes_l : L = G (2U)^(1/4).
-    ellipticity : k = 1.0339 (ry/rx)^0.636 (Hamrock & Brewe 1983 fit).
+    ellipticity : k = a/b, exact (elliptic integrals, :func:`ellipticity`); 1 for ry = rx.
     """
 
     speed_u: np.ndarray
@@ -55,11 +54,28 @@ class DimensionlessGroups:
     ellipticity: np.ndarray
 
 
-def ellipticity_approx(rx, ry):
-    """Ellipticity k = a/b ~ 1.0339 (ry/rx)^0.636 (Hamrock & Brewe 1983; Hamrock 1994, eq. 17.17).
+def ellipticity(rx, ry):
+    """Exact Hertz ellipticity k = a/b [-] of the contact of principal radii rx (along the
+    entrainment) and ry (across), from the complete elliptic integrals (one executor:
+    :func:`flexrv.contact.hertz.point_contact`, whose ellipticity does not depend on load or
+    modulus). k = 1 for a circular contact (ry = rx); k < 1 for rx > ry.
 
-    Within 3.4 % of the exact value for 1 <= ry/rx <= 30 (6 % at 100); :func:`flexrv.contact.hertz.point_contact`
-    gives the exact value.
+    This is the k of the Hamrock–Dowson formulas: their own curve fit k ~ 1.0339 (ry/rx)^0.636
+    (:func:`ellipticity_approx`) gives 1.0339 for a circular contact, +1.0 % on h_c and +2.3 %
+    on h_min there (issue 17 (2)).
+    """
+    from flexrv.contact.hertz import point_contact
+
+    rx = np.asarray(rx, dtype=float)
+    ry = np.asarray(ry, dtype=float)
+    return np.asarray(point_contact(np.ones(np.broadcast(rx, ry).shape), rx, ry, 1.0).ellipticity, dtype=float)
+
+
+def ellipticity_approx(rx, ry):
+    """Ellipticity k = a/b ~ 1.0339 (ry/rx)^0.636 (:cite:`hamrock1983`; :cite:`hamrock1994`, eq. 17.17).
+
+    Within 3.4 % of the exact value for 1 <= ry/rx <= 30 (6 % at 100), but 1.0339 instead of 1 for
+    a circular contact; flexrv uses the exact :func:`ellipticity` (kept for comparison only).
     """
     return 1.0339 * (np.asarray(ry, dtype=float) / np.asarray(rx, dtype=float)) ** 0.636
 
@@ -87,16 +103,16 @@ def dimensionless_groups(load, speed, rx, ry, e_eff, viscosity, pressure_viscosi
     g = alpha * e_eff
     w = load / (e_eff * rx**2)
     return DimensionlessGroups(speed_u=u, material_g=g, load_w=w, moes_m=w * (2.0 * u) ** -0.75,
-                               moes_l=g * (2.0 * u) ** 0.25, ellipticity=ellipticity_approx(rx, ry))
+                               moes_l=g * (2.0 * u) ** 0.25, ellipticity=ellipticity(rx, ry))
 
 
 def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, ellipticity=None):
-    """Hamrock–Dowson (1977) central and minimum film thickness [m].
+    """Hamrock–Dowson central and minimum film thickness [m] :cite:`hamrock1977`.
 
     h_c / rx   = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 exp(-0.73 k)),
     h_min / rx = 3.63 U^0.68 G^0.49 W^-0.073 (1 - exp(-0.68 k))
 
-    (Hamrock & Dowson, J. Lubr. Technol. 99 (1977) 264-276; Hamrock 1994, eqs.
+    (:cite:`hamrock1977`; :cite:`hamrock1994`, eqs.
     22.18-22.19). Fitted for 1 <= k <= 8, 0.3e-11 < U < 1e-10 (roughly), G ~ 2500-5000
     and W up to ~1e-4, i.e. the piezoviscous-elastic regime; outside it the formula
     is an extrapolation.
@@ -106,7 +122,11 @@ def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, el
     load, speed, rx, ry, e_eff, viscosity, pressure_viscosity :
         as in :func:`dimensionless_groups`.
     ellipticity : array_like, optional
-        k = a/b; default the Hamrock–Brewe fit 1.0339 (ry/rx)^0.636.
+        k = a/b; default the exact Hertz ellipticity (:func:`ellipticity`; k = 1 for ry = rx).
+        Hamrock & Dowson evaluate k from a curve fit, 1.03 (ry/rx)^0.64, which is 1.03 instead
+        of 1 for a circular contact; with the exact k the circular films are
+        h_c = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^-0.73) rx and
+        h_min = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^-0.68) rx (tests/test_ehl_film.py).
 
     Returns
     -------
@@ -122,11 +142,11 @@ def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, el
 
 
 def moes_asymptotes(moes_m, moes_l, curvature_ratio):
-    """The four asymptotic central films of Nijenbanning, Venner & Moes (1994) (dimensionless).
+    """The four asymptotic central films of Nijenbanning, Venner & Moes :cite:`nijenbanning1994` (dimensionless).
 
     With lambda = rx/ry (<= 1 for entrainment along the minor axis of the contact ellipse),
     H = h_c/rx (2U)^-1/2, M = W (2U)^-3/4, L = G (2U)^1/4 (U, W, G of Hamrock, 2U uses the
-    sum speed u1 + u2), Nijenbanning, Venner & Moes, Wear 176 (1994) 217-229, eqs. (5)-(8):
+    sum speed u1 + u2), :cite:`nijenbanning1994`, eqs. (5)-(8):
 
     * rigid-isoviscous     H_RI = 145 (1 + 0.796 lambda^(14/15))^(-15/7) lambda^-1 M^-2,
     * elastic-isoviscous   H_EI = 3.18 (1 + 0.006 ln lambda + 0.63 lambda^(4/7))^(-14/25) lambda^(-1/15) M^(-2/15),
@@ -155,10 +175,10 @@ def moes_asymptotes(moes_m, moes_l, curvature_ratio):
 
 
 def moes_dimensionless(moes_m, moes_l, curvature_ratio):
-    """Dimensionless central film H = h_c/rx (2U)^-1/2 of Nijenbanning, Venner & Moes (1994).
+    """Dimensionless central film H = h_c/rx (2U)^-1/2 of Nijenbanning, Venner & Moes :cite:`nijenbanning1994`.
 
-    Blend of the asymptotes of :func:`moes_asymptotes` (Nijenbanning, Venner & Moes,
-    Wear 176 (1994) 217-229, eqs. (9)-(10)):
+    Blend of the asymptotes of :func:`moes_asymptotes` (:cite:`nijenbanning1994`,
+    eqs. (9)-(10)):
 
         H = { [H_RI^(3/2) + (H_EI^-4 + H_00^-4)^(-3/8)]^(2s/3) + (H_RP^-8 + H_EP^-8)^(-s/8) }^(1/s),
         s = 1.5 (1 + exp(-1.2 H_EI/H_RI)),   H_00 = 1.8 lambda^-1.
@@ -180,12 +200,11 @@ def moes_dimensionless(moes_m, moes_l, curvature_ratio):
 
 
 def moes_central(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity):
-    """Central film thickness [m] from the Nijenbanning–Venner–Moes (1994) formula.
+    """Central film thickness [m] from the Nijenbanning–Venner–Moes formula :cite:`nijenbanning1994`.
 
     h_c = H(M, L, lambda) rx (2U)^(1/2) with H of :func:`moes_dimensionless`,
-    lambda = rx/ry (Nijenbanning, Venner & Moes, "Film thickness in elastohydrodynamically
-    lubricated elliptic contacts", Wear 176 (1994) 217-229; the circular case lambda = 1 is
-    the point-contact formula quoted in Venner & Lubrecht 2000).
+    lambda = rx/ry (:cite:`nijenbanning1994`; the circular case lambda = 1 is the point-contact
+    formula quoted in :cite:`venner2000`).
 
     Unlike Hamrock–Dowson it bridges all four regimes (rigid/elastic x
     isoviscous/piezoviscous). Verification status (tests/test_ehl_film.py,
@@ -205,12 +224,12 @@ def moes_central(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity):
 
 
 def pan_hamrock_line(load, length, speed, r_eff, e_eff, viscosity, pressure_viscosity):
-    """Pan & Hamrock (1989) central and minimum film of an EHL line contact [m].
+    """Pan & Hamrock central and minimum film of an EHL line contact [m] :cite:`pan1989`.
 
     h_c / R   = 2.922 W'^-0.166 U^0.692 G^0.470,
     h_min / R = 1.714 W'^-0.128 U^0.694 G^0.568,
     W' = w / (E' R L) (load per unit length), U = eta0 u / (E' R), G = alpha E'
-    (Pan & Hamrock, J. Tribol. 111 (1989) 246-251; Hamrock 1994, eqs. 21.60-21.61).
+    (:cite:`pan1989`; :cite:`hamrock1994`, eqs. 21.60-21.61).
 
     Parameters
     ----------

@@ -26,13 +26,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from flexrv.cache import atomic_path, cache_dir, content_hash, library_versions
+from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
 from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, hamrock_dowson
 from flexrv.ehl.solver import LubricantProperties, solve_point_contact
 from flexrv.errors import ConvergenceError, InputError
 
 #: Bump when the solver or the map layout changes (part of the cache key).
-MAP_SCHEMA = 3  # 3: fixed map grid (no adaptive refinement), half-domain solver; 2: second-order + Richardson
+#: 4: the maps store the ratio to Hamrock–Dowson, whose ellipticity is now the exact Hertz k
+#: (1.0 for circular contacts); 3: fixed map grid (no adaptive refinement), half-domain solver;
+#: 2: second-order + Richardson
+MAP_SCHEMA = 4
 
 
 @dataclass(frozen=True)
@@ -227,18 +230,21 @@ def film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, speed_ra
                       versions=library_versions("numpy", "scipy", "flexrv"))
     key = content_hash(key_inputs)
     path = cache_dir() / "ehl_maps" / f"film_map_{key}.npz"
-    if path.exists():
-        try:
-            with np.load(path) as data:
-                return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant,
-                               log_load=data["log_load"], log_speed=data["log_speed"], log_ratio=data["log_ratio"],
-                               h_central=data["h_central"], valid=data["valid"], grid=int(grid))
-        except (OSError, KeyError, ValueError):
-            pass  # unreadable cache entry: rebuild and overwrite
-    fmap = build_film_map(rx, ry, e_eff, lubricant, load_range, speed_range, n_load=n_load, n_speed=n_speed,
-                          grid=grid, **solver_kw)
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, log_load=fmap.log_load, log_speed=fmap.log_speed, log_ratio=fmap.log_ratio,
-                     h_central=fmap.h_central, valid=fmap.valid, inputs=np.array(json.dumps(key_inputs, default=str)))
+    def _load() -> FilmMap:
+        with np.load(path) as data:
+            return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant,
+                           log_load=data["log_load"], log_speed=data["log_speed"], log_ratio=data["log_ratio"],
+                           h_central=data["h_central"], valid=data["valid"], grid=int(grid))
+
+    def _build() -> FilmMap:
+        fmap = build_film_map(rx, ry, e_eff, lubricant, load_range, speed_range, n_load=n_load, n_speed=n_speed,
+                              grid=grid, **solver_kw)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as fh:
+                np.savez(fh, log_load=fmap.log_load, log_speed=fmap.log_speed, log_ratio=fmap.log_ratio,
+                         h_central=fmap.h_central, valid=fmap.valid,
+                         inputs=np.array(json.dumps(key_inputs, default=str)))
+        return fmap
+
+    fmap, _ = cached_entry([path], key, _load, _build)
     return fmap

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flexrv.cache import atomic_path, cache_dir, content_hash, library_versions
+from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
 from flexrv.errors import InputError
 from flexrv.fem.reduction import (RacewaySpec, default_harmonics, fourier_loads, hcb_basis, nodal_areas,
                                   periodic_cubic, raceway_weights)
@@ -284,8 +284,17 @@ def build_reduced_body(mesh_result, material: dict, n_eig: int = 20, raceway: Ra
     key = content_hash(mesh_result.key, material, settings, BODY_FORMAT_VERSION,
                        library_versions("exudyn", "scikit-fem", "scipy", "numpy"))
     path = cache_dir() / f"{part}-{key}.cms.npz"
-    if cache and path.exists():
-        return ReducedBody.load(path)
+
+    def _build() -> "ReducedBody":
+        return _reduce_uncached(mesh_result, mesh, part, material, settings, ifaces, n_eig, raceway, stress, fe,
+                                path, cache)
+
+    body, _ = cached_entry([path], key, lambda: ReducedBody.load(path), _build, enabled=cache)
+    return body
+
+
+def _reduce_uncached(mesh_result, mesh, part, material, settings, ifaces, n_eig, raceway, stress, fe, path, cache):
+    """The reduction of :func:`reduce_mesh` without the cache lookup (writes ``path`` if ``cache``)."""
     t0 = time.perf_counter()
     if fe is None:
         fe = _assemble(mesh, material)

@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from flexrv.cache import atomic_write_text, cache_dir, content_hash, library_versions
+from flexrv.cache import atomic_write_text, cache_dir, cached_entry, content_hash, library_versions
 
 FORMAT_VERSION = 1
 
@@ -80,20 +80,24 @@ def crank_compliance(reducer, size: float | None = None, cache: bool = True) -> 
     mat = material_dict(reducer, "crankshaft")
     key = content_hash(mres.key, mat, FORMAT_VERSION, library_versions("scikit-fem", "scipy", "numpy"))
     path = cache_dir() / f"crankshaft-{key}.compliance.json"
-    if cache and path.exists():
-        return CrankCompliance(**json.loads(path.read_text()))
-    d = mres.data
-    fe = _assemble(d, mat)
-    seat, ecc1, ecc2, sup_a, sup_b = (d.node_set(g) for g in ("gear_seat", "eccentric_1", "eccentric_2",
-                                                              "support_a", "support_b"))
-    seat_t, ecc = _disjoint(seat, np.union1d(ecc1, ecc2))
-    k_t = 1.0 / seat_compliance(fe.K, d.nodes, seat_t, [ecc])[5, 5]
-    seat_l, a, b = _disjoint(seat, sup_a, sup_b)
-    c_l = seat_compliance(fe.K, d.nodes, seat_l, [a, b])
-    fixed = np.unique(np.concatenate([seat, ecc1, ecc2, sup_a, sup_b]))
-    f_hz, _ = eigenmodes(fe.K, fe.M, 1, fixed_nodes=fixed)
-    out = CrankCompliance(torsional=float(k_t), lateral_x=float(1.0 / c_l[0, 0]), lateral_y=float(1.0 / c_l[1, 1]),
-                          lowest_clamped_hz=float(f_hz[0]), n_nodes=int(d.n_nodes), mesh_key=mres.key)
-    if cache:
-        atomic_write_text(path, json.dumps(asdict(out)))
+
+    def _build() -> CrankCompliance:
+        d = mres.data
+        fe = _assemble(d, mat)
+        seat, ecc1, ecc2, sup_a, sup_b = (d.node_set(g) for g in ("gear_seat", "eccentric_1", "eccentric_2",
+                                                                  "support_a", "support_b"))
+        seat_t, ecc = _disjoint(seat, np.union1d(ecc1, ecc2))
+        k_t = 1.0 / seat_compliance(fe.K, d.nodes, seat_t, [ecc])[5, 5]
+        seat_l, a, b = _disjoint(seat, sup_a, sup_b)
+        c_l = seat_compliance(fe.K, d.nodes, seat_l, [a, b])
+        fixed = np.unique(np.concatenate([seat, ecc1, ecc2, sup_a, sup_b]))
+        f_hz, _ = eigenmodes(fe.K, fe.M, 1, fixed_nodes=fixed)
+        out = CrankCompliance(torsional=float(k_t), lateral_x=float(1.0 / c_l[0, 0]), lateral_y=float(1.0 / c_l[1, 1]),
+                              lowest_clamped_hz=float(f_hz[0]), n_nodes=int(d.n_nodes), mesh_key=mres.key)
+        if cache:
+            atomic_write_text(path, json.dumps(asdict(out)))
+        return out
+
+    out, _ = cached_entry([path], key, lambda: CrankCompliance(**json.loads(path.read_text())), _build,
+                          enabled=cache)
     return out

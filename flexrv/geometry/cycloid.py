@@ -36,25 +36,37 @@ def center_curve(phi, z_rp: int, radius: float, eccentricity: float):
     c, dc, ddc : ndarray, shape (..., 2)
         Position [m] and derivatives w.r.t. phi.
     """
-    return _center_curve_kernel(np.asarray(phi, dtype=float), z_rp, radius, eccentricity)
+    phi = np.asarray(phi, dtype=float)
+    out = _CURVE(np.ascontiguousarray(phi).ravel(), int(z_rp), float(radius), float(eccentricity))
+    out = out.reshape((3,) + phi.shape + (2,))
+    return out[0], out[1], out[2]
 
 
-def _center_curve_kernel(phi, z_rp, radius, eccentricity):
-    """Body of :func:`center_curve` on a float array ``phi`` (numba-compilable)."""
+def _center_curve_point(phi, z_rp, radius, eccentricity):
+    """C(phi), C'(phi), C''(phi) at one curve parameter as six floats
+    (cx, cy, d1x, d1y, d2x, d2y): the single implementation of the curve."""
     s, c = np.sin(phi), np.cos(phi)
     zphi = z_rp * phi
     sz, cz = np.sin(zphi), np.cos(zphi)
     rs, rc = radius * s, radius * c
-    out = np.empty((3,) + phi.shape + (2,))  # one allocation instead of three np.stack calls
-    pos, d1, d2 = out[0], out[1], out[2]
-    pos[..., 0] = rs - eccentricity * sz
-    pos[..., 1] = rc - eccentricity * cz
-    ez, ez2 = eccentricity * z_rp, eccentricity * z_rp**2
-    d1[..., 0] = rc - ez * cz
-    d1[..., 1] = -rs + ez * sz
-    d2[..., 0] = -rs + ez2 * sz
-    d2[..., 1] = -rc + ez2 * cz
-    return pos, d1, d2
+    ez, ez2 = eccentricity * z_rp, eccentricity * z_rp * z_rp
+    return (rs - eccentricity * sz, rc - eccentricity * cz, rc - ez * cz, -rs + ez * sz,
+            -rs + ez2 * sz, -rc + ez2 * cz)
+
+
+_POINT = _jit(_center_curve_point)
+
+
+def _center_curve_kernel(phi, z_rp, radius, eccentricity):
+    """:func:`_center_curve_point` over a flat array ``phi`` (M,): (3, M, 2)."""
+    out = np.empty((3, phi.shape[0], 2))
+    for i in range(phi.shape[0]):
+        out[0, i, 0], out[0, i, 1], out[1, i, 0], out[1, i, 1], out[2, i, 0], out[2, i, 1] = _POINT(
+            phi[i], z_rp, radius, eccentricity)
+    return out
+
+
+_CURVE = _jit(_center_curve_kernel)
 
 
 def center_curve_curvature(phi, z_rp: int, radius: float, eccentricity: float):
@@ -148,43 +160,89 @@ def _rotate(v, angle):
 
 
 # =========================================================================== signed pin gap
-def _dot2(a, b):
-    """Dot product over the last axis of length 2 (cheaper than einsum on small arrays)."""
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol, max_iter):
+    """Newton iteration of :func:`pin_gap` on g(phi) = |P - C(phi)|^2 / 2 for one
+    point P = (px, py) from the start ``phi``; steps clipped to ``max_step``, a
+    descent step where g'' <= 0. The single implementation (numba-compiled): the
+    pin-contact kernel and :func:`pin_gap` call it.
 
-
-_CURVE = _jit(_center_curve_kernel)
-_DOT2 = _jit(_dot2)
-
-
-def _closest_point_newton(pp, phi, z_rp, radius, eccentricity, max_step, tol, max_iter):
-    """Newton iteration of :func:`pin_gap` on g(phi) = |P - C(phi)|^2 / 2 from the
-    starts ``phi`` (..., S) for the points ``pp`` (..., 1, 2); steps clipped to
-    ``max_step``, a descent step where g'' <= 0. Returns (phi, converged) with
-    converged = max |step| < ``tol`` [rad]. numba-compilable."""
-    converged = False
+    Returns (phi, converged, residual, s, nx, ny, dist2) at the LAST EVALUATED
+    parameter phi (the next Newton step from it is below ``tol`` [rad] when
+    converged, so phi is the foot point to O(tol)): the first-order residual
+    |(P - C).C'|/|C'| [m], the signed distance s(P) = (P - C).n_out (> 0 outside,
+    away from the disc centre) with the unit outward normal n_out = C'/|C'| turned
+    by +90 deg (clockwise traversal), and |P - C|^2."""
     for _ in range(max_iter):
-        c, d1, d2 = _CURVE(phi, z_rp, radius, eccentricity)
-        r = pp - c
-        g1 = -_DOT2(r, d1)
-        g2 = _DOT2(d1, d1) - _DOT2(r, d2)
-        step = np.where(g2 > 0, -g1 / np.where(g2 > 0, g2, 1.0), -np.sign(g1) * max_step)
-        step = np.clip(step, -max_step, max_step)
-        phi = phi + step
-        if np.max(np.abs(step)) < tol:
-            converged = True
+        cx, cy, d1x, d1y, d2x, d2y = _POINT(phi, z_rp, radius, eccentricity)
+        rx, ry = px - cx, py - cy
+        g1 = -(rx * d1x + ry * d1y)
+        g2 = d1x * d1x + d1y * d1y - (rx * d2x + ry * d2y)
+        if g2 > 0.0:
+            step = -g1 / g2
+        else:
+            step = -np.sign(g1) * max_step
+        step = min(max(step, -max_step), max_step)
+        if abs(step) < tol:
             break
-    return phi, converged
+        phi = phi + step
+    else:
+        cx, cy, d1x, d1y, _, _ = _POINT(phi, z_rp, radius, eccentricity)
+        rx, ry = px - cx, py - cy
+        step = np.inf
+    inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
+    nx, ny = -d1y * inv, d1x * inv
+    residual = abs(rx * d1x + ry * d1y) * inv
+    return phi, abs(step) < tol, residual, rx * nx + ry * ny, nx, ny, rx * rx + ry * ry
 
 
 _NEWTON = _jit(_closest_point_newton)
 
+#: relative positions of the cold starts within one lobe (fraction of the lobe angle)
+_COLD_STARTS = np.linspace(-0.375, 0.375, 7)
 
-def _outward_normal(d1):
-    """Unit outward normal (away from the disc centre) of the clockwise-traversed
-    pin-centre curve: the unit tangent rotated by +90 deg."""
-    t = d1 / np.linalg.norm(d1, axis=-1, keepdims=True)
-    return np.stack([-t[..., 1], t[..., 0]], axis=-1)
+
+def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter):
+    """Foot point of P = (px, py) on C: Newton from the warm start ``phi0`` if it is
+    finite, else (or if that fails or lands more than half a lobe from P's polar
+    angle theta: a warm start from a far-away state, e.g. a diverging Newton trial,
+    can reach another lobe's local minimum) from seven starts across the lobe
+    around theta, keeping the nearest converged foot point. A start counts as
+    converged when the step fell below ``tol`` or the first-order residual is below
+    1e-12 m. Returns (phi, ok, s, nx, ny) (see :func:`_closest_point_newton`)."""
+    lobe = 2.0 * np.pi / (z_rp - 1)
+    theta = np.arctan2(px, py)
+    if np.isfinite(phi0):
+        phi, conv, res, sd, nx, ny, _ = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
+        off = phi - theta
+        off -= 2.0 * np.pi * np.rint(off / (2.0 * np.pi))
+        if (conv or res <= 1e-12) and abs(off) <= 0.5 * lobe:
+            return phi, True, sd, nx, ny
+    best = (theta, False, np.nan, np.nan, np.nan)
+    best_d2 = np.inf
+    for k in range(_COLD_STARTS.shape[0]):
+        phi, conv, res, sd, nx, ny, d2 = _NEWTON(px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius,
+                                                 eccentricity, max_step, tol, max_iter)
+        if (conv or res <= 1e-12) and d2 < best_d2:
+            best, best_d2 = (phi, True, sd, nx, ny), d2
+    return best
+
+
+_FOOT = _jit(_foot_point)
+
+
+def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter, out):
+    """Foot point, signed distance and outward normal of every point (flat
+    arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
+    failed = 0
+    for i in range(px.shape[0]):
+        phi, ok, out[0, i], out[1, i], out[2, i] = _FOOT(px[i], py[i], phi0[i], z_rp, radius, eccentricity,
+                                                         max_step, tol, max_iter)
+        failed += not ok
+        out[3, i] = phi
+    return failed
+
+
+_PIN_GAP = _jit(_pin_gap_kernel)
 
 
 def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
@@ -246,43 +304,29 @@ def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, ecce
         raise InputError("points must be finite")
     if d_rotation:
         p = _rotate(p, -d_rotation)
-    radius = pin_circle_radius + d_radius
-    lobe = 2.0 * np.pi / (z_rp - 1)
-    if phi0 is None:
-        theta = np.arctan2(p[..., 0], p[..., 1])
-        phi = theta[..., None] + lobe * np.linspace(-0.375, 0.375, 7)
-    else:
-        phi = np.asarray(phi0, dtype=float)[..., None] + np.zeros(1)
-        phi = np.broadcast_to(phi, p.shape[:-1] + (1,)).copy()
-    pp = p[..., None, :]
-    max_step = lobe / 8.0
-    scale = np.hypot(pin_circle_radius, 1.0)
-    if phi.size == 0:
-        converged = True
-    else:
-        phi, converged = _NEWTON(np.ascontiguousarray(pp), np.ascontiguousarray(phi), int(z_rp), float(radius),
-                                 float(eccentricity), float(max_step), float(tol * scale), int(max_iter))
-    if not converged:
-        # accept if the first-order condition holds to round-off
-        c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
-        r = pp - c
-        res = np.abs(_dot2(r, d1)) / np.linalg.norm(d1, axis=-1)
-        if np.max(res, initial=0.0) > 1e-12:
-            raise ConvergenceError(f"pin_gap: closest-point iteration did not converge in {max_iter} "
-                                   f"iterations (max residual {np.max(res):.3g} m)")
-    if phi.shape[-1] > 1:  # several starts: keep the nearest foot point
-        c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
-        dist2 = _dot2(pp - c, pp - c)
-        best = np.argmin(dist2, axis=-1)[..., None]
-        phi = np.take_along_axis(phi, best, axis=-1)
-    phi = phi[..., 0]
-    c, d1, _ = center_curve(phi, z_rp, radius, eccentricity)
-    n_out = _outward_normal(d1)
-    signed = _dot2(p - c, n_out)
-    gap = signed + d_pin_radius
+    shape = p.shape[:-1]
+    flat = np.ascontiguousarray(p.reshape(-1, 2))
+    phi0 = np.full(flat.shape[0], np.nan) if phi0 is None else np.ascontiguousarray(
+        np.broadcast_to(np.asarray(phi0, dtype=float), shape)).ravel()
+    out = np.empty((4, flat.shape[0]))
+    failed = _PIN_GAP(flat[:, 0].copy(), flat[:, 1].copy(), phi0, int(z_rp), float(pin_circle_radius + d_radius),
+                      float(eccentricity), *closest_point_settings(z_rp, pin_circle_radius, tol, max_iter), out)
+    if failed:
+        raise ConvergenceError(f"pin_gap: closest-point iteration did not converge in {max_iter} "
+                               f"iterations for {failed} point(s)")
+    gap = out[0].reshape(shape) + d_pin_radius
+    n_out = np.stack([out[1], out[2]], axis=-1).reshape(shape + (2,))
     if d_rotation:
         n_out = _rotate(n_out, d_rotation)
-    return gap, n_out, phi
+    return gap, n_out, out[3].reshape(shape)
+
+
+def closest_point_settings(z_rp: int, pin_circle_radius: float, tol: float = 1e-14, max_iter: int = 40):
+    """(max_step [rad], tolerance [rad], max_iter) of the closest-point Newton
+    iteration: steps clipped to an eighth of a lobe, tolerance ``tol`` scaled by
+    hypot(R_p, 1)."""
+    lobe = 2.0 * np.pi / (z_rp - 1)
+    return float(lobe / 8.0), float(tol * np.hypot(pin_circle_radius, 1.0)), int(max_iter)
 
 
 # =========================================================================== curvature, arms, stiffness

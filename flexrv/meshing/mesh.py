@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flexrv.cache import atomic_path, cache_dir, content_hash, library_versions
+from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
 from flexrv.errors import InputError
 from flexrv.meshing import parts as P
 
@@ -215,42 +215,45 @@ def generate_mesh(spec, part: str, size: float | None = None, *, local_size: flo
     folder = cache_dir()
     stem = f"{part}-{key}"
     msh, vtu, npz = (folder / f"{stem}{ext}" for ext in (".msh", ".vtu", ".npz"))
-    if cache and msh.exists() and vtu.exists() and npz.exists():
-        return MeshResult(MeshData.load_npz(npz), msh, vtu, npz, True, key)
-    t0 = time.perf_counter()
-    with gmsh_session(stem, threads=threads) as gmsh:
-        groups = P.BUILDERS[part](gmsh, spec, size)
-        for name, faces in groups.items():
-            gmsh.model.addPhysicalGroup(2, faces, name=name)
-        vol = gmsh.model.getEntities(3)[0][1]
-        gmsh.model.addPhysicalGroup(3, [vol], name=part)
-        _apply_size_field(gmsh, spec, groups, size, chk["local_size"])
-        gmsh.option.setNumber("Mesh.ElementOrder", 2)
-        gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
-        gmsh.option.setNumber("Mesh.HighOrderOptimize", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 10 if threads > 1 else 1)
-        t1 = time.perf_counter()
-        try:
-            gmsh.model.mesh.generate(3)
-        except Exception as exc:  # gmsh raises a bare Exception
-            raise InputError(f"meshing {part} with size {size * 1e3:.4g} mm failed: {exc}") from None
-        t2 = time.perf_counter()
-        info = {"local_size": chk["local_size"], "estimated_nodes": chk["estimated_nodes"],
-                "t_geometry_s": t1 - t0, "t_mesh_s": t2 - t1}
-        if isinstance(spec, P.CycloidDiscSpec):
-            info["profile_deviation_m"] = P.profile_deviation(gmsh, spec)
-        nodes, tets, tris, tri_group, names = _extract(gmsh, groups)
-        if tets.shape[0] == 0:
-            raise InputError(f"meshing {part} produced no volume elements")
-        data = MeshData(nodes, tets, tris, tri_group, names, part, P.spec_dict(spec), size, info)
-        gmsh.option.setNumber("Mesh.Binary", 1)
-        with atomic_path(msh) as tmp:
-            gmsh.write(str(tmp))
-    with atomic_path(vtu) as tmp:
-        data.to_meshio().write(tmp, file_format="vtu")
-    with atomic_path(npz) as tmp:
-        data.save_npz(tmp)
-    return MeshResult(data, msh, vtu, npz, False, key)
+
+    def _build() -> MeshData:
+        t0 = time.perf_counter()
+        with gmsh_session(stem, threads=threads) as gmsh:
+            groups = P.BUILDERS[part](gmsh, spec, size)
+            for name, faces in groups.items():
+                gmsh.model.addPhysicalGroup(2, faces, name=name)
+            vol = gmsh.model.getEntities(3)[0][1]
+            gmsh.model.addPhysicalGroup(3, [vol], name=part)
+            _apply_size_field(gmsh, spec, groups, size, chk["local_size"])
+            gmsh.option.setNumber("Mesh.ElementOrder", 2)
+            gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
+            gmsh.option.setNumber("Mesh.HighOrderOptimize", 0)
+            gmsh.option.setNumber("Mesh.Algorithm3D", 10 if threads > 1 else 1)
+            t1 = time.perf_counter()
+            try:
+                gmsh.model.mesh.generate(3)
+            except Exception as exc:  # gmsh raises a bare Exception
+                raise InputError(f"meshing {part} with size {size * 1e3:.4g} mm failed: {exc}") from None
+            t2 = time.perf_counter()
+            info = {"local_size": chk["local_size"], "estimated_nodes": chk["estimated_nodes"],
+                    "t_geometry_s": t1 - t0, "t_mesh_s": t2 - t1}
+            if isinstance(spec, P.CycloidDiscSpec):
+                info["profile_deviation_m"] = P.profile_deviation(gmsh, spec)
+            nodes, tets, tris, tri_group, names = _extract(gmsh, groups)
+            if tets.shape[0] == 0:
+                raise InputError(f"meshing {part} produced no volume elements")
+            data = MeshData(nodes, tets, tris, tri_group, names, part, P.spec_dict(spec), size, info)
+            gmsh.option.setNumber("Mesh.Binary", 1)
+            with atomic_path(msh) as tmp:
+                gmsh.write(str(tmp))
+        with atomic_path(vtu) as tmp:
+            data.to_meshio().write(tmp, file_format="vtu")
+        with atomic_path(npz) as tmp:
+            data.save_npz(tmp)
+        return data
+
+    data, hit = cached_entry([msh, vtu, npz], key, lambda: MeshData.load_npz(npz), _build, enabled=cache)
+    return MeshResult(data, msh, vtu, npz, hit, key)
 
 
 def build_mesh(reducer, part: str, size: float | None = None, **kw) -> MeshResult:

@@ -3,21 +3,21 @@ groups and the assembled model.
 
 A *member* is a body with its own Exudyn ``NodeGenericODE2`` (coordinates are
 absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
-*force group* couples several members through ONE ``ObjectGenericODE2`` whose
-Python force function evaluates every contact of the group at once with numpy
-(see the facts note: one user-function call costs ~18 us, so the number of
-groups, not the number of contacts, sets the overhead). Optionally
-(``assemble(model, merge=True)``) each run of consecutive groups with the
-default glue shares ONE element (:func:`add_merged`): the rigid model then
-makes two Python calls per residual instead of five (measured gain < 5 %,
-see :func:`flexrv.model.factory.assemble`).
+*force group* couples several members. The rigid reducer's groups (gear stage,
+crank supports, needle bearings, pins, rigid main bearing, loads) are
+:class:`KernelGroup` s: their physics is one numba-compiled kernel each, and the
+model evaluates all of them in ONE compiled call from ONE ``ObjectGenericODE2``
+(:class:`flexrv.model.kernels.FusedForces`; issue 15: 95 % of a step was Python
+overhead with one numpy element per group). Other groups (ball-resolved bearing,
+flexible crank) keep one element each with a Python force function.
+The assembled model (:class:`flexrv.model.assembled.AssembledModel`) lives in its
+own module, above the kernels it calls.
 
-Each group's kernel ``evaluate(t, q, v)`` is written once and broadcasts over
-leading axes: the Exudyn callback calls it with one state (q of shape (n,)),
-post-processing calls it with a whole time history (shape (T, n)) to recover
-every contact force as a named output. Replacing a member group by a flexible
-one (flexible-bearing issue) means registering another group under the same
-output names.
+A group's ``evaluate(t, q, v)`` accepts one state (q of shape (n,), the solver
+path) or a whole time history (shape (T, n)), from which post-processing
+recovers every contact force as a named output. Replacing a member group by a
+flexible one (flexible-bearing issue) means registering another group under the
+same output names.
 """
 
 from __future__ import annotations
@@ -126,15 +126,6 @@ class ForceGroup:
                                                forceUserFunction=force_fn, **kwargs))
 
     @property
-    def mergeable(self) -> bool:
-        """True if the group can share a merged Python element
-        (:func:`add_merged`): default Exudyn glue and an analytic Jacobian. The
-        merged element's Jacobian is dense over ALL member coordinates, so a
-        model with many coordinates (e.g. modal ring members) should override
-        this to False for its groups or assemble with ``merge=False``."""
-        return type(self).add_to is ForceGroup.add_to and self.analytic_jacobian
-
-    @property
     def stats(self) -> list[int]:
         """[force calls, jacobian calls] (mutable counters)."""
         if not hasattr(self, "_stats"):
@@ -142,107 +133,95 @@ class ForceGroup:
         return self._stats
 
 
-@dataclass
-class AssembledModel:
-    """A model ready to simulate: Exudyn system, members, groups, drive."""
-
-    name: str
-    reducer: object
-    params: object
-    members: dict[str, Member]
-    groups: list[ForceGroup]
-    input_angle: Callable  #: theta_in(t) [rad], vectorised
-    input_speed: Callable  #: omega_in(t) [rad/s]
-    load_torque: Callable  #: T_load(t) [N m] acting against the output rotation
-    mbs: object = None
-    sc: object = None
-    n: int = 0
-    info: dict = field(default_factory=dict)
-
-    def slice(self, member: str) -> slice:
-        m = self.members[member]
-        return slice(m.offset, m.offset + m.n)
-
-    def group_state(self, group: ForceGroup, q: np.ndarray) -> np.ndarray:
-        """Local coordinates of ``group`` from full states (..., n_total)."""
-        return np.concatenate([q[..., self.slice(name)] for name in group.members], axis=-1)
-
-    @property
-    def q0(self) -> np.ndarray:
-        return np.concatenate([m.q0 for m in self.members.values()])
-
-    def generalized_forces(self, t, q: np.ndarray, v: np.ndarray, jacobian: bool = True):
-        """Sum of every group's generalized force at one state, and its Jacobians.
-
-        Returns ``(f, dfdq, dfdv)`` with f of shape (n,) and the Jacobians (n, n)
-        (``None`` if ``jacobian`` is False). The same group kernels as the Exudyn
-        elements; every call is an exact evaluation (no within-step
-        linearisation), so a static solver can iterate on it.
-        """
-        n = self.n
-        f = np.zeros(n)
-        dq = np.zeros((n, n)) if jacobian else None
-        dv = np.zeros((n, n)) if jacobian else None
-        for g in self.groups:
-            idx = group_index([self.members[m].offset for m in g.members], [self.members[m].n for m in g.members])
-            g.new_step()
-            qg, vg = q[idx], v[idx]
-            fg, _ = g.evaluate(t, qg, vg)
-            f[idx] += fg
-            if jacobian:
-                jq, jv = g.jacobian(t, qg, vg)
-                ix = np.ix_(np.arange(n)[idx], np.arange(n)[idx])
-                dq[ix] += jq
-                dv[ix] += jv
-        return f, dq, dv
+_NO_JACOBIAN = np.zeros((0, 0))
 
 
-def group_index(offsets: list[int], sizes: list[int]):
-    """Indices of a group's local vector in a state vector: a slice if the
-    members are contiguous and in order, else an integer array."""
-    idx = np.concatenate([np.arange(o, o + n) for o, n in zip(offsets, sizes)])
-    if len(idx) and np.all(np.diff(idx) == 1):
-        return slice(int(idx[0]), int(idx[-1]) + 1)
-    return idx
+class KernelGroup(ForceGroup):
+    """A force group whose physics is ONE numba-compiled kernel (issue 15).
 
+    The kernel (a module-level function of the group's module, written with
+    explicit loops) adds the group's generalized forces, and optionally its
+    Jacobians, into preallocated arrays over ANY coordinate vector: ``pack(idx)``
+    returns the kernel's argument tuple, ``idx`` giving the position of each of the
+    group's local coordinates in that vector. The group's own :meth:`evaluate` /
+    :meth:`jacobian` call the kernel on the local vector (idx = 0..n-1); the
+    fused element (:class:`flexrv.model.kernels.FusedForces`) calls the same
+    kernels, inside one compiled function, on the model's vector. Per-contact
+    results of the last call stay in the group's arrays (``record``), from which
+    :meth:`outputs` builds the named outputs; a time history (T, n) loops the
+    kernel over the samples.
 
-def add_merged(mbs, groups: list[ForceGroup], nodes: list[int], index: list, n: int) -> int:
-    """Add ONE ``ObjectGenericODE2`` over ``nodes`` whose force and Jacobian user
-    functions evaluate every group of ``groups`` and sum their contributions.
-
-    One Python call per residual instead of one per group: Exudyn's per-call cost
-    (argument lists, ``np.asarray``) is paid once. ``index[i]`` selects group i's
-    local coordinates in the merged vector of ``n`` coordinates (the nodes'
-    coordinates in order, see :func:`group_index`). Each group keeps
-    its own :meth:`ForceGroup.evaluate` kernel, outputs and call counters, so the
-    sum is the same generalized force as with one element per group.
+    Subclasses set ``kind`` (their slot in the fused kernel) and implement
+    :meth:`pack`, :meth:`run`, :meth:`record` and :meth:`outputs`.
     """
-    from exudyn.itemInterface import ObjectGenericODE2
 
-    parts = [(g, ix, isinstance(ix, slice)) for g, ix in zip(groups, index)]
+    analytic_jacobian = True
+    kind: str = ""
 
-    def force_fn(mbs_, t, item, q, q_t):
-        q = np.asarray(q)
-        v = np.asarray(q_t)
+    def pack(self, idx: np.ndarray, history: bool = False) -> tuple:
+        """Kernel arguments for coordinates at ``idx`` (int64); ``history``: fresh
+        warm-start state (post-processing of a time history)."""
+        raise NotImplementedError
+
+    def time_inputs(self, t) -> tuple:
+        """Time-dependent kernel inputs at scalar t (drive angle, loads)."""
+        return ()
+
+    def time_inputs_many(self, ts: np.ndarray):
+        """Time-dependent inputs for every sample of a history (vectorised; row i is
+        passed to :meth:`run` as ``inputs``), or None."""
+        return None
+
+    def run(self, t, q, v, f, jq, jv, jac: bool, pack: tuple, inputs=None) -> None:
+        """Call the compiled kernel: add forces into f (and Jacobians into jq, jv);
+        ``inputs``: precomputed time inputs at t (else :meth:`time_inputs`)."""
+        raise NotImplementedError
+
+    def record(self) -> dict:
+        """Copies of the per-contact results of the last kernel call."""
+        return {}
+
+    def outputs(self, t, rec: dict) -> dict:
+        """Named outputs from stacked records (leading axis time)."""
+        return {}
+
+    def evaluate(self, t, q, v, want_outputs: bool = False):
+        q = np.ascontiguousarray(q, dtype=float)
+        v = np.ascontiguousarray(v, dtype=float)
+        n = q.shape[-1]
+        idx = np.arange(n, dtype=np.int64)
+        if q.ndim == 1:
+            f = np.zeros(n)
+            self.run(float(t), q, v, f, _NO_JACOBIAN, _NO_JACOBIAN, False, self.pack(idx))
+            out = None
+            if want_outputs:
+                rec = {k: a[None] for k, a in self.record().items()}
+                out = {k: Output(o.values[0], o.dims, o.units, o.long_name)
+                       for k, o in self.outputs(np.asarray(t, dtype=float)[None], rec).items()}
+            return f, out
+        lead = q.shape[:-1]
+        qf, vf = q.reshape(-1, n), np.broadcast_to(v, q.shape).reshape(-1, n)
+        ts = np.broadcast_to(np.asarray(t, dtype=float), lead).ravel()
+        pack = self.pack(idx, history=True)
+        f = np.zeros(qf.shape)
+        recs = []
+        inputs = self.time_inputs_many(ts)
+        for i in range(qf.shape[0]):
+            self.run(float(ts[i]), qf[i], vf[i], f[i], _NO_JACOBIAN, _NO_JACOBIAN, False, pack,
+                     None if inputs is None else inputs[i])
+            if want_outputs:
+                recs.append(self.record())
+        out = None
+        if want_outputs:
+            rec = {k: np.stack([r[k] for r in recs]).reshape(lead + recs[0][k].shape) for k in recs[0]} if recs else {}
+            out = self.outputs(ts.reshape(lead), rec) if recs else {}
+        return f.reshape(q.shape), out
+
+    def jacobian(self, t, q, v):
+        q = np.ascontiguousarray(q, dtype=float)
+        v = np.ascontiguousarray(v, dtype=float)
+        n = q.shape[-1]
         f = np.zeros(n)
-        for g, ix, _ in parts:
-            g.stats[0] += 1
-            fg, _ = g.evaluate(t, q[ix], v[ix])
-            f[ix] += fg
-        return f
-
-    def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-        q = np.asarray(q)
-        v = np.asarray(q_t)
-        jac = np.zeros((n, n))
-        for g, ix, is_slice in parts:
-            g.stats[1] += 1
-            dq, dv = g.jacobian(t, q[ix], v[ix])
-            if is_slice:
-                jac[ix, ix] -= f_q * dq + f_v * dv
-            else:
-                jac[np.ix_(ix, ix)] -= f_q * dq + f_v * dv
-        return jac
-
-    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes,
-                                           forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
+        dq, dv = np.zeros((n, n)), np.zeros((n, n))
+        self.run(float(t), q, v, f, dq, dv, True, self.pack(np.arange(n, dtype=np.int64)))
+        return dq, dv

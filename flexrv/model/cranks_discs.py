@@ -2,14 +2,22 @@
 eccentrics and the cycloid discs.
 
 Crank supports (group ``crank_supports``, members carrier + cranks): each crank
-centre is tied to its bore in the carrier, h_j = c_c + Rot(theta_c) a_w
-(cos beta_j0, sin beta_j0), by an isotropic linear spring-damper of the two
-support bearings (k = 2 k_sb, c = 2 c_sb); the crank turns freely.
+centre is tied to its bore in the carrier, h_j = c_c + Rot(theta_c) b_j (b_j the
+as-built bore centre ``crank_bores``, nominally a_w (cos beta_j0, sin beta_j0)),
+by an isotropic spring-damper of the two support bearings (k = 2 k_sb, c =
+2 c_sb) with the radial clearance c_j (``support_clearances``): with d = p_j - h_j,
+the spring force on the crank is -k max(|d| - c_j, 0) d/|d| and the damper -c dd/dt
+acts while |d| > c_j (c_j = 0: the linear spring-damper -k d - c dd/dt); the
+crank turns freely. Jacobian: -k [(1 - c_j/|d|) I + (c_j/|d|) u u^T] (exact for
+the spring, u = d/|d|) and -c I; the terms of the bore's rotation with theta_c in
+the damper are dropped.
 
 Needle bearings (group ``needle_bearings``, members cranks + discs): the journal
-centre of crank j under disc k is E = p_j + e (sin chi, cos chi), chi = chi0_k -
-phi_j (clockwise eccentric angle, :mod:`flexrv.geometry.cycloid` convention); the
-hole centre is H = c_k + Rot(psi_k) h_kj. With d = E - H:
+centre of crank j under disc k is E = p_j + e_jk (sin chi, cos chi), chi = chi0_k +
+err_jk - phi_j (clockwise eccentric angle, :mod:`flexrv.geometry.cycloid`
+convention; e_jk, err_jk the as-built ``eccentricities`` and
+``eccentric_phase_errors``); the hole centre is H = c_k + Rot(psi_k) h_kj. With
+d = E - H and the as-built radial clearance c_r = c_jk (``needle_clearances``):
 
 * ``empirical`` (seed 004): a radial power law on the eccentricity of the journal
   in its hole, delta = |d| - c_r, F = K delta^(10/9) along d/|d|. The constant
@@ -26,210 +34,296 @@ hole centre is H = c_k + Rot(psi_k) h_kj. With d = E - H:
 
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
 Generalized forces are Q = -F d(delta)/dq (exact); analytic Jacobians keep the
-contact-stiffness terms and drop the geometric (direction-rotation) ones.
+contact-stiffness terms (and, empirical law, the exact rotation term F/|d| of the
+direction d/|d|) and drop the others (rotation of the eccentric and hole arms).
+
+Skipped pin: disc k's rotation must stay at its conjugate value psi_k =
+chi_jk / z_c (mean over the cranks, :func:`flexrv.geometry.cycloid.nominal_disc_pose`)
+up to elastic deflections; a disc that skipped a pin is off by a whole tooth
+pitch 2 pi / z_c. :meth:`NeedleBearings.check` reports a failure when the
+departure exceeds half a pin pitch, pi / z_rp.
+
+Compiled kernels (numba, :func:`crank_support_kernel`, :func:`needle_kernel`) are
+the only executors: the groups' evaluate/jacobian and the model's fused element
+call them.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from flexrv.contact.hertz import LINE_EXPONENT
-from flexrv.contact.laws import impact_force
-from flexrv.model.base import ForceGroup, Output
+from flexrv.contact.laws import _impact_one
+from flexrv.model.base import KernelGroup, Output
+from flexrv.units import DEG_PER_RAD
 
 
-class CrankSupports(ForceGroup):
+@njit(cache=True)
+def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
+    """jq[ii, ii] -= w B^T K B for a 2 x m map B (rows b[0], b[1]) and the symmetric
+    2 x 2 matrix K = [[kxx, kxy], [kxy, kyy]]."""
+    m = ii.shape[0]
+    for r in range(m):
+        kb0 = kxx * b[0, r] + kxy * b[1, r]
+        kb1 = kxy * b[0, r] + kyy * b[1, r]
+        for s in range(m):
+            jq[ii[s], ii[r]] -= w * (b[0, s] * kb0 + b[1, s] * kb1)
+
+
+@njit(cache=True)
+def crank_support_kernel(q, v, f, jq, jv, jac, pack):
+    """Crank supports (module docstring): Q into f[idx], Jacobians into jq, jv; the
+    force on each crank into out_fx, out_fy."""
+    idx, sc, bores, clear, out_fx, out_fy = pack
+    k, cd = sc[0], sc[1]
+    th, om = q[idx[2]], v[idx[2]]
+    c, s = np.cos(th), np.sin(th)
+    b = np.zeros((2, 5))
+    ii = np.zeros(5, np.int64)
+    for j in range(bores.shape[0]):
+        lx, ly = bores[j, 0], bores[j, 1]
+        rx, ry = c * lx - s * ly, s * lx + c * ly
+        jx, jy = idx[6 + 3 * j], idx[7 + 3 * j]
+        dx = q[jx] - q[idx[0]] - rx
+        dy = q[jy] - q[idx[1]] - ry
+        dvx = v[jx] - v[idx[0]] + om * ry
+        dvy = v[jy] - v[idx[1]] - om * rx
+        cj = clear[j]
+        kxx, kxy, kyy, damp = k, 0.0, k, cd
+        if cj > 0.0:  # dead band of the radial clearance
+            dist = np.sqrt(dx * dx + dy * dy)
+            if dist > cj:
+                sk = k * (1.0 - cj / dist)
+                ux, uy = dx / dist, dy / dist
+                w = k * cj / dist
+                fx = -sk * dx - cd * dvx
+                fy = -sk * dy - cd * dvy
+                kxx, kxy, kyy = sk + w * ux * ux, w * ux * uy, sk + w * uy * uy
+            else:
+                fx, fy = 0.0, 0.0
+                kxx, kxy, kyy, damp = 0.0, 0.0, 0.0, 0.0
+        else:
+            fx = -k * dx - cd * dvx  # on the crank
+            fy = -k * dy - cd * dvy
+        f[idx[0]] -= fx
+        f[idx[1]] -= fy
+        f[idx[2]] -= rx * fy - ry * fx
+        f[jx] += fx
+        f[jy] += fy
+        out_fx[j], out_fy[j] = fx, fy
+        if jac:  # B = d(d)/d(crank x, y; carrier x, y, theta)
+            ii[0], ii[1], ii[2], ii[3], ii[4] = jx, jy, idx[0], idx[1], idx[2]
+            b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4] = 1.0, 0.0, -1.0, 0.0, ry
+            b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4] = 0.0, 1.0, 0.0, -1.0, -rx
+            _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
+            _add_btkb(jv, ii, b, 1.0, 0.0, 1.0, damp)
+
+
+class CrankSupports(KernelGroup):
     """Crank centres in their carrier bores (members: carrier, crank0..N-1)."""
 
     name = "crank_supports"
-    analytic_jacobian = True
+    kind = "supports"
 
     def __init__(self, params):
         p = params
         self.n = p.n_cranks
         self.members = ("carrier",) + tuple(f"crank{j}" for j in range(self.n))
-        self.local = p.center_distance * np.stack([np.cos(p.crank_angles), np.sin(p.crank_angles)], axis=-1)
+        self.bores = np.ascontiguousarray(p.crank_bores, dtype=float)
+        self.clear = np.ascontiguousarray(p.support_clearances, dtype=float)
         self.k = p.support_stiffness
         self.c = p.support_damping
+        self.sc = np.array([self.k, self.c])
+        self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
 
-    def _kin(self, q, v):
-        th, om = q[..., 2:3], v[..., 2:3]
-        c, s = np.cos(th), np.sin(th)
-        lx, ly = self.local[:, 0], self.local[:, 1]
-        rx, ry = c * lx - s * ly, s * lx + c * ly  # (..., n) bore offsets in the housing frame
-        dx = q[..., 6::3] - q[..., 0:1] - rx
-        dy = q[..., 7::3] - q[..., 1:2] - ry
-        dvx = v[..., 6::3] - v[..., 0:1] + om * ry
-        dvy = v[..., 7::3] - v[..., 1:2] - om * rx
-        return rx, ry, dx, dy, dvx, dvy
+    def pack(self, idx, history=False):
+        return (idx, self.sc, self.bores, self.clear, self.fx, self.fy)
 
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        rx, ry, dx, dy, dvx, dvy = self._kin(q, v)
-        fx = -self.k * dx - self.c * dvx  # on the cranks
-        fy = -self.k * dy - self.c * dvy
-        gen = np.zeros(q.shape)
-        gen[..., 0] = -fx.sum(axis=-1)
-        gen[..., 1] = -fy.sum(axis=-1)
-        gen[..., 2] = -(rx * fy - ry * fx).sum(axis=-1)
-        gen[..., 6::3] = fx
-        gen[..., 7::3] = fy
-        out = None
-        if want_outputs:
-            out = {"crank_support_force": Output(np.hypot(fx, fy), ("time", "crank"), "N",
-                                                 "radial force of the carrier on each crank (both support bearings)")}
-        return gen, out
+    @staticmethod
+    def empty_pack():
+        z = np.zeros(0)
+        return (np.zeros(6, np.int64), np.zeros(2), np.zeros((0, 2)), z, z, z)
 
-    def jacobian(self, t, q, v):
-        rx, ry, _, _, _, _ = self._kin(q, v)
-        n = q.shape[-1]
-        dq = np.zeros((n, n))
-        dv = np.zeros((n, n))
-        for j in range(self.n):
-            b = np.zeros((2, n))  # d(d_j)/dq
-            b[:, 6 + 3 * j:8 + 3 * j] = np.eye(2)
-            b[:, 0:2] = -np.eye(2)
-            b[:, 2] = [ry[j], -rx[j]]
-            bb = b.T @ b
-            dq -= self.k * bb
-            dv -= self.c * bb
-        return dq, dv
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        crank_support_kernel(q, v, f, jq, jv, jac, pack)
+
+    def record(self):
+        return {"fx": self.fx.copy(), "fy": self.fy.copy()}
+
+    def outputs(self, t, rec):
+        return {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
+                                              "radial force of the carrier on each crank (both support bearings)")}
 
 
-class NeedleBearings(ForceGroup):
+@njit(cache=True)
+def needle_kernel(q, v, f, jq, jv, jac, pack):
+    """Needle bearings (module docstring): Q into f[idx], Jacobians into jq, jv;
+    per-bearing force on the disc into out_fx, out_fy, roller forces and angles
+    (rollers model) into out_roll, out_angle; state[0] = min gap [m], state[1 + k]
+    = disc k's departure from its conjugate rotation [rad]."""
+    idx, sc, chi0, ecc, err, hx, hy, clear, roller_angles, out_fx, out_fy, out_roll, out_angle, state = pack
+    k_c, expo, c_max, depth, rollers, g_ratio, z_c = sc[0], sc[1], sc[2], sc[3], sc[4] > 0.5, sc[5], sc[6]
+    nc, nd = ecc.shape[0], ecc.shape[1]
+    min_gap = np.inf
+    b = np.zeros((2, 6))
+    ii = np.zeros(6, np.int64)
+    for kd in range(nd):
+        acc = 0.0
+        for j in range(nc):
+            acc += (chi0[kd] + err[j, kd] - q[idx[3 * j + 2]]) / z_c
+        state[1 + kd] = q[idx[3 * nc + 3 * kd + 2]] - acc / nc
+    for j in range(nc):
+        ixc, iyc, ipc = idx[3 * j], idx[3 * j + 1], idx[3 * j + 2]
+        phc = q[ipc]
+        for kd in range(nd):
+            ixd, iyd, ipd = idx[3 * nc + 3 * kd], idx[3 * nc + 3 * kd + 1], idx[3 * nc + 3 * kd + 2]
+            psd = q[ipd]
+            e = ecc[j, kd]
+            chi = chi0[kd] + err[j, kd] - phc
+            sch, cch = np.sin(chi), np.cos(chi)
+            epx, epy = -e * cch, e * sch  # dE/dphi
+            c, s = np.cos(psd), np.sin(psd)
+            rhx, rhy = c * hx[j, kd] - s * hy[j, kd], s * hx[j, kd] + c * hy[j, kd]
+            hpx, hpy = -rhy, rhx  # dH/dpsi
+            dx = q[ixc] + e * sch - q[ixd] - rhx
+            dy = q[iyc] + e * cch - q[iyd] - rhy
+            dvx = v[ixc] + epx * v[ipc] - v[ixd] - hpx * v[ipd]
+            dvy = v[iyc] + epy * v[ipc] - v[iyd] - hpy * v[ipd]
+            fx = fy = mc = md = 0.0
+            kxx = kxy = kyy = dxx = dxy = dyy = 0.0
+            if not rollers:
+                r = np.sqrt(dx * dx + dy * dy + 1e-30)
+                ux, uy = dx / r, dy / r
+                delta = r - clear[j, kd]
+                fr, dfg, dfr = _impact_one(-delta, -(ux * dvx + uy * dvy), k_c, expo, c_max, depth)
+                min_gap = min(min_gap, -delta)
+                fx, fy = fr * ux, fr * uy
+                mc, md = fr * (ux * epx + uy * epy), fr * (ux * hpx + uy * hpy)
+                kq, kv = -dfg, -dfr
+                if fr > 0.0 or kq > 0.0:
+                    w = fr / r
+                    kxx, kxy, kyy = kq * ux * ux + w * (1.0 - ux * ux), (kq - w) * ux * uy, kq * uy * uy + w * (1.0 - uy * uy)
+                    dxx, dxy, dyy = kv * ux * ux, kv * ux * uy, kv * uy * uy
+            else:
+                gam0 = 0.5 * ((1.0 - g_ratio) * phc + (1.0 + g_ratio) * psd)
+                for i in range(roller_angles.shape[0]):
+                    gam = gam0 + roller_angles[i]
+                    ux, uy = np.cos(gam), np.sin(gam)
+                    delta = dx * ux + dy * uy - clear[j, kd]
+                    fr, dfg, dfr = _impact_one(-delta, -(dvx * ux + dvy * uy), k_c, expo, c_max, depth)
+                    min_gap = min(min_gap, -delta)
+                    fx += fr * ux
+                    fy += fr * uy
+                    mc += fr * (ux * epx + uy * epy)
+                    md += fr * (ux * hpx + uy * hpy)
+                    out_roll[j, kd, i], out_angle[j, kd, i] = fr, np.arctan2(uy, ux)
+                    kq, kv = -dfg, -dfr
+                    kxx += kq * ux * ux
+                    kxy += kq * ux * uy
+                    kyy += kq * uy * uy
+                    dxx += kv * ux * ux
+                    dxy += kv * ux * uy
+                    dyy += kv * uy * uy
+            f[ixc] -= fx
+            f[iyc] -= fy
+            f[ipc] -= mc
+            f[ixd] += fx
+            f[iyd] += fy
+            f[ipd] += md
+            out_fx[j, kd], out_fy[j, kd] = fx, fy
+            if jac:  # B = d(d)/d(crank x, y, phi; disc x, y, psi)
+                ii[0], ii[1], ii[2], ii[3], ii[4], ii[5] = ixc, iyc, ipc, ixd, iyd, ipd
+                b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4], b[0, 5] = 1.0, 0.0, epx, -1.0, 0.0, -hpx
+                b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4], b[1, 5] = 0.0, 1.0, epy, 0.0, -1.0, -hpy
+                _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
+                _add_btkb(jv, ii, b, dxx, dxy, dyy, 1.0)
+    state[0] = min_gap
+
+
+class NeedleBearings(KernelGroup):
     """All crank–disc needle bearings in one element (members: cranks, discs)."""
 
     name = "needle_bearings"
-    analytic_jacobian = True
+    kind = "needles"
 
     def __init__(self, params, model: str, k_empirical: float | None = None):
         p = params
         self.nc, self.nd = p.n_cranks, p.n_discs
         self.members = tuple(f"crank{j}" for j in range(self.nc)) + tuple(f"disc{k}" for k in range(self.nd))
         self.model = model
-        self.e = p.eccentricity
-        self.chi0 = p.chi0  # (nd,)
-        self.hx = p.holes[..., 0].T  # (nc, nd) hole centres in the disc frames
-        self.hy = p.holes[..., 1].T
-        self.clear = p.needle_clearance
-        self.c_max = p.needle_c_max
+        self.chi0 = np.ascontiguousarray(p.chi0, dtype=float)
+        self.ecc = np.ascontiguousarray(p.eccentricities, dtype=float)  # (nc, nd)
+        self.err = np.ascontiguousarray(p.eccentric_phase_errors, dtype=float)
+        self.hx = np.ascontiguousarray(p.holes[..., 0].T)  # (nc, nd) hole centres in the disc frames
+        self.hy = np.ascontiguousarray(p.holes[..., 1].T)
+        self.clear = np.ascontiguousarray(p.needle_clearances, dtype=float)
         self.depth = p.contact_depth
-        self.exponent = LINE_EXPONENT
+        self.z_c, self.z_rp = p.z_c, p.z_rp
         if model == "empirical":
             if k_empirical is None:
                 raise ValueError("k_empirical required for the empirical needle model")
             self.k = float(k_empirical)
+            self.roller_angles = np.zeros(0)
         else:
             self.k = p.needle_roller_k
-            self.z = p.needle_roller_count
-            self.g = p.needle_pitch_ratio
-            self.roller_angles = 2.0 * np.pi * np.arange(self.z) / self.z
-        self.min_gap = np.inf
+            z = p.needle_roller_count
+            self.roller_angles = 2.0 * np.pi * np.arange(z) / z
+        g = p.needle_pitch_ratio
+        self.sc = np.array([self.k, LINE_EXPONENT, p.needle_c_max, p.contact_depth, float(model == "rollers"), g,
+                            float(p.z_c)])
+        z = len(self.roller_angles)
+        self.fx, self.fy = np.zeros((self.nc, self.nd)), np.zeros((self.nc, self.nd))
+        self.roll, self.angle = np.zeros((self.nc, self.nd, z)), np.zeros((self.nc, self.nd, z))
+        self.state = np.full(1 + self.nd, np.nan)
+        self.reset()
 
-    def _kin(self, q, v):
-        """Journal offsets d = E - H and their rates, in components (..., nc, nd)."""
-        nc = self.nc
-        xc, yc, phc = q[..., 0:3 * nc:3, None], q[..., 1:3 * nc:3, None], q[..., 2:3 * nc:3, None]
-        vxc, vyc, vphc = v[..., 0:3 * nc:3, None], v[..., 1:3 * nc:3, None], v[..., 2:3 * nc:3, None]
-        xd, yd, psd = q[..., None, 3 * nc::3], q[..., None, 3 * nc + 1::3], q[..., None, 3 * nc + 2::3]
-        vxd, vyd, vpsd = v[..., None, 3 * nc::3], v[..., None, 3 * nc + 1::3], v[..., None, 3 * nc + 2::3]
-        chi = self.chi0 - phc
-        sc, cc = np.sin(chi), np.cos(chi)
-        epx, epy = -self.e * cc, self.e * sc  # dE/dphi
-        c, s = np.cos(psd), np.sin(psd)
-        rhx, rhy = c * self.hx - s * self.hy, s * self.hx + c * self.hy
-        hpx, hpy = -rhy, rhx  # dH/dpsi
-        dx = xc + self.e * sc - xd - rhx
-        dy = yc + self.e * cc - yd - rhy
-        dvx = vxc + epx * vphc - vxd - hpx * vpsd
-        dvy = vyc + epy * vphc - vyd - hpy * vpsd
-        return dx, dy, dvx, dvy, epx, epy, hpx, hpy, phc, psd
+    def pack(self, idx, history=False):
+        return (idx, self.sc, self.chi0, self.ecc, self.err, self.hx, self.hy, self.clear, self.roller_angles,
+                self.fx, self.fy, self.roll, self.angle, self.state)
 
-    def _contacts(self, q, v):
-        dx, dy, dvx, dvy, epx, epy, hpx, hpy, phc, psd = self._kin(q, v)
-        if self.model == "empirical":
-            r = np.sqrt(dx * dx + dy * dy + 1e-30)
-            ux, uy = dx / r, dy / r
-            delta = r - self.clear
-            rate = ux * dvx + uy * dvy
-        else:
-            gam = (0.5 * ((1.0 - self.g) * phc + (1.0 + self.g) * psd))[..., None] + self.roller_angles
-            ux, uy = np.cos(gam), np.sin(gam)  # (..., nc, nd, z)
-            dx, dy, dvx, dvy = dx[..., None], dy[..., None], dvx[..., None], dvy[..., None]
-            epx, epy, hpx, hpy = epx[..., None], epy[..., None], hpx[..., None], hpy[..., None]
-            delta = dx * ux + dy * uy - self.clear
-            rate = dvx * ux + dvy * uy
-        f, df, dfr = impact_force(-delta, -rate, self.k, self.exponent, self.c_max, self.depth)
-        return dict(delta=delta, f=f, kq=-df, kv=-dfr, ux=ux, uy=uy,
-                    gc=(ux * epx + uy * epy), gd=(ux * hpx + uy * hpy), ep=(epx, epy), hp=(hpx, hpy))
+    @staticmethod
+    def empty_pack():
+        z1, z2, z3 = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0, 0))
+        return (np.zeros(0, np.int64), np.zeros(7), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, np.zeros(1))
 
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        c = self._contacts(q, v)
-        f, ux, uy = c["f"], c["ux"], c["uy"]
-        fx, fy, mc, md = f * ux, f * uy, f * c["gc"], f * c["gd"]
-        if self.model == "rollers":  # sum over the rollers of each bearing
-            fx, fy, mc, md = fx.sum(axis=-1), fy.sum(axis=-1), mc.sum(axis=-1), md.sum(axis=-1)
-        nc = self.nc
-        gen = np.empty(q.shape)
-        gen[..., 0:3 * nc:3] = -fx.sum(axis=-1)
-        gen[..., 1:3 * nc:3] = -fy.sum(axis=-1)
-        gen[..., 2:3 * nc:3] = -mc.sum(axis=-1)
-        gen[..., 3 * nc::3] = fx.sum(axis=-2)
-        gen[..., 3 * nc + 1::3] = fy.sum(axis=-2)
-        gen[..., 3 * nc + 2::3] = md.sum(axis=-2)
-        if q.ndim == 1:
-            self.min_gap = float(np.min(-c["delta"]))
-        out = None
-        if want_outputs:
-            dims = ("time", "crank", "disc")
-            out = {"needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
-                   "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
-                   "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
-            if self.model == "rollers":
-                out["roller_force"] = Output(f, dims + ("roller",), "N", "needle roller contact force")
-                out["roller_angle"] = Output(np.arctan2(uy, ux), dims + ("roller",), "rad",
-                                             "direction of each roller's contact force on the disc (housing frame)")
-        return gen, out
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        needle_kernel(q, v, f, jq, jv, jac, pack)
 
-    def jacobian(self, t, q, v):
-        c = self._contacts(q, v)
-        n = q.shape[-1]
-        dq = np.zeros((n, n))
-        dv = np.zeros((n, n))
-        nc = self.nc
-        eye = np.eye(2)
-        epx, epy = c["ep"]
-        hpx, hpy = c["hp"]
-        for j in range(nc):
-            for k in range(self.nd):
-                idx = np.r_[3 * j:3 * j + 3, 3 * nc + 3 * k:3 * nc + 3 * k + 3]
-                b = np.zeros((2, 6))  # d(d)/d(local coordinates of crank j, disc k)
-                b[:, 0:2], b[:, 3:5] = eye, -eye
-                b[:, 2] = [np.ravel(epx[j, k])[0], np.ravel(epy[j, k])[0]]
-                b[:, 5] = [-np.ravel(hpx[j, k])[0], -np.ravel(hpy[j, k])[0]]
-                kq, kv, f = c["kq"][j, k], c["kv"][j, k], c["f"][j, k]
-                if self.model == "empirical":
-                    if f <= 0 and kq <= 0:
-                        continue
-                    u = np.array([c["ux"][j, k], c["uy"][j, k]])
-                    uu = np.outer(u, u)
-                    r = c["delta"][j, k] + self.clear
-                    stiff = kq * uu + (f / r) * (eye - uu)
-                    damp = kv * uu
-                else:
-                    act = kq != 0
-                    if not np.any(act):
-                        continue
-                    u = np.stack([c["ux"][j, k][act], c["uy"][j, k][act]], axis=-1)
-                    stiff = (u.T * kq[act]) @ u
-                    damp = (u.T * kv[act]) @ u
-                dq[np.ix_(idx, idx)] -= b.T @ stiff @ b
-                dv[np.ix_(idx, idx)] -= b.T @ damp @ b
-        return dq, dv
+    @property
+    def min_gap(self) -> float:
+        """Smallest gap [m] of the last evaluation (negative: penetration)."""
+        return float(self.state[0])
+
+    def record(self):
+        rec = {"fx": self.fx.copy(), "fy": self.fy.copy()}
+        if self.model == "rollers":
+            rec.update(roll=self.roll.copy(), angle=self.angle.copy())
+        return rec
+
+    def outputs(self, t, rec):
+        fx, fy = rec["fx"], rec["fy"]
+        dims = ("time", "crank", "disc")
+        out = {"needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
+               "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
+               "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
+        if self.model == "rollers":
+            out["roller_force"] = Output(rec["roll"], dims + ("roller",), "N", "needle roller contact force")
+            out["roller_angle"] = Output(rec["angle"], dims + ("roller",), "rad",
+                                         "direction of each roller's contact force on the disc (housing frame)")
+        return out
 
     def reset(self) -> None:
-        self.min_gap = np.inf
+        self.state[:] = np.nan
+        self.state[0] = np.inf
 
     def check(self) -> str | None:
         if self.min_gap < -max(20.0 * self.depth, 50e-6):
             return f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit"
+        dep = self.state[1:]
+        limit = np.pi / self.z_rp
+        if np.any(np.abs(dep) > limit):
+            k = int(np.nanargmax(np.abs(dep)))
+            return (f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
+                    f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)")
         return None

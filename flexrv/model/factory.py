@@ -26,7 +26,8 @@ from typing import Callable
 import numpy as np
 
 from flexrv.errors import ConfigError
-from flexrv.model.base import AssembledModel, Member, group_index, add_merged
+from flexrv.model.assembled import AssembledModel, group_index
+from flexrv.model.base import Member
 
 
 def _members(p) -> dict[str, Member]:
@@ -139,21 +140,13 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     return assemble(model)
 
 
-def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
+def assemble(model: AssembledModel) -> AssembledModel:
     """Create the Exudyn system: one NodeGenericODE2 + mass object per member and
-    the force elements. Default: one ObjectGenericODE2 per group. With ``merge``
-    each run of consecutive groups
-    with the default glue and an analytic Jacobian shares ONE ObjectGenericODE2
-    (:func:`flexrv.model.base.add_merged`: one Python call per residual instead of
-    one per group); groups with their own
-    :meth:`~flexrv.model.base.ForceGroup.add_to` (e.g. constant matrices) get their
-    own object between the runs (group order kept). Both sum the same group
-    kernels and differ only in floating-point summation order inside Exudyn
-    (tests/test_model_groups.py::test_merged_force_element_matches_one_element_per_group).
-    Measured (benchmarks/bench_rigid.py): merging saves < 5 % (within the timing
-    noise) on the rigid model, while the changed round-off lets the modified-Newton
-    path of rv221 drift (TE differences up to 0.08 arcsec on a 5 arcsec ripple), so
-    it is off by default to keep results bit-reproducible."""
+    the force elements. The compiled kernel groups (:class:`flexrv.model.base.KernelGroup`:
+    gear stage, crank supports, needle bearings, pins, rigid main bearing, loads)
+    share ONE ObjectGenericODE2 (:class:`flexrv.model.kernels.FusedForces`, one
+    compiled call per residual); every other group (ball bearing rows, flexible
+    cranks) adds its own element(s) through :meth:`~flexrv.model.base.ForceGroup.add_to`."""
     import exudyn as exu
     from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2
 
@@ -171,18 +164,17 @@ def assemble(model: AssembledModel, merge: bool = False) -> AssembledModel:
         mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix, **extra))
         m.offset = offset
         offset += m.n
-    all_nodes = [m.node for m in model.members.values()]
-    merged, index = [], []
-    for g in model.groups + [None]:
-        if g is not None and merge and g.mergeable:
-            merged.append(g)
-            index.append(group_index([model.members[name].offset for name in g.members],
-                                     [model.members[name].n for name in g.members]))
-            continue
-        if merged:  # close the run of consecutive mergeable groups (group order kept)
-            add_merged(mbs, merged, all_nodes, index, offset)
-            merged, index = [], []
-        if g is not None:
+    from flexrv.model.base import KernelGroup
+    from flexrv.model.kernels import FusedForces
+
+    kernel_groups = [g for g in model.groups if isinstance(g, KernelGroup)]
+    if kernel_groups:  # ONE element for every compiled group (issue 15)
+        model.fused = FusedForces(model, kernel_groups)
+        for g in kernel_groups:
+            g._stats = model.fused.stats  # the groups report the fused element's call counts
+        model.fused.add_to(mbs, [model.members[name].node for name in model.fused.member_names])
+    for g in model.groups:
+        if not isinstance(g, KernelGroup):
             g.add_to(mbs, [model.members[name].node for name in g.members],
                      [model.members[name].n for name in g.members])
     mbs.Assemble()

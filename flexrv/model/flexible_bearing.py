@@ -588,10 +588,6 @@ class BallBearingGroup(ForceGroup):
         self._index = index  # per row: element coordinates in the group's local vector
         self._n = int(sum(sizes))
 
-    @property
-    def mergeable(self) -> bool:
-        return False
-
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
         """One Exudyn element per row over [carrier, the row's ring modes, its balls]
         (instead of one over the whole group): the rows do not interact except

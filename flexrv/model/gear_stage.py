@@ -26,114 +26,147 @@ are Q = -F d(delta)/dq (exact, the deflection being a function of the
 coordinates). Analytic Jacobian: -dF/d(delta) g g^T and -c g g^T (g = d delta/dq;
 the curvature terms of beta(x, y) are dropped, modified Newton converges on the
 exact residual).
+
+As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): sun runout
+(A_s, ph_s), planet runout (A_j, ph_j) and planet assembly phase errors err_j
+add to the deflection
+
+    delta_j += A_s sin(theta_s - beta_j + ph_s) + A_j sin(phi_j - beta_j + ph_j) + r_bp err_j,
+
+and their derivatives enter g (d/dphi_j = r_bp + A_j cos(.), d/dbeta_j gains
+-A_s cos(.) - A_j cos(.)), so Q = -F g stays exact. All zero: the ideal stage.
+
+One compiled kernel (:func:`gear_stage_kernel`, numba) is the only executor: the
+group's evaluate/jacobian and the fused element of the model call it.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from flexrv.model.base import ForceGroup, Output
+from flexrv.analysis.mesh_stiffness import mesh_stiffness_ramped
+from flexrv.model.base import KernelGroup, Output
 from flexrv.units import TWO_PI
 
+#: order of the scalars in the kernel's ``sc`` array
+SCALARS = ("rbs", "rbp", "sin_alpha_w", "a_w", "z_s", "b_n", "k_single", "eps_alpha", "ramp", "c", "A_sun", "ph_sun")
 
 
-class GearMeshes(ForceGroup):
+@njit(cache=True)
+def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
+    """Sun–planet meshes (module docstring) at sun angle ``ts`` and speed ``ws``:
+    adds Q into f[idx] and, if ``jac``, dQ/dq, dQ/dv into jq, jv. Per-mesh force,
+    deflection and stiffness go to the pack's output arrays."""
+    idx, sc, beta0, planet, out_f, out_d, out_k = pack
+    rbs, rbp, sw, aw, zs, bn, ks, eps, ramp, c, a_s, ph_s = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6],
+                                                              sc[7], sc[8], sc[9], sc[10], sc[11])
+    r = rbs + rbp
+    th_c = q[idx[2]]
+    for j in range(beta0.shape[0]):
+        ix, iy, ip = idx[6 + 3 * j], idx[7 + 3 * j], idx[8 + 3 * j]
+        x, y, phi = q[ix], q[iy], q[ip]
+        a2 = x * x + y * y
+        a = np.sqrt(a2)
+        rel = np.arctan2(y, x) - th_c - beta0[j]
+        rel -= TWO_PI * np.rint(rel / TWO_PI)
+        beta = th_c + beta0[j] + rel
+        a_p, ph_p, err = planet[j, 0], planet[j, 1], planet[j, 2]
+        cos_s = a_s * np.cos(ts - beta + ph_s)
+        cos_p = a_p * np.cos(phi - beta + ph_p)
+        delta = (rbs * ts + rbp * phi - r * (beta - beta0[j]) - sw * (a - aw)
+                 + a_s * np.sin(ts - beta + ph_s) + a_p * np.sin(phi - beta + ph_p) + rbp * err)
+        rb = r + cos_s + cos_p  # -d delta / d beta
+        gx = rb * y / a2 - sw * x / a
+        gy = -rb * x / a2 - sw * y / a
+        gp = rbp + cos_p
+        ddelta = (rbs + cos_s) * ws + gx * v[ix] + gy * v[iy] + gp * v[ip]
+        k = mesh_stiffness_ramped((zs / TWO_PI) * (ts - beta - beta0[j]), ks, eps, ramp)
+        force = 0.0
+        active = False
+        if delta > 0.0:
+            force = max(k * delta + c * ddelta, 0.0)
+            active = force > 0.0
+        elif delta < -bn:
+            force = min(k * (delta + bn) + c * ddelta, 0.0)
+            active = force < 0.0
+        f[ix] -= force * gx
+        f[iy] -= force * gy
+        f[ip] -= force * gp
+        out_f[j], out_d[j], out_k[j] = force, delta, k
+        if jac and active:
+            g = (gx, gy, gp)
+            ii = (ix, iy, ip)
+            for m in range(3):
+                for n in range(3):
+                    jq[ii[m], ii[n]] -= k * g[m] * g[n]
+                    jv[ii[m], ii[n]] -= c * g[m] * g[n]
+
+
+class GearMeshes(KernelGroup):
     """All sun–planet meshes in one element (members: carrier, crank0..N-1)."""
 
     name = "gear_stage"
-    analytic_jacobian = True
+    kind = "gear"
 
     def __init__(self, params, stage, input_angle, input_speed, ramp_fraction: float = 0.2):
-        from flexrv.analysis.mesh_stiffness import time_varying_mesh_stiffness
-
         p = params
         self.n = p.n_cranks
         self.members = ("carrier",) + tuple(f"crank{j}" for j in range(self.n))
         self.rbs, self.rbp = p.base_radius_sun, p.base_radius_planet
-        self.sw = np.sin(p.working_pressure_angle)
-        self.aw = p.center_distance
-        self.beta0 = p.crank_angles
-        self.zs = p.z_s
+        self.beta0 = np.ascontiguousarray(p.crank_angles, dtype=float)
         self.bn = p.normal_backlash
-        self.k_single = stage.k_single
-        self.eps = stage.eps_alpha
-        w1 = self.eps - 1.0
-        self.ramp = ramp_fraction * min(w1, 1.0 - w1)
         self.c = stage.c12
+        w1 = stage.eps_alpha - 1.0
+        ramp = ramp_fraction * min(w1, 1.0 - w1)
+        sun = np.asarray(p.sun_runout, dtype=float)
+        self.sc = np.array([p.base_radius_sun, p.base_radius_planet, np.sin(p.working_pressure_angle),
+                            p.center_distance, float(p.z_s), p.normal_backlash, stage.k_single, stage.eps_alpha,
+                            ramp, stage.c12, sun[0], sun[1]])
+        #: (N, 3): planet runout amplitude [m], phase [rad], assembly phase error [rad]
+        self.planet = np.ascontiguousarray(np.column_stack([np.asarray(p.planet_runout, dtype=float).reshape(-1, 2),
+                                                            np.asarray(p.planet_phase_errors, dtype=float)]))
         self.theta_s, self.omega_s = input_angle, input_speed
-        self._k_of = time_varying_mesh_stiffness
         self._drive_cache = None
+        self.force, self.deflection, self.stiffness = np.zeros(self.n), np.zeros(self.n), np.zeros(self.n)
 
-    def _drive(self, t):
-        """Sun angle and speed (..., 1) at t; cached for a scalar t (all Newton
-        iterations of a step evaluate the same time)."""
-        if np.ndim(t) == 0:
-            c = self._drive_cache
-            if c is not None and c[0] == t:
-                return c[1], c[2]
-        ts = np.asarray(self.theta_s(t), dtype=float)[..., None]
-        ws = np.asarray(self.omega_s(t), dtype=float)[..., None]
-        if np.ndim(t) == 0:
-            self._drive_cache = (float(t), ts, ws)
-        return ts, ws
+    def pack(self, idx, history=False):
+        return (idx, self.sc, self.beta0, self.planet, self.force, self.deflection, self.stiffness)
+
+    @staticmethod
+    def empty_pack():
+        z = np.zeros(0)
+        return (np.zeros(6, np.int64), np.zeros(len(SCALARS)), z, np.zeros((0, 3)), z, z, z)
+
+    def time_inputs(self, t):
+        """(sun angle, sun speed) at t; cached (all Newton iterations of a step
+        evaluate the same time)."""
+        c = self._drive_cache
+        if c is None or c[0] != t:
+            c = self._drive_cache = (t, float(self.theta_s(t)), float(self.omega_s(t)))
+        return c[1], c[2]
+
+    def time_inputs_many(self, ts):
+        return np.stack([np.broadcast_to(np.asarray(self.theta_s(ts), dtype=float), ts.shape),
+                         np.broadcast_to(np.asarray(self.omega_s(ts), dtype=float), ts.shape)], axis=-1)
+
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        ts, ws = self.time_inputs(t) if inputs is None else inputs
+        gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack)
+
+    def record(self):
+        return {"force": self.force.copy(), "deflection": self.deflection.copy(), "stiffness": self.stiffness.copy()}
+
+    def outputs(self, t, rec):
+        force = rec["force"]
+        return {
+            "mesh_force": Output(force, ("time", "planet"), "N", "sun-planet mesh force along the line of action"),
+            "mesh_deflection": Output(rec["deflection"], ("time", "planet"), "m",
+                                      "mesh deflection along the line of action"),
+            "mesh_stiffness": Output(rec["stiffness"], ("time", "planet"), "N/m", "time-varying mesh stiffness"),
+            "sun_torque": Output(self.rbs * force.sum(axis=-1), ("time",), "N m", "torque of the meshes on the sun"),
+        }
 
     def reset(self) -> None:
         self._drive_cache = None
         super().reset()
-
-    def _kin(self, t, q, v):
-        n = self.n
-        x, y, phi = q[..., 6::3], q[..., 7::3], q[..., 8::3]
-        vx, vy, vphi = v[..., 6::3], v[..., 7::3], v[..., 8::3]
-        th_c = q[..., 2:3]
-        a2 = x * x + y * y
-        a = np.sqrt(a2)
-        rel = np.arctan2(y, x) - th_c - self.beta0
-        rel -= TWO_PI * np.rint(rel / TWO_PI)
-        beta = th_c + self.beta0 + rel
-        ts, ws = self._drive(t)
-        r = self.rbs + self.rbp
-        delta = self.rbs * ts + self.rbp * phi - r * (beta - self.beta0) - self.sw * (a - self.aw)
-        gx = r * y / a2 - self.sw * x / a
-        gy = -r * x / a2 - self.sw * y / a
-        ddelta = self.rbs * ws + gx * vx + gy * vy + self.rbp * vphi
-        phase = (self.zs / TWO_PI) * (ts - beta - self.beta0)
-        k = self._k_of(phase, self.k_single, self.eps, self.ramp)
-        drive = delta > 0.0
-        coast = delta < -self.bn
-        f_drive = np.maximum(k * delta + self.c * ddelta, 0.0)
-        f_coast = np.minimum(k * (delta + self.bn) + self.c * ddelta, 0.0)
-        force = np.where(drive, f_drive, np.where(coast, f_coast, 0.0))
-        active = (drive & (f_drive > 0)) | (coast & (f_coast < 0))
-        return delta, ddelta, force, (gx, gy), k, active
-
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        delta, ddelta, force, (gx, gy), k, active = self._kin(t, q, v)
-        gen = np.zeros(q.shape)
-        gen[..., 6::3] = -force * gx
-        gen[..., 7::3] = -force * gy
-        gen[..., 8::3] = -force * self.rbp
-        out = None
-        if want_outputs:
-            out = {
-                "mesh_force": Output(force, ("time", "planet"), "N", "sun-planet mesh force along the line of action"),
-                "mesh_deflection": Output(delta, ("time", "planet"), "m", "mesh deflection along the line of action"),
-                "mesh_stiffness": Output(k, ("time", "planet"), "N/m", "time-varying mesh stiffness"),
-                "sun_torque": Output(self.rbs * force.sum(axis=-1), ("time",), "N m", "torque of the meshes on the sun"),
-            }
-        return gen, out
-
-    def jacobian(self, t, q, v):
-        _, _, _, (gx, gy), k, active = self._kin(t, q, v)
-        grad = np.stack([gx, gy, np.full_like(gx, self.rbp)], axis=-1)
-        n = q.shape[-1]
-        dq = np.zeros((n, n))
-        dv = np.zeros((n, n))
-        for j in range(self.n):
-            if not active[j]:
-                continue
-            s = slice(6 + 3 * j, 9 + 3 * j)
-            gg = np.outer(grad[j], grad[j])
-            dq[s, s] = -k[j] * gg
-            dv[s, s] = -self.c * gg
-        return dq, dv

@@ -14,9 +14,10 @@
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from flexrv.contact.laws import adams_step
-from flexrv.model.base import ForceGroup, Output
+from flexrv.model.base import KernelGroup, Output
 
 
 def ramp_drive(speed: float, ramp_time: float):
@@ -84,13 +85,14 @@ def piecewise_torque(times, values):
     return torque
 
 
-class OutputLoads(ForceGroup):
+class OutputLoads(KernelGroup):
     """Load torque and external forces on the carrier (member ``carrier``:
-    x, y, theta, z, rx, ry)."""
+    x, y, theta, z, rx, ry). The loads depend on time only: :meth:`time_inputs`
+    evaluates them (cached per time), the fused kernel adds them."""
 
     name = "loads"
+    kind = "loads"
     members = ("carrier",)
-    analytic_jacobian = True
 
     def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0,
                  ramp: tuple[float, float] | None = None):
@@ -99,6 +101,7 @@ class OutputLoads(ForceGroup):
         #: the external forces/moment ramp in with step(t, t1, 0, t2, 1) (None: from t = 0)
         self.ramp = ramp
         self._cache = None
+        self.load = np.zeros(6)
 
     def _forces(self, t, shape):
         f = np.broadcast_to(self.const, shape).copy()
@@ -108,21 +111,40 @@ class OutputLoads(ForceGroup):
         f[..., 2] = -self.torque(t)
         return f
 
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        if q.ndim == 1:  # solver call: the load depends on t only (same t in all Newton iterations)
-            if self._cache is None or self._cache[0] != t:
-                self._cache = (t, self._forces(np.asarray(t, dtype=float), (6,)))
-            return self._cache[1].copy(), (self._outputs(np.asarray(t, dtype=float), q) if want_outputs else None)
-        t = np.asarray(t, dtype=float)
-        return self._forces(t, q.shape), (self._outputs(t, q) if want_outputs else None)
+    def time_inputs(self, t):
+        """Generalized load vector (6,) at t (cached: same t in all Newton iterations)."""
+        if self._cache is None or self._cache[0] != t:
+            self._cache = (t, self._forces(np.asarray(t, dtype=float), (6,)))
+        return self._cache[1]
 
-    def _outputs(self, t, q):
-        return {"load_torque": Output(self.torque(t) + 0.0 * q[..., 0], ("time",), "N m", "load torque on the output")}
+    def pack(self, idx, history=False):
+        return (idx, self.load)
+
+    @staticmethod
+    def empty_pack():
+        return (np.zeros(0, np.int64), np.zeros(0))
+
+    def time_inputs_many(self, ts):
+        return self._forces(ts, ts.shape + (6,))
+
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        self.load[:] = self.time_inputs(t) if inputs is None else inputs
+        loads_kernel(q, v, f, jq, jv, jac, pack)
+
+    def record(self):
+        return {"load": self.load.copy()}
+
+    def outputs(self, t, rec):
+        return {"load_torque": Output(-rec["load"][..., 2], ("time",), "N m", "load torque on the output")}
 
     def reset(self) -> None:
         self._cache = None
         super().reset()
 
-    def jacobian(self, t, q, v):
-        z = np.zeros((6, 6))
-        return z, z
+
+@njit(cache=True)
+def loads_kernel(q, v, f, jq, jv, jac, pack):
+    """f[idx] += load (no state dependence: no Jacobian)."""
+    idx, load = pack
+    for i in range(idx.shape[0]):
+        f[idx[i]] += load[i]

@@ -1,7 +1,8 @@
 """Rigid-model main bearing: the carrier on a linear spring-damper in five DOF
 (radial x, y; axial z; tilting rx, ry), the carrier's rotation free.
 
-A constant-matrix ``ObjectGenericODE2`` (no Python call per step). The
+Diagonal stiffness and damping, f = -K q - C v: evaluated by
+:func:`main_bearing_kernel` (numba) inside the model's fused element. The
 flexible-bearing model replaces this group by the ball-resolved bearing of
 :mod:`flexrv.model.flexible_bearing` under the same output names.
 """
@@ -9,40 +10,58 @@ flexible-bearing model replaces this group by the ball-resolved bearing of
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from flexrv.model.base import ForceGroup, Output
+from flexrv.model.base import KernelGroup, Output
 
 #: carrier coordinate order (see :mod:`flexrv.model.parameters`)
 CARRIER_COORDS = ("x", "y", "theta", "z", "rx", "ry")
 
 
-class RigidMainBearing(ForceGroup):
+@njit(cache=True)
+def main_bearing_kernel(q, v, f, jq, jv, jac, pack):
+    """f[idx] -= K q + C v (diagonal K, C), force into out; Jacobians -K, -C."""
+    idx, k, c, out = pack
+    for i in range(idx.shape[0]):
+        ii = idx[i]
+        out[i] = -k[i] * q[ii] - c[i] * v[ii]
+        f[ii] += out[i]
+        if jac:
+            jq[ii, ii] -= k[i]
+            jv[ii, ii] -= c[i]
+
+
+class RigidMainBearing(KernelGroup):
     """Linear 5-DOF main-bearing element on the carrier."""
 
     name = "main_bearing"
+    kind = "main_bearing"
     members = ("carrier",)
 
     def __init__(self, params):
         k5, c5 = params.main_bearing_stiffness, params.main_bearing_damping
-        self.k = np.diag([k5[0], k5[1], 0.0, k5[2], k5[3], k5[4]])
-        self.c = np.diag([c5[0], c5[1], 0.0, c5[2], c5[3], c5[4]])
+        self.kd = np.array([k5[0], k5[1], 0.0, k5[2], k5[3], k5[4]], dtype=float)
+        self.cd = np.array([c5[0], c5[1], 0.0, c5[2], c5[3], c5[4]], dtype=float)
+        self.k, self.c = np.diag(self.kd), np.diag(self.cd)
+        self.force = np.zeros(6)
 
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        f = -(q @ self.k.T) - (v @ self.c.T)
-        out = None
-        if want_outputs:
-            out = {"main_bearing_radial_force": Output(np.hypot(f[..., 0], f[..., 1]), ("time",), "N",
-                                                       "radial reaction of the main bearing on the carrier"),
-                   "main_bearing_axial_force": Output(f[..., 3], ("time",), "N", "axial reaction on the carrier"),
-                   "main_bearing_tilting_moment": Output(np.hypot(f[..., 4], f[..., 5]), ("time",), "N m",
-                                                         "tilting reaction moment on the carrier")}
-        return f, out
+    def pack(self, idx, history=False):
+        return (idx, self.kd, self.cd, self.force)
 
-    def jacobian(self, t, q, v):
-        return -self.k, -self.c
+    @staticmethod
+    def empty_pack():
+        return (np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0))
 
-    def add_to(self, mbs, nodes, sizes):
-        from exudyn.itemInterface import ObjectGenericODE2
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        main_bearing_kernel(q, v, f, jq, jv, jac, pack)
 
-        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=np.zeros((6, 6)),
-                                               stiffnessMatrix=self.k, dampingMatrix=self.c))
+    def record(self):
+        return {"f": self.force.copy()}
+
+    def outputs(self, t, rec):
+        f = rec["f"]
+        return {"main_bearing_radial_force": Output(np.hypot(f[..., 0], f[..., 1]), ("time",), "N",
+                                                    "radial reaction of the main bearing on the carrier"),
+                "main_bearing_axial_force": Output(f[..., 3], ("time",), "N", "axial reaction on the carrier"),
+                "main_bearing_tilting_moment": Output(np.hypot(f[..., 4], f[..., 5]), ("time",), "N m",
+                                                      "tilting reaction moment on the carrier")}

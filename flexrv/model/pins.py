@@ -2,8 +2,23 @@
 
 For disc k with centre c_k and rotation psi_k, the housing-fixed pin centres P_i
 are expressed in the disc frame and their exact signed gap g to the modified
-profile is found by :func:`flexrv.geometry.cycloid.pin_gap` (closest point on the
-pin-centre epitrochoid; warm-started from the previous evaluation). With the
+profile is found as in :func:`flexrv.geometry.cycloid.pin_gap` (the same compiled
+closest-point Newton, :func:`flexrv.geometry.cycloid._foot_point`, on the
+pin-centre epitrochoid; warm-started per (disc, pin) from the previous
+evaluation). Every evaluation is exact (no linearisation within a time step).
+
+As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): actual pin
+centres ``pins`` and radii r_i (``pin_radii``), per-disc modifications (dR_p,
+dr_rp, d_rotation) (``disc_profile``) and profile harmonics A cos(order phi +
+phase) (``profile_harmonics``, material added along the normal):
+
+    g = s(P) + r_nom + dr_rp,k - r_i - sum A cos(order phi* + phase),
+
+s(P) the signed distance of the pin centre from the pin-centre curve at its foot
+point phi*, r_nom the nominal pin radius (to which the curve is offset). The
+harmonics change the gap but not its direction: the tilt of the normal they
+cause, O(order A / |C'|), is neglected (below 1e-3 rad for 10 um at order 10 on a
+~100 mm curve). With the
 housing-frame normal n (from the profile to the pin), the gap's derivatives are
 (envelope theorem, the closest point being stationary)
 
@@ -19,140 +34,197 @@ force -F n acts on the disc along the line through the pin centre), so
 modification clearance, separation and the number of pins in mesh emerge from
 the contact physics. The pins are rigidly fixed in the housing (their own
 bending and the pin-housing contact are not modelled).
+
+One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
+evaluate/jacobian and the model's fused element call it. Solver calls skip pins
+that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
+time histories (outputs) evaluate every gap exactly.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from flexrv.contact.laws import impact_force
+from flexrv.contact.laws import _impact_one
 from flexrv.errors import ConvergenceError
-from flexrv.geometry.cycloid import pin_gap
-from flexrv.model.base import ForceGroup, Output
+from flexrv.geometry.cycloid import _FOOT, closest_point_settings
+from flexrv.model.base import KernelGroup, Output
 
 
-class PinContacts(ForceGroup):
+@njit(cache=True)
+def pin_kernel(q, v, f, jq, jv, jac, pack):
+    """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv.
+    Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
+    the output arrays; phi is the closest-point warm start (updated; NaN: cold
+    start). ctr[0] counts calls (a cold restart every ctr[1] calls), ctr[2] counts
+    closest-point failures; ctr[3] = 1 allows skipping pins that are provably open.
+
+    Skipping (exact for the forces): the gap is 1-Lipschitz in the pin's position
+    relative to the disc (distance to a curve) up to the harmonics' variation, so
+    with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
+    pin whose bound is positive carries no force (and no Jacobian); its closest
+    point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
+    P0y) of the last exact evaluation."""
+    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, ctr) = pack
+    z_rp, R_p, r_nom, ecc, k, expo, c_max, depth = int(sc[0]), sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
+    max_step, tol, max_iter = sc[8], sc[9], int(sc[10])
+    cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0
+    skip = ctr[3] > 0
+    ctr[0] += 1
+    for kd in range(profile.shape[0]):
+        ix, iy, ip = idx[3 * kd], idx[3 * kd + 1], idx[3 * kd + 2]
+        xd, yd, psi = q[ix], q[iy], q[ip]
+        c, s = np.cos(psi), np.sin(psi)
+        d_r, d_rp, d_rot = profile[kd, 0], profile[kd, 1], profile[kd, 2]
+        cr, sr = np.cos(d_rot), np.sin(d_rot)
+        radius = R_p + d_r
+        margin = 0.0
+        for h in range(harm.shape[1]):
+            margin += 2.0 * abs(harm[kd, h, 1])
+        gxx = gxy = gxp = gyy = gyp = gpp = 0.0
+        hxx = hxy = hxp = hyy = hyp = hpp = 0.0
+        fx = fy = fp = 0.0
+        for i in range(pins.shape[0]):
+            rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
+            lx, ly = c * rx + s * ry, -s * rx + c * ry  # disc frame
+            px, py = cr * lx + sr * ly, -sr * lx + cr * ly  # profile frame (rotation modification removed)
+            if skip and not cold:
+                bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
+                if bound > 0.0:  # provably open (NaN: never skipped)
+                    out_gap[kd, i], out_f[kd, i] = bound, 0.0
+                    continue
+            start = np.nan if cold else phi[kd, i]
+            ph, ok, dist, nlx, nly = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
+            if not ok:
+                ctr[2] += 1
+            phi[kd, i] = ph
+            gap = dist + r_nom + d_rp - radii[i]
+            for h in range(harm.shape[1]):
+                gap -= harm[kd, h, 1] * np.cos(harm[kd, h, 0] * ph + harm[kd, h, 2])
+            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2] = gap, px, py
+            mx, my = cr * nlx - sr * nly, sr * nlx + cr * nly  # disc frame
+            nx, ny = c * mx - s * my, s * mx + c * my  # housing frame
+            rxn = rx * ny - ry * nx
+            g0, g1, g2 = -nx, -ny, -rxn  # d gap / d(x, y, psi)
+            rate = g0 * v[ix] + g1 * v[iy] + g2 * v[ip]
+            force, dfg, dfr = _impact_one(gap, rate, k, expo, c_max, depth)
+            out_gap[kd, i], out_f[kd, i], out_nx[kd, i], out_ny[kd, i], out_rxn[kd, i] = gap, force, nx, ny, rxn
+            fx += force * g0
+            fy += force * g1
+            fp += force * g2
+            if jac and (dfg != 0.0 or dfr != 0.0):
+                gxx += dfg * g0 * g0
+                gxy += dfg * g0 * g1
+                gxp += dfg * g0 * g2
+                gyy += dfg * g1 * g1
+                gyp += dfg * g1 * g2
+                gpp += dfg * g2 * g2
+                hxx += dfr * g0 * g0
+                hxy += dfr * g0 * g1
+                hxp += dfr * g0 * g2
+                hyy += dfr * g1 * g1
+                hyp += dfr * g1 * g2
+                hpp += dfr * g2 * g2
+        f[ix] += fx
+        f[iy] += fy
+        f[ip] += fp
+        if jac:
+            jq[ix, ix] += gxx
+            jq[ix, iy] += gxy
+            jq[iy, ix] += gxy
+            jq[ix, ip] += gxp
+            jq[ip, ix] += gxp
+            jq[iy, iy] += gyy
+            jq[iy, ip] += gyp
+            jq[ip, iy] += gyp
+            jq[ip, ip] += gpp
+            jv[ix, ix] += hxx
+            jv[ix, iy] += hxy
+            jv[iy, ix] += hxy
+            jv[ix, ip] += hxp
+            jv[ip, ix] += hxp
+            jv[iy, iy] += hyy
+            jv[iy, ip] += hyp
+            jv[ip, iy] += hyp
+            jv[ip, ip] += hpp
+
+
+class PinContacts(KernelGroup):
     """Pin–disc contacts (members: disc0..n_discs-1)."""
 
     name = "pins"
-    analytic_jacobian = True
+    kind = "pins"
 
     def __init__(self, params, penetration_limit: float = 100e-6, restart_every: int = 500):
         p = params
         self.nd = p.n_discs
         self.members = tuple(f"disc{k}" for k in range(self.nd))
-        self.pins = p.pins  # (z, 2)
-        self.geo = dict(z_rp=p.z_rp, pin_circle_radius=p.pin_circle_radius, pin_radius=p.pin_radius,
-                        eccentricity=p.eccentricity, d_radius=p.d_radius, d_pin_radius=p.d_pin_radius,
-                        d_rotation=p.d_rotation)
+        self.pins = np.ascontiguousarray(p.pins, dtype=float)  # (z, 2) actual centres
+        self.radii = np.ascontiguousarray(p.pin_radii, dtype=float)
+        self.profile = np.ascontiguousarray(p.disc_profile, dtype=float).reshape(self.nd, 3)
+        self.harmonics = np.ascontiguousarray(p.profile_harmonics, dtype=float).reshape(self.nd, -1, 3)
         self.k, self.e = p.pin_k, p.pin_exponent
         self.c_max, self.depth = p.pin_c_max, p.contact_depth
         self.limit = penetration_limit
-        self.restart_every = restart_every
-        self.phi = None
-        self.calls = 0
-        self.exact_calls = 0
-        self.min_gap = np.inf
-        self._cache = None
-        #: max coordinate change [m, rad] before the gap is re-evaluated exactly within a step
-        self.relinearise = 1e-6
+        self.sc = np.array([float(p.z_rp), p.pin_circle_radius, p.pin_radius, p.eccentricity, p.pin_k,
+                            p.pin_exponent, p.pin_c_max, p.contact_depth,
+                            *closest_point_settings(p.z_rp, p.pin_circle_radius)])
+        z = len(self.pins)
+        self.phi = np.full((self.nd, z), np.nan)
+        self.gap, self.force = np.zeros((self.nd, z)), np.zeros((self.nd, z))
+        self.nx, self.ny, self.rxn = np.zeros((self.nd, z)), np.zeros((self.nd, z)), np.zeros((self.nd, z))
+        self.last = np.full((self.nd, z, 3), np.nan)
+        #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
+        self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
 
-    def _exact(self, q, phi0=None):
-        """Exact gaps, housing normals and arms r = P - c at the discs' pose q;
-        returns (gap, grad, n, r, phi)."""
-        lead = q.shape[:-1]
-        qd = q.reshape(lead + (self.nd, 1, 3))
-        psi = qd[..., 2]
-        r = self.pins - qd[..., :2]  # (..., nd, z, 2) housing frame, from disc centre to pin
-        c, s = np.cos(psi), np.sin(psi)
-        local = np.stack([c * r[..., 0] + s * r[..., 1], -s * r[..., 0] + c * r[..., 1]], axis=-1)
-        try:
-            gap, n_loc, phi = pin_gap(local, phi0=phi0, **self.geo)
-        except ConvergenceError:
-            if phi0 is None:
-                raise
-            gap, n_loc, phi = pin_gap(local, phi0=None, **self.geo)  # multi-start from the polar angle
-        n = np.stack([c * n_loc[..., 0] - s * n_loc[..., 1], s * n_loc[..., 0] + c * n_loc[..., 1]], axis=-1)
-        rxn = r[..., 0] * n[..., 1] - r[..., 1] * n[..., 0]
-        grad = np.stack([-n[..., 0], -n[..., 1], -rxn], axis=-1)  # (..., nd, z, 3)
-        return gap, grad, n, r, phi
+    def pack(self, idx, history=False):
+        phi, last, ctr = self.phi, self.last, self.ctr
+        if history:  # post-processing: cold start at the first sample, then warm; every gap exact
+            phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
+            ctr = np.array([1, 0, 0, 0], dtype=np.int64)
+        return (idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
+                self.nx, self.ny, self.rxn, ctr)
 
-    def _history(self, q):
-        """Exact evaluation over a time history (T, n), sample by sample with the
-        closest-point parameter warm-started from the previous sample."""
-        out = [np.empty(q.shape[:-1] + (self.nd, len(self.pins))), np.empty(q.shape[:-1] + (self.nd, len(self.pins), 3)),
-               np.empty(q.shape[:-1] + (self.nd, len(self.pins), 2)), np.empty(q.shape[:-1] + (self.nd, len(self.pins), 2))]
-        phi = None
-        for i in range(q.shape[0]):
-            gap, grad, n, r, phi = self._exact(q[i], phi0=phi)
-            out[0][i], out[1][i], out[2][i], out[3][i] = gap, grad, n, r
-        return tuple(out)
+    @staticmethod
+    def empty_pack():
+        z2 = np.zeros((0, 0))
+        return (np.zeros(0, np.int64), np.zeros(11), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
+                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, np.array([1, 0, 0, 0], dtype=np.int64))
 
-    def _contacts(self, q, v):
-        if q.ndim == 1:
-            # Within one time step Newton moves the discs by far less than the contact
-            # curvature radii: the gap is taken to first order about the first
-            # (exact) evaluation of the step, g = g0 + grad0 . (q - q0), error
-            # O(|q - q0|^2 / rho) (< 2e-10 m within the 1e-6 re-evaluation threshold, rho > 3 mm).
-            c = self._cache
-            dqmax = np.inf if c is None else np.max(np.abs(q - c[0]))
-            if c is None or dqmax > self.relinearise:
-                self.calls += 1
-                warm = self.phi if (self.phi is not None and self.calls % self.restart_every) else None
-                gap, grad, n, r, self.phi = self._exact(q, warm)
-                self._cache = (q.copy(), gap, grad, n, r)
-                self.exact_calls += 1
-            else:
-                q0, gap0, grad, n, r = c
-                gap = gap0 + np.einsum("dzk,dk->dz", grad, (q - q0).reshape(self.nd, 3))
-            self.min_gap = float(gap.min())
-        elif q.ndim == 2:
-            gap, grad, n, r = self._history(q)
-        else:
-            gap, grad, n, r, _ = self._exact(q)
-        vd = v.reshape(v.shape[:-1] + (self.nd, 1, 3))
-        rate = np.einsum("...k,...k->...", grad, vd)
-        f, dfg, dfr = impact_force(gap, rate, self.k, self.e, self.c_max, self.depth)
-        return gap, f, dfg, dfr, grad, n, r
+    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
+        ctr = pack[-1]
+        before = ctr[2]
+        pin_kernel(q, v, f, jq, jv, jac, pack)
+        if ctr[2] != before:
+            raise ConvergenceError("pin gap: closest-point iteration did not converge")
 
-    def new_step(self):
-        """Force an exact evaluation at the next call (called at each step start)."""
-        self._cache = None
+    @property
+    def min_gap(self) -> float:
+        return float(self.gap.min()) if self.ctr[0] > 0 else np.inf
+
+    def record(self):
+        return {"gap": self.gap.copy(), "force": self.force.copy(), "nx": self.nx.copy(), "ny": self.ny.copy(),
+                "rxn": self.rxn.copy()}
+
+    def outputs(self, t, rec):
+        f, nx, ny = rec["force"], rec["nx"], rec["ny"]
+        dims = ("time", "disc", "pin")
+        return {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
+                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration)"),
+                "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
+                "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
+                                          "torque of the pin forces on each disc about its centre"),
+                "housing_pin_torque": Output((f * (self.pins[:, 0] * ny - self.pins[:, 1] * nx)).sum(axis=-1),
+                                             ("time", "disc"), "N m",
+                                             "torque of each disc's pin forces on the housing about the axis")}
 
     def reset(self):
-        """Drop the linearisation cache and the closest-point warm start."""
-        self._cache = None
-        self.phi = None
-        self.min_gap = np.inf
-
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        gap, f, _, _, grad, n, r = self._contacts(q, v)
-        gen = (f[..., None] * grad).sum(axis=-2).reshape(q.shape)
-        out = None
-        if want_outputs:
-            dims = ("time", "disc", "pin")
-            torque = -(f * (r[..., 0] * n[..., 1] - r[..., 1] * n[..., 0])).sum(axis=-1)
-            out = {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
-                   "pin_gap": Output(gap, dims, "m", "signed pin-profile gap (negative = penetration)"),
-                   "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
-                   "disc_pin_torque": Output(torque, ("time", "disc"), "N m",
-                                             "torque of the pin forces on each disc about its centre"),
-                   "housing_pin_torque": Output((f * (self.pins[:, 0] * n[..., 1] - self.pins[:, 1] * n[..., 0])).sum(axis=-1),
-                                                ("time", "disc"), "N m",
-                                                "torque of each disc's pin forces on the housing about the axis")}
-        return gen, out
-
-    def jacobian(self, t, q, v):
-        gap, f, dfg, dfr, grad, _, _ = self._contacts(q, v)
-        n = q.shape[-1]
-        dq = np.zeros((n, n))
-        dv = np.zeros((n, n))
-        for k in range(self.nd):
-            s = slice(3 * k, 3 * k + 3)
-            g = grad[k]
-            dq[s, s] = (g.T * dfg[k]) @ g
-            dv[s, s] = (g.T * dfr[k]) @ g
-        return dq, dv
+        """Forget the closest-point warm start and the call counter."""
+        self.phi[:] = np.nan
+        self.last[:] = np.nan
+        self.ctr[0] = 0
+        self.gap[:] = 0.0
 
     def check(self) -> str | None:
         if self.min_gap < -self.limit:

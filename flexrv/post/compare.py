@@ -26,6 +26,8 @@ import numpy as np
 
 from flexrv.cache import atomic_write_text, to_jsonable
 
+#: the reducer seeds 000/001 simulate (their TE values are a reference for this preset only)
+SEED_REDUCER = "rv221"
 #: seeds 000/001: TE range [arcsec] and period [s] of the rigid and the flexible-bearing model
 SEED_TE = {"rigid": {"te_min_arcsec": -25.2, "te_max_arcsec": 21.6, "period_s": 0.15},
            "flexible": {"te_min_arcsec": -43.2, "te_max_arcsec": 45.0, "period_s": 0.28}}
@@ -42,6 +44,13 @@ class CompareResult:
     files: list = field(default_factory=list)
 
 
+def seed_reference(reducer) -> dict | None:
+    """Seeds 000/001's TE ranges and periods if ``reducer`` is the reducer they simulate
+    (preset :data:`SEED_REDUCER`, RV-221), else None: another design has no seed reference."""
+    name = getattr(reducer, "name", reducer)
+    return SEED_TE if str(name) == SEED_REDUCER else None
+
+
 def te_numbers(res) -> dict:
     """TE statistics over the steady window, dominant TE frequency/period from the
     amplitude spectrum, and the bearing extremes of one run (JSON-ready)."""
@@ -51,7 +60,9 @@ def te_numbers(res) -> dict:
     freq, amp, marks = te_spectrum(res)
     out = {key: s[key] for key in ("te_min_arcsec", "te_max_arcsec", "te_pp_arcsec", "te_mean_arcsec",
                                    "te_rms_fluctuation_arcsec", "ratio_simulated_over_theoretical",
-                                   "steady_window_s")}
+                                   "steady_window_s", "steady_state", "steady_note")}
+    out["spectrum_window_s"] = float(s["steady_window_s"][1] - s["steady_window_s"][0])
+    out["spectrum_resolution_hz"] = float(freq[1] - freq[0]) if len(freq) > 1 else None
     if len(freq) > 2:
         k = 1 + int(np.argmax(amp[1:]))
         out["dominant_frequency_hz"] = float(freq[k])
@@ -68,19 +79,20 @@ def te_numbers(res) -> dict:
     return out
 
 
-def compare_numbers(rigid, flexible) -> dict:
-    """Numbers of both runs and their differences."""
+def compare_numbers(rigid, flexible, seed: dict | None = None) -> dict:
+    """Numbers of both runs and their differences; ``seed``: the seeds' reference
+    (:func:`seed_reference`) or None."""
     nr, nf = te_numbers(rigid), te_numbers(flexible)
     return {"rigid": nr, "flexible": nf,
             "difference": {"te_pp_arcsec": nf["te_pp_arcsec"] - nr["te_pp_arcsec"],
                            "te_mean_arcsec": nf["te_mean_arcsec"] - nr["te_mean_arcsec"]},
-            "seed": SEED_TE}
+            "seed": seed}
 
 
-def period_note(periods: dict, tolerance: float = 0.1) -> str:
+def period_note(periods: dict, tolerance: float = 0.1, seed: dict | None = SEED_TE) -> str:
     """Which characteristic period (or its double/half) each seed period matches (within ``tolerance``)."""
     out = []
-    for model, seed in SEED_TE.items():
+    for model, seed in (seed or {}).items():
         best = None
         for name, t in periods.items():
             for factor, label in ((1.0, ""), (2.0, "2 x "), (0.5, "1/2 x ")):
@@ -97,51 +109,77 @@ def period_note(periods: dict, tolerance: float = 0.1) -> str:
 
 
 def summary_markdown(reducer, parts, numbers: dict, timing: dict) -> str:
-    """summary.md: rigid vs flexible table (seeds 000/001 style) and notes."""
+    """summary.md: rigid vs flexible table, with seeds 000/001's values only for their
+    reducer (``numbers["seed"]``), and notes computed from the numbers in the table."""
     nr, nf = numbers["rigid"], numbers["flexible"]
+    seed_ref = numbers.get("seed")
 
     def f(x, fmt=".2f"):
         return "–" if x is None else format(x, fmt)
 
-    lines = [f"# Rigid vs flexible model: {reducer.name}", "",
-             f"Flexible parts: {', '.join(parts)}. Identical design, drive, load program and step. "
-             f"Steady window: {nr['steady_window_s'][0]:.3f}-{nr['steady_window_s'][1]:.3f} s.", "",
-             "| model | TE min [arcsec] | TE max [arcsec] | TE p-p [arcsec] | TE mean [arcsec] | dominant period [s] |"
-             " seed 000/001 TE range [arcsec] | seed period [s] |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = [f"# Rigid vs flexible model: {reducer.name}", ""]
+    if not (nr.get("steady_state", True) and nf.get("steady_state", True)):
+        lines += [f"> **NOT STEADY**: {nr.get('steady_note') or nf.get('steady_note')}", ""]
+    lines += [f"Flexible parts: {', '.join(parts)}. Identical design, drive, load program and step. "
+              f"Steady window: {nr['steady_window_s'][0]:.3f}-{nr['steady_window_s'][1]:.3f} s"
+              + (f" ({nr['steady_note']})" if nr.get("steady_state", True) and nr.get("steady_note") else "")
+              + ".", ""]
+    head = "| model | TE min [arcsec] | TE max [arcsec] | TE p-p [arcsec] | TE mean [arcsec] | dominant period [s] |"
+    rule = "|---|---|---|---|---|---|"
+    if seed_ref:
+        head += " seed 000/001 TE range [arcsec] | seed period [s] |"
+        rule += "---|---|"
+    lines += [head, rule]
     for name, n in (("rigid", nr), ("flexible", nf)):
-        seed = SEED_TE[name]
-        lines.append(f"| {name} | {f(n['te_min_arcsec'])} | {f(n['te_max_arcsec'])} | {f(n['te_pp_arcsec'])} | "
-                     f"{f(n['te_mean_arcsec'])} | {f(n.get('dominant_period_s'), '.4g')} | "
-                     f"{seed['te_min_arcsec']} .. {seed['te_max_arcsec']} | {seed['period_s']} |")
+        row = (f"| {name} | {f(n['te_min_arcsec'])} | {f(n['te_max_arcsec'])} | {f(n['te_pp_arcsec'])} | "
+               f"{f(n['te_mean_arcsec'])} | {f(n.get('dominant_period_s'), '.4g')} |")
+        if seed_ref:
+            seed = seed_ref[name]
+            row += f" {seed['te_min_arcsec']} .. {seed['te_max_arcsec']} | {seed['period_s']} |"
+        lines.append(row)
     lines.append("")
     if "max_ball_load_N" in nf:
         lines += ["| flexible bearing (steady window) | value |", "|---|---|",
                   f"| max ball load [N] | {f(nf['max_ball_load_N'], '.1f')} |"]
         if "max_ring_deformation_m" in nf:
-            lines.append(f"| max outer-ring deflection at the most-loaded ball [um] | "
+            lines.append(f"| max outer-ring deflection at the most-loaded ball [µm] | "
                          f"{f(1e6 * nf['max_ring_deformation_m'], '.3f')} |")
         if "max_inner_ring_deformation_m" in nf:
-            lines.append(f"| max inner-ring deflection at the most-loaded ball [um] | "
+            lines.append(f"| max inner-ring deflection at the most-loaded ball [µm] | "
                          f"{f(1e6 * nf['max_inner_ring_deformation_m'], '.3f')} |")
         if nf.get("min_film_thickness_m") is not None:
-            lines.append(f"| min central EHL film of the loaded balls [um] | "
+            lines.append(f"| min central EHL film of the loaded balls [µm] | "
                          f"{f(1e6 * nf['min_film_thickness_m'], '.3f')} |")
         lines.append("")
     marks = nr["characteristic_frequencies_hz"]
-    lines += ["Characteristic frequencies [Hz]: " + ", ".join(f"{k} {v:.4g}" for k, v in marks.items()) + ".", ""]
+    lines += ["Characteristic frequencies [Hz]: " + ", ".join(f"{k.replace('_', ' ')} {v:.4g}"
+                                                            for k, v in marks.items()) + ".", ""]
+    if nr.get("spectrum_resolution_hz"):
+        lines += [f"Spectrum: steady window of {nr['spectrum_window_s']:.4g} s, resolution "
+                  f"{nr['spectrum_resolution_hz']:.3g} Hz (Hann window).", ""]
     periods = {k: 1.0 / v for k, v in marks.items() if v > 0}
-    lines += [
-        "Seeds 000/001 report TE ranges of about +/-25 arcsec (rigid) and +/-45 arcsec (flexible main bearing), "
-        "symmetric about zero, with periods 0.15/0.28 s. In flexrv the loaded TE is the offset of the torque "
-        "path (clearances closed in the load direction plus the elastic wind-up; "
-        f"mean {f(nr['te_mean_arcsec'])} arcsec rigid, {f(nf['te_mean_arcsec'])} arcsec flexible) "
-        f"with a ripple of {f(nr['te_pp_arcsec'])} / {f(nf['te_pp_arcsec'])} arcsec peak-to-peak. "
-        + period_note(periods) + " The flexible - rigid difference comes from the ball-bearing compliance "
-        "(carrier shift and tilt), the ring deflection under the balls (local, ~1 um: the rings are clamped at "
-        "their fits) and, if flexible, the crankshaft torsion.", "",
-        f"Wall time: rigid {timing.get('rigid_s', 0):.1f} s, flexible {timing.get('flexible_s', 0):.1f} s "
-        f"(including model build: meshing and CMS if not cached).", ""]
+    d_mean = nf["te_mean_arcsec"] - nr["te_mean_arcsec"]
+    d_pp = nf["te_pp_arcsec"] - nr["te_pp_arcsec"]
+    text = (f"TE mean {f(nr['te_mean_arcsec'])} arcsec rigid, {f(nf['te_mean_arcsec'])} arcsec flexible "
+            f"({d_mean:+.3g} arcsec); ripple {f(nr['te_pp_arcsec'])} / {f(nf['te_pp_arcsec'])} arcsec "
+            f"peak-to-peak ({d_pp:+.3g} arcsec). In flexrv the loaded TE is the offset of the torque path "
+            "(clearances closed in the load direction plus the elastic wind-up) with a ripple about it.")
+    if "max_ring_deformation_m" in nf:
+        text += (f" The ring deflection under the most-loaded ball is {1e6 * nf['max_ring_deformation_m']:.3g} µm "
+                 "(outer ring) in this run.")
+    if seed_ref:
+        text += (" Seeds 000/001 report TE ranges of "
+                 f"{seed_ref['rigid']['te_min_arcsec']} .. {seed_ref['rigid']['te_max_arcsec']} arcsec (rigid) and "
+                 f"{seed_ref['flexible']['te_min_arcsec']} .. {seed_ref['flexible']['te_max_arcsec']} arcsec "
+                 "(flexible main bearing) for this reducer. " + period_note(periods, seed=seed_ref))
+    else:
+        text += (f" No seed reference: seeds 000/001 simulate the {SEED_REDUCER} only, "
+                 f"not {reducer.name}.")
+    lines += [text, "",
+              f"Wall time: rigid {timing.get('rigid_s', 0):.1f} s, flexible {timing.get('flexible_s', 0):.1f} s "
+              f"(including model build: meshing and CMS if not cached).", "",
+              "## References", "",
+              "Seed studies: keys `seed000` and `seed001` of `docs/references.md` in the flexrv repository.", ""]
     return "\n".join(lines)
 
 
@@ -170,7 +208,7 @@ def run_compare(preset_or_reducer, t_end: float | None = None, parts=("main_bear
         res.save(out / name)
         timing[f"{name}_s"] = time.perf_counter() - t0
         runs[name] = res
-    numbers = compare_numbers(runs["rigid"], runs["flexible"])
+    numbers = compare_numbers(runs["rigid"], runs["flexible"], seed=seed_reference(reducer))
     numbers["parts"] = list(parts)
     numbers["timing"] = timing
     files = [compare_plots.plot_te_overlay(runs["rigid"], runs["flexible"], out / "te_overlay.png"),

@@ -1,11 +1,17 @@
 """Save/load of a run directory: ``results.nc`` (NetCDF4 via h5netcdf),
-``config.toml`` (the design used), ``summary.json``, ``summary.md`` and PNGs.
-Every file is written atomically (:func:`flexrv.cache.atomic_path`)."""
+``config.toml`` (the design used), ``summary.json``, ``summary.md``, PNGs and,
+while a run is going, ``checkpoint.npz`` (the recorded states, for
+``flexrv simulate --resume``). Every file is written atomically
+(:func:`flexrv.cache.atomic_path`); ``results.nc`` is written last, so a
+``results.nc`` with status "completed" implies the other files are there."""
 
 from __future__ import annotations
 
+import io
 import json
 from pathlib import Path
+
+import numpy as np
 
 from flexrv.cache import atomic_path, atomic_write_text
 
@@ -25,6 +31,7 @@ def summary_markdown(res, summ: dict) -> str:
              f"steady window: {summ['steady_window_s'][0]:.4g} – {summ['steady_window_s'][1]:.4g} s, "
              f"dt = {res.attrs.get('dt_s')} s, needle model {res.attrs.get('needle_model')}, "
              f"pin law {res.attrs.get('pin_law')}", "",
+             *[f"> {note}\n" for note in summ.get("notes", [])],
              "## Kinematic validation (mean over the steady window)", "",
              "| quantity | unit | theory | simulated | error [%] |", "|---|---|---|---|---|"]
     for row in summ["kinematics"]:
@@ -46,18 +53,73 @@ def save(res, directory) -> Path:
 
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
-    with atomic_path(d / "results.nc") as tmp:
-        res.ds.to_netcdf(tmp, engine="h5netcdf")
     if res.reducer is not None:
         atomic_write_text(d / "config.toml", to_toml(res.reducer))
     summ = res.summary()
     from flexrv.cache import to_jsonable
 
-    atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summ), indent=2))
-    atomic_write_text(d / "summary.md", summary_markdown(res, summ))
     if len(res.time) > 1:
         res.plot(d)
+    atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summ), indent=2))
+    atomic_write_text(d / "summary.md", summary_markdown(res, summ))
+    with atomic_path(d / "results.nc") as tmp:
+        res.ds.to_netcdf(tmp, engine="h5netcdf")
     return d
+
+
+def save_partial(res, directory) -> Path:
+    """Checkpoint of a running simulation: ``results.nc`` (status "running") and
+    ``config.toml`` only (no summary, no plots: cheap enough to repeat)."""
+    from flexrv.design import to_toml
+
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    if res.reducer is not None and not (d / "config.toml").exists():
+        atomic_write_text(d / "config.toml", to_toml(res.reducer))
+    with atomic_path(d / "results.nc") as tmp:
+        res.ds.to_netcdf(tmp, engine="h5netcdf")
+    return d
+
+
+CHECKPOINT = "checkpoint.npz"
+
+
+def save_checkpoint(directory, t, q, v, meta: dict, reducer, a_last=None) -> Path:
+    """Write the recorded states (t, q, v) of a run, its run options ``meta`` and
+    its design atomically to ``<directory>/checkpoint.npz``."""
+    from flexrv.cache import atomic_write_bytes, to_jsonable
+    from flexrv.design import to_toml
+
+    buf = io.BytesIO()
+    np.savez(buf, t=np.asarray(t, dtype=float), q=np.asarray(q, dtype=float), v=np.asarray(v, dtype=float),
+             meta=np.array(json.dumps(to_jsonable(meta))), config=np.array(to_toml(reducer)),
+             **({} if a_last is None else {"a": np.asarray(a_last, dtype=float)}))
+    return atomic_write_bytes(Path(directory) / CHECKPOINT, buf.getvalue())
+
+
+def load_checkpoint(directory) -> dict:
+    """Read ``checkpoint.npz`` of a run directory: t, q, v, meta, reducer.
+
+    Raises InputError naming the directory if there is none or it is unreadable."""
+    from flexrv.design import loads
+    from flexrv.errors import InputError
+
+    path = Path(directory) / CHECKPOINT
+    if not path.is_file():
+        raise InputError(f"--resume {directory}: no {CHECKPOINT} there (not a run directory of flexrv simulate, "
+                         "or the run was killed before its first checkpoint)")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {"t": z["t"], "q": z["q"], "v": z["v"], "meta": json.loads(str(z["meta"])),
+                    "config": str(z["config"]), "a": z["a"] if "a" in z.files else None}
+    except Exception as exc:  # truncated / foreign file
+        raise InputError(f"--resume {directory}: {CHECKPOINT} is unreadable ({type(exc).__name__}: {exc})") from None
+    if not data["meta"].get("resumable", True):
+        raise InputError(f"--resume {directory}: the run used a custom drive or load program and cannot be resumed")
+    if len(data["t"]) < 1:
+        raise InputError(f"--resume {directory}: {CHECKPOINT} holds no state")
+    data["reducer"] = loads(data["config"], source=f"{path} (config)")
+    return data
 
 
 def load_results(directory):
@@ -67,7 +129,15 @@ def load_results(directory):
     from flexrv.design import load
     from flexrv.post.results import Results
 
+    from flexrv.errors import InputError
+
     d = Path(directory)
-    ds = xr.load_dataset(d / "results.nc", engine="h5netcdf")
+    try:
+        ds = xr.load_dataset(d / "results.nc", engine="h5netcdf")
+    except FileNotFoundError:
+        raise InputError(f"{d} is not a result folder (no results.nc)") from None
+    except Exception as exc:  # not NetCDF / truncated
+        raise InputError(f"{d / 'results.nc'} is not a readable flexrv NetCDF file "
+                         f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
     reducer = load(d / "config.toml") if (d / "config.toml").exists() else None
     return Results(ds, reducer=reducer)

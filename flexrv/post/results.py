@@ -25,6 +25,8 @@ integration error; with load TE is the (varying) elastic wind-up.
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -78,6 +80,12 @@ class Results:
         """(t0, t1) [s] of the steady-state window stored with the run."""
         return float(self.attrs["steady_start_s"]), float(self.attrs["steady_end_s"])
 
+    @property
+    def is_steady(self) -> bool:
+        """True if the window holds >= 1 whole crank revolution after the ramps
+        (:func:`steady_window_rule`); runs saved before the rule count as steady."""
+        return bool(int(self.attrs.get("steady", 1)))
+
     def steady(self, key: str) -> xr.DataArray:
         t0, t1 = self.steady_window()
         return self[key].sel(time=slice(t0, t1))
@@ -115,14 +123,77 @@ def _var(values, dims, units, long_name):
     return xr.Variable(dims, np.asarray(values), attrs={"units": units, "long_name": long_name})
 
 
-def steady_window_for(reducer, t_end: float, settle: float = 0.05) -> tuple[float, float]:
-    """Steady window: from the end of the speed and load ramps plus ``settle`` to
-    t_end; if that leaves less than 0.02 s, the last half of the run."""
+#: settle time [s] after the end of the speed and load ramps before the steady window may
+#: start (a numerical choice of the evaluation, not a physical estimate: several periods of
+#: the slowest structural mode, ~1 ms, and of the contact transients after the ramps)
+STEADY_SETTLE_S = 0.05
+
+
+@dataclass(frozen=True)
+class SteadyWindow:
+    """The steady-state window of a run (see :func:`steady_window_rule`)."""
+
+    start_s: float
+    end_s: float
+    steady: bool  #: True: a whole number (>= 1) of crank revolutions after the ramps and settle time
+    revolutions: int  #: whole crank revolutions (relative to the carrier) in the window
+    crank_period_s: float  #: one crank revolution relative to the carrier [s] (inf: no input rotation)
+    note: str  #: why the window is (not) steady, in words
+
+
+def steady_window_rule(ramps_end_s: float, t_end: float, crank_period_s: float,
+                       settle_s: float = STEADY_SETTLE_S) -> SteadyWindow:
+    """The steady window chosen from the drive program.
+
+    Rule: the window may start at ``ramps_end_s + settle_s`` (the later of the speed and the
+    load ramp's end, plus the settle time); it is the last whole number n >= 1 of crank
+    revolutions relative to the carrier (period ``crank_period_s``) before ``t_end``, i.e.
+    [t_end - n T, t_end] with n = floor((t_end - ramps_end_s - settle_s) / T). A whole number
+    of revolutions makes the mean and the spectrum free of a partial load cycle (the needle
+    and pin loads repeat once per crank revolution relative to the carrier).
+
+    If not even one revolution fits (or the input does not rotate), the run has no steady
+    state: the window returned is what remains after the ramps and settle time (or the last
+    half of the run if nothing remains) and is flagged ``steady=False`` with the reason and
+    the ``t_end`` needed.
+
+    Example: rv40e at 1215 r/min, crank period 0.1 s, ramps end 0.2 s: t_end = 0.6 s gives
+    n = floor(0.35 / 0.1) = 3, window [0.3, 0.6] s; t_end = 0.2 s gives no steady state.
+    """
+    t_ready = ramps_end_s + settle_s
+    if not (math.isfinite(crank_period_s) and crank_period_s > 0):
+        t0 = t_ready if t_end - t_ready > 0 else 0.5 * t_end
+        return SteadyWindow(t0, t_end, False, 0, float("inf"),
+                            "no input rotation (locked or zero-speed drive): no crank revolution to average over")
+    n = int(math.floor((t_end - t_ready) / crank_period_s + 1e-9)) if t_end > t_ready else 0
+    if n >= 1:
+        return SteadyWindow(t_end - n * crank_period_s, t_end, True, n, crank_period_s,
+                            f"{n} whole crank revolution{'s' if n > 1 else ''} (relative to the carrier, "
+                            f"{crank_period_s:.4g} s each) after the ramps (end {ramps_end_s:.4g} s) and "
+                            f"{settle_s:.3g} s settle time")
+    t0 = t_ready if t_end - t_ready > 0 else 0.5 * t_end
+    where = ("inside the speed/load ramps" if t0 < ramps_end_s else "shorter than one crank revolution")
+    return SteadyWindow(t0, t_end, False, 0, crank_period_s,
+                        f"NOT STEADY: the run ends at {t_end:.4g} s; the window {t0:.4g} - {t_end:.4g} s is {where}. "
+                        f"A steady state needs t_end >= {t_ready + crank_period_s:.4g} s (ramps end "
+                        f"{ramps_end_s:.4g} s + settle {settle_s:.3g} s + one crank revolution "
+                        f"{crank_period_s:.4g} s); the statistics below are NOT steady-state values")
+
+
+def steady_window_for(reducer, t_end: float, input_speed: float | None = None,
+                      settle: float = STEADY_SETTLE_S) -> SteadyWindow:
+    """:func:`steady_window_rule` for a reducer's drive program: ramps from
+    ``reducer.operating``, crank period from the input speed at the end of the run
+    (``input_speed`` [rad/s], default the operating point's) and the tooth counts
+    (:func:`flexrv.geometry.kinematics.member_speeds`)."""
+    from flexrv.geometry.kinematics import member_speeds
+
     op = reducer.operating
-    t0 = max(op.speed_ramp_time_s, op.load_ramp_end_s) + settle
-    if t_end - t0 < 0.02:
-        t0 = 0.5 * t_end
-    return t0, t_end
+    w = op.input_speed if input_speed is None else float(input_speed)
+    fs, ss = reducer.first_stage, reducer.second_stage
+    w_rel = abs(float(member_speeds(w, fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count).crank_relative))
+    period = 2.0 * math.pi / w_rel if w_rel > 0 else float("inf")
+    return steady_window_rule(max(op.speed_ramp_time_s, op.load_ramp_end_s), t_end, period, settle)
 
 
 def results_from_states(model, t, q, v, dt: float, status: str = "completed", timing: dict | None = None,
@@ -209,11 +280,15 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
     red = model.reducer
     t_end = float(t[-1]) if len(t) else 0.0
-    s0, s1 = steady_window_for(red, t_end)
+    w_end = abs(float(np.asarray(model.input_speed(np.array([t_end])), dtype=float).ravel()[0])) if len(t) else 0.0
+    win = steady_window_for(red, t_end, input_speed=w_end)
+    s0, s1 = win.start_s, win.end_s
     ks = member_speeds(1.0, p.z_s, p.z_p, p.z_c, p.z_rp)
     ds.attrs.update({
         "preset": red.name, "model": model.name, "status": status, "dt_s": dt, "ratio": p.ratio,
         "rated_input_speed_rad_s": p.input_speed, "steady_start_s": s0, "steady_end_s": s1,
+        "steady": int(win.steady), "steady_revolutions": win.revolutions, "steady_note": win.note,
+        "crank_period_s": win.crank_period_s,
         "crank_relative_per_input": float(ks.crank_relative), "crank_absolute_per_input": float(ks.crank_absolute),
         "needle_model": red.needle_bearing.model, "pin_law": red.contact.pin_law,
         "timing": json.dumps(to_jsonable(timing or {})),

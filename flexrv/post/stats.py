@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -59,11 +61,17 @@ def summary(res) -> dict:
     p_in = float(np.mean(sel["power_in"].values)) if len(te) else float("nan")
     p_out = float(np.mean(sel["power_out"].values)) if len(te) else float("nan")
     ke = sel["kinetic_energy"].values
-    dke = float((ke[-1] - ke[0]) / (t1 - t0)) if len(te) > 1 else 0.0
+    tw = sel["time"].values
+    dke = float((ke[-1] - ke[0]) / (tw[-1] - tw[0])) if len(te) > 1 and tw[-1] > tw[0] else 0.0
     finite = len(te) > 0
-    return {
+    steady = bool(int(res.attrs.get("steady", 1)))
+    balance = power_balance(p_in, p_out, dke, steady=steady)
+    out = {
         "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
         "steady_window_s": [t0, t1],
+        "steady_state": steady,
+        "steady_revolutions": int(res.attrs.get("steady_revolutions", 0)),
+        "steady_note": str(res.attrs.get("steady_note", "")),
         "ratio_theoretical": float(res.attrs["ratio"]),
         "ratio_simulated": ratio_sim,
         "ratio_simulated_over_theoretical": ratio_sim / float(res.attrs["ratio"]),
@@ -77,11 +85,71 @@ def summary(res) -> dict:
         "pins_in_contact_max": int(np.max(in_contact)) if finite else None,
         "mean_input_power_W": p_in, "mean_output_power_W": p_out,
         "mean_kinetic_energy_rate_W": dke,
-        "mean_dissipation_W": p_in - p_out - dke,
+        "mean_dissipation_W": balance["dissipation_W"],
+        "power_balance_note": balance["note"],
+        "notes": ([] if steady else [str(res.attrs.get("steady_note", "NOT STEADY"))]) + [balance["note"]],
         "kinematics": table,
         "failure": res.attrs.get("failure"),
         **_bearing_summary(sel, finite),
     }
+    out["units"] = summary_units(res, out)
+    return out
+
+
+#: summary key -> the result variable whose ``units`` attribute it carries
+_UNIT_SOURCE = {"te_min_arcsec": "te", "te_max_arcsec": "te", "te_pp_arcsec": "te", "te_mean_arcsec": "te",
+                "te_rms_fluctuation_arcsec": "te", "max_pin_force_N": "pin_force", "mean_input_power_W": "power_in",
+                "mean_output_power_W": "power_out", "mean_dissipation_W": "power_in",
+                "mean_kinetic_energy_rate_W": "power_in", "max_ball_load_N": "ball_load_inner",
+                "max_ring_deformation_m": "ring_deformation_outer", "max_inner_ring_deformation_m":
+                "ring_deformation_inner", "max_ball_pressure_Pa": "ball_max_pressure",
+                "min_film_thickness_m": "ball_film_thickness", "pins_in_contact_mean": "pins_in_contact",
+                "pins_in_contact_max": "pins_in_contact"}
+
+
+def summary_units(res, summ: dict) -> dict:
+    """Units of the summary's numbers, carried from the result variables' ``units``
+    attributes (the model's declared outputs), not parsed from the key names; the steady
+    window in the time coordinate's units, ratios dimensionless ("-")."""
+    units = {}
+    for key, var in _UNIT_SOURCE.items():
+        if key in summ and var in res.ds:
+            units[key] = str(res.ds[var].attrs.get("units", ""))
+    units["steady_window_s"] = str(res.ds["time"].attrs.get("units", "s"))
+    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical"):
+        units[key] = "-"
+    return units
+
+
+def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True) -> dict:
+    """Mean power balance over a window: dissipation D = P_in - P_out - dE_kin/dt [W]
+    (every term the window mean; dE_kin/dt = (E_kin(t1) - E_kin(t0)) / (t1 - t0) is exactly
+    the mean of the rate). ``note`` says in words what the numbers mean: D < 0 beyond
+    ``tol`` P_in cannot be dissipation — energy is then released from storage the balance
+    does not count (elastic energy of the contacts, e.g. while the load still ramps, or a
+    window that is not steady) or the integration error shows."""
+    d = p_in - p_out - dke_dt
+    scale = max(abs(p_in), abs(p_out), 1e-12)
+    if not all(map(math.isfinite, (p_in, p_out, dke_dt))):
+        note = "power balance not available"
+    elif abs(d) <= tol * scale:
+        note = (f"power balance closes: P_in {p_in:.4g} W = P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W "
+                f"+ remainder {d:.3g} W; the remainder is within {100 * tol:.0f} % of the power, the accuracy of "
+                "the window means (P_in uses the numerically differentiated input speed): the contact damping "
+                "dissipates less than that")
+    elif d > 0:
+        note = (f"power balance: P_in {p_in:.4g} W - P_out {p_out:.4g} W - dE_kin/dt {dke_dt:.3g} W = "
+                f"{d:.4g} W dissipated (contact damping), efficiency P_out/P_in = {p_out / p_in:.4f}"
+                if p_in else f"power balance: {d:.4g} W dissipated")
+    else:
+        note = (f"power balance: P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W exceeds P_in {p_in:.4g} W by "
+                f"{-d:.4g} W: not a negative dissipation but energy released from elastic storage (contact "
+                "and mesh deflections, not counted in E_kin) — the window is not in steady state (ramps) or "
+                "too short")
+    if not steady:
+        note += ("; the window is NOT steady: energy stored elastically in the contacts while the load ramps "
+                 "is not part of E_kin, so the balance above is not a dissipation measurement")
+    return {"dissipation_W": float(d), "note": note}
 
 
 def _bearing_summary(sel, finite: bool) -> dict:

@@ -34,6 +34,13 @@ class StiffnessTest:
     lost_motion_arcmin: float
     hysteresis_arcmin: float
     angle_at_rated_arcmin: float
+    #: where the figures are read on the loop (for the plot and the saved file)
+    fit_range_low_Nm: float = float("nan")  #: rigidity fit over |T| in [low, rated]
+    lost_motion_torque_Nm: float = float("nan")  #: the +-3 % band of the lost motion
+    lost_motion_negative_arcmin: float = float("nan")  #: mean-curve angle at -3 % T_r
+    lost_motion_positive_arcmin: float = float("nan")  #: mean-curve angle at +3 % T_r
+    hysteresis_returning_arcmin: float = float("nan")  #: returning branch at T = 0
+    hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
 
 
 def _fit_slope(torque, angle, lo, hi):
@@ -68,8 +75,83 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
     d3 = 0.03 * rated
     mid_p = 0.5 * (_angle_at(torque[down], a[down], d3) + _angle_at(asc_t, asc_a, d3))
     mid_n = 0.5 * (_angle_at(torque[down], a[down], -d3) + _angle_at(asc_t, asc_a, -d3))
-    hyst = _angle_at(torque[down], a[down], 0.0) - _angle_at(torque[back], a[back], 0.0)
+    a_down0, a_back0 = _angle_at(torque[down], a[down], 0.0), _angle_at(torque[back], a[back], 0.0)
     return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
                          rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
-                         lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=hyst,
-                         angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated))
+                         lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
+                         angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
+                         fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
+                         lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
+                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0)
+
+
+#: (variable, StiffnessTest field, units, long name) of the saved figures
+_FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the loop"),
+            ("torsional_rigidity", "rigidity_Nm_per_arcmin", "N m/arcmin",
+             "torsional rigidity, mean of the +T_r and -T_r branch slopes over T_r/2 <= abs(T) <= T_r"),
+            ("torsional_rigidity_positive", "rigidity_positive_Nm_per_arcmin", "N m/arcmin",
+             "slope of the +T_r loading branch over T in [T_r/2, T_r]"),
+            ("torsional_rigidity_negative", "rigidity_negative_Nm_per_arcmin", "N m/arcmin",
+             "slope of the -T_r branch over -T in [T_r/2, T_r]"),
+            ("lost_motion", "lost_motion_arcmin", "arcmin",
+             "lost motion: rotation between +3 % and -3 % of T_r on the mean curve"),
+            ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
+            ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
+            ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
+            ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
+            ("lost_motion_negative_angle", "lost_motion_negative_arcmin", "arcmin", "mean-curve angle at -3 % T_r"),
+            ("lost_motion_positive_angle", "lost_motion_positive_arcmin", "arcmin", "mean-curve angle at +3 % T_r"),
+            ("hysteresis_returning_angle", "hysteresis_returning_arcmin", "arcmin", "returning branch at T = 0"),
+            ("hysteresis_descending_angle", "hysteresis_descending_arcmin", "arcmin", "descending branch at T = 0"))
+
+
+def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=None):
+    """The test's numbers as an :class:`xarray.Dataset`: every figure a scalar variable
+    with ``units`` and ``long_name`` (rigidity, lost motion, hysteresis, ...), and the loop
+    ``loop_torque`` [N m] / ``loop_angle`` [arcmin] over ``time`` [s]; merged into ``base``
+    (the run's dataset) if given."""
+    import xarray as xr
+
+    data = {name: xr.Variable((), float(getattr(figures, field)), {"units": units, "long_name": long})
+            for name, field, units, long in _FIGURES}
+    data["loop_torque"] = xr.Variable(("time",), np.asarray(torque, dtype=float),
+                                      {"units": "N m", "long_name": "output torque of the test loop"})
+    data["loop_angle"] = xr.Variable(("time",), np.asarray(angle_arcmin, dtype=float),
+                                     {"units": "arcmin", "long_name": "output rotation of the test loop"})
+    ds = xr.Dataset(data, coords={"time": ("time", np.asarray(time, dtype=float), {"units": "s"})})
+    if base is not None:
+        ds = base.assign(**{k: ds[k] for k in ds.data_vars})
+        ds.attrs = {k: v for k, v in base.attrs.items() if k != "stiffness_test"}
+    ds.attrs["kind"] = "stiffness_test"
+    return ds
+
+
+def stiffness_json(figures: StiffnessTest) -> dict:
+    """JSON-ready figures: ``{name: {"value", "units", "description"}}``."""
+    return {name: {"value": float(getattr(figures, field)), "units": units, "description": long}
+            for name, field, units, long in _FIGURES}
+
+
+def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, quarter_time: float,
+                               dt: float, plot: str | None = "hysteresis.png") -> str:
+    """summary.md of a stiffness test (not the time-simulation template): the program,
+    the figures with units and how each is read, the loop plot, References."""
+    f = figures
+    lines = [f"# Stiffness test {preset} ({model} model)", "",
+             f"Input locked; output torque 0 -> +{f.rated_torque:.4g} -> -{f.rated_torque:.4g} -> 0 N m, each "
+             f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
+             "catalogue and seed 004 (average slope of the loading and unloading curves).", "",
+             "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
+    for name, field, units, long in _FIGURES[:7]:
+        lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
+    lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
+              f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
+              f"{f.lost_motion_positive_arcmin:.4g} arcmin); hysteresis at T = 0 ({f.hysteresis_returning_arcmin:.4g}"
+              f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
+    if plot:
+        lines += [f"![torque vs output rotation loop]({plot})", ""]
+    lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
+              "stiffness.json, config.toml.", "", "## References", "",
+              "Seed 004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "
+              "repository.", ""]
+    return "\n".join(lines)

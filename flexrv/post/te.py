@@ -117,7 +117,7 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
             ("loaded TE, mean (wind-up)", s["te_mean_arcsec"], "arcsec"),
             ("no-load TE, peak to peak", s["no_load_te_pp_arcsec"], "arcsec"),
             ("lost motion (±3 % rated torque)", s["lost_motion_arcmin"], "arcmin"),
-            ("backlash (±1 % rated torque)", s["backlash_arcmin"], "arcmin"),
+            (f"backlash (±{s['no_load_torque_Nm']:.3g} N m)", s["backlash_arcmin"], "arcmin"),
             ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
             ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
             ("max pin force", s.get("max_pin_force_N"), "N"),
@@ -145,10 +145,10 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
               "| order | amplitude [arcsec] | nearest characteristic order |", "|---|---|---|"]
     for line in s["spectrum_lines"]:
         lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
-    lines += ["", "Definitions: TE = theta_out - theta_in / i; no-load TE at 1 % of the rated torque; lost motion "
-              "and backlash are the output rotations between the reversed loads at ±3 % and ±1 % of the rated "
-              "torque with the input locked (largest over the evaluated positions); rigidity in "
-              f"N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad)."]
+    lines += ["", f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; lost "
+              "motion and backlash are the output rotations between the reversed loads at ±3 % of the rated torque "
+              f"and at ±{s['no_load_torque_Nm']:.3g} N m with the input locked (largest over the evaluated "
+              f"positions); rigidity in N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad)."]
     return "\n".join(lines) + "\n"
 
 

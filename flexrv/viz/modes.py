@@ -25,6 +25,12 @@ def _pyvista():
     return pv
 
 
+#: scalar-bar placement of every 3-D view: vertical at the right, title above the bar
+#: (never over a tick label), three significant figures
+SCALAR_BAR = {"vertical": True, "position_x": 0.86, "position_y": 0.12, "width": 0.06, "height": 0.7,
+              "title_font_size": 14, "label_font_size": 12, "fmt": "%.3g"}
+
+
 def surface_polydata(nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray | None = None,
                      scale: float = 1.0, scalars: np.ndarray | None = None, name: str = "|u|"):
     """pyvista PolyData of the boundary (corner triangles of the Tri6 faces), nodes
@@ -63,7 +69,8 @@ def render_mode_png(path: str | os.PathLike, nodes: np.ndarray, tris6: np.ndarra
     plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
     try:
         plotter.add_mesh(ref, style="wireframe", color="grey", opacity=0.15)
-        plotter.add_mesh(poly, scalars=scalar_name, cmap="viridis", show_edges=False)
+        plotter.add_mesh(poly, scalars=scalar_name, cmap="viridis", show_edges=False,
+                         scalar_bar_args={"title": scalar_name, **SCALAR_BAR})
         if title:
             plotter.add_text(title, font_size=10)
         return save_screenshot(plotter, path)

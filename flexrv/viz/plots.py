@@ -60,47 +60,118 @@ def plot_speeds(res, path) -> Path:
 
 
 def plot_pin_forces(res, path) -> Path:
-    """Pin forces of disc 0 over time and pin number (map) and the largest pin force."""
+    """Pin force maps (pin angle vs time) of every disc, one panel each, and the largest
+    pin force per disc below; all panels share the time axis and the same width (the
+    colour bar sits in its own column so the panels stay aligned)."""
     plt = _plt()
     f = res["pin_force"].values  # (time, disc, pin)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    n_disc, n_pin = f.shape[1], f.shape[2]
     t = res.time
-    im = axes[0].pcolormesh(t, np.arange(f.shape[2]), f[:, 0, :].T, shading="auto", cmap="viridis")
-    fig.colorbar(im, ax=axes[0], label="force [N]")
-    axes[0].set_ylabel("pin (disc 0)")
-    for k in range(f.shape[1]):
-        axes[1].plot(t, f[:, k, :].max(axis=-1), lw=0.8, label=f"disc {k}: max pin force")
-    axes[1].set_xlabel("time [s]")
-    axes[1].set_ylabel("force [N]")
-    axes[1].legend(loc="best")
-    fig.tight_layout()
+    fig = plt.figure(figsize=(8, 2.4 * n_disc + 2.6))
+    gs = fig.add_gridspec(n_disc + 1, 2, width_ratios=[40, 1], hspace=0.35, wspace=0.04)
+    angle = np.arange(n_pin) * 360.0 / n_pin  # pin angle on the pin circle [deg]
+    vmax = float(f.max()) if f.size and f.max() > 0 else 1.0
+    axes = []
+    for k in range(n_disc):
+        ax = fig.add_subplot(gs[k, 0], sharex=axes[0] if axes else None)
+        im = ax.pcolormesh(t, angle, f[:, k, :].T, shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
+        ax.set_ylabel(f"disc {k + 1}\npin angle [deg]")
+        ax.set_yticks(np.arange(0, 361, 90))
+        ax.tick_params(labelbottom=False)
+        axes.append(ax)
+    cax = fig.add_subplot(gs[:n_disc, 1])
+    fig.colorbar(im, cax=cax, label="pin force [N]")
+    ax = fig.add_subplot(gs[n_disc, 0], sharex=axes[0])
+    for k in range(n_disc):
+        ax.plot(t, f[:, k, :].max(axis=-1), lw=0.8, label=f"disc {k + 1}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("largest pin force [N]")
+    ax.legend(loc="best", fontsize=8)
+    axes[0].set_title(f"Pin forces, {res.attrs.get('preset')} ({res.attrs.get('model')} model), "
+                      f"{n_pin} pins, {n_disc} discs")
     return _save(fig, Path(path))
 
 
+#: characteristic frequencies in words (plot labels)
+FREQUENCY_LABELS = {"crank_rotation": "crank revolution (rel. carrier)", "first_stage_mesh": "first-stage mesh",
+                    "cycloid_mesh": "cycloid mesh", "input": "input shaft", "carrier": "output (carrier)",
+                    "pin_passing": "pin passing", "crank_absolute": "crank (absolute)"}
+
+
+def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None = None, decades: float = 4.0):
+    """Draw an amplitude spectrum on ``ax``: log amplitude axis limited to ``decades``
+    below the peak (not down to numerical zero), the characteristic frequencies as
+    dashed lines labelled in words and staggered so that labels do not overlap, and the
+    window length and frequency resolution in the title."""
+    line = None
+    if len(freq) > 1:
+        f, a = freq[1:], amp[1:]
+        top = float(a.max()) if a.size and a.max() > 0 else 1.0
+        line = ax.semilogy(f, np.maximum(a, top * 10 ** -decades), lw=0.8, label=label)[0]
+        ax.set_ylim(top * 10 ** -decades, top * 3.0)
+        hi = max(marks.values()) if marks else f[-1]
+        ax.set_xlim(0, min(f[-1], 1.25 * hi))
+    res_hz = float(freq[1] - freq[0]) if len(freq) > 1 else float("nan")
+    y_top = ax.get_ylim()[1]
+    placed = []
+    span = ax.get_xlim()[1] - ax.get_xlim()[0]
+    for name, f0 in sorted(marks.items(), key=lambda kv: kv[1]):
+        if not (ax.get_xlim()[0] <= f0 <= ax.get_xlim()[1]):
+            continue
+        ax.axvline(f0, ls="--", lw=0.6, color="0.5")
+        level = sum(1 for p in placed if f0 - p < 0.25 * span)  # stagger: a label is ~1/4 of the axis wide
+        placed.append(f0)
+        ax.annotate(f"{FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz", (f0, y_top),
+                    xytext=(3, -4 - 11 * level), textcoords="offset points", rotation=0, va="top", ha="left",
+                    fontsize=7, color="0.25")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_title(f"window {window_s:.3g} s, resolution {res_hz:.3g} Hz (Hann)", fontsize=9)
+    return line
+
+
 def plot_te_spectrum(res, path) -> Path:
-    """TE amplitude spectrum over the steady window with characteristic frequencies."""
+    """TE amplitude spectrum over the steady window with characteristic frequencies
+    (labels in words), window length and resolution stated."""
     from flexrv.post.spectra import te_spectrum
 
     plt = _plt()
     freq, amp, marks = te_spectrum(res)
-    fig, ax = plt.subplots(figsize=(8, 3.5))
-    if len(freq):
-        ax.semilogy(freq[1:], np.maximum(amp[1:], 1e-9), lw=0.8)
-        ax.set_xlim(0, min(freq[-1], 5 * max(marks.values())))
-    for name, f0 in marks.items():
-        ax.axvline(f0, ls="--", lw=0.6, color="0.5")
-        ax.text(f0, ax.get_ylim()[1], name, rotation=90, va="top", fontsize=7)
-    ax.set_xlabel("frequency [Hz]")
+    t0, t1 = res.steady_window()
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    spectrum_axis(ax, freq, amp, marks, t1 - t0)
     ax.set_ylabel("TE amplitude [arcsec]")
+    if not getattr(res, "is_steady", True):
+        ax.text(0.5, 0.5, "NOT STEADY: window in the ramps or < 1 crank revolution", transform=ax.transAxes,
+                ha="center", color="red", fontsize=9)
+    fig.suptitle(f"TE spectrum, {res.attrs.get('preset')} ({res.attrs.get('model')} model)", fontsize=10)
     fig.tight_layout()
     return _save(fig, Path(path))
 
 
-def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteresis") -> Path:
-    """Torque vs output rotation loop of the stiffness test."""
+def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteresis", figures=None) -> Path:
+    """Torque vs output rotation loop of the stiffness test; with ``figures``
+    (:class:`flexrv.post.stiffness.StiffnessTest`) the rigidity fit range (shaded
+    bands and the fitted slope), the lost motion (at +-3 % T_r on the mean curve) and
+    the hysteresis (loop width at T = 0) are marked and stated in the legend."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    ax.plot(angle_arcmin, torque, lw=0.9)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    a, tq = np.asarray(angle_arcmin, dtype=float), np.asarray(torque, dtype=float)
+    ax.plot(a, tq, lw=0.9, color="C0", label="loop")
+    if figures is not None:
+        f = figures
+        lo, hi = f.fit_range_low_Nm, f.rated_torque
+        for sgn in (1, -1):
+            ax.axhspan(sgn * lo, sgn * hi, color="C2", alpha=0.12, lw=0)
+        ax.plot([], [], color="C2", alpha=0.4, lw=6,
+                label=f"rigidity fit |T| {lo:.3g}..{hi:.3g} N m: {f.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
+        ax.plot([f.lost_motion_negative_arcmin, f.lost_motion_positive_arcmin],
+                [-f.lost_motion_torque_Nm, f.lost_motion_torque_Nm], "o-", color="C3", ms=4,
+                label=f"lost motion (±3 % T_r): {f.lost_motion_arcmin:.3g} arcmin")
+        ax.plot([f.hysteresis_returning_arcmin, f.hysteresis_descending_arcmin], [0.0, 0.0], "s-", color="C1",
+                ms=4, label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin")
+        ax.axhline(0, color="0.6", lw=0.5)
+        ax.axvline(0, color="0.6", lw=0.5)
+        ax.legend(loc="upper left", fontsize=8)
     ax.set_xlabel("output rotation [arcmin]")
     ax.set_ylabel("output torque [N m]")
     ax.set_title(title)

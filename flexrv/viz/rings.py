@@ -22,7 +22,7 @@ import numpy as np
 
 from flexrv.cache import atomic_path, atomic_write_text
 from flexrv.errors import InputError
-from flexrv.viz.modes import _pyvista, save_screenshot, surface_polydata
+from flexrv.viz.modes import SCALAR_BAR, _pyvista, save_screenshot, surface_polydata
 
 FIELDS = ("displacement", "von_mises")
 
@@ -91,9 +91,25 @@ def _polydata(state: RingState, scale: float, field: str):
         if state.von_mises is None:
             raise InputError("field von_mises needs the rings' stress modes: they are built on request "
                              "(flexrv view ... --field von_mises rebuilds them, ~1 min per ring)")
-        return surface_polydata(state.nodes, state.tris, state.displacement, scale, state.von_mises, "von Mises [Pa]")
+        return surface_polydata(state.nodes, state.tris, state.displacement, scale, 1e-6 * state.von_mises,
+                                FIELD_TITLES["von_mises"])
     return surface_polydata(state.nodes, state.tris, state.displacement, scale,
-                            np.linalg.norm(state.displacement, axis=1), "|u| [m]")
+                            1e6 * np.linalg.norm(state.displacement, axis=1), FIELD_TITLES["displacement"])
+
+
+#: scalar-bar titles (one unit style: quantity [unit], engineering units for display)
+FIELD_TITLES = {"displacement": "displacement |u| [µm]", "von_mises": "von Mises stress [MPa]"}
+
+
+def ring_label_points(states: list[RingState]) -> tuple[np.ndarray, list[str]]:
+    """One label point per ring (its outermost node at the top, +y) and the label text
+    ("outer ring, row 1", ...) to identify rings and rows in a 3-D view."""
+    pts, labels = [], []
+    for st in states:
+        j = int(np.argmax(st.nodes[:, 1] + (1e-3 if st.label == "outer" else 0.0) * st.nodes[:, 2]))
+        pts.append(st.nodes[j])
+        labels.append(f"{st.label} ring, row {st.row + 1}")
+    return np.array(pts), labels
 
 
 def auto_scale(states: list[RingState], fraction: float = 0.03) -> float:
@@ -114,9 +130,12 @@ def render_rings_png(res, path, time: float | None = None, scale: float | None =
     scale = auto_scale(states) if scale is None else float(scale)
     plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
     try:
-        name = "von Mises [Pa]" if field == "von_mises" else "|u| [m]"
+        name = FIELD_TITLES[field]
         for st in states:
-            plotter.add_mesh(_polydata(st, scale, field), scalars=name, cmap="viridis", show_edges=False)
+            plotter.add_mesh(_polydata(st, scale, field), scalars=name, cmap="viridis", show_edges=False,
+                             scalar_bar_args={"title": name, **SCALAR_BAR})
+        pts, labels = ring_label_points(states)
+        plotter.add_point_labels(pts, labels, font_size=12, point_size=6, always_visible=True)
         t = res.time
         i = len(t) - 1 if time is None else int(np.argmin(np.abs(t - time)))
         plotter.add_text(f"{res.attrs.get('preset')} main-bearing rings, t = {t[i]:.4f} s, scale x{scale:.3g}",
@@ -142,7 +161,7 @@ def show_rings(res, time: float | None = None, scale: float | None = None, field
 
 def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> Path:
     """Write the ring surfaces of every ``every``-th record as VTU files (point data
-    ``displacement`` [m] and |u|, undeformed coordinates: warp in ParaView) and a
+    ``displacement`` [m] and |u| [µm], undeformed coordinates: warp in ParaView) and a
     ParaView PVD collection ``rings.pvd`` with the simulation times. Atomic writes."""
     if every < 1:
         raise InputError(f"every = {every!r} must be >= 1")
@@ -154,6 +173,8 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement") -> P
     for i in range(0, len(t), every):
         for st in ring_states(res, float(t[i]), stress=field == "von_mises", bodies=bodies):
             poly = _polydata(st, 0.0, field)
+            for name in list(poly.point_data.keys()):  # ASCII array names in files for other tools
+                poly.point_data[name.replace("µm", "um")] = poly.point_data.pop(name)
             used = np.unique(st.tris[:, :3])
             poly.point_data["displacement"] = st.displacement[used]
             fname = f"{st.label}_row{st.row}_{i:06d}.vtu"

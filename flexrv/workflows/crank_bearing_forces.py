@@ -18,14 +18,14 @@ sweep 1.0/1.5/2.0 mm. flexrv:
 4. repeats 1-2 over the eccentricities that give a valid cycloid profile on this
    geometry.
 
-Run: ``python -m workflows.crank_bearing_forces`` or ``flexrv workflow crank_bearing_forces``.
+Run: ``python -m flexrv.workflows.crank_bearing_forces`` or ``flexrv workflow crank_bearing_forces``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "crank_bearing_forces"
 PRESET = "rv40e"
@@ -153,7 +153,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         else t_end
     size = SMOKE["mesh_size"] if smoke else None
     r = WorkflowResult(NAME, f"Crank-bearing forces, crankshaft stress and life ({red.name}, 2000 r/min, 600 N m)",
-                       ["003 (RV-40E crank bearing forces, Nastran stress, L10, eccentricity sweep)"])
+                       ["003 (RV-40E crank bearing forces, Nastran stress, L10, eccentricity sweep)"], smoke=smoke)
     res = Simulation(red, model="rigid").run(t_end=t_end)
     i, k, j = max_load_instant(res)
     f = res["roller_force"].values[i, 0, k]

@@ -4,7 +4,7 @@ renderings of the first modes of every flexible part of both presets.
 Uses :func:`flexrv.fem.body.part_modes` and :func:`flexrv.viz.modes.render_mode_png`
 exactly as ``flexrv modes PRESET --part PART --png DIR`` does.
 
-Run: ``python -m workflows.mode_gallery`` or ``flexrv workflow mode_gallery``.
+Run: ``python -m flexrv.workflows.mode_gallery`` or ``flexrv workflow mode_gallery``.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from workflows._common import RESULTS_ROOT, WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, default_out, new_figure
 
 NAME = "mode_gallery"
 PARTS = ("outer_ring", "inner_ring", "crankshaft", "cycloid_disc")
@@ -36,9 +36,9 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
         presets, parts = presets or SMOKE["presets"], parts or SMOKE["parts"]
         n_modes, size = n_modes or SMOKE["n_modes"], size or SMOKE["size"]
     presets, parts, n_modes = tuple(presets or PRESETS), tuple(parts or PARTS), int(n_modes or N_MODES)
-    out = Path(out_dir) if out_dir else RESULTS_ROOT / NAME
+    out = Path(out_dir) if out_dir else default_out(NAME, smoke)
     out.mkdir(parents=True, exist_ok=True)
-    r = WorkflowResult(NAME, "Mode gallery: free-free modes of the flexible parts", ["issue 7 item 8"])
+    r = WorkflowResult(NAME, "Mode gallery: free-free modes of the flexible parts", ["issue 7 item 8"], smoke=smoke)
     rows, gallery, freq = [], [], {}
     for p in presets:
         red = load(p)
@@ -67,7 +67,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
     fig, ax = new_figure(figsize=(8, 3.5))
     for j, c in enumerate(freq):
         ax.plot(np.arange(1, n_modes + 1), freq[c], "o-", label=c)
-    ax.set_xlabel("mode"), ax.set_ylabel("free-free frequency [Hz]"), ax.set_yscale("log"), ax.legend(fontsize=7)
+    ax.set_xlabel("mode number"), ax.set_ylabel("free-free frequency [Hz]"), ax.set_yscale("log"), ax.legend(fontsize=7)
+    ax.set_xticks(np.arange(1, n_modes + 1))  # whole mode numbers only
     fig.tight_layout()
     r.figures["frequencies"] = fig
     r.save(out)

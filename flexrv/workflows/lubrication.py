@@ -16,14 +16,14 @@ Each case runs the reducer with the flexible main bearing (``model="flexible"``)
 and records the minimum central film over the loaded balls, the maximum contact
 pressure and the TE statistics of the loaded steady state.
 
-Run: ``python -m workflows.lubrication`` or ``flexrv workflow lubrication``.
+Run: ``python -m flexrv.workflows.lubrication`` or ``flexrv workflow lubrication``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "lubrication"
 PRESET = "rv221"
@@ -68,7 +68,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     viscosities = SMOKE["viscosities"] if smoke else VISCOSITIES
     radial = SMOKE["radial_loads"] if smoke else RADIAL_LOADS
     r = WorkflowResult(NAME, f"Main-bearing lubrication and TE ({base.name}, model {model})",
-                       ["000 (rigid vs flexible TE)", "001 (lubrication table)"])
+                       ["000 (rigid vs flexible TE)", "001 (lubrication table)"], smoke=smoke)
     film_rows = [_case(override(base, {"contact.ehl": "dry"}), model, t_end, "viscosity [Pa s]", 0.0)]
     for eta in viscosities:
         red = override(base, {"contact.ehl": "hamrock_dowson", "lubricant.viscosity_Pa_s": eta})
@@ -125,7 +125,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                    label="flexrv (TE mean, min..max)")
     ax[0].axhline(film_rows[0]["TE mean [arcsec]"], color="k", ls=":", label="dry Hertz")
     ax[0].set_xscale("log")
-    ax[0].set_xlabel("minimum central film h_c [um]")
+    ax[0].set_xlabel("minimum central film h_c [µm]")
     ax[0].set_ylabel("TE [arcsec]")
     ax[0].legend(fontsize=8)
     ax[1].errorbar([row["max contact pressure [GPa]"] for row in pressure_rows],

@@ -8,12 +8,12 @@ and the flexible model (ball-resolved bearing, reduced flexible inner and outer
 rings of both rows, Hamrock–Dowson EHL contacts) on identical inputs — and puts
 its numbers beside the seeds'.
 
-Run: ``python -m workflows.rigid_vs_flexible`` or ``flexrv workflow rigid_vs_flexible``.
+Run: ``python -m flexrv.workflows.rigid_vs_flexible`` or ``flexrv workflow rigid_vs_flexible``.
 """
 
 from __future__ import annotations
 
-from workflows._common import WorkflowResult
+from flexrv.workflows._common import WorkflowResult
 
 NAME = "rigid_vs_flexible"
 PRESET = "rv221"
@@ -29,24 +29,27 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     import numpy as np
 
     from flexrv.design import load
-    from flexrv.post.compare import SEED_TE, run_compare
-    from workflows._common import RESULTS_ROOT
+    from flexrv.post.compare import run_compare, seed_reference
+    from flexrv.workflows._common import default_out
 
     red = load(preset)
-    out = RESULTS_ROOT / NAME if out_dir is None else out_dir
+    out = default_out(NAME, smoke) if out_dir is None else out_dir
     options = SMOKE["flexible_options"] if smoke else None
     if t_end is None:
         t_end = SMOKE["t_end"] if smoke else T_END
     cmp = run_compare(red, t_end=t_end, out_dir=out, flexible_options=options)
     nr, nf = cmp.numbers["rigid"], cmp.numbers["flexible"]
     r = WorkflowResult(NAME, f"Rigid vs flexible main bearing: TE of the {red.name}",
-                       ["000 (rigid vs compliant-bearing TE)", "001 (flexible main bearing, contact forces)"])
+                       ["000 (rigid vs compliant-bearing TE)", "001 (flexible main bearing, contact forces)"], smoke=smoke)
+    ref = seed_reference(red)  # the seeds' values only for their reducer (rv221)
     for model in ("rigid", "flexible"):
-        n, seed = cmp.numbers[model], SEED_TE[model]
-        r.compare(f"TE range, {model} model", "arcsec", f"{seed['te_min_arcsec']} .. {seed['te_max_arcsec']}",
+        n, seed = cmp.numbers[model], (ref or {}).get(model)
+        r.compare(f"TE range, {model} model", "arcsec",
+                  f"{seed['te_min_arcsec']} .. {seed['te_max_arcsec']}" if seed else None,
                   f"{n['te_min_arcsec']:.2f} .. {n['te_max_arcsec']:.2f}",
-                  "flexrv: steady window after the speed and load ramps")
-        r.compare(f"TE period, {model} model", "s", seed["period_s"], n.get("dominant_period_s"),
+                  "flexrv: steady window after the speed and load ramps"
+                  + ("" if seed else f"; no seed value: seeds 000/001 simulate the rv221, not {red.name}"))
+        r.compare(f"TE period, {model} model", "s", seed["period_s"] if seed else None, n.get("dominant_period_s"),
                   "flexrv: period of the largest TE spectral peak")
     loads = cmp.flexible["ball_load_inner"]
     t0, _ = cmp.flexible.steady_window()

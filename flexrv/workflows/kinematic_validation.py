@@ -1,18 +1,14 @@
 """Kinematic validation (seeds 000, 001, 002): rigid multibody runs of both presets
 against the closed-form kinematics of :mod:`flexrv.geometry.kinematics`.
 
-Run: ``python -m workflows.kinematic_validation`` or ``flexrv workflow kinematic_validation``.
+Run: ``python -m flexrv.workflows.kinematic_validation`` or ``flexrv workflow kinematic_validation``.
 """
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
-
 from flexrv.units import DEG_PER_RAD, RAD_PER_DEG, RAD_S_PER_RPM, RPM_PER_RAD_S
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "kinematic_validation"
 PRESETS = ("rv221", "rv40e")
@@ -60,13 +56,15 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         t_end = t_end or SMOKE["t_end"]
     presets = tuple(presets or PRESETS)
     r = WorkflowResult(NAME, "Kinematic validation: rigid multibody vs closed-form kinematics",
-                       ["000 (RV-221 Adams)", "001 (RV-221 planets)", "002 (RV-40E frequencies)"])
+                       ["000 (RV-221 Adams)", "001 (RV-221 planets)", "002 (RV-40E frequencies)"], smoke=smoke)
     sims = {}
     for p in presets:
         res, summ = _simulate(p, t_end, dt)
         sims[p] = (res, summ)
         r.datasets[f"speeds_{p}"] = _speeds_dataset(res)
         tab = summ["kinematics"]
+        if not summ.get("steady_state", True):
+            r.text.append(f"**{p}: {summ['steady_note']}.**")
         r.tables[f"{p}: steady-window speeds (simulated vs theory at the simulated input speed)"] = tab
         ratio = _row(tab, "total ratio")
         r.numbers[p] = {"ratio_theory": ratio["theory"], "ratio_simulated": ratio["simulated"],
@@ -110,7 +108,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
     r.compare("RV-40E crank speed, relative", "r/min", 600.0, abs(float(s40.crank_relative)) * RPM_PER_RAD_S, "= 10 Hz")
     r.compare("RV-40E output speed", "r/min", 15.0, abs(float(s40.carrier)) * RPM_PER_RAD_S, "1215/81")
     seed_f = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
-              "cycloid_mesh": 390.0, "pin_passing": 400.0}
+              "cycloid_mesh": 390.0, "pins_x_crank_rotation": 400.0}
     freqs = {}
     for key, val in seed_f.items():
         got = float(getattr(f40, key))
@@ -132,7 +130,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
         t = ds["time"].values
         for key in ds.data_vars:
             y = ds[key].values.reshape(len(t), -1) * RPM_PER_RAD_S
-            ax.plot(t, y, lw=0.8, label=[key] + ["_"] * (y.shape[1] - 1))
+            ax.plot(t, y, lw=0.8, label=[ds[key].attrs.get("long_name", key.replace("_", " "))]
+                    + ["_"] * (y.shape[1] - 1))
         ax.axvspan(ds.attrs["steady_start_s"], ds.attrs["steady_end_s"], color="0.9")
         ax.set_title(f"{p}: member speeds (grey: steady window)")
         ax.set_ylabel("speed [r/min]")

@@ -3,14 +3,14 @@ torsional stiffness vs meshing phase, meshing-zone identification from the measu
 3.06e8 N mm/rad, pins in contact (analytic pin-load distribution and contact
 simulation) and the stiffness-test bench.
 
-Run: ``python -m workflows.torsional_stiffness`` or ``flexrv workflow torsional_stiffness``.
+Run: ``python -m flexrv.workflows.torsional_stiffness`` or ``flexrv workflow torsional_stiffness``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "torsional_stiffness"
 PRESET = "rv40e"
@@ -42,7 +42,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     red = load(preset)
     ss = red.second_stage
     t_rated = red.operating.rated_torque_Nm
-    r = WorkflowResult(NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"])
+    r = WorkflowResult(NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke)
 
     # ---- per-pin contributions
     th, ktc = seed004_pin_contributions(red)
@@ -134,10 +134,15 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     a1.semilogy(np.degrees(th[:n]), ktc[:n], "s-", label="flexrv")
     a1.axvspan(np.degrees(th[z_seed4.first - 1]), np.degrees(th[z_seed4.last - 1]), color="C0", alpha=0.2,
                label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}")
-    a1.set_xlabel("meshing phase [deg]"), a1.set_ylabel("KTC_j [N m/rad]"), a1.legend(fontsize=7)
+    k_top = float(max(np.max(seed_ktc[:n]), np.max(ktc[:n])))
+    a1.set_ylim(k_top * 1e-4, k_top * 3)  # 4 decades: the loaded pins, not the numerically unloaded ones
+    a1.set_xlabel("meshing phase [deg]"), a1.set_ylabel("pin stiffness KTC_j [N m/rad]"), a1.legend(fontsize=7)
     a2.plot(ang, tq, lw=0.8)
     a2.set_xlabel("twist [arcmin]"), a2.set_ylabel("output torque [N m]")
-    a2.set_title(f"stiffness test: {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
+    a2.set_title(f"stiffness test: rigidity {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin,\n"
+                 f"lost motion {st.lost_motion_arcmin:.3g} arcmin, hysteresis {st.hysteresis_arcmin:.3g} arcmin",
+                 fontsize=9)
+    a2.grid(True, lw=0.3)
     fig.tight_layout()
     r.figures["stiffness"] = fig
     r.save(out_dir)

@@ -9,14 +9,14 @@ reports the raceway deflection at the most-loaded contact (along the contact
 normal, ring clamped at its fit) of the outer and inner rings, the ball loads and
 the TE range of both.
 
-Run: ``python -m workflows.ring_deformation`` or ``flexrv workflow ring_deformation``.
+Run: ``python -m flexrv.workflows.ring_deformation`` or ``flexrv workflow ring_deformation``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "ring_deformation"
 PRESET = "rv221"
@@ -42,7 +42,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         t_end = SMOKE["t_end"] if smoke else max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.1
     ring_options = SMOKE["ring_options"] if smoke else {}
     r = WorkflowResult(NAME, f"Main-bearing ring deformation vs external load ({base.name})",
-                       ["001 (flexible main bearing, load cases 15/20, 20/25, 25/30 kN)"])
+                       ["001 (flexible main bearing, load cases 15/20, 20/25, 25/30 kN)"], smoke=smoke)
     rows, te_series = [], {}
     for k, (fa, fr) in enumerate(cases):
         red = override(base, {"operating.external_axial_force_N": fa, "operating.external_radial_force_N": fr})
@@ -125,7 +125,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     ax[0].bar(x + 0.2, [row["seed deformation [um]"] or 0.0 for row in rows], 0.4, label="seed 001")
     ax[0].set_xticks(x, [f"{row['axial [kN]']:.0f}/{row['radial [kN]']:.0f}" for row in rows])
     ax[0].set_xlabel("axial/radial load [kN]")
-    ax[0].set_ylabel("ring deformation [um]")
+    ax[0].set_ylabel("ring deformation [µm]")
     ax[0].legend()
     for k, (te_f, te_r) in te_series.items():
         ax[1].plot(te_f["time"], te_f, label=f"flexible, case {k + 1}")

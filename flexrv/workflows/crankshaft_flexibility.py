@@ -9,14 +9,14 @@ the first-stage mesh. flexrv runs :func:`flexrv.post.compare.run_compare` with t
 crankshafts flexible (:mod:`flexrv.model.flexible_crank`: FE-condensed torsion and
 gear-seat bending) and compares the spectra at the Table 4 frequencies.
 
-Run: ``python -m workflows.crankshaft_flexibility`` or ``flexrv workflow crankshaft_flexibility``.
+Run: ``python -m flexrv.workflows.crankshaft_flexibility`` or ``flexrv workflow crankshaft_flexibility``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from workflows._common import WorkflowResult, new_figure
+from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "crankshaft_flexibility"
 PRESET = "rv40e"
@@ -43,17 +43,17 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     from flexrv.geometry.kinematics import reducer_kinematics
     from flexrv.post.compare import run_compare
     from flexrv.post.spectra import te_spectrum
-    from workflows._common import RESULTS_ROOT
+    from flexrv.workflows._common import default_out
 
     red = load(preset)
-    out = RESULTS_ROOT / NAME if out_dir is None else out_dir
+    out = default_out(NAME, smoke) if out_dir is None else out_dir
     t_end = (SMOKE["t_end"] if smoke else T_END) if t_end is None else t_end
     options = {"crank_options": SMOKE["crank_options"]} if smoke else None
     cmp = run_compare(red, t_end=t_end, parts=("crankshaft",), out_dir=out, flexible_options=options)
     kin = reducer_kinematics(red)
     cf = kin.frequencies
     r = WorkflowResult(NAME, f"Crankshaft flexibility and the TE spectrum ({red.name})",
-                       ["002 (RV-40E rigid-flexible coupling, Table 4, TE spectrum)"])
+                       ["002 (RV-40E rigid-flexible coupling, Table 4, TE spectrum)"], smoke=smoke)
     ours = {"input shaft": float(cf.input), "crank rotation": float(cf.crank_rotation),
             "carrier (crank revolution)": float(cf.carrier), "first-stage mesh": float(cf.first_stage_mesh),
             "cycloid mesh": float(cf.cycloid_mesh)}
@@ -73,6 +73,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                      "flexible/rigid": a_f / a_r if a_r and np.isfinite(a_r) and a_r > 0 else None})
     r.tables["TE amplitude at the characteristic frequencies (steady window)"] = rows
     nr, nf = cmp.numbers["rigid"], cmp.numbers["flexible"]
+    if not nr.get("steady_state", True):
+        r.text.append(f"**{nr['steady_note']}: the spectra below are not steady-state spectra.**")
     twist = cmp.flexible.steady("crank_twist").values
     r.compare("TE, rigid model (steady)", "arcsec", "periodic, smaller",
               f"{nr['te_min_arcsec']:.2f} .. {nr['te_max_arcsec']:.2f}", "seed 002 gives no numbers, only plots")
@@ -115,14 +117,20 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                                            "amplitude_flexible": ("frequency_flexible", a_f)},
                                           coords={"frequency_rigid": f_r, "frequency_flexible": f_f})
     fig, ax = new_figure(figsize=(10, 4))
+    top = max([float(a[1:].max()) for a in (a_r, a_f) if len(a) > 1] or [1.0])
+    floor = top * 1e-4  # four decades below the largest line: the meaningful range
     if len(f_r) > 1:
-        ax.semilogy(f_r[1:], np.maximum(a_r[1:], 1e-9), lw=0.8, label="rigid")
+        ax.semilogy(f_r[1:], np.maximum(a_r[1:], floor), lw=0.8, label="rigid")
     if len(f_f) > 1:
-        ax.semilogy(f_f[1:], np.maximum(a_f[1:], 1e-9), lw=0.8, label="flexible crankshafts")
+        ax.semilogy(f_f[1:], np.maximum(a_f[1:], floor), lw=0.8, label="flexible crankshafts")
+    ax.set_ylim(floor, 3 * top)
     for label, f0 in lines:
         ax.axvline(f0, ls="--", lw=0.6, color="0.4")
         ax.text(f0, 1.0, f" {label}", rotation=90, va="top", fontsize=7, transform=ax.get_xaxis_transform())
     ax.set_xlim(0, 1.3 * max(cf.cycloid_mesh, 2 * cf.first_stage_mesh))
+    window = float(np.diff(cmp.rigid.steady_window())[0])
+    ax.set_title(f"TE spectra: steady window {window:.3g} s, resolution "
+                 f"{(f_r[1] - f_r[0]) if len(f_r) > 1 else float('nan'):.3g} Hz (Hann)", fontsize=9)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("TE amplitude [arcsec]")
     ax.legend(loc="lower left")

@@ -1,0 +1,210 @@
+"""Every plot type rendered headless (Agg / pyvista off-screen): the PNG is not blank
+(pixel variance) and, where cheap, one plotted value is checked against its data.
+
+Synthetic inputs with known values are used where a real run would be slow (the
+flexible model's ball loads and ring deflections, an EHL solution); the time-history
+plots use a 20 ms rigid rv40e run."""
+
+from __future__ import annotations
+
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+def _not_blank(path, min_var=1e-3):
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(path)[..., :3]
+    assert img.size > 1000 and float(img.var()) > min_var, f"{path} looks blank (variance {img.var():.2g})"
+    return img
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """Keep the figures the plot functions save (they close them after saving)."""
+    import flexrv.viz.compare_plots as cp
+    import flexrv.viz.plots as vp
+
+    figs = []
+    orig = vp._save
+
+    def keep(fig, path):
+        figs.append(fig)
+        from flexrv.cache import atomic_path
+
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=60, format="png")
+        return path
+
+    monkeypatch.setattr(vp, "_save", keep)
+    monkeypatch.setattr(cp, "_save", keep)
+    yield figs
+    import matplotlib.pyplot as plt
+
+    for f in figs:
+        plt.close(f)
+    assert orig is not None
+
+
+@pytest.fixture(scope="module")
+def run():
+    from flexrv.simulation import Simulation
+
+    return Simulation("rv40e").run(t_end=0.02, dt=1e-4)
+
+
+def test_te_and_speed_plots(run, tmp_path, captured):
+    from flexrv.viz.plots import plot_speeds, plot_te
+
+    _not_blank(plot_te(run, tmp_path / "te.png"))
+    line = captured[-1].axes[0].lines[0]
+    assert np.allclose(line.get_ydata(), run["te"].values)
+    _not_blank(plot_speeds(run, tmp_path / "speeds.png"))
+
+
+def test_pin_force_map_shows_every_disc_aligned(run, tmp_path, captured):
+    """One map per disc (both discs of rv40e), pin angle in degrees, map and line panels of
+    equal width (aligned time axes); the line panel plots each disc's largest pin force."""
+    from flexrv.viz.plots import plot_pin_forces
+
+    _not_blank(plot_pin_forces(run, tmp_path / "pins.png"))
+    fig = captured[-1]
+    f = run["pin_force"].values
+    maps = [ax for ax in fig.axes if ax.collections and "pin angle" in ax.get_ylabel()]
+    assert len(maps) == f.shape[1] == 2
+    line_ax = [ax for ax in fig.axes if "largest pin force" in ax.get_ylabel()][0]
+    widths = {round(ax.get_position().width, 4) for ax in maps + [line_ax]}
+    lefts = {round(ax.get_position().x0, 4) for ax in maps + [line_ax]}
+    assert len(widths) == 1 and len(lefts) == 1
+    assert np.allclose(line_ax.lines[1].get_ydata(), f[:, 1, :].max(axis=-1))
+
+
+def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captured):
+    """A 2 arcsec sine at the rv40e cycloid-mesh frequency (390 Hz at 1215 r/min, seed 002):
+    the plotted peak is 2 +- 0.1 arcsec; labels are words, not snake_case; the title states
+    the window (0.3 s) and resolution (1/0.3 s); the log axis spans 4 decades, not 1e-9..1."""
+    import xarray as xr
+
+    from flexrv.design import load
+    from flexrv.post.results import Results
+    from flexrv.viz.plots import plot_te_spectrum
+
+    red = load("rv40e")
+    w_in = red.operating.input_speed
+    t = np.arange(0, 0.6, 1e-4)
+    ds = xr.Dataset({"te": ("time", 2.0 * np.sin(2 * np.pi * 390.0 * t)), "theta_in": ("time", w_in * t)},
+                    coords={"time": t})
+    ds.attrs.update({"steady_start_s": 0.3, "steady_end_s": float(t[-1]), "preset": "rv40e", "model": "rigid",
+                     "steady": 1})
+    _not_blank(plot_te_spectrum(Results(ds, red), tmp_path / "spec.png"))
+    ax = captured[-1].axes[0]
+    y = ax.lines[0].get_ydata()
+    assert y.max() == pytest.approx(2.0, abs=0.1)
+    x = ax.lines[0].get_xdata()
+    assert x[np.argmax(y)] == pytest.approx(390.0, abs=4.0)
+    texts = [tx.get_text() for tx in ax.texts]
+    assert any(tx.startswith("cycloid mesh 390") for tx in texts) and not any("_" in tx for tx in texts)
+    assert "window 0.3 s" in ax.get_title() and "resolution 3.33 Hz" in ax.get_title()
+    lo, hi = ax.get_ylim()
+    assert hi / lo == pytest.approx(3e4, rel=1e-6)
+
+
+def test_hysteresis_plot_marks_fit_range_lost_motion_hysteresis(tmp_path, captured):
+    """Bilinear loop (k = 100 N m/arcmin, band +-0.5 arcmin) with a 0.2 arcmin hysteresis: the
+    legend states the figures; the lost-motion marker spans the figures' two angles."""
+    from flexrv.post.stiffness import evaluate_stiffness_test
+    from flexrv.units import ARCMIN_PER_RAD
+    from flexrv.viz.plots import plot_hysteresis
+
+    t = np.linspace(0, 4, 4001)
+    torque = np.interp(t, [0, 1, 3, 4], [0, 400.0, -400.0, 0])
+    shift = np.where((t > 1) & (t < 3), 0.1, -0.1) * (t > 1)
+    angle_arcmin = torque / 100.0 + np.sign(torque) * 0.5 + shift
+    fig = evaluate_stiffness_test(t, torque, angle_arcmin / ARCMIN_PER_RAD, (0.0, 1.0, 3.0, 4.0))
+    _not_blank(plot_hysteresis(angle_arcmin, torque, tmp_path / "loop.png", figures=fig))
+    ax = captured[-1].axes[0]
+    labels = [ln.get_label() for ln in ax.lines]
+    assert any(lab.startswith("lost motion") for lab in labels) and any(lab.startswith("hysteresis") for lab in labels)
+    assert any("rigidity fit" in lab and f"{fig.rigidity_Nm_per_arcmin:.4g}" in lab for lab in labels)
+    lm = [ln for ln in ax.lines if ln.get_label().startswith("lost motion")][0]
+    assert np.ptp(lm.get_xdata()) == pytest.approx(fig.lost_motion_arcmin)
+    assert len(ax.patches) >= 2  # the two shaded fit bands
+
+
+def _synthetic_flexible(red, n_ball=20, rows=2):
+    import xarray as xr
+
+    from flexrv.post.results import Results
+
+    t = np.arange(0, 0.3, 1e-4)
+    ball = np.zeros((len(t), rows, n_ball))
+    ball[:, :, 5] = 150.0  # ball 6 (pocket angle 90 deg) carries 150 N
+    ds = xr.Dataset({"ball_load_inner": (("time", "bearing_row", "ball"), ball),
+                     "ring_deformation_outer": (("time", "bearing_row"), np.full((len(t), rows), 0.8e-6)),
+                     "te": ("time", 0.5 * np.sin(2 * np.pi * 100 * t)),
+                     "theta_in": ("time", red.operating.input_speed * t)}, coords={"time": t})
+    ds.attrs.update({"steady_start_s": 0.1, "steady_end_s": float(t[-1]), "preset": red.name, "model": "flexible"})
+    return Results(ds, red)
+
+
+def test_compare_plots(tmp_path, captured):
+    """Ball loads over the pocket angle (the 150 N ball at 90 deg), ring deflection in µm
+    (0.8), TE overlay and spectra render non-blank."""
+    from flexrv.design import load
+    from flexrv.viz import compare_plots as cp
+
+    red = load("rv40e")
+    res = _synthetic_flexible(red)
+    _not_blank(cp.plot_ball_loads(res, tmp_path / "balls.png"))
+    ax = captured[-1].axes[0]
+    x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
+    assert x[np.argmax(y)] == pytest.approx(90.0) and "angle" in ax.get_xlabel()
+    _not_blank(cp.plot_ring_deformation(res, tmp_path / "ring.png"))
+    ax = captured[-1].axes[0]
+    assert ax.lines[0].get_ydata()[0] == pytest.approx(0.8) and "µm" in ax.get_ylabel()
+    _not_blank(cp.plot_te_overlay(res, res, tmp_path / "overlay.png"))
+    _not_blank(cp.plot_te_spectra(res, res, tmp_path / "spectra.png"))
+    ax = captured[-1].axes[0]
+    assert ax.get_ylim()[1] / ax.get_ylim()[0] == pytest.approx(3e4, rel=1e-6)
+
+
+def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
+    """An 8:1 elliptic film/pressure field: both maps drawn with equal aspect, labels in µm;
+    the PNG is not blank."""
+    import matplotlib.pyplot as plt
+
+    from flexrv.viz.ehl_plots import ehl_figure, plot_ehl_solution
+
+    x = np.linspace(-2e-4, 2e-4, 41)
+    y = np.linspace(-1.6e-3, 1.6e-3, 81)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    r2 = (X / 1e-4) ** 2 + (Y / 8e-4) ** 2
+    p = 1.5e9 * np.sqrt(np.clip(1 - r2, 0, None))
+    h = 0.2e-6 + 1e-6 * np.clip(r2 - 1, 0, None)
+    result = SimpleNamespace(x=x, y=y, pressure=p, film=h, h_central=0.2e-6, h_min=0.18e-6, p_max=1.5e9,
+                             hertz_pressure=1.5e9)
+    fig = ehl_figure(result)
+    maps = [ax for ax in fig.axes if ax.get_title().startswith(("pressure", "film thickness"))]
+    assert len(maps) == 2 and all(ax.get_aspect() == 1.0 for ax in maps)
+    labels = " ".join(ax.get_ylabel() for ax in fig.axes)
+    assert "µm" in labels and "um]" not in labels
+    plt.close(fig)
+    _not_blank(plot_ehl_solution(result, tmp_path / "ehl.png"))
+
+
+def test_mode_png_offscreen(tmp_path):
+    """pyvista off-screen render of a warped tetrahedron surface is not blank."""
+    pytest.importorskip("pyvista")
+    from flexrv.viz.modes import render_mode_png
+
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1],
+                      [.5, 0, 0], [.5, .5, 0], [0, .5, 0], [0, 0, .5], [.5, 0, .5], [0, .5, .5]], float)
+    tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
+    disp = np.zeros_like(nodes)
+    disp[3] = [0.1, 0.1, 0.2]
+    _not_blank(render_mode_png(tmp_path / "mode.png", nodes, tris, disp, title="test mode"), min_var=1e-4)
