@@ -136,7 +136,7 @@ def test_tolerances_inside_design_toml(tmp_path):
 def test_same_seed_identical_samples(rv40e, sampler):
     """Same seed -> bit-identical unit samples, values and [errors] tables; another seed differs.
     Every drawn error set passes the design's [errors] validation; band draws stay in the band."""
-    from flexrv.design.manufacturing import with_errors
+    from flexrv.design import with_errors
 
     tol = load_tolerances("rv40e", rv40e)
     a, b, c = (TolerancePlan.build(rv40e, tol, s) for s in (7, 7, 8))
@@ -228,7 +228,7 @@ def test_first_order_propagation_mean_te(rv40e):
     computed mean TE within 5 % of its standard deviation (fails for a wrong sensitivity)."""
     from scipy.stats import chi2
 
-    from flexrv.design.manufacturing import with_errors
+    from flexrv.design import with_errors
 
     table = {"discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 0.3},
              "pins.pin_tangential_position_um": {"distribution": "normal", "sigma_um": 0.5, "scope": "per_reducer"}}
