@@ -309,7 +309,7 @@ def test_study_outputs_and_rerun_identical(local_run, tmp_path):
 
 @pytest.mark.slow
 def test_sigkill_resume_identical(local_run, tmp_path):
-    """SIGKILL the whole study (client and LocalCluster) once two samples are stored; rerunning the
+    """SIGKILL the whole study (client and LocalCluster) once a sample is stored; rerunning the
     same command computes only the missing samples (finished ones are skipped, their files
     untouched) and the table equals the uninterrupted run's."""
     out = tmp_path / "killed"
@@ -321,16 +321,16 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     t0 = time.time()
     try:
         while time.time() - t0 < 300:
-            if cases.is_dir() and len(list(cases.glob("*.json"))) >= 2:
+            if cases.is_dir() and len(list(cases.glob("*.json"))) >= 1:
                 break
             if proc.poll() is not None:
                 break
-            time.sleep(0.2)
+            time.sleep(0.02)
     finally:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)
     done = {p.name: p.stat().st_mtime_ns for p in cases.glob("*.json")}
-    assert 2 <= len(done) < 4, done
+    assert 1 <= len(done) < 4, done
     res = _cli(*args[4:])
     assert res.returncode == 0, res.stderr
     data = json.loads(res.stdout)

@@ -29,15 +29,31 @@ Pipeline
 
 Resolution of one evaluation: :data:`DEFAULT_RESOLUTION`, one crank revolution
 at 2 points per pin-mesh period (78 loaded + 78 no-load positions on rv40e).
-Its accuracy against 8 points per mesh over the same crank revolution, measured
-on one sample (rv40e with the example error set ``iso_grade5_rv40e``, rated
-torque, :func:`te_task`): TE p-p 6.354 vs 6.462 arcsec (-1.7 %), mean TE
--125.2877 vs -125.2876 arcsec (1e-6), no-load TE p-p 7.995 vs 8.004 arcsec
-(-0.1 %), lost motion 1.0668 vs 1.0839 arcmin (-1.6 %), backlash 0.9113 vs
-0.9382 arcmin (-2.9 %), tangent rigidity 274.13 vs 274.40 N m/arcmin (-0.1 %);
-cost 14 s vs 19 s on a shared core. The error-induced TE is dominated by low
-orders (crank rotation and its first harmonics), which 2 points per mesh
-resolve; the pin-mesh ripple is under-sampled (its p-p share is ~0.2 arcsec).
+Measured on one sample (rv40e with the example error set ``iso_grade5_rv40e``,
+rated torque, :func:`te_task`, compiled kernels, shared core):
+
+=====================  ==========  ==========  ===========  ===========
+quantity               crank, K=2  crank, K=8  output, K=2  output, K=8
+=====================  ==========  ==========  ===========  ===========
+TE p-p [arcsec]        53.2256     53.2256     57.1531      57.2632
+mean TE [arcsec]       -124.2471   -124.2466   -124.5481    -124.5478
+no-load TE p-p         53.666      53.901      77.499       78.251
+lost motion [arcmin]   0.3044      0.2892      0.1756       0.1806
+backlash [arcmin]      0.0920      0.0901      0.0560       0.0611
+rigidity [N m/arcmin]  267.01      266.49      269.00       268.43
+wall time [s]          1.8         2.0         51 (retry)   34
+=====================  ==========  ==========  ===========  ===========
+
+(crank = one crank revolution, output = one output revolution, K = points per
+pin-mesh period.) Against K = 8 over the same crank revolution, K = 2 changes
+TE p-p by < 1e-4, mean TE by 4e-6, no-load TE p-p by -0.4 %, lost motion by
++5 %, backlash by +2 %, rigidity by +0.2 %. Over one crank revolution the
+once-per-output-revolution variation of cumulative pitch errors (disc order-1
+harmonic, pin-position patterns) is not seen: TE p-p is 7 % below the
+output-revolution value on this sample, lost motion and backlash are the
+largest over catalog positions spread over a different range. One output
+revolution costs 17-28x more per sample today; give ``output_revolutions=1``
+(``--output-revolutions 1``) when the budget allows.
 
 Sensitivities
 -------------
@@ -86,22 +102,12 @@ from flexrv.errors import ConfigError, InputError
 OUTPUTS = ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motion_arcmin", "backlash_arcmin",
            "torsional_rigidity_Nm_per_arcmin")
 
-#: Default resolution of one evaluation. Why: one output revolution at 2 points
-#: per mesh is 3120 positions (x2 with the no-load curve), ~50-100 s per sample
-#: with the numpy kernels, which no 1,000-sample study affords today; one crank
-#: revolution at 2 points per mesh (78 + 78 positions) costs 6-18 s (shared core). It resolves
-#: every error that repeats once per crank revolution (eccentrics, crank bores,
-#: needle clearances, the pin-mesh ripple of pin and profile errors, the lost
-#: motion and rigidity, which are evaluated at catalog positions within it), but
-#: NOT the once-per-output-revolution variation of cumulative pitch errors
-#: (disc harmonic order 1, pin position patterns): TE p-p over one crank
-#: revolution is a lower bound of the p-p over one output revolution. Use
-#: ``output_revolutions=1`` once the compiled kernel makes it affordable.
-#: force_tol 1e-6 (of T_rated / a_w, i.e. ~0.01 N on rv40e, 1e-5 of a rated pin
-#: force; measured against 1e-7 on the example error set: TE p-p and mean TE
-#: change by < 1e-6 arcsec) and max_iter 200: with
-#: errors the solver's default 1e-7 / 60 fails at some positions (measured on
-#: the example error set at 0.0013 N vs 0.0011 N).
+#: Default resolution of one evaluation (accuracy and cost measured in the module
+#: docstring): one crank revolution at 2 points per pin-mesh period. force_tol
+#: 1e-6 (of T_rated / a_w, ~0.01 N on rv40e, 1e-5 of a rated pin force; measured
+#: against 1e-7 on the example error set: TE p-p and mean TE change by < 1e-6
+#: arcsec) and max_iter 200: with errors, the solver's default 1e-7 / 60 stalled
+#: just above its tolerance at some positions (measured 0.0013 N vs 0.0011 N).
 DEFAULT_RESOLUTION = {"crank_revolutions": 1.0, "output_revolutions": None, "points_per_mesh": 2,
                       "force_tol": 1e-6, "max_iter": 200, "torque": None}
 
