@@ -656,35 +656,39 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
 
 
 def _what_if(parts, y, specs) -> dict[str, Any]:
+    """What-if rows (see module docstring). Paired: for each tolerance only the
+    samples whose unscaled, halved and doubled evaluations all succeeded count
+    (a failed evaluation would otherwise bias one side); ``samples_used`` says
+    how many."""
     m = parts["what_if_m"]
     if m == 0:
         return {"samples": 0, "rows": []}
     j = OUTPUTS.index("te_pp_arcsec")
-    base = y[:m]
-    rows = []
-    cases = parts["cases"]
-    idx = {}
-    for pos, c in enumerate(cases):
+    need = sorted({j, *(OUTPUTS.index(s.output) for s in specs)})
+    idx: dict[tuple[str, float], list[int]] = {}
+    for pos, c in enumerate(parts["cases"]):
         if c[0] == "what_if":
             idx.setdefault((c[2], c[3]), []).append(pos)
 
     def stats(block):
-        te = block[:, j]
-        te = te[np.isfinite(te)]
-        yl = yield_estimate({k: block[:, i] for i, k in enumerate(OUTPUTS)}, specs)
-        return (float(np.percentile(te, 95.0)) if te.size else None), (yl["yield"] if yl else None)
+        p95 = float(np.percentile(block[:, j], 95.0)) if len(block) else None
+        yl = yield_estimate({k: block[:, i] for i, k in enumerate(OUTPUTS)}, specs) if len(block) else None
+        return p95, (yl["yield"] if yl else None)
 
-    p95_0, y0 = stats(base)
+    rows = []
     for (key, f), pos in idx.items():
         if f != 0.5:
             continue
-        p_half, y_half = stats(y[pos])
-        p_dbl, y_dbl = stats(y[idx[(key, 2.0)]])
-        rows.append({"tolerance": key, "p95_te_pp_arcsec": p95_0, "p95_te_pp_arcsec_halved": p_half,
-                     "p95_te_pp_arcsec_doubled": p_dbl, "yield": y0, "yield_halved": y_half, "yield_doubled": y_dbl})
+        blocks = [y[:m], y[pos], y[idx[(key, 2.0)]]]
+        ok = np.all([np.all(np.isfinite(b[:, need]), axis=1) for b in blocks], axis=0)
+        (p0, y0), (ph, yh), (pd, yd) = (stats(b[ok]) for b in blocks)
+        rows.append({"tolerance": key, "samples_used": int(ok.sum()), "p95_te_pp_arcsec": p0,
+                     "p95_te_pp_arcsec_halved": ph, "p95_te_pp_arcsec_doubled": pd,
+                     "yield": y0, "yield_halved": yh, "yield_doubled": yd})
     rows.sort(key=lambda r: -abs((r["p95_te_pp_arcsec_doubled"] or 0.0) - (r["p95_te_pp_arcsec_halved"] or 0.0)))
     return {"samples": m, "method": "re-evaluation of the first M plain samples with the tolerance's deviations "
-                                    "scaled by 0.5 / 2 (paired with the same M samples unscaled)", "rows": rows}
+                                    "scaled by 0.5 / 2, paired with the same samples unscaled (samples with a "
+                                    "failed evaluation left out of that row)", "rows": rows}
 
 
 def _ranking(result) -> dict[str, list[dict[str, Any]]]:
@@ -778,13 +782,13 @@ def _tornado(out: Path, result) -> Path | None:
     rows = result["what_if"]["rows"]
     fig, ax = plt.subplots(figsize=(8, 0.45 * max(len(rows), 4) + 1.5))
     if rows and rows[0]["p95_te_pp_arcsec"] is not None:
-        base = rows[0]["p95_te_pp_arcsec"]
+        base = [r["p95_te_pp_arcsec"] or 0.0 for r in rows][::-1]
         names = [r["tolerance"] for r in rows][::-1]
-        lo = [(r["p95_te_pp_arcsec_halved"] or base) - base for r in rows][::-1]
-        hi = [(r["p95_te_pp_arcsec_doubled"] or base) - base for r in rows][::-1]
+        lo = [(r["p95_te_pp_arcsec_halved"] or b) - b for r, b in zip(rows[::-1], base)]
+        hi = [(r["p95_te_pp_arcsec_doubled"] or b) - b for r, b in zip(rows[::-1], base)]
         ax.barh(names, hi, left=base, color="C3", label="tolerance doubled")
         ax.barh(names, lo, left=base, color="C0", label="tolerance halved")
-        ax.axvline(base, color="k", lw=1)
+        ax.axvline(base[-1], color="k", lw=1)
         ax.set_xlabel(f"P95 TE p-p [arcsec] on {result['what_if']['samples']} re-evaluated samples")
         ax.legend(fontsize=8)
     else:
@@ -822,10 +826,11 @@ def _markdown(r: dict[str, Any]) -> str:
     w = r["what_if"]
     if w["rows"]:
         lines += ["", f"## What if ({w['method']}; M = {w['samples']})", "",
-                  "| tolerance | P95 TE p-p | halved | doubled | yield | halved | doubled |", "|---|---|---|---|---|---|---|"]
+                  "| tolerance | samples | P95 TE p-p | halved | doubled | yield | halved | doubled |",
+                  "|---|---|---|---|---|---|---|---|"]
         for row in w["rows"]:
             f = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
-            lines.append(f"| {row['tolerance']} | {f(row['p95_te_pp_arcsec'])} | {f(row['p95_te_pp_arcsec_halved'])} | "
+            lines.append(f"| {row['tolerance']} | {row['samples_used']} | {f(row['p95_te_pp_arcsec'])} | {f(row['p95_te_pp_arcsec_halved'])} | "
                          f"{f(row['p95_te_pp_arcsec_doubled'])} | {f(row['yield'])} | {f(row['yield_halved'])} | "
                          f"{f(row['yield_doubled'])} |")
     return "\n".join(lines) + "\n"
