@@ -287,7 +287,7 @@ def local_run(tmp_path_factory):
 
 @pytest.mark.slow
 def test_study_outputs_and_rerun_identical(local_run, tmp_path):
-    """The study writes samples.nc / summary / PNGs with finite outputs; a second identical command
+    """(slow: three tiny studies.) The study writes samples.nc / summary / PNGs with finite outputs; a second identical command
     recomputes nothing; a fresh run in another directory gives the identical table."""
     out, data = local_run
     assert data["samples"] == 4 and data["evaluations"] == 4
@@ -307,7 +307,6 @@ def test_study_outputs_and_rerun_identical(local_run, tmp_path):
     _assert_same(t, _table(fresh))
 
 
-@pytest.mark.slow
 def test_sigkill_resume_identical(local_run, tmp_path):
     """SIGKILL the whole study (client and LocalCluster) once a sample is stored; rerunning the
     same command computes only the missing samples (finished ones are skipped, their files
@@ -339,7 +338,6 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     _assert_same(_table(local_run[0]), _table(out))
 
 
-@pytest.mark.slow
 def test_real_dask_scheduler_and_workers(local_run, tmp_path):
     """A real `dask scheduler` and two `dask worker` processes on 127.0.0.1 (free ports, bounded
     waits, killed at the end): the study through --scheduler equals the LocalCluster run."""
