@@ -782,14 +782,16 @@ def _tornado(out: Path, result) -> Path | None:
     rows = result["what_if"]["rows"]
     fig, ax = plt.subplots(figsize=(8, 0.45 * max(len(rows), 4) + 1.5))
     if rows and rows[0]["p95_te_pp_arcsec"] is not None:
-        base = [r["p95_te_pp_arcsec"] or 0.0 for r in rows][::-1]
-        names = [r["tolerance"] for r in rows][::-1]
-        lo = [(r["p95_te_pp_arcsec_halved"] or b) - b for r, b in zip(rows[::-1], base)]
-        hi = [(r["p95_te_pp_arcsec_doubled"] or b) - b for r, b in zip(rows[::-1], base)]
-        ax.barh(names, hi, left=base, color="C3", label="tolerance doubled")
-        ax.barh(names, lo, left=base, color="C0", label="tolerance halved")
-        ax.axvline(base[-1], color="k", lw=1)
-        ax.set_xlabel(f"P95 TE p-p [arcsec] on {result['what_if']['samples']} re-evaluated samples")
+        rows_up = rows[::-1]  # largest span on top
+        names = [r["tolerance"] for r in rows_up]
+        base = [r["p95_te_pp_arcsec"] or 0.0 for r in rows_up]
+        lo = [(r["p95_te_pp_arcsec_halved"] or b) - b for r, b in zip(rows_up, base)]
+        hi = [(r["p95_te_pp_arcsec_doubled"] or b) - b for r, b in zip(rows_up, base)]
+        ax.barh(names, hi, color="C3", label="tolerance doubled")
+        ax.barh(names, lo, color="C0", label="tolerance halved")
+        ax.axvline(0.0, color="k", lw=1)
+        ax.set_xlabel(f"change of P95 TE p-p [arcsec] (paired, up to {result['what_if']['samples']} "
+                      "re-evaluated samples per row)")
         ax.legend(fontsize=8)
     else:
         ranking = result["ranked_sensitivities"].get("te_pp_arcsec", [])
