@@ -69,7 +69,8 @@ Sensitivities
 * With ``--sobol``: first-order and total Sobol' indices per tolerance entry
   (SALib, grouped variables) on a Saltelli design of N (G + 2) evaluations, G =
   number of entries; its A and B blocks (2N quasi-random samples) are the plain
-  samples of the distribution statistics.
+  samples of the distribution statistics. A base sample with a failed
+  evaluation is left out of the indices (``sobol_base_samples_used``).
 
 What-if table
 -------------
@@ -639,14 +640,19 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
         y_salt[parts["plain_in_saltelli"]] = y_plain
         extra = [i for i in range(n_salt) if i not in set(parts["plain_in_saltelli"].tolist())]
         y_salt[extra] = y[n_plain:n_plain + len(extra)]
-        sob = {}
+        sob, used = {}, {}
+        step = len(plan.groups) + 2
         for j, k in enumerate(OUTPUTS[:4]):
-            col = y_salt[:, j]
-            if np.all(np.isfinite(col)):
-                sob[k] = sobol_indices(plan.salib_problem(), col, cfg.seed)
+            # a failed evaluation removes its whole base sample (block [A, AB_1..AB_G, B])
+            blocks = y_salt[:, j].reshape(-1, step)
+            keep = np.all(np.isfinite(blocks), axis=1)
+            if keep.sum() >= 2:
+                sob[k] = sobol_indices(plan.salib_problem(), blocks[keep].ravel(), cfg.seed)
             else:
-                sob[k] = {"error": f"{int(np.sum(~np.isfinite(col)))} failed evaluations: Sobol' indices need all"}
+                sob[k] = {"error": f"only {int(keep.sum())} base samples without a failed evaluation"}
+            used[k] = int(keep.sum())
         result["sensitivity_sobol"] = sob
+        result["sobol_base_samples_used"] = used
     result["what_if"] = _what_if(parts, y, specs)
     result["ranked_sensitivities"] = _ranking(result)
     _write_outputs(out, cfg, plan, parts, y_plain, status[:n_plain], ids[:n_plain], specs, result)
