@@ -31,7 +31,7 @@ app = typer.Typer(
 
 #: Command modules; each defines ``register(app)``. A module that is not present
 #: (capability not installed yet) is skipped.
-_COMMAND_MODULES = ("design", "ehl", "mesh", "simulate", "te", "compare", "view", "sweep", "workflows")
+_COMMAND_MODULES = ("design", "ehl", "mesh", "simulate", "te", "compare", "view", "sweep", "tolerance", "workflows")
 
 for _name in _COMMAND_MODULES:
     try:

@@ -1,0 +1,1 @@
+"""Studies built on the models: many evaluations of a design (tolerance analysis)."""
