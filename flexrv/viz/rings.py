@@ -189,7 +189,7 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement", noti
             grid = poly.cast_to_unstructured_grid()
             if i == 0:
                 frame_bytes += (grid.points.nbytes + sum(grid.point_data[k].nbytes for k in grid.point_data.keys())
-                                + grid.cells.nbytes + grid.celltypes.nbytes + grid.offset.nbytes)
+                                + grid.cells.nbytes + grid.celltypes.nbytes)
             with atomic_path(d / fname) as tmp:
                 grid.save(str(tmp), binary=True)
             entries.append((float(t[i]), f"{st.label}_row{st.row}", fname))
