@@ -290,3 +290,39 @@ def test_design_report_load_sanity_warnings():
     assert warnings[0].startswith("main_bearing.external.hertz_max_ball.inner_p_max_Pa = 4.3 GPa")
     assert warnings[1].startswith("pin_loads.rated_torque.max_hertz_pressure_Pa = 4.05 GPa")
     assert load_sanity_warnings(design_report(load("rv40e"))) == []
+
+
+def test_toml_template_comments_round_trip_and_optional_provenance(tmp_path):
+    """`show --toml` writes a comment with the description and allowed range above every
+    described field; the commented text loads back to the same design. A design without a
+    [provenance] table loads (own designs), and `show` warns about it on stderr."""
+    import subprocess
+    import sys
+
+    from flexrv.design import load, loads, to_toml
+
+    red = load("rv40e")
+    text = to_toml(red, comments=True)
+    assert "# Sun gear teeth z_s [-]; allowed: 8 <= value <= 200\nsun_teeth = 16" in text
+    assert loads(text) == red
+    bare = "\n".join(line for line in to_toml(red).splitlines())
+    bare = bare[:bare.index("[provenance]")]
+    path = tmp_path / "own.toml"
+    path.write_text(bare)
+    assert load(path).provenance == {}
+    cp = subprocess.run([sys.executable, "-m", "flexrv", "show", str(path)], capture_output=True, text=True,
+                        timeout=120)
+    assert cp.returncode == 0 and "no [provenance] table" in cp.stderr
+
+
+def test_involute_undercut_is_refused():
+    """Practical undercut limit x >= 5/6 - z sin^2(alpha)/2 (DIN 3960 / Niemann: 14 teeth at
+    20 deg without shift): a 12-tooth sun without profile shift (limit 0.131) is refused
+    naming the field; the presets (rv221: 12 teeth with x = 0.5, rv40e: 16 teeth, x = 0)
+    pass."""
+    from flexrv.design import load, override
+    from flexrv.errors import ConfigError
+
+    load("rv40e"), load("rv221")
+    with pytest.raises(ConfigError, match=r"first_stage.sun_profile_shift = 0.0 .*>= 0.131"):
+        override("rv221", {"first_stage.sun_profile_shift": 0.0})

@@ -40,8 +40,14 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
          json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Print a design (all fields, with provenance notes of estimated values)."""
     reducer = load(preset)
+    if not reducer.provenance:  # optional for an own design, but then nothing says where estimates come from
+        from rich.console import Console
+
+        Console(stderr=True, markup=False, highlight=False).print(
+            f"warning: {reducer.name} has no [provenance] table: no field says where its value comes from "
+            "(add 'field.path = \"note\"' lines for every estimated value)")
     if toml:
-        print(to_toml(reducer), end="")
+        print(to_toml(reducer, comments=True), end="")
         return
 
     def render(r) -> None:

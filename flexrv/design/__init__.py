@@ -138,8 +138,13 @@ def override(reducer: Reducer | str | Path, overrides: dict[str, Any]) -> Reduce
     return from_dict(apply_overrides(base.model_dump(), overrides), source=f"{base.name} + {sorted(overrides)}")
 
 
-def to_toml(reducer: Reducer) -> str:
-    """Serialise a design to TOML that :func:`loads` reads back unchanged."""
+def to_toml(reducer: Reducer, comments: bool = False) -> str:
+    """Serialise a design to TOML that :func:`loads` reads back unchanged.
+
+    With ``comments`` every field is preceded by a comment with its description
+    and allowed range (the template ``flexrv show --toml`` prints); comments do
+    not change what loads back.
+    """
     data = reducer.model_dump(mode="python")
     data.pop("errors", None)
     if not reducer.errors.is_zero():  # the [errors] table only when there are errors, non-zero fields only
@@ -147,7 +152,29 @@ def to_toml(reducer: Reducer) -> str:
     head = {k: data.pop(k) for k in ("name", "description", "sources")}
     provenance = data.pop("provenance")
     ordered = {**head, **data, "provenance": provenance}
-    return tomli_w.dumps(ordered)
+    text = tomli_w.dumps(ordered)
+    return _commented(text) if comments else text
+
+
+def _commented(text: str) -> str:
+    """Insert ``# description; allowed: range`` above every ``key = value`` line whose
+    field the data model describes (table headers give the path)."""
+    out: list[str] = []
+    section: tuple = ()
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("["):
+            section = tuple(p.strip().strip('"') for p in stripped.strip("[]").split("."))
+        elif "=" in stripped and not stripped.startswith("#") and section[:1] != ("provenance",):
+            key = stripped.split("=", 1)[0].strip().strip('"')
+            info = _field_info(Reducer, section + (key,))
+            if info is not None:
+                rng = _allowed_range(info)
+                text = info.description or key.replace("_", " ")  # the unit is in the key's name
+                if info.description or rng:
+                    out.append(f"# {text}" + (f"; allowed: {rng}" if rng else ""))
+        out.append(line)
+    return "\n".join(out) + "\n"
 
 
 # ----------------------------------------------------------------- error messages

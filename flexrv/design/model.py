@@ -101,6 +101,18 @@ class FirstStage(_Strict):
                        f"the transverse contact ratio eps_alpha = {shown} of sun_teeth = {self.sun_teeth}, "
                        f"planet_teeth = {self.planet_teeth}, planet_profile_shift = {self.planet_profile_shift:g} "
                        f"must lie in {lo:g} < eps_alpha < {hi:g}", "change the profile shifts or tooth numbers")
+        # involute undercut (practical limit, DIN 3960 / Niemann & Winter: slight undercut allowed
+        # down to z' = 5/6 of the theoretical 2 h_a / sin^2(alpha), i.e. 14 teeth at 20 deg):
+        # x >= 5/6 h_a - z sin^2(alpha) / 2 with the addendum h_a = 1 module
+        s2 = math.sin(self.pressure_angle) ** 2
+        for name, z, x in (("sun", self.sun_teeth, self.sun_profile_shift),
+                           ("planet", self.planet_teeth, self.planet_profile_shift)):
+            x_min = 5.0 / 6.0 - 0.5 * z * s2
+            if x < x_min - 1e-12:
+                raise _bad(f"first_stage.{name}_profile_shift", x,
+                           f"must be >= {x_min:.3f} for {z} teeth at {self.pressure_angle_deg:g} deg "
+                           "(involute undercut; practical limit 5/6 h_a - z sin^2(alpha)/2)",
+                           "the tooth root would be cut away by the generating tool")
         return self
 
 
@@ -386,7 +398,9 @@ class Reducer(_Strict):
     name: str = Field(min_length=1, max_length=64)
     description: str
     sources: list[str] = Field(description="Where the values come from (seeds, handbooks)")
-    provenance: dict[str, str] = Field(description="field path -> note, for every estimated value")
+    provenance: dict[str, str] = Field(default_factory=dict,
+                                       description="field path -> note, for every estimated value (optional; "
+                                                   "`flexrv show` warns where it is missing)")
     first_stage: FirstStage
     second_stage: SecondStage
     crankshaft: Crankshaft

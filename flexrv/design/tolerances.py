@@ -326,7 +326,7 @@ def parse_tolerances(table: Any, reducer, source: str = "[tolerances]") -> Toler
 
 def load_tolerances(path_or_table: str | Path | dict, reducer) -> ToleranceSet:
     """A tolerance set from a TOML file (its ``[tolerances]`` table, e.g. the design
-    file itself or a separate file), a preset name (``tolerances_<name>.toml`` in
+    file itself or a separate file), a preset name (``tolerances/<name>.toml`` in
     the presets) or a dict."""
     if isinstance(path_or_table, dict):
         return parse_tolerances(path_or_table, reducer)
@@ -334,7 +334,7 @@ def load_tolerances(path_or_table: str | Path | dict, reducer) -> ToleranceSet:
 
     text = str(path_or_table)
     path = Path(text)
-    preset = Path(str(resources.files("flexrv.design.presets") / f"tolerances_{text}.toml"))
+    preset = Path(str(resources.files("flexrv.design.presets") / "tolerances" / f"{text}.toml"))
     if not path.is_file() and preset.is_file():
         path = preset
     if not path.is_file():
