@@ -267,24 +267,37 @@ def error_set_path(name: str):
     return Path(str(resources.files("flexrv.design.presets") / "errors" / f"{name}.toml"))
 
 
-def load_error_set(name_or_path: str) -> dict[str, Any]:
-    """The ``[errors]`` table of a built-in example error set (by name, see
-    :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
-    plain dict (validate it with :func:`with_errors`)."""
+def read_named_table(name_or_path: str, folder: str, table: str, what: str) -> dict[str, Any]:
+    """The ``[table]`` of a built-in TOML under ``presets/<folder>/<name>.toml`` (by
+    name) or of any TOML file (by path), as a plain dict; ConfigError naming the
+    file for a missing file, an unreadable one or one without the table. ``what``
+    names the kind of file in the messages (e.g. "error set")."""
     import tomllib
     from pathlib import Path
 
     text_name = str(name_or_path)
-    path = error_set_path(text_name) if text_name in error_set_names() else Path(text_name)
+    builtin = Path(str(resources.files("flexrv.design.presets") / folder / f"{text_name}.toml"))
+    path = Path(text_name)
+    if not path.is_file() and builtin.is_file():
+        path = builtin
     if not path.is_file():
-        raise ConfigError(f"unknown error set {text_name!r}: choose one of {error_set_names()} or give a TOML file")
+        known = sorted(p.name[:-5] for p in (resources.files("flexrv.design.presets") / folder).iterdir()
+                       if p.name.endswith(".toml"))
+        raise ConfigError(f"unknown {what} {text_name!r}: choose one of {known} or give a TOML file")
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot read error set {str(path)!r}: {exc}") from None
-    if not isinstance(data.get("errors"), dict):
-        raise ConfigError(f"error set {str(path)!r} has no [errors] table")
-    return data["errors"]
+        raise ConfigError(f"cannot read {what} {str(path)!r}: {exc}") from None
+    if not isinstance(data.get(table), dict):
+        raise ConfigError(f"{what} {str(path)!r} has no [{table}] table")
+    return data[table]
+
+
+def load_error_set(name_or_path: str) -> dict[str, Any]:
+    """The ``[errors]`` table of a built-in example error set (by name, see
+    :func:`error_set_names`) or of any TOML file with an ``[errors]`` table, as a
+    plain dict (validate it with :func:`with_errors`)."""
+    return read_named_table(name_or_path, "errors", "errors", "error set")
 
 
 def with_errors(reducer, errors):

@@ -330,22 +330,11 @@ def load_tolerances(path_or_table: str | Path | dict, reducer) -> ToleranceSet:
     the presets) or a dict."""
     if isinstance(path_or_table, dict):
         return parse_tolerances(path_or_table, reducer)
-    from importlib import resources
+    from flexrv.design import read_named_table
 
     text = str(path_or_table)
-    path = Path(text)
-    preset = Path(str(resources.files("flexrv.design.presets") / "tolerances" / f"{text}.toml"))
-    if not path.is_file() and preset.is_file():
-        path = preset
-    if not path.is_file():
-        raise ConfigError(f"tolerance file {text!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot read tolerance file {text!r}: {exc}") from None
-    if "tolerances" not in data:
-        raise ConfigError(f"{text}: no [tolerances] table")
-    return parse_tolerances(data["tolerances"], reducer, source=text)
+    table = read_named_table(text, "tolerances", "tolerances", "tolerance file")
+    return parse_tolerances(table, reducer, source=text)
 
 
 def design_tolerance_table(path: str | Path) -> tuple[dict | None, dict | None]:
