@@ -141,3 +141,16 @@ def test_atomic_write_mode_and_stale_temp_files(tmp_path):
     shutil.rmtree(tmp_path)
     assert remove_stale_temp_files(tmp_path) == []
     assert cache.STAMP_SUFFIX.endswith(".json")
+
+
+def test_cli_cache_dir_option(tmp_path):
+    """`flexrv --cache-dir DIR ...` puts the cache entries in DIR (overriding the
+    environment and the user cache directory)."""
+    import subprocess
+    import sys
+
+    d = tmp_path / "cache"
+    cp = subprocess.run([sys.executable, "-m", "flexrv", "--cache-dir", str(d), "mesh", "rv40e", "--part",
+                         "outer_ring", "--size", "12", "--json"], capture_output=True, text=True, timeout=300)
+    assert cp.returncode == 0, cp.stderr
+    assert any(p.name.startswith("outer_ring-") and p.suffix == ".msh" for p in d.iterdir())

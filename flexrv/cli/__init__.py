@@ -13,7 +13,9 @@ stderr and exits 2, like any other usage error. Ctrl-C / SIGTERM exit 130.
 from __future__ import annotations
 
 import importlib
+import os
 import sys
+from pathlib import Path
 
 import typer
 
@@ -28,6 +30,22 @@ app = typer.Typer(
     # plain help texts: rich markup would eat the units in square brackets ("End time [s]")
     rich_markup_mode=None,
 )
+
+@app.callback()
+def _options(cache_dir: Path = typer.Option(None, "--cache-dir",
+                                            help="Folder of the cached meshes, reduced bodies and EHL maps "
+                                                 "(default: $FLEXRV_CACHE_DIR, else the user cache directory, "
+                                                 "~/.cache/flexrv on Linux).")) -> None:
+    """Transmission error, stiffness and contact loads of RV reducers (gmsh -> FE -> CMS -> Exudyn)."""
+    if cache_dir is not None:
+        from flexrv.cache import CACHE_ENV
+
+        if cache_dir.exists() and not cache_dir.is_dir():
+            from flexrv.errors import InputError
+
+            raise InputError(f"--cache-dir {cache_dir}: exists and is not a directory")
+        os.environ[CACHE_ENV] = str(cache_dir)
+
 
 #: Command modules; each defines ``register(app)``. A module that is not present
 #: (capability not installed yet) is skipped.
