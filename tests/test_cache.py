@@ -151,6 +151,6 @@ def test_cli_cache_dir_option(tmp_path):
 
     d = tmp_path / "cache"
     cp = subprocess.run([sys.executable, "-m", "flexrv", "--cache-dir", str(d), "mesh", "rv40e", "--part",
-                         "outer_ring", "--size", "12", "--json"], capture_output=True, text=True, timeout=300)
+                         "outer_ring", "--json"], capture_output=True, text=True, timeout=300)
     assert cp.returncode == 0, cp.stderr
     assert any(p.name.startswith("outer_ring-") and p.suffix == ".msh" for p in d.iterdir())
