@@ -6,11 +6,12 @@ folder is numba's default ``__pycache__`` next to the sources, or ``NUMBA_CACHE_
 The first run of a fresh install therefore spends most of its time compiling, with
 no progress: :func:`announce_compile` prints one line before that happens.
 
-Measured (rv221, ``flexrv simulate rv221 --model rigid``, fresh ``NUMBA_CACHE_DIR``,
-2 shared cores, numba 0.68): 110 s first run, of which 86 s numba compilation —
-67 s for the pin-gap closest-point kernel (``geometry.cycloid._closest_point_newton``
-with the curve kernels it calls) and 20 s for the impact law
-(``contact.laws._impact_kernel``); 16 s for the same run with the cache filled.
+Measured (``benchmarks/bench_first_run.py``: ``flexrv simulate rv40e --t-end 0.01``,
+fresh ``NUMBA_CACHE_DIR``, 2 shared cores, numba 0.68, after the force groups became
+one compiled fused kernel): 13.6 s first run against 3.1 s with the cache filled, i.e.
+10.5 s of compilation (before the fused kernel, rv221's first run spent 86 s compiling
+the array kernels of the pin gap and the impact law). The ball-bearing row kernels
+add their own compile time to the first ``balls``/``flexible`` run.
 """
 
 from __future__ import annotations
@@ -19,13 +20,12 @@ import os
 import sys
 from pathlib import Path
 
-#: (module, attribute) of every cached numba dispatcher that a run may compile
-KERNELS = (("flexrv.geometry.cycloid", "_NEWTON"), ("flexrv.geometry.cycloid", "_CURVE"),
-           ("flexrv.geometry.cycloid", "_DOT2"), ("flexrv.contact.laws", "_impact_jit"),
-           ("flexrv.contact.laws", "_STEP"), ("flexrv.model.bearing_kernel", "row_kernel"),
-           ("flexrv.model.bearing_kernel", "row_force_kernel"))
-#: measured first-compile time [s] of the kernels above (see module docstring), for the message
-COMPILE_ESTIMATE_S = 90
+#: modules whose cached numba dispatchers a run may compile (every dispatcher found in them counts)
+KERNEL_MODULES = ("flexrv.geometry.cycloid", "flexrv.contact.laws", "flexrv.analysis.mesh_stiffness",
+                  "flexrv.model.pins", "flexrv.model.gear_stage", "flexrv.model.cranks_discs", "flexrv.model.loads",
+                  "flexrv.model.main_bearing_rigid", "flexrv.model.kernels", "flexrv.model.bearing_kernel")
+#: measured first-compile time [s] of the rigid model's kernels (see module docstring), for the message
+COMPILE_ESTIMATE_S = 15
 
 
 def uncached_kernels(modules: dict | None = None) -> list[str]:
@@ -34,13 +34,15 @@ def uncached_kernels(modules: dict | None = None) -> list[str]:
     not used by the run and are skipped; without numba the list is empty."""
     modules = sys.modules if modules is None else modules
     out = []
-    for mod_name, attr in KERNELS:
+    for mod_name in KERNEL_MODULES:
         mod = modules.get(mod_name)
-        disp = getattr(mod, attr, None) if mod is not None else None
-        cache = getattr(disp, "_cache", None)
-        index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-        if index is not None and not Path(index).exists():
-            out.append(f"{mod_name.rsplit('.', 1)[-1]}.{attr}")
+        if mod is None:
+            continue
+        for attr, disp in sorted(vars(mod).items()):
+            cache = getattr(disp, "_cache", None)
+            index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+            if index is not None and not Path(index).exists():
+                out.append(f"{mod_name.rsplit('.', 1)[-1]}.{attr}")
     return out
 
 
@@ -50,7 +52,7 @@ def cache_dir() -> str:
 
 
 def announce_compile(stream=None, modules: dict | None = None) -> bool:
-    """Print ``flexrv: compiling numba kernels (once, ~90 s) ...`` on stderr if any kernel
+    """Print ``flexrv: compiling numba kernels (once, ~15 s) ...`` on stderr if any kernel
     the run uses is not cached yet; returns whether it printed."""
     missing = uncached_kernels(modules)
     if not missing:
