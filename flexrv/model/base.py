@@ -22,8 +22,7 @@ same output names.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -106,7 +105,6 @@ class ForceGroup:
         """Add the group's ObjectGenericODE2 to ``mbs``; return its object number."""
         from exudyn.itemInterface import ObjectGenericODE2
 
-        n = int(sum(sizes))
         stats = self.stats
 
         def force_fn(mbs_, t, item, q, q_t):

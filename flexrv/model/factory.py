@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from flexrv.errors import ConfigError
-from flexrv.model.assembled import AssembledModel, group_index
+from flexrv.model.assembled import AssembledModel
 from flexrv.model.base import Member
 
 

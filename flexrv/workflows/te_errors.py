@@ -70,7 +70,7 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
     for row_i, preset in enumerate(presets):
         base = load(preset)
         errors = ManufacturingErrors(**load_error_set(f"iso_grade5_{preset}"))
-        rows, curves = [], {}
+        rows = []
         ideal_row, ideal = _case(base, "ideal geometry", span)
         rows.append(ideal_row)
         for group in GROUPS:
