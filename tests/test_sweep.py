@@ -30,7 +30,7 @@ fail_above = 1.25
 
 [grid]
 "second_stage.eccentricity_mm" = [1.0, 1.1, 1.2, 1.3]
-"first_stage.sun_teeth" = [16, 8]
+"first_stage.sun_teeth" = [16, 15]
 
 [[cases]]
 "second_stage.eccentricity_mm" = 5.0
