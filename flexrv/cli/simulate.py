@@ -139,8 +139,8 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
             data[key] = s[key]
 
     def render(d):
-        rows = [(k, v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}", "") for k, v in d.items()]
-        console.print(kv_table(f"simulate {preset} ({model})", rows))
+        rows = [(*_label_unit(k), v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}") for k, v in d.items()]
+        console.print(kv_table(f"simulate {preset} ({model})", [(k, v, u) for k, u, v in rows]))
 
     emit(data, json, render)
     code = _exit_code(res)
@@ -174,9 +174,18 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     data = {"output_dir": str(out), **asdict(fig)}
 
     def render(d):
-        console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, "") for k, v in d.items()]))
+        rows = [(*_label_unit(k), v) for k, v in d.items()]
+        console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
 
     emit(data, json, render)
+
+
+def _label_unit(key: str) -> tuple[str, str]:
+    """(label, unit) of a unit-suffixed result key for the table's unit column."""
+    from flexrv.cli._common import split_unit
+
+    label, unit = split_unit(key)
+    return label.replace("_", " "), unit
 
 
 def register(app: typer.Typer) -> None:
