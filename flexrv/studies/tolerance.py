@@ -747,13 +747,9 @@ def _write_outputs(out: Path, cfg, plan, parts, y, status, ids, specs, result) -
 
 
 def _histograms(out: Path, y: np.ndarray, specs: list[Spec]) -> Path:
-    import matplotlib
+    from flexrv.viz.plots import _plt, _save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from flexrv.cache import atomic_path
-
+    plt = _plt()
     fig, axes = plt.subplots(2, 3, figsize=(13, 7))
     for ax, (j, k) in zip(axes.ravel(), enumerate(OUTPUTS)):
         v = y[:, j][np.isfinite(y[:, j])]
@@ -770,21 +766,13 @@ def _histograms(out: Path, y: np.ndarray, specs: list[Spec]) -> Path:
         ax.legend(fontsize=7)
     fig.suptitle(f"tolerance study: {len(y)} samples")
     fig.tight_layout()
-    path = out / "histograms.png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
-    return path
+    return _save(fig, out / "histograms.png")
 
 
 def _tornado(out: Path, result) -> Path | None:
-    import matplotlib
+    from flexrv.viz.plots import _plt, _save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from flexrv.cache import atomic_path
-
+    plt = _plt()
     rows = result["what_if"]["rows"]
     fig, ax = plt.subplots(figsize=(8, 0.45 * max(len(rows), 4) + 1.5))
     if rows and rows[0]["p95_te_pp_arcsec"] is not None:
@@ -807,11 +795,7 @@ def _tornado(out: Path, result) -> Path | None:
         ax.set_xlabel("sensitivity of TE p-p (" + (ranking[0]["method"] if ranking else "-") + ")")
     ax.set_title(f"tolerance study {result['design']}: which tolerance drives TE p-p")
     fig.tight_layout()
-    path = out / "tornado.png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
-    return path
+    return _save(fig, out / "tornado.png")
 
 
 def _markdown(r: dict[str, Any]) -> str:
