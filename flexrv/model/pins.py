@@ -53,6 +53,18 @@ from flexrv.model.base import KernelGroup, Output
 
 
 @njit(cache=True)
+def _add_outer3(m, ix, iy, ip, w, g0, g1, g2):
+    """m[a, b] += w g_a g_b over one disc's coordinates (a, b in x, y, psi): a
+    pin's contribution w (dF/dgap or dF/dgap_rate) to the Jacobian through its gap
+    gradient g."""
+    ii = (ix, iy, ip)
+    g = (g0, g1, g2)
+    for a in range(3):
+        for b in range(3):
+            m[ii[a], ii[b]] += w * g[a] * g[b]
+
+
+@njit(cache=True)
 def pin_kernel(q, v, f, jq, jv, jac, pack):
     """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv.
     Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
@@ -82,8 +94,6 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         margin = 0.0
         for h in range(harm.shape[1]):
             margin += 2.0 * abs(harm[kd, h, 1])
-        gxx = gxy = gxp = gyy = gyp = gpp = 0.0
-        hxx = hxy = hxp = hyy = hyp = hpp = 0.0
         fx = fy = fp = 0.0
         for i in range(pins.shape[0]):
             rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
@@ -114,40 +124,11 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             fy += force * g1
             fp += force * g2
             if jac and (dfg != 0.0 or dfr != 0.0):
-                gxx += dfg * g0 * g0
-                gxy += dfg * g0 * g1
-                gxp += dfg * g0 * g2
-                gyy += dfg * g1 * g1
-                gyp += dfg * g1 * g2
-                gpp += dfg * g2 * g2
-                hxx += dfr * g0 * g0
-                hxy += dfr * g0 * g1
-                hxp += dfr * g0 * g2
-                hyy += dfr * g1 * g1
-                hyp += dfr * g1 * g2
-                hpp += dfr * g2 * g2
+                _add_outer3(jq, ix, iy, ip, dfg, g0, g1, g2)
+                _add_outer3(jv, ix, iy, ip, dfr, g0, g1, g2)
         f[ix] += fx
         f[iy] += fy
         f[ip] += fp
-        if jac:
-            jq[ix, ix] += gxx
-            jq[ix, iy] += gxy
-            jq[iy, ix] += gxy
-            jq[ix, ip] += gxp
-            jq[ip, ix] += gxp
-            jq[iy, iy] += gyy
-            jq[iy, ip] += gyp
-            jq[ip, iy] += gyp
-            jq[ip, ip] += gpp
-            jv[ix, ix] += hxx
-            jv[ix, iy] += hxy
-            jv[iy, ix] += hxy
-            jv[ix, ip] += hxp
-            jv[ip, ix] += hxp
-            jv[iy, iy] += hyy
-            jv[iy, ip] += hyp
-            jv[ip, iy] += hyp
-            jv[ip, ip] += hpp
 
 
 class PinContacts(KernelGroup):
