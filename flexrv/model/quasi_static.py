@@ -41,7 +41,12 @@ rated torque):
   converge poorly (many contacts sit at the onset kink of their laws, and the
   cranks' load sharing inside their clearances becomes indeterminate: an
   extrapolation to T -> 0 from two such paths amplified that indeterminacy into
-  spurious spikes, so it is not used);
+  spurious spikes, so it is not used). The same indeterminacy makes the no-load
+  path itself path-dependent where several cranks could carry the small torque:
+  rv221 over one crank revolution at 8 points per mesh follows, for positions
+  18-23, a neighbouring equilibrium 3-5 arcsec away (converged, residual within
+  tolerance), so its no-load p-p reads 6.1 arcsec against 2.0 over a whole output
+  revolution; the loaded curve is unique;
 * backlash: output rotation between +T0 and -T0 at T0 = ``no_load_fraction`` of
   the rated torque, input locked;
 * lost motion: output rotation between +3 % and -3 % of rated torque, input locked;
