@@ -24,7 +24,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.cold:
         os.environ["FLEXRV_CACHE"] = tempfile.mkdtemp(prefix="flexrv-bench-")
-    from flexrv.post.compare import run_compare
+    from flexrv.studies.compare import run_compare
 
     out = tempfile.mkdtemp(prefix="flexrv-compare-")
     t0 = time.perf_counter()

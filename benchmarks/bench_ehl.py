@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from flexrv.contact.ehl_law import EHLPointLaw  # noqa: E402
+from flexrv.ehl.law import EHLPointLaw  # noqa: E402
 from flexrv.ehl.maps import film_map  # noqa: E402
 from flexrv.ehl.solver import LubricantProperties, solve_point_contact  # noqa: E402
 

@@ -1,6 +1,6 @@
 """flexrv — transmission error, stiffness and contact loads of RV reducers.
 
-Pipeline: design (validated presets) -> geometry -> meshing -> fem/cms -> contact/ehl
+Pipeline: design (validated presets; geometry checks) -> geometry -> meshing -> fem/cms -> contact/ehl
 -> model -> simulation -> post/viz. See README.md.
 """
 
@@ -15,8 +15,8 @@ from flexrv._version import __version__  # noqa: F401
 #: (``flexrv/__init__.py``, a facade) and ``flexrv/__main__.py`` (-> cli) are outside the order.
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("units", "errors", "cache", "references", "_version"),  # base utilities, no flexrv imports
-    ("design",),  # validated design model and presets
-    ("geometry",),  # kinematics, involute, cycloid and bearing geometry
+    ("geometry",),  # kinematics, involute, cycloid, bearing and as-built geometry (of numbers / a design)
+    ("design",),  # validated design model and presets (its validation uses geometry)
     ("contact",),  # contact laws (Hertz, EHL-corrected laws)
     ("ehl",),  # closed-form films, numerical EHL solver, solver maps
     ("analysis",),  # analytic design calculations (pin loads, stiffness, life, report)

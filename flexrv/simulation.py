@@ -35,7 +35,7 @@ import numpy as np
 
 from flexrv.design import load
 from flexrv.errors import InputError, SimulationError
-from flexrv.post.results import Results  # noqa: F401  (re-exported: flexrv.Results)
+from flexrv.viz.plots import PlottedResults as Results  # re-exported: flexrv.Results (saves its PNGs)
 from flexrv.units import ARCMIN_PER_RAD
 
 #: systems with more coordinates than this use Exudyn's sparse linear solver
@@ -290,7 +290,8 @@ class Simulation:
             status = "interrupted"
         from flexrv.post.results import results_from_states
 
-        res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=dt, status=status, timing=self.timing)
+        res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=dt, status=status, timing=self.timing,
+                                  cls=Results)
         if state["signal"] is not None:
             res.attrs["signal"] = state["signal"]
         if checkpoint is not None and k > 1:  # the complete record, so a resume of a finished run is a no-op

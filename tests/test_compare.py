@@ -23,7 +23,7 @@ RING_SIZE = 0.003  #: coarse rv40e rings (default 1.7 mm)
 
 @pytest.fixture(scope="module")
 def compared(tmp_path_factory):
-    from flexrv.post.compare import run_compare
+    from flexrv.studies.compare import run_compare
 
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     out = tmp_path_factory.mktemp("compare")
@@ -33,7 +33,7 @@ def compared(tmp_path_factory):
 
 
 def test_compare_writes_everything_and_numbers_match_netcdf(compared):
-    from flexrv.post.io import load_results
+    from flexrv.post.results import load_results
     from flexrv.post.spectra import te_spectrum
 
     out = compared.out_dir
@@ -67,7 +67,7 @@ def test_compare_cli_rejects_unknown_part(tmp_path):
 def test_view_png_and_pvd_match_the_reduced_bodies(compared, tmp_path):
     import meshio
 
-    from flexrv.post.io import load_results
+    from flexrv.post.results import load_results
     from flexrv.viz.rings import ring_bodies, render_rings_png, write_pvd
 
     res = load_results(compared.out_dir / "flexible")

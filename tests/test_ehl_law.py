@@ -1,4 +1,4 @@
-"""EHL-corrected contact laws (flexrv.contact.ehl_law) and solver maps (flexrv.ehl.maps).
+"""EHL-corrected contact laws (flexrv.ehl.law) and solver maps (flexrv.ehl.maps).
 
 Independent references: Hertz approach from flexrv.contact.hertz.point_contact
 (Hamrock 1994 ch. 17), Palmgren's line law (flexrv.contact.hertz.line_contact),
@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from flexrv.contact.ehl_law import EHLLineLaw, EHLPointLaw
+from flexrv.ehl.law import EHLLineLaw, EHLPointLaw
 from flexrv.contact.hertz import line_contact, point_contact
 from flexrv.ehl.film import hamrock_dowson, pan_hamrock_line
 from flexrv.ehl.maps import build_film_map, film_map

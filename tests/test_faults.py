@@ -74,7 +74,7 @@ def test_signal_keeps_partial_results(tmp_path, sig, code):
 
 @pytest.mark.slow
 def test_sigkill_checkpoint_and_resume(tmp_path):
-    from flexrv.post.io import load_results
+    from flexrv.post.results import load_results
 
     t_end = 0.3
     killed = tmp_path / "killed"

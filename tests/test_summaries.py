@@ -94,7 +94,7 @@ def test_compare_reference_only_for_the_seeds_reducer():
     """rv221 (seeds 000/001's RV-221) gets the seeds' TE ranges and periods; rv40e none, and
     its prose quotes the table's ring deflection (0.02 µm), not a fixed '~1 µm'."""
     from flexrv.design import load
-    from flexrv.post.compare import SEED_TE, seed_reference, summary_markdown
+    from flexrv.studies.compare import SEED_TE, seed_reference, summary_markdown
 
     assert seed_reference(load("rv221")) is SEED_TE and seed_reference(load("rv40e")) is None
     own = summary_markdown(load("rv40e"), ("main_bearing",), _numbers(None), {})

@@ -21,7 +21,7 @@ def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
     """Run the rigid and the flexible model on identical inputs: TE overlay, TE spectra with the
     characteristic frequencies, ball loads, ring deflection, summary.md and compare.json."""
     from flexrv.model.factory import parse_parts
-    from flexrv.post.compare import run_compare
+    from flexrv.studies.compare import run_compare
 
     part_list = parse_parts(parts)
     if out is not None:

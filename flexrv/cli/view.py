@@ -22,7 +22,7 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
     """Deformed rings (scaled) coloured by displacement or von Mises stress: PNG off-screen,
     interactive with --show, PVD/VTU time series for ParaView with --vtu."""
     from flexrv.errors import InputError
-    from flexrv.post.io import load_results
+    from flexrv.post.results import load_results
     from flexrv.viz.rings import render_rings_png, show_rings, write_pvd
 
     from flexrv.cli._common import check_output_dir, check_output_file

@@ -13,7 +13,7 @@ entry for rigid and modal rings, dry Hertz and the Hamrock–Dowson EHL law.
 
 Supported: rings given by a raceway table (:class:`flexrv.model.flexible_bearing.
 ModalRing`) or rigid, normal laws :class:`flexrv.contact.ball_raceway.HertzLaw`
-or :class:`flexrv.contact.ehl_law.EHLPointLaw` in mode ``dry`` /
+or :class:`flexrv.ehl.law.EHLPointLaw` in mode ``dry`` /
 ``hamrock_dowson`` with scalar radii. Anything else (the solver-map law, other
 ring models) falls back to :func:`evaluate_row` (:func:`kernel_inputs` returns
 None).
@@ -35,7 +35,7 @@ def law_parameters(law) -> np.ndarray | None:
     """Kernel parameters of a normal law (see :data:`LAW_FIELDS`), or None if the
     kernel does not cover it."""
     from flexrv.contact.ball_raceway import HertzLaw
-    from flexrv.contact.ehl_law import EHLPointLaw
+    from flexrv.ehl.law import EHLPointLaw
     from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT
 
     if isinstance(law, HertzLaw) and np.ndim(law.k) == 0:
@@ -77,7 +77,7 @@ def kernel_inputs(model) -> tuple | None:
 @njit(cache=True)
 def _normal_load(delta, rate, speed, law):
     """(Q, dQ/d delta, dQ/d rate) of the EHL-corrected / dry law
-    (flexrv.contact.ehl_law._solve and flexrv.contact.laws.impact_force, n = 3/2)."""
+    (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2)."""
     k, h_unit, lexp, sexp, floor, c_max, depth, iters = (law[0], law[1], law[2], law[3], law[4], law[5],
                                                          law[6], int(law[7]))
     hu = h_unit * speed**sexp if h_unit > 0.0 and speed > 0.0 else 0.0

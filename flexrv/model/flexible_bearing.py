@@ -469,11 +469,11 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
     ----------
     inner, outer : per-row lists of :class:`RingModes` (``None``: rigid rings).
     ehl : ``"dry"``, ``"hamrock_dowson"`` or ``"map"`` (default: ``reducer.contact.ehl``);
-        the lubricated laws come from :class:`flexrv.contact.ehl_law.EHLPointLaw`
+        the lubricated laws come from :class:`flexrv.ehl.law.EHLPointLaw`
         and use the entrainment speed of the frame's rotation.
     c_max, depth : contact damping and its ramp depth (default: the design's).
     """
-    from flexrv.contact.ehl_law import EHLPointLaw
+    from flexrv.ehl.law import EHLPointLaw
     from flexrv.contact.hertz import effective_modulus
     from flexrv.geometry.bearing import BallBearingGeometry
 
@@ -724,7 +724,7 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     coordinates (for :mod:`flexrv.viz.rings`). The film is the quasi-static EHL
     h_c(Q, u) of the contact law at the entrainment speed of the carrier's
     rotation; the pressure is the Hertz p_max of the load (the EHL pressure spike
-    is not resolved by the law, see :mod:`flexrv.contact.ehl_law`).
+    is not resolved by the law, see :mod:`flexrv.ehl.law`).
     """
     from flexrv.contact.hertz import point_contact
 

@@ -40,8 +40,9 @@ def summary_markdown(res, summ: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def save(res, directory) -> Path:
-    """Write a run directory; returns its path."""
+def save(res, directory, figures=None) -> Path:
+    """Write a run directory; returns its path. ``figures(directory)``, if given, writes the
+    run's PNGs (runs of more than one record) before ``results.nc``, which comes last."""
     from flexrv.design import to_toml
 
     d = Path(directory)
@@ -51,8 +52,8 @@ def save(res, directory) -> Path:
     summ = res.summary()
     from flexrv.cache import to_jsonable
 
-    if len(res.time) > 1:
-        res.plot(d)
+    if figures is not None and len(res.time) > 1:
+        figures(d)
     atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summ), indent=2))
     atomic_write_text(d / "summary.md", summary_markdown(res, summ))
     with atomic_path(d / "results.nc") as tmp:
@@ -115,13 +116,13 @@ def load_checkpoint(directory) -> dict:
     return data
 
 
-def load_results(directory):
-    """Read a run directory written by :func:`save`."""
+def read_run(directory):
+    """(dataset, design or None) of a run directory written by :func:`save`.
+
+    Raises InputError naming the directory if it holds no readable ``results.nc``."""
     import xarray as xr
 
     from flexrv.design import load
-    from flexrv.post.results import Results
-
     from flexrv.errors import InputError
 
     d = Path(directory)
@@ -133,4 +134,4 @@ def load_results(directory):
         raise InputError(f"{d / 'results.nc'} is not a readable flexrv NetCDF file "
                          f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
     reducer = load(d / "config.toml") if (d / "config.toml").exists() else None
-    return Results(ds, reducer=reducer)
+    return ds, reducer

@@ -31,11 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from flexrv.cache import to_jsonable
 import xarray as xr
 
+from flexrv.cache import to_jsonable
 from flexrv.units import ARCSEC_PER_RAD
-
 
 
 class Results:
@@ -98,21 +97,25 @@ class Results:
         return summary(self)
 
     def save(self, directory: str | Path) -> Path:
+        """Write the run directory (:func:`flexrv.post.io.save`): results.nc, config.toml,
+        summary.json, summary.md and the figures of :meth:`write_figures`."""
         from flexrv.post.io import save
 
-        return save(self, directory)
+        return save(self, directory, figures=self.write_figures)
 
-    def plot(self, directory: str | Path | None = None) -> list[Path]:
-        """Write the standard PNGs (TE, speeds, pin forces, TE spectrum); returns paths."""
-        from flexrv.viz.plots import standard_plots
-
-        return standard_plots(self, directory)
+    def write_figures(self, directory: Path) -> list[Path]:
+        """Figures written with the data by :meth:`save`: none at this layer. A subclass above
+        the plotting layer adds its plots (:class:`flexrv.viz.plots.PlottedResults`, the
+        results of :class:`flexrv.simulation.Simulation`)."""
+        return []
 
     @classmethod
     def load(cls, directory: str | Path) -> "Results":
-        from flexrv.post.io import load_results
+        """Read a run directory written by :meth:`save` (:func:`flexrv.post.io.read_run`)."""
+        from flexrv.post.io import read_run
 
-        return load_results(directory)
+        ds, reducer = read_run(directory)
+        return cls(ds, reducer=reducer)
 
     def __repr__(self) -> str:
         return f"Results({self.attrs.get('preset')}, model={self.attrs.get('model')}, {len(self.time)} samples, " \
@@ -197,9 +200,14 @@ def steady_window_for(reducer, t_end: float, input_speed: float | None = None,
 
 
 def results_from_states(model, t, q, v, dt: float, status: str = "completed", timing: dict | None = None,
-                        chunk: int = 1000) -> Results:
-    """Build :class:`Results` from recorded states (T,), (T, n), (T, n)."""
+                        chunk: int = 1000, cls: type[Results] = Results) -> Results:
+    """Build :class:`Results` (or the subclass ``cls``) from recorded states (T,), (T, n), (T, n).
+
+    The variables are the model's declared outputs (:func:`flexrv.model.outputs.model_outputs`,
+    read by name: this module never sees the state layout or the member names), plus
+    TE = (theta_out - theta_in / i) in arcsec and the input and output power."""
     from flexrv.geometry.kinematics import member_speeds
+    from flexrv.model.outputs import model_outputs
 
     p = model.params
     t = np.asarray(t, dtype=float)
@@ -207,76 +215,15 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         keep = np.r_[np.diff(t) > 0, True]
         t, q, v = t[keep], q[keep], v[keep]
     data: dict[str, xr.Variable] = {}
-    th_in = np.asarray(model.input_angle(t), dtype=float)
-    w_in = np.asarray(model.input_speed(t), dtype=float)
-    cs = model.slice("carrier")
-    th_out = q[:, cs][:, 2]
-    w_out = v[:, cs][:, 2]
-    data["theta_in"] = _var(th_in, ("time",), "rad", "input angle")
-    data["theta_out"] = _var(th_out, ("time",), "rad", "output angle")
-    data["omega_in"] = _var(w_in, ("time",), "rad/s", "input speed")
-    data["omega_out"] = _var(w_out, ("time",), "rad/s", "output speed")
-    data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC_PER_RAD, ("time",), "arcsec", "TE")
-    crank = np.stack([q[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
-    crank_v = np.stack([v[:, model.slice(f"crank{j}")] for j in range(p.n_cranks)], axis=1)
-    disc = np.stack([q[:, model.slice(f"disc{k}")] for k in range(p.n_discs)], axis=1)
-    disc_v = np.stack([v[:, model.slice(f"disc{k}")] for k in range(p.n_discs)], axis=1)
-    data["crank_speed"] = _var(crank_v[..., 2], ("time", "crank"), "rad/s", "crank (planet) speed, absolute")
-    data["crank_speed_relative"] = _var(crank_v[..., 2] - w_out[:, None], ("time", "crank"), "rad/s",
-                                        "crank speed relative to the carrier")
-    data["crank_angle"] = _var(crank[..., 2], ("time", "crank"), "rad", "crank (planet) angle, absolute")
-    data["crank_x"] = _var(crank[..., 0], ("time", "crank"), "m", "crank centre x")
-    data["crank_y"] = _var(crank[..., 1], ("time", "crank"), "m", "crank centre y")
-    data["disc_x"] = _var(disc[..., 0], ("time", "disc"), "m", "disc centre x")
-    data["disc_y"] = _var(disc[..., 1], ("time", "disc"), "m", "disc centre y")
-    data["disc_speed"] = _var(disc_v[..., 2], ("time", "disc"), "rad/s", "disc rotation speed")
-    data["carrier_x"] = _var(q[:, cs][:, 0], ("time",), "m", "carrier centre x")
-    data["carrier_y"] = _var(q[:, cs][:, 1], ("time",), "m", "carrier centre y")
-    data["carrier_z"] = _var(q[:, cs][:, 3], ("time",), "m", "carrier axial displacement")
-    data["carrier_tilt"] = _var(np.hypot(q[:, cs][:, 4], q[:, cs][:, 5]), ("time",), "rad",
-                                "carrier tilt (magnitude of the rotations about x and y)")
-    # group outputs, evaluated on the time history in chunks
-    outs: dict[str, list] = {}
-    meta: dict[str, tuple] = {}
-    for g in model.groups:
-        qg_all = model.group_state(g, q)
-        vg_all = model.group_state(g, v)
-        for a in range(0, len(t), chunk):
-            b = min(a + chunk, len(t))
-            _, out = g.evaluate(t[a:b], qg_all[a:b], vg_all[a:b], want_outputs=True)
-            for name, o in (out or {}).items():
-                outs.setdefault(name, []).append(np.asarray(o.values))
-                meta[name] = (o.dims, o.units, o.long_name)
-    for name, parts in outs.items():
-        dims, units, long_name = meta[name]
-        values = np.concatenate(parts, axis=0) if len(t) else np.zeros((0,) + parts[0].shape[1:])
-        data[name] = _var(values, dims, units, long_name)
-    # torques and power
-    acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)
-    t_in = (data["sun_torque"].values if "sun_torque" in data else 0.0) + p.input_inertia * acc_in
-    data["input_torque"] = _var(t_in, ("time",), "N m", "input torque")
-    t_load = np.asarray(model.load_torque(t), dtype=float)
-    data["output_torque"] = _var(t_load, ("time",), "N m", "output (load) torque")
-    data["power_in"] = _var(t_in * w_in, ("time",), "W", "input power")
-    data["power_out"] = _var(t_load * w_out, ("time",), "W", "output power")
-    ke = np.zeros_like(t)
-    for m in model.members.values():
-        vm = v[:, model.slice(m.name)]
-        ke += 0.5 * np.einsum("ti,ij,tj->t", vm, m.mass_matrix, vm)
-    ke += 0.5 * p.input_inertia * w_in**2
-    data["kinetic_energy"] = _var(ke, ("time",), "J", "kinetic energy")
-    lz = np.zeros_like(t)
-    for m in model.members.values():
-        qm, vm = q[:, model.slice(m.name)], v[:, model.slice(m.name)]
-        if m.kind == "planar":  # x, y, rotation first
-            lz += m.mass_matrix[2, 2] * vm[:, 2] + m.mass_matrix[0, 0] * (qm[:, 0] * vm[:, 1] - qm[:, 1] * vm[:, 0])
-        elif m.kind == "points":  # (x, y, z) per point, diagonal mass
-            mass = np.diag(m.mass_matrix)[0::3]
-            lz += ((qm[:, 0::3] * vm[:, 1::3] - qm[:, 1::3] * vm[:, 0::3]) * mass).sum(axis=-1)
-        # modal members: elastic vibration of the reduced bodies about their frames
-        # carries no net angular momentum about the axis to first order
-    data["angular_momentum"] = _var(lz, ("time",), "N m s",
-                                    "angular momentum of the rigid members and balls about the axis")
+    for name, o in model_outputs(model, t, q, v, chunk=chunk).items():
+        data[name] = _var(o.values, o.dims, o.units, o.long_name)
+        if name == "omega_out":
+            th_in, th_out = data["theta_in"].values, data["theta_out"].values
+            data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC_PER_RAD, ("time",), "arcsec", "TE")
+        elif name == "output_torque":
+            data["power_in"] = _var(data["input_torque"].values * data["omega_in"].values, ("time",), "W",
+                                    "input power")
+            data["power_out"] = _var(o.values * data["omega_out"].values, ("time",), "W", "output power")
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
     red = model.reducer
     t_end = float(t[-1]) if len(t) else 0.0
@@ -295,6 +242,9 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     })
     for key, value in model.info.items():  # e.g. flexible_bodies: how to rebuild the reduced bodies
         ds.attrs[key] = value if isinstance(value, (str, int, float)) else json.dumps(to_jsonable(value))
-    return Results(ds, reducer=red)
+    return cls(ds, reducer=red)
 
 
+def load_results(directory: str | Path) -> Results:
+    """Read a run directory written by :meth:`Results.save`."""
+    return Results.load(directory)

@@ -1,1 +1,2 @@
-"""Studies built on the models: many evaluations of a design (tolerance analysis)."""
+"""Studies built on the models: many evaluations of a design (tolerance analysis, rigid vs
+flexible comparison)."""

@@ -1,4 +1,4 @@
-"""Plots of the rigid-vs-flexible comparison (:mod:`flexrv.post.compare`), matplotlib Agg."""
+"""Plots of the rigid-vs-flexible comparison (:mod:`flexrv.studies.compare`), matplotlib Agg."""
 
 from __future__ import annotations
 

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from flexrv.post.results import Results
+
 
 def _plt():
     import matplotlib
@@ -190,3 +192,16 @@ def standard_plots(res, directory=None) -> list[Path]:
     if res.steady("te").size > 16 and float(abs(res["omega_in"]).max()) > 0:
         paths.append(plot_te_spectrum(res, d / "te_spectrum.png"))
     return paths
+
+
+class PlottedResults(Results):
+    """:class:`flexrv.post.results.Results` that write their standard PNGs with the data:
+    :meth:`save` adds TE, speeds, pin forces and TE spectrum (:func:`standard_plots`). The
+    results of :class:`flexrv.simulation.Simulation` are of this class."""
+
+    def write_figures(self, directory: Path) -> list[Path]:
+        return standard_plots(self, directory)
+
+    def plot(self, directory: str | Path | None = None) -> list[Path]:
+        """Write the standard PNGs into ``directory`` (default cwd); returns their paths."""
+        return standard_plots(self, directory)

@@ -217,7 +217,7 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
     import numpy as np
     import xarray as xr
 
-    from flexrv.post.compare import SEED_TE
+    from flexrv.studies.compare import SEED_TE
 
     root = Path(results_root) if results_root is not None else results_root_default()
     sfx = SMOKE_SUFFIX if smoke else ""

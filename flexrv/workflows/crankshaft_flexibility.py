@@ -5,7 +5,7 @@ once fully rigid and once with flexible crankshafts (and discs, pins), and finds
 in the flexible model's TE spectrum peaks at 2, 3, 4 x the crank rotation
 frequency (10 Hz), at the first-stage mesh frequency (320 Hz) and its harmonics
 and near the cycloid mesh frequency (390 Hz), while the rigid model shows mainly
-the first-stage mesh. flexrv runs :func:`flexrv.post.compare.run_compare` with the
+the first-stage mesh. flexrv runs :func:`flexrv.studies.compare.run_compare` with the
 crankshafts flexible (:mod:`flexrv.model.flexible_crank`: FE-condensed torsion and
 gear-seat bending) and compares the spectra at the Table 4 frequencies.
 
@@ -41,7 +41,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
 
     from flexrv.design import load
     from flexrv.geometry.kinematics import reducer_kinematics
-    from flexrv.post.compare import run_compare
+    from flexrv.studies.compare import run_compare
     from flexrv.post.spectra import te_spectrum
     from flexrv.workflows._common import default_out
 

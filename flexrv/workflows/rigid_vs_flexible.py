@@ -2,7 +2,7 @@
 
 Seeds 000/001 compare a fully rigid RV reducer model with one whose main-bearing
 rings are flexible (and lubricated): TE from -25.2..21.6 arcsec (period 0.15 s)
-to -43.2..45.0 arcsec (period 0.28 s). flexrv runs :func:`flexrv.post.compare.
+to -43.2..45.0 arcsec (period 0.28 s). flexrv runs :func:`flexrv.studies.compare.
 run_compare` on the rv221 preset — the rigid model (5-DOF main-bearing element)
 and the flexible model (ball-resolved bearing, reduced flexible inner and outer
 rings of both rows, Hamrock–Dowson EHL contacts) on identical inputs — and puts
@@ -29,7 +29,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     import numpy as np
 
     from flexrv.design import load
-    from flexrv.post.compare import run_compare, seed_reference
+    from flexrv.studies.compare import run_compare, seed_reference
     from flexrv.workflows._common import default_out
 
     red = load(preset)

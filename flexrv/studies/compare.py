@@ -1,6 +1,6 @@
 """Rigid vs flexible model on identical inputs (seeds 000/001's comparison).
 
->>> from flexrv.post.compare import run_compare                      # doctest: +SKIP
+>>> from flexrv.studies.compare import run_compare                      # doctest: +SKIP
 >>> cmp = run_compare("rv221", t_end=0.4, parts=("main_bearing",))    # doctest: +SKIP
 >>> cmp.numbers["flexible"]["te_pp_arcsec"]                         # doctest: +SKIP
 
