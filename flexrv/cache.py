@@ -144,8 +144,11 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
 
     Examples
     --------
-    >>> with atomic_path("out.nc") as tmp:          # doctest: +SKIP
-    ...     dataset.to_netcdf(tmp)
+    >>> target = Path(tempfile.mkdtemp()) / "out.txt"
+    >>> with atomic_path(target) as tmp:
+    ...     _ = tmp.write_text("complete")
+    >>> target.read_text(), tmp.exists()
+    ('complete', False)
     """
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)

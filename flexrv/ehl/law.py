@@ -154,8 +154,19 @@ class EHLPointLaw:
 
     Examples
     --------
-    >>> law = EHLPointLaw(rx, ry, e_eff, lub, mode="hamrock_dowson")      # doctest: +SKIP
-    >>> out = law(delta, delta_rate, speed)                                 # doctest: +SKIP
+    Dry, the law is Hertz's Q = K delta^1.5; lubricated, the film carries load before the dry
+    bodies touch (delta = 0):
+
+    >>> from flexrv.ehl.solver import LubricantProperties
+    >>> dry = EHLPointLaw(5e-3, 50e-3, 2.3e11, mode="dry")       # rx, ry [m], E' [Pa]
+    >>> bool(np.isclose(dry(1e-6, 0.0, 1.0).force, dry.stiffness * 1e-6**1.5))
+    True
+    >>> oil = LubricantProperties(viscosity=0.1, pressure_viscosity=2e-8, roelands_z=0.6,
+    ...                           roelands_p0=1.96e8, density=870.0)
+    >>> wet = EHLPointLaw(5e-3, 50e-3, 2.3e11, oil, mode="hamrock_dowson")
+    >>> out = wet(0.0, 0.0, 1.0)                                 # delta, its rate, entrainment speed
+    >>> round(float(out.film) * 1e6, 2), bool(out.force > 0)     # central film [um], load carried
+    (0.52, True)
     """
 
     rx: object

@@ -1,10 +1,14 @@
 """Reduced flexible bodies of the reducer parts: build, cache, raceway
 interpolation, and Exudyn loaders.
 
->>> from flexrv.design import load                          # doctest: +SKIP
->>> body = reduce_part(load("rv221"), "outer_ring")
->>> u = body.raceway_displacement(q, azimuth)             # (..., 3) [m], body frame
->>> Q = body.raceway_load_vector(azimuth, force)          # (..., m) modal forces [N]
+Not run as a doctest (meshing and reduction take minutes on a fresh cache; the tests in
+tests/test_fem_reduction.py run them); ``u`` is (..., 3) [m] in the body frame, ``Q`` the
+(..., m) modal forces [N]:
+
+>>> from flexrv.design import load                        # doctest: +SKIP
+>>> body = reduce_part(load("rv221"), "outer_ring")       # doctest: +SKIP
+>>> u = body.raceway_displacement(q, azimuth)             # doctest: +SKIP
+>>> Q = body.raceway_load_vector(azimuth, force)          # doctest: +SKIP
 
 A reduced body file (``<part>-<key>.cms.npz`` under :func:`flexrv.cache.cache_dir`,
 format :data:`BODY_FORMAT_VERSION`) holds the Ritz basis, the diagonal reduced

@@ -1,9 +1,12 @@
 """gmsh (OCC) builders of the reducer parts -> cached second-order tet meshes.
 
+Not run as a doctest (gmsh meshing of a part takes seconds to minutes; tests/test_meshing.py
+runs it):
+
 >>> from flexrv.design import load                      # doctest: +SKIP
->>> from flexrv.meshing import build_mesh
->>> res = build_mesh(load("rv221"), "outer_ring", size=6e-3)
->>> res.data.n_nodes, res.msh_path
+>>> from flexrv.meshing import build_mesh               # doctest: +SKIP
+>>> res = build_mesh(load("rv221"), "outer_ring", size=6e-3)   # doctest: +SKIP
+>>> res.data.n_nodes, res.msh_path                      # doctest: +SKIP
 
 Only this package imports gmsh.
 """
