@@ -151,12 +151,6 @@ mesh_stiffness_ramped = njit(cache=True)(_mesh_stiffness_ramped)
 _RAMPED_ARRAY = njit(cache=True)(_ramped_array)
 
 
-def mesh_phase(sun_angle_relative, z_sun: int, phase0: float = 0.0):
-    """Mesh phase [-] from the sun's rotation relative to the carrier [rad]:
-    one base pitch per tooth, phase = z_s theta / (2 pi) + phase0."""
-    return z_sun * np.asarray(sun_angle_relative, dtype=float) / (2.0 * np.pi) + phase0
-
-
 @dataclass(frozen=True)
 class InvoluteStage:
     """First-stage numbers (SI).

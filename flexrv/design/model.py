@@ -254,10 +254,13 @@ class MainBearing(_Strict):
         min_wall = 0.1 * d
         if not bore < dm < od:
             raise _bad("main_bearing.pitch_diameter_mm", dm, f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm")
-        ca = math.cos(self.contact_angle_deg * RAD_PER_DEG)
-        # groove bottoms (torus of radius f D about the curvature centres, flexrv.geometry.bearing)
-        bottom_i = dm / 2 + (self.inner_conformity - 0.5) * d * ca - self.inner_conformity * d
-        bottom_o = dm / 2 - (self.outer_conformity - 0.5) * d * ca + self.outer_conformity * d
+        from flexrv.geometry.bearing import BallBearingGeometry
+        from flexrv.units import M_PER_MM
+
+        # groove bottoms [mm] (torus of radius f D about the curvature centres)
+        geo = BallBearingGeometry.from_design(self)
+        bottom_i = geo.groove_bottom_radius("inner") / M_PER_MM
+        bottom_o = geo.groove_bottom_radius("outer") / M_PER_MM
         if bottom_i - bore / 2 < min_wall:
             raise _bad("main_bearing.ball_diameter_mm", d,
                        f"too large for the inner ring section: the wall under the groove is {bottom_i - bore / 2:.4g} mm, "

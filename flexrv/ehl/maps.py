@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
-from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, hamrock_dowson
+from flexrv.ehl.film import hamrock_dowson
 from flexrv.ehl.solver import LubricantProperties, solve_point_contact
 from flexrv.errors import ConvergenceError, InputError
 
@@ -105,15 +105,6 @@ class FilmMap:
             return c.reshape(shape), dc.reshape(shape)
 
         return interp
-
-    def central_film(self, load, speed):
-        """h_c [m] and d ln h_c / d ln Q at (load [N], speed [m/s]) (arrays broadcast)."""
-        load = np.asarray(load, dtype=float)
-        speed = np.asarray(speed, dtype=float)
-        h_hd, _ = hamrock_dowson(load, speed, self.rx, self.ry, self.e_eff, self.lubricant.viscosity,
-                                 self.lubricant.pressure_viscosity)
-        c, dc = self.log_correction(load, speed)
-        return h_hd * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
 
 
 def _bilinear(table, gx, gy, x, y):

@@ -6,9 +6,9 @@ Public API
 - :func:`flexrv.fem.assembly.assemble` -> FEModel (K, M in Exudyn node-wise order)
 - :func:`flexrv.fem.modal.eigenmodes` (free-free / clamped, shift-invert)
 - :func:`flexrv.fem.body.reduce_part` -> :class:`ReducedBody` with
-  ``raceway_displacement(q, azimuth)``, ``raceway_load_vector(azimuth, F)``,
-  ``add_modal_body(mbs)`` (NodeGenericODE2 + ObjectGenericODE2) and
-  ``add_ffrf_body(mbs)`` (ObjectFFRFreducedOrder)
+  ``raceway_displacement(q, azimuth)``, ``raceway_load_vector(azimuth, F)`` and
+  ``add_modal_body(mbs)`` (NodeGenericODE2 + ObjectGenericODE2), the one Exudyn glue path
+  of a reduced body
 - :func:`flexrv.fem.body.part_modes` (free and constrained frequencies)
 - :func:`flexrv.fem.stress.nodal_stress`, :func:`flexrv.fem.stress.von_mises`
 

@@ -61,13 +61,6 @@ class FEModel:
     def n_dof(self) -> int:
         return int(self.K.shape[0])
 
-    def to_skfem(self, u: np.ndarray) -> np.ndarray:
-        """Exudyn-ordered vector(s) (3N, ...) -> scikit-fem DOF order."""
-        out = np.empty_like(u)
-        out[self.perm] = u
-        return out
-
-
 def skfem_basis(nodes: np.ndarray, tets: np.ndarray, intorder: int = 2):
     """scikit-fem isoparametric P2 vector basis of a Tet10 mesh (VTK order).
 

@@ -101,13 +101,6 @@ class ReducedBody:
         if self.raceway is None or self.table is None:
             raise InputError(f"part {self.part!r} has no raceway")
 
-    def contact_points(self, azimuth) -> np.ndarray:
-        """Nominal contact points (..., 3) [m] at the given azimuths [rad]."""
-        self._require_raceway()
-        a = np.asarray(azimuth, dtype=float)
-        return np.stack([self.raceway.r * np.cos(a), self.raceway.r * np.sin(a),
-                         np.full_like(a, self.raceway.z)], axis=-1)
-
     def contact_normals(self, azimuth) -> np.ndarray:
         """Unit contact directions (..., 3) into the ring at the given azimuths."""
         self._require_raceway()
@@ -171,54 +164,6 @@ class ReducedBody:
                                                   stiffnessMatrix=self.stiffness_matrix, dampingMatrix=damp,
                                                   visualization=eii.VObjectGenericODE2(show=False), name=name))
         return node, obj
-
-    def ffrf_interface(self):
-        """Exudyn ``ObjectFFRFreducedOrderInterface`` of this body (built from the
-        full mass matrix, cached next to the body file)."""
-        from exudyn.FEM import ObjectFFRFreducedOrderInterface
-
-        ffrf_path = self.path.with_name(self.path.name.replace(".cms.npz", ".ffrf.npz")) if self.path else None
-        cms = ObjectFFRFreducedOrderInterface()
-        if ffrf_path is not None and ffrf_path.exists():
-            cms.LoadFromFile(str(ffrf_path))
-            return cms
-        fem = self.fem_interface()
-        cms = ObjectFFRFreducedOrderInterface(fem)
-        if ffrf_path is not None:
-            with atomic_path(ffrf_path) as tmp:
-                cms.SaveToFile(str(tmp))
-        return cms
-
-    def fem_interface(self):
-        """An ``exudyn.FEM.FEMinterface`` with nodes, surface, this mode basis and the
-        full K, M (re-assembled from the cached mesh)."""
-        from exudyn.FEM import FEMinterface
-
-        from flexrv.meshing.mesh import MeshData
-
-        mesh = MeshData.load_npz(self.info["mesh_path"])
-        fe = _assemble(mesh, self.info["material"])
-        fem = FEMinterface()
-        fem.nodes = {"Position": mesh.nodes}
-        fem.elements = [{"Name": self.part, "Tet10": mesh.tets}]
-        fem.massMatrix, fem.stiffnessMatrix = fe.M, fe.K
-        fem.surface = [{"Name": "surface", "Trigs": mesh.tris[:, :3], "Trigs6": mesh.tris}]
-        fem.modeBasis = {"matrix": self.modes, "type": "HCBmodes"}
-        fem.eigenValues = self.omega2
-        if self.stress_modes is not None:
-            import exudyn as exu
-            fem.postProcessingModes = {"matrix": self.stress_modes,
-                                       "outputVariableType": exu.OutputVariableType.StressLocal}
-        return fem
-
-    def add_ffrf_body(self, mbs, position=(0.0, 0.0, 0.0), rotation=None, damping=(0.0, 0.0), name: str = ""):
-        """Add the body as ``ObjectFFRFreducedOrder`` (moving frame). Returns the dict
-        of Exudyn's ``AddObjectFFRFreducedOrder`` (nRigidBody, nGenericODE2, oFFRFreducedOrder)."""
-        cms = self.ffrf_interface()
-        return cms.AddObjectFFRFreducedOrder(mbs, positionRef=list(position),
-                                             rotationMatrixRef=[] if rotation is None else np.asarray(rotation),
-                                             massProportionalDamping=damping[0],
-                                             stiffnessProportionalDamping=damping[1], name=name)
 
     # ------------------------------------------------------------ file
     def save(self, path: Path) -> None:
