@@ -182,3 +182,15 @@ def test_no_new_import_cycle():
     assert not new, "import cycles:\n" + "\n".join("  " + " <-> ".join(sorted(c)) for c in new)
     gone = set(ALLOWED_CYCLES) - cycles
     assert not gone, "fixed - delete from ALLOWED_CYCLES: " + str([sorted(c) for c in gone])
+
+
+def test_readme_states_the_same_layer_order():
+    """README.md writes the layer order once, identically to flexrv.LAYERS (private modules
+    such as ``_version`` are left out of the prose)."""
+    import re
+
+    text = " ".join((ROOT.parent / "README.md").read_text(encoding="utf-8").split())
+    match = re.search(r"Layers, lowest first \(`flexrv\.LAYERS`[^)]*\): ((?:[\w/]+ < )+[\w/]+)", text)
+    assert match, "README.md: no 'Layers, lowest first (`flexrv.LAYERS` ...): a < b < ...' sentence"
+    expected = " < ".join("/".join(n for n in layer if not n.startswith("_")) for layer in flexrv.LAYERS)
+    assert match.group(1) == expected

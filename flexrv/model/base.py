@@ -14,8 +14,8 @@ The assembled model (:class:`flexrv.model.assembled.AssembledModel`) lives in it
 own module, above the kernels it calls.
 
 A group's ``evaluate(t, q, v)`` accepts one state (q of shape (n,), the solver
-path) or a whole time history (shape (T, n)), from which post-processing
-recovers every contact force as a named output. Replacing a member group by a
+path) or a whole time history (shape (T, n)), from which the declared outputs
+(:mod:`flexrv.model.outputs`) recover every contact force as a named output. Replacing a member group by a
 flexible one (flexible-bearing issue) means registering another group under the
 same output names.
 """
@@ -31,8 +31,8 @@ import numpy as np
 class Member:
     """A body of the model: ``n`` coordinates, constant mass matrix, initial state.
 
-    ``kind`` says what the coordinates are (used by post-processing for kinetic
-    energy bookkeeping and angular momentum): ``"planar"`` (x, y, rotation about the
+    ``kind`` says what the coordinates are (used by the declared outputs,
+    :mod:`flexrv.model.outputs`, for the kinetic energy and the angular momentum): ``"planar"`` (x, y, rotation about the
     axis first, as carrier, cranks and discs), ``"points"`` (x, y, z of point masses,
     e.g. the balls) or ``"modal"`` (elastic modal coordinates of a reduced body, with
     constant ``stiffness_matrix`` and ``damping_matrix`` added to the member's own
