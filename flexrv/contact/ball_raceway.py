@@ -157,12 +157,6 @@ def raceway_contacts(ball_pos, ball_vel, center_pos, center_vel, offset: float, 
                         stiffness=stiffness, damping=damping)
 
 
-def ball_azimuths(ball_pos) -> np.ndarray:
-    """Azimuth psi [rad] of each ball centre about the bearing axis (z)."""
-    ball_pos = np.asarray(ball_pos, dtype=float)
-    return np.arctan2(ball_pos[:, 1], ball_pos[:, 0])
-
-
 def solve_ball_positions(row: RowContactGeometry, inner_centers, outer_centers, law_inner: NormalLaw,
                          law_outer: NormalLaw, ball_pos0=None, external=None, tol: float = 1e-12,
                          max_iter: int = 60) -> tuple[np.ndarray, ContactState, ContactState]:
