@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexrv.errors import InputError
+from flexrv.units import M_PER_MM, M_PER_UM, RAD_PER_DEG
 
 #: K_Hc [N/mm] = NEEDLE_COEFF * F^0.1 [N] * Z^0.9 * l^0.8 [mm] * cos^1.9 (seed 004).
 NEEDLE_COEFF = 0.34e4
@@ -267,3 +268,114 @@ def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0
                                 c_bearings=c_hc, c_mesh_seed=c_c_seed, c_mesh_tangent=c_c_tan,
                                 c_w_seed=float(series_stiffness(c_hc, c_c_seed)),
                                 c_w_tangent=float(series_stiffness(c_hc, c_c_tan)), n_contact=res.n_contact)
+
+
+# --------------------------------------------------------------------------- crank bending and supports
+@dataclass(frozen=True)
+class CrankBending:
+    """Bending of the crankshaft between its support journals (simply supported at
+    their centres) under the needle forces at the eccentrics' centres (SI).
+
+    compliance : (2, 2) lateral compliance matrix C_ij [m/N] of eccentric i under a
+        unit force at eccentric j (deflection relative to the line through the
+        support centres); k_symmetric : stiffness [N/m] of the crank centre in the
+        planar model, 1 / (sum_ij C_ij / 4): the crank's total force split equally
+        between the two eccentrics (the torque-carrying couple of the needle forces
+        is the same on both discs); k_antisymmetric : 1 / ((C11 + C22 - 2 C12) / 4),
+        equal and opposite forces (the discs' radial pin resultants), which tilt the
+        crank and do not enter the planar model; positions : (z_A, z_1, z_2, z_B) [m].
+    """
+
+    compliance: np.ndarray
+    k_symmetric: float
+    k_antisymmetric: float
+    positions: tuple[float, float, float, float]
+
+
+def _shear_coefficient(nu: float) -> float:
+    """Timoshenko shear coefficient of a solid circular section, Cowper (1966):
+    kappa = 6 (1 + nu) / (7 + 6 nu)."""
+    return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+
+
+def crank_bending(reducer) -> CrankBending:
+    """Timoshenko stepped-shaft bending of the crank (see :class:`CrankBending`).
+
+    Axial layout of :class:`flexrv.design.model.Crankshaft` (gear seat, support A,
+    eccentric 1, eccentric 2, support B), each segment a solid circular section of
+    its journal diameter (the eccentric sections bend about their own centroid;
+    the eccentric offset does not change a circle's I). Unit-load method
+    (Castigliano; Timoshenko & Gere, *Mechanics of Materials*, ch. 9; shear term
+    Timoshenko 1921):
+
+        C_ij = int_A^B [ m_i m_j / (E I(z)) + v_i v_j / (kappa G A(z)) ] dz,
+
+    m_i, v_i the bending moment and shear of the simply supported span A-B under a
+    unit load at eccentric i; 3-point Gauss quadrature on every interval between
+    section changes and load points is exact (m_i m_j is quadratic there). The
+    overhung gear seat carries no needle force and adds nothing. Material: the
+    design's crankshaft steel. Verified against the FE condensation
+    (:func:`flexrv.fem.crankshaft.crank_bending_compliance`) in tests/test_fem_crank_bending.py.
+    """
+    cs = reducer.crankshaft
+    mat = reducer.material("crankshaft")
+    e_mod, nu = mat.youngs_modulus, mat.poisson_ratio
+    g_mod, kappa = e_mod / (2.0 * (1.0 + nu)), _shear_coefficient(nu)
+    segs = [(cs.support_journal_diameter_mm, cs.support_journal_length_mm),
+            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+            (cs.support_journal_diameter_mm, cs.support_journal_length_mm)]
+    edges = np.cumsum([0.0] + [M_PER_MM * length for _, length in segs])
+    z_a, z_b = 0.5 * (edges[0] + edges[1]), 0.5 * (edges[3] + edges[4])
+    z1, z2 = 0.5 * (edges[1] + edges[2]), 0.5 * (edges[2] + edges[3])
+    span = z_b - z_a
+    loads = np.array([z1, z2]) - z_a
+    breaks = np.unique(np.r_[z_a, z_b, edges[1:4], z1, z2])
+    gx, gw = np.polynomial.legendre.leggauss(3)
+    c = np.zeros((2, 2))
+    for lo, hi in zip(breaks[:-1], breaks[1:]):
+        zm = 0.5 * (lo + hi)
+        seg = min(int(np.searchsorted(edges, zm)) - 1, 3)
+        d = M_PER_MM * segs[seg][0]
+        area, inertia = np.pi * d * d / 4.0, np.pi * d**4 / 64.0
+        z = zm + 0.5 * (hi - lo) * gx - z_a
+        w = 0.5 * (hi - lo) * gw
+        m = np.array([np.where(z <= a, (1.0 - a / span) * z, a * (1.0 - z / span)) for a in loads])
+        v = np.array([np.where(z <= a, 1.0 - a / span, -a / span) for a in loads])
+        c += (m * w) @ m.T / (e_mod * inertia) + (v * w) @ v.T / (kappa * g_mod * area)
+    return CrankBending(compliance=c, k_symmetric=float(4.0 / c.sum()),
+                        k_antisymmetric=float(4.0 / (c[0, 0] + c[1, 1] - 2.0 * c[0, 1])),
+                        positions=(float(z_a), float(z1), float(z2), float(z_b)))
+
+
+def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(sc, roller angles, is_linear) of a design's crank support for
+    :func:`flexrv.contact.tapered_roller.crank_support_force` (the one law of the
+    kernel and the budget): roller constant K = series(K_cone, K_cup) of two
+    Palmgren line contacts of length l (E' of crankshaft/rolling-element steel),
+    cos(alpha), delta_0 = s_a sin(alpha), k_bend (0: rigid crank), g = D cos(alpha)/d_m."""
+    from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
+
+    cs = reducer.crankshaft
+    linear = cs.support_bearing_model == "linear"
+    k_bend = crank_bending(reducer).k_symmetric if cs.bending_model == "timoshenko" else 0.0
+    from flexrv.contact.tapered_roller import SC_COS_A, SC_DELTA0, SC_EXPONENT, SC_G, SC_K_BEND, SC_K_ROLLER, SC_LINEAR
+
+    sc = np.zeros(7)
+    sc[SC_K_BEND] = k_bend
+    sc[SC_EXPONENT] = LINE_EXPONENT
+    if linear:
+        sc[SC_LINEAR] = 2.0 * cs.support_bearing_radial_stiffness_N_per_m
+        return sc, np.zeros(0), True
+    mc, mr = reducer.material("crankshaft"), reducer.material("rolling_elements")
+    e_eff = effective_modulus(mc.youngs_modulus, mc.poisson_ratio, mr.youngs_modulus, mr.poisson_ratio)
+    k_line = float(line_contact_stiffness(cs.support_bearing_roller_length_mm * M_PER_MM, e_eff))
+    a = cs.support_bearing_contact_angle_deg * RAD_PER_DEG
+    sc[SC_K_ROLLER] = float(series_stiffness(k_line, k_line, LINE_EXPONENT))
+    sc[SC_COS_A] = np.cos(a)
+    sc[SC_DELTA0] = cs.support_bearing_axial_preload_um * M_PER_UM * np.sin(a)
+    sc[SC_G] = cs.support_bearing_roller_diameter_mm * np.cos(a) / cs.support_bearing_pitch_diameter_mm
+    z = cs.support_bearing_roller_count
+    return sc, 2.0 * np.pi * np.arange(z) / z, False
+
+
