@@ -298,34 +298,25 @@ def _shear_coefficient(nu: float) -> float:
     return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
 
 
-def crank_bending(reducer) -> CrankBending:
-    """Timoshenko stepped-shaft bending of the crank (see :class:`CrankBending`).
-
-    Axial layout of :class:`flexrv.design.model.Crankshaft` (gear seat, support A,
-    eccentric 1, eccentric 2, support B), each segment a solid circular section of
-    its journal diameter (the eccentric sections bend about their own centroid;
-    the eccentric offset does not change a circle's I). Unit-load method
-    (Castigliano; Timoshenko & Gere, *Mechanics of Materials*, ch. 9; shear term
+def stepped_shaft_bending(segments, youngs_modulus: float, poisson_ratio: float) -> CrankBending:
+    """Timoshenko bending of a stepped shaft of four coaxial solid segments
+    (support A, eccentric 1, eccentric 2, support B), ``segments`` = ((d, L), ...)
+    [m], simply supported at the support segments' centres, unit loads at the
+    eccentric segments' centres (see :class:`CrankBending`). Unit-load method
+    (Castigliano; Timoshenko & Gere, *Mechanics of Materials*, ch. 9; shear term of
     Timoshenko 1921):
 
         C_ij = int_A^B [ m_i m_j / (E I(z)) + v_i v_j / (kappa G A(z)) ] dz,
 
     m_i, v_i the bending moment and shear of the simply supported span A-B under a
-    unit load at eccentric i; 3-point Gauss quadrature on every interval between
-    section changes and load points is exact (m_i m_j is quadratic there). The
-    overhung gear seat carries no needle force and adds nothing. Material: the
-    design's crankshaft steel. Verified against the FE condensation
-    (:func:`flexrv.fem.crankshaft.crank_bending_compliance`) in tests/test_fem_crank_bending.py.
-    """
-    cs = reducer.crankshaft
-    mat = reducer.material("crankshaft")
-    e_mod, nu = mat.youngs_modulus, mat.poisson_ratio
+    unit load at eccentric i, kappa = 6 (1 + nu)/(7 + 6 nu) (Cowper 1966, solid
+    circle); 3-point Gauss quadrature on every interval between section changes and
+    load points is exact (m_i m_j is quadratic there)."""
+    if len(segments) != 4 or any(d <= 0 or length <= 0 for d, length in segments):
+        raise InputError(f"segments = {segments!r}: need four (diameter > 0, length > 0) pairs")
+    e_mod, nu = youngs_modulus, poisson_ratio
     g_mod, kappa = e_mod / (2.0 * (1.0 + nu)), _shear_coefficient(nu)
-    segs = [(cs.support_journal_diameter_mm, cs.support_journal_length_mm),
-            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
-            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
-            (cs.support_journal_diameter_mm, cs.support_journal_length_mm)]
-    edges = np.cumsum([0.0] + [M_PER_MM * length for _, length in segs])
+    edges = np.cumsum([0.0] + [length for _, length in segments])
     z_a, z_b = 0.5 * (edges[0] + edges[1]), 0.5 * (edges[3] + edges[4])
     z1, z2 = 0.5 * (edges[1] + edges[2]), 0.5 * (edges[2] + edges[3])
     span = z_b - z_a
@@ -335,8 +326,7 @@ def crank_bending(reducer) -> CrankBending:
     c = np.zeros((2, 2))
     for lo, hi in zip(breaks[:-1], breaks[1:]):
         zm = 0.5 * (lo + hi)
-        seg = min(int(np.searchsorted(edges, zm)) - 1, 3)
-        d = M_PER_MM * segs[seg][0]
+        d = segments[min(int(np.searchsorted(edges, zm)) - 1, 3)][0]
         area, inertia = np.pi * d * d / 4.0, np.pi * d**4 / 64.0
         z = zm + 0.5 * (hi - lo) * gx - z_a
         w = 0.5 * (hi - lo) * gw
@@ -346,6 +336,26 @@ def crank_bending(reducer) -> CrankBending:
     return CrankBending(compliance=c, k_symmetric=float(4.0 / c.sum()),
                         k_antisymmetric=float(4.0 / (c[0, 0] + c[1, 1] - 2.0 * c[0, 1])),
                         positions=(float(z_a), float(z1), float(z2), float(z_b)))
+
+
+def crank_bending(reducer) -> CrankBending:
+    """Bending of a design's crankshaft between its support journals and its
+    eccentrics: :func:`stepped_shaft_bending` of the journals of
+    :class:`flexrv.design.model.Crankshaft` (support A, eccentric 1, eccentric 2,
+    support B; each a solid circle of its journal diameter; the eccentric sections
+    bend about their own centroids, the offset does not change a circle's I; the
+    overhung gear seat carries no needle force), material of the crankshaft.
+    Verified against the FE condensation
+    (:func:`flexrv.fem.crankshaft.crank_bending_compliance`) in
+    tests/test_fem_crank_bending.py."""
+    cs = reducer.crankshaft
+    mat = reducer.material("crankshaft")
+    segs = [(M_PER_MM * d, M_PER_MM * length) for d, length in (
+        (cs.support_journal_diameter_mm, cs.support_journal_length_mm),
+        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+        (cs.support_journal_diameter_mm, cs.support_journal_length_mm))]
+    return stepped_shaft_bending(segs, mat.youngs_modulus, mat.poisson_ratio)
 
 
 def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -379,3 +389,72 @@ def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
     return sc, 2.0 * np.pi * np.arange(z) / z, False
 
 
+
+
+@dataclass(frozen=True)
+class StiffnessBudget:
+    """Analytic series model of the torsional compliance at the output (SI).
+
+    compliances : element -> torsional compliance [rad/(N m)] referred to the
+    output; total : their sum; rigidity = 1 / total [N m/rad]; shares : element ->
+    fraction of the total; torque : output torque [N m]; support_forces : (N,) force
+    on each crank's support [N]."""
+
+    compliances: dict
+    total: float
+    rigidity: float
+    shares: dict
+    torque: float
+    support_forces: np.ndarray
+
+
+#: budget element names, shared with the quasi-static model's force groups where they coincide
+BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending")
+
+
+def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> StiffnessBudget:
+    """Torsional compliance of each element of the torque path, in series
+    (output carrier held against the housing through the path carrier -> crank
+    supports -> crank shaft -> eccentrics -> needle bearings -> discs -> pins):
+
+    * pins: 1 / C_c with the tangent pin stiffness of the Palmgren pin-load solution
+      (:func:`second_stage_stiffness`, ``c_mesh_tangent``);
+    * needle_bearings: 1 / C_Hc (seed 004's law at the bearing forces);
+    * support_bearings and crank_bending: each crank's support carries the couple
+      part of its needle forces, T / (N a_w) tangential (the discs' radial pin
+      resultants, equal and opposite for two discs 180 deg apart, cancel on the
+      crank; :func:`crank_bearing_forces`), through the law of the dynamic and
+      quasi-static models (:func:`flexrv.contact.tapered_roller.support_deflection`
+      with :func:`support_constants`): the bearings' tangent K_b and the shaft's
+      k_bend in series per crank, the N cranks in parallel on the lever a_w:
+      1 / (a_w^2 sum_j t_j . K_b,j t_j) and 1 / (N a_w^2 k_bend).
+
+    Neglected (stated): the first stage (its mesh compliance reaches the output
+    only through the eccentricity's lever, < 0.1 % in the quasi-static budget), the
+    crank torsion, the carrier, the housing and the main bearing (not in the torque
+    path of the rigid model either).
+    """
+    from flexrv.contact.tapered_roller import SC_K_BEND, crank_support_force, support_deflection
+
+    torque = reducer.operating.rated_torque_Nm if output_torque is None else float(output_torque)
+    st = second_stage_stiffness(reducer, torque, crank_angle)
+    n = reducer.first_stage.n_planets
+    a_w = reducer.first_stage.center_distance
+    sc, angles, linear = support_constants(reducer)
+    rigid = sc.copy()
+    rigid[SC_K_BEND] = 0.0
+    th = crank_hole_angles(n)
+    f_sup = abs(torque) / (n * a_w)
+    k_bear = 0.0
+    for j in range(n):
+        t = np.array([-np.sin(th[j]), np.cos(th[j])])
+        _, _, b = support_deflection(f_sup * t, sc, angles, linear)
+        _, _, kxx, kxy, kyy, *_ = crank_support_force(b[0], b[1], 0.0, 0.0, rigid, angles, linear, b[0], b[1])
+        k_bear += t @ np.array([[kxx, kxy], [kxy, kyy]]) @ t
+    comp = {"pins": 1.0 / st.c_mesh_tangent, "needle_bearings": 1.0 / st.c_bearings,
+            "support_bearings": 1.0 / (a_w**2 * k_bear),
+            "crank_bending": 1.0 / (n * a_w**2 * sc[SC_K_BEND]) if sc[SC_K_BEND] > 0.0 else 0.0}
+    total = float(sum(comp.values()))
+    return StiffnessBudget(compliances=comp, total=total, rigidity=1.0 / total,
+                           shares={k: v / total for k, v in comp.items()}, torque=torque,
+                           support_forces=np.full(n, f_sup))
