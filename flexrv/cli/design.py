@@ -83,7 +83,8 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
            json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Analytic design report at the preset's operating point (kinematics, ISO 6336
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
-    loads, Hertz, film thickness, life)."""
+    loads, Hertz, film thickness, life) and the stiffness budget of the torque path
+    (each element's torsional compliance, share and the total)."""
     from flexrv.analysis.report import design_report
     from flexrv.errors import ConvergenceError
 

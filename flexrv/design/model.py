@@ -239,7 +239,7 @@ class Crankshaft(_Strict):
         if self.support_bearing_model == "linear":
             if self.support_bearing_radial_stiffness_N_per_m is None:
                 raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", None,
-                           "required (1e6 < value <= 1e12 N/m) with support_bearing_model = 'linear'")
+                           "missing required field of support_bearing_model = 'linear' (1e6 < value <= 1e12 N/m)")
             given = [f for f in tapered if getattr(self, f) is not None]
             if given:
                 raise _bad(f"crankshaft.{given[0]}", getattr(self, given[0]),
@@ -247,7 +247,7 @@ class Crankshaft(_Strict):
             return self
         for f in tapered:
             if getattr(self, f) is None:
-                raise _bad(f"crankshaft.{f}", None, "required with support_bearing_model = 'tapered_rollers'")
+                raise _bad(f"crankshaft.{f}", None, "missing required field of support_bearing_model = 'tapered_rollers'")
         if self.support_bearing_radial_stiffness_N_per_m is not None:
             raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", self.support_bearing_radial_stiffness_N_per_m,
                        "only used with support_bearing_model = 'linear'; remove it (the tapered-roller law computes it)")
