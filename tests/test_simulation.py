@@ -143,8 +143,8 @@ def test_torsional_rigidity_vs_series_model(name):
     zero-clearance assumptions hold. Tolerance 15 %: the analytic model linearises
     at T_r while the test fits the secant over [T_r/2, T_r], and lets neither the
     discs translate nor the torque split unevenly between the cranks (the needle
-    bearings then carry the pin resultants as well; the quasi-static tangent of
-    rv40e is 8 % below the analytic figure, issue 14)."""
+    bearings then share the load unevenly; the quasi-static tangent of rv40e is 4 %
+    below the analytic figure, issue 14)."""
     from flexrv.analysis.torsional import stiffness_budget
 
     r = ideal(load(name))

@@ -419,7 +419,15 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
 
     * pins: 1 / C_c with the tangent pin stiffness of the Palmgren pin-load solution
       (:func:`second_stage_stiffness`, ``c_mesh_tangent``);
-    * needle_bearings: 1 / C_Hc (seed 004's law at the bearing forces);
+    * needle_bearings: the needle bearings of all discs and cranks in parallel on
+      the lever a_w, each with the direction-resolved tangent of seed 004's
+      empirical law as the models integrate it (F = (0.9 C delta)^(10/9),
+      delta = |d| - c_r with the radial clearance c_r, K_Hc = C F^0.1): along its
+      load K_Hc, across it F / |d| (the load's direction turns with d), so a
+      bearing whose force F_jk (:func:`crank_bearing_forces`; disc k's pin
+      resultant turned by 2 pi k / n_discs with its eccentric) makes the angle
+      beta with the tangent t_j gives a_w^2 (K_Hc cos^2 beta + F/|d| sin^2 beta);
+      seed 004's C_Hc is the limit beta = 0;
     * support_bearings and crank_bending: each crank's support carries the couple
       part of its needle forces, T / (N a_w) tangential (the discs' radial pin
       resultants, equal and opposite for two discs 180 deg apart, cancel on the
@@ -434,6 +442,7 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     crank torsion, the carrier, the housing and the main bearing (not in the torque
     path of the rigid model either).
     """
+    from flexrv.analysis.pin_load import reducer_pin_loads
     from flexrv.contact.tapered_roller import SC_K_BEND, crank_support_force, support_deflection
 
     torque = reducer.operating.rated_torque_Nm if output_torque is None else float(output_torque)
@@ -451,9 +460,24 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
         _, _, b = support_deflection(f_sup * t, sc, angles, linear)
         _, _, kxx, kxy, kyy, *_ = crank_support_force(b[0], b[1], 0.0, 0.0, rigid, angles, linear, b[0], b[1])
         k_bear += t @ np.array([[kxx, kxy], [kxy, kyy]]) @ t
-    comp = {"pins": 1.0 / st.c_mesh_tangent, "needle_bearings": 1.0 / st.c_bearings,
-            "support_bearings": 1.0 / (a_w**2 * k_bear),
-            "crank_bending": 1.0 / (n * a_w**2 * sc[SC_K_BEND]) if sc[SC_K_BEND] > 0.0 else 0.0}
+    nb, nd = reducer.needle_bearing, reducer.second_stage.n_discs
+    c_emp = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * M_PER_MM))  # K_Hc = C F^0.1
+    clear = nb.radial_clearance_um * M_PER_UM
+    k_needle = 0.0
+    pins = reducer_pin_loads(reducer, torque, crank_angle)
+    for k in range(nd):
+        turn = 2.0 * np.pi * k / nd
+        rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+        forces = crank_bearing_forces(rot @ pins.resultant, torque / nd, a_w, n)
+        for j in range(n):
+            fm = float(np.linalg.norm(forces[j]))
+            cos2 = (forces[j] @ np.array([-np.sin(th[j]), np.cos(th[j])]) / fm) ** 2
+            k_along = c_emp * fm**0.1
+            k_across = fm / (fm**0.9 / (0.9 * c_emp) + clear)
+            k_needle += a_w**2 * (k_along * cos2 + k_across * (1.0 - cos2))
+    comp = {"pins": float(1.0 / st.c_mesh_tangent), "needle_bearings": float(1.0 / k_needle),
+            "support_bearings": float(1.0 / (a_w**2 * k_bear)),
+            "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0}
     total = float(sum(comp.values()))
     return StiffnessBudget(compliances=comp, total=total, rigidity=1.0 / total,
                            shares={k: v / total for k, v in comp.items()}, torque=torque,
