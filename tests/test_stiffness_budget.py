@@ -28,3 +28,53 @@ def test_analytic_and_quasi_static_budgets_agree():
     assert b.total == pytest.approx(c_qs, rel=0.10)
     support = b.compliances["support_bearings"] + b.compliances["crank_bending"]
     assert shares["crank_supports"] * c_qs == pytest.approx(support, rel=0.03)
+
+
+def test_design_cli_prints_the_budget():
+    """``flexrv design rv40e --json``: the stiffness budget's elements (compliance
+    in arcsec/(N m), share in %) sum to the total and 100 %, the rigidity is its
+    inverse in N m/arcmin, the numbers are those of stiffness_budget; the table
+    names every element."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from flexrv.cli import app
+    from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+    res = CliRunner().invoke(app, ["design", "rv40e", "--json"])
+    assert res.exit_code == 0, res.output
+    b = json.loads(res.output)["stiffness_budget"]
+    el = b["elements"]
+    assert set(el) == {"pins", "needle_bearings", "support_bearings", "crank_bending"}
+    assert sum(e["share_percent"] for e in el.values()) == pytest.approx(100.0, rel=1e-12)
+    total = sum(e["compliance_arcsec_per_Nm"] for e in el.values())
+    assert b["total_compliance_arcsec_per_Nm"] == pytest.approx(total, rel=1e-12)
+    assert b["rigidity_Nm_per_arcmin"] == pytest.approx(ARCSEC_PER_RAD * RAD_PER_ARCMIN / total, rel=1e-12)
+    ref = stiffness_budget(load("rv40e"))
+    assert b["rigidity_Nm_per_arcmin"] == pytest.approx(ref.rigidity * RAD_PER_ARCMIN, rel=1e-12)
+    table = CliRunner().invoke(app, ["design", "rv40e"]).output
+    for name in ("crank bending", "support bearings", "needle bearings", "pins", "total"):
+        assert name in table
+
+
+def test_quasi_static_budget_splits_the_crank_supports():
+    """``flexrv te``'s budget (flexrv.cli.te.quasi_static_budget): each group's share
+    times the tangent compliance; the crank-support group split by the mean
+    reported bending share into support bearings and crank bending."""
+    import numpy as np
+
+    from flexrv.cli.te import quasi_static_budget
+    from flexrv.model.base import Output
+    from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+    summary = {"torsional_rigidity_Nm_per_arcmin": 250.0, "torque_Nm": 412.0,
+               "compliance_budget_percent": {"crank_supports": 60.0, "needle_bearings": 30.0, "pins": 10.0}}
+    frac = Output(np.array([[0.5, 0.6, 0.7], [0.5, 0.6, 0.7]]), ("position", "crank"), "1", "")
+    b = quasi_static_budget(summary, {"crank_bending_fraction": frac})
+    total = RAD_PER_ARCMIN / 250.0 * ARCSEC_PER_RAD
+    assert b["total_compliance_arcsec_per_Nm"] == pytest.approx(total, rel=1e-12)
+    assert b["elements"]["crank_bending"]["share_percent"] == pytest.approx(36.0, rel=1e-12)
+    assert b["elements"]["support_bearings"]["share_percent"] == pytest.approx(24.0, rel=1e-12)
+    assert b["elements"]["pins"]["compliance_arcsec_per_Nm"] == pytest.approx(0.1 * total, rel=1e-12)
+    assert b["rigidity_Nm_per_arcmin"] == pytest.approx(250.0, rel=1e-12)
