@@ -169,6 +169,12 @@ class CrankSupports(KernelGroup):
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         crank_support_kernel(q, v, f, jq, jv, jac, pack)
 
+    def reset(self) -> None:
+        """Forget the bearing displacements of earlier evaluations (the inner Newton's
+        start; the solution does not depend on it beyond its 1e-13 tolerance)."""
+        self.bstate[:] = 0.0
+        super().reset()
+
     def record(self):
         return {"fx": self.fx.copy(), "fy": self.fy.copy(), "bend": self.bend.copy()}
 
