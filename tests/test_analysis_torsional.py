@@ -74,3 +74,76 @@ def test_second_stage_stiffness_rv40e_monotone_in_torque():
     assert np.all(np.diff(cw) > 0)
     for s in runs:
         assert s.c_w_tangent < min(s.c_bearings, s.c_mesh_tangent)
+
+
+# ----------------------------------------------------------------------------- issue 14: crank bending, budget
+def test_stepped_shaft_bending_uniform_closed_form():
+    """A uniform shaft (four equal segments) is a simply supported Timoshenko beam
+    of span L between the support centres: under a unit load at a (b = L - a),
+    the deflection at x <= a is b x (L^2 - b^2 - x^2) / (6 E I L) + b x / (kappa G A L)
+    (Timoshenko & Gere, Mechanics of Materials, app. G; shear term: the shear
+    force b/L over [0, a]), kappa = 6 (1 + nu)/(7 + 6 nu) (Cowper 1966). Exact
+    (quadrature exact for the piecewise-linear moments): 1e-12."""
+    from flexrv.analysis.torsional import stepped_shaft_bending
+
+    d, seg, e, nu = 0.02, 0.01, 210e9, 0.3
+    res = stepped_shaft_bending([(d, seg)] * 4, e, nu)
+    span, x1, x2 = 3 * seg, seg, 2 * seg  # support centres at 0.5 seg and 3.5 seg
+    ei, kga = e * np.pi * d**4 / 64, 6 * (1 + nu) / (7 + 6 * nu) * e / (2 * (1 + nu)) * np.pi * d**2 / 4
+
+    def defl(x, a):  # deflection at x under a unit load at a (x <= a)
+        b = span - a
+        return b * x * (span**2 - b**2 - x**2) / (6 * ei * span) + b * x / (kga * span)
+
+    np.testing.assert_allclose(res.compliance, [[defl(x1, x1), defl(x1, x2)], [defl(x1, x2), defl(x2, x2)]],
+                               rtol=1e-12)
+    assert res.k_symmetric == pytest.approx(4.0 / res.compliance.sum(), rel=1e-15)
+
+
+def test_stepped_shaft_bad_input():
+    from flexrv.analysis.torsional import stepped_shaft_bending
+
+    with pytest.raises(InputError, match="four"):
+        stepped_shaft_bending([(0.01, 0.01)] * 3, 210e9, 0.3)
+
+
+def test_stiffness_budget_elements():
+    """Analytic budget of rv40e at the rated torque: the elements sum to the total,
+    the shares to 1; the crank-bending element is exactly 1 / (N a_w^2 k_b) with
+    the Timoshenko k_b, the pins are seed 004's C_c (tangent) of
+    second_stage_stiffness, the needles bounded by seed 004's C_Hc (see below);
+    with the linear legacy support law (rigid crank)
+    the support element is exactly 1 / (N a_w^2 2 k_sb)."""
+    from flexrv.analysis.torsional import crank_bending, stiffness_budget
+    from flexrv.design import load, override
+    from tests.data.make_force_reference import legacy_supports
+
+    r = load("rv40e")
+    b = stiffness_budget(r)
+    assert sum(b.compliances.values()) == pytest.approx(b.total, rel=1e-14)
+    assert sum(b.shares.values()) == pytest.approx(1.0, rel=1e-14)
+    a_w, n = r.first_stage.center_distance, r.first_stage.n_planets
+    assert b.compliances["crank_bending"] == pytest.approx(1.0 / (n * a_w**2 * crank_bending(r).k_symmetric), rel=1e-12)
+    st = second_stage_stiffness(r, r.operating.rated_torque_Nm)
+    assert b.compliances["pins"] == pytest.approx(1.0 / st.c_mesh_tangent, rel=1e-12)
+    # needles without clearance: across its load a bearing is F/delta = 0.9 K_Hc stiff, so the
+    # direction-resolved element lies between seed 004's 1/C_Hc and 1/(0.9 C_Hc); the clearance softens it
+    tight = stiffness_budget(override(r, {"needle_bearing.radial_clearance_um": 0.0}))
+    assert 1.0 / st.c_bearings < tight.compliances["needle_bearings"] < 1.0 / (0.9 * st.c_bearings)
+    assert b.compliances["needle_bearings"] > tight.compliances["needle_bearings"]
+    lin = stiffness_budget(legacy_supports(r, "rv40e"))
+    assert lin.compliances["crank_bending"] == 0.0
+    assert lin.compliances["support_bearings"] == pytest.approx(1.0 / (n * a_w**2 * 4e8), rel=1e-9)
+
+
+def test_support_bearings_stiffen_with_load_and_preload():
+    """The tapered-roller pair's tangent (budget element) stiffens with load (the
+    Palmgren line contacts, Q ~ delta^(10/9)) and with the axial preload."""
+    from flexrv.analysis.torsional import stiffness_budget
+    from flexrv.design import load, override
+
+    r = load("rv40e")
+    c = [stiffness_budget(r, t).compliances["support_bearings"] for t in (100.0, 412.0, 800.0)]
+    assert c[0] > c[1] > c[2]
+    stiff = override(r, {"crankshaft.support_bearing_axial_preload_um": 10.0})
+    assert stiffness_budget(stiff).compliances["support_bearings"] < c[1]

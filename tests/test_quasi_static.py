@@ -236,7 +236,9 @@ def test_compliance_budget_predicts_a_stiffer_support():
         q = ramp_to(sm, 0.0, sm.kinematic_pose(0.0), red.operating.rated_torque_Nm)
         return 1.0 / sm.tangent_rigidity(0.0, q), sm.compliance_budget(0.0, q)
 
-    red = load("rv40e")
+    from tests.data.make_force_reference import legacy_supports  # the linear support law (issue 14)
+
+    red = legacy_supports(load("rv40e"), "rv40e")
     c0, budget = compliance(red)
     assert sum(budget.values()) == pytest.approx(1.0, abs=1e-9)
     k = red.crankshaft.support_bearing_radial_stiffness_N_per_m

@@ -135,24 +135,21 @@ def test_failure_is_reported_with_partial_results():
 
 @pytest.mark.parametrize("name", ["rv40e", "rv221"])
 def test_torsional_rigidity_vs_series_model(name):
-    """Virtual stiffness test (input locked, 0 -> +T_r -> -T_r -> 0) vs the seed 004
-    series model C_W = C_Hc C_c / (C_Hc + C_c) (flexrv.analysis.torsional,
-    tangent Palmgren pin stiffness at T_r), extended by the crank-support
-    compliance in series, C_s = n_cranks k_s a_w^2 (the model's crank bearings in
-    the carrier are elastic; seed 004 neglects them). Ideal geometry so that the
-    analytic zero-clearance assumptions hold. Measured: -10 % (rv40e), -9 %
-    (rv221); tolerance 15 %: the analytic model linearises at T_r while the test
-    fits the secant over [T_r/2, T_r], and lets neither the discs translate nor
-    the torque split unevenly between the cranks."""
-    from flexrv.analysis.torsional import second_stage_stiffness
-    from flexrv.model.parameters import rigid_parameters
+    """Virtual stiffness test (input locked, 0 -> +T_r -> -T_r -> 0) vs the analytic
+    series model of the torque path (flexrv.analysis.torsional.stiffness_budget:
+    seed 004's C_W = C_Hc C_c / (C_Hc + C_c) with the tangent Palmgren pin stiffness
+    at T_r, plus the crank supports, tapered-roller pairs and crank bending in
+    series, with the law of the dynamic model). Ideal geometry so that the analytic
+    zero-clearance assumptions hold. Tolerance 15 %: the analytic model linearises
+    at T_r while the test fits the secant over [T_r/2, T_r], and lets neither the
+    discs translate nor the torque split unevenly between the cranks (the needle
+    bearings then share the load unevenly; the quasi-static tangent of rv40e is 4 %
+    below the analytic figure, issue 14)."""
+    from flexrv.analysis.torsional import stiffness_budget
 
     r = ideal(load(name))
     fig, _ = stiffness_test(r, quarter_time=0.01)
-    a = second_stage_stiffness(r, r.operating.rated_torque_Nm)
-    p = rigid_parameters(r)
-    c_s = p.n_cranks * p.support_stiffness * p.center_distance**2
-    c_w = 1.0 / (1.0 / a.c_w_tangent + 1.0 / c_s)
+    c_w = stiffness_budget(r).rigidity
     arcmin = np.pi / 180 / 60
     assert fig.rigidity_Nm_per_arcmin == pytest.approx(c_w * arcmin, rel=0.15)
     assert abs(fig.lost_motion_arcmin) < 0.2  # ideal geometry: no clearance to take up

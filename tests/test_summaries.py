@@ -122,7 +122,10 @@ def test_stiffness_test_saves_its_numbers(tmp_path):
     assert ds["lost_motion"].attrs["units"] == "arcmin" and ds["hysteresis"].attrs["units"] == "arcmin"
     assert float(ds["lost_motion"]) == pytest.approx(fig.lost_motion_arcmin, rel=1e-12)
     assert np.allclose(ds["loop_angle"].values, -res["theta_out"].values * ARCMIN_PER_RAD)
-    assert float(ds["loop_torque"].max()) == pytest.approx(fig.rated_torque)
+    # the samples are the recorded steps: after an adaptive step reduction they may lie off the dt grid
+    # (issue 14: rv40e's tapered-roller supports, two halved steps shift them by dt/2), so the sampled
+    # peak may miss the rated torque by up to one slope x dt/2 = T_r / quarter_time x dt/2 = 0.5 %
+    assert float(ds["loop_torque"].max()) == pytest.approx(fig.rated_torque, rel=0.006)
     js = json.loads((tmp_path / "stiffness.json").read_text())["figures"]
     assert js["hysteresis"]["value"] == pytest.approx(fig.hysteresis_arcmin) and js["hysteresis"]["units"] == "arcmin"
     text = (tmp_path / "summary.md").read_text()

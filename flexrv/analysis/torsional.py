@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexrv.errors import InputError
+from flexrv.units import M_PER_MM, M_PER_UM, RAD_PER_DEG
 
 #: K_Hc [N/mm] = NEEDLE_COEFF * F^0.1 [N] * Z^0.9 * l^0.8 [mm] * cos^1.9 (seed 004).
 NEEDLE_COEFF = 0.34e4
@@ -267,3 +268,217 @@ def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0
                                 c_bearings=c_hc, c_mesh_seed=c_c_seed, c_mesh_tangent=c_c_tan,
                                 c_w_seed=float(series_stiffness(c_hc, c_c_seed)),
                                 c_w_tangent=float(series_stiffness(c_hc, c_c_tan)), n_contact=res.n_contact)
+
+
+# --------------------------------------------------------------------------- crank bending and supports
+@dataclass(frozen=True)
+class CrankBending:
+    """Bending of the crankshaft between its support journals (simply supported at
+    their centres) under the needle forces at the eccentrics' centres (SI).
+
+    compliance : (2, 2) lateral compliance matrix C_ij [m/N] of eccentric i under a
+        unit force at eccentric j (deflection relative to the line through the
+        support centres); k_symmetric : stiffness [N/m] of the crank centre in the
+        planar model, 1 / (sum_ij C_ij / 4): the crank's total force split equally
+        between the two eccentrics (the torque-carrying couple of the needle forces
+        is the same on both discs); k_antisymmetric : 1 / ((C11 + C22 - 2 C12) / 4),
+        equal and opposite forces (the discs' radial pin resultants), which tilt the
+        crank and do not enter the planar model; positions : (z_A, z_1, z_2, z_B) [m].
+    """
+
+    compliance: np.ndarray
+    k_symmetric: float
+    k_antisymmetric: float
+    positions: tuple[float, float, float, float]
+
+
+def _shear_coefficient(nu: float) -> float:
+    """Timoshenko shear coefficient of a solid circular section, Cowper (1966):
+    kappa = 6 (1 + nu) / (7 + 6 nu)."""
+    return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+
+
+def stepped_shaft_bending(segments, youngs_modulus: float, poisson_ratio: float) -> CrankBending:
+    """Timoshenko bending of a stepped shaft of four coaxial solid segments
+    (support A, eccentric 1, eccentric 2, support B), ``segments`` = ((d, L), ...)
+    [m], simply supported at the support segments' centres, unit loads at the
+    eccentric segments' centres (see :class:`CrankBending`). Unit-load method
+    (Castigliano; Timoshenko & Gere, *Mechanics of Materials*, ch. 9; shear term of
+    Timoshenko 1921):
+
+        C_ij = int_A^B [ m_i m_j / (E I(z)) + v_i v_j / (kappa G A(z)) ] dz,
+
+    m_i, v_i the bending moment and shear of the simply supported span A-B under a
+    unit load at eccentric i, kappa = 6 (1 + nu)/(7 + 6 nu) (Cowper 1966, solid
+    circle); 3-point Gauss quadrature on every interval between section changes and
+    load points is exact (m_i m_j is quadratic there)."""
+    if len(segments) != 4 or any(d <= 0 or length <= 0 for d, length in segments):
+        raise InputError(f"segments = {segments!r}: need four (diameter > 0, length > 0) pairs")
+    e_mod, nu = youngs_modulus, poisson_ratio
+    g_mod, kappa = e_mod / (2.0 * (1.0 + nu)), _shear_coefficient(nu)
+    edges = np.cumsum([0.0] + [length for _, length in segments])
+    z_a, z_b = 0.5 * (edges[0] + edges[1]), 0.5 * (edges[3] + edges[4])
+    z1, z2 = 0.5 * (edges[1] + edges[2]), 0.5 * (edges[2] + edges[3])
+    span = z_b - z_a
+    loads = np.array([z1, z2]) - z_a
+    breaks = np.unique(np.r_[z_a, z_b, edges[1:4], z1, z2])
+    gx, gw = np.polynomial.legendre.leggauss(3)
+    c = np.zeros((2, 2))
+    for lo, hi in zip(breaks[:-1], breaks[1:]):
+        zm = 0.5 * (lo + hi)
+        d = segments[min(int(np.searchsorted(edges, zm)) - 1, 3)][0]
+        area, inertia = np.pi * d * d / 4.0, np.pi * d**4 / 64.0
+        z = zm + 0.5 * (hi - lo) * gx - z_a
+        w = 0.5 * (hi - lo) * gw
+        m = np.array([np.where(z <= a, (1.0 - a / span) * z, a * (1.0 - z / span)) for a in loads])
+        v = np.array([np.where(z <= a, 1.0 - a / span, -a / span) for a in loads])
+        c += (m * w) @ m.T / (e_mod * inertia) + (v * w) @ v.T / (kappa * g_mod * area)
+    return CrankBending(compliance=c, k_symmetric=float(4.0 / c.sum()),
+                        k_antisymmetric=float(4.0 / (c[0, 0] + c[1, 1] - 2.0 * c[0, 1])),
+                        positions=(float(z_a), float(z1), float(z2), float(z_b)))
+
+
+def crank_bending(reducer) -> CrankBending:
+    """Bending of a design's crankshaft between its support journals and its
+    eccentrics: :func:`stepped_shaft_bending` of the journals of
+    :class:`flexrv.design.model.Crankshaft` (support A, eccentric 1, eccentric 2,
+    support B; each a solid circle of its journal diameter; the eccentric sections
+    bend about their own centroids, the offset does not change a circle's I; the
+    overhung gear seat carries no needle force), material of the crankshaft.
+    Verified against the FE condensation
+    (:func:`flexrv.fem.crankshaft.crank_bending_compliance`) in
+    tests/test_fem_crank_bending.py."""
+    cs = reducer.crankshaft
+    mat = reducer.material("crankshaft")
+    segs = [(M_PER_MM * d, M_PER_MM * length) for d, length in (
+        (cs.support_journal_diameter_mm, cs.support_journal_length_mm),
+        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+        (cs.support_journal_diameter_mm, cs.support_journal_length_mm))]
+    return stepped_shaft_bending(segs, mat.youngs_modulus, mat.poisson_ratio)
+
+
+def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(sc, roller angles, is_linear) of a design's crank support for
+    :func:`flexrv.contact.tapered_roller.crank_support_force` (the one law of the
+    kernel and the budget): roller constant K = series(K_cone, K_cup) of two
+    Palmgren line contacts of length l (E' of crankshaft/rolling-element steel),
+    cos(alpha), delta_0 = s_a sin(alpha), k_bend (0: rigid crank), g = D cos(alpha)/d_m."""
+    from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
+
+    cs = reducer.crankshaft
+    linear = cs.support_bearing_model == "linear"
+    k_bend = crank_bending(reducer).k_symmetric if cs.bending_model == "timoshenko" else 0.0
+    from flexrv.contact.tapered_roller import SC_COS_A, SC_DELTA0, SC_EXPONENT, SC_G, SC_K_BEND, SC_K_ROLLER, SC_LINEAR
+
+    sc = np.zeros(7)
+    sc[SC_K_BEND] = k_bend
+    sc[SC_EXPONENT] = LINE_EXPONENT
+    if linear:
+        sc[SC_LINEAR] = 2.0 * cs.support_bearing_radial_stiffness_N_per_m
+        return sc, np.zeros(0), True
+    mc, mr = reducer.material("crankshaft"), reducer.material("rolling_elements")
+    e_eff = effective_modulus(mc.youngs_modulus, mc.poisson_ratio, mr.youngs_modulus, mr.poisson_ratio)
+    k_line = float(line_contact_stiffness(cs.support_bearing_roller_length_mm * M_PER_MM, e_eff))
+    a = cs.support_bearing_contact_angle_deg * RAD_PER_DEG
+    sc[SC_K_ROLLER] = float(series_stiffness(k_line, k_line, LINE_EXPONENT))
+    sc[SC_COS_A] = np.cos(a)
+    sc[SC_DELTA0] = cs.support_bearing_axial_preload_um * M_PER_UM * np.sin(a)
+    sc[SC_G] = cs.support_bearing_roller_diameter_mm * np.cos(a) / cs.support_bearing_pitch_diameter_mm
+    z = cs.support_bearing_roller_count
+    return sc, 2.0 * np.pi * np.arange(z) / z, False
+
+
+
+
+@dataclass(frozen=True)
+class StiffnessBudget:
+    """Analytic series model of the torsional compliance at the output (SI).
+
+    compliances : element -> torsional compliance [rad/(N m)] referred to the
+    output; total : their sum; rigidity = 1 / total [N m/rad]; shares : element ->
+    fraction of the total; torque : output torque [N m]; support_forces : (N,) force
+    on each crank's support [N]."""
+
+    compliances: dict
+    total: float
+    rigidity: float
+    shares: dict
+    torque: float
+    support_forces: np.ndarray
+
+
+#: budget element names, shared with the quasi-static model's force groups where they coincide
+BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending")
+
+
+def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> StiffnessBudget:
+    """Torsional compliance of each element of the torque path, in series
+    (output carrier held against the housing through the path carrier -> crank
+    supports -> crank shaft -> eccentrics -> needle bearings -> discs -> pins):
+
+    * pins: 1 / C_c with the tangent pin stiffness of the Palmgren pin-load solution
+      (:func:`second_stage_stiffness`, ``c_mesh_tangent``);
+    * needle_bearings: the needle bearings of all discs and cranks in parallel on
+      the lever a_w, each with the direction-resolved tangent of seed 004's
+      empirical law as the models integrate it (F = (0.9 C delta)^(10/9),
+      delta = |d| - c_r with the radial clearance c_r, K_Hc = C F^0.1): along its
+      load K_Hc, across it F / |d| (the load's direction turns with d), so a
+      bearing whose force F_jk (:func:`crank_bearing_forces`; disc k's pin
+      resultant turned by 2 pi k / n_discs with its eccentric) makes the angle
+      beta with the tangent t_j gives a_w^2 (K_Hc cos^2 beta + F/|d| sin^2 beta);
+      seed 004's C_Hc is the limit beta = 0;
+    * support_bearings and crank_bending: each crank's support carries the couple
+      part of its needle forces, T / (N a_w) tangential (the discs' radial pin
+      resultants, equal and opposite for two discs 180 deg apart, cancel on the
+      crank; :func:`crank_bearing_forces`), through the law of the dynamic and
+      quasi-static models (:func:`flexrv.contact.tapered_roller.support_deflection`
+      with :func:`support_constants`): the bearings' tangent K_b and the shaft's
+      k_bend in series per crank, the N cranks in parallel on the lever a_w:
+      1 / (a_w^2 sum_j t_j . K_b,j t_j) and 1 / (N a_w^2 k_bend).
+
+    Neglected (stated): the first stage (its mesh compliance reaches the output
+    only through the eccentricity's lever, < 0.1 % in the quasi-static budget), the
+    crank torsion, the carrier, the housing and the main bearing (not in the torque
+    path of the rigid model either).
+    """
+    from flexrv.analysis.pin_load import reducer_pin_loads
+    from flexrv.contact.tapered_roller import SC_K_BEND, crank_support_force, support_deflection
+
+    torque = reducer.operating.rated_torque_Nm if output_torque is None else float(output_torque)
+    st = second_stage_stiffness(reducer, torque, crank_angle)
+    n = reducer.first_stage.n_planets
+    a_w = reducer.first_stage.center_distance
+    sc, angles, linear = support_constants(reducer)
+    rigid = sc.copy()
+    rigid[SC_K_BEND] = 0.0
+    th = crank_hole_angles(n)
+    f_sup = abs(torque) / (n * a_w)
+    k_bear = 0.0
+    for j in range(n):
+        t = np.array([-np.sin(th[j]), np.cos(th[j])])
+        _, _, b = support_deflection(f_sup * t, sc, angles, linear)
+        _, _, kxx, kxy, kyy, *_ = crank_support_force(b[0], b[1], 0.0, 0.0, rigid, angles, linear, b[0], b[1])
+        k_bear += t @ np.array([[kxx, kxy], [kxy, kyy]]) @ t
+    nb, nd = reducer.needle_bearing, reducer.second_stage.n_discs
+    c_emp = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * M_PER_MM))  # K_Hc = C F^0.1
+    clear = nb.radial_clearance_um * M_PER_UM
+    k_needle = 0.0
+    pins = reducer_pin_loads(reducer, torque, crank_angle)
+    for k in range(nd):
+        turn = 2.0 * np.pi * k / nd
+        rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+        forces = crank_bearing_forces(rot @ pins.resultant, torque / nd, a_w, n)
+        for j in range(n):
+            fm = float(np.linalg.norm(forces[j]))
+            cos2 = (forces[j] @ np.array([-np.sin(th[j]), np.cos(th[j])]) / fm) ** 2
+            k_along = c_emp * fm**0.1
+            k_across = fm / (fm**0.9 / (0.9 * c_emp) + clear)
+            k_needle += a_w**2 * (k_along * cos2 + k_across * (1.0 - cos2))
+    comp = {"pins": float(1.0 / st.c_mesh_tangent), "needle_bearings": float(1.0 / k_needle),
+            "support_bearings": float(1.0 / (a_w**2 * k_bear)),
+            "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0}
+    total = float(sum(comp.values()))
+    return StiffnessBudget(compliances=comp, total=total, rigidity=1.0 / total,
+                           shares={k: v / total for k, v in comp.items()}, torque=torque,
+                           support_forces=np.full(n, f_sup))

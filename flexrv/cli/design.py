@@ -83,7 +83,8 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
            json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Analytic design report at the preset's operating point (kinematics, ISO 6336
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
-    loads, Hertz, film thickness, life)."""
+    loads, Hertz, film thickness, life) and the stiffness budget of the torque path
+    (each element's torsional compliance, share and the total)."""
     from flexrv.analysis.report import design_report
     from flexrv.errors import ConvergenceError
 
@@ -102,13 +103,55 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
     warnings = load_sanity_warnings(report)
     if warnings:
         report["warnings"] = warnings
+    report["stiffness_budget"] = analytic_budget(reducer)
 
     def render(rep):
-        render_nested(f"Design report: {reducer.name}", {k: v for k, v in rep.items() if k != "warnings"})
+        render_nested(f"Design report: {reducer.name}",
+                      {k: v for k, v in rep.items() if k not in ("warnings", "stiffness_budget")})
+        console.print(budget_table(f"stiffness budget (analytic series model) at {rep['stiffness_budget']['torque_Nm']:.6g} N m",
+                                   rep["stiffness_budget"]))
         for message in rep.get("warnings", []):
             console.print(f"warning: {message}", style="yellow")
 
     emit(report, json, render)
+
+
+def budget_dict(compliances: dict[str, float], torque: float) -> dict:
+    """Stiffness budget in engineering units: per element its torsional compliance
+    at the output [arcsec/(N m)] and share [%], the total and the rigidity
+    [N m/arcmin] (``flexrv design`` and ``flexrv te`` print the same dict)."""
+    from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+    total = sum(compliances.values())
+    return {"elements": {k: {"compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD, "share_percent": 100.0 * v / total}
+                         for k, v in compliances.items()},
+            "total_compliance_arcsec_per_Nm": total * ARCSEC_PER_RAD,
+            "rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / total, "torque_Nm": torque}
+
+
+def analytic_budget(reducer, torque: float | None = None) -> dict:
+    """:func:`budget_dict` of :func:`flexrv.analysis.torsional.stiffness_budget` at
+    ``torque`` [N m] (default: the rated torque)."""
+    from flexrv.analysis.torsional import stiffness_budget
+
+    b = stiffness_budget(reducer, torque)
+    return budget_dict(b.compliances, b.torque)
+
+
+def budget_table(title: str, budget: dict) -> Table:
+    """Table element | compliance | share of a :func:`budget_dict`, with the total."""
+    table = Table(title=title, title_justify="left")
+    for col, just in (("element", "left"), ("compliance [arcsec/(N m)]", "right"), ("share [%]", "right")):
+        table.add_column(col, justify=just)
+    for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
+        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]))
+    table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100")
+    table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "")
+    if "analytic_rigidity_Nm_per_arcmin" in budget:
+        table.add_row("analytic series model (flexrv design) [N m/arcmin]",
+                      fmt(budget["analytic_rigidity_Nm_per_arcmin"]),
+                      f"{budget['analytic_difference_percent']:+.3g} % total")
+    return table
 
 
 #: ISO 76:2006 static load rating: the contact pressure at the static rating is

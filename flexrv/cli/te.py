@@ -5,9 +5,11 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
 import typer
 
 from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
+from flexrv.cli.design import analytic_budget, budget_table
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -44,6 +46,11 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     save_te(ds, summary, reducer, out)
     te_plots(ds, summary, out)
     data = {"output_dir": str(out), **summary}
+    data["stiffness_budget"] = quasi_static_budget(summary, result.outputs)
+    analytic = analytic_budget(reducer, summary["torque_Nm"])
+    data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
+    data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
+        analytic["total_compliance_arcsec_per_Nm"] / data["stiffness_budget"]["total_compliance_arcsec_per_Nm"] - 1.0)
 
     def render(d):
         rows = [("loaded TE p-p", d["te_pp_arcsec"], "arcsec"), ("loaded TE mean", d["te_mean_arcsec"], "arcsec"),
@@ -55,12 +62,38 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
                 ("max pin force", d.get("max_pin_force_N"), "N"), ("positions", d["positions"], "-"),
                 ("solve time", d["solve_time_s"], "s"), ("output", d["output_dir"], "")]
         console.print(kv_table(f"quasi-static TE {reducer.name} at {d['torque_Nm']:.6g} N m", rows))
-        budget = sorted(d.get("compliance_budget_percent", {}).items(), key=lambda kv: -kv[1])
-        console.print(kv_table("compliance budget", [(k.replace("_", " "), v, "%") for k, v in budget]))
+        console.print(budget_table(f"stiffness budget (quasi-static, strain energy) at {d['torque_Nm']:.6g} N m",
+                                   d["stiffness_budget"]))
         lines = [(f"{x['label']}", x["amplitude_arcsec"], f"order {x['order']:.4g}") for x in d["spectrum_lines"]]
         console.print(kv_table("largest TE lines [arcsec]", lines))
 
     emit(data, json, render)
+
+
+def quasi_static_budget(summary: dict, outputs: dict) -> dict:
+    """Stiffness budget of the quasi-static solution in the elements of ``flexrv
+    design`` (:func:`flexrv.cli.design.budget_dict`): each force group's share of the
+    tangent compliance 1 / k_t (strain-energy fractions,
+    :meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`) times 1 / k_t;
+    the crank-support group (bearings and crank bending in series, one element) is
+    split by its bending share of the tangential compliance (output
+    ``crank_bending_fraction``, mean over positions and cranks)."""
+    from flexrv.cli.design import budget_dict
+    from flexrv.units import RAD_PER_ARCMIN
+
+    total = RAD_PER_ARCMIN / summary["torsional_rigidity_Nm_per_arcmin"]
+    shares = dict(summary.get("compliance_budget_percent", {}))
+    comp = {}
+    bend = outputs.get("crank_bending_fraction")
+    frac = float(np.nanmean(bend.values)) if bend is not None else 0.0
+    for name, pct in shares.items():
+        c = 0.01 * pct * total
+        if name == "crank_supports":
+            comp["support_bearings"] = (1.0 - frac) * c
+            comp["crank_bending"] = frac * c
+        else:
+            comp[name] = c
+    return budget_dict(comp, summary["torque_Nm"])
 
 
 def register(app: typer.Typer) -> None:

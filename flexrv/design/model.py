@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, model_serializer, model_validator
 
 from flexrv.design._base import _bad, _Strict
 
@@ -212,8 +212,63 @@ class Crankshaft(_Strict):
     support_journal_length_mm: float = Field(gt=1.0, le=200.0)
     eccentric_journal_diameter_mm: float = Field(gt=1.0, le=200.0, description="Needle-bearing inner raceway diameter [mm]")
     eccentric_journal_length_mm: float = Field(gt=1.0, le=200.0)
-    support_bearing_radial_stiffness_N_per_m: float = Field(gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing")
+    support_bearing_model: Literal["tapered_rollers", "linear"] = Field(
+        default="tapered_rollers", description="Crank support law: roller-resolved preloaded tapered-roller pair "
+        "(flexrv.contact.tapered_roller) or the linear spring of support_bearing_radial_stiffness_N_per_m")
+    support_bearing_roller_count: int | None = Field(default=None, ge=6, le=60, description="Rollers per support bearing Z [-]")
+    support_bearing_roller_diameter_mm: float | None = Field(default=None, gt=0.5, le=50.0, description="Mean roller diameter D [mm]")
+    support_bearing_roller_length_mm: float | None = Field(default=None, gt=0.5, le=100.0, description="Effective roller contact length l [mm]")
+    support_bearing_pitch_diameter_mm: float | None = Field(default=None, gt=2.0, le=500.0, description="Roller-set pitch diameter d_m [mm]")
+    support_bearing_contact_angle_deg: float | None = Field(default=None, ge=5.0, le=35.0, description="Cup (outer raceway) half-angle alpha [deg]")
+    support_bearing_axial_preload_um: float | None = Field(default=None, ge=-50.0, le=50.0, description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end play (-) [um]")
+    support_bearing_radial_stiffness_N_per_m: float | None = Field(default=None, gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing (linear model only)")
     support_bearing_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
+    bending_model: Literal["timoshenko", "rigid"] = Field(
+        default="timoshenko", description="Crank bending between the support journals and the eccentrics in series with the supports")
+
+    @model_serializer(mode="wrap")
+    def _drop_unused(self, handler):
+        """Dump without the fields of the other support law (None): TOML has no null,
+        and a dump loads back unchanged."""
+        return {k: v for k, v in handler(self).items() if v is not None}
+
+    @model_validator(mode="after")
+    def _support_bearing(self) -> "Crankshaft":
+        tapered = ("support_bearing_roller_count", "support_bearing_roller_diameter_mm", "support_bearing_roller_length_mm",
+                   "support_bearing_pitch_diameter_mm", "support_bearing_contact_angle_deg", "support_bearing_axial_preload_um")
+        if self.support_bearing_model == "linear":
+            if self.support_bearing_radial_stiffness_N_per_m is None:
+                raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", None,
+                           "missing required field of support_bearing_model = 'linear' (1e6 < value <= 1e12 N/m)")
+            given = [f for f in tapered if getattr(self, f) is not None]
+            if given:
+                raise _bad(f"crankshaft.{given[0]}", getattr(self, given[0]),
+                           "only used with support_bearing_model = 'tapered_rollers'; remove it")
+            return self
+        for f in tapered:
+            if getattr(self, f) is None:
+                raise _bad(f"crankshaft.{f}", None, "missing required field of support_bearing_model = 'tapered_rollers'")
+        if self.support_bearing_radial_stiffness_N_per_m is not None:
+            raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", self.support_bearing_radial_stiffness_N_per_m,
+                       "only used with support_bearing_model = 'linear'; remove it (the tapered-roller law computes it)")
+        d_j, dm = self.support_journal_diameter_mm, self.support_bearing_pitch_diameter_mm
+        dw, z = self.support_bearing_roller_diameter_mm, self.support_bearing_roller_count
+        wall = 0.15 * dw  # cone (inner ring) section under the roller
+        if dm - dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG) < d_j + 2.0 * wall:
+            raise _bad("crankshaft.support_bearing_pitch_diameter_mm", dm,
+                       f"must be >= {d_j + 2.0 * wall + dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG):.4g} mm: "
+                       f"the cone raceway (d_m - D cos alpha) must clear the {d_j:g} mm support journal by a "
+                       f"ring wall of 0.15 D = {wall:.3g} mm", "the bearing does not fit on the journal")
+        z_max = int(math.pi * dm / (1.05 * dw))
+        if z > z_max:
+            raise _bad("crankshaft.support_bearing_roller_count", z,
+                       f"must be <= {z_max}: {z} rollers of {dw:g} mm on the {dm:g} mm pitch circle need a 5 % cage "
+                       "bar gap", "the rollers would overlap")
+        if self.support_bearing_roller_length_mm > self.support_journal_length_mm:
+            raise _bad("crankshaft.support_bearing_roller_length_mm", self.support_bearing_roller_length_mm,
+                       f"must be <= support_journal_length_mm = {self.support_journal_length_mm:g} mm",
+                       "the bearing sits on the support journal")
+        return self
 
 
 class NeedleBearing(_Strict):

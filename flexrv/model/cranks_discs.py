@@ -4,13 +4,19 @@ eccentrics and the cycloid discs.
 Crank supports (group ``crank_supports``, members carrier + cranks): each crank
 centre is tied to its bore in the carrier, h_j = c_c + Rot(theta_c) b_j (b_j the
 as-built bore centre ``crank_bores``, nominally a_w (cos beta_j0, sin beta_j0)),
-by an isotropic spring-damper of the two support bearings (k = 2 k_sb, c =
-2 c_sb) with the radial clearance c_j (``support_clearances``): with d = p_j - h_j,
-the spring force on the crank is -k max(|d| - c_j, 0) d/|d| and the damper -c dd/dt
-acts while |d| > c_j (c_j = 0: the linear spring-damper -k d - c dd/dt); the
-crank turns freely. Jacobian: -k [(1 - c_j/|d|) I + (c_j/|d|) u u^T] (exact for
-the spring, u = d/|d|) and -c I; the terms of the bore's rotation with theta_c in
-the damper are dropped.
+through its two support bearings in series with the crank's bending
+(:mod:`flexrv.contact.tapered_roller`: a roller-resolved preloaded tapered-roller
+pair with the as-built radial clearance c_j ``support_clearances``, or the linear
+law as the explicit option, and the Timoshenko bending stiffness of the shaft
+between its supports and eccentrics): with d = p_j - h_j the force on the crank is
+f(d, gamma) of :func:`flexrv.contact.tapered_roller.crank_support_force`, gamma =
+(1 - g) phi_j / 2 + (1 + g) theta_c / 2 the cage angle, plus the damper -c dd/dt
+(c = 2 c_sb) while the support is loaded; the crank turns freely (rollers carry
+no torque). Jacobian (exact for the spring): B^T (-K_s B + h dgamma/dq) with the
+series tangent K_s and h = df/dgamma of the law, plus the bore's rotation in the
+carrier's moment, (r . f) on (theta, theta); the terms of the bore's rotation with
+theta in the damper are dropped, and for the linear law also in the spring (its
+Jacobian is kept as in tests/data/force_reference.npz).
 
 Needle bearings (group ``needle_bearings``, members cranks + discs): the journal
 centre of crank j under disc k is E = p_j + e_jk (sin chi, cos chi), chi = chi0_k +
@@ -55,6 +61,7 @@ from numba import njit
 
 from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _impact_one
+from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
 from flexrv.units import DEG_PER_RAD
 
@@ -74,9 +81,12 @@ def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
 @njit(cache=True)
 def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     """Crank supports (module docstring): Q into f[idx], Jacobians into jq, jv; the
-    force on each crank into out_fx, out_fy."""
-    idx, sc, bores, clear, out_fx, out_fy = pack
-    k, cd = sc[0], sc[1]
+    force on each crank into out_fx, out_fy, the bearing displacement into bstate
+    (the next call's Newton start) and the bending share of each support's
+    tangential compliance into out_bend."""
+    idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend = pack
+    cd, linear = dc[0], dc[1] > 0.5
+    kb, g = sc[SC_K_BEND], sc[SC_G]
     th, om = q[idx[2]], v[idx[2]]
     c, s = np.cos(th), np.sin(th)
     b = np.zeros((2, 5))
@@ -84,44 +94,51 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     for j in range(bores.shape[0]):
         lx, ly = bores[j, 0], bores[j, 1]
         rx, ry = c * lx - s * ly, s * lx + c * ly
-        jx, jy = idx[6 + 3 * j], idx[7 + 3 * j]
+        jx, jy, jp = idx[6 + 3 * j], idx[7 + 3 * j], idx[8 + 3 * j]
         dx = q[jx] - q[idx[0]] - rx
         dy = q[jy] - q[idx[1]] - ry
         dvx = v[jx] - v[idx[0]] + om * ry
         dvy = v[jy] - v[idx[1]] - om * rx
-        cj = clear[j]
-        kxx, kxy, kyy, damp = k, 0.0, k, cd
-        if cj > 0.0:  # dead band of the radial clearance
-            dist = np.sqrt(dx * dx + dy * dy)
-            if dist > cj:
-                sk = k * (1.0 - cj / dist)
-                ux, uy = dx / dist, dy / dist
-                w = k * cj / dist
-                fx = -sk * dx - cd * dvx
-                fy = -sk * dy - cd * dvy
-                kxx, kxy, kyy = sk + w * ux * ux, w * ux * uy, sk + w * uy * uy
-            else:
-                fx, fy = 0.0, 0.0
-                kxx, kxy, kyy, damp = 0.0, 0.0, 0.0, 0.0
-        else:
-            fx = -k * dx - cd * dvx  # on the crank
-            fy = -k * dy - cd * dvy
+        gam = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
+        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qs = crank_support_force(dx, dy, gam, clear[j], sc, angles, linear,
+                                                                       bstate[j, 0], bstate[j, 1])
+        bstate[j, 0], bstate[j, 1] = bx, by
+        damp = cd if (qs > 0.0 or kxx + kyy > 0.0) else 0.0
+        fx -= damp * dvx  # on the crank
+        fy -= damp * dvy
         f[idx[0]] -= fx
         f[idx[1]] -= fy
         f[idx[2]] -= rx * fy - ry * fx
         f[jx] += fx
         f[jy] += fy
         out_fx[j], out_fy[j] = fx, fy
+        # bending share of the tangential compliance: |K_s t|^2 / (k_bend t.K_s t) (module docstring
+        # of flexrv.contact.tapered_roller: the shaft deflection is K_s dd / k_bend)
+        rr = np.sqrt(rx * rx + ry * ry) + 1e-300
+        tx, ty = -ry / rr, rx / rr
+        ktx, kty = kxx * tx + kxy * ty, kxy * tx + kyy * ty
+        ktt = tx * ktx + ty * kty
+        out_bend[j] = (ktx * ktx + kty * kty) / (kb * ktt) if (kb > 0.0 and ktt > 0.0) else 0.0
         if jac:  # B = d(d)/d(crank x, y; carrier x, y, theta)
             ii[0], ii[1], ii[2], ii[3], ii[4] = jx, jy, idx[0], idx[1], idx[2]
             b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4] = 1.0, 0.0, -1.0, 0.0, ry
             b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4] = 0.0, 1.0, 0.0, -1.0, -rx
             _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
             _add_btkb(jv, ii, b, 1.0, 0.0, 1.0, damp)
+            if not linear:  # the bore's rotation in the carrier's moment: d(ry fx - rx fy)/dtheta at fixed f
+                # (the linear legacy law keeps its Jacobian of tests/data/force_reference.npz, without it)
+                jq[idx[2], idx[2]] += rx * (fx + damp * dvx) + ry * (fy + damp * dvy)
+            # the cage angle gamma(phi_j, theta): Q = B^T f, df/dgamma = h
+            for r in range(5):
+                bh = b[0, r] * hx + b[1, r] * hy
+                jq[ii[r], jp] += 0.5 * (1.0 - g) * bh
+                jq[ii[r], idx[2]] += 0.5 * (1.0 + g) * bh
 
 
 class CrankSupports(KernelGroup):
-    """Crank centres in their carrier bores (members: carrier, crank0..N-1)."""
+    """Crank centres in their carrier bores (members: carrier, crank0..N-1); the law
+    of :func:`flexrv.contact.tapered_roller.crank_support_force` with the constants of
+    :func:`flexrv.analysis.torsional.support_constants`."""
 
     name = "crank_supports"
     kind = "supports"
@@ -132,28 +149,42 @@ class CrankSupports(KernelGroup):
         self.members = ("carrier",) + tuple(f"crank{j}" for j in range(self.n))
         self.bores = np.ascontiguousarray(p.crank_bores, dtype=float)
         self.clear = np.ascontiguousarray(p.support_clearances, dtype=float)
-        self.k = p.support_stiffness
+        self.sc = np.ascontiguousarray(p.support_law, dtype=float)
+        self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
+        self.linear = bool(p.support_linear)
         self.c = p.support_damping
-        self.sc = np.array([self.k, self.c])
+        self.dc = np.array([self.c, float(self.linear)])
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
+        self.bstate = np.zeros((self.n, 2))
+        self.bend = np.zeros(self.n)
 
     def pack(self, idx, history=False):
-        return (idx, self.sc, self.bores, self.clear, self.fx, self.fy)
+        return (idx, self.sc, self.dc, self.bores, self.clear, self.angles, self.fx, self.fy, self.bstate, self.bend)
 
     @staticmethod
     def empty_pack():
         z = np.zeros(0)
-        return (np.zeros(6, np.int64), np.zeros(2), np.zeros((0, 2)), z, z, z)
+        return (np.zeros(6, np.int64), np.zeros(7), np.zeros(2), np.zeros((0, 2)), z, z, z, z, np.zeros((0, 2)), z)
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         crank_support_kernel(q, v, f, jq, jv, jac, pack)
 
+    def reset(self) -> None:
+        """Forget the bearing displacements of earlier evaluations (the inner Newton's
+        start; the solution does not depend on it beyond its 1e-13 tolerance)."""
+        self.bstate[:] = 0.0
+        super().reset()
+
     def record(self):
-        return {"fx": self.fx.copy(), "fy": self.fy.copy()}
+        return {"fx": self.fx.copy(), "fy": self.fy.copy(), "bend": self.bend.copy()}
 
     def outputs(self, t, rec):
-        return {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
-                                              "radial force of the carrier on each crank (both support bearings)")}
+        out = {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
+                                             "radial force of the carrier on each crank (both support bearings)")}
+        if self.sc[SC_K_BEND] > 0.0:  # elastic crank
+            out["crank_bending_fraction"] = Output(rec["bend"], ("time", "crank"), "1",
+                                                   "share of crank bending in the crank support's tangential compliance")
+        return out
 
 
 @njit(cache=True)

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexrv.analysis.torsional import support_constants
 from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
 from flexrv.geometry.as_built import as_built
 from flexrv.geometry.kinematics import member_speeds, total_ratio
@@ -79,8 +80,11 @@ class RigidParameters:
     carrier_inertia: float
     input_inertia: float
     # compliances
-    support_stiffness: float  #: radial stiffness of one crank in the carrier (two bearings) [N/m]
+    support_stiffness: float  #: linear support law only: radial stiffness of one crank (two bearings) [N/m]; NaN otherwise
     support_damping: float
+    support_law: np.ndarray  #: (7,) constants of flexrv.contact.tapered_roller.crank_support_force
+    support_roller_angles: np.ndarray  #: (Z,) roller spacing of a support bearing [rad] (empty: linear law)
+    support_linear: bool  #: the linear support law (crankshaft.support_bearing_model = "linear")
     main_bearing_stiffness: np.ndarray  #: (5,) x, y, z, rx, ry [N/m, N m/rad]
     main_bearing_damping: np.ndarray
     pin_k: float  #: pin-contact constant [N/m^e]
@@ -190,6 +194,7 @@ def rigid_parameters(reducer) -> RigidParameters:
     roller_k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
     d_roll = nb.roller_diameter_mm * 1e-3
     dm = cs.eccentric_journal_diameter_mm * 1e-3 + d_roll
+    support_law, support_angles, support_linear = support_constants(reducer)
     k_r = 2.0e9
     s = reducer.main_bearing.row_spacing_mm * 1e-3
     kmb = np.array([k_r, k_r, 1.0e9, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
@@ -206,8 +211,9 @@ def rigid_parameters(reducer) -> RigidParameters:
         disc_mass=disc_mass, disc_inertia=disc_inertia,
         carrier_mass=reducer.inertia.carrier_mass_kg, carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
         input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
-        support_stiffness=2.0 * cs.support_bearing_radial_stiffness_N_per_m,
+        support_stiffness=(2.0 * cs.support_bearing_radial_stiffness_N_per_m if support_linear else float("nan")),
         support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
+        support_law=support_law, support_roller_angles=support_angles, support_linear=support_linear,
         main_bearing_stiffness=kmb, main_bearing_damping=cmb,
         pin_k=pin_k, pin_exponent=pin_e, pin_c_max=ct.pin_max_damping_Ns_per_m, contact_depth=depth,
         needle_clearance=nb.radial_clearance_um * 1e-6, needle_roller_count=nb.roller_count, needle_roller_k=roller_k,
