@@ -10,8 +10,8 @@ Jacobians; adaptive step reduction on Newton failure. A run is integrated in
 segments of :data:`SEGMENT_STEPS` steps, the integrator restarted at every
 boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
-cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, same
-TE mean to 1e-5 arcsec). States are recorded by a pre-step hook every
+cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
+mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
 ``output_every`` steps, so a run that fails (Newton failure, NaN, penetration
 beyond the physical limit, a disc that skipped a pin) or is interrupted (Ctrl-C,
 SIGTERM) still returns the results up to that time:
@@ -22,7 +22,7 @@ them if ``save_to`` was given); an interrupted run returns results with
 Default step and Newton tolerances (:data:`DEFAULT_DT`, :data:`DEFAULT_NEWTON_TOLERANCE`):
 verified in tests/test_time_step.py against a 4x finer step with a 100x tighter
 tolerance (rv40e: TE mean within 1e-4 arcsec, lines up to the cycloid mesh within
-0.15 %; rv221: mean within 0.012 arcsec and its dominant line within 0.1 %, while
+0.1 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
 its 200-300 Hz lines depend on the start-up history at the Newton-tolerance level
 -- two steady responses, see that module). Cost (benchmarks/bench_rigid.py):
 ~3.6-4.4 Newton iterations per step, ~9 us per compiled residual call plus ~7 us
@@ -67,8 +67,11 @@ CHECKPOINT_INTERVAL_S = 10.0
 
 #: steps per integrator segment: the integrator restarts from the reached state at
 #: every multiple of this step index, so a checkpoint (always at such a boundary)
-#: resumes bit-identically (:meth:`Simulation.run`)
-SEGMENT_STEPS = 200
+#: resumes bit-identically (:meth:`Simulation.run`). 1000 (0.1 s at the default
+#: step; ~0.1 s of CPU for the rigid model, ~12 s for the flexible rings): a restart
+#: is a small perturbation (see run), so fewer are better; a kill loses at most one
+#: checkpoint interval plus one segment
+SEGMENT_STEPS = 1000
 
 #: signal numbers that stop a run gracefully (partial results kept): Ctrl-C, kill
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
@@ -146,7 +149,15 @@ class Simulation:
         (:meth:`~flexrv.model.base.ForceGroup.reset`: warm starts, caches). The state
         at a boundary is therefore everything the rest of the run depends on, and a
         run resumed from a boundary (:meth:`resume`) repeats exactly, bit for bit,
-        what the uninterrupted run did.
+        what the uninterrupted run did. The restart's one approximation: Exudyn
+        restarts the generalized-alpha's algorithmic accelerations from the given
+        accelerations (it has no setter for them), i.e. a_alg := a at the boundary;
+        with spectral radius 0.5 (alpha_m = 0, alpha_f = 1/3, gamma = 5/6) that
+        changes the first step's velocity by (1 - gamma) h (a_alg - a) =
+        h (a_n-1 - a_n) / 18, of the order of the scheme's own local error (rv40e:
+        TE mean unchanged to 1e-5 arcsec, lines to 0.1 %; in a start-up with
+        backlash impacts, and on rv221's two steady responses, any perturbation
+        of this size -- a Newton tolerance as well -- grows, tests/test_time_step.py).
 
         With ``save_to``, a checkpoint is written at the first segment boundary after
         every ``checkpoint_s`` seconds of wall time (``checkpoint.npz``: the records
