@@ -37,6 +37,17 @@ differences of the start-up, not monotonically in dt (both persist to t_end =
 rv221 is the dominant line at twice the crank rotation (13.6 Hz, within 1.1 % for
 every setting) and the mean within 0.08 arcsec: those are what the rv221 case
 asserts.
+
+Why: the rv221 preset runs at a light load (load_torque_Nm = 20 of 3000 rated),
+where the first-stage mesh carries 2.7 N on average with 10 um backlash: the two
+responses differ in its force fluctuation (std 1.6 N in the reference's, 0.34 N in
+the other; crank-support force std 11.5 / 3.2 N) -- a nearly unloaded mesh with
+backlash, whose periodic responses need not be unique. Loaded, the response is
+unique and converged: at 300 N m the TE mean is within 4e-4 arcsec of the
+reference for dt 1e-4 and 2e-4 s and either tolerance, at 3000 N m within 2e-4
+arcsec, the lines (13.6 and 298 Hz, >= 5 % of the largest) within 0.1 %; the
+next, 386 Hz at 0.6 % of the largest, is 1.6 % off at 1e-4 s and 2.6 % at 2e-4 s
+-- one reason to keep 1e-4 s as the default.
 """
 
 from __future__ import annotations
@@ -108,17 +119,20 @@ def test_default_step_and_tolerance_rv40e_fast():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["rv40e", "rv221"])
-def test_default_step_and_tolerance_against_fine_reference(name):
+@pytest.mark.parametrize("name, torque", [("rv40e", None), ("rv221", None), ("rv221", 3000.0)])
+def test_default_step_and_tolerance_against_fine_reference(name, torque):
     """Default settings against the fine reference (dt 2.5e-5 s, tolerance
-    1e-5 / 1e-3 N), default ramps and t_end (module table). rv40e: the full
-    criterion. rv221: mean within 0.1 arcsec and the dominant line (13.6 Hz)
-    within 2 %; its 200-300 Hz lines are not unique (module docstring). ~15 s each."""
+    1e-5 / 1e-3 N), default ramps and t_end (module table). rv40e and rv221 at its
+    rated 3000 N m: the full criterion. rv221 at its preset load (20 N m): mean
+    within 0.1 arcsec and the dominant line (13.6 Hz) within 2 %; its 200-300 Hz
+    lines are not unique (module docstring). ~7-15 s each."""
     r = load(name)
+    if torque is not None:
+        r = r.model_copy(update={"operating": r.operating.model_copy(update={"load_torque_Nm": torque})})
     run = te_signal(r, 0.4, DEFAULT_DT, DEFAULT_NEWTON_TOLERANCE)
     ref = te_signal(r, 0.4, 2.5e-5, (1e-5, 1e-3))
     d_mean, d_lines, freqs = deviations(r, run, ref)
-    if name == "rv40e":
+    if name == "rv40e" or torque is not None:
         assert d_mean < 0.05
         assert d_lines < 0.02
     else:
