@@ -216,9 +216,8 @@ class Simulation:
             q_b, v_b, a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
             state["k"] = k0
         checkpoint = None
-        if save_to is not None:
-            checkpoint = _Checkpointer(self, Path(save_to), t_end, dt, output_every, seg,
-                                       float(checkpoint_s) if checkpoint_s else None)
+        if save_to is not None and checkpoint_s is not None and checkpoint_s > 0:
+            checkpoint = _Checkpointer(self, Path(save_to), t_end, dt, output_every, seg, float(checkpoint_s))
             checkpoint.meta.update(newton_tolerance=list(newton_tolerance), spectral_radius=spectral_radius,
                                    newton_options=dict(newton_options or {}))
         report = _progress_callback(progress, t_end)
@@ -431,23 +430,23 @@ class _Checkpointer:
     :meth:`Simulation.resume`; the boundary state is its last row, its
     accelerations ``a``) and the partial results (``results.nc`` + ``config.toml``,
     status "running"), at the first boundary after every ``interval`` s of wall time
-    (None: only the final one), and at least 5x the time the last checkpoint took
+    and at least 5x the time the last checkpoint took
     (so a long run never spends more than ~1/6 of its time saving)."""
 
     def __init__(self, sim: "Simulation", directory: Path, t_end: float, dt: float, output_every: int,
-                 segment_steps: int, interval: float | None):
+                 segment_steps: int, interval: float):
         self.sim, self.directory, self.interval = sim, directory, interval
         self.meta = {"model": sim.model_name, "model_options": sim.model_options, "drive": sim.drive,
                      "t_end": t_end, "dt": dt, "output_every": output_every, "segment_steps": segment_steps}
         self.custom = sim.drive != "ramp" or sim.torque is not None  # not resumable from files
-        self.next_at = _time.perf_counter() + (interval or 0.0)
+        self.next_at = _time.perf_counter() + interval
         self.count = 0
         self.spent = 0.0
 
     def maybe_write(self, model, ts, qs, vs, boundary) -> None:
         now = _time.perf_counter()
         k = boundary[1]
-        if self.interval is None or now < self.next_at or k < 2:
+        if now < self.next_at or k < 2:
             return
         try:
             self.write_states(ts, qs, vs, boundary)
