@@ -1,16 +1,14 @@
 """No run ever lost: Ctrl-C / SIGTERM keep the partial results with exit code
-130 / 143; a SIGKILL leaves the last checkpoint readable (``results.nc`` with
-status "running" and ``checkpoint.npz``), and ``flexrv simulate --resume DIR``
-completes the run.
+130 / 143 (128 + the signal number); a SIGKILL leaves the last checkpoint readable
+(``results.nc`` with status "running" and ``checkpoint.npz``), and ``flexrv
+simulate --resume DIR`` completes the run.
 
-Resume tolerance (measured on rv40e, rigid model, t_end = 0.3 s, killed in the
-start-up): the resumed TE equals the uninterrupted run's within 1e-6 arcsec over
-the steady window (measured ~1e-10 arcsec). It is not bit-identical during the
-start-up transient before it: the restarted integrator (fresh Newton Jacobian, the
-generalized-alpha's algorithmic accelerations re-initialised at the checkpoint)
-differs at the Newton-tolerance level, which the backlash impacts of the start-up
-amplify to up to ~10 arcsec; the difference decays with the transient (< 1e-3
-arcsec after t = 0.15 s).
+Resume is bit-identical to the uninterrupted run, by construction: every run is
+integrated in segments of SEGMENT_STEPS steps, restarting the integrator at each
+boundary from the reached coordinates, velocities and accelerations with every
+group's history (pin closest-point warm starts, time caches) reset, and checkpoints
+are written only at boundaries (flexrv.simulation.Simulation.run). The SIGKILL test
+compares every variable of the two results.nc with np.array_equal.
 """
 
 from __future__ import annotations
@@ -76,7 +74,7 @@ def test_signal_keeps_partial_results(tmp_path, sig, code):
 def test_sigkill_checkpoint_and_resume(tmp_path):
     from flexrv.post.results import load_results
 
-    t_end = 0.3
+    t_end = 0.5  # 5 segments: the kill comes after a checkpoint at a boundary, long before the end
     killed = tmp_path / "killed"
     proc = _start(killed, t_end=t_end, checkpoint_s=0.3)
     _wait_for_checkpoint(proc, killed)
@@ -86,7 +84,6 @@ def test_sigkill_checkpoint_and_resume(tmp_path):
     assert part.attrs["status"] == "running"
     t_part = part["time"].values
     assert 0.0 < t_part[-1] < t_end and np.all(np.isfinite(part["te"].values))
-    assert not list(killed.glob(".*.tmp*")) or True  # a temp file of the killed save may stay until the next save
 
     resumed = subprocess.run([sys.executable, "-m", "flexrv", "simulate", "--resume", str(killed), "--json"],
                              cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=600)
@@ -98,13 +95,12 @@ def test_sigkill_checkpoint_and_resume(tmp_path):
     assert full.returncode == 0, full.stderr[-2000:]
     a, b = load_results(killed), load_results(tmp_path / "full")
     assert a.attrs["status"] == b.attrs["status"] == "completed"
-    np.testing.assert_allclose(a.time, b.time, rtol=0, atol=1e-12)
-    np.testing.assert_array_equal(a["te"].values[: len(t_part) - 1], part["te"].values[: len(t_part) - 1])
-    s0, s1 = b.steady_window()
-    steady = (b.time >= s0) & (b.time <= s1)
-    assert steady.sum() > 100
-    np.testing.assert_allclose(a["te"].values[steady], b["te"].values[steady], rtol=0, atol=1e-6)
-    assert abs(a.summary()["te_pp_arcsec"] - b.summary()["te_pp_arcsec"]) < 1e-6
+    assert np.array_equal(a.time, b.time)
+    assert set(a.ds.data_vars) == set(b.ds.data_vars) and len(a.ds.data_vars) > 20
+    differ = [n for n in a.ds.data_vars if not np.array_equal(a.ds[n].values, b.ds[n].values, equal_nan=True)]
+    assert differ == []  # bit-identical, start-up transient included
+    np.testing.assert_array_equal(a["te"].values[: len(t_part)], part["te"].values)
+    assert a.summary()["te_pp_arcsec"] == b.summary()["te_pp_arcsec"]
 
 
 def test_resume_refuses_what_it_cannot_continue(tmp_path):

@@ -195,3 +195,22 @@ def test_ctrl_c_keeps_partial_results(tmp_path):
     assert res.attrs["status"] == "interrupted"
     assert 0.003 < res.time[-1] < 0.05
     assert (tmp_path / "partial" / "results.nc").is_file()
+
+
+def test_start_with_a_skipped_pin_is_a_failure_not_a_result():
+    """Issue 15 start-up robustness: a disc that skipped a pin (every crank one full
+    turn ahead of its disc, so TE would jump by a pin pitch, 2 pi / z_c of output
+    rotation) is a failed run (SimulationError naming it, partial results with
+    status 'failed'), never returned as a result. The detection itself
+    (NeedleBearings.check: disc rotation departing from its conjugate value by more
+    than half a pin pitch) is tested in tests/test_kernel.py::test_skipped_pin_is_a_failure."""
+    sim = Simulation(fast("rv40e"))
+    m = sim.build()
+    for j in range(m.params.n_cranks):
+        m.members[f"crank{j}"].q0[2] += 2 * np.pi
+    with pytest.raises(SimulationError, match="skipped a pin") as exc:
+        sim.run(t_end=0.005, dt=1e-4)
+    assert exc.value.results.attrs["status"] == "failed"
+    for j in range(m.params.n_cranks):  # the same model from its nominal start runs
+        m.members[f"crank{j}"].q0[2] -= 2 * np.pi
+    assert sim.run(t_end=0.005, dt=1e-4).attrs["status"] == "completed"

@@ -63,6 +63,8 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
+DT_HELP = ("Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s: TE mean and lines within 0.05 arcsec / "
+           "2 % of a 4x finer reference on rv40e, tests/test_time_step.py).")
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
 
 
@@ -79,7 +81,7 @@ def _exit_code(res) -> int:
 def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --resume."),
              model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
              t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
-             dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+             dt: float = typer.Option(None, "--dt", help=DT_HELP),
              parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
              out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
              overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
@@ -92,8 +94,9 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
     import math
 
     from flexrv.errors import InputError
-    from flexrv.simulation import Simulation
+    from flexrv.simulation import DEFAULT_DT, Simulation
 
+    dt = DEFAULT_DT if dt is None else dt
     if not (math.isfinite(checkpoint) and checkpoint >= 0):
         raise InputError(f"--checkpoint-s {checkpoint}: must be a finite number >= 0 s")
     bar = _bar(not json)
@@ -151,7 +154,7 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
 def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
                        model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
                        quarter_time: float = typer.Option(0.02, "--quarter-time", help="Duration of each quarter of the torque loop [s]."),
-                       dt: float = typer.Option(1e-4, "--dt", help="Time step [s]."),
+                       dt: float = typer.Option(None, "--dt", help=DT_HELP),
                        parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
                        overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
@@ -160,8 +163,9 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     torsional rigidity, lost motion, hysteresis loop PNG."""
     from dataclasses import asdict
 
-    from flexrv.simulation import stiffness_test
+    from flexrv.simulation import DEFAULT_DT, stiffness_test
 
+    dt = DEFAULT_DT if dt is None else dt
     options = model_options(model, parts)
     out = check_output_dir(out or _default_out(preset, model, "stiffness"), "--out", overwrite=overwrite)
     bar = _bar(not json)

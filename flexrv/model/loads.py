@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from flexrv.contact.laws import adams_step
+from flexrv.contact.laws import _step_and_slope, adams_step
 from flexrv.model.base import KernelGroup, Output
 
 
@@ -24,12 +24,21 @@ def ramp_drive(speed: float, ramp_time: float):
     """(theta(t), omega(t)) of the Adams-STEP speed ramp; vectorised in t."""
 
     def omega(t):
+        if isinstance(t, float):  # the solver's scalar path: no array round trip (issue 15)
+            return speed * _step_and_slope(t, 0.0, 0.0, ramp_time, 1.0)[0] if ramp_time > 0 else speed
         t = np.asarray(t, dtype=float)
         if ramp_time <= 0:
             return np.full_like(t, speed)
         return speed * adams_step(t, 0.0, 0.0, ramp_time, 1.0)
 
     def theta(t):
+        if isinstance(t, float):
+            if ramp_time <= 0:
+                return speed * t
+            if t > ramp_time:
+                return speed * (t - 0.5 * ramp_time)
+            s = min(max(t / ramp_time, 0.0), 1.0)
+            return speed * ramp_time * (s**3 - 0.5 * s**4)
         t = np.asarray(t, dtype=float)
         if ramp_time <= 0:
             return speed * t
@@ -66,6 +75,10 @@ def step_torque(t_max: float, t1: float, t2: float):
     """T(t) = T_max step(t, t1, 0, t2, 1) (jump at t1 if t2 == t1)."""
 
     def torque(t):
+        if isinstance(t, float):  # scalar path of the solver
+            if t2 <= t1:
+                return t_max if t >= t1 else 0.0
+            return t_max * _step_and_slope(t, t1, 0.0, t2, 1.0)[0]
         t = np.asarray(t, dtype=float)
         if t2 <= t1:
             return np.where(t >= t1, t_max, 0.0)
@@ -114,7 +127,12 @@ class OutputLoads(KernelGroup):
     def time_inputs(self, t):
         """Generalized load vector (6,) at t (cached: same t in all Newton iterations)."""
         if self._cache is None or self._cache[0] != t:
-            self._cache = (t, self._forces(np.asarray(t, dtype=float), (6,)))
+            if isinstance(t, float) and not self.const.any():  # torque only: the solver's scalar path
+                f = np.zeros(6)
+                f[2] = -float(self.torque(t))
+            else:
+                f = self._forces(np.asarray(t, dtype=float), (6,))
+            self._cache = (t, f)
         return self._cache[1]
 
     def pack(self, idx, history=False):
