@@ -301,6 +301,12 @@ class MainBearing(_Strict):
     row_spacing_mm: float = Field(gt=1.0, le=1000.0, description="Axial distance between the two rows' ball centres")
     axial_preload_um: float = Field(ge=-100.0, le=100.0, description="Axial interference per row (+ preload, - clearance)")
     ball_damping_Ns_per_m: float = Field(ge=0.0, le=1e7, description="Max contact damping c_max of the impact law")
+    rigid_radial_stiffness_N_per_m: float = Field(
+        gt=1e6, le=1e12, description="Radial stiffness of the pair in the rigid main-bearing model (the ball model resolves it)")
+    rigid_axial_stiffness_N_per_m: float = Field(
+        gt=1e6, le=1e12, description="Axial stiffness of the pair in the rigid main-bearing model")
+    rigid_damping_ratio: float = Field(
+        ge=0.0, le=1.0, description="Damping ratio of the rigid main bearing's carrier modes (c = 2 zeta sqrt(k m))")
 
     @model_validator(mode="after")
     def _fits(self) -> "MainBearing":

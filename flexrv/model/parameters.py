@@ -135,10 +135,11 @@ def rigid_parameters(reducer) -> RigidParameters:
     crank = planet gear (pitch-circle disc, face width b) + gear seat + two support
     journals + two eccentric journals; disc = annulus between the centre hole and
     the root circle R_p - r_rp - a minus the crank holes (J = m (R^2 + r^2)/2 of
-    the annulus, hole correction by parallel axes). Rigid main bearing: radial
-    stiffness 2e9 N/m, axial 1e9 N/m, tilting k_r (s/2)^2 with the row spacing s
-    (estimate typical of a preloaded thin-section pair of this size; the flexible
-    main-bearing model replaces it).
+    the annulus, hole correction by parallel axes). Rigid main bearing: the
+    design's radial and axial stiffness (``main_bearing.rigid_*``, estimates with
+    provenance in the presets), tilting k_r (s/2)^2 with the row spacing s, and
+    carrier-mode damping 2 zeta sqrt(k m) (the ball-resolved and flexible
+    main-bearing models replace it).
     """
     fs, ss, cs, nb = reducer.first_stage, reducer.second_stage, reducer.crankshaft, reducer.needle_bearing
     op, ct = reducer.operating, reducer.contact
@@ -195,10 +196,11 @@ def rigid_parameters(reducer) -> RigidParameters:
     d_roll = nb.roller_diameter_mm * 1e-3
     dm = cs.eccentric_journal_diameter_mm * 1e-3 + d_roll
     support_law, support_angles, support_linear = support_constants(reducer)
-    k_r = 2.0e9
-    s = reducer.main_bearing.row_spacing_mm * 1e-3
-    kmb = np.array([k_r, k_r, 1.0e9, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
-    cmb = 2.0 * 0.05 * np.sqrt(kmb * np.array([reducer.inertia.carrier_mass_kg] * 3
+    mb = reducer.main_bearing
+    k_r = mb.rigid_radial_stiffness_N_per_m
+    s = mb.row_spacing_mm * 1e-3
+    kmb = np.array([k_r, k_r, mb.rigid_axial_stiffness_N_per_m, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
+    cmb = 2.0 * mb.rigid_damping_ratio * np.sqrt(kmb * np.array([reducer.inertia.carrier_mass_kg] * 3
                                               + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2))
     return RigidParameters(
         n_cranks=n, n_discs=nd, z_s=z_s, z_p=z_p, z_c=z_c, z_rp=z_rp, ratio=ratio,
