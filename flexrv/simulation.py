@@ -40,7 +40,7 @@ from typing import Callable
 import numpy as np
 
 from flexrv.design import load
-from flexrv.errors import InputError, SimulationError
+from flexrv.errors import InputError, SimulationError, check_options
 from flexrv.viz.plots import PlottedResults as Results  # re-exported: flexrv.Results (saves its PNGs)
 from flexrv.units import ARCMIN_PER_RAD
 
@@ -197,6 +197,8 @@ class Simulation:
         check_step_count(t_end, dt, output_every, t_start=t_start)
         import exudyn as exu
 
+        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+
         model = self.model if self.model is not None else self.build()
         from flexrv.model.kernel_cache import announce_compile
 
@@ -268,7 +270,7 @@ class Simulation:
         ti.newton.useModifiedNewton = True
         ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
         ti.generalizedAlpha.spectralRadius = spectral_radius
-        for key, value in (newton_options or {}).items():
+        for key, value in newton_options.items():
             setattr(ti.newton, key, value)
         # massless (quasi-static) coordinates make M singular: start from rest with
         # zero accelerations instead (every run starts at rest in equilibrium)
@@ -480,6 +482,14 @@ class _Checkpointer:
         save_checkpoint(self.directory, np.append(ts[:k], t_b), np.vstack([qs[:k], q_b[None]]),
                         np.vstack([vs[:k], v_b[None]]), meta, self.sim.reducer, a_b)
         self.spent += _time.perf_counter() - t0
+
+
+def _newton_settings(exu) -> dict[str, object]:
+    """Exudyn's Newton settings by name with their default values (the options
+    ``newton_options`` may set, :func:`flexrv.errors.check_options`)."""
+    ns = exu.SimulationSettings().timeIntegration.newton
+    return {k: getattr(ns, k) for k in dir(ns)
+            if not k.startswith("_") and isinstance(getattr(ns, k), (bool, int, float, str))}
 
 
 def _progress_callback(progress, t_end):

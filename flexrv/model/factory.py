@@ -25,7 +25,7 @@ from typing import Callable
 
 import numpy as np
 
-from flexrv.errors import ConfigError
+from flexrv.errors import ConfigError, check_options, signature_options
 from flexrv.model.assembled import AssembledModel
 from flexrv.model.base import Member
 
@@ -112,7 +112,8 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         if main_bearing == "flexible":
             from flexrv.model.flexible_bearing import flexible_rings
 
-            rings = flexible_rings(reducer, **(ring_options or {}))
+            rings = flexible_rings(reducer, **check_options("ring_options", ring_options,
+                                                            signature_options(flexible_rings, skip=1)))
             info["flexible_bodies"] = rings["bodies"]
             info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
         group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer")))
@@ -123,7 +124,8 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     if crankshaft == "flexible":
         from flexrv.model.flexible_crank import add_flexible_cranks
 
-        info.update(add_flexible_cranks(reducer, p, members, groups, **(crank_options or {})))
+        info.update(add_flexible_cranks(reducer, p, members, groups, **check_options(
+            "crank_options", crank_options, signature_options(add_flexible_cranks, skip=4))))
     elif crankshaft != "rigid":
         raise ConfigError(f"crankshaft = {crankshaft!r} is not allowed: choose 'rigid' or 'flexible'")
     info.update(main_bearing=main_bearing, crankshaft=crankshaft)
@@ -235,4 +237,12 @@ def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
     """Build the named model for a design (see :data:`MODELS`)."""
     if model not in MODELS:
         raise ConfigError(f"model = {model!r} is not allowed: choose one of {sorted(MODELS)}")
-    return MODELS[model](reducer, **kwargs)
+    builder = MODELS[model]
+    allowed = signature_options(builder, skip=1, exclude=("model_name", "exudyn"))
+    if builder is not build_rigid:  # build_balls / build_flexible pass the rest on to build_rigid
+        set_here = ("main_bearing", "crankshaft") if builder is build_flexible else ("main_bearing",)
+        allowed = {**signature_options(build_rigid, skip=1, exclude=("model_name", "exudyn") + set_here), **allowed}
+        allowed.pop("kwargs", None)
+    opts = check_options(f"model options of {model!r}", {k: v for k, v in kwargs.items() if k not in ("drive", "torque")},
+                         allowed)
+    return builder(reducer, **{**kwargs, **opts})
