@@ -97,9 +97,31 @@ def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
         if jac and active:
             g = (gx, gy, gp)
             ii = (ix, iy, ip)
-            for m in range(3):
-                for n in range(3):
-                    jq[ii[m], ii[n]] -= k * g[m] * g[n]
+            # curvature of delta(x, y, phi) (module docstring, "Jacobian")
+            ss = a_s * np.sin(ts - beta + ph_s)
+            sp = a_p * np.sin(phi - beta + ph_p)
+            sb = ss + sp  # d rb / d beta
+            a4, a3 = a2 * a2, a2 * a
+            hxx = -sb * y * y / a4 - 2.0 * rb * x * y / a4 - sw * y * y / a3
+            hxy = sb * x * y / a4 + rb * (x * x - y * y) / a4 + sw * x * y / a3
+            hyy = -sb * x * x / a4 + 2.0 * rb * x * y / a4 - sw * x * x / a3
+            hxp, hyp, hpp = -sp * y / a2, sp * x / a2, -sp
+            hess = ((hxx, hxy, hxp), (hxy, hyy, hyp), (hxp, hyp, hpp))
+            # d beta / dq and the stiffness' slope along the mesh phase (central difference of the
+            # one stiffness law, exact for its piecewise-linear ramps beyond 1e-6 of their corners)
+            bx, by = -y / a2, x / a2
+            xi = (zs / TWO_PI) * (ts - beta - beta0[j])
+            dk = (mesh_stiffness_ramped(xi + 1e-6, ks, eps, ramp)
+                  - mesh_stiffness_ramped(xi - 1e-6, ks, eps, ramp)) / 2e-6 * (-zs / TWO_PI)
+            d_eff = delta if delta > 0.0 else delta + bn
+            vv = (v[ix], v[iy], v[ip])
+            for n in range(3):
+                db = bx if n == 0 else (by if n == 1 else 0.0)
+                # dF/dq_n: stiffness, its phase change, damping through g(q) and the sun runout's rate
+                hv = hess[0][n] * vv[0] + hess[1][n] * vv[1] + hess[2][n] * vv[2]
+                dfn = k * g[n] + d_eff * dk * db + c * (hv + ss * ws * db)
+                for m in range(3):
+                    jq[ii[m], ii[n]] -= g[m] * dfn + force * hess[m][n]
                     jv[ii[m], ii[n]] -= c * g[m] * g[n]
 
 

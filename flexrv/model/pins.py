@@ -48,7 +48,7 @@ from numba import njit
 
 from flexrv.contact.laws import _impact_one
 from flexrv.errors import ConvergenceError
-from flexrv.geometry.cycloid import _FOOT, closest_point_settings
+from flexrv.geometry.cycloid import _FOOT, _POINT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output
 
 
@@ -57,11 +57,40 @@ def _add_outer3(m, ix, iy, ip, w, g0, g1, g2):
     """m[a, b] += w g_a g_b over one disc's coordinates (a, b in x, y, psi): a
     pin's contribution w (dF/dgap or dF/dgap_rate) to the Jacobian through its gap
     gradient g."""
+    _add_outer3ab(m, ix, iy, ip, w, g0, g1, g2, g0, g1, g2)
+
+
+@njit(cache=True)
+def _add_outer3ab(m, ix, iy, ip, w, a0, a1, a2, b0, b1, b2):
+    """m[a, b] += w a_a b_b over one disc's coordinates (x, y, psi)."""
     ii = (ix, iy, ip)
-    g = (g0, g1, g2)
-    for a in range(3):
-        for b in range(3):
-            m[ii[a], ii[b]] += w * g[a] * g[b]
+    a = (a0, a1, a2)
+    b = (b0, b1, b2)
+    for r in range(3):
+        for c in range(3):
+            m[ii[r], ii[c]] += w * a[r] * b[c]
+
+
+@njit(cache=True)
+def _gap_curvature(ph, z_rp, radius, ecc, dist, nlx, nly, cr, sr, c, s, rx, ry, nx, ny, harm, kd):
+    """Second-order terms of one pin's gap for the exact Jacobian (module
+    docstring, "Jacobian"): returns (h, w0, w1, w2, b, s02, s12, s22) with the
+    gradient's derivative d G / dq = h w w^T + S (S nonzero in the psi row and
+    column only: S[0, 2] = s02, S[1, 2] = s12, S[2, 2] = s22) and the gap's exact
+    gradient dg/dq = G + b w (b: the harmonics' change with the foot point)."""
+    _, _, d1x, d1y, d2x, d2y = _POINT(ph, z_rp, radius, ecc)
+    speed2 = d1x * d1x + d1y * d1y
+    mc2 = nlx * d2x + nly * d2y
+    den = speed2 - dist * mc2  # d2/dphi2 of |P - C|^2 / 2 at the foot point (> 0: a minimum)
+    h = -mc2 / den
+    speed = np.sqrt(speed2)
+    tx, ty = d1x / speed, d1y / speed  # unit tangent, profile frame
+    ux, uy = cr * tx - sr * ty, sr * tx + cr * ty  # disc frame
+    tx, ty = c * ux - s * uy, s * ux + c * uy  # housing frame
+    a_h = 0.0
+    for k in range(harm.shape[1]):
+        a_h += harm[kd, k, 1] * harm[kd, k, 0] * np.sin(harm[kd, k, 0] * ph + harm[kd, k, 2])
+    return h, tx, ty, rx * ty - ry * tx, -a_h * speed / den, ny, -nx, -(rx * nx + ry * ny)
 
 
 @njit(cache=True)
@@ -123,8 +152,23 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             fx += force * g0
             fy += force * g1
             fp += force * g2
-            if jac and (dfg != 0.0 or dfr != 0.0):
-                _add_outer3(jq, ix, iy, ip, dfg, g0, g1, g2)
+            if jac and (force != 0.0 or dfg != 0.0 or dfr != 0.0):
+                h, w0, w1, w2, b, s02, s12, s22 = _gap_curvature(ph, z_rp, radius, ecc, dist, nlx, nly, cr, sr, c, s,
+                                                                 rx, ry, nx, ny, harm, kd)
+                # dF/dgap g (G + b w)^T: the force's change; the exact gap gradient includes the harmonics' b w
+                _add_outer3ab(jq, ix, iy, ip, dfg, g0, g1, g2, g0 + b * w0, g1 + b * w1, g2 + b * w2)
+                # F dG/dq = F (h w w^T + S): the turn of the normal and of the arm (curvature terms)
+                _add_outer3(jq, ix, iy, ip, force * h, w0, w1, w2)
+                jq[ix, ip] += force * s02
+                jq[ip, ix] += force * s02
+                jq[iy, ip] += force * s12
+                jq[ip, iy] += force * s12
+                jq[ip, ip] += force * s22
+                # dF/drate d(rate)/dq = dF/drate G (dG/dq v)^T (zero at rest)
+                wv = h * (w0 * v[ix] + w1 * v[iy] + w2 * v[ip])
+                hv0, hv1 = wv * w0 + s02 * v[ip], wv * w1 + s12 * v[ip]
+                hv2 = wv * w2 + s02 * v[ix] + s12 * v[iy] + s22 * v[ip]
+                _add_outer3ab(jq, ix, iy, ip, dfr, g0, g1, g2, hv0, hv1, hv2)
                 _add_outer3(jv, ix, iy, ip, dfr, g0, g1, g2)
         f[ix] += fx
         f[iy] += fy
