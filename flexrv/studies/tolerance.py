@@ -487,6 +487,8 @@ class StudyConfig:
     sobol: bool = False
     out: str | None = None
     what_if_samples: int = 16
+    #: tolerance entries of the what-if table (None: every entry; cost 2 M per entry)
+    what_if_entries: list[str] | None = None
     resolution: dict[str, Any] = field(default_factory=lambda: dict(DEFAULT_RESOLUTION))
 
 
@@ -514,6 +516,8 @@ def _validate(cfg: StudyConfig) -> list[Spec]:
         raise InputError(f"--workers {cfg.workers}: must be >= 1")
     if cfg.what_if_samples < 0:
         raise InputError(f"--what-if-samples {cfg.what_if_samples}: must be >= 0")
+    if cfg.what_if_entries is not None and not isinstance(cfg.what_if_entries, (list, tuple)):
+        raise InputError(f"what_if_entries {cfg.what_if_entries!r}: must be a list of tolerance entries")
     if not isinstance(cfg.seed, int) or cfg.seed < 0:
         raise InputError(f"--seed {cfg.seed!r}: must be an integer >= 0")
     unknown = set(cfg.resolution) - set(DEFAULT_RESOLUTION)
@@ -569,7 +573,11 @@ def plan_cases(cfg: StudyConfig, reducer, tol) -> tuple[TolerancePlan, dict[str,
         cases += [("saltelli", i, "", 1.0, plan.errors_for(parts["saltelli_x"][i]))
                   for i in range(len(parts["saltelli_x"])) if i not in done]
     m = min(cfg.what_if_samples, len(x))
-    for key in tol.entries:
+    what_if = list(tol.entries) if cfg.what_if_entries is None else list(cfg.what_if_entries)
+    unknown = [k for k in what_if if k not in tol.entries]
+    if unknown:
+        raise InputError(f"what-if entries {unknown} are not in the tolerance set; allowed: {sorted(tol.entries)}")
+    for key in what_if:
         for f in (0.5, 2.0):
             cases += [("what_if", i, key, f, plan.errors_for(x[i], {key: f})) for i in range(m)]
     parts["cases"] = cases
