@@ -131,11 +131,12 @@ def _fd(fun, x, h):
 @pytest.mark.parametrize("name,needle", CASES)
 def test_fused_jacobian_vs_central_differences(name, needle):
     """dF/dq and dF/dv of the fused kernel vs central differences (h = 1e-10) of
-    its own force at a loaded state: within 1 % of the largest entry. Dropped by
-    design (modified Newton converges on the exact residual): the curvature terms
-    F d2g/dq2 of the pin gaps (normal rotation, ~F/rho), of the mesh deflection
-    (beta(x, y), a(x, y): ~F/a_w), the rotation of the needle arms and roller
-    directions (~F e) and of the support bores in the damper (~c omega)."""
+    its own force at a loaded state (with speeds): within 1e-3 of the largest entry
+    (measured 3e-8 with the roller needle model, 3e-5 / 1e-4 on rv40e / rv221 with
+    the empirical one). The pin and gear-mesh Jacobians are complete (see
+    test_completed_jacobians_vs_central_differences); still dropped by design
+    (modified Newton converges on the exact residual): the rotation of the
+    empirical needle arms (~F e) and of the support bores in the damper (~c omega)."""
     m = build_model(_variant(name, needle), exudyn=False)
     q, v = _loaded(m)
     t = 0.002
@@ -143,8 +144,8 @@ def test_fused_jacobian_vs_central_differences(name, needle):
     nq = _fd(lambda x: m.generalized_forces(t, x, v, jacobian=False)[0], q, 1e-10)
     nv = _fd(lambda x: m.generalized_forces(t, q, x, jacobian=False)[0], v, 1e-6)
     assert np.abs(nq).max() > 1e6 and np.abs(nv).max() > 10.0  # contacts loaded
-    assert np.abs(dq - nq).max() <= 0.01 * np.abs(nq).max()
-    assert np.abs(dv - nv).max() <= 0.01 * np.abs(nv).max()
+    assert np.abs(dq - nq).max() <= 1e-3 * np.abs(nq).max()
+    assert np.abs(dv - nv).max() <= 1e-3 * np.abs(nv).max()
 
 
 def _static_states(reducer, torques=(1.0, 0.01)):

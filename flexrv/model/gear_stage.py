@@ -23,9 +23,19 @@ time_varying_mesh_stiffness` at the mesh phase xi_j = z_s (theta_s - beta_j)/2pi
 the planet), and the mesh damping c12 of
 :func:`flexrv.analysis.mesh_stiffness.involute_stage`. The generalized forces
 are Q = -F d(delta)/dq (exact, the deflection being a function of the
-coordinates). Analytic Jacobian: -dF/d(delta) g g^T and -c g g^T (g = d delta/dq;
-the curvature terms of beta(x, y) are dropped, modified Newton converges on the
-exact residual).
+coordinates). Jacobian (complete, g = d delta/dq over the planet's (x, y, phi)):
+
+    dQ/dq = -g (dF/dq)^T - F H,   dQ/dv = -c g g^T,
+    dF/dq = k g + delta_e (dk/dxi) dxi/dq + c (H v + A_s sin(theta_s - beta + ph_s) omega_s dbeta/dq),
+
+H = d2 delta/dq2 the deflection's curvature (from beta(x, y) = atan2(y, x), the
+radius a(x, y) and the runout terms), delta_e = delta (drive flank) or delta + b_n
+(coast flank), xi the mesh phase (dxi/dq = -z_s/2pi dbeta/dq). The stiffness
+slope dk/dxi is the central difference (+-1e-6 in phase) of the one stiffness law
+:func:`~flexrv.analysis.mesh_stiffness.mesh_stiffness_ramped`, exact for its
+piecewise-linear ramps except within 1e-6 of their corners. Verified against
+central differences in tests/test_kernel.py (1e-6 of the largest entry; measured
+7-8e-8).
 
 As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): sun runout
 (A_s, ph_s), planet runout (A_j, ph_j) and planet assembly phase errors err_j
