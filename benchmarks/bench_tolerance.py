@@ -25,9 +25,15 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import sys
 import tempfile
 import time
+from pathlib import Path
 
+#: this checkout's flexrv, in this process and in the spawned dask workers
+ROOT = str(Path(__file__).resolve().parent.parent)
+sys.path.insert(0, ROOT)
+os.environ["PYTHONPATH"] = os.pathsep.join([ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -57,8 +63,10 @@ def main() -> None:
     ap.add_argument("--crank-revolutions", type=float, default=1.0)
     ap.add_argument("--points-per-mesh", type=int, default=2)
     args = ap.parse_args()
+    import flexrv
     from flexrv.studies.tolerance import DEFAULT_RESOLUTION
 
+    print(f"flexrv from {Path(flexrv.__file__).parent}", flush=True)
     n1, n2 = sorted(args.samples)
     if n1 >= n2 or n1 < 1:
         ap.error("--samples N1 N2 with 1 <= N1 < N2")
