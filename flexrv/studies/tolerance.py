@@ -30,30 +30,42 @@ Pipeline
 Resolution of one evaluation: :data:`DEFAULT_RESOLUTION`, one crank revolution
 at 2 points per pin-mesh period (78 loaded + 78 no-load positions on rv40e).
 Measured on one sample (rv40e with the example error set ``iso_grade5_rv40e``,
-rated torque, :func:`te_task`, compiled kernels, shared core):
+rated torque, :func:`te_task`, compiled kernels, CPU time in a warm process;
+2026-11-24, after the pins' and gear meshes' Jacobians were completed):
 
 =====================  ==========  ==========  ===========  ===========
 quantity               crank, K=2  crank, K=8  output, K=2  output, K=8
 =====================  ==========  ==========  ===========  ===========
 TE p-p [arcsec]        53.2256     53.2256     57.1531      57.2632
 mean TE [arcsec]       -124.2471   -124.2466   -124.5481    -124.5478
-no-load TE p-p         53.666      53.901      77.499       78.251
+no-load TE p-p         50.613      50.727      68.191       68.422
 lost motion [arcmin]   0.3044      0.2892      0.1756       0.1806
 backlash [arcmin]      0.0920      0.0901      0.0560       0.0611
-rigidity [N m/arcmin]  267.01      266.49      269.00       268.43
-wall time [s]          1.8         2.0         51 (retry)   34
+rigidity [N m/arcmin]  267.10      266.59      269.19       268.60
+CPU time [s]           0.18        0.40        4.3          13.2
 =====================  ==========  ==========  ===========  ===========
 
 (crank = one crank revolution, output = one output revolution, K = points per
 pin-mesh period.) Against K = 8 over the same crank revolution, K = 2 changes
-TE p-p by < 1e-4, mean TE by 4e-6, no-load TE p-p by -0.4 %, lost motion by
+TE p-p by < 1e-4, mean TE by 4e-6, no-load TE p-p by -0.2 %, lost motion by
 +5 %, backlash by +2 %, rigidity by +0.2 %. Over one crank revolution the
 once-per-output-revolution variation of cumulative pitch errors (disc order-1
 harmonic, pin-position patterns) is not seen: TE p-p is 7 % below the
 output-revolution value on this sample, lost motion and backlash are the
 largest over catalog positions spread over a different range. One output
-revolution costs 17-28x more per sample today; give ``output_revolutions=1``
-(``--output-revolutions 1``) when the budget allows.
+revolution costs 24x more per sample (4.3 s against 0.18 s); give
+``output_revolutions=1`` (``--output-revolutions 1``) when the budget allows.
+Before the Jacobians were completed the same sample took 1.0 s at crank K=2
+(45,500 residual calls, 1,030 finite-difference Jacobians; now 2,300-3,200
+calls and none); TE, lost motion and backlash are unchanged to the digits
+shown, the tangent rigidity rose by 0.04-0.07 % (it is read from the Jacobian,
+which now includes the contacts' curvature terms).
+
+Throughput (benchmarks/bench_tolerance.py, 2026-11-24, machine shared with
+other jobs at a load average of 8-10 on its 2 cores): 0.28 CPU s per sample in
+a study (dask included), fixed start-up 10-15 s, steady 1.25 samples/s with one
+worker and 2.21 with two (x1.76), projected 1,000 samples in 7.8 min on two
+workers under that load.
 
 Sensitivities
 -------------

@@ -131,7 +131,7 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
                  f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec on the first {best['samples_used']} samples.")
     r.text.append(text)
     r.text.append("Why the numbers can differ from a measurement: the range is one crank revolution (cost: the "
-                  "output revolution is 17-28x dearer per sample), the discs, crankshafts and housing are rigid, "
+                  "output revolution is 24x dearer per sample), the discs, crankshafts and housing are rigid, "
                   "the tolerance set is a stated ISO grade (not a measured process), and a bench measures under its "
                   "own load and speed. Nothing is tuned to the published values.")
     # figures: the two distributions with the published values, the what-if bars
