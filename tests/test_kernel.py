@@ -474,3 +474,40 @@ def test_fused_element_coexists_with_ball_bearing():
     _close(f, fr, what="force")
     _close(dq, dqr, what="jac_q")
     _close(dv, dvr, what="jac_v")
+
+
+def test_curve_reach_and_certified_warm_start():
+    """The pin-centre curve's reach (pins._curve_reach) on rv40e: outside, the
+    lobe tip's radius of curvature (closed form at phi = 0, |C'|^3 / |C' x C''|),
+    times the 0.9 safety factor, within 1 %; inside, several mm. A pin whose warm
+    start sits on a wrong flank (phi moved by 0.06 rad, where the local search
+    finds a ~mm gap) gets the cold-start gap: the same gaps as a fresh group to
+    1e-12 m and forces to 1e-9 (without the reach check the gaps are wrong)."""
+    from flexrv.geometry.cycloid import center_curve
+    from flexrv.model.pins import PinContacts, _curve_reach
+
+    p = _params()
+    radius = p.pin_circle_radius + p.disc_profile[0][0]
+    out, inside = _curve_reach(int(p.z_rp), float(radius), float(p.eccentricity))
+    _, d1, d2 = center_curve(np.array([0.0]), p.z_rp, radius, p.eccentricity)
+    rho = np.hypot(*d1[0]) ** 3 / abs(d1[0, 0] * d2[0, 1] - d1[0, 1] * d2[0, 0])
+    assert out == pytest.approx(0.9 * rho, rel=0.01)
+    assert inside > 1e-3
+    m = build_model(_variant("rv40e", "empirical"), exudyn=False)
+    q, v = _loaded(m)
+    g = next(x for x in m.groups if x.name == "pins")
+    qg, vg = m.group_state(g, q), m.group_state(g, v)
+    g.reset()
+    f_ref, _ = g.evaluate(0.0, qg, vg)
+    gap_ref = g.gap.copy()
+    phi_ref = g.phi.copy()
+    for reach, ok in ((1.0, False), (None, True)):  # reach 1 m: every warm start trusted (before the check)
+        sc = g.sc.copy()
+        if reach:
+            g.sc[11:] = reach
+        g.phi[:] = phi_ref + 0.06  # every warm start on the neighbouring flank's side
+        g.last[:] = np.nan  # nothing skipped
+        f, _ = g.evaluate(0.0, qg, vg)
+        g.sc[:] = sc
+        assert (np.abs(g.gap - gap_ref).max() <= 1e-12) == ok
+    assert np.abs(f - f_ref).max() <= 1e-9 * np.abs(f_ref).max()

@@ -361,9 +361,10 @@ def test_catalog_level_independent_of_warm_start_history():
     position the -3 % level was once reached from a wrong warm-started closest
     point of five pins per disc (gaps of 1-2 mm instead of ~10 um, residual 5.5 kN
     on a cold evaluation), giving lost motion 0.1848 instead of 0.1625 arcmin.
-    StaticModel.solve now checks every solution with cold closest points: each
-    catalog level equals the one from a fresh model (fresh warm starts) started at
-    the loaded path's state, within 1e-6 arcmin."""
+    The pins kernel now re-finds a warm-started closest point from cold starts
+    wherever it lies beyond the curve's reach: each catalog level equals the one
+    from a fresh model (fresh warm starts) started at the loaded path's state,
+    within 1e-6 arcmin."""
     from flexrv.design import load_error_set, with_errors
     from flexrv.model import quasi_static as qs
 

@@ -139,8 +139,6 @@ class StaticModel:
         #: finite-difference Jacobian in the solver's exact phase (the analytic one is exact; kept
         #: for checks: 20x the residual calls)
         self.fd_fallback = False
-        #: solutions re-iterated after the cold check of the pin gaps (:meth:`solve`)
-        self.cold_restarts = 0
 
     @property
     def torque(self) -> float:
@@ -189,33 +187,6 @@ class StaticModel:
     def solve(self, theta_in: float, q_start: np.ndarray) -> tuple[np.ndarray, int]:
         """Static equilibrium at ``theta_in`` from ``q_start``; returns (q, iterations).
 
-        The iteration (:meth:`_iterate`) evaluates the pin gaps with warm-started
-        closest points; after a long excursion a warm start can track a wrong local
-        minimum of the distance (a neighbouring flank, gap ~2 mm instead of ~10 um:
-        found on rv40e with the grade-5 error set at -3 % torque, residual 5.5 kN on
-        a cold evaluation of the "converged" state). Every solution is therefore
-        checked by a cold evaluation of the pin gaps (multi-start closest points)
-        and iterated on if the two residuals differ by more than the force tolerance.
-        """
-        q, its = self._iterate(theta_in, q_start)
-        tol = self.options.force_tol * self.f_ref
-        for _ in range(3):
-            f_warm, _ = self.residual(theta_in, q, jacobian=False)
-            for g in self.model.groups:
-                if g.name == "pins":
-                    g.reset()  # the next evaluation finds every closest point from cold starts
-            f_cold, _ = self.residual(theta_in, q, jacobian=False)
-            if np.max(np.abs(f_cold - f_warm) / self.arm) <= tol:
-                return q, its
-            self.cold_restarts += 1
-            q, more = self._iterate(theta_in, q)
-            its += more
-        raise ConvergenceError(f"static equilibrium at input angle {theta_in:.6g} rad: the pin gaps' closest points "
-                               "disagree between warm and cold starts")
-
-    def _iterate(self, theta_in: float, q_start: np.ndarray) -> tuple[np.ndarray, int]:
-        """The equilibrium iteration of :meth:`solve`.
-
         Each iteration solves (s M - J) dq = R (M the members' masses, J = dR/dq):
         Newton's step for s -> 0, an over-damped pseudo-time step for larger s.
 
@@ -240,6 +211,13 @@ class StaticModel:
           such a kink, a residual that stagnates, or a best iterate, below 10x the
           tolerance (0.11 N on rv40e: an output-angle error of about 0.11 N x a_w /
           k_t = 4e-9 rad = 0.0008 arcsec with k_t ~ 1e6 N m/rad).
+
+        * The pin gaps' closest points are warm-started; the pins kernel re-finds one
+          from cold starts wherever the warm result lies beyond the curve's reach
+          (:func:`flexrv.model.pins._curve_reach`). Before that check a warm start could
+          track a wrong local minimum after a long excursion (a neighbouring flank, gap
+          ~2 mm instead of ~10 um: rv40e with the grade-5 error set at -3 % torque,
+          residual 5.5 kN on a cold evaluation of the "converged" state).
 
         Raises :class:`flexrv.errors.ConvergenceError` otherwise.
         """
