@@ -42,7 +42,7 @@ no-load TE p-p         50.613      50.727      68.191       68.422
 lost motion [arcmin]   0.3044      0.2892      0.1756       0.1806
 backlash [arcmin]      0.0920      0.0901      0.0560       0.0611
 rigidity [N m/arcmin]  267.10      266.59      269.19       268.60
-CPU time [s]           0.18        0.40        4.3          13.2
+CPU time [s]           0.11        0.21        2.6          6.8
 =====================  ==========  ==========  ===========  ===========
 
 (crank = one crank revolution, output = one output revolution, K = points per
@@ -53,19 +53,22 @@ once-per-output-revolution variation of cumulative pitch errors (disc order-1
 harmonic, pin-position patterns) is not seen: TE p-p is 7 % below the
 output-revolution value on this sample, lost motion and backlash are the
 largest over catalog positions spread over a different range. One output
-revolution costs 24x more per sample (4.3 s against 0.18 s); give
+revolution costs 24x more per sample (2.6 s against 0.11 s); give
 ``output_revolutions=1`` (``--output-revolutions 1``) when the budget allows.
 Before the Jacobians were completed the same sample took 1.0 s at crank K=2
-(45,500 residual calls, 1,030 finite-difference Jacobians; now 2,300-3,200
+(45,500 residual calls, 1,030 finite-difference Jacobians; now 2,250-2,700
 calls and none); TE, lost motion and backlash are unchanged to the digits
 shown, the tangent rigidity rose by 0.04-0.07 % (it is read from the Jacobian,
 which now includes the contacts' curvature terms).
 
-Throughput (benchmarks/bench_tolerance.py, 2026-11-24, machine shared with
-other jobs at a load average of 8-10 on its 2 cores): 0.28 CPU s per sample in
-a study (dask included), fixed start-up 10-15 s, steady 1.25 samples/s with one
-worker and 2.21 with two (x1.76), projected 1,000 samples in 7.8 min on two
-workers under that load.
+Throughput (benchmarks/bench_tolerance.py, 2026-11-24, 16 and 128 samples, on
+the 2 cores shared with other jobs at a load average of about 5): 0.19 CPU s
+per sample in a study (dask included; 0.14-0.16 s in a warm process), fixed
+start-up 12-20 s (LocalCluster, worker imports and numba cache loads), steady
+3.85 samples/s with one worker and 6.61 with two (x1.72), projected 1,000
+samples in 2.9 min on two workers (4.5 min on one). At a load average of 8-10
+the same benchmark gave 1.25 / 2.21 samples/s (7.8 min). Before the Jacobians
+were completed: 0.44 / 0.54 samples/s on 8 samples.
 
 Sensitivities
 -------------

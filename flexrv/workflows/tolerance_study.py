@@ -30,7 +30,7 @@ Outputs beside the published values:
   tolerance alone is halved or doubled, by re-evaluating the first M samples
   (paired with the same samples unscaled).
 
-The full run (1,000 samples, M = 100) takes about 5 min on 2 cores; ``--smoke``
+The full run (1,000 samples, M = 100: 1,600 evaluations) takes about 5 min on 2 cores; ``--smoke``
 runs 20 samples and M = 4 (a check that the workflow runs, not a result).
 
 Run: ``flexrv workflow tolerance_study`` or ``python -m flexrv.workflows.tolerance_study``.
