@@ -18,14 +18,14 @@ damping terms vanish, so this is the dynamic model's equilibrium manifold.
 
 Solver: Newton's method on R with the groups' analytic Jacobians
 (:meth:`flexrv.model.assembled.AssembledModel.generalized_forces`, one compiled
-call; complete for the pins and gear meshes, and within 1e-7 of central
-differences for the whole rigid model at its equilibria, so no finite-difference
-Jacobian is needed: tests/test_quasi_static.py), globalised by pseudo-transient continuation (Kelley & Keyes 1998
-:cite:`kelley1998ptc`): each step solves (s M - J) dq = R with the members' mass
-matrix M as the metric, so a step through a clearance, where J is singular,
-becomes an over-damped motion towards contact, and near the solution the
-iteration is Newton's (details and the fallbacks for contacts at their onset in
-:meth:`StaticModel.solve`). Successive positions are warm-started from the
+call; complete for the pins and gear meshes, and within 1e-6 of (extrapolated)
+central differences for the whole rigid model at its equilibria, so no
+finite-difference Jacobian is needed: tests/test_quasi_static.py), globalised by
+pseudo-transient continuation (Kelley & Keyes 1998 :cite:`kelley1998ptc`): each
+step solves (s M - J) dq = R with the members' mass matrix M as the metric, so a
+step through a clearance, where J is singular, becomes an over-damped motion
+towards contact, and near the solution the iteration is Newton's (details and
+the fallbacks for contacts at their onset in :meth:`StaticModel.solve`). Successive positions are warm-started from the
 previous solution advanced by the nominal kinematic increment
 (:func:`equilibrium_path`: 2.0 Newton iterations per position on rv40e).
 
@@ -204,8 +204,9 @@ class StaticModel:
           which is exact, or with ``fd_fallback`` the finite-difference one of
           :meth:`fd_jacobian`, as before the pins' and meshes' Jacobians were
           completed: 20x the residual calls), which may raise the norm below twice
-          its largest of the last four values (non-monotone, :cite:`grippo1986nonmonotone`), halved after such
-          a rise so that a 2-cycle across a contact's onset kink contracts.
+          its largest of the last four values (non-monotone,
+          :cite:`grippo1986nonmonotone`), halved after such a rise so that a 2-cycle
+          across a contact's onset kink contracts.
         * Convergence: max |R_i / l_i| below ``force_tol`` times T_rated / a_w; or an
           exact Newton step below ``position_tol`` (0.1 nm on the crank circle); or, at
           such a kink, a residual that stagnates, or a best iterate, below 10x the
@@ -266,9 +267,10 @@ class StaticModel:
                     # the exact Newton step locates the equilibrium to 0.1 nm: at a kink of the
                     # contact laws (a contact at its onset) the residual norm need not fall further
                     return q, it
-                # monotone, except for exact Newton steps (no pseudo-time term), which may raise the residual norm for a step or two while
-                # the contact set settles (non-monotone acceptance, Grippo, Lampariello & Lucidi
-                # 1986 :cite:`grippo1986nonmonotone`): below twice the largest of the last four
+                # monotone, except for exact Newton steps (no pseudo-time term), which may raise
+                # the residual norm for a step or two while the contact set settles (non-monotone
+                # acceptance, Grippo, Lampariello & Lucidi 1986 :cite:`grippo1986nonmonotone`):
+                # below twice the largest of the last four
                 newton = exact and shift <= 1e-8 * s0
                 if np.isfinite(merit_new) and (merit_new < merit or newton and merit_new < 2.0 * max(history[-4:])):
                     rose = merit_new > merit

@@ -92,10 +92,11 @@ What-if table
 Estimated by **re-evaluation**: the first M plain samples (``what_if_samples``)
 are re-run with one entry's deviations from its mean scaled by 0.5 and by 2
 (exactly the samples of the halved / doubled tolerance: sigma, band and bounds
-scale together), every other error unchanged. The table gives P95 of TE p-p and
-the yield on those M samples beside the same M samples unscaled (a paired
-comparison: the difference is the tolerance's effect; the absolute values carry
-the sampling error of M samples). Cost: 2 G M extra evaluations.
+scale together), every other error unchanged. The table gives P95 of TE p-p,
+the median lost motion and the yield on those M samples beside the same M samples
+unscaled (a paired comparison: the difference is the tolerance's effect; the
+absolute values carry the sampling error of M samples). Cost: 2 G M extra
+evaluations (G: the entries of ``what_if_entries``, default all).
 """
 
 from __future__ import annotations
@@ -693,7 +694,8 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
     if m == 0:
         return {"samples": 0, "rows": []}
     j = OUTPUTS.index("te_pp_arcsec")
-    need = sorted({j, *(OUTPUTS.index(s.output) for s in specs)})
+    j_lm = OUTPUTS.index("lost_motion_arcmin")
+    need = sorted({j, j_lm, *(OUTPUTS.index(s.output) for s in specs)})
     idx: dict[tuple[str, float], list[int]] = {}
     for pos, c in enumerate(parts["cases"]):
         if c[0] == "what_if":
@@ -702,7 +704,8 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
     def stats(block):
         p95 = float(np.percentile(block[:, j], 95.0)) if len(block) else None
         yl = yield_estimate({k: block[:, i] for i, k in enumerate(OUTPUTS)}, specs) if len(block) else None
-        return p95, (yl["yield"] if yl else None)
+        lm50 = float(np.percentile(block[:, j_lm], 50.0)) if len(block) else None
+        return p95, (yl["yield"] if yl else None), lm50
 
     rows = []
     for (key, f), pos in idx.items():
@@ -710,10 +713,11 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
             continue
         blocks = [y[:m], y[pos], y[idx[(key, 2.0)]]]
         ok = np.all([np.all(np.isfinite(b[:, need]), axis=1) for b in blocks], axis=0)
-        (p0, y0), (ph, yh), (pd, yd) = (stats(b[ok]) for b in blocks)
+        (p0, y0, l0), (ph, yh, lh), (pd, yd, ld) = (stats(b[ok]) for b in blocks)
         rows.append({"tolerance": key, "samples_used": int(ok.sum()), "p95_te_pp_arcsec": p0,
                      "p95_te_pp_arcsec_halved": ph, "p95_te_pp_arcsec_doubled": pd,
-                     "yield": y0, "yield_halved": yh, "yield_doubled": yd})
+                     "yield": y0, "yield_halved": yh, "yield_doubled": yd, "p50_lost_motion_arcmin": l0,
+                     "p50_lost_motion_arcmin_halved": lh, "p50_lost_motion_arcmin_doubled": ld})
     rows.sort(key=lambda r: -abs((r["p95_te_pp_arcsec_doubled"] or 0.0) - (r["p95_te_pp_arcsec_halved"] or 0.0)))
     return {"samples": m, "method": "re-evaluation of the first M plain samples with the tolerance's deviations "
                                     "scaled by 0.5 / 2, paired with the same samples unscaled (samples with a "
