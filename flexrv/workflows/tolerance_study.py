@@ -142,7 +142,7 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
         para = (f"The tolerances that matter most for TE p-p: {', '.join(top)}"
                 + (f" (SRC on the {src.get('best')} basis, R^2 {fit.get('r2', float('nan')):.2f}: the linear fit "
                    "explains that share of the variance)" if fit else "")
-                + f"; {len(strong)} of them reach an SRC^2 of 0.01" + (f" ({', '.join(strong)})." if strong else "."))
+                + f"; {len(strong)} of them reach{'es' if len(strong) == 1 else ''} an SRC^2 of 0.01" + (f" ({', '.join(strong)})." if strong else "."))
         if best is not None and best["p95_te_pp_arcsec"] is not None and best["p95_te_pp_arcsec_halved"] is not None:
             para += (f" Halving {best['tolerance']} alone moves P95 TE p-p from {best['p95_te_pp_arcsec']:.3g} to "
                      f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec (doubling: {best['p95_te_pp_arcsec_doubled']:.3g}) "
