@@ -1,52 +1,89 @@
-"""Benchmark: tolerance-study throughput on rv40e (samples per second with 1 and 2
-LocalCluster workers) at the study's default resolution
-(:data:`flexrv.studies.tolerance.DEFAULT_RESOLUTION`: one crank revolution, 2
-points per pin mesh), with the rv40e tolerance preset; prints the projected wall
-time of 1,000 samples (issue 13's target: <= 10 min on this machine's 2 cores).
+"""Benchmark: tolerance-study throughput on rv40e with 1 and 2 LocalCluster workers
+at the study's default resolution (:data:`flexrv.studies.tolerance.DEFAULT_RESOLUTION`:
+one crank revolution, 2 points per pin mesh), with the rv40e tolerance preset.
 
-    python benchmarks/bench_tolerance.py [--samples 8] [--workers 1 2] [--crank-revolutions 1]
+    python benchmarks/bench_tolerance.py [--samples 16 128] [--workers 1 2]
 
-Each run uses a fresh output directory (nothing is resumed). The rate is the
-whole study's wall time (cluster start-up and numba's first-call compile on each
-worker included), i.e. what a user sees for a study of this size; with more
-samples the fixed part weighs less.
+Every worker count runs two studies of different sizes N1 < N2 (fresh output
+folders, nothing resumed) and separates the whole study's wall time T(N) = T0 +
+N / rate into
+
+* the fixed start-up T0 (LocalCluster and worker processes, imports, numba's
+  cache load on each worker, sampling, NetCDF and plots) and
+* the steady rate (samples per second) = (N2 - N1) / (T(N2) - T(N1)),
+
+and projects 1,000 samples as T0 + 1000 / rate (issue 13's target: <= 10 min on
+this machine's 2 cores). Wall time on a shared machine is noisy; the CPU time of
+the study (this process and its worker processes, which are reaped when the
+cluster closes: getrusage SELF + CHILDREN) is printed beside it, with its own
+per-sample value (CPU s per sample, the same on 1 or 2 workers if the scaling is
+clean).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
+import sys
 import tempfile
 import time
+from pathlib import Path
 
+#: this checkout's flexrv, in this process and in the spawned dask workers
+ROOT = str(Path(__file__).resolve().parent.parent)
+sys.path.insert(0, ROOT)
+os.environ["PYTHONPATH"] = os.pathsep.join([ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 
+def _cpu() -> float:
+    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+
+
+def study(n: int, workers: int, res: dict) -> tuple[float, float, int]:
+    """(wall s, CPU s, failed) of one fresh study of ``n`` samples."""
+    from flexrv.studies.tolerance import StudyConfig, run_study
+
+    with tempfile.TemporaryDirectory() as tmp:
+        cfg = StudyConfig(design="rv40e", tolerances="rv40e", samples=n, seed=1, sampler="sobol", workers=workers,
+                          what_if_samples=0, out=tmp, resolution=res)
+        c0, t0 = _cpu(), time.perf_counter()
+        r = run_study(cfg, progress=False)
+        return time.perf_counter() - t0, _cpu() - c0, r["failed"]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--samples", type=int, default=8)
+    ap.add_argument("--samples", type=int, nargs=2, default=[16, 128], metavar=("N1", "N2"))
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--crank-revolutions", type=float, default=1.0)
     ap.add_argument("--points-per-mesh", type=int, default=2)
     args = ap.parse_args()
-    from flexrv.studies.tolerance import DEFAULT_RESOLUTION, StudyConfig, run_study
+    import flexrv
+    from flexrv.studies.tolerance import DEFAULT_RESOLUTION
 
+    print(f"flexrv from {Path(flexrv.__file__).parent}", flush=True)
+    n1, n2 = sorted(args.samples)
+    if n1 >= n2 or n1 < 1:
+        ap.error("--samples N1 N2 with 1 <= N1 < N2")
     res = dict(DEFAULT_RESOLUTION, crank_revolutions=args.crank_revolutions, points_per_mesh=args.points_per_mesh)
     rates = {}
     for w in args.workers:
-        with tempfile.TemporaryDirectory() as tmp:
-            cfg = StudyConfig(design="rv40e", tolerances="rv40e", samples=args.samples, seed=1, sampler="sobol",
-                              workers=w, what_if_samples=0, out=tmp, resolution=res)
-            t0 = time.perf_counter()
-            r = run_study(cfg, progress=False)
-            wall = time.perf_counter() - t0
-        rates[w] = args.samples / wall
-        print(f"workers {w}: {args.samples} samples in {wall:.1f} s -> {rates[w]:.3f} samples/s "
-              f"({r['failed']} failed); projected 1,000 samples: {1000 / rates[w] / 60:.1f} min", flush=True)
+        (t1, c1, f1), (t2, c2, f2) = study(n1, w, res), study(n2, w, res)
+        rate = (n2 - n1) / (t2 - t1)
+        fixed = t1 - n1 / rate
+        cpu_per = (c2 - c1) / (n2 - n1)
+        rates[w] = rate
+        print(f"workers {w}: {n1} samples {t1:.1f} s wall ({c1:.1f} s CPU), {n2} samples {t2:.1f} s wall "
+              f"({c2:.1f} s CPU), failed {f1} / {f2}", flush=True)
+        print(f"  fixed start-up {fixed:.1f} s, steady {rate:.2f} samples/s ({cpu_per:.3f} CPU s per sample); "
+              f"projected 1,000 samples: {(fixed + 1000 / rate) / 60:.1f} min", flush=True)
     if 1 in rates and 2 in rates:
-        print(f"scaling 1 -> 2 workers: x{rates[2] / rates[1]:.2f}")
+        print(f"steady-rate scaling 1 -> 2 workers: x{rates[2] / rates[1]:.2f}")
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ class Workflow(str, enum.Enum):
     crankshaft_flexibility = "crankshaft_flexibility"
     crank_bearing_forces = "crank_bearing_forces"
     te_errors = "te_errors"
+    tolerance_study = "tolerance_study"
 
 
 def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_sensitive=True),

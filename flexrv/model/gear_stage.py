@@ -23,9 +23,19 @@ time_varying_mesh_stiffness` at the mesh phase xi_j = z_s (theta_s - beta_j)/2pi
 the planet), and the mesh damping c12 of
 :func:`flexrv.analysis.mesh_stiffness.involute_stage`. The generalized forces
 are Q = -F d(delta)/dq (exact, the deflection being a function of the
-coordinates). Analytic Jacobian: -dF/d(delta) g g^T and -c g g^T (g = d delta/dq;
-the curvature terms of beta(x, y) are dropped, modified Newton converges on the
-exact residual).
+coordinates). Jacobian (complete, g = d delta/dq over the planet's (x, y, phi)):
+
+    dQ/dq = -g (dF/dq)^T - F H,   dQ/dv = -c g g^T,
+    dF/dq = k g + delta_e (dk/dxi) dxi/dq + c (H v + A_s sin(theta_s - beta + ph_s) omega_s dbeta/dq),
+
+H = d2 delta/dq2 the deflection's curvature (from beta(x, y) = atan2(y, x), the
+radius a(x, y) and the runout terms), delta_e = delta (drive flank) or delta + b_n
+(coast flank), xi the mesh phase (dxi/dq = -z_s/2pi dbeta/dq). The stiffness
+slope dk/dxi is the central difference (+-1e-6 in phase) of the one stiffness law
+:func:`~flexrv.analysis.mesh_stiffness.mesh_stiffness_ramped`, exact for its
+piecewise-linear ramps except within 1e-6 of their corners. Verified against
+central differences in tests/test_kernel.py (1e-6 of the largest entry; measured
+7-8e-8).
 
 As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): sun runout
 (A_s, ph_s), planet runout (A_j, ph_j) and planet assembly phase errors err_j
@@ -97,9 +107,31 @@ def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
         if jac and active:
             g = (gx, gy, gp)
             ii = (ix, iy, ip)
-            for m in range(3):
-                for n in range(3):
-                    jq[ii[m], ii[n]] -= k * g[m] * g[n]
+            # curvature of delta(x, y, phi) (module docstring, "Jacobian")
+            ss = a_s * np.sin(ts - beta + ph_s)
+            sp = a_p * np.sin(phi - beta + ph_p)
+            sb = ss + sp  # d rb / d beta
+            a4, a3 = a2 * a2, a2 * a
+            hxx = -sb * y * y / a4 - 2.0 * rb * x * y / a4 - sw * y * y / a3
+            hxy = sb * x * y / a4 + rb * (x * x - y * y) / a4 + sw * x * y / a3
+            hyy = -sb * x * x / a4 + 2.0 * rb * x * y / a4 - sw * x * x / a3
+            hxp, hyp, hpp = -sp * y / a2, sp * x / a2, -sp
+            hess = ((hxx, hxy, hxp), (hxy, hyy, hyp), (hxp, hyp, hpp))
+            # d beta / dq and the stiffness' slope along the mesh phase (central difference of the
+            # one stiffness law, exact for its piecewise-linear ramps beyond 1e-6 of their corners)
+            bx, by = -y / a2, x / a2
+            xi = (zs / TWO_PI) * (ts - beta - beta0[j])
+            dk = (mesh_stiffness_ramped(xi + 1e-6, ks, eps, ramp)
+                  - mesh_stiffness_ramped(xi - 1e-6, ks, eps, ramp)) / 2e-6 * (-zs / TWO_PI)
+            d_eff = delta if delta > 0.0 else delta + bn
+            vv = (v[ix], v[iy], v[ip])
+            for n in range(3):
+                db = bx if n == 0 else (by if n == 1 else 0.0)
+                # dF/dq_n: stiffness, its phase change, damping through g(q) and the sun runout's rate
+                hv = hess[0][n] * vv[0] + hess[1][n] * vv[1] + hess[2][n] * vv[2]
+                dfn = k * g[n] + d_eff * dk * db + c * (hv + ss * ws * db)
+                for m in range(3):
+                    jq[ii[m], ii[n]] -= g[m] * dfn + force * hess[m][n]
                     jv[ii[m], ii[n]] -= c * g[m] * g[n]
 
 

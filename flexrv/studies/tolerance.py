@@ -30,30 +30,45 @@ Pipeline
 Resolution of one evaluation: :data:`DEFAULT_RESOLUTION`, one crank revolution
 at 2 points per pin-mesh period (78 loaded + 78 no-load positions on rv40e).
 Measured on one sample (rv40e with the example error set ``iso_grade5_rv40e``,
-rated torque, :func:`te_task`, compiled kernels, shared core):
+rated torque, :func:`te_task`, compiled kernels, CPU time in a warm process;
+2026-11-24, after the pins' and gear meshes' Jacobians were completed):
 
 =====================  ==========  ==========  ===========  ===========
 quantity               crank, K=2  crank, K=8  output, K=2  output, K=8
 =====================  ==========  ==========  ===========  ===========
 TE p-p [arcsec]        53.2256     53.2256     57.1531      57.2632
 mean TE [arcsec]       -124.2471   -124.2466   -124.5481    -124.5478
-no-load TE p-p         53.666      53.901      77.499       78.251
+no-load TE p-p         50.613      50.727      68.191       68.422
 lost motion [arcmin]   0.3044      0.2892      0.1756       0.1806
 backlash [arcmin]      0.0920      0.0901      0.0560       0.0611
-rigidity [N m/arcmin]  267.01      266.49      269.00       268.43
-wall time [s]          1.8         2.0         51 (retry)   34
+rigidity [N m/arcmin]  267.10      266.59      269.19       268.60
+CPU time [s]           0.11        0.21        2.6          6.8
 =====================  ==========  ==========  ===========  ===========
 
 (crank = one crank revolution, output = one output revolution, K = points per
 pin-mesh period.) Against K = 8 over the same crank revolution, K = 2 changes
-TE p-p by < 1e-4, mean TE by 4e-6, no-load TE p-p by -0.4 %, lost motion by
+TE p-p by < 1e-4, mean TE by 4e-6, no-load TE p-p by -0.2 %, lost motion by
 +5 %, backlash by +2 %, rigidity by +0.2 %. Over one crank revolution the
 once-per-output-revolution variation of cumulative pitch errors (disc order-1
 harmonic, pin-position patterns) is not seen: TE p-p is 7 % below the
 output-revolution value on this sample, lost motion and backlash are the
 largest over catalog positions spread over a different range. One output
-revolution costs 17-28x more per sample today; give ``output_revolutions=1``
-(``--output-revolutions 1``) when the budget allows.
+revolution costs 24x more per sample (2.6 s against 0.11 s); give
+``output_revolutions=1`` (``--output-revolutions 1``) when the budget allows.
+Before the Jacobians were completed the same sample took 1.0 s at crank K=2
+(45,500 residual calls, 1,030 finite-difference Jacobians; now 2,250-2,700
+calls and none); TE, lost motion and backlash are unchanged to the digits
+shown, the tangent rigidity rose by 0.04-0.07 % (it is read from the Jacobian,
+which now includes the contacts' curvature terms).
+
+Throughput (benchmarks/bench_tolerance.py, 2026-11-24, 16 and 128 samples, on
+the 2 cores shared with other jobs at a load average of about 5): 0.19 CPU s
+per sample in a study (dask included; 0.14-0.16 s in a warm process), fixed
+start-up 12-20 s (LocalCluster, worker imports and numba cache loads), steady
+3.85 samples/s with one worker and 6.61 with two (x1.72), projected 1,000
+samples in 2.9 min on two workers (4.5 min on one). At a load average of 8-10
+the same benchmark gave 1.25 / 2.21 samples/s (7.8 min). Before the Jacobians
+were completed: 0.44 / 0.54 samples/s on 8 samples.
 
 Sensitivities
 -------------
@@ -77,10 +92,11 @@ What-if table
 Estimated by **re-evaluation**: the first M plain samples (``what_if_samples``)
 are re-run with one entry's deviations from its mean scaled by 0.5 and by 2
 (exactly the samples of the halved / doubled tolerance: sigma, band and bounds
-scale together), every other error unchanged. The table gives P95 of TE p-p and
-the yield on those M samples beside the same M samples unscaled (a paired
-comparison: the difference is the tolerance's effect; the absolute values carry
-the sampling error of M samples). Cost: 2 G M extra evaluations.
+scale together), every other error unchanged. The table gives P95 of TE p-p,
+the median lost motion and the yield on those M samples beside the same M samples
+unscaled (a paired comparison: the difference is the tolerance's effect; the
+absolute values carry the sampling error of M samples). Cost: 2 G M extra
+evaluations (G: the entries of ``what_if_entries``, default all).
 """
 
 from __future__ import annotations
@@ -487,6 +503,8 @@ class StudyConfig:
     sobol: bool = False
     out: str | None = None
     what_if_samples: int = 16
+    #: tolerance entries of the what-if table (None: every entry; cost 2 M per entry)
+    what_if_entries: list[str] | None = None
     resolution: dict[str, Any] = field(default_factory=lambda: dict(DEFAULT_RESOLUTION))
 
 
@@ -514,6 +532,8 @@ def _validate(cfg: StudyConfig) -> list[Spec]:
         raise InputError(f"--workers {cfg.workers}: must be >= 1")
     if cfg.what_if_samples < 0:
         raise InputError(f"--what-if-samples {cfg.what_if_samples}: must be >= 0")
+    if cfg.what_if_entries is not None and not isinstance(cfg.what_if_entries, (list, tuple)):
+        raise InputError(f"what_if_entries {cfg.what_if_entries!r}: must be a list of tolerance entries")
     if not isinstance(cfg.seed, int) or cfg.seed < 0:
         raise InputError(f"--seed {cfg.seed!r}: must be an integer >= 0")
     unknown = set(cfg.resolution) - set(DEFAULT_RESOLUTION)
@@ -569,7 +589,11 @@ def plan_cases(cfg: StudyConfig, reducer, tol) -> tuple[TolerancePlan, dict[str,
         cases += [("saltelli", i, "", 1.0, plan.errors_for(parts["saltelli_x"][i]))
                   for i in range(len(parts["saltelli_x"])) if i not in done]
     m = min(cfg.what_if_samples, len(x))
-    for key in tol.entries:
+    what_if = list(tol.entries) if cfg.what_if_entries is None else list(cfg.what_if_entries)
+    unknown = [k for k in what_if if k not in tol.entries]
+    if unknown:
+        raise InputError(f"what-if entries {unknown} are not in the tolerance set; allowed: {sorted(tol.entries)}")
+    for key in what_if:
         for f in (0.5, 2.0):
             cases += [("what_if", i, key, f, plan.errors_for(x[i], {key: f})) for i in range(m)]
     parts["cases"] = cases
@@ -670,7 +694,8 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
     if m == 0:
         return {"samples": 0, "rows": []}
     j = OUTPUTS.index("te_pp_arcsec")
-    need = sorted({j, *(OUTPUTS.index(s.output) for s in specs)})
+    j_lm = OUTPUTS.index("lost_motion_arcmin")
+    need = sorted({j, j_lm, *(OUTPUTS.index(s.output) for s in specs)})
     idx: dict[tuple[str, float], list[int]] = {}
     for pos, c in enumerate(parts["cases"]):
         if c[0] == "what_if":
@@ -679,7 +704,8 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
     def stats(block):
         p95 = float(np.percentile(block[:, j], 95.0)) if len(block) else None
         yl = yield_estimate({k: block[:, i] for i, k in enumerate(OUTPUTS)}, specs) if len(block) else None
-        return p95, (yl["yield"] if yl else None)
+        lm50 = float(np.percentile(block[:, j_lm], 50.0)) if len(block) else None
+        return p95, (yl["yield"] if yl else None), lm50
 
     rows = []
     for (key, f), pos in idx.items():
@@ -687,10 +713,11 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
             continue
         blocks = [y[:m], y[pos], y[idx[(key, 2.0)]]]
         ok = np.all([np.all(np.isfinite(b[:, need]), axis=1) for b in blocks], axis=0)
-        (p0, y0), (ph, yh), (pd, yd) = (stats(b[ok]) for b in blocks)
+        (p0, y0, l0), (ph, yh, lh), (pd, yd, ld) = (stats(b[ok]) for b in blocks)
         rows.append({"tolerance": key, "samples_used": int(ok.sum()), "p95_te_pp_arcsec": p0,
                      "p95_te_pp_arcsec_halved": ph, "p95_te_pp_arcsec_doubled": pd,
-                     "yield": y0, "yield_halved": yh, "yield_doubled": yd})
+                     "yield": y0, "yield_halved": yh, "yield_doubled": yd, "p50_lost_motion_arcmin": l0,
+                     "p50_lost_motion_arcmin_halved": lh, "p50_lost_motion_arcmin_doubled": ld})
     rows.sort(key=lambda r: -abs((r["p95_te_pp_arcsec_doubled"] or 0.0) - (r["p95_te_pp_arcsec_halved"] or 0.0)))
     return {"samples": m, "method": "re-evaluation of the first M plain samples with the tolerance's deviations "
                                     "scaled by 0.5 / 2, paired with the same samples unscaled (samples with a "
