@@ -487,9 +487,22 @@ class _Checkpointer:
 def _newton_settings(exu) -> dict[str, object]:
     """Exudyn's Newton settings by name with their default values (the options
     ``newton_options`` may set, :func:`flexrv.errors.check_options`)."""
+    import warnings
+
     ns = exu.SimulationSettings().timeIntegration.newton
-    return {k: getattr(ns, k) for k in dir(ns)
-            if not k.startswith("_") and isinstance(getattr(ns, k), (bool, int, float, str))}
+    out = {}
+    for k in dir(ns):
+        if k.startswith("_"):
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # deprecated names (Exudyn warns on access) are not offered
+            try:
+                value = getattr(ns, k)
+            except Warning:
+                continue
+        if isinstance(value, (bool, int, float, str)):
+            out[k] = value
+    return out
 
 
 def _progress_callback(progress, t_end):

@@ -238,10 +238,10 @@ def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
     if model not in MODELS:
         raise ConfigError(f"model = {model!r} is not allowed: choose one of {sorted(MODELS)}")
     builder = MODELS[model]
-    allowed = signature_options(builder, skip=1, exclude=("model_name", "exudyn"))
+    allowed = signature_options(builder, skip=1, exclude=("model_name",))
     if builder is not build_rigid:  # build_balls / build_flexible pass the rest on to build_rigid
         set_here = ("main_bearing", "crankshaft") if builder is build_flexible else ("main_bearing",)
-        allowed = {**signature_options(build_rigid, skip=1, exclude=("model_name", "exudyn") + set_here), **allowed}
+        allowed = {**signature_options(build_rigid, skip=1, exclude=("model_name",) + set_here), **allowed}
         allowed.pop("kwargs", None)
     opts = check_options(f"model options of {model!r}", {k: v for k, v in kwargs.items() if k not in ("drive", "torque")},
                          allowed)
