@@ -321,7 +321,8 @@ class SweepSummary:
 
 
 def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, scheduler: str | None = None,
-              n_workers: int | None = None, retry_failed: bool = False, progress: bool = True) -> SweepSummary:
+              n_workers: int | None = None, retry_failed: bool = False, progress: bool = True,
+              plots: bool = True) -> SweepSummary:
     """Run the missing cases of a sweep on dask.distributed and write the table.
 
     Parameters
@@ -331,6 +332,8 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
     scheduler : address of an existing dask scheduler; a LocalCluster with
         ``n_workers`` (default: CPU count) single-threaded worker processes otherwise.
     retry_failed : recompute cases recorded as failed.
+    plots : draw one PNG per output against the first varied parameter (studies whose
+        cases are random draws, e.g. the tolerance study, draw their own figures).
     """
     from dask.distributed import Client, LocalCluster, as_completed
 
@@ -353,7 +356,7 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
     if changed or not (out / "table.csv").exists():
         # the table always matches spec.json: rebuilt now (pending cases marked "missing"),
         # so a rerun killed before its end never leaves the table of an older spec
-        write_table(spec, cases, out)
+        write_table(spec, cases, out, plots=False)
     todo = pending_cases(out, cases, retry_failed)
     failed = 0
     if todo:
@@ -384,12 +387,12 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
             client.close()
             if cluster is not None:
                 cluster.close()
-    csv_path, nc_path, plots = write_table(spec, cases, out)
+    csv_path, nc_path, plot_paths = write_table(spec, cases, out, plots=plots)
     total_failed = sum(json.loads(case_file(out, c).read_text()).get("status") != "ok" for c in cases)
     if output_keys is None:
         _check_outputs_after(spec, cases, out)
     return SweepSummary(out_dir=out, total=len(cases), computed=len(todo), skipped=len(cases) - len(todo),
-                        failed=total_failed, table_csv=csv_path, table_nc=nc_path, plots=plots)
+                        failed=total_failed, table_csv=csv_path, table_nc=nc_path, plots=plot_paths)
 
 
 def connect_scheduler(address: str, timeout_s: float = 5.0):
@@ -435,8 +438,8 @@ def _as_float(value: Any) -> float:
     return math.nan
 
 
-def write_table(spec: SweepSpec, cases: list[Case], out: Path) -> tuple[Path, Path, list[Path]]:
-    """Collect all stored case results into ``table.csv``, ``table.nc`` and plots."""
+def write_table(spec: SweepSpec, cases: list[Case], out: Path, plots: bool = True) -> tuple[Path, Path, list[Path]]:
+    """Collect all stored case results into ``table.csv``, ``table.nc`` and (``plots``) PNGs."""
     import numpy as np
     import xarray as xr
 
@@ -473,8 +476,7 @@ def write_table(spec: SweepSpec, cases: list[Case], out: Path) -> tuple[Path, Pa
     nc_path = out / "table.nc"
     with atomic_path(nc_path) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
-    plots = _plot_table(spec, rows, params, out)
-    return csv_path, nc_path, plots
+    return csv_path, nc_path, (_plot_table(spec, rows, params, out) if plots else [])
 
 
 def _plot_table(spec: SweepSpec, rows: list[dict], params: list[str], out: Path) -> list[Path]:

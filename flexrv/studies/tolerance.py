@@ -631,7 +631,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     t0 = time.perf_counter()
     workers = cfg.workers or min(2, os.cpu_count() or 1)
     summary_sweep = run_sweep(spec, out_dir=out / "runs", scheduler=cfg.scheduler, n_workers=workers,
-                              progress=progress)
+                              progress=progress, plots=False)  # the study draws its own figures
     wall = time.perf_counter() - t0
     ids = [c.case_id for c in build_cases(spec)]
     records = []
