@@ -422,6 +422,11 @@ class ContactSettings(_Strict):
     impact_damping_depth_mm: float = Field(gt=0.0, le=1.0, description="Penetration d over which damping ramps to c_max")
     pin_max_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
     ehl: Literal["dry", "hamrock_dowson", "map"] = Field(description="EHL correction of lubricated contacts")
+    pin_penetration_limit_um: float = Field(
+        gt=0.0, le=1000.0, description="Pin-disc penetration beyond which a run is stopped as failed [um]")
+    needle_penetration_limit_um: float = Field(
+        gt=0.0, le=1000.0, description="Needle-bearing penetration beyond which a run is stopped as failed [um] "
+                                       "(at least 20 x the impact law's damping depth)")
 
 
 class OperatingPoint(_Strict):

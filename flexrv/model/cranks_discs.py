@@ -290,6 +290,7 @@ class NeedleBearings(KernelGroup):
         self.hy = np.ascontiguousarray(p.holes[..., 1].T)
         self.clear = np.ascontiguousarray(p.needle_clearances, dtype=float)
         self.depth = p.contact_depth
+        self.limit = p.needle_penetration_limit  # design contact.needle_penetration_limit_um
         self.z_c, self.z_rp = p.z_c, p.z_rp
         if model == "empirical":
             if k_empirical is None:
@@ -349,12 +350,14 @@ class NeedleBearings(KernelGroup):
         self.state[0] = np.inf
 
     def check(self) -> str | None:
-        if self.min_gap < -max(20.0 * self.depth, 50e-6):
-            return f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit"
+        # a skipped pin first: it is the cause, and the needle penetration it then produces the symptom
         dep = self.state[1:]
         limit = np.pi / self.z_rp
         if np.any(np.abs(dep) > limit):
             k = int(np.nanargmax(np.abs(dep)))
             return (f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
                     f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)")
+        if self.min_gap < -max(20.0 * self.depth, self.limit):
+            return (f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
+                    f"{max(20.0 * self.depth, self.limit) * 1e6:.3g} um")
         return None

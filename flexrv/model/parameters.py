@@ -91,6 +91,8 @@ class RigidParameters:
     pin_exponent: float
     pin_c_max: float
     contact_depth: float
+    pin_penetration_limit: float  #: [m] a run stops as failed beyond it
+    needle_penetration_limit: float  #: [m]
     needle_clearance: float
     needle_roller_count: int
     needle_roller_k: float  #: roller constant (inner + outer line contacts in series) [N/m^(10/9)]
@@ -218,6 +220,8 @@ def rigid_parameters(reducer) -> RigidParameters:
         support_law=support_law, support_roller_angles=support_angles, support_linear=support_linear,
         main_bearing_stiffness=kmb, main_bearing_damping=cmb,
         pin_k=pin_k, pin_exponent=pin_e, pin_c_max=ct.pin_max_damping_Ns_per_m, contact_depth=depth,
+        pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
+        needle_penetration_limit=ct.needle_penetration_limit_um * 1e-6,
         needle_clearance=nb.radial_clearance_um * 1e-6, needle_roller_count=nb.roller_count, needle_roller_k=roller_k,
         needle_pitch_ratio=d_roll / dm, needle_c_max=ct.pin_max_damping_Ns_per_m,
         input_speed=op.input_speed, speed_ramp_time=op.speed_ramp_time_s, load_torque=op.load_torque_Nm,

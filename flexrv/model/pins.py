@@ -246,7 +246,7 @@ class PinContacts(KernelGroup):
     name = "pins"
     kind = "pins"
 
-    def __init__(self, params, penetration_limit: float = 100e-6, restart_every: int = 500):
+    def __init__(self, params, restart_every: int = 500):
         p = params
         self.nd = p.n_discs
         self.members = tuple(f"disc{k}" for k in range(self.nd))
@@ -256,7 +256,7 @@ class PinContacts(KernelGroup):
         self.harmonics = np.ascontiguousarray(p.profile_harmonics, dtype=float).reshape(self.nd, -1, 3)
         self.k, self.e = p.pin_k, p.pin_exponent
         self.c_max, self.depth = p.pin_c_max, p.contact_depth
-        self.limit = penetration_limit
+        self.limit = params.pin_penetration_limit  # design contact.pin_penetration_limit_um
         reach = [_curve_reach(int(p.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(p.eccentricity))
                  for kd in range(self.nd)]
         self.sc = np.array([float(p.z_rp), p.pin_circle_radius, p.pin_radius, p.eccentricity, p.pin_k,
