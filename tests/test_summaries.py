@@ -172,13 +172,21 @@ def test_first_compile_notice(tmp_path):
 
     from flexrv.model.kernel_cache import announce_compile, uncached_kernels
 
-    index = tmp_path / "cycloid._closest_point_newton-1.py311.nbi"
-    disp = SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace(_index_path=str(index))))
-    modules = {"flexrv.geometry.cycloid": SimpleNamespace(_NEWTON=disp)}
-    assert uncached_kernels(modules) == ["cycloid._NEWTON"]
+    def dispatcher(name):
+        index = tmp_path / f"{name}-1.py311.nbi"
+        return index, SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace(_index_path=str(index))))
+
+    helper_index, helper = dispatcher("cycloid._pin_gap_kernel")
+    entry_index, entry = dispatcher("kernels.fused_kernel")
+    modules = {"flexrv.geometry.cycloid": SimpleNamespace(_PIN_GAP=helper),
+               "flexrv.model.kernels": SimpleNamespace(fused_kernel=entry)}
+    assert uncached_kernels(modules) == ["cycloid._PIN_GAP", "kernels.fused_kernel"]
     out = io.StringIO()
     assert announce_compile(out, modules) and "compiling numba kernels (once, ~" in out.getvalue()
-    index.write_bytes(b"")
+    entry_index.write_bytes(b"")
+    # only an array helper a run never calls is uncached: no notice (it printed on every run before)
+    assert uncached_kernels(modules) == ["cycloid._PIN_GAP"] and not announce_compile(io.StringIO(), modules)
+    helper_index.write_bytes(b"")
     assert uncached_kernels(modules) == [] and not announce_compile(io.StringIO(), modules)
 
 
