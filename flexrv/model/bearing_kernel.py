@@ -1,22 +1,44 @@
-"""Compiled (numba) generalized force and Jacobian of one bearing row — the hot
-path of the ball-resolved and flexible main bearing.
+"""Compiled (numba) generalized force and Jacobian of one bearing row — THE
+implementation of the ball-resolved and flexible main bearing (issue 15/16).
 
-:func:`flexrv.model.flexible_bearing.evaluate_row` is the reference
-implementation (numpy, with every contact state for post-processing). During a
-run Exudyn asks for the residual ~6 times per step and for the Jacobian every
-~5-50 steps; both are evaluated here in one compiled loop over the balls with the
-same formulas (the numpy version spends ~1.4 ms per row force in ~200 small array
-operations, this kernel ~0.05 ms; the Jacobian of a flexible row 5.2 -> 0.9 ms,
-its T^T K T sums done as one stacked product). tests/test_model_flexible_rings.py
-checks force and Jacobians against :func:`evaluate_row` to 1e-9 of the largest
-entry for rigid and modal rings, dry Hertz and the Hamrock–Dowson EHL law.
+One row element sees the coordinates [frame(6), inner modes, outer modes,
+balls(3Z)]: the inner ring rides on the frame (carrier), the outer ring sits in
+the housing, the balls are point masses held by a kinematic cage. A ring is
 
-Supported: rings given by a raceway table (:class:`flexrv.model.flexible_bearing.
-ModalRing`) or rigid, normal laws :class:`flexrv.contact.ball_raceway.HertzLaw`
-or :class:`flexrv.contact.ehl_law.EHLPointLaw` in mode ``dry`` /
-``hamrock_dowson`` with scalar radii. Anything else (the solver-map law, other
-ring models) falls back to :func:`evaluate_row` (:func:`kernel_inputs` returns
-None).
+* **rigid** (no table),
+* **modal** — its modal coordinates are element coordinates (a dynamic ring with
+  mass, or the uncondensed quasi-static ring kept for verification), or
+* **condensed** — a quasi-static (massless) ring whose modal coordinates are
+  eliminated by static condensation: with K q = sum_k B_k^T g_k (B_k the raceway
+  basis at the contact azimuth psi_k, g_k the contact force on the ring) the
+  raceway displacements at the contacts are u_j = sum_k C_jk g_k with the
+  compliance C_jk = B_j K^-1 B_k^T. C is interpolated from the ring's
+  precomputed table G[i, i'] = T_i K^-1 T_i'^T on the raceway grid
+  (:meth:`flexrv.fem.body.ReducedBody.raceway_compliance`) with the same
+  Catmull–Rom weights as the basis, so it equals B_j K^-1 B_k^T of the
+  interpolated basis exactly (to round-off). The contact deflections solve the
+  local nonlinear system u = C g(e0 - u) (e0: ball minus rigid-ring groove
+  centre) by Newton iterations whose Jacobian keeps the normal contact
+  stiffness (I + C N diag(dQ/d delta) N^T, solved by the Woodbury identity as a
+  Z x Z system); the neglected geometric term Q/L (I - n n^T) is ~1e-2 of it, so
+  the iteration converges linearly to the exact solution (tolerance
+  ``CONDENSE_TOL``). The element Jacobian uses the condensed tangent
+  (I - K C)^-1 K of the contacts in series with the ring (dense over the
+  balls of the row). The ring's velocity at the contacts is neglected in the
+  contact damping (u_dot = 0: the ring deflection ~1 um changes at the ball-pass
+  rate, its velocity is 1e-3 of the balls' vibration velocities in the runs;
+  measured effect on TE in benchmarks/bench_flexible_model.py).
+
+Per-ball results of a call go to ``rec`` (:data:`RECORD_FIELDS`) when it has Z
+rows: post-processing runs the same kernel on every recorded sample; the
+condensed rings' modal amplitudes follow from the recorded ring loads by
+:func:`ring_modal_amplitudes` (q = K^-1 sum_j B_j^T g_j).
+
+Supported laws: :class:`flexrv.contact.ball_raceway.HertzLaw` and
+:class:`flexrv.contact.ehl_law.EHLPointLaw` in mode ``dry`` / ``hamrock_dowson``
+with scalar radii (:func:`law_parameters`). The kernel takes plain arrays only
+(the bearing's data classes live in :mod:`flexrv.model.flexible_bearing`, which
+prepares them).
 """
 
 from __future__ import annotations
@@ -29,6 +51,19 @@ from numba import njit
 #: law parameters: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m], load and speed
 #: exponents of the film, load floor [N], c_max [N s/m], damping depth [m], Newton steps
 LAW_FIELDS = ("k", "h_unit", "load_exponent", "speed_exponent", "load_floor", "c_max", "depth", "iterations")
+
+#: columns of the per-ball record ``rec`` (Z, len(RECORD_FIELDS)): loads [N], unit
+#: normals (global), ring azimuths [rad], contact force on each ring in the ring's
+#: own Cartesian frame [N], raceway displacement of each ring at the contact
+#: (global) [m], ball centre (global) [m]
+RECORD_FIELDS = ("load_inner", "load_outer", "nix", "niy", "niz", "nox", "noy", "noz", "psi_inner", "psi_outer",
+                 "gix", "giy", "giz", "gox", "goy", "goz", "uix", "uiy", "uiz", "uox", "uoy", "uoz", "bx", "by", "bz")
+N_RECORD = len(RECORD_FIELDS)
+
+#: local condensation: absolute tolerance on the contact deflections [m] and the
+#: iteration limit (a solve that does not converge counts in ``state``, see :func:`row_kernel`)
+CONDENSE_TOL = 1e-15
+CONDENSE_MAXIT = 50
 
 
 def law_parameters(law) -> np.ndarray | None:
@@ -45,33 +80,6 @@ def law_parameters(law) -> np.ndarray | None:
         return np.array([float(law.stiffness), h_unit, HAMROCK_DOWSON_LOAD_EXPONENT, 0.67, law.load_floor,
                          law.c_max, law.damping_depth, float(law.iterations)])
     return None
-
-
-def ring_table(ring) -> tuple[np.ndarray, float] | None:
-    """(cylindrical raceway table (n_grid, 3, m), z sign) of a ring, a (1, 3, 0)
-    table for a rigid ring, or None if the ring model has no table."""
-    from flexrv.model.flexible_bearing import ModalRing
-
-    if ring is None:
-        return np.zeros((1, 3, 0)), 1.0
-    if isinstance(ring, ModalRing) and getattr(ring.body, "table", None) is not None:
-        return np.ascontiguousarray(ring.body.table, dtype=float), -1.0 if ring.mirror else 1.0
-    return None
-
-
-def kernel_inputs(model) -> tuple | None:
-    """Everything :func:`row_force_kernel` needs of a :class:`RowModel`, or None."""
-    laws = [law_parameters(model.law_inner), law_parameters(model.law_outer)]
-    rings = [ring_table(model.inner), ring_table(model.outer)]
-    if any(x is None for x in laws + rings):
-        return None
-    row = model.row
-    geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
-                         row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
-                         model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
-                         model.pocket_stiffness])
-    return (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, rings[0][0], rings[0][1],
-            rings[1][0], rings[1][1], laws[0], laws[1])
 
 
 @njit(cache=True)
@@ -113,8 +121,8 @@ def _normal_load(delta, rate, speed, law):
 
 @njit(cache=True)
 def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
-    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w
-    (flexrv.contact.ball_raceway.raceway_contacts): (|e|, unit normal, Q, dQ/ddelta, dQ/drate)."""
+    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w:
+    (|e|, unit normal, Q, dQ/ddelta, dQ/drate); the force on the ball is -Q n."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
     q, dq, c = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
@@ -122,26 +130,38 @@ def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
 
 
 @njit(cache=True)
-def _basis(table, zsign, psi, out):
-    """Cartesian raceway displacement per modal coordinate at azimuth psi -> out (3, m)
-    (Catmull–Rom periodic cubic of the cylindrical table, flexrv.fem.reduction.periodic_cubic)."""
-    ng = table.shape[0]
-    m = table.shape[2]
+def _taps(psi, ng, idx, w):
+    """Grid indices idx[4] and weights w[4] of the periodic Catmull–Rom cubic on the
+    uniform grid 2 pi i / ng at azimuth psi (flexrv.fem.reduction.periodic_cubic)."""
     u = (psi % (2.0 * math.pi)) * (ng / (2.0 * math.pi))
     i = int(math.floor(u))
     t = u - i
     t2 = t * t
     t3 = t2 * t
-    w0 = 0.5 * (-t3 + 2.0 * t2 - t)
-    w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0)
-    w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t)
-    w3 = 0.5 * (t3 - t2)
-    i0, i1, i2, i3 = (i - 1) % ng, i % ng, (i + 1) % ng, (i + 2) % ng
+    w[0] = 0.5 * (-t3 + 2.0 * t2 - t)
+    w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0)
+    w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t)
+    w[3] = 0.5 * (t3 - t2)
+    for a in range(4):
+        idx[a] = (i - 1 + a) % ng
+
+
+@njit(cache=True)
+def _basis(table, zsign, psi, out):
+    """Cartesian raceway displacement per modal coordinate at azimuth psi -> out (3, m)
+    (the periodic cubic of the cylindrical table, z mirrored by zsign)."""
+    m = table.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
+    _taps(psi, table.shape[0], idx, w)
     c, s = math.cos(psi), math.sin(psi)
     for j in range(m):
-        ar = w0 * table[i0, 0, j] + w1 * table[i1, 0, j] + w2 * table[i2, 0, j] + w3 * table[i3, 0, j]
-        at = w0 * table[i0, 1, j] + w1 * table[i1, 1, j] + w2 * table[i2, 1, j] + w3 * table[i3, 1, j]
-        az = w0 * table[i0, 2, j] + w1 * table[i1, 2, j] + w2 * table[i2, 2, j] + w3 * table[i3, 2, j]
+        ar = w[0] * table[idx[0], 0, j] + w[1] * table[idx[1], 0, j] + w[2] * table[idx[2], 0, j] \
+            + w[3] * table[idx[3], 0, j]
+        at = w[0] * table[idx[0], 1, j] + w[1] * table[idx[1], 1, j] + w[2] * table[idx[2], 1, j] \
+            + w[3] * table[idx[3], 1, j]
+        az = w[0] * table[idx[0], 2, j] + w[1] * table[idx[1], 2, j] + w[2] * table[idx[2], 2, j] \
+            + w[3] * table[idx[3], 2, j]
         out[0, j] = c * ar - s * at
         out[1, j] = s * ar + c * at
         out[2, j] = zsign * az
@@ -150,8 +170,9 @@ def _basis(table, zsign, psi, out):
 @njit(cache=True)
 def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
     """d force_ball / d ball position and velocity (3x3) of one contact
-    (flexrv.contact.ball_raceway.raceway_contacts, plus the follower term Q/L
-    e_t e_t^T of evaluate_row: the groove centre follows the ball's azimuth)."""
+    (d/db of -Q n: -(dQ n n^T + Q/L (I - n n^T)), plus the follower term Q/L e_t e_t^T:
+    the groove centre follows the ball's azimuth, so a tangential ball motion does
+    not rotate the contact normal)."""
     n = (nx, ny, nz)
     et = (etx, ety, 0.0)
     ql = q_load / length
@@ -164,17 +185,142 @@ def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
 
 
 @njit(cache=True)
-def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, jacobian):
+def _compliance_matrix(psi, rot, comp, zsign, out):
+    """Global compliance (3Z, 3Z) of a condensed ring at the contact azimuths psi (Z,):
+    C_jk = R_j S G(psi_j, psi_k) S R_k^T, G the bicubic interpolation of the
+    cylindrical table ``comp`` (ng, ng, 3, 3), S = diag(1, 1, zsign), R_j (3,3) the
+    ring-cylindrical -> global rotation of contact j (rot (Z,3,3))."""
+    nz = psi.shape[0]
+    ng = comp.shape[0]
+    idx = np.empty((nz, 4), np.int64)
+    w = np.empty((nz, 4))
+    for j in range(nz):
+        _taps(psi[j], ng, idx[j], w[j])
+    sgn = (1.0, 1.0, zsign)
+    g = np.empty((3, 3))
+    h = np.empty((3, 3))
+    for j in range(nz):
+        for k in range(j, nz):
+            for a in range(3):
+                for b in range(3):
+                    g[a, b] = 0.0
+            for ta in range(4):
+                ia = idx[j, ta]
+                for tb in range(4):
+                    wab = w[j, ta] * w[k, tb]
+                    ib = idx[k, tb]
+                    for a in range(3):
+                        for b in range(3):
+                            g[a, b] += wab * comp[ia, ib, a, b]
+            for a in range(3):
+                for b in range(3):
+                    g[a, b] *= sgn[a] * sgn[b]
+            # h = R_j g R_k^T
+            for a in range(3):
+                for b in range(3):
+                    s = 0.0
+                    for c in range(3):
+                        s += g[a, c] * rot[k, b, c]
+                    h[a, b] = s
+            for a in range(3):
+                for b in range(3):
+                    s = 0.0
+                    for c in range(3):
+                        s += rot[j, a, c] * h[c, b]
+                    out[3 * j + a, 3 * k + b] = s
+                    out[3 * k + b, 3 * j + a] = s
+
+
+@njit(cache=True)
+def _condense(e0, w0, cmat, offset, speed, law, u, loads, normals, dq, cd, lengths):
+    """Solve the contact deflections u (Z,3, global; in: warm start) of a condensed
+    ring: u = C g(e0 - u), g_j = Q_j n_j the force on the ring. Fills the contact
+    results at the solution (loads, normals, dQ/ddelta, damping coefficient,
+    |e|); returns the number of Newton iterations (-1: not converged)."""
+    nz = e0.shape[0]
+    n3 = 3 * nz
+    gvec = np.empty(n3)
+    r = np.empty(n3)
+    cn = np.empty((n3, nz))
+    smat = np.empty((nz, nz))
+    for it in range(CONDENSE_MAXIT + 1):
+        for j in range(nz):
+            length, nx, ny, nzz, q, d, c = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1], e0[j, 2] - u[j, 2],
+                                                    w0[j, 0], w0[j, 1], w0[j, 2], offset, speed, law)
+            loads[j], dq[j], cd[j], lengths[j] = q, d, c, length
+            normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
+            gvec[3 * j], gvec[3 * j + 1], gvec[3 * j + 2] = q * nx, q * ny, q * nzz
+        cg = cmat @ gvec
+        err = 0.0
+        for i in range(n3):
+            r[i] = u[i // 3, i % 3] - cg[i]
+            err = max(err, abs(r[i]))
+        if err <= CONDENSE_TOL:
+            return it
+        if it == CONDENSE_MAXIT:
+            break
+        # Newton step with the normal contact stiffness (Woodbury, Z x Z):
+        # (I + C N L N^T) du = -r -> du = -(r - C N L (I + N^T C N L)^-1 N^T r)
+        for i in range(n3):
+            for k in range(nz):
+                cn[i, k] = cmat[i, 3 * k] * normals[k, 0] + cmat[i, 3 * k + 1] * normals[k, 1] \
+                    + cmat[i, 3 * k + 2] * normals[k, 2]
+        ntr = np.empty(nz)
+        for j in range(nz):
+            ntr[j] = normals[j, 0] * r[3 * j] + normals[j, 1] * r[3 * j + 1] + normals[j, 2] * r[3 * j + 2]
+            for k in range(nz):
+                smat[j, k] = (normals[j, 0] * cn[3 * j, k] + normals[j, 1] * cn[3 * j + 1, k]
+                              + normals[j, 2] * cn[3 * j + 2, k]) * dq[k]
+            smat[j, j] += 1.0
+        y = np.linalg.solve(smat, ntr)
+        for k in range(nz):
+            y[k] *= dq[k]
+        corr = cn @ y
+        for i in range(n3):
+            u[i // 3, i % 3] -= r[i] - corr[i]
+    return -1
+
+
+@njit(cache=True)
+def _rotation_z(a, psi, out):
+    """out = a Rz(psi): ring-cylindrical components at psi -> global."""
+    c, s = math.cos(psi), math.sin(psi)
+    for i in range(3):
+        out[i, 0] = a[i, 0] * c + a[i, 1] * s
+        out[i, 1] = -a[i, 0] * s + a[i, 1] * c
+        out[i, 2] = a[i, 2]
+
+
+@njit(cache=True)
+def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+               state, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n); coordinates ordered
-    [frame(6), inner modes, outer modes, balls(3Z)] (see evaluate_row, whose
-    Jacobian blocks K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j this assembles)."""
+    [frame(6), inner modes, outer modes, balls(3Z)].
+
+    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
+    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
+    compliance tables (n_grid, n_grid, 3, 3) of CONDENSED rings ((0, 0, 3, 3):
+    none); u_i / u_o (Z, 3): their contact deflections (warm start, updated);
+    state[0]: count of non-converged condensations, state[1]: 1 if the last call
+    had one (else 0); rec: (Z, N_RECORD) per-ball
+    record, or (0, N_RECORD).
+
+    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
+    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
+    and K the contact stiffness — block diagonal for rigid and modal rings, the
+    dense condensed (I - K C)^-1 K for condensed rings (geometric-stiffness terms
+    of the frame rotation are dropped; the modified Newton iteration converges on
+    the residual, which is exact)."""
     z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (geometry[0], geometry[1], geometry[2], geometry[3],
                                                        geometry[4], geometry[5], geometry[6], geometry[7])
     speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (geometry[8], geometry[9], geometry[10], geometry[11],
                                                          geometry[12])
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    state[1] = 0
     nz = ball_ref.shape[0]
     n = 6 + m_i + m_o + 3 * nz
     b0 = 6 + m_i + m_o
@@ -191,86 +337,168 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     a[1, 0], a[1, 1], a[1, 2] = ca * sc + sa * sb * cc, ca * cc - sa * sb * sc, -sa * cb
     a[2, 0], a[2, 1], a[2, 2] = sa * sc - ca * sb * cc, sa * cc + ca * sb * sc, ca * cb
     g = np.array([[1.0, 0.0, sb], [0.0, ca, -sa * cb], [0.0, sa, ca * cb]])
+    eye3 = np.eye(3)
     om = g @ qt[3:6]
     speed = speed_factor * abs(qt[5])
     bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
-    t_i = np.zeros((3, nx_i))
-    k_i = np.empty((3, 3))
-    d_i = np.empty((3, 3))
-    k_o = np.empty((3, 3))
-    d_o = np.empty((3, 3))
     two_pi = 2.0 * math.pi
+    # ---------------- pass 1: geometry of every ball with the rings undeflected
+    # (modal rings: with their coordinates), ball minus groove centre e0 and
+    # relative velocity w0 of both contacts
+    bpos = np.empty((nz, 3))
+    psi_i = np.empty(nz)
+    psi_o = np.empty(nz)
+    arm = np.empty((nz, 3))  # A p: groove centre relative to the frame origin (global axes)
+    e0_i = np.empty((nz, 3))
+    w0_i = np.empty((nz, 3))
+    e0_o = np.empty((nz, 3))
+    w0_o = np.empty((nz, 3))
+    du_i = np.zeros((nz, 3))  # raceway displacement at the contact (global), modal or condensed
+    du_o = np.zeros((nz, 3))
+    rot_i = np.empty((nz, 3, 3))
+    rot_o = np.empty((nz, 3, 3))
     nzj = nz if jacobian else 0
-    ti_all = np.zeros((3 * nzj, nx_i))
-    kti_q = np.zeros((3 * nzj, nx_i))
-    kti_v = np.zeros((3 * nzj, nx_i))
-    to_all = np.zeros((3 * nzj, m_o))
-    kto_q = np.zeros((3 * nzj, m_o))
-    kto_v = np.zeros((3 * nzj, m_o))
+    bas_i_all = np.zeros((nzj, 3, m_i))
+    bas_o_all = np.zeros((nzj, 3, m_o))
     for j in range(nz):
         bj = b0 + 3 * j
         bx = ball_ref[j, 0] + q[bj]
         by = ball_ref[j, 1] + q[bj + 1]
         bz = ball_ref[j, 2] + q[bj + 2]
+        bpos[j, 0], bpos[j, 1], bpos[j, 2] = bx, by, bz
         vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
         # ---- inner ring (frame)
         dx, dy, dz = bx - q[0], by - q[1], bz - q[2]
         lx = dx * a[0, 0] + dy * a[1, 0] + dz * a[2, 0]
         ly = dx * a[0, 1] + dy * a[1, 1] + dz * a[2, 1]
-        psi_i = math.atan2(ly, lx)
-        p = np.array([ci_r * math.cos(psi_i), ci_r * math.sin(psi_i), ci_z + z_row])
+        psi = math.atan2(ly, lx)
+        psi_i[j] = psi
+        p = np.array([ci_r * math.cos(psi), ci_r * math.sin(psi), ci_z + z_row])
         pv = np.zeros(3)
         if m_i > 0:
-            _basis(tab_i, zs_i, psi_i, bas_i)
-            p += bas_i @ q[6:6 + m_i]
+            _basis(tab_i, zs_i, psi, bas_i)
+            dp = bas_i @ q[6:6 + m_i]
+            p += dp
             pv = bas_i @ qt[6:6 + m_i]
+            du_i[j] = a @ dp
+            if jacobian:
+                bas_i_all[j] = bas_i
+        if cond_i:
+            _rotation_z(a, psi, rot_i[j])
         ap = a @ p
-        cx, cy, cz = q[0] + ap[0], q[1] + ap[1], q[2] + ap[2]
+        arm[j] = ap
         apv = a @ pv
-        cvx = qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0]
-        cvy = qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1]
-        cvz = qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2]
-        len_i, nix, niy, niz, qi, dqi, cdi = _contact(bx - cx, by - cy, bz - cz, vx - cvx, vy - cvy, vz - cvz,
-                                                      off_i, speed, law_i)
-        fix, fiy, fiz = -qi * nix, -qi * niy, -qi * niz
-        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
-        f[0] -= fix
-        f[1] -= fiy
-        f[2] -= fiz
-        mx = ap[1] * fiz - ap[2] * fiy
-        my = ap[2] * fix - ap[0] * fiz
-        mz = ap[0] * fiy - ap[1] * fix
-        for r in range(3):
-            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
-        if m_i > 0:
-            flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
-            fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
-            flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
-            for k in range(m_i):
-                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
+        e0_i[j, 0], e0_i[j, 1], e0_i[j, 2] = bx - q[0] - ap[0], by - q[1] - ap[1], bz - q[2] - ap[2]
+        w0_i[j, 0] = vx - (qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0])
+        w0_i[j, 1] = vy - (qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1])
+        w0_i[j, 2] = vz - (qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2])
         # ---- outer ring (housing)
         psi = math.atan2(by, bx)
+        psi_o[j] = psi
         cos_p, sin_p = math.cos(psi), math.sin(psi)
         ox, oy, oz = co_r * cos_p, co_r * sin_p, co_z + z_row
         ovx = ovy = ovz = 0.0
         if m_o > 0:
             _basis(tab_o, zs_o, psi, bas_o)
+            ux = uy = uz = 0.0
             for k in range(m_o):
                 qk, vk = q[6 + m_i + k], qt[6 + m_i + k]
-                ox += bas_o[0, k] * qk
-                oy += bas_o[1, k] * qk
-                oz += bas_o[2, k] * qk
+                ux += bas_o[0, k] * qk
+                uy += bas_o[1, k] * qk
+                uz += bas_o[2, k] * qk
                 ovx += bas_o[0, k] * vk
                 ovy += bas_o[1, k] * vk
                 ovz += bas_o[2, k] * vk
-        len_o, nox, noy, noz, qo, dqo, cdo = _contact(bx - ox, by - oy, bz - oz, vx - ovx, vy - ovy, vz - ovz,
-                                                      off_o, speed, law_o)
-        fox, foy, foz = -qo * nox, -qo * noy, -qo * noz
+            du_o[j, 0], du_o[j, 1], du_o[j, 2] = ux, uy, uz
+            ox, oy, oz = ox + ux, oy + uy, oz + uz
+            if jacobian:
+                bas_o_all[j] = bas_o
+        if cond_o:
+            _rotation_z(eye3, psi, rot_o[j])
+        e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
+        w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
+    # ---------------- condensed rings: contact deflections
+    load_i = np.empty(nz)
+    load_o = np.empty(nz)
+    nrm_i = np.empty((nz, 3))
+    nrm_o = np.empty((nz, 3))
+    dq_i = np.empty(nz)
+    dq_o = np.empty(nz)
+    cd_i = np.empty(nz)
+    cd_o = np.empty(nz)
+    len_i = np.empty(nz)
+    len_o = np.empty(nz)
+    cmat_i = np.zeros((3 * nz if cond_i else 0, 3 * nz if cond_i else 0))
+    cmat_o = np.zeros((3 * nz if cond_o else 0, 3 * nz if cond_o else 0))
+    if cond_i:
+        _compliance_matrix(psi_i, rot_i, comp_i, zs_i, cmat_i)
+        if _condense(e0_i, w0_i, cmat_i, off_i, speed, law_i, u_i, load_i, nrm_i, dq_i, cd_i, len_i) < 0:
+            state[0] += 1
+            state[1] = 1
+        for j in range(nz):
+            for c in range(3):
+                du_i[j, c] = u_i[j, c]
+                arm[j, c] += u_i[j, c]
+    else:
+        for j in range(nz):
+            len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j] = _contact(
+                e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
+    if cond_o:
+        _compliance_matrix(psi_o, rot_o, comp_o, zs_o, cmat_o)
+        if _condense(e0_o, w0_o, cmat_o, off_o, speed, law_o, u_o, load_o, nrm_o, dq_o, cd_o, len_o) < 0:
+            state[0] += 1
+            state[1] = 1
+        for j in range(nz):
+            for c in range(3):
+                du_o[j, c] = u_o[j, c]
+    else:
+        for j in range(nz):
+            len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j] = _contact(
+                e0_o[j, 0], e0_o[j, 1], e0_o[j, 2], w0_o[j, 0], w0_o[j, 1], w0_o[j, 2], off_o, speed, law_o)
+    # ---------------- pass 2: generalized forces (and Jacobian blocks)
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
+    t_i = np.zeros((3, nx_i))
+    ti_all = np.zeros((3 * nzj, nx_i))
+    kbi_q = np.zeros((3 * nzj, 3))  # per-ball 3x3 contact blocks, stacked
+    kbi_v = np.zeros((3 * nzj, 3))
+    kbo_q = np.zeros((3 * nzj, 3))
+    kbo_v = np.zeros((3 * nzj, 3))
+    record = rec.shape[0] == nz
+    for j in range(nz):
+        bj = b0 + 3 * j
+        bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
+        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+        qi, qo = load_i[j], load_o[j]
+        fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
+        fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
+        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
+        f[0] -= fix
+        f[1] -= fiy
+        f[2] -= fiz
+        ap = arm[j]
+        mx = ap[1] * fiz - ap[2] * fiy
+        my = ap[2] * fix - ap[0] * fiz
+        mz = ap[0] * fiy - ap[1] * fix
+        for r in range(3):
+            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
+        flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
+        fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
+        flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
+        if m_i > 0:
+            _basis(tab_i, zs_i, psi_i[j], bas_i)
+            for k in range(m_i):
+                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
         if m_o > 0:
+            _basis(tab_o, zs_o, psi_o[j], bas_o)
             for k in range(m_o):
                 f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
         # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
+        psi = psi_o[j]
+        cos_p, sin_p = math.cos(psi), math.sin(psi)
         pocket = two_pi * j / nz + cage_ratio * az
         dev = psi - pocket
         dev = math.atan2(math.sin(dev), math.cos(dev))
@@ -282,21 +510,32 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
         f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
         f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
+        if record:
+            rec[j, 0], rec[j, 1] = qi, qo
+            for c in range(3):
+                rec[j, 2 + c] = nrm_i[j, c]
+                rec[j, 5 + c] = nrm_o[j, c]
+                rec[j, 16 + c] = du_i[j, c]
+                rec[j, 19 + c] = du_o[j, c]
+                rec[j, 22 + c] = bpos[j, c]
+            rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
+            rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
+            rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
         if not jacobian:
             continue
         # ---- Jacobian blocks
-        _contact_blocks(qi, dqi, cdi, len_i, nix, niy, niz, etx, ety, k_i, d_i)
-        _contact_blocks(qo, dqo, cdo, len_o, nox, noy, noz, etx, ety, k_o, d_o)
+        _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+        _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
         et = (etx, ety, 0.0)
         for c1 in range(3):
             for c2 in range(3):
                 ee = et[c1] * et[c2]
                 eye = 1.0 if c1 == c2 else 0.0
-                jq[bj + c1, bj + c2] += k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
-                jv[bj + c1, bj + c2] += d_i[c1, c2] + d_o[c1, c2] - cage_c * ee
+                jq[bj + c1, bj + c2] += -cage_k * ee - pocket_k * (eye - ee)
+                jv[bj + c1, bj + c2] += -cage_c * ee
             jq[bj + c1, 5] += cage_k * radius * cage_ratio * et[c1]
             jv[bj + c1, 5] += cage_c * radius * cage_ratio * et[c1]
-        # T_i = [I | -[Ap]x G | A basis_i]; stacked over the balls for one product each at the end
+        # T_i = [I | -[Ap]x G | A basis_i]
         rows3 = slice(3 * j, 3 * j + 3)
         for r in range(3):
             for c1 in range(3):
@@ -304,31 +543,79 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         skew = np.array([[0.0, -ap[2], ap[1]], [ap[2], 0.0, -ap[0]], [-ap[1], ap[0], 0.0]])
         t_i[:, 3:6] = -(skew @ g)
         if m_i > 0:
-            t_i[:, 6:] = a @ bas_i
+            t_i[:, 6:] = a @ bas_i_all[j]
         ti_all[rows3] = t_i
-        kti_q[rows3] = k_i @ t_i
-        kti_v[rows3] = d_i @ t_i
-        if m_o > 0:
-            to_all[rows3] = bas_o
-            kto_q[rows3] = k_o @ bas_o
-            kto_v[rows3] = d_o @ bas_o
+        kbi_q[rows3] = k_i
+        kbi_v[rows3] = d_i
+        kbo_q[rows3] = k_o
+        kbo_v[rows3] = d_o
     if jacobian:
-        # d f_ball/d x = -K T; d g/d b = -T^T K (K symmetric); d g/d x = sum T^T K T
         ball = slice(b0, b0 + 3 * nz)
         o = slice(6 + m_i, 6 + m_i + m_o)
-        for jac, kt, kto in ((jq, kti_q, kto_q), (jv, kti_v, kto_v)):
+        to_all = np.zeros((3 * nz, m_o))
+        for j in range(nz):
+            to_all[3 * j:3 * j + 3] = bas_o_all[j]
+        ki_q = _contact_matrix(kbi_q, kbi_v, cmat_i, cond_i)
+        ko_q = _contact_matrix(kbo_q, kbo_v, cmat_o, cond_o)
+        for jac, kim, kom in ((jq, ki_q[0], ko_q[0]), (jv, ki_q[1], ko_q[1])):
+            # d f_ball/d b = K; d f_ball/d x = -K T; d g/d b = -T^T K; d g/d x = T^T K T
+            jac[ball, ball] += kim + kom
+            kt = kim @ ti_all
             jac[ball, 0:nx_i] -= kt
-            jac[0:nx_i, ball] -= kt.T
-            jac[0:nx_i, 0:nx_i] += ti_all.T @ kt
+            tk = ti_all.T @ kim
+            jac[0:nx_i, ball] -= tk
+            jac[0:nx_i, 0:nx_i] += tk @ ti_all
             if m_o > 0:
+                kto = kom @ to_all
                 jac[ball, o] -= kto
-                jac[o, ball] -= kto.T
-                jac[o, o] += to_all.T @ kto
+                tko = to_all.T @ kom
+                jac[o, ball] -= tko
+                jac[o, o] += tko @ to_all
     return f, jq, jv
 
 
 @njit(cache=True)
-def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o):
+def _contact_matrix(blocks_q, blocks_v, cmat, condensed):
+    """(3Z, 3Z) contact stiffness and damping of one ring's contacts: block
+    diagonal from the per-ball blocks (stacked (3Z, 3)), or for a condensed ring
+    the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D."""
+    n3 = blocks_q.shape[0]
+    kq = np.zeros((n3, n3))
+    kv = np.zeros((n3, n3))
+    for j in range(n3 // 3):
+        kq[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_q[3 * j:3 * j + 3]
+        kv[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_v[3 * j:3 * j + 3]
+    if not condensed:
+        return kq, kv
+    m = np.eye(n3) - kq @ cmat
+    both = np.empty((n3, 2 * n3))
+    both[:, :n3] = kq
+    both[:, n3:] = kv
+    sol = np.linalg.solve(m, both)
+    return np.ascontiguousarray(sol[:, :n3]), np.ascontiguousarray(sol[:, n3:])
+
+
+@njit(cache=True)
+def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+                     state):
     """Generalized force (n,) of a row element (see :func:`row_kernel`)."""
-    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, False)
+    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+                         state, False, np.zeros((0, N_RECORD)))
     return f
+
+
+@njit(cache=True)
+def ring_modal_amplitudes(psi, g_local, table, zsign, compliance_diag):
+    """Modal amplitudes q = K^-1 sum_j B(psi_j)^T g_j of a condensed ring from its
+    contact loads g (Z, 3) in the ring's own Cartesian frame at azimuths psi (Z,)
+    (K diagonal: ``compliance_diag`` = 1 / diag K)."""
+    m = table.shape[2]
+    bas = np.empty((3, m))
+    out = np.zeros(m)
+    for j in range(psi.shape[0]):
+        _basis(table, zsign, psi[j], bas)
+        for k in range(m):
+            out[k] += bas[0, k] * g_local[j, 0] + bas[1, k] * g_local[j, 1] + bas[2, k] * g_local[j, 2]
+    for k in range(m):
+        out[k] *= compliance_diag[k]
+    return out
