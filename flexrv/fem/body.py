@@ -121,24 +121,20 @@ class ReducedBody:
         return np.stack([c * A[..., 0, :] - s * A[..., 1, :], s * A[..., 0, :] + c * A[..., 1, :], A[..., 2, :]],
                         axis=-2)
 
-    def raceway_compliance(self, stiffness_scale: float = 1.0) -> np.ndarray:
-        """(n_grid, n_grid, 3, 3) raceway compliance [m/N] of the ring with its fit
-        clamped: G[i, k] = T_i K^-1 T_k^T (cylindrical components at the grid
-        azimuths i, k; T the raceway table, K = ``stiffness_scale`` diag(omega^2)),
-        i.e. the raceway displacement at grid point i per unit raceway force at
-        grid point k. Interpolated with the table's own Catmull–Rom weights in both
-        indices it equals B(psi_j) K^-1 B(psi_k)^T of the interpolated basis exactly
-        (static condensation of a quasi-static ring onto its contacts,
-        :mod:`flexrv.model.bearing_kernel`). Computed once per body and scale
-        (one BLAS product, ~0.3 s for 560 x 127) and kept with the body."""
+    def raceway_compliance_factors(self, stiffness_scale: float = 1.0) -> np.ndarray:
+        """(n_grid, 3, m) raceway table scaled by K^-1/2 (K = ``stiffness_scale``
+        diag(omega^2)): the raceway compliance of the ring with its fit clamped
+        between grid azimuths i and k is W_i W_k^T [m/N] (cylindrical components),
+        and interpolated with the table's Catmull–Rom weights it is
+        B(psi_j) K^-1 B(psi_k)^T of the interpolated basis exactly (static
+        condensation of a quasi-static ring onto its ball contacts,
+        :mod:`flexrv.model.bearing_kernel`). Kept with the body, per scale."""
         self._require_raceway()
-        cache = self.__dict__.setdefault("_compliance", {})
+        cache = self.__dict__.setdefault("_compliance_factors", {})
         key = float(stiffness_scale)
         if key not in cache:
-            ng, _, m = self.table.shape
-            w = (np.asarray(self.table, dtype=float) / np.sqrt(key * np.asarray(self.omega2, dtype=float))).reshape(
-                3 * ng, m)
-            cache[key] = np.ascontiguousarray((w @ w.T).reshape(ng, 3, ng, 3).transpose(0, 2, 1, 3))
+            scale = 1.0 / np.sqrt(key * np.asarray(self.omega2, dtype=float))
+            cache[key] = np.ascontiguousarray(np.asarray(self.table, dtype=float) * scale)
         return cache[key]
 
     def raceway_displacement(self, q_modal, azimuth) -> np.ndarray:

@@ -12,15 +12,16 @@ the housing, the balls are point masses held by a kinematic cage. A ring is
   eliminated by static condensation: with K q = sum_k B_k^T g_k (B_k the raceway
   basis at the contact azimuth psi_k, g_k the contact force on the ring) the
   raceway displacements at the contacts are u_j = sum_k C_jk g_k with the
-  compliance C_jk = B_j K^-1 B_k^T. C is interpolated from the ring's
-  precomputed table G[i, i'] = T_i K^-1 T_i'^T on the raceway grid
-  (:meth:`flexrv.fem.body.ReducedBody.raceway_compliance`) with the same
-  Catmull–Rom weights as the basis, so it equals B_j K^-1 B_k^T of the
-  interpolated basis exactly (to round-off). The contact deflections solve the
+  compliance C_jk = B_j K^-1 B_k^T = W_j W_k^T, W_j = B_j K^-1/2 interpolated
+  from the ring's factor table T K^-1/2 (T the raceway table,
+  :meth:`flexrv.fem.body.ReducedBody.raceway_compliance_factors`) with the same
+  Catmull–Rom weights as the basis — so C equals B_j K^-1 B_k^T of the
+  interpolated basis exactly (to round-off), and is never formed in the
+  residual (u = W (W^T g): 2 Z x 3 x m products). The contact deflections solve the
   local nonlinear system u = C g(e0 - u) (e0: ball minus rigid-ring groove
   centre) by Newton iterations whose Jacobian keeps the normal contact
   stiffness (I + C N diag(dQ/d delta) N^T, solved by the Woodbury identity as a
-  Z x Z system); the neglected geometric term Q/L (I - n n^T) is ~1e-2 of it, so
+  Z x Z SPD system); the neglected geometric term Q/L (I - n n^T) is ~1e-2 of it, so
   the iteration converges linearly to the exact solution (tolerance
   ``CONDENSE_TOL``). The element Jacobian uses the condensed tangent
   (I - K C)^-1 K of the contacts in series with the ring (dense over the
@@ -62,7 +63,7 @@ N_RECORD = len(RECORD_FIELDS)
 
 #: local condensation: absolute tolerance on the contact deflections [m] and the
 #: iteration limit (a solve that does not converge counts in ``state``, see :func:`row_kernel`)
-CONDENSE_TOL = 1e-15
+CONDENSE_TOL = 1e-13
 CONDENSE_MAXIT = 50
 
 
@@ -185,100 +186,182 @@ def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
 
 
 @njit(cache=True)
-def _compliance_matrix(psi, rot, comp, zsign, out):
-    """Global compliance (3Z, 3Z) of a condensed ring at the contact azimuths psi (Z,):
-    C_jk = R_j S G(psi_j, psi_k) S R_k^T, G the bicubic interpolation of the
-    cylindrical table ``comp`` (ng, ng, 3, 3), S = diag(1, 1, zsign), R_j (3,3) the
-    ring-cylindrical -> global rotation of contact j (rot (Z,3,3))."""
+def _local_factors(psi, wtab, zsign, out):
+    """Compliance factors (Z, 3, m) of a condensed ring at the contact azimuths psi:
+    out[j] = S B_cyl(psi_j) K^-1/2 in the ring's cylindrical components at contact j
+    (the periodic cubic of ``wtab`` = T K^-1/2, (ng, 3, m)), S = diag(1, 1, zsign);
+    the compliance blocks are C_jk = out[j] out[k]^T."""
     nz = psi.shape[0]
-    ng = comp.shape[0]
-    idx = np.empty((nz, 4), np.int64)
-    w = np.empty((nz, 4))
+    ng = wtab.shape[0]
+    m = wtab.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
     for j in range(nz):
-        _taps(psi[j], ng, idx[j], w[j])
-    sgn = (1.0, 1.0, zsign)
-    g = np.empty((3, 3))
-    h = np.empty((3, 3))
-    for j in range(nz):
-        for k in range(j, nz):
-            for a in range(3):
-                for b in range(3):
-                    g[a, b] = 0.0
-            for ta in range(4):
-                ia = idx[j, ta]
-                for tb in range(4):
-                    wab = w[j, ta] * w[k, tb]
-                    ib = idx[k, tb]
-                    for a in range(3):
-                        for b in range(3):
-                            g[a, b] += wab * comp[ia, ib, a, b]
-            for a in range(3):
-                for b in range(3):
-                    g[a, b] *= sgn[a] * sgn[b]
-            # h = R_j g R_k^T
-            for a in range(3):
-                for b in range(3):
-                    s = 0.0
-                    for c in range(3):
-                        s += g[a, c] * rot[k, b, c]
-                    h[a, b] = s
-            for a in range(3):
-                for b in range(3):
-                    s = 0.0
-                    for c in range(3):
-                        s += rot[j, a, c] * h[c, b]
-                    out[3 * j + a, 3 * k + b] = s
-                    out[3 * k + b, 3 * j + a] = s
+        _taps(psi[j], ng, idx, w)
+        for a in range(3):
+            sg = zsign if a == 2 else 1.0
+            r0, r1, r2, r3 = wtab[idx[0], a], wtab[idx[1], a], wtab[idx[2], a], wtab[idx[3], a]
+            w0, w1, w2, w3 = sg * w[0], sg * w[1], sg * w[2], sg * w[3]
+            for k in range(m):
+                out[j, a, k] = w0 * r0[k] + w1 * r1[k] + w2 * r2[k] + w3 * r3[k]
 
 
 @njit(cache=True)
-def _condense(e0, w0, cmat, offset, speed, law, u, loads, normals, dq, cd, lengths):
-    """Solve the contact deflections u (Z,3, global; in: warm start) of a condensed
-    ring: u = C g(e0 - u), g_j = Q_j n_j the force on the ring. Fills the contact
-    results at the solution (loads, normals, dQ/ddelta, damping coefficient,
-    |e|); returns the number of Newton iterations (-1: not converged)."""
+def _cholesky(m):
+    """In-place lower Cholesky factor of a small SPD matrix m."""
+    n = m.shape[0]
+    for j in range(n):
+        d = m[j, j]
+        for k in range(j):
+            d -= m[j, k] * m[j, k]
+        d = math.sqrt(max(d, 1e-300))
+        m[j, j] = d
+        for i in range(j + 1, n):
+            v = m[i, j]
+            for k in range(j):
+                v -= m[i, k] * m[j, k]
+            m[i, j] = v / d
+
+
+@njit(cache=True)
+def _cholesky_solve(m, b):
+    """b <- m^-1 b with m's lower Cholesky factor (from :func:`_cholesky`)."""
+    n = m.shape[0]
+    for i in range(n):
+        v = b[i]
+        for k in range(i):
+            v -= m[i, k] * b[k]
+        b[i] = v / m[i, i]
+    for i in range(n - 1, -1, -1):
+        v = b[i]
+        for k in range(i + 1, n):
+            v -= m[k, i] * b[k]
+        b[i] = v / m[i, i]
+
+
+@njit(cache=True)
+def _condense(e0, w0, wl, offset, speed, law, u, loads, normals, dq, cd, lengths):
+    """Contact deflections u (Z,3; in: warm start) of a condensed ring, everything in
+    each contact's ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k),
+    C_jk = W_j W_k^T (wl: (Z, 3, m) factors W_j = S B_j K^-1/2), g_k = Q_k n_k the
+    force on the ring. Fills the contact results at the solution (loads, normals,
+    dQ/ddelta, damping coefficient, |e|); returns the number of iterations (-1:
+    not converged).
+
+    Newton-type iterations with the normal contact stiffness only:
+    (I + C N L N^T) du = -r, L = diag(dQ/d delta), solved by the Woodbury identity
+    as the SPD Z x Z system (I + L^1/2 N^T C N L^1/2) with N^T C N = P P^T,
+    P_k = W_k^T n_k. The tangent is kept while the residual drops at least 10x per
+    iteration, else refreshed."""
     nz = e0.shape[0]
-    n3 = 3 * nz
-    gvec = np.empty(n3)
-    r = np.empty(n3)
-    cn = np.empty((n3, nz))
+    m = wl.shape[2]
+    r = np.empty((nz, 3))
+    y = np.empty(m)
+    p = np.empty((nz, m))
+    nf = np.empty((nz, 3))
     smat = np.empty((nz, nz))
+    sq = np.empty(nz)
+    rhs = np.empty(nz)
+    err_prev = 0.0
     for it in range(CONDENSE_MAXIT + 1):
+        for k in range(m):
+            y[k] = 0.0
         for j in range(nz):
             length, nx, ny, nzz, q, d, c = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1], e0[j, 2] - u[j, 2],
                                                     w0[j, 0], w0[j, 1], w0[j, 2], offset, speed, law)
             loads[j], dq[j], cd[j], lengths[j] = q, d, c, length
             normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
-            gvec[3 * j], gvec[3 * j + 1], gvec[3 * j + 2] = q * nx, q * ny, q * nzz
-        cg = cmat @ gvec
+            if q != 0.0:
+                g0, g1, g2 = q * nx, q * ny, q * nzz
+                for k in range(m):
+                    y[k] += wl[j, 0, k] * g0 + wl[j, 1, k] * g1 + wl[j, 2, k] * g2
         err = 0.0
-        for i in range(n3):
-            r[i] = u[i // 3, i % 3] - cg[i]
-            err = max(err, abs(r[i]))
+        for j in range(nz):
+            for a in range(3):
+                v = u[j, a]
+                for k in range(m):
+                    v -= wl[j, a, k] * y[k]
+                r[j, a] = v
+                err = max(err, abs(v))
         if err <= CONDENSE_TOL:
             return it
         if it == CONDENSE_MAXIT:
             break
-        # Newton step with the normal contact stiffness (Woodbury, Z x Z):
-        # (I + C N L N^T) du = -r -> du = -(r - C N L (I + N^T C N L)^-1 N^T r)
-        for i in range(n3):
-            for k in range(nz):
-                cn[i, k] = cmat[i, 3 * k] * normals[k, 0] + cmat[i, 3 * k + 1] * normals[k, 1] \
-                    + cmat[i, 3 * k + 2] * normals[k, 2]
-        ntr = np.empty(nz)
+        if it == 0 or err > 0.1 * err_prev:
+            # tangent: P_k = W_k^T n_k; M = I + L^1/2 P P^T L^1/2, Cholesky-factored
+            for j in range(nz):
+                sq[j] = math.sqrt(max(dq[j], 0.0))
+                n0, n1, n2 = normals[j, 0], normals[j, 1], normals[j, 2]
+                nf[j, 0], nf[j, 1], nf[j, 2] = n0, n1, n2
+                for k in range(m):
+                    p[j, k] = wl[j, 0, k] * n0 + wl[j, 1, k] * n1 + wl[j, 2, k] * n2
+            for j in range(nz):
+                for i in range(j + 1):
+                    v = 0.0
+                    if sq[j] > 0.0 and sq[i] > 0.0:
+                        for k in range(m):
+                            v += p[j, k] * p[i, k]
+                        v *= sq[j] * sq[i]
+                    smat[j, i] = v
+                    smat[i, j] = v
+                smat[j, j] += 1.0
+            _cholesky(smat)
         for j in range(nz):
-            ntr[j] = normals[j, 0] * r[3 * j] + normals[j, 1] * r[3 * j + 1] + normals[j, 2] * r[3 * j + 2]
-            for k in range(nz):
-                smat[j, k] = (normals[j, 0] * cn[3 * j, k] + normals[j, 1] * cn[3 * j + 1, k]
-                              + normals[j, 2] * cn[3 * j + 2, k]) * dq[k]
-            smat[j, j] += 1.0
-        y = np.linalg.solve(smat, ntr)
-        for k in range(nz):
-            y[k] *= dq[k]
-        corr = cn @ y
-        for i in range(n3):
-            u[i // 3, i % 3] -= r[i] - corr[i]
+            rhs[j] = sq[j] * (nf[j, 0] * r[j, 0] + nf[j, 1] * r[j, 1] + nf[j, 2] * r[j, 2])
+        _cholesky_solve(smat, rhs)
+        # correction C N L y' = W (P^T (L^1/2 z))
+        for k in range(m):
+            y[k] = 0.0
+        for j in range(nz):
+            zj = sq[j] * rhs[j]
+            if zj != 0.0:
+                for k in range(m):
+                    y[k] += p[j, k] * zj
+        for j in range(nz):
+            for a in range(3):
+                corr = 0.0
+                for k in range(m):
+                    corr += wl[j, a, k] * y[k]
+                u[j, a] -= r[j, a] - corr
+        err_prev = err
     return -1
+
+
+@njit(cache=True)
+def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, u, loads, normals, dq, cd, lengths, du,
+                    cglobal):
+    """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
+    each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
+    the compliance factors, the contact solve (:func:`_condense`, deflections u
+    kept in these local frames as the next call's warm start), and back to global
+    normals and raceway displacements du. With ``cglobal`` of shape (3Z, 3Z) the
+    global compliance matrix C_jk = R_j W_j W_k^T R_k^T (for the Jacobian).
+    Returns the iteration count."""
+    nz = psi.shape[0]
+    m = wtab.shape[2]
+    wl = np.empty((nz, 3, m))
+    _local_factors(psi, wtab, zsign, wl)
+    el = np.empty((nz, 3))
+    wv = np.empty((nz, 3))
+    for j in range(nz):
+        for a in range(3):
+            el[j, a] = rot[j, 0, a] * e0[j, 0] + rot[j, 1, a] * e0[j, 1] + rot[j, 2, a] * e0[j, 2]
+            wv[j, a] = rot[j, 0, a] * w0[j, 0] + rot[j, 1, a] * w0[j, 1] + rot[j, 2, a] * w0[j, 2]
+    nl = np.empty((nz, 3))
+    its = _condense(el, wv, wl, offset, speed, law, u, loads, nl, dq, cd, lengths)
+    for j in range(nz):
+        for a in range(3):
+            normals[j, a] = rot[j, a, 0] * nl[j, 0] + rot[j, a, 1] * nl[j, 1] + rot[j, a, 2] * nl[j, 2]
+            du[j, a] = rot[j, a, 0] * u[j, 0] + rot[j, a, 1] * u[j, 1] + rot[j, a, 2] * u[j, 2]
+    if cglobal.shape[0] == 3 * nz:
+        wg = np.empty((3 * nz, m))  # R_j W_j stacked
+        for j in range(nz):
+            for a in range(3):
+                for k in range(m):
+                    wg[3 * j + a, k] = rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] \
+                        + rot[j, a, 2] * wl[j, 2, k]
+        cglobal[:, :] = wg @ wg.T
+    return its
 
 
 @njit(cache=True)
@@ -300,10 +383,11 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
 
     tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
     coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
-    compliance tables (n_grid, n_grid, 3, 3) of CONDENSED rings ((0, 0, 3, 3):
-    none); u_i / u_o (Z, 3): their contact deflections (warm start, updated);
-    state[0]: count of non-converged condensations, state[1]: 1 if the last call
-    had one (else 0); rec: (Z, N_RECORD) per-ball
+    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
+    ((0, 3, 0): none); u_i / u_o (Z, 3): their contact deflections in the contacts' ring-
+    cylindrical frames (warm start, updated);
+    state (int64, 4): [non-converged condensations, 1 if the last call had one,
+    sum of the local iterations, local solves]; rec: (Z, N_RECORD) per-ball
     record, or (0, N_RECORD).
 
     Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
@@ -429,29 +513,33 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     cd_o = np.empty(nz)
     len_i = np.empty(nz)
     len_o = np.empty(nz)
-    cmat_i = np.zeros((3 * nz if cond_i else 0, 3 * nz if cond_i else 0))
-    cmat_o = np.zeros((3 * nz if cond_o else 0, 3 * nz if cond_o else 0))
+    cmat_i = np.zeros((3 * nz if (cond_i and jacobian) else 0, 3 * nz if (cond_i and jacobian) else 0))
+    cmat_o = np.zeros((3 * nz if (cond_o and jacobian) else 0, 3 * nz if (cond_o and jacobian) else 0))
     if cond_i:
-        _compliance_matrix(psi_i, rot_i, comp_i, zs_i, cmat_i)
-        if _condense(e0_i, w0_i, cmat_i, off_i, speed, law_i, u_i, load_i, nrm_i, dq_i, cd_i, len_i) < 0:
+        its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, u_i, load_i,
+                              nrm_i, dq_i, cd_i, len_i, du_i, cmat_i)
+        state[3] += 1
+        if its < 0:
             state[0] += 1
             state[1] = 1
+        else:
+            state[2] += its
         for j in range(nz):
             for c in range(3):
-                du_i[j, c] = u_i[j, c]
-                arm[j, c] += u_i[j, c]
+                arm[j, c] += du_i[j, c]
     else:
         for j in range(nz):
             len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j] = _contact(
                 e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
     if cond_o:
-        _compliance_matrix(psi_o, rot_o, comp_o, zs_o, cmat_o)
-        if _condense(e0_o, w0_o, cmat_o, off_o, speed, law_o, u_o, load_o, nrm_o, dq_o, cd_o, len_o) < 0:
+        its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, u_o, load_o,
+                              nrm_o, dq_o, cd_o, len_o, du_o, cmat_o)
+        state[3] += 1
+        if its < 0:
             state[0] += 1
             state[1] = 1
-        for j in range(nz):
-            for c in range(3):
-                du_o[j, c] = u_o[j, c]
+        else:
+            state[2] += its
     else:
         for j in range(nz):
             len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j] = _contact(

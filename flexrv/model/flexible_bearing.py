@@ -124,10 +124,11 @@ class ModalRing:
         return np.ascontiguousarray(self.body.table, dtype=float)
 
     @property
-    def compliance_table(self) -> np.ndarray:
-        """(n_grid, n_grid, 3, 3) raceway compliance T_i K^-1 T_k^T [m/N] of the
-        (scaled) ring (:meth:`flexrv.fem.body.ReducedBody.raceway_compliance`)."""
-        return self.body.raceway_compliance(self.stiffness_scale)
+    def compliance_factors(self) -> np.ndarray:
+        """(n_grid, 3, m) raceway table times K^-1/2 of the (scaled) ring: the
+        compliance at the contacts is W_j W_k^T
+        (:meth:`flexrv.fem.body.ReducedBody.raceway_compliance_factors`)."""
+        return self.body.raceway_compliance_factors(self.stiffness_scale)
 
     @property
     def compliance_diag(self) -> np.ndarray:
@@ -218,11 +219,11 @@ class RowModel:
 
 
 _NO_TABLE = np.zeros((1, 3, 0))
-_NO_COMPLIANCE = np.zeros((0, 0, 3, 3))
+_NO_COMPLIANCE = np.zeros((0, 3, 0))
 
 
 def _ring_arrays(ring, ball_count: int) -> tuple:
-    """(modal table, z sign, compliance table, deflection state) of a ring for the kernel."""
+    """(modal table, z sign, compliance factors, deflection state) of a ring for the kernel."""
     if ring is None:
         return _NO_TABLE, 1.0, _NO_COMPLIANCE, np.zeros((ball_count, 3))
     zs = -1.0 if getattr(ring, "mirror", False) else 1.0
@@ -231,7 +232,7 @@ def _ring_arrays(ring, ball_count: int) -> tuple:
         raise ConfigError(f"ring model {type(ring).__name__} has no raceway table: the bearing kernel needs one")
     table = np.ascontiguousarray(table, dtype=float)
     if _is_condensed(ring):
-        return _NO_TABLE, zs, np.ascontiguousarray(ring.compliance_table, dtype=float), np.zeros((ball_count, 3))
+        return _NO_TABLE, zs, np.ascontiguousarray(ring.compliance_factors, dtype=float), np.zeros((ball_count, 3))
     return table, zs, _NO_COMPLIANCE, np.zeros((ball_count, 3))
 
 
@@ -258,7 +259,7 @@ def kernel_inputs(model: RowModel) -> tuple:
                          model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
                          model.pocket_stiffness])
     inputs = (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, tab_i, zs_i, tab_o, zs_o,
-              laws[0], laws[1], comp_i, comp_o, u_i, u_o, np.zeros(2, np.int64))
+              laws[0], laws[1], comp_i, comp_o, u_i, u_o, np.zeros(4, np.int64))
     model._kernel_inputs = inputs
     return inputs
 
