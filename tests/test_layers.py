@@ -47,8 +47,6 @@ ALLOWED_UPWARD = {
 ALLOWED_CYCLES: dict[frozenset, str] = {
     frozenset({"flexrv.post.io", "flexrv.post.results"}):
         "Results.save/load delegate to io, and io.load_results builds a Results (in-function import)",
-    frozenset({"flexrv.model.bearing_kernel", "flexrv.model.flexible_bearing"}):
-        "the numba kernel reads ModalRing data and the bearing group calls the kernel (issue 16)",
 }
 
 

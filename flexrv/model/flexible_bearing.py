@@ -311,6 +311,7 @@ class RowEvaluation:
     jac_q: np.ndarray | None  # (n, n) d force / d q
     jac_v: np.ndarray | None  # (n, n) d force / d q_t
     ball_pos: np.ndarray
+    azimuth: np.ndarray  # (Z,) ball azimuths in the housing [rad]
 
 
 def _contacts(rec: np.ndarray, label: str) -> RaceContacts:
@@ -336,7 +337,7 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
                            *kernel_inputs(model), bool(jacobian), rec)
     return RowEvaluation(inner=_contacts(rec, "inner"), outer=_contacts(rec, "outer"), force=f,
                          jac_q=jq if jacobian else None, jac_v=jv if jacobian else None,
-                         ball_pos=rec[:, [_REC["bx"], _REC["by"], _REC["bz"]]])
+                         ball_pos=rec[:, [_REC["bx"], _REC["by"], _REC["bz"]]], azimuth=rec[:, _REC["psi_outer"]].copy())
 
 
 def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEvaluation) -> np.ndarray:
