@@ -239,28 +239,54 @@ def _cholesky_solve(m, b):
         b[i] = v / m[i, i]
 
 
-@njit(cache=True)
-def _condense(e0, w0, wl, offset, speed, law, u, loads, normals, dq, cd, lengths):
-    """Contact deflections u (Z,3; in: warm start) of a condensed ring, everything in
-    each contact's ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k),
-    C_jk = W_j W_k^T (wl: (Z, 3, m) factors W_j = S B_j K^-1/2), g_k = Q_k n_k the
-    force on the ring. Fills the contact results at the solution (loads, normals,
-    dQ/ddelta, damping coefficient, |e|); returns the number of iterations (-1:
-    not converged).
+def condense_workspace(ball_count: int, n_modes: int) -> np.ndarray:
+    """Persistent work array of a condensed ring in a row (see :func:`_split_workspace`):
+    the contact deflections (warm start) and the last Newton tangent."""
+    z = int(ball_count)
+    return np.zeros(3 * z + 1 + z + 3 * z + z * int(n_modes) + z * z)
 
-    Newton-type iterations with the normal contact stiffness only:
+
+@njit(cache=True)
+def _split_workspace(ws, nz, m):
+    """Views of a condensed ring's work array: deflections u (Z,3), tangent-valid
+    flag (1,), L^1/2 (Z,), normals (Z,3), P = W^T n (Z,m), Cholesky factor (Z,Z)."""
+    o = 0
+    u = ws[o:o + 3 * nz].reshape((nz, 3))
+    o += 3 * nz
+    valid = ws[o:o + 1]
+    o += 1
+    sq = ws[o:o + nz]
+    o += nz
+    nf = ws[o:o + 3 * nz].reshape((nz, 3))
+    o += 3 * nz
+    p = ws[o:o + nz * m].reshape((nz, m))
+    o += nz * m
+    smat = ws[o:o + nz * nz].reshape((nz, nz))
+    return u, valid, sq, nf, p, smat
+
+
+@njit(cache=True)
+def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, lengths):
+    """Contact deflections u of a condensed ring, everything in each contact's
+    ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k), C_jk = W_j W_k^T
+    (wl: (Z, 3, m) factors W_j = S B_j K^-1/2), g_k = Q_k n_k the force on the
+    ring. ``ws``: the ring's work array (u's warm start and the last tangent, see
+    :func:`condense_workspace`). Fills the contact results at the solution
+    (loads, normals, dQ/ddelta, damping coefficient, |e|); returns the number of
+    iterations (-1: not converged).
+
+    Chord (Newton-type) iterations with the normal contact stiffness only:
     (I + C N L N^T) du = -r, L = diag(dQ/d delta), solved by the Woodbury identity
     as the SPD Z x Z system (I + L^1/2 N^T C N L^1/2) with N^T C N = P P^T,
-    P_k = W_k^T n_k. The tangent is kept while the residual drops at least 10x per
-    iteration, else refreshed."""
+    P_k = W_k^T n_k. The tangent is kept (also from one call to the next) while
+    the residual drops at least 10x per iteration, else refreshed; the
+    convergence test is on the exact residual, so the tangent only sets the
+    speed."""
     nz = e0.shape[0]
     m = wl.shape[2]
+    u, valid, sq, nf, p, smat = _split_workspace(ws, nz, m)
     r = np.empty((nz, 3))
     y = np.empty(m)
-    p = np.empty((nz, m))
-    nf = np.empty((nz, 3))
-    smat = np.empty((nz, nz))
-    sq = np.empty(nz)
     rhs = np.empty(nz)
     err_prev = 0.0
     for it in range(CONDENSE_MAXIT + 1):
@@ -287,7 +313,7 @@ def _condense(e0, w0, wl, offset, speed, law, u, loads, normals, dq, cd, lengths
             return it
         if it == CONDENSE_MAXIT:
             break
-        if it == 0 or err > 0.1 * err_prev:
+        if valid[0] == 0.0 or (it > 0 and err > 0.1 * err_prev):
             # tangent: P_k = W_k^T n_k; M = I + L^1/2 P P^T L^1/2, Cholesky-factored
             for j in range(nz):
                 sq[j] = math.sqrt(max(dq[j], 0.0))
@@ -306,6 +332,7 @@ def _condense(e0, w0, wl, offset, speed, law, u, loads, normals, dq, cd, lengths
                     smat[i, j] = v
                 smat[j, j] += 1.0
             _cholesky(smat)
+            valid[0] = 1.0
         for j in range(nz):
             rhs[j] = sq[j] * (nf[j, 0] * r[j, 0] + nf[j, 1] * r[j, 1] + nf[j, 2] * r[j, 2])
         _cholesky_solve(smat, rhs)
@@ -328,12 +355,13 @@ def _condense(e0, w0, wl, offset, speed, law, u, loads, normals, dq, cd, lengths
 
 
 @njit(cache=True)
-def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, u, loads, normals, dq, cd, lengths, du,
+def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, du,
                     cglobal):
     """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
     each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
     the compliance factors, the contact solve (:func:`_condense`, deflections u
-    kept in these local frames as the next call's warm start), and back to global
+    kept in these local frames in the work array ``ws`` as the next call's warm
+    start), and back to global
     normals and raceway displacements du. With ``cglobal`` of shape (3Z, 3Z) the
     global compliance matrix C_jk = R_j W_j W_k^T R_k^T (for the Jacobian).
     Returns the iteration count."""
@@ -348,7 +376,8 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, u, loads,
             el[j, a] = rot[j, 0, a] * e0[j, 0] + rot[j, 1, a] * e0[j, 1] + rot[j, 2, a] * e0[j, 2]
             wv[j, a] = rot[j, 0, a] * w0[j, 0] + rot[j, 1, a] * w0[j, 1] + rot[j, 2, a] * w0[j, 2]
     nl = np.empty((nz, 3))
-    its = _condense(el, wv, wl, offset, speed, law, u, loads, nl, dq, cd, lengths)
+    its = _condense(el, wv, wl, offset, speed, law, ws, loads, nl, dq, cd, lengths)
+    u = ws[0:3 * nz].reshape((nz, 3))
     for j in range(nz):
         for a in range(3):
             normals[j, a] = rot[j, a, 0] * nl[j, 0] + rot[j, a, 1] * nl[j, 1] + rot[j, a, 2] * nl[j, 2]
@@ -375,7 +404,7 @@ def _rotation_z(a, psi, out):
 
 
 @njit(cache=True)
-def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
                state, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n); coordinates ordered
@@ -384,8 +413,8 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
     coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
     compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); u_i / u_o (Z, 3): their contact deflections in the contacts' ring-
-    cylindrical frames (warm start, updated);
+    ((0, 3, 0): none); ws_i / ws_o: their work arrays (:func:`condense_workspace`:
+    contact deflections and last tangent, updated);
     state (int64, 4): [non-converged condensations, 1 if the last call had one,
     sum of the local iterations, local solves]; rec: (Z, N_RECORD) per-ball
     record, or (0, N_RECORD).
@@ -516,7 +545,7 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     cmat_i = np.zeros((3 * nz if (cond_i and jacobian) else 0, 3 * nz if (cond_i and jacobian) else 0))
     cmat_o = np.zeros((3 * nz if (cond_o and jacobian) else 0, 3 * nz if (cond_o and jacobian) else 0))
     if cond_i:
-        its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, u_i, load_i,
+        its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i,
                               nrm_i, dq_i, cd_i, len_i, du_i, cmat_i)
         state[3] += 1
         if its < 0:
@@ -532,7 +561,7 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
             len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j] = _contact(
                 e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
     if cond_o:
-        its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, u_o, load_o,
+        its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o,
                               nrm_o, dq_o, cd_o, len_o, du_o, cmat_o)
         state[3] += 1
         if its < 0:
@@ -684,10 +713,10 @@ def _contact_matrix(blocks_q, blocks_v, cmat, condensed):
 
 
 @njit(cache=True)
-def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
                      state):
     """Generalized force (n,) of a row element (see :func:`row_kernel`)."""
-    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, u_i, u_o,
+    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
                          state, False, np.zeros((0, N_RECORD)))
     return f
 

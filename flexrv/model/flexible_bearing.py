@@ -44,8 +44,8 @@ import numpy as np
 from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
-from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, law_parameters, ring_modal_amplitudes,
-                                         row_force_kernel, row_kernel)
+from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
+                                         ring_modal_amplitudes, row_force_kernel, row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -223,17 +223,18 @@ _NO_COMPLIANCE = np.zeros((0, 3, 0))
 
 
 def _ring_arrays(ring, ball_count: int) -> tuple:
-    """(modal table, z sign, compliance factors, deflection state) of a ring for the kernel."""
+    """(modal table, z sign, compliance factors, work array) of a ring for the kernel."""
     if ring is None:
-        return _NO_TABLE, 1.0, _NO_COMPLIANCE, np.zeros((ball_count, 3))
+        return _NO_TABLE, 1.0, _NO_COMPLIANCE, np.zeros(0)
     zs = -1.0 if getattr(ring, "mirror", False) else 1.0
     table = getattr(ring, "table", None)
     if table is None:
         raise ConfigError(f"ring model {type(ring).__name__} has no raceway table: the bearing kernel needs one")
     table = np.ascontiguousarray(table, dtype=float)
     if _is_condensed(ring):
-        return _NO_TABLE, zs, np.ascontiguousarray(ring.compliance_factors, dtype=float), np.zeros((ball_count, 3))
-    return table, zs, _NO_COMPLIANCE, np.zeros((ball_count, 3))
+        factors = np.ascontiguousarray(ring.compliance_factors, dtype=float)
+        return _NO_TABLE, zs, factors, condense_workspace(ball_count, factors.shape[2])
+    return table, zs, _NO_COMPLIANCE, np.zeros(0)
 
 
 def kernel_inputs(model: RowModel) -> tuple:
@@ -251,15 +252,15 @@ def kernel_inputs(model: RowModel) -> tuple:
             raise ConfigError(f"contact.ehl = {mode!r} is not supported by the ball-resolved main bearing "
                               f"({side} contact): choose 'dry' or 'hamrock_dowson'")
         laws.append(p)
-    tab_i, zs_i, comp_i, u_i = _ring_arrays(model.inner, model.ball_count)
-    tab_o, zs_o, comp_o, u_o = _ring_arrays(model.outer, model.ball_count)
+    tab_i, zs_i, comp_i, ws_i = _ring_arrays(model.inner, model.ball_count)
+    tab_o, zs_o, comp_o, ws_o = _ring_arrays(model.outer, model.ball_count)
     row = model.row
     geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
                          row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
                          model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
                          model.pocket_stiffness])
     inputs = (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, tab_i, zs_i, tab_o, zs_o,
-              laws[0], laws[1], comp_i, comp_o, u_i, u_o, np.zeros(4, np.int64))
+              laws[0], laws[1], comp_i, comp_o, ws_i, ws_o, np.zeros(4, np.int64))
     model._kernel_inputs = inputs
     return inputs
 
