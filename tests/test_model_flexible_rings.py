@@ -248,9 +248,8 @@ def _fd(row, q, qt, which, h):
 
 @pytest.mark.parametrize("ehl", ["dry", "hamrock_dowson"])
 def test_condensed_row_jacobian_vs_finite_difference(rings, ehl):
-    """The condensed tangent of the contacts in series with the rings (normal
-    stiffness condensed through N^T C N; both rings flexible, row 1 mirrored)
-    against central differences of
+    """The condensed tangent (I - K C)^-1 K of the contacts in series with the
+    rings (both rings flexible, row 1 mirrored) against central differences of
     the exact condensed force at a loaded state with um displacements, mrad tilts
     and a turning frame: within 2 % of the largest entry (the geometric-stiffness
     terms of the frame rotation and of the compliance's azimuth dependence are
