@@ -677,8 +677,8 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         to_all = np.zeros((3 * nz, m_o))
         for j in range(nz):
             to_all[3 * j:3 * j + 3] = bas_o_all[j]
-        ki_q = _contact_matrix(kbi_q, kbi_v, cmat_i, cond_i)
-        ko_q = _contact_matrix(kbo_q, kbo_v, cmat_o, cond_o)
+        ki_q = _contact_matrix(kbi_q, kbi_v, cmat_i, cond_i, nrm_i, cd_i)
+        ko_q = _contact_matrix(kbo_q, kbo_v, cmat_o, cond_o, nrm_o, cd_o)
         for jac, kim, kom in ((jq, ki_q[0], ko_q[0]), (jv, ki_q[1], ko_q[1])):
             # d f_ball/d b = K; d f_ball/d x = -K T; d g/d b = -T^T K; d g/d x = T^T K T
             jac[ball, ball] += kim + kom
@@ -697,24 +697,44 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
 
 
 @njit(cache=True)
-def _contact_matrix(blocks_q, blocks_v, cmat, condensed):
+def _contact_matrix(blocks_q, blocks_v, cmat, condensed, normals, cd):
     """(3Z, 3Z) contact stiffness and damping of one ring's contacts: block
     diagonal from the per-ball blocks (stacked (3Z, 3)), or for a condensed ring
-    the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D."""
+    the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D
+    (K block diagonal, so I - K C is formed block row by block row; the damping
+    blocks are -c n n^T, so (I - K C)^-1 D = -[(I - K C)^-1 N] diag(c) N^T: one
+    LU with 3Z + Z right-hand sides)."""
     n3 = blocks_q.shape[0]
+    nz = n3 // 3
     kq = np.zeros((n3, n3))
     kv = np.zeros((n3, n3))
-    for j in range(n3 // 3):
+    for j in range(nz):
         kq[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_q[3 * j:3 * j + 3]
         kv[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_v[3 * j:3 * j + 3]
     if not condensed:
         return kq, kv
-    m = np.eye(n3) - kq @ cmat
-    both = np.empty((n3, 2 * n3))
-    both[:, :n3] = kq
-    both[:, n3:] = kv
-    sol = np.linalg.solve(m, both)
-    return np.ascontiguousarray(sol[:, :n3]), np.ascontiguousarray(sol[:, n3:])
+    m = np.empty((n3, n3))
+    rhs = np.zeros((n3, n3 + nz))
+    for j in range(nz):
+        blk = blocks_q[3 * j:3 * j + 3]
+        m[3 * j:3 * j + 3] = -(blk @ cmat[3 * j:3 * j + 3])
+        for a in range(3):
+            m[3 * j + a, 3 * j + a] += 1.0
+            for b in range(3):
+                rhs[3 * j + a, 3 * j + b] = blk[a, b]
+            rhs[3 * j + a, n3 + j] = normals[j, a]
+    sol = np.linalg.solve(m, rhs)
+    kq = np.ascontiguousarray(sol[:, :n3])
+    for j in range(n3):
+        for k in range(nz):
+            x = -sol[j, n3 + k] * cd[k]
+            if x != 0.0:
+                for b in range(3):
+                    kv[j, 3 * k + b] = x * normals[k, b]
+            else:
+                for b in range(3):
+                    kv[j, 3 * k + b] = 0.0
+    return kq, kv
 
 
 @njit(cache=True)
