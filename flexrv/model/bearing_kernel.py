@@ -29,10 +29,12 @@ the housing, the balls are point masses held by a kinematic cage. A ring is
   condenses only the normal stiffness (Z x Z solve through N^T C N, 4x cheaper)
   moved rv40e's TE mean by 0.5 arcsec and its p-p by 2 arcsec over 0.05-0.1 s
   (the integrator's Newton tolerance lets the tangent shape the answer), so the
-  full one is kept. The ring's velocity at the contacts is neglected in the
-  contact damping (u_dot = 0: the ring deflection ~1 um changes at the ball-pass
-  rate, its velocity is 1e-3 of the balls' vibration velocities in the runs;
-  measured effect on TE in benchmarks/bench_flexible_model.py).
+  full one is kept. The ring's own velocity at the contacts is left out of the
+  contact damping (u_dot = 0; the uncondensed massless ring's modal velocities
+  enter it): the one modelling difference to the uncondensed formulation, exact
+  in statics (tests/test_model_flexible_rings.py); its effect on the TE is
+  within the integrator's Newton-tolerance scatter (benchmarks/
+  bench_flexible_model.py, condensed vs ``{"condense": false}``).
 
 Per-ball results of a call go to ``rec`` (:data:`RECORD_FIELDS`) when it has Z
 rows: post-processing runs the same kernel on every recorded sample; the
