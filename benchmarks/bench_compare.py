@@ -8,6 +8,12 @@ Goal (issue 15): ``flexrv compare rv221 --t-end 1`` from a cold mesh/CMS cache i
 bench_first_run.py for the first compile). Prints the wall time of each phase,
 the process CPU time (``time.process_time``; quote it on a shared machine) and
 the TE statistics of both models (so speed never buys a different answer).
+
+Measured 2026-11-24 (rv221, --t-end 1, cold, condensed rings): 87 s CPU (217 s
+wall on the loaded machine): rigid 6.6 s, flexible 206 s wall incl. the cold
+ring build (31 s CPU for both rings without fixed-interface eigenmodes, was
+54 s with 12). README before: 178 s wall. TE mean / p-p: rigid -20.4171 /
+3.1418 arcsec, flexible -20.4168 / 3.1197 arcsec. Goal not reached.
 """
 
 from __future__ import annotations

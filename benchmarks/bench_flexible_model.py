@@ -15,6 +15,22 @@ so a speed change can be checked for an unchanged answer.
 Goal (issue 15): flexible rings model (condensed rings, main bearing flexible)
 <= 15 s per simulated second on rv221 and on rv40e (dt 1e-4, one BLAS thread).
 Machine note: 2 shared cores: quote the CPU column (wall is noisy).
+
+Measured 2026-11-24 (``--t-end 0.3 --window 0.1 --models flexible``, CPU of
+run() per simulated s; before = commit b1eee8d, uncondensed massless ring modes):
+
+=====  ===================  =================  ======================  ======================
+preset CPU before -> after  coordinates        TE mean before / after  TE p-p before / after
+=====  ===================  =================  ======================  ======================
+rv221  64.8 -> 27.1 s/s     650 -> 174         -20.4392 / -20.4446"    2.9228 / 3.0010"
+rv40e  363.3 -> 55.3 s/s    989 -> 249         -131.4744 / -131.4744"  0.3147 / 0.3154"
+=====  ===================  =================  ======================  ======================
+
+(max inner ball load 105.30 / 107.43 N and 19.74 / 19.75 N, outer-ring
+deflection 0.0448 / 0.0454 um and 0.0197 / 0.0197 um). The goal is not reached:
+the bearing rows are ~60 % of the remaining solve (two row residuals of ~115 us
+(rv221) / ~255 us (rv40e) per Newton iteration, Jacobians 0.7 / 1.4 ms per row,
+0.3-1 per step).
 """
 
 from __future__ import annotations
