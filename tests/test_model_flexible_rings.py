@@ -200,10 +200,10 @@ def test_condensed_rings_match_the_uncondensed_formulation(rings):
     rings' massless modal coordinates as system coordinates, same kernel): seed
     001's 20 kN radial + 15 kN axial case on the standalone bearing, both rings
     flexible, both rows. Ball loads and raceway deflections at the contacts agree
-    within 1e-6 of their maxima (measured 1e-9 and 8e-9: the local solve's
+    within 1e-6 of their maxima (measured 2e-9 and 2e-8: the local solve's
     tolerance 1e-13 m on ~1 um deflections, and the static solver's), the
     frame displacement within 1e-6, the recovered modal amplitudes within 1e-6
-    (measured 8e-10). Evaluated at the SAME state (the uncondensed solution's
+    (measured 2e-9). Evaluated at the SAME state (the uncondensed solution's
     frame and balls), the condensed element reproduces the uncondensed ring's
     deflections B q and contact loads within 1e-6 (ring equilibrium K q = sum
     B^T g holds for the uncondensed solution)."""
