@@ -25,10 +25,7 @@ ROOT = Path(__file__).resolve().parents[1] / "flexrv"
 ALLOWED_UPWARD: dict[tuple[str, str], str] = {}
 
 #: import cycles (sets of modules of one strongly connected component) -> reason
-ALLOWED_CYCLES: dict[frozenset, str] = {
-    frozenset({"flexrv.model.bearing_kernel", "flexrv.model.flexible_bearing"}):
-        "the numba kernel reads ModalRing data and the bearing group calls the kernel (issue 16)",
-}
+ALLOWED_CYCLES: dict[frozenset, str] = {}
 
 
 def _module_name(path: Path) -> str:

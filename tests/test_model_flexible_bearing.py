@@ -158,22 +158,24 @@ def test_rigid_ring_limit_matches_analytic_distribution(name, force, moment):
 
 
 class _FourierRing:
-    """Synthetic RingModes: radial/axial Fourier deflection shapes (k = 0..2),
-    enough to exercise the modal coupling paths of the contact element."""
+    """Synthetic RingModes: radial/axial Fourier deflection shapes (k = 0..2) as a
+    cylindrical raceway table (the kernel's ring input), enough to exercise the
+    modal coupling paths of the contact element."""
 
-    def __init__(self, scale=1.0):
+    mirror = False
+    condensed = False
+
+    def __init__(self, scale=1.0, n_grid=64):
         self.m = 5
         self.mass = np.eye(self.m)
         self.stiffness = np.diag(np.full(self.m, 4e7))
         self.damping = np.zeros((self.m, self.m))
-        self.scale = scale
-
-    def groove_basis(self, azimuth):
-        a = np.asarray(azimuth, dtype=float)
-        er = np.stack([np.cos(a), np.sin(a), 0 * a], -1)
-        ez = np.stack([0 * a, 0 * a, 1 + 0 * a], -1)
-        shapes = [er, er * np.cos(2 * a)[:, None], er * np.sin(2 * a)[:, None], ez, ez * np.cos(a)[:, None]]
-        return self.scale * np.stack(shapes, axis=-1)
+        a = 2 * np.pi * np.arange(n_grid) / n_grid
+        one, zero = np.ones(n_grid), np.zeros(n_grid)
+        table = np.zeros((n_grid, 3, self.m))
+        table[:, 0, :] = np.stack([one, np.cos(2 * a), np.sin(2 * a), zero, zero], -1)
+        table[:, 2, :] = np.stack([zero, zero, zero, one, np.cos(a)], -1)
+        self.table = scale * table
 
 
 def test_jacobian_with_modal_rings_vs_finite_difference():

@@ -118,6 +118,22 @@ class ReducedBody:
         return np.stack([c * A[..., 0, :] - s * A[..., 1, :], s * A[..., 0, :] + c * A[..., 1, :], A[..., 2, :]],
                         axis=-2)
 
+    def raceway_compliance_factors(self, stiffness_scale: float = 1.0) -> np.ndarray:
+        """(n_grid, 3, m) raceway table scaled by K^-1/2 (K = ``stiffness_scale``
+        diag(omega^2)): the raceway compliance of the ring with its fit clamped
+        between grid azimuths i and k is W_i W_k^T [m/N] (cylindrical components),
+        and interpolated with the table's Catmull–Rom weights it is
+        B(psi_j) K^-1 B(psi_k)^T of the interpolated basis exactly (static
+        condensation of a quasi-static ring onto its ball contacts,
+        :mod:`flexrv.model.bearing_kernel`). Kept with the body, per scale."""
+        self._require_raceway()
+        cache = self.__dict__.setdefault("_compliance_factors", {})
+        key = float(stiffness_scale)
+        if key not in cache:
+            scale = 1.0 / np.sqrt(key * np.asarray(self.omega2, dtype=float))
+            cache[key] = np.ascontiguousarray(np.asarray(self.table, dtype=float) * scale)
+        return cache[key]
+
     def raceway_displacement(self, q_modal, azimuth) -> np.ndarray:
         """Raceway displacement (..., 3) [m] (body frame, Cartesian) at ``azimuth`` [rad]
         for modal coordinates ``q_modal`` (m,) or broadcastable (..., m)."""

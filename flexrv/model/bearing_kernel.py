@@ -1,22 +1,51 @@
-"""Compiled (numba) generalized force and Jacobian of one bearing row — the hot
-path of the ball-resolved and flexible main bearing.
+"""Compiled (numba) generalized force and Jacobian of one bearing row — THE
+implementation of the ball-resolved and flexible main bearing (issue 15/16).
 
-:func:`flexrv.model.flexible_bearing.evaluate_row` is the reference
-implementation (numpy, with every contact state for post-processing). During a
-run Exudyn asks for the residual ~6 times per step and for the Jacobian every
-~5-50 steps; both are evaluated here in one compiled loop over the balls with the
-same formulas (the numpy version spends ~1.4 ms per row force in ~200 small array
-operations, this kernel ~0.05 ms; the Jacobian of a flexible row 5.2 -> 0.9 ms,
-its T^T K T sums done as one stacked product). tests/test_model_flexible_rings.py
-checks force and Jacobians against :func:`evaluate_row` to 1e-9 of the largest
-entry for rigid and modal rings, dry Hertz and the Hamrock–Dowson EHL law.
+One row element sees the coordinates [frame(6), inner modes, outer modes,
+balls(3Z)]: the inner ring rides on the frame (carrier), the outer ring sits in
+the housing, the balls are point masses held by a kinematic cage. A ring is
 
-Supported: rings given by a raceway table (:class:`flexrv.model.flexible_bearing.
-ModalRing`) or rigid, normal laws :class:`flexrv.contact.ball_raceway.HertzLaw`
-or :class:`flexrv.ehl.law.EHLPointLaw` in mode ``dry`` /
-``hamrock_dowson`` with scalar radii. Anything else (the solver-map law, other
-ring models) falls back to :func:`evaluate_row` (:func:`kernel_inputs` returns
-None).
+* **rigid** (no table),
+* **modal** — its modal coordinates are element coordinates (a dynamic ring with
+  mass, or the uncondensed quasi-static ring kept for verification), or
+* **condensed** — a quasi-static (massless) ring whose modal coordinates are
+  eliminated by static condensation: with K q = sum_k B_k^T g_k (B_k the raceway
+  basis at the contact azimuth psi_k, g_k the contact force on the ring) the
+  raceway displacements at the contacts are u_j = sum_k C_jk g_k with the
+  compliance C_jk = B_j K^-1 B_k^T = W_j W_k^T, W_j = B_j K^-1/2 interpolated
+  from the ring's factor table T K^-1/2 (T the raceway table,
+  :meth:`flexrv.fem.body.ReducedBody.raceway_compliance_factors`) with the same
+  Catmull–Rom weights as the basis — so C equals B_j K^-1 B_k^T of the
+  interpolated basis exactly (to round-off), and is never formed in the
+  residual (u = W (W^T g): 2 Z x 3 x m products). The contact deflections solve the
+  local nonlinear system u = C g(e0 - u) (e0: ball minus rigid-ring groove
+  centre) by Newton iterations whose Jacobian keeps the normal contact
+  stiffness (I + C N diag(dQ/d delta) N^T, solved by the Woodbury identity as a
+  Z x Z SPD system); the neglected geometric term Q/L (I - n n^T) is ~1e-2 of it, so
+  the iteration converges linearly to the exact solution (tolerance
+  ``CONDENSE_TOL``). The element Jacobian uses the condensed tangent
+  (I - K C)^-1 K of the contacts in series with the ring (dense over the
+  balls of the row; :func:`_contact_matrix`). Measured: a cheaper tangent that
+  condenses only the normal stiffness (Z x Z solve through N^T C N, 4x cheaper)
+  moved rv40e's TE mean by 0.5 arcsec and its p-p by 2 arcsec over 0.05-0.1 s
+  (the integrator's Newton tolerance lets the tangent shape the answer), so the
+  full one is kept. The ring's own velocity at the contacts is left out of the
+  contact damping (u_dot = 0; the uncondensed massless ring's modal velocities
+  enter it): the one modelling difference to the uncondensed formulation, exact
+  in statics (tests/test_model_flexible_rings.py); its effect on the TE is
+  within the integrator's Newton-tolerance scatter (benchmarks/
+  bench_flexible_model.py, condensed vs ``{"condense": false}``).
+
+Per-ball results of a call go to ``rec`` (:data:`RECORD_FIELDS`) when it has Z
+rows: post-processing runs the same kernel on every recorded sample; the
+condensed rings' modal amplitudes follow from the recorded ring loads by
+:func:`ring_modal_amplitudes` (q = K^-1 sum_j B_j^T g_j).
+
+Supported laws: :class:`flexrv.contact.ball_raceway.HertzLaw` and
+:class:`flexrv.ehl.law.EHLPointLaw` in mode ``dry`` / ``hamrock_dowson``
+with scalar radii (:func:`law_parameters`). The kernel takes plain arrays only
+(the bearing's data classes live in :mod:`flexrv.model.flexible_bearing`, which
+prepares them).
 """
 
 from __future__ import annotations
@@ -29,6 +58,19 @@ from numba import njit
 #: law parameters: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m], load and speed
 #: exponents of the film, load floor [N], c_max [N s/m], damping depth [m], Newton steps
 LAW_FIELDS = ("k", "h_unit", "load_exponent", "speed_exponent", "load_floor", "c_max", "depth", "iterations")
+
+#: columns of the per-ball record ``rec`` (Z, len(RECORD_FIELDS)): loads [N], unit
+#: normals (global), ring azimuths [rad], contact force on each ring in the ring's
+#: own Cartesian frame [N], raceway displacement of each ring at the contact
+#: (global) [m], ball centre (global) [m]
+RECORD_FIELDS = ("load_inner", "load_outer", "nix", "niy", "niz", "nox", "noy", "noz", "psi_inner", "psi_outer",
+                 "gix", "giy", "giz", "gox", "goy", "goz", "uix", "uiy", "uiz", "uox", "uoy", "uoz", "bx", "by", "bz")
+N_RECORD = len(RECORD_FIELDS)
+
+#: local condensation: absolute tolerance on the contact deflections [m] and the
+#: iteration limit (a solve that does not converge counts in ``state``, see :func:`row_kernel`)
+CONDENSE_TOL = 1e-13
+CONDENSE_MAXIT = 50
 
 
 def law_parameters(law) -> np.ndarray | None:
@@ -45,33 +87,6 @@ def law_parameters(law) -> np.ndarray | None:
         return np.array([float(law.stiffness), h_unit, HAMROCK_DOWSON_LOAD_EXPONENT, 0.67, law.load_floor,
                          law.c_max, law.damping_depth, float(law.iterations)])
     return None
-
-
-def ring_table(ring) -> tuple[np.ndarray, float] | None:
-    """(cylindrical raceway table (n_grid, 3, m), z sign) of a ring, a (1, 3, 0)
-    table for a rigid ring, or None if the ring model has no table."""
-    from flexrv.model.flexible_bearing import ModalRing
-
-    if ring is None:
-        return np.zeros((1, 3, 0)), 1.0
-    if isinstance(ring, ModalRing) and getattr(ring.body, "table", None) is not None:
-        return np.ascontiguousarray(ring.body.table, dtype=float), -1.0 if ring.mirror else 1.0
-    return None
-
-
-def kernel_inputs(model) -> tuple | None:
-    """Everything :func:`row_force_kernel` needs of a :class:`RowModel`, or None."""
-    laws = [law_parameters(model.law_inner), law_parameters(model.law_outer)]
-    rings = [ring_table(model.inner), ring_table(model.outer)]
-    if any(x is None for x in laws + rings):
-        return None
-    row = model.row
-    geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
-                         row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
-                         model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
-                         model.pocket_stiffness])
-    return (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, rings[0][0], rings[0][1],
-            rings[1][0], rings[1][1], laws[0], laws[1])
 
 
 @njit(cache=True)
@@ -113,8 +128,8 @@ def _normal_load(delta, rate, speed, law):
 
 @njit(cache=True)
 def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
-    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w
-    (flexrv.contact.ball_raceway.raceway_contacts): (|e|, unit normal, Q, dQ/ddelta, dQ/drate)."""
+    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w:
+    (|e|, unit normal, Q, dQ/ddelta, dQ/drate); the force on the ball is -Q n."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
     q, dq, c = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
@@ -122,26 +137,38 @@ def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
 
 
 @njit(cache=True)
-def _basis(table, zsign, psi, out):
-    """Cartesian raceway displacement per modal coordinate at azimuth psi -> out (3, m)
-    (Catmull–Rom periodic cubic of the cylindrical table, flexrv.fem.reduction.periodic_cubic)."""
-    ng = table.shape[0]
-    m = table.shape[2]
+def _taps(psi, ng, idx, w):
+    """Grid indices idx[4] and weights w[4] of the periodic Catmull–Rom cubic on the
+    uniform grid 2 pi i / ng at azimuth psi (flexrv.fem.reduction.periodic_cubic)."""
     u = (psi % (2.0 * math.pi)) * (ng / (2.0 * math.pi))
     i = int(math.floor(u))
     t = u - i
     t2 = t * t
     t3 = t2 * t
-    w0 = 0.5 * (-t3 + 2.0 * t2 - t)
-    w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0)
-    w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t)
-    w3 = 0.5 * (t3 - t2)
-    i0, i1, i2, i3 = (i - 1) % ng, i % ng, (i + 1) % ng, (i + 2) % ng
+    w[0] = 0.5 * (-t3 + 2.0 * t2 - t)
+    w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0)
+    w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t)
+    w[3] = 0.5 * (t3 - t2)
+    for a in range(4):
+        idx[a] = (i - 1 + a) % ng
+
+
+@njit(cache=True)
+def _basis(table, zsign, psi, out):
+    """Cartesian raceway displacement per modal coordinate at azimuth psi -> out (3, m)
+    (the periodic cubic of the cylindrical table, z mirrored by zsign)."""
+    m = table.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
+    _taps(psi, table.shape[0], idx, w)
     c, s = math.cos(psi), math.sin(psi)
     for j in range(m):
-        ar = w0 * table[i0, 0, j] + w1 * table[i1, 0, j] + w2 * table[i2, 0, j] + w3 * table[i3, 0, j]
-        at = w0 * table[i0, 1, j] + w1 * table[i1, 1, j] + w2 * table[i2, 1, j] + w3 * table[i3, 1, j]
-        az = w0 * table[i0, 2, j] + w1 * table[i1, 2, j] + w2 * table[i2, 2, j] + w3 * table[i3, 2, j]
+        ar = w[0] * table[idx[0], 0, j] + w[1] * table[idx[1], 0, j] + w[2] * table[idx[2], 0, j] \
+            + w[3] * table[idx[3], 0, j]
+        at = w[0] * table[idx[0], 1, j] + w[1] * table[idx[1], 1, j] + w[2] * table[idx[2], 1, j] \
+            + w[3] * table[idx[3], 1, j]
+        az = w[0] * table[idx[0], 2, j] + w[1] * table[idx[1], 2, j] + w[2] * table[idx[2], 2, j] \
+            + w[3] * table[idx[3], 2, j]
         out[0, j] = c * ar - s * at
         out[1, j] = s * ar + c * at
         out[2, j] = zsign * az
@@ -150,8 +177,9 @@ def _basis(table, zsign, psi, out):
 @njit(cache=True)
 def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
     """d force_ball / d ball position and velocity (3x3) of one contact
-    (flexrv.contact.ball_raceway.raceway_contacts, plus the follower term Q/L
-    e_t e_t^T of evaluate_row: the groove centre follows the ball's azimuth)."""
+    (d/db of -Q n: -(dQ n n^T + Q/L (I - n n^T)), plus the follower term Q/L e_t e_t^T:
+    the groove centre follows the ball's azimuth, so a tangential ball motion does
+    not rotate the contact normal)."""
     n = (nx, ny, nz)
     et = (etx, ety, 0.0)
     ql = q_load / length
@@ -164,17 +192,255 @@ def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
 
 
 @njit(cache=True)
-def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, jacobian):
+def _local_factors(psi, wtab, zsign, out):
+    """Compliance factors (Z, 3, m) of a condensed ring at the contact azimuths psi:
+    out[j] = S B_cyl(psi_j) K^-1/2 in the ring's cylindrical components at contact j
+    (the periodic cubic of ``wtab`` = T K^-1/2, (ng, 3, m)), S = diag(1, 1, zsign);
+    the compliance blocks are C_jk = out[j] out[k]^T."""
+    nz = psi.shape[0]
+    ng = wtab.shape[0]
+    m = wtab.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
+    for j in range(nz):
+        _taps(psi[j], ng, idx, w)
+        for a in range(3):
+            sg = zsign if a == 2 else 1.0
+            r0, r1, r2, r3 = wtab[idx[0], a], wtab[idx[1], a], wtab[idx[2], a], wtab[idx[3], a]
+            w0, w1, w2, w3 = sg * w[0], sg * w[1], sg * w[2], sg * w[3]
+            for k in range(m):
+                out[j, a, k] = w0 * r0[k] + w1 * r1[k] + w2 * r2[k] + w3 * r3[k]
+
+
+@njit(cache=True)
+def _cholesky(m):
+    """In-place lower Cholesky factor of a small SPD matrix m."""
+    n = m.shape[0]
+    for j in range(n):
+        d = m[j, j]
+        for k in range(j):
+            d -= m[j, k] * m[j, k]
+        d = math.sqrt(max(d, 1e-300))
+        m[j, j] = d
+        for i in range(j + 1, n):
+            v = m[i, j]
+            for k in range(j):
+                v -= m[i, k] * m[j, k]
+            m[i, j] = v / d
+
+
+@njit(cache=True)
+def _cholesky_solve(m, b):
+    """b <- m^-1 b with m's lower Cholesky factor (from :func:`_cholesky`)."""
+    n = m.shape[0]
+    for i in range(n):
+        v = b[i]
+        for k in range(i):
+            v -= m[i, k] * b[k]
+        b[i] = v / m[i, i]
+    for i in range(n - 1, -1, -1):
+        v = b[i]
+        for k in range(i + 1, n):
+            v -= m[k, i] * b[k]
+        b[i] = v / m[i, i]
+
+
+def condense_workspace(ball_count: int, n_modes: int) -> np.ndarray:
+    """Persistent work array of a condensed ring in a row (see :func:`_split_workspace`):
+    the contact deflections (warm start) and the last Newton tangent."""
+    z = int(ball_count)
+    return np.zeros(3 * z + 1 + z + 3 * z + z * int(n_modes) + z * z)
+
+
+@njit(cache=True)
+def _split_workspace(ws, nz, m):
+    """Views of a condensed ring's work array: deflections u (Z,3), tangent-valid
+    flag (1,), L^1/2 (Z,), normals (Z,3), P = W^T n (Z,m), Cholesky factor (Z,Z)."""
+    o = 0
+    u = ws[o:o + 3 * nz].reshape((nz, 3))
+    o += 3 * nz
+    valid = ws[o:o + 1]
+    o += 1
+    sq = ws[o:o + nz]
+    o += nz
+    nf = ws[o:o + 3 * nz].reshape((nz, 3))
+    o += 3 * nz
+    p = ws[o:o + nz * m].reshape((nz, m))
+    o += nz * m
+    smat = ws[o:o + nz * nz].reshape((nz, nz))
+    return u, valid, sq, nf, p, smat
+
+
+@njit(cache=True)
+def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, lengths):
+    """Contact deflections u of a condensed ring, everything in each contact's
+    ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k), C_jk = W_j W_k^T
+    (wl: (Z, 3, m) factors W_j = S B_j K^-1/2), g_k = Q_k n_k the force on the
+    ring. ``ws``: the ring's work array (u's warm start and the last tangent, see
+    :func:`condense_workspace`). Fills the contact results at the solution
+    (loads, normals, dQ/ddelta, damping coefficient, |e|); returns the number of
+    iterations (-1: not converged).
+
+    Chord (Newton-type) iterations with the normal contact stiffness only:
+    (I + C N L N^T) du = -r, L = diag(dQ/d delta), solved by the Woodbury identity
+    as the SPD Z x Z system (I + L^1/2 N^T C N L^1/2) with N^T C N = P P^T,
+    P_k = W_k^T n_k. The tangent is kept (also from one call to the next) while
+    the residual drops at least 10x per iteration, else refreshed; the
+    convergence test is on the exact residual, so the tangent only sets the
+    speed."""
+    nz = e0.shape[0]
+    m = wl.shape[2]
+    u, valid, sq, nf, p, smat = _split_workspace(ws, nz, m)
+    r = np.empty((nz, 3))
+    y = np.empty(m)
+    rhs = np.empty(nz)
+    err_prev = 0.0
+    for it in range(CONDENSE_MAXIT + 1):
+        for k in range(m):
+            y[k] = 0.0
+        for j in range(nz):
+            length, nx, ny, nzz, q, d, c = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1], e0[j, 2] - u[j, 2],
+                                                    w0[j, 0], w0[j, 1], w0[j, 2], offset, speed, law)
+            loads[j], dq[j], cd[j], lengths[j] = q, d, c, length
+            normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
+            if q != 0.0:
+                g0, g1, g2 = q * nx, q * ny, q * nzz
+                for k in range(m):
+                    y[k] += wl[j, 0, k] * g0 + wl[j, 1, k] * g1 + wl[j, 2, k] * g2
+        err = 0.0
+        for j in range(nz):
+            for a in range(3):
+                v = u[j, a]
+                for k in range(m):
+                    v -= wl[j, a, k] * y[k]
+                r[j, a] = v
+                err = max(err, abs(v))
+        if err <= CONDENSE_TOL:
+            return it
+        if it == CONDENSE_MAXIT:
+            break
+        if valid[0] == 0.0 or (it > 0 and err > 0.1 * err_prev):
+            # tangent: P_k = W_k^T n_k; M = I + L^1/2 P P^T L^1/2, Cholesky-factored
+            for j in range(nz):
+                sq[j] = math.sqrt(max(dq[j], 0.0))
+                n0, n1, n2 = normals[j, 0], normals[j, 1], normals[j, 2]
+                nf[j, 0], nf[j, 1], nf[j, 2] = n0, n1, n2
+                for k in range(m):
+                    p[j, k] = wl[j, 0, k] * n0 + wl[j, 1, k] * n1 + wl[j, 2, k] * n2
+            for j in range(nz):
+                for i in range(j + 1):
+                    v = 0.0
+                    if sq[j] > 0.0 and sq[i] > 0.0:
+                        for k in range(m):
+                            v += p[j, k] * p[i, k]
+                        v *= sq[j] * sq[i]
+                    smat[j, i] = v
+                    smat[i, j] = v
+                smat[j, j] += 1.0
+            _cholesky(smat)
+            valid[0] = 1.0
+        for j in range(nz):
+            rhs[j] = sq[j] * (nf[j, 0] * r[j, 0] + nf[j, 1] * r[j, 1] + nf[j, 2] * r[j, 2])
+        _cholesky_solve(smat, rhs)
+        # correction C N L y' = W (P^T (L^1/2 z))
+        for k in range(m):
+            y[k] = 0.0
+        for j in range(nz):
+            zj = sq[j] * rhs[j]
+            if zj != 0.0:
+                for k in range(m):
+                    y[k] += p[j, k] * zj
+        for j in range(nz):
+            for a in range(3):
+                corr = 0.0
+                for k in range(m):
+                    corr += wl[j, a, k] * y[k]
+                u[j, a] -= r[j, a] - corr
+        err_prev = err
+    return -1
+
+
+@njit(cache=True)
+def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, du,
+                    cglobal):
+    """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
+    each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
+    the compliance factors, the contact solve (:func:`_condense`, deflections u
+    kept in these local frames in the work array ``ws`` as the next call's warm
+    start), and back to global
+    normals and raceway displacements du. With ``cglobal`` of shape (3Z, 3Z) the
+    global compliance matrix C_jk = R_j W_j W_k^T R_k^T (for the Jacobian).
+    Returns the iteration count."""
+    nz = psi.shape[0]
+    m = wtab.shape[2]
+    wl = np.empty((nz, 3, m))
+    _local_factors(psi, wtab, zsign, wl)
+    el = np.empty((nz, 3))
+    wv = np.empty((nz, 3))
+    for j in range(nz):
+        for a in range(3):
+            el[j, a] = rot[j, 0, a] * e0[j, 0] + rot[j, 1, a] * e0[j, 1] + rot[j, 2, a] * e0[j, 2]
+            wv[j, a] = rot[j, 0, a] * w0[j, 0] + rot[j, 1, a] * w0[j, 1] + rot[j, 2, a] * w0[j, 2]
+    nl = np.empty((nz, 3))
+    its = _condense(el, wv, wl, offset, speed, law, ws, loads, nl, dq, cd, lengths)
+    u = ws[0:3 * nz].reshape((nz, 3))
+    for j in range(nz):
+        for a in range(3):
+            normals[j, a] = rot[j, a, 0] * nl[j, 0] + rot[j, a, 1] * nl[j, 1] + rot[j, a, 2] * nl[j, 2]
+            du[j, a] = rot[j, a, 0] * u[j, 0] + rot[j, a, 1] * u[j, 1] + rot[j, a, 2] * u[j, 2]
+    if cglobal.shape[0] == 3 * nz:
+        wg = np.empty((3 * nz, m))  # R_j W_j stacked
+        for j in range(nz):
+            for a in range(3):
+                for k in range(m):
+                    wg[3 * j + a, k] = rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] \
+                        + rot[j, a, 2] * wl[j, 2, k]
+        cglobal[:, :] = wg @ wg.T
+    return its
+
+
+@njit(cache=True)
+def _rotation_z(a, psi, out):
+    """out = a Rz(psi): ring-cylindrical components at psi -> global."""
+    c, s = math.cos(psi), math.sin(psi)
+    for i in range(3):
+        out[i, 0] = a[i, 0] * c + a[i, 1] * s
+        out[i, 1] = -a[i, 0] * s + a[i, 1] * c
+        out[i, 2] = a[i, 2]
+
+
+@njit(cache=True)
+def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+               state, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n); coordinates ordered
-    [frame(6), inner modes, outer modes, balls(3Z)] (see evaluate_row, whose
-    Jacobian blocks K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j this assembles)."""
+    [frame(6), inner modes, outer modes, balls(3Z)].
+
+    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
+    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
+    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
+    ((0, 3, 0): none); ws_i / ws_o: their work arrays (:func:`condense_workspace`:
+    contact deflections and last tangent, updated);
+    state (int64, 4): [non-converged condensations, 1 if the last call had one,
+    sum of the local iterations, local solves]; rec: (Z, N_RECORD) per-ball
+    record, or (0, N_RECORD).
+
+    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
+    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
+    and K the contact stiffness — block diagonal for rigid and modal rings, the
+    dense condensed (I - K C)^-1 K for condensed rings (:func:`_contact_matrix`;
+    geometric-stiffness terms
+    of the frame rotation are dropped; the modified Newton iteration converges on
+    the residual, which is exact)."""
     z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (geometry[0], geometry[1], geometry[2], geometry[3],
                                                        geometry[4], geometry[5], geometry[6], geometry[7])
     speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (geometry[8], geometry[9], geometry[10], geometry[11],
                                                          geometry[12])
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    state[1] = 0
     nz = ball_ref.shape[0]
     n = 6 + m_i + m_o + 3 * nz
     b0 = 6 + m_i + m_o
@@ -191,86 +457,172 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     a[1, 0], a[1, 1], a[1, 2] = ca * sc + sa * sb * cc, ca * cc - sa * sb * sc, -sa * cb
     a[2, 0], a[2, 1], a[2, 2] = sa * sc - ca * sb * cc, sa * cc + ca * sb * sc, ca * cb
     g = np.array([[1.0, 0.0, sb], [0.0, ca, -sa * cb], [0.0, sa, ca * cb]])
+    eye3 = np.eye(3)
     om = g @ qt[3:6]
     speed = speed_factor * abs(qt[5])
     bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
-    t_i = np.zeros((3, nx_i))
-    k_i = np.empty((3, 3))
-    d_i = np.empty((3, 3))
-    k_o = np.empty((3, 3))
-    d_o = np.empty((3, 3))
     two_pi = 2.0 * math.pi
+    # ---------------- pass 1: geometry of every ball with the rings undeflected
+    # (modal rings: with their coordinates), ball minus groove centre e0 and
+    # relative velocity w0 of both contacts
+    bpos = np.empty((nz, 3))
+    psi_i = np.empty(nz)
+    psi_o = np.empty(nz)
+    arm = np.empty((nz, 3))  # A p: groove centre relative to the frame origin (global axes)
+    e0_i = np.empty((nz, 3))
+    w0_i = np.empty((nz, 3))
+    e0_o = np.empty((nz, 3))
+    w0_o = np.empty((nz, 3))
+    du_i = np.zeros((nz, 3))  # raceway displacement at the contact (global), modal or condensed
+    du_o = np.zeros((nz, 3))
+    rot_i = np.empty((nz, 3, 3))
+    rot_o = np.empty((nz, 3, 3))
     nzj = nz if jacobian else 0
-    ti_all = np.zeros((3 * nzj, nx_i))
-    kti_q = np.zeros((3 * nzj, nx_i))
-    kti_v = np.zeros((3 * nzj, nx_i))
-    to_all = np.zeros((3 * nzj, m_o))
-    kto_q = np.zeros((3 * nzj, m_o))
-    kto_v = np.zeros((3 * nzj, m_o))
+    bas_i_all = np.zeros((nzj, 3, m_i))
+    bas_o_all = np.zeros((nzj, 3, m_o))
     for j in range(nz):
         bj = b0 + 3 * j
         bx = ball_ref[j, 0] + q[bj]
         by = ball_ref[j, 1] + q[bj + 1]
         bz = ball_ref[j, 2] + q[bj + 2]
+        bpos[j, 0], bpos[j, 1], bpos[j, 2] = bx, by, bz
         vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
         # ---- inner ring (frame)
         dx, dy, dz = bx - q[0], by - q[1], bz - q[2]
         lx = dx * a[0, 0] + dy * a[1, 0] + dz * a[2, 0]
         ly = dx * a[0, 1] + dy * a[1, 1] + dz * a[2, 1]
-        psi_i = math.atan2(ly, lx)
-        p = np.array([ci_r * math.cos(psi_i), ci_r * math.sin(psi_i), ci_z + z_row])
+        psi = math.atan2(ly, lx)
+        psi_i[j] = psi
+        p = np.array([ci_r * math.cos(psi), ci_r * math.sin(psi), ci_z + z_row])
         pv = np.zeros(3)
         if m_i > 0:
-            _basis(tab_i, zs_i, psi_i, bas_i)
-            p += bas_i @ q[6:6 + m_i]
+            _basis(tab_i, zs_i, psi, bas_i)
+            dp = bas_i @ q[6:6 + m_i]
+            p += dp
             pv = bas_i @ qt[6:6 + m_i]
+            du_i[j] = a @ dp
+            if jacobian:
+                bas_i_all[j] = bas_i
+        if cond_i:
+            _rotation_z(a, psi, rot_i[j])
         ap = a @ p
-        cx, cy, cz = q[0] + ap[0], q[1] + ap[1], q[2] + ap[2]
+        arm[j] = ap
         apv = a @ pv
-        cvx = qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0]
-        cvy = qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1]
-        cvz = qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2]
-        len_i, nix, niy, niz, qi, dqi, cdi = _contact(bx - cx, by - cy, bz - cz, vx - cvx, vy - cvy, vz - cvz,
-                                                      off_i, speed, law_i)
-        fix, fiy, fiz = -qi * nix, -qi * niy, -qi * niz
-        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
-        f[0] -= fix
-        f[1] -= fiy
-        f[2] -= fiz
-        mx = ap[1] * fiz - ap[2] * fiy
-        my = ap[2] * fix - ap[0] * fiz
-        mz = ap[0] * fiy - ap[1] * fix
-        for r in range(3):
-            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
-        if m_i > 0:
-            flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
-            fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
-            flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
-            for k in range(m_i):
-                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
+        e0_i[j, 0], e0_i[j, 1], e0_i[j, 2] = bx - q[0] - ap[0], by - q[1] - ap[1], bz - q[2] - ap[2]
+        w0_i[j, 0] = vx - (qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0])
+        w0_i[j, 1] = vy - (qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1])
+        w0_i[j, 2] = vz - (qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2])
         # ---- outer ring (housing)
         psi = math.atan2(by, bx)
+        psi_o[j] = psi
         cos_p, sin_p = math.cos(psi), math.sin(psi)
         ox, oy, oz = co_r * cos_p, co_r * sin_p, co_z + z_row
         ovx = ovy = ovz = 0.0
         if m_o > 0:
             _basis(tab_o, zs_o, psi, bas_o)
+            ux = uy = uz = 0.0
             for k in range(m_o):
                 qk, vk = q[6 + m_i + k], qt[6 + m_i + k]
-                ox += bas_o[0, k] * qk
-                oy += bas_o[1, k] * qk
-                oz += bas_o[2, k] * qk
+                ux += bas_o[0, k] * qk
+                uy += bas_o[1, k] * qk
+                uz += bas_o[2, k] * qk
                 ovx += bas_o[0, k] * vk
                 ovy += bas_o[1, k] * vk
                 ovz += bas_o[2, k] * vk
-        len_o, nox, noy, noz, qo, dqo, cdo = _contact(bx - ox, by - oy, bz - oz, vx - ovx, vy - ovy, vz - ovz,
-                                                      off_o, speed, law_o)
-        fox, foy, foz = -qo * nox, -qo * noy, -qo * noz
+            du_o[j, 0], du_o[j, 1], du_o[j, 2] = ux, uy, uz
+            ox, oy, oz = ox + ux, oy + uy, oz + uz
+            if jacobian:
+                bas_o_all[j] = bas_o
+        if cond_o:
+            _rotation_z(eye3, psi, rot_o[j])
+        e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
+        w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
+    # ---------------- condensed rings: contact deflections
+    load_i = np.empty(nz)
+    load_o = np.empty(nz)
+    nrm_i = np.empty((nz, 3))
+    nrm_o = np.empty((nz, 3))
+    dq_i = np.empty(nz)
+    dq_o = np.empty(nz)
+    cd_i = np.empty(nz)
+    cd_o = np.empty(nz)
+    len_i = np.empty(nz)
+    len_o = np.empty(nz)
+    cmat_i = np.zeros((3 * nz if (cond_i and jacobian) else 0, 3 * nz if (cond_i and jacobian) else 0))
+    cmat_o = np.zeros((3 * nz if (cond_o and jacobian) else 0, 3 * nz if (cond_o and jacobian) else 0))
+    if cond_i:
+        its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i,
+                              nrm_i, dq_i, cd_i, len_i, du_i, cmat_i)
+        state[3] += 1
+        if its < 0:
+            state[0] += 1
+            state[1] = 1
+        else:
+            state[2] += its
+        for j in range(nz):
+            for c in range(3):
+                arm[j, c] += du_i[j, c]
+    else:
+        for j in range(nz):
+            len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j] = _contact(
+                e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
+    if cond_o:
+        its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o,
+                              nrm_o, dq_o, cd_o, len_o, du_o, cmat_o)
+        state[3] += 1
+        if its < 0:
+            state[0] += 1
+            state[1] = 1
+        else:
+            state[2] += its
+    else:
+        for j in range(nz):
+            len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j] = _contact(
+                e0_o[j, 0], e0_o[j, 1], e0_o[j, 2], w0_o[j, 0], w0_o[j, 1], w0_o[j, 2], off_o, speed, law_o)
+    # ---------------- pass 2: generalized forces (and Jacobian blocks)
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
+    t_i = np.zeros((3, nx_i))
+    ti_all = np.zeros((3 * nzj, nx_i))
+    kbi_q = np.zeros((3 * nzj, 3))  # per-ball 3x3 contact blocks, stacked
+    kbi_v = np.zeros((3 * nzj, 3))
+    kbo_q = np.zeros((3 * nzj, 3))
+    kbo_v = np.zeros((3 * nzj, 3))
+    record = rec.shape[0] == nz
+    for j in range(nz):
+        bj = b0 + 3 * j
+        bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
+        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+        qi, qo = load_i[j], load_o[j]
+        fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
+        fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
+        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
+        f[0] -= fix
+        f[1] -= fiy
+        f[2] -= fiz
+        ap = arm[j]
+        mx = ap[1] * fiz - ap[2] * fiy
+        my = ap[2] * fix - ap[0] * fiz
+        mz = ap[0] * fiy - ap[1] * fix
+        for r in range(3):
+            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
+        flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
+        fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
+        flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
+        if m_i > 0:
+            _basis(tab_i, zs_i, psi_i[j], bas_i)
+            for k in range(m_i):
+                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
         if m_o > 0:
+            _basis(tab_o, zs_o, psi_o[j], bas_o)
             for k in range(m_o):
                 f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
         # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
+        psi = psi_o[j]
+        cos_p, sin_p = math.cos(psi), math.sin(psi)
         pocket = two_pi * j / nz + cage_ratio * az
         dev = psi - pocket
         dev = math.atan2(math.sin(dev), math.cos(dev))
@@ -282,21 +634,32 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
         f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
         f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
+        if record:
+            rec[j, 0], rec[j, 1] = qi, qo
+            for c in range(3):
+                rec[j, 2 + c] = nrm_i[j, c]
+                rec[j, 5 + c] = nrm_o[j, c]
+                rec[j, 16 + c] = du_i[j, c]
+                rec[j, 19 + c] = du_o[j, c]
+                rec[j, 22 + c] = bpos[j, c]
+            rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
+            rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
+            rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
         if not jacobian:
             continue
         # ---- Jacobian blocks
-        _contact_blocks(qi, dqi, cdi, len_i, nix, niy, niz, etx, ety, k_i, d_i)
-        _contact_blocks(qo, dqo, cdo, len_o, nox, noy, noz, etx, ety, k_o, d_o)
+        _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+        _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
         et = (etx, ety, 0.0)
         for c1 in range(3):
             for c2 in range(3):
                 ee = et[c1] * et[c2]
                 eye = 1.0 if c1 == c2 else 0.0
-                jq[bj + c1, bj + c2] += k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
-                jv[bj + c1, bj + c2] += d_i[c1, c2] + d_o[c1, c2] - cage_c * ee
+                jq[bj + c1, bj + c2] += -cage_k * ee - pocket_k * (eye - ee)
+                jv[bj + c1, bj + c2] += -cage_c * ee
             jq[bj + c1, 5] += cage_k * radius * cage_ratio * et[c1]
             jv[bj + c1, 5] += cage_c * radius * cage_ratio * et[c1]
-        # T_i = [I | -[Ap]x G | A basis_i]; stacked over the balls for one product each at the end
+        # T_i = [I | -[Ap]x G | A basis_i]
         rows3 = slice(3 * j, 3 * j + 3)
         for r in range(3):
             for c1 in range(3):
@@ -304,31 +667,99 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         skew = np.array([[0.0, -ap[2], ap[1]], [ap[2], 0.0, -ap[0]], [-ap[1], ap[0], 0.0]])
         t_i[:, 3:6] = -(skew @ g)
         if m_i > 0:
-            t_i[:, 6:] = a @ bas_i
+            t_i[:, 6:] = a @ bas_i_all[j]
         ti_all[rows3] = t_i
-        kti_q[rows3] = k_i @ t_i
-        kti_v[rows3] = d_i @ t_i
-        if m_o > 0:
-            to_all[rows3] = bas_o
-            kto_q[rows3] = k_o @ bas_o
-            kto_v[rows3] = d_o @ bas_o
+        kbi_q[rows3] = k_i
+        kbi_v[rows3] = d_i
+        kbo_q[rows3] = k_o
+        kbo_v[rows3] = d_o
     if jacobian:
-        # d f_ball/d x = -K T; d g/d b = -T^T K (K symmetric); d g/d x = sum T^T K T
         ball = slice(b0, b0 + 3 * nz)
         o = slice(6 + m_i, 6 + m_i + m_o)
-        for jac, kt, kto in ((jq, kti_q, kto_q), (jv, kti_v, kto_v)):
+        to_all = np.zeros((3 * nz, m_o))
+        for j in range(nz):
+            to_all[3 * j:3 * j + 3] = bas_o_all[j]
+        ki_q = _contact_matrix(kbi_q, kbi_v, cmat_i, cond_i, nrm_i, cd_i)
+        ko_q = _contact_matrix(kbo_q, kbo_v, cmat_o, cond_o, nrm_o, cd_o)
+        for jac, kim, kom in ((jq, ki_q[0], ko_q[0]), (jv, ki_q[1], ko_q[1])):
+            # d f_ball/d b = K; d f_ball/d x = -K T; d g/d b = -T^T K; d g/d x = T^T K T
+            jac[ball, ball] += kim + kom
+            kt = kim @ ti_all
             jac[ball, 0:nx_i] -= kt
-            jac[0:nx_i, ball] -= kt.T
-            jac[0:nx_i, 0:nx_i] += ti_all.T @ kt
+            tk = ti_all.T @ kim
+            jac[0:nx_i, ball] -= tk
+            jac[0:nx_i, 0:nx_i] += tk @ ti_all
             if m_o > 0:
+                kto = kom @ to_all
                 jac[ball, o] -= kto
-                jac[o, ball] -= kto.T
-                jac[o, o] += to_all.T @ kto
+                tko = to_all.T @ kom
+                jac[o, ball] -= tko
+                jac[o, o] += tko @ to_all
     return f, jq, jv
 
 
 @njit(cache=True)
-def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o):
+def _contact_matrix(blocks_q, blocks_v, cmat, condensed, normals, cd):
+    """(3Z, 3Z) contact stiffness and damping of one ring's contacts: block
+    diagonal from the per-ball blocks (stacked (3Z, 3)), or for a condensed ring
+    the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D
+    (K block diagonal, so I - K C is formed block row by block row; the damping
+    blocks are -c n n^T, so (I - K C)^-1 D = -[(I - K C)^-1 N] diag(c) N^T: one
+    LU with 3Z + Z right-hand sides)."""
+    n3 = blocks_q.shape[0]
+    nz = n3 // 3
+    kq = np.zeros((n3, n3))
+    kv = np.zeros((n3, n3))
+    for j in range(nz):
+        kq[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_q[3 * j:3 * j + 3]
+        kv[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_v[3 * j:3 * j + 3]
+    if not condensed:
+        return kq, kv
+    m = np.empty((n3, n3))
+    rhs = np.zeros((n3, n3 + nz))
+    for j in range(nz):
+        blk = blocks_q[3 * j:3 * j + 3]
+        m[3 * j:3 * j + 3] = -(blk @ cmat[3 * j:3 * j + 3])
+        for a in range(3):
+            m[3 * j + a, 3 * j + a] += 1.0
+            for b in range(3):
+                rhs[3 * j + a, 3 * j + b] = blk[a, b]
+            rhs[3 * j + a, n3 + j] = normals[j, a]
+    sol = np.linalg.solve(m, rhs)
+    kq = np.ascontiguousarray(sol[:, :n3])
+    for j in range(n3):
+        for k in range(nz):
+            x = -sol[j, n3 + k] * cd[k]
+            if x != 0.0:
+                for b in range(3):
+                    kv[j, 3 * k + b] = x * normals[k, b]
+            else:
+                for b in range(3):
+                    kv[j, 3 * k + b] = 0.0
+    return kq, kv
+
+
+@njit(cache=True)
+def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                     state):
     """Generalized force (n,) of a row element (see :func:`row_kernel`)."""
-    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, False)
+    f, _, _ = row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                         state, False, np.zeros((0, N_RECORD)))
     return f
+
+
+@njit(cache=True)
+def ring_modal_amplitudes(psi, g_local, table, zsign, compliance_diag):
+    """Modal amplitudes q = K^-1 sum_j B(psi_j)^T g_j of a condensed ring from its
+    contact loads g (Z, 3) in the ring's own Cartesian frame at azimuths psi (Z,)
+    (K diagonal: ``compliance_diag`` = 1 / diag K)."""
+    m = table.shape[2]
+    bas = np.empty((3, m))
+    out = np.zeros(m)
+    for j in range(psi.shape[0]):
+        _basis(table, zsign, psi[j], bas)
+        for k in range(m):
+            out[k] += bas[0, k] * g_local[j, 0] + bas[1, k] * g_local[j, 1] + bas[2, k] * g_local[j, 2]
+    for k in range(m):
+        out[k] *= compliance_diag[k]
+    return out

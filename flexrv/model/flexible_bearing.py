@@ -5,16 +5,12 @@ Members per row of the back-to-back pair:
 
 * the **inner ring** rides on a rigid frame node (``NodeRigidBodyRxyz``: the
   carrier, or a frame rigidly joined to it). Its elastic raceway displacement is
-  ``Phi_i(psi) q_i`` in the frame's coordinates, with modal coordinates ``q_i`` on
-  their own ``NodeGenericODE2`` (reduced K; by default massless, see
-  :class:`ModalRing`: the fit-clamped ring's lowest mode is 47-167 kHz, so the
-  ring deforms quasi-statically). The inertia coupling between the ring's slow
-  frame rotation (carrier, ~0.7-1.6 rad/s) and its elastic modes is neglected:
-  centrifugal and Coriolis terms scale with omega_c^2 ~ 1 s^-2, eight orders
-  below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2 — so no FFRF
-  body is needed for the inner rings either;
-* the **outer ring** sits in the housing (fixed frame): plain modal coordinates
-  ``q_o`` (20x cheaper than an FFRF body, see the facts note);
+  ``Phi_i(psi) q_i`` in the frame's coordinates. The inertia coupling between the
+  ring's slow frame rotation (carrier, ~0.7-1.6 rad/s) and its elastic modes is
+  neglected: centrifugal and Coriolis terms scale with omega_c^2 ~ 1 s^-2, eight
+  orders below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2 — so no
+  FFRF body is needed for the inner rings either;
+* the **outer ring** sits in the housing (fixed frame), modal coordinates ``q_o``;
 * **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`);
 * a kinematic **cage**: a tangential spring-damper pulls every ball towards its
   pocket at theta_cage + 2 pi j / Z, theta_cage = cage_ratio * theta_frame (pure
@@ -22,20 +18,20 @@ Members per row of the back-to-back pair:
   circumferentially; the cage's reaction torque (stiffness x the balls' tiny lag)
   is carried by the kinematic constraint, not by the frame.
 
-Rings given as ``None`` are rigid (no modal node) — the stiff-ring limit.
+Rings given as ``None`` are rigid. A flexible ring (:class:`ModalRing`) is by
+default quasi-static AND **condensed** (issue 15): its massless modal
+coordinates are not system coordinates; the row kernel solves the contact
+deflections from the ring's compliance at the ball contacts
+(:mod:`flexrv.model.bearing_kernel`), and the ring's modal amplitudes are
+recovered from the recorded contact loads for the outputs and ``flexrv view``.
+``condense=False`` keeps the massless modal coordinates as Exudyn coordinates
+(the uncondensed formulation, for verification), ``quasi_static=False`` gives
+the ring mass and modal damping (dynamic modes, then always uncondensed).
 
 The contact element of a row is one ``ObjectGenericODE2`` over the nodes
-[frame, inner modes, outer modes, balls]: one Python call evaluates all ball
-contacts of the row — the force by the compiled kernel of
-:mod:`flexrv.model.bearing_kernel` (:func:`row_force`), the reference and the
-analytic Jacobian with numpy (:func:`evaluate_row`,
-:func:`flexrv.contact.ball_raceway.raceway_contacts`), assembled from per-ball
-3x3 blocks. The groove centre of
-ball j depends linearly on the element's ring coordinates x through
-c_j = c0_j + T_j x; the generalized reaction is -sum T_j^T f_j and the Jacobian
-blocks are K_j, -K_j T_j, -T_j^T K_j, sum T_j^T K_j T_j (geometric-stiffness terms
-of the frame rotation are dropped; the modified Newton iteration converges on the
-residual, which is exact).
+[frame, modal rings' modes, balls]; its force and Jacobian are ONE compiled
+kernel, :func:`flexrv.model.bearing_kernel.row_kernel` (the only implementation
+of the bearing's physics: :func:`evaluate_row` and the outputs call it too).
 """
 
 from __future__ import annotations
@@ -46,8 +42,12 @@ from typing import Protocol
 import numpy as np
 
 from flexrv.errors import ConfigError
-from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law, raceway_contacts
+from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
+from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
+                                         ring_modal_amplitudes, row_force_kernel, row_kernel)
+
+_REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
 
 class RingModes(Protocol):
@@ -56,6 +56,9 @@ class RingModes(Protocol):
     mass: np.ndarray  #: (m, m) reduced mass matrix [kg]
     stiffness: np.ndarray  #: (m, m) reduced stiffness matrix [N/m]
     damping: np.ndarray  #: (m, m) reduced damping matrix [N s/m]
+    table: np.ndarray  #: (n_grid, 3, m) cylindrical raceway displacement per modal coordinate
+    mirror: bool  #: z -> -z image of the table (second row of the pair)
+    condensed: bool  #: True: modal coordinates condensed into the row element
 
     def groove_basis(self, azimuth: np.ndarray) -> np.ndarray:
         """(N, 3, m): groove-centre displacement (ring frame, Cartesian) per unit
@@ -72,18 +75,18 @@ class ModalRing:
     ``stiffness_scale`` multiplies the ring's stiffness (a stiffened ring for the
     stiff-ring consistency checks; 1 = the real ring).
 
-    ``quasi_static=True`` (default) drops the ring's inertia: the modal
-    coordinates become massless, K q = Q(contacts) holds at every instant (static
-    condensation of the ring onto its raceway loads, solved by the integrator's
-    Newton iteration together with the dynamics). Justification: with the fit
-    clamped (rigid housing / carrier) the lowest ring mode is 160-260 kHz for
-    rv40e (``frequencies_hz``; :func:`flexrv.model.flexible_bearing.flexible_rings`
-    records it), 2-3 orders above every excitation of the bearing (ball pass
-    < 1 kHz, first-stage mesh < 1 kHz), so the ring's dynamic amplification
-    (f/f_1)^2 < 1e-4 — while these stiff modes (omega dt ~ 100) make the modified
-    Newton iteration of the dynamic version take ~5x more iterations and ~100x
-    more Jacobians (measured: rv40e, 5 ms: 278 vs 88 Newton iterations, 96 vs 1
-    Jacobians). ``quasi_static=False`` keeps M = I and modal damping ``damping_ratio``.
+    ``quasi_static=True`` (default) drops the ring's inertia: K q = Q(contacts)
+    holds at every instant. Justification: with the fit clamped (rigid housing /
+    carrier) the lowest ring mode is 47-260 kHz (rv221 / rv40e,
+    ``frequencies_hz``; :func:`flexible_rings` records it), 2-3 orders above every
+    excitation of the bearing (ball pass < 1 kHz, first-stage mesh < 1 kHz), so
+    the ring's dynamic amplification (f/f_1)^2 < 1e-4 — while these stiff modes
+    (omega dt ~ 100) make the modified Newton iteration of the dynamic version
+    take ~5x more iterations and ~100x more Jacobians (measured: rv40e, 5 ms: 278
+    vs 88 Newton iterations, 96 vs 1 Jacobians). No dynamic ring mode is
+    therefore kept by default: all modes of a quasi-static ring are condensed
+    (``condense=True``, see the module docstring). ``quasi_static=False`` keeps
+    M = I and modal damping ``damping_ratio`` as system coordinates.
     """
 
     body: object
@@ -91,10 +94,15 @@ class ModalRing:
     mirror: bool = False
     stiffness_scale: float = 1.0
     quasi_static: bool = True
+    condense: bool = True
 
     @property
     def n_modes(self) -> int:
         return int(self.body.n_modes)
+
+    @property
+    def condensed(self) -> bool:
+        return bool(self.quasi_static and self.condense)
 
     @property
     def mass(self) -> np.ndarray:
@@ -111,20 +119,27 @@ class ModalRing:
         omega2 = self.stiffness_scale * np.asarray(self.body.omega2, dtype=float)
         return np.diag(2.0 * self.damping_ratio * np.sqrt(omega2))
 
+    @property
+    def table(self) -> np.ndarray:
+        return np.ascontiguousarray(self.body.table, dtype=float)
+
+    @property
+    def compliance_factors(self) -> np.ndarray:
+        """(n_grid, 3, m) raceway table times K^-1/2 of the (scaled) ring: the
+        compliance at the contacts is W_j W_k^T
+        (:meth:`flexrv.fem.body.ReducedBody.raceway_compliance_factors`)."""
+        return self.body.raceway_compliance_factors(self.stiffness_scale)
+
+    @property
+    def compliance_diag(self) -> np.ndarray:
+        """1 / diag K [m/N] (the reduced stiffness is diagonal, K = diag(omega^2))."""
+        return 1.0 / (self.stiffness_scale * np.asarray(self.body.omega2, dtype=float))
+
     def groove_basis(self, azimuth: np.ndarray) -> np.ndarray:
         basis = np.array(self.body.raceway_matrix(azimuth), dtype=float)
         if self.mirror:
             basis[..., 2, :] *= -1.0
         return basis
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """Skew matrices [v]x of an (N,3) array -> (N,3,3)."""
-    out = np.zeros(v.shape[:-1] + (3, 3))
-    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
-    return out
 
 
 def rxyz_matrices(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -135,12 +150,17 @@ def rxyz_matrices(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(RotXYZ2RotationMatrix(phi)), np.asarray(RotXYZ2G(phi))
 
 
+def _is_condensed(ring) -> bool:
+    return ring is not None and bool(getattr(ring, "condensed", False))
+
+
 @dataclass
 class RowModel:
     """Everything one row's contact element needs (SI).
 
     ``z`` is the axial position of the row's ball plane in the frame (and housing)
     coordinates; ``row`` holds the groove-centre loci in row coordinates.
+    Condensed rings (:class:`ModalRing` with ``condensed``) add no coordinates.
     """
 
     row: RowContactGeometry
@@ -169,7 +189,8 @@ class RowModel:
     ball_reference: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
-        self._sizes = tuple(0 if r is None else r.stiffness.shape[0] for r in (self.inner, self.outer))
+        self._sizes = tuple(0 if (r is None or _is_condensed(r)) else r.stiffness.shape[0]
+                            for r in (self.inner, self.outer))
         psi = 2.0 * np.pi * np.arange(self.ball_count) / self.ball_count
         rb = self.row.ball_radius_pitch
         self.ball_reference = np.stack([rb * np.cos(psi), rb * np.sin(psi), np.full(self.ball_count, self.z)], -1)
@@ -192,184 +213,145 @@ class RowModel:
         b = a + self.m_outer
         return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + 3 * self.ball_count)
 
+    def ring_nodes(self) -> list[str]:
+        """Labels of the rings with modal coordinates in the element ("inner", "outer")."""
+        return [label for label, m in (("inner", self.m_inner), ("outer", self.m_outer)) if m > 0]
 
-def _kernel(model: RowModel):
-    """Inputs of the compiled row kernel (prepared once per row), or None."""
-    inputs = getattr(model, "_kernel_inputs", False)
-    if inputs is False:
-        from flexrv.model.bearing_kernel import kernel_inputs
 
-        inputs = model._kernel_inputs = kernel_inputs(model)
+_NO_TABLE = np.zeros((1, 3, 0))
+_NO_COMPLIANCE = np.zeros((0, 3, 0))
+
+
+def _ring_arrays(ring, ball_count: int) -> tuple:
+    """(modal table, z sign, compliance factors, work array) of a ring for the kernel."""
+    if ring is None:
+        return _NO_TABLE, 1.0, _NO_COMPLIANCE, np.zeros(0)
+    zs = -1.0 if getattr(ring, "mirror", False) else 1.0
+    table = getattr(ring, "table", None)
+    if table is None:
+        raise ConfigError(f"ring model {type(ring).__name__} has no raceway table: the bearing kernel needs one")
+    table = np.ascontiguousarray(table, dtype=float)
+    if _is_condensed(ring):
+        factors = np.ascontiguousarray(ring.compliance_factors, dtype=float)
+        return _NO_TABLE, zs, factors, condense_workspace(ball_count, factors.shape[2])
+    return table, zs, _NO_COMPLIANCE, np.zeros(0)
+
+
+def kernel_inputs(model: RowModel) -> tuple:
+    """Arguments of :func:`flexrv.model.bearing_kernel.row_kernel` after (q, q_t) for a
+    row (prepared once per row and kept on it: the condensed rings' deflections
+    are the local solve's warm start). A law the kernel does not cover is refused."""
+    inputs = getattr(model, "_kernel_inputs", None)
+    if inputs is not None:
+        return inputs
+    laws = []
+    for side, law in (("inner", model.law_inner), ("outer", model.law_outer)):
+        p = law_parameters(law)
+        if p is None:
+            mode = getattr(law, "mode", type(law).__name__)
+            raise ConfigError(f"contact.ehl = {mode!r} is not supported by the ball-resolved main bearing "
+                              f"({side} contact): choose 'dry' or 'hamrock_dowson'")
+        laws.append(p)
+    tab_i, zs_i, comp_i, ws_i = _ring_arrays(model.inner, model.ball_count)
+    tab_o, zs_o, comp_o, ws_o = _ring_arrays(model.outer, model.ball_count)
+    row = model.row
+    geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
+                         row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
+                         model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
+                         model.pocket_stiffness])
+    inputs = (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, tab_i, zs_i, tab_o, zs_o,
+              laws[0], laws[1], comp_i, comp_o, ws_i, ws_o, np.zeros(4, np.int64))
+    model._kernel_inputs = inputs
     return inputs
 
 
 def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
-    """Generalized force of a row element (as ``evaluate_row(...).force``), from the
-    compiled kernel of :mod:`flexrv.model.bearing_kernel` when it covers the row's
-    rings and laws, else from :func:`evaluate_row`."""
-    inputs = _kernel(model)
-    if inputs is None:
-        return evaluate_row(model, q, q_t, jacobian=False).force
-    from flexrv.model.bearing_kernel import row_force_kernel
+    """Generalized force of a row element (compiled row kernel)."""
+    return row_force_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
+                            *kernel_inputs(model))
 
-    return row_force_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *inputs)
+
+_NO_RECORD = np.zeros((0, N_RECORD))
 
 
 def row_jacobian(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(d force/d q, d force/d q_t) of a row element (as :func:`evaluate_row`), compiled
-    where :func:`row_force` is."""
-    inputs = _kernel(model)
-    if inputs is None:
-        ev = evaluate_row(model, q, q_t, jacobian=True)
-        return ev.jac_q, ev.jac_v
-    from flexrv.model.bearing_kernel import row_kernel
-
-    _, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *inputs,
-                           True)
+    """(d force/d q, d force/d q_t) of a row element (compiled row kernel)."""
+    _, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
+                           *kernel_inputs(model), True, _NO_RECORD)
     return jq, jv
+
+
+@dataclass
+class RaceContacts:
+    """One ring's contacts with the balls of a row (arrays over the balls, global frame)."""
+
+    load: np.ndarray  #: (Z,) normal load [N]
+    normal: np.ndarray  #: (Z, 3) unit normal, groove centre -> ball
+    displacement: np.ndarray  #: (Z, 3) raceway displacement of the ring at the contact [m]
+    azimuth: np.ndarray  #: (Z,) contact azimuth in the ring's frame [rad]
+    ring_load: np.ndarray  #: (Z, 3) contact force on the ring in the ring's own frame [N]
+
+    @property
+    def force_ball(self) -> np.ndarray:
+        """(Z, 3) force of the ring on each ball [N]."""
+        return -self.load[:, None] * self.normal
+
+    @property
+    def contact_angle(self) -> np.ndarray:
+        """(Z,) angle of the normal to the radial plane [rad]."""
+        return np.arctan2(np.abs(self.normal[:, 2]), np.hypot(self.normal[:, 0], self.normal[:, 1]))
 
 
 @dataclass
 class RowEvaluation:
     """Result of :func:`evaluate_row` (arrays over the row's balls)."""
 
-    inner: object  # ContactState
-    outer: object
+    inner: RaceContacts
+    outer: RaceContacts
     force: np.ndarray  # (n,) generalized force vector of the element
     jac_q: np.ndarray | None  # (n, n) d force / d q
     jac_v: np.ndarray | None  # (n, n) d force / d q_t
     ball_pos: np.ndarray
-    azimuth: np.ndarray
-    cage_force: np.ndarray
+    azimuth: np.ndarray  # (Z,) ball azimuths in the housing [rad]
+
+
+def _contacts(rec: np.ndarray, label: str) -> RaceContacts:
+    s = label[0]
+    return RaceContacts(load=rec[:, _REC[f"load_{label}"]].copy(),
+                        normal=rec[:, [_REC[f"n{s}x"], _REC[f"n{s}y"], _REC[f"n{s}z"]]],
+                        displacement=rec[:, [_REC[f"u{s}x"], _REC[f"u{s}y"], _REC[f"u{s}z"]]],
+                        azimuth=rec[:, _REC[f"psi_{label}"]].copy(),
+                        ring_load=rec[:, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]])
 
 
 def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool = True) -> RowEvaluation:
-    """Generalized forces (and Jacobians) of one row's contact element.
+    """Generalized forces (and Jacobians) of one row's contact element with every
+    contact's state — one call of the compiled row kernel.
 
     Parameters
     ----------
     q, q_t : element coordinates and velocities (displacements from the reference
         configuration), ordered [frame(6), inner modes, outer modes, balls(3Z)].
     """
-    sf, si, so, sb = model.slices()
-    z_count = model.ball_count
-    r, phi = q[0:3], q[3:6]
-    r_t, phi_t = q_t[0:3], q_t[3:6]
-    a_mat, g_mat = rxyz_matrices(phi)
-    balls = model.ball_reference + q[sb].reshape(z_count, 3)
-    balls_t = q_t[sb].reshape(z_count, 3)
-    row = model.row
-    speed = model.speed_factor * abs(phi_t[2])
-    law_inner = model.law_inner.normal_law(speed) if hasattr(model.law_inner, "normal_law") else model.law_inner
-    law_outer = model.law_outer.normal_law(speed) if hasattr(model.law_outer, "normal_law") else model.law_outer
+    rec = np.zeros((model.ball_count, N_RECORD))
+    f, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
+                           *kernel_inputs(model), bool(jacobian), rec)
+    return RowEvaluation(inner=_contacts(rec, "inner"), outer=_contacts(rec, "outer"), force=f,
+                         jac_q=jq if jacobian else None, jac_v=jv if jacobian else None,
+                         ball_pos=rec[:, [_REC["bx"], _REC["by"], _REC["bz"]]], azimuth=rec[:, _REC["psi_outer"]].copy())
 
-    # ---------------- inner ring (on the frame)
-    local = (balls - r) @ a_mat  # rows: A^T (b - r)
-    psi_i = np.arctan2(local[:, 1], local[:, 0])
-    p = row.groove_centers(psi_i, "inner")
-    p[:, 2] += model.z
-    nx_i = 6 + model.m_inner
-    t_i = np.zeros((z_count, 3, nx_i))
-    t_i[:, :, 0:3] = np.eye(3)
-    if model.inner is not None:
-        basis_i = model.inner.groove_basis(psi_i)  # (N,3,m)
-        p = p + np.einsum("nkm,m->nk", basis_i, q[si])
-        t_i[:, :, 6:] = np.einsum("jk,nkm->njm", a_mat, basis_i)
-    ap = p @ a_mat.T  # A p
-    t_i[:, :, 3:6] = -_skew(ap) @ g_mat
-    c_i = r + ap
-    x_i_t = np.concatenate([r_t, phi_t, q_t[si]]) if model.inner is not None else np.concatenate([r_t, phi_t])
-    c_i_t = np.einsum("njx,x->nj", t_i, x_i_t)
-    st_i = raceway_contacts(balls, balls_t, c_i, c_i_t, row.inner_offset, law_inner)
 
-    # ---------------- outer ring (housing)
-    psi_o = np.arctan2(balls[:, 1], balls[:, 0])
-    c_o = row.groove_centers(psi_o, "outer")
-    c_o[:, 2] += model.z
-    c_o_t = np.zeros_like(c_o)
-    t_o = None
-    if model.outer is not None:
-        basis_o = model.outer.groove_basis(psi_o)
-        c_o = c_o + np.einsum("nkm,m->nk", basis_o, q[so])
-        c_o_t = np.einsum("nkm,m->nk", basis_o, q_t[so])
-        t_o = basis_o
-    st_o = raceway_contacts(balls, balls_t, c_o, c_o_t, row.outer_offset, law_outer)
-
-    # The groove centres follow the ball's azimuth, so a tangential ball motion
-    # does not rotate the contact normal: drop the geometric stiffness Q/L in the
-    # circumferential direction that raceway_contacts assigns for fixed centres.
-    psi = np.arctan2(balls[:, 1], balls[:, 0])
-    e_t = np.stack([-np.sin(psi), np.cos(psi), np.zeros(z_count)], -1)
-    ett = np.einsum("ni,nj->nij", e_t, e_t)
-    for st, offset in ((st_i, row.inner_offset), (st_o, row.outer_offset)):
-        st.stiffness += (st.load / (st.approach + offset))[:, None, None] * ett
-
-    # ---------------- cage: tangential springs to the kinematic pockets
-    cage_angle = model.cage_ratio * phi[2]
-    pockets = 2.0 * np.pi * np.arange(z_count) / z_count + cage_angle
-    dev = np.angle(np.exp(1j * (psi - pockets)))
-    radius = np.hypot(balls[:, 0], balls[:, 1])
-    s_t = np.einsum("nk,nk->n", balls_t, e_t) - radius * model.cage_ratio * phi_t[2]
-    f_cage = -(model.cage_stiffness * radius * dev + model.cage_damping * s_t)[:, None] * e_t
-    # weak radial/axial pocket spring: keeps unloaded balls determinate (statics)
-    # while being 1e5 times softer than a loaded contact
-    e_r = np.stack([np.cos(psi), np.sin(psi), np.zeros(z_count)], -1)
-    pocket_dev = (radius - model.row.ball_radius_pitch)[:, None] * e_r
-    pocket_dev[:, 2] = balls[:, 2] - model.z
-    f_cage = f_cage - model.pocket_stiffness * pocket_dev
-
-    # ---------------- generalized forces
-    n = model.n_coordinates
-    force = np.zeros(n)
-    f_ball = st_i.force_ball + st_o.force_ball + f_cage
-    force[sb] = f_ball.ravel()
-    g_i = -np.einsum("njx,nj->x", t_i, st_i.force_ball)
-    force[0:6] = g_i[0:6]
-    if model.inner is not None:
-        force[si] = g_i[6:]
-    if t_o is not None:
-        force[so] = -np.einsum("njm,nj->m", t_o, st_o.force_ball)
-
-    jac_q = jac_v = None
-    if jacobian:
-        jac_q = np.zeros((n, n))
-        jac_v = np.zeros((n, n))
-        ball_idx = sb.start + 3 * np.arange(z_count)[:, None] + np.arange(3)[None, :]  # (N,3)
-        x_i_idx = np.concatenate([np.arange(6), np.arange(si.start, si.stop)])
-        cage_k = model.cage_stiffness * np.einsum("ni,nj->nij", e_t, e_t)
-        cage_c = model.cage_damping * np.einsum("ni,nj->nij", e_t, e_t)
-        for jac, blocks, extra in ((jac_q, (st_i.stiffness, st_o.stiffness), cage_k),
-                                   (jac_v, (st_i.damping, st_o.damping), cage_c)):
-            k_i, k_o = blocks
-            kb = k_i + k_o - extra
-            if jac is jac_q:
-                kb = kb - model.pocket_stiffness * (np.eye(3)[None] - np.einsum("ni,nj->nij", e_t, e_t))
-            for c in range(3):
-                for d in range(3):
-                    jac[ball_idx[:, c], ball_idx[:, d]] += kb[:, c, d]
-            # the kinematic cage angle follows the frame rotation phi_z
-            coef = (model.cage_stiffness if jac is jac_q else model.cage_damping) * radius * model.cage_ratio
-            for c in range(3):
-                jac[ball_idx[:, c], 5] += coef * e_t[:, c]
-            kt = np.einsum("nab,nbx->nax", k_i, t_i)  # K_j T_j
-            # d f_ball / d x = -K T ; d g / d b = -T^T K ; d g / d x = sum T^T K T
-            for c in range(3):
-                jac[np.ix_(ball_idx[:, c], x_i_idx)] -= kt[:, c, :]
-            ttk = np.einsum("nax,nab->nxb", t_i, k_i)
-            for d in range(3):
-                jac[np.ix_(x_i_idx, ball_idx[:, d])] -= ttk[:, :, d].T
-            jac[np.ix_(x_i_idx, x_i_idx)] += np.einsum("nax,nay->xy", t_i, kt)
-            if t_o is not None:
-                o_idx = np.arange(so.start, so.stop)
-                kto = np.einsum("nab,nbm->nam", k_o, t_o)
-                for c in range(3):
-                    jac[np.ix_(ball_idx[:, c], o_idx)] -= kto[:, c, :]
-                ttko = np.einsum("nam,nab->nmb", t_o, k_o)
-                for d in range(3):
-                    jac[np.ix_(o_idx, ball_idx[:, d])] -= ttko[:, :, d].T
-                jac[np.ix_(o_idx, o_idx)] += np.einsum("nam,nak->mk", t_o, kto)
-    return RowEvaluation(inner=st_i, outer=st_o, force=force, jac_q=jac_q, jac_v=jac_v, ball_pos=balls,
-                         azimuth=psi, cage_force=f_cage)
+def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEvaluation) -> np.ndarray:
+    """Modal amplitudes of a row's flexible ring: the element coordinates of a modal
+    ring, or q = K^-1 sum_j B_j^T g_j of a condensed one from its contact loads."""
+    ring = getattr(model, label)
+    if not _is_condensed(ring):
+        _, si, so, _ = model.slices()
+        return np.asarray(q)[si if label == "inner" else so].copy()
+    st = getattr(ev, label)
+    zs = -1.0 if ring.mirror else 1.0
+    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth), np.ascontiguousarray(st.ring_load),
+                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))
 
 
 # ---------------------------------------------------------------------------- Exudyn
@@ -429,7 +411,7 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ra
     for model in rows:
         node_list = [frame_node]
         for ring, store in ((model.inner, inner_nodes), (model.outer, outer_nodes)):
-            if ring is None:
+            if ring is None or _is_condensed(ring):
                 store.append(None)
                 continue
             m = ring.stiffness.shape[0]
@@ -507,14 +489,17 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
 
 #: raceway Fourier harmonics K (None: the reduction's patch-width default,
 #: :func:`flexrv.fem.reduction.default_harmonics`) and fixed-interface
-#: eigenmodes of the rings in the dynamic model (see :func:`flexible_rings`)
+#: eigenmodes of the rings: 12 for dynamic rings; none for quasi-static
+#: (condensed) rings, whose static compliance at the raceway is exact in the span
+#: of the raceway attachment modes alone (see :func:`flexible_rings`)
 RING_HARMONICS = None
 RING_EIGENMODES = 12
+RING_EIGENMODES_QUASI_STATIC = 0
 
 
-def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int = RING_EIGENMODES, size: float | None = None,
+def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int | None = None, size: float | None = None,
                    damping_ratio: float = 0.02, stiffness_scale: float = 1.0, quasi_static: bool = True,
-                   rings: tuple[str, ...] = ("inner", "outer")) -> dict:
+                   rings: tuple[str, ...] = ("inner", "outer"), condense: bool = True) -> dict:
     """Reduced flexible rings of a design's main bearing for both rows.
 
     Returns ``{"inner": [row0, row1], "outer": [row0, row1], "bodies": {...}}`` with
@@ -530,9 +515,24 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int =
     15 kN axial, deflection at the loaded balls vs the full FE, see
     tests/test_model_flexible_rings.py): K = 24/40/57/80 -> -42/2.7/0.08/0.04 %.
     The default K is the reduction's patch-width rule (57 for rv221).
+
+    ``condense`` (default True): quasi-static rings are condensed into the row
+    elements (no modal system coordinates; issue 15); False keeps their massless
+    modal coordinates (the uncondensed formulation, for verification).
+
+    ``n_eig`` (None: :data:`RING_EIGENMODES` for dynamic rings,
+    :data:`RING_EIGENMODES_QUASI_STATIC` = 0 for quasi-static ones). A
+    quasi-static ring only needs its static compliance at the raceway, which the
+    attachment modes of the raceway loads span exactly; the fixed-interface
+    eigenmodes were 45 % of the cold build of the rv221 rings (23 of 54 s CPU)
+    and 12 of the 127 modes the condensed kernel carries. The recorded lowest
+    mode (``lowest_mode_hz``) is then the Ritz estimate of the attachment basis
+    (an upper bound; measured rv221 outer ring: see the report of issue 15).
     """
     from flexrv.fem.body import reduce_part
 
+    if n_eig is None:
+        n_eig = RING_EIGENMODES_QUASI_STATIC if quasi_static else RING_EIGENMODES
     out: dict = {"bodies": {}}
     for label in rings:
         if label not in ("inner", "outer"):
@@ -540,7 +540,8 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int =
         part = f"{label}_ring"
         settings = {"size": size, "n_eig": int(n_eig), "n_harmonics": None if harmonics is None else int(harmonics)}
         body = reduce_part(reducer, part, **settings)
-        opts = dict(damping_ratio=damping_ratio, stiffness_scale=stiffness_scale, quasi_static=quasi_static)
+        opts = dict(damping_ratio=damping_ratio, stiffness_scale=stiffness_scale, quasi_static=quasi_static,
+                    condense=bool(condense))
         out[label] = [ModalRing(body, **opts), ModalRing(body, mirror=True, **opts)]
         out["bodies"][part] = settings
         out.setdefault("lowest_mode_hz", {})[part] = float(np.sqrt(stiffness_scale) * body.frequencies_hz.min())
@@ -560,11 +561,12 @@ class BallBearingGroup(ForceGroup):
     Members: ``carrier`` (x, y, theta, z, rx, ry — the tilts are small, so the
     Tait–Bryan frame (rx, ry, theta) of the row elements is the carrier pose) and,
     per row k, ``main_bearing_inner<k>`` / ``main_bearing_outer<k>`` (modal
-    coordinates of a flexible ring, only if the row's ring is flexible; the inner
-    ring's modes live in the carrier frame, the outer ring's in the housing) and
+    coordinates of an uncondensed flexible ring only; the inner ring's modes live
+    in the carrier frame, the outer ring's in the housing) and
     ``main_bearing_balls<k>`` (absolute ball-centre positions, 3 Z coordinates).
-    Each row's contact element (:func:`evaluate_row`) sees the coordinates
-    [frame(6), inner modes, outer modes, balls]; the group scatters them.
+    Each row's contact element (:func:`flexrv.model.bearing_kernel.row_kernel`)
+    sees the coordinates [frame(6), inner modes, outer modes, balls]; the group
+    scatters them.
     """
 
     name = "main_bearing"
@@ -589,7 +591,7 @@ class BallBearingGroup(ForceGroup):
         self._n = int(sum(sizes))
 
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
-        """One Exudyn element per row over [carrier, the row's ring modes, its balls]
+        """One Exudyn element per row over [carrier, the row's modal rings, its balls]
         (instead of one over the whole group): the rows do not interact except
         through the carrier, and separate elements keep the zero row-row blocks out
         of the system Jacobian (measured: ~half the nonzeros for two flexible rows).
@@ -598,7 +600,7 @@ class BallBearingGroup(ForceGroup):
 
         stats, objects, pos = self.stats, [], 1
         for k, row in enumerate(self.rows):
-            count = 1 + (row.inner is not None) + (row.outer is not None)
+            count = 1 + len(row.ring_nodes())
             row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
             pos += count
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
@@ -629,16 +631,23 @@ class BallBearingGroup(ForceGroup):
     def flexible(self) -> bool:
         return any(r.inner is not None or r.outer is not None for r in self.rows)
 
+    def check(self) -> str | None:
+        """Failure message if a condensed ring's local contact solve did not converge
+        in the last evaluation (the accepted state of the step)."""
+        if any(int(kernel_inputs(r)[-1][1]) for r in self.rows if hasattr(r, "_kernel_inputs")):
+            return "main bearing: the condensed rings' contact deflections did not converge"
+        return None
+
     def new_members(self) -> dict:
-        """The group's own members (balls at the preload equilibrium, ring modes at
-        rest) as :class:`flexrv.model.base.Member` objects, in the group's order."""
+        """The group's own members (balls at the preload equilibrium, modal ring
+        coordinates at rest) as :class:`flexrv.model.base.Member` objects, in the
+        group's order."""
         from flexrv.model.base import Member
 
         out = {}
         for k, row in enumerate(self.rows):
-            for label, ring in (("inner", row.inner), ("outer", row.outer)):
-                if ring is None:
-                    continue
+            for label in row.ring_nodes():
+                ring = getattr(row, label)
                 m = ring.stiffness.shape[0]
                 out[f"main_bearing_{label}{k}"] = Member(
                     f"main_bearing_{label}{k}", np.asarray(ring.mass, dtype=float), np.zeros(m), np.zeros(m),
@@ -658,23 +667,12 @@ class BallBearingGroup(ForceGroup):
         return qe, v[..., idx], idx
 
     def _force(self, q, v) -> np.ndarray:
-        """Generalized force of one state (compiled row kernels where possible)."""
+        """Generalized force of one state (compiled row kernels)."""
         f = np.zeros(self._n)
         for k in range(len(self.rows)):
             qe, ve, idx = self._element_state(q, v, k)
             f[idx] += row_force(self.rows[k], qe, ve)
         return f
-
-    def _evaluate_rows(self, q, v):
-        """Generalized force and the full row evaluations (numpy reference) of one state."""
-        f = np.zeros(self._n)
-        evals = []
-        for k, row in enumerate(self.rows):
-            qe, ve, idx = self._element_state(q, v, k)
-            ev = evaluate_row(row, qe, ve, jacobian=False)
-            evals.append(ev)
-            f[idx] += ev.force
-        return f, evals
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
         """Generalized forces for one state (n,) or a history (T, n)."""
@@ -685,9 +683,14 @@ class BallBearingGroup(ForceGroup):
         forces = np.zeros_like(q)
         history = []
         for i in range(q.shape[0]):
-            forces[i], evals = self._evaluate_rows(q[i], v[i])
-            if want_outputs:
-                history.append(evals)
+            evals = []
+            for k, row in enumerate(self.rows):
+                qe, ve, idx = self._element_state(q[i], v[i], k)
+                ev = evaluate_row(row, qe, ve, jacobian=False)
+                forces[i, idx] += ev.force
+                if want_outputs:
+                    evals.append((ev, qe))
+            history.append(evals)
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
 
@@ -721,10 +724,12 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     contact (the more heavily stressed: convex–convex, smaller rx); per row: the
     ring's raceway deflection at its most-loaded contact along the contact load
     (positive: the raceway yields away from the ball), and the rings' modal
-    coordinates (for :mod:`flexrv.viz.rings`). The film is the quasi-static EHL
-    h_c(Q, u) of the contact law at the entrainment speed of the carrier's
+    coordinates (for :mod:`flexrv.viz.rings`; a condensed ring's from its recorded
+    contact loads, :func:`ring_modal_coordinates`). The film is the quasi-static
+    EHL h_c(Q, u) of the contact law at the entrainment speed of the carrier's
     rotation; the pressure is the Hertz p_max of the load (the EHL pressure spike
     is not resolved by the law, see :mod:`flexrv.ehl.law`).
+    ``history[i][k]`` is (row evaluation, element coordinates) of sample i, row k.
     """
     from flexrv.contact.hertz import point_contact
 
@@ -733,22 +738,19 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     shape = (n_t, n_r, n_b)
     load_i, load_o, angle = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     film, p_max = np.zeros(shape), np.zeros(shape)
-    defl_i, defl_o = np.zeros((n_t, n_r)), np.zeros((n_t, n_r))
+    defl = {"inner": np.zeros((n_t, n_r)), "outer": np.zeros((n_t, n_r))}
+    modal = {label: [np.zeros((n_t, getattr(row, label).stiffness.shape[0])) if getattr(row, label) is not None
+                     else None for row in rows] for label in ("inner", "outer")}
     for i, evals in enumerate(history):
-        for k, (row, ev) in enumerate(zip(rows, evals)):
+        for k, (row, (ev, qe)) in enumerate(zip(rows, evals)):
             load_i[i, k], load_o[i, k], angle[i, k] = ev.inner.load, ev.outer.load, ev.inner.contact_angle
-            qe, _, _ = group._element_state(q[i], v[i], k)
-            _, si, so, _ = row.slices()
-            for ring, st, q_modal, store, frame in ((row.inner, ev.inner, qe[si], defl_i, True),
-                                                    (row.outer, ev.outer, qe[so], defl_o, False)):
-                if ring is None:
+            for label in ("inner", "outer"):
+                if getattr(row, label) is None:
                     continue
+                st = getattr(ev, label)
                 j = int(np.argmax(st.load))
-                local = ev.ball_pos[j] - qe[0:3] if frame else ev.ball_pos[j]
-                a_mat = rxyz_matrices(qe[3:6])[0] if frame else np.eye(3)
-                psi = float(np.arctan2(*(local @ a_mat)[[1, 0]]))
-                u = a_mat @ (ring.groove_basis(np.array([psi]))[0] @ q_modal)
-                store[i, k] = float(u @ st.normal[j])
+                defl[label][i, k] = float(st.displacement[j] @ st.normal[j])
+                modal[label][k][i] = ring_modal_coordinates(row, label, qe, ev)
     carrier_speed = np.abs(v[:, 2])
     for k, row in enumerate(rows):
         speed = (row.speed_factor * carrier_speed)[:, None]
@@ -767,19 +769,11 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
            "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
            "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
            "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact")}
-    for label, store in (("inner", defl_i), ("outer", defl_o)):
-        ring_rows = [k for k, row in enumerate(rows) if getattr(row, label) is not None]
-        if not ring_rows:
+    for label in ("inner", "outer"):
+        if any(m is None for m in modal[label]):
             continue
-        out[f"ring_deformation_{label}"] = Output(store, ("time", "bearing_row"), "m",
+        out[f"ring_deformation_{label}"] = Output(defl[label], ("time", "bearing_row"), "m",
                                                   f"{label} raceway deflection at the most-loaded contact")
-        modal = np.stack([q[:, group._index[k]][:, slice(*_modal_range(rows[k], label))] for k in range(n_r)], 1)
-        out[f"ring_modal_{label}"] = Output(modal, ("time", "bearing_row", f"mode_{label}"), "1",
+        out[f"ring_modal_{label}"] = Output(np.stack(modal[label], 1), ("time", "bearing_row", f"mode_{label}"), "1",
                                             f"modal coordinates of the {label} rings")
     return out
-
-
-def _modal_range(row: RowModel, label: str) -> tuple[int, int]:
-    _, si, so, _ = row.slices()
-    s = si if label == "inner" else so
-    return s.start, s.stop
