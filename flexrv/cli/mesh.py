@@ -19,6 +19,7 @@ class Part(str, enum.Enum):
     inner_ring = "inner_ring"
     crankshaft = "crankshaft"
     cycloid_disc = "cycloid_disc"
+    carrier = "carrier"
 
 
 PART_OPT = typer.Option(..., "--part", help="Part to mesh.", case_sensitive=True)
