@@ -177,16 +177,20 @@ class CarrierSpec:
         return plates + len(self.pillar_angles) * math.pi * self.pillar_radius**2 * self.gap
 
     def default_size(self) -> float:
-        """Default global mesh size [m]: a third of the thinnest plate, at most half
-        the pillar radius and the thinnest ligament around a crank bore."""
-        return min(min(self.input_thickness, self.output_thickness) / 3.0, 0.5 * self.pillar_radius,
-                   self.min_feature())
+        """Default global mesh size [m]: a third of the thinnest plate, at most the
+        thinnest ligament around a crank bore."""
+        return min(min(self.input_thickness, self.output_thickness) / 3.0, self.min_feature())
+
+    def pillar_size(self, size: float) -> float:
+        """Mesh size on the pillars [m]: <= half the pillar radius (beam bending
+        of the pillars is the carrier's main compliance)."""
+        return min(size, 0.5 * self.pillar_radius)
 
     def min_feature(self) -> float:
-        """Smallest wall [m]: plate thickness, ligaments around the crank bores, pillar radius."""
+        """Smallest wall [m]: plate thickness, ligaments around the crank bores."""
         lig = min(self.plate_radius - self.crank_circle_radius - self.crank_bore_radius,
                   self.crank_circle_radius - self.crank_bore_radius - self.center_bore_radius)
-        return min(self.input_thickness, self.output_thickness, lig, self.pillar_radius)
+        return min(self.input_thickness, self.output_thickness, lig)
 
 
 def spec_for(reducer, part: str):
@@ -299,8 +303,9 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
             raise InputError("carrier: a crank bore cuts the plate rim or the centre bore; the geometry self-intersects")
         if size > limit:
             raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the carrier: must be <= "
-                             f"{limit * 1e3:.4g} mm (thinnest plate, ligament around a crank bore, or pillar radius)")
-        local = size
+                             f"{limit * 1e3:.4g} mm (thinnest plate or ligament around a crank bore)")
+        local = spec.pillar_size(size)
+        est_local = NODE_DENSITY * len(spec.pillar_angles) * math.pi * spec.pillar_radius**2 * spec.gap / local**3
     else:  # pragma: no cover - spec_for guards the type
         raise InputError(f"unknown spec {type(spec).__name__}")
     est = int(NODE_DENSITY * spec.volume() / size**3 + est_local)
