@@ -73,7 +73,7 @@ class PinContactCase:
 def pin_contact_case(reducer, output_torque: float, crank_angle: float = 0.0, disc: int = 0) -> PinContactCase:
     """Contact points, directions and forces of disc ``disc`` at the output torque
     (:func:`flexrv.analysis.pin_load.reducer_pin_loads`, Palmgren law): the pins'
-    centres in the loaded disc frame, their foot points on the as-built profile
+    centres in the disc frame at the no-load contact pose, their foot points on the as-built profile
     (centre - (r_i + gap_i) n_i, n the profile -> pin normal) and the force
     direction -n_i on the disc."""
     from flexrv.analysis.pin_load import reducer_pin_loads
@@ -84,7 +84,9 @@ def pin_contact_case(reducer, output_torque: float, crank_angle: float = 0.0, di
     res = reducer_pin_loads(reducer, output_torque, crank_angle=crank_angle, disc=disc)
     ab = as_built(reducer)
     center, rot = nominal_disc_pose(ss.pin_count, ss.eccentricity, crank_angle + float(ab.chi0[disc]))
-    p = to_disc_frame(ab.pins, center, rot + res.rotation)
+    # at the no-load contact pose, where the solver takes the moment arms (the
+    # elastic rotation beyond it, ~1e-4 rad, moves the points by < R_p * 1e-4)
+    p = to_disc_frame(ab.pins, center, rot + res.backlash_rotation)
     gap, normal, _ = as_built_pin_gap(p, ab.pin_radii, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
                                       ss.eccentricity, tuple(float(v) for v in ab.disc_profile[disc]),
                                       ab.profile_harmonics[disc])
