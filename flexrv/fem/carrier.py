@@ -163,7 +163,7 @@ class CarrierCompliance:
     matrix: list
     labels: list
     torsional: float
-    torsional_rbe2: float
+    torsional_rbe2: float | None
     split_input: float
     crank_circle_radius: float
     n_cranks: int
@@ -198,16 +198,18 @@ def carrier_material(reducer) -> dict:
 
 
 def carrier_compliance(reducer, size: float | None = None, split_input: float = 0.5,
-                       local_size: float | None = None, cache: bool = True) -> CarrierCompliance:
+                       local_size: float | None = None, rigid_bound: bool = True,
+                       cache: bool = True) -> CarrierCompliance:
     """Condensed bore compliance and torsional compliance of a design's carrier
     (module doc). ``size``: global mesh size [m] (part default if None), ``local_size``
-    the pillar mesh size [m] (part default if None)."""
+    the pillar mesh size [m] (part default if None); ``rigid_bound`` also
+    computes the RBE2 (rigid-bore) bound (a second factorisation; None if False)."""
     from flexrv.fem.body import _assemble
     from flexrv.meshing import build_mesh
 
     mres = build_mesh(reducer, "carrier", size, local_size=local_size, cache=cache)
     mat = carrier_material(reducer)
-    key = content_hash(mres.key, mat, float(split_input), FORMAT_VERSION,
+    key = content_hash(mres.key, mat, float(split_input), bool(rigid_bound), FORMAT_VERSION,
                        library_versions("scikit-fem", "scipy", "numpy"))
     path = cache_dir() / f"carrier-{key}.compliance.json"
 
@@ -222,7 +224,7 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
         C, _ = clamped_flexibility(fe.K, flange, W)
         g = torque_load_vector(n, a_w, split_input)
         c_t = float(g @ C @ g)
-        c_rbe2 = float(g @ rbe2_bore_compliance(fe.K, d, names) @ g)
+        c_rbe2 = float(g @ rbe2_bore_compliance(fe.K, d, names) @ g) if rigid_bound else None
         labels = [f"{b} {c}" for b in names for c in ("x", "y")]
         out = CarrierCompliance(matrix=C.tolist(), labels=labels, torsional=c_t, torsional_rbe2=c_rbe2,
                                 split_input=float(split_input), crank_circle_radius=float(a_w), n_cranks=int(n),
