@@ -12,7 +12,7 @@ import scipy.sparse.linalg as spla
 from flexrv.design import load, override
 from flexrv.errors import ConfigError, InputError
 from flexrv.fem.assembly import assemble
-from flexrv.fem.carrier import (bore_groups, carrier_compliance, carrier_material, clamped_flexibility,
+from flexrv.fem.carrier import (bore_groups, carrier_compliance, clamped_flexibility,
                                 pillar_frame_stiffness, rbe2_bore_compliance, rbe3_loads, rigid_plate_frame_stiffness,
                                 torque_load_vector)
 from flexrv.fem.static import solve_static

@@ -137,3 +137,27 @@ def test_disc_mesh_convergence_slow():
     assert p > 0.5
     c_inf = c[2] + (c[2] - c[1]) / (r**p - 1)
     assert abs(c_inf / c[2] - 1) < 0.05
+
+
+@pytest.mark.slow
+def test_body_compliances_for_the_budget():
+    """body_compliances: the carrier and disc entries equal carrier_compliance /
+    disc_compliance (output share c_d / n_discs), stiffness = RAD_PER_ARCMIN / c,
+    every entry names its source; a design without [carrier] reports None for it."""
+    from flexrv.design import from_dict
+    from flexrv.fem.carrier import carrier_compliance
+    from flexrv.fem.disc import body_compliances
+
+    rv = load("rv40e")
+    b = body_compliances(rv, carrier_size=0.008, disc_size=0.008)
+    c = carrier_compliance(rv, size=0.008)
+    d = disc_compliance(rv, size=0.008)
+    assert b["carrier"]["compliance_rad_per_Nm"] == c.torsional
+    assert b["cycloid_disc"]["compliance_rad_per_Nm"] == pytest.approx(d.torsional / rv.second_stage.n_discs)
+    for entry in b.values():
+        assert entry["stiffness_Nm_per_arcmin"] == pytest.approx(RAD_PER_ARCMIN / entry["compliance_rad_per_Nm"])
+        assert "FE condensation" in entry["source"]
+    data = rv.model_dump()
+    data.pop("carrier")
+    bare = body_compliances(from_dict(data), disc_size=0.008)
+    assert bare["carrier"]["compliance_rad_per_Nm"] is None and "no [carrier]" in bare["carrier"]["source"]

@@ -35,6 +35,9 @@ Not modelled: the pillar holes of the disc (the ``cycloid_disc`` part has none;
 they make the real disc softer), needle bearing ovalisation of the crank holes
 (rigid bores: a stiff bound).
 
+:func:`body_compliances` gives the carrier's and the discs' torsional
+compliances at the output together, for the stiffness budget.
+
 Verification (tests/test_fem_disc.py): the condensed C reproduces the full FE
 solve of the same load case (Lagrange-multiplier solve of the constrained
 system) to 1e-8; mesh convergence with the patch fixed.
@@ -201,4 +204,43 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
 
     out, _ = cached_entry([path], key, lambda: DiscCompliance(**json.loads(path.read_text())), _build,
                           enabled=cache)
+    return out
+
+
+def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
+                     output_torque: float | None = None, cache: bool = True) -> dict:
+    """Torsional compliances [rad/(N m)] at the output of the carrier and the
+    cycloid disc bodies, from the FE condensations (for the stiffness budget).
+
+    Returns ``{"carrier": {...}, "cycloid_disc": {...}}``, each entry with
+    ``compliance_rad_per_Nm`` (the value to add in series), ``stiffness_Nm_per_arcmin``,
+    ``source`` (method and interfaces, for the budget's provenance column) and the
+    mesh facts; the carrier entry also ``compliance_rbe2_rad_per_Nm`` (rigid
+    bores, the stiff bound). A design without a ``[carrier]`` table gives
+    ``{"compliance_rad_per_Nm": None, "source": <why>}`` for the carrier.
+    ``output_torque`` (default rated) sets the disc's pin load distribution.
+    """
+    from flexrv.fem.carrier import carrier_compliance
+
+    out: dict = {}
+    if reducer.carrier is None:
+        out["carrier"] = {"compliance_rad_per_Nm": None, "stiffness_Nm_per_arcmin": None,
+                          "source": "no [carrier] table in the design: carrier compliance not computed"}
+    else:
+        c = carrier_compliance(reducer, size=carrier_size, cache=cache)
+        out["carrier"] = {"compliance_rad_per_Nm": c.torsional,
+                          "stiffness_Nm_per_arcmin": c.torsional_stiffness_Nm_per_arcmin,
+                          "compliance_rbe2_rad_per_Nm": c.torsional_rbe2,
+                          "source": (f"FE condensation (flexrv.fem.carrier): Tet10 carrier, {c.n_nodes} nodes, size "
+                                     f"{c.size * 1e3:.3g} mm; flange held, crank bores RBE3, tangential crank forces "
+                                     f"T/(N a_w) split {c.split_input:g}/{1 - c.split_input:g} input/output plate"),
+                          "n_nodes": c.n_nodes, "mesh_size_m": c.size}
+    d = disc_compliance(reducer, output_torque=output_torque, size=disc_size, cache=cache)
+    out["cycloid_disc"] = {"compliance_rad_per_Nm": d.output_share,
+                           "stiffness_Nm_per_arcmin": d.output_stiffness_Nm_per_arcmin,
+                           "compliance_one_disc_rad_per_Nm": d.torsional,
+                           "source": (f"FE condensation (flexrv.fem.disc): Tet10 disc, {d.n_nodes} nodes; crank holes "
+                                      f"held (RBE2, rz free), {d.n_loaded} loaded pins at T = {d.torque:g} N m as RBE3 "
+                                      f"patches of half-width {d.patch * 1e3:.3g} mm; {d.n_discs} discs in parallel"),
+                           "n_nodes": d.n_nodes, "mesh_size_m": d.size}
     return out
