@@ -12,7 +12,8 @@ from flexrv.design import load
 from flexrv.errors import InputError
 from flexrv.fem.assembly import assemble
 from flexrv.fem.body import material_dict
-from flexrv.fem.disc import disc_compliance, held_flexibility, hole_masters, pin_contact_case, pin_patch_loads
+from flexrv.fem.disc import (disc_compliance, disc_compliance_sweep, held_flexibility, hole_masters, pin_contact_case,
+                             pin_patch_loads)
 from flexrv.meshing import build_mesh
 from flexrv.units import RAD_PER_ARCMIN
 
@@ -124,6 +125,23 @@ def test_disc_compliance_api_and_cache():
         disc_compliance(rv, output_torque=0.0, size=SIZE, local_size=LOCAL)
 
 
+def test_sweep_over_crank_angles_equals_single_cases():
+    """disc_compliance_sweep (one factorisation, the load cases of all crank
+    angles as right-hand sides) gives at each angle the c_d of a separate
+    disc_compliance solve (1e-9), and the mean is their average; c_d varies with
+    the crank angle (the loaded flank turns against the three holes)."""
+    rv = load("rv40e")
+    sw = disc_compliance_sweep(rv, n_angles=2, size=SIZE, local_size=LOCAL)
+    assert sw.angles[1] == pytest.approx(math.pi / rv.first_stage.n_planets)
+    for a, c in zip(sw.angles, sw.torsional):
+        assert c == pytest.approx(disc_compliance(rv, crank_angle=a, size=SIZE, local_size=LOCAL).torsional, rel=1e-9)
+    assert sw.mean == pytest.approx(np.mean(sw.torsional))
+    assert sw.output_share == pytest.approx(sw.mean / rv.second_stage.n_discs)
+    assert abs(sw.torsional[1] / sw.torsional[0] - 1) > 0.02
+    with pytest.raises(InputError, match="n_angles"):
+        disc_compliance_sweep(rv, n_angles=0, size=SIZE, local_size=LOCAL)
+
+
 @pytest.mark.slow
 def test_disc_mesh_convergence_slow():
     """rv40e disc torsional compliance (patch fixed at r_rp / 2) on flank mesh
@@ -149,7 +167,7 @@ def test_body_compliances_for_the_budget():
     from flexrv.fem.disc import body_compliances
 
     rv = load("rv40e")
-    b = body_compliances(rv, carrier_size=0.008, disc_size=0.008)
+    b = body_compliances(rv, carrier_size=0.008, disc_size=0.008, disc_angles=1)
     c = carrier_compliance(rv, size=0.008)
     d = disc_compliance(rv, size=0.008)
     assert b["carrier"]["compliance_rad_per_Nm"] == c.torsional
@@ -159,5 +177,5 @@ def test_body_compliances_for_the_budget():
         assert "FE condensation" in entry["source"]
     data = rv.model_dump()
     data.pop("carrier")
-    bare = body_compliances(from_dict(data), disc_size=0.008)
+    bare = body_compliances(from_dict(data), disc_size=0.008, disc_angles=1)
     assert bare["carrier"]["compliance_rad_per_Nm"] is None and "no [carrier]" in bare["carrier"]["source"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 from pathlib import Path
 from typing import Optional
 
@@ -32,7 +33,7 @@ def _size_m(size_mm: Optional[float]) -> Optional[float]:
 
 COMPLIANCE_HELP = ("carrier / cycloid_disc: also condense the part (FE) and print its torsional compliance at the "
                    "output (carrier: flange held, crank bores loaded by the torque path; disc: crank holes held, pin "
-                   "loads at the rated torque).")
+                   "loads at the rated torque, mean over 6 crank angles of one crank-hole period).")
 
 
 def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
@@ -65,10 +66,10 @@ def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_
             data["torsional_stiffness_Nm_per_arcmin"] = c.torsional_stiffness_Nm_per_arcmin
             data["rigid_bore_stiffness_Nm_per_arcmin"] = RAD_PER_ARCMIN / c.torsional_rbe2
         else:
-            from flexrv.fem.disc import disc_compliance
+            from flexrv.fem.disc import disc_compliance_sweep
 
-            c = disc_compliance(reducer, size=_size_m(size))
-            data["loaded_pins"] = c.n_loaded
+            c = disc_compliance_sweep(reducer, size=_size_m(size))
+            data["crank_angles_deg"] = [round(math.degrees(a), 6) for a in c.angles]
             data["one_disc_compliance_rad_per_Nm"] = c.torsional
             data["torsional_compliance_rad_per_Nm"] = c.output_share
             data["torsional_stiffness_Nm_per_arcmin"] = c.output_stiffness_Nm_per_arcmin

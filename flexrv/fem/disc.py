@@ -207,8 +207,77 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
     return out
 
 
+
+@dataclass(frozen=True)
+class DiscSweep:
+    """Disc body torsional compliance c_d [rad/(N m)] over crank angles (one
+    factorisation, all load cases as right-hand sides): ``angles`` [rad],
+    ``torsional`` per angle, ``mean`` over them, ``output_share`` = mean / n_discs."""
+
+    angles: list
+    torsional: list
+    mean: float
+    output_share: float
+    n_discs: int
+    torque: float
+    patch: float
+    n_nodes: int
+    size: float
+    mesh_key: str
+
+    @property
+    def output_stiffness_Nm_per_arcmin(self) -> float:
+        return RAD_PER_ARCMIN / self.output_share
+
+
+def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | None = None, size: float | None = None,
+                          patch: float | None = None, local_size: float | None = None, cache: bool = True) -> DiscSweep:
+    """c_d at ``n_angles`` crank angles 2 pi k / (N n_angles), k = 0..n-1, over one
+    period of the crank-hole pattern (the loaded flank turns against the N holes
+    as the crank turns; c_d varies by +-20 % on the rv40e), and their mean (the
+    budget's value). Same model as :func:`disc_compliance`."""
+    from flexrv.fem.body import _assemble, material_dict
+    from flexrv.meshing import build_mesh
+
+    ss = reducer.second_stage
+    if not (isinstance(n_angles, int) and 1 <= n_angles <= 64):
+        raise InputError(f"n_angles = {n_angles!r} must be an integer in 1..64")
+    torque = float(reducer.operating.rated_torque_Nm if output_torque is None else output_torque)
+    if not (np.isfinite(torque) and torque != 0.0):
+        raise InputError(f"output_torque = {output_torque!r} must be finite and non-zero")
+    patch = float(0.5 * ss.pin_radius if patch is None else patch)
+    if not patch > 0:
+        raise InputError(f"patch = {patch!r} m must be > 0")
+    n = reducer.first_stage.n_planets
+    angles = [2.0 * np.pi * k / (n * n_angles) for k in range(n_angles)]
+    mres = build_mesh(reducer, "cycloid_disc", size, local_size=local_size, cache=cache)
+    mat = material_dict(reducer, "cycloid_disc")
+    cases = [pin_contact_case(reducer, torque, a) for a in angles]
+    key = content_hash(mres.key, mat, [(c.points, c.directions, c.forces) for c in cases], patch, FORMAT_VERSION,
+                       library_versions("scikit-fem", "scipy", "numpy"))
+    path = cache_dir() / f"cycloid_disc-{key}.sweep.json"
+
+    def _build() -> DiscSweep:
+        d = mres.data
+        fe = _assemble(d, mat)
+        F = sp.hstack([pin_patch_loads(d, c, patch) @ sp.csc_matrix((c.forces / abs(c.disc_torque))[:, None])
+                       for c in cases]).tocsc()
+        C, _ = held_flexibility(fe.K, d, F)
+        cd = np.diag(C).tolist()
+        mean = float(np.mean(cd))
+        out = DiscSweep(angles=angles, torsional=cd, mean=mean, output_share=mean / ss.n_discs,
+                        n_discs=int(ss.n_discs), torque=torque, patch=patch, n_nodes=int(d.n_nodes),
+                        size=float(d.size), mesh_key=mres.key)
+        if cache:
+            atomic_write_text(path, json.dumps(asdict(out)))
+        return out
+
+    out, _ = cached_entry([path], key, lambda: DiscSweep(**json.loads(path.read_text())), _build, enabled=cache)
+    return out
+
+
 def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
-                     output_torque: float | None = None, cache: bool = True) -> dict:
+                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True) -> dict:
     """Torsional compliances [rad/(N m)] at the output of the carrier and the
     cycloid disc bodies, from the FE condensations (for the stiffness budget).
 
@@ -218,7 +287,9 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
     mesh facts; the carrier entry also ``compliance_rbe2_rad_per_Nm`` (rigid
     bores, the stiff bound). A design without a ``[carrier]`` table gives
     ``{"compliance_rad_per_Nm": None, "source": <why>}`` for the carrier.
-    ``output_torque`` (default rated) sets the disc's pin load distribution.
+    ``output_torque`` (default rated) sets the disc's pin load distribution; the
+    disc value is the mean over ``disc_angles`` crank angles
+    (:func:`disc_compliance_sweep`), its range in ``compliance_one_disc_range_rad_per_Nm``.
     """
     from flexrv.fem.carrier import carrier_compliance
 
@@ -235,12 +306,14 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
                                      f"{c.size * 1e3:.3g} mm; flange held, crank bores RBE3, tangential crank forces "
                                      f"T/(N a_w) split {c.split_input:g}/{1 - c.split_input:g} input/output plate"),
                           "n_nodes": c.n_nodes, "mesh_size_m": c.size}
-    d = disc_compliance(reducer, output_torque=output_torque, size=disc_size, cache=cache)
+    d = disc_compliance_sweep(reducer, n_angles=disc_angles, output_torque=output_torque, size=disc_size, cache=cache)
     out["cycloid_disc"] = {"compliance_rad_per_Nm": d.output_share,
                            "stiffness_Nm_per_arcmin": d.output_stiffness_Nm_per_arcmin,
-                           "compliance_one_disc_rad_per_Nm": d.torsional,
+                           "compliance_one_disc_rad_per_Nm": d.mean,
+                           "compliance_one_disc_range_rad_per_Nm": [min(d.torsional), max(d.torsional)],
                            "source": (f"FE condensation (flexrv.fem.disc): Tet10 disc, {d.n_nodes} nodes; crank holes "
-                                      f"held (RBE2, rz free), {d.n_loaded} loaded pins at T = {d.torque:g} N m as RBE3 "
-                                      f"patches of half-width {d.patch * 1e3:.3g} mm; {d.n_discs} discs in parallel"),
+                                      f"held (RBE2, rz free), pin loads at T = {d.torque:g} N m as RBE3 patches of "
+                                      f"half-width {d.patch * 1e3:.3g} mm, mean over {len(d.angles)} crank angles of "
+                                      f"one hole period; {d.n_discs} discs in parallel"),
                            "n_nodes": d.n_nodes, "mesh_size_m": d.size}
     return out
