@@ -146,7 +146,9 @@ def test_sweep_over_crank_angles_equals_single_cases():
 def test_disc_mesh_convergence_slow():
     """rv40e disc torsional compliance (patch fixed at r_rp / 2) on flank mesh
     sizes 3, 2.12, 1.5 mm: changes shrink, observed Richardson rate > 0.5, the
-    extrapolated value within 5 % of the finest."""
+    extrapolated value within 5 % of the finest (measured: 1.3577, 1.3621,
+    1.3634e-7 rad/(N m) on 12.6k, 22.8k, 39.0k nodes, p = 3.4, extrapolated
+    1.3641e-7)."""
     rv = load("rv40e")
     h = [0.003, 0.003 / math.sqrt(2), 0.0015]
     c = [disc_compliance(rv, size=SIZE, local_size=x, cache=False).torsional for x in h]
