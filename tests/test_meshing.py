@@ -89,3 +89,33 @@ def test_self_intersecting_geometry_is_rejected():
     limacon = np.stack([(0.5 + np.cos(t)) * np.cos(t), (0.5 + np.cos(t)) * np.sin(t)], axis=1)  # inner loop
     circle = np.stack([np.cos(t), np.sin(t)], axis=1)
     assert not profile_is_simple(limacon) and profile_is_simple(circle)
+
+
+def test_carrier_part_groups_and_cli(tmp_path, monkeypatch):
+    """`flexrv mesh rv40e --part carrier --json`: every interface group meshed
+    (crank bores per plate, flange, seats, pillars), the bores on the crank circle
+    a_w at 2 pi k / N; --compliance is refused for parts without a condensation."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from flexrv.cli import app
+
+    monkeypatch.setenv("FLEXRV_CACHE_DIR", str(tmp_path))
+    rv = load("rv40e")
+    r = CliRunner().invoke(app, ["mesh", "rv40e", "--part", "carrier", "--size", "8", "--json"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.output)
+    n = rv.first_stage.n_planets
+    expected = {f"bore_{p}_{k}" for p in ("in", "out") for k in range(1, n + 1)} | {
+        "flange", "seat_in", "seat_out", "pillar", "center_bore"}
+    assert expected <= set(data["groups"]) and all(data["groups"][g] > 0 for g in expected)
+    d = MeshData.load_npz(data["msh"].replace(".msh", ".npz"))
+    spec = spec_for(rv, "carrier")
+    for k in range(n):
+        x = d.nodes[d.node_set(f"bore_in_{k + 1}")]
+        c = 0.5 * (x[:, :2].max(axis=0) + x[:, :2].min(axis=0))  # bore axis (bounding-box centre)
+        assert np.hypot(*c) == pytest.approx(spec.crank_circle_radius, rel=1e-4)
+        assert np.arctan2(c[1], c[0]) % (2 * np.pi) == pytest.approx(2 * np.pi * k / n, abs=1e-4)
+    bad = CliRunner().invoke(app, ["mesh", "rv40e", "--part", "crankshaft", "--compliance"])
+    assert isinstance(bad.exception, InputError) and "--compliance" in str(bad.exception)  # exit 2 via flexrv.cli.main

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 from pathlib import Path
 from typing import Optional
 
@@ -19,6 +20,7 @@ class Part(str, enum.Enum):
     inner_ring = "inner_ring"
     crankshaft = "crankshaft"
     cycloid_disc = "cycloid_disc"
+    carrier = "carrier"
 
 
 PART_OPT = typer.Option(..., "--part", help="Part to mesh.", case_sensitive=True)
@@ -29,13 +31,23 @@ def _size_m(size_mm: Optional[float]) -> Optional[float]:
     return None if size_mm is None else size_mm * 1e-3
 
 
+COMPLIANCE_HELP = ("carrier / cycloid_disc: also condense the part (FE) and print its torsional compliance at the "
+                   "output (carrier: flange held, crank bores loaded by the torque path; disc: crank holes held, pin "
+                   "loads at the rated torque, mean over 6 crank angles of one crank-hole period).")
+
+
 def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
-         size: Optional[float] = SIZE_OPT, json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+         size: Optional[float] = SIZE_OPT, json: bool = typer.Option(False, "--json", help=JSON_HELP),
+         compliance: bool = typer.Option(False, "--compliance", help=COMPLIANCE_HELP)) -> None:
     """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
+    from flexrv.errors import InputError
     from flexrv.meshing import build_mesh
 
-    res = build_mesh(load(preset), part.value, _size_m(size))
+    if compliance and part.value not in ("carrier", "cycloid_disc"):
+        raise InputError(f"--compliance: only for --part carrier or cycloid_disc, not {part.value}")
+    reducer = load(preset)
+    res = build_mesh(reducer, part.value, _size_m(size))
     d = res.data
     data = {"part": part.value, "msh": str(res.msh_path), "vtu": str(res.vtu_path), "cached": res.cached,
             "nodes": d.n_nodes, "elements": d.n_elements, "element_type": "tetra10",
@@ -43,6 +55,24 @@ def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_
             "groups": {g: int(len(d.node_set(g))) for g in d.group_names}}
     if "profile_deviation_m" in d.info:
         data["profile_deviation_um"] = d.info["profile_deviation_m"] * 1e6
+    if compliance:
+        from flexrv.units import RAD_PER_ARCMIN
+
+        if part.value == "carrier":
+            from flexrv.fem.carrier import carrier_compliance
+
+            c = carrier_compliance(reducer, size=_size_m(size))
+            data["torsional_compliance_rad_per_Nm"] = c.torsional
+            data["torsional_stiffness_Nm_per_arcmin"] = c.torsional_stiffness_Nm_per_arcmin
+            data["rigid_bore_stiffness_Nm_per_arcmin"] = RAD_PER_ARCMIN / c.torsional_rbe2
+        else:
+            from flexrv.fem.disc import disc_compliance_sweep
+
+            c = disc_compliance_sweep(reducer, size=_size_m(size))
+            data["crank_angles_deg"] = [round(math.degrees(a), 6) for a in c.angles]
+            data["one_disc_compliance_rad_per_Nm"] = c.torsional
+            data["torsional_compliance_rad_per_Nm"] = c.output_share
+            data["torsional_stiffness_Nm_per_arcmin"] = c.output_stiffness_Nm_per_arcmin
 
     def render(x):
         rows = [(k, v, "") for k, v in x.items() if k != "groups"]

@@ -354,6 +354,122 @@ class MainBearing(_Strict):
         return self.contact_angle_deg * RAD_PER_DEG
 
 
+#: thinnest ligament [mm] left between two holes of the carrier, or between a hole
+#: and a plate edge: below it the parts touch (the geometry self-intersects) or a
+#: Tet10 mesh of the part cannot resolve the wall. A check constant, not a physical
+#: estimate.
+MIN_LIGAMENT_MM = 1.0
+
+
+class Carrier(_Strict):
+    """Carrier of the second stage: two end plates (input side and output flange)
+    joined by pillars that pass through the cycloid discs; each plate has one bore
+    per crankshaft for its support bearing, on the crank circle a_w. Pillar k sits at
+    the angle pi/N_p + 2 pi k/N_p (midway between the cranks when N_p = N), the
+    cranks at 2 pi k/N (the disc's crank holes). The plates' rims seat the main
+    bearing; the output plate's outer face is the output flange."""
+
+    plate_outer_diameter_mm: float = Field(gt=10.0, le=3000.0, description="End-plate outer diameter = main-bearing inner-ring seat [mm]")
+    input_plate_thickness_mm: float = Field(gt=1.0, le=300.0, description="Axial thickness of the input-side end plate [mm]")
+    output_plate_thickness_mm: float = Field(gt=1.0, le=300.0, description="Axial thickness of the output-flange plate [mm]")
+    plate_gap_mm: float = Field(gt=1.0, le=1000.0, description="Axial gap between the plates (disc stack + clearances) [mm]")
+    crank_bore_diameter_mm: float = Field(gt=1.0, le=600.0, description="Bore of a crank support-bearing seat in a plate [mm]")
+    center_bore_diameter_mm: float = Field(ge=0.0, le=2000.0, description="Central through-bore (input shaft) [mm]; 0 = none")
+    pillar_count: int = Field(ge=2, le=12, description="Number of pillars N_p [-]")
+    pillar_circle_radius_mm: float = Field(gt=1.0, le=1500.0, description="Radius of the pillar-centre circle [mm]")
+    pillar_diameter_mm: float = Field(gt=1.0, le=600.0, description="Diameter of a (round) pillar [mm]")
+
+    def pillar_angles(self) -> list[float]:
+        """Angles [rad] of the pillar centres."""
+        n = self.pillar_count
+        return [math.pi / n + 2.0 * math.pi * k / n for k in range(n)]
+
+    @model_validator(mode="after")
+    def _fits(self) -> "Carrier":
+        lig = MIN_LIGAMENT_MM
+        r_o, r_c = 0.5 * self.plate_outer_diameter_mm, 0.5 * self.center_bore_diameter_mm
+        rp, rc_p = 0.5 * self.pillar_diameter_mm, self.pillar_circle_radius_mm
+        if rc_p + rp + lig > r_o:
+            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
+                       f"must be <= {r_o - rp - lig:.4g} mm (plate_outer_diameter_mm / 2 = {r_o:g} mm - pillar radius {rp:g} mm "
+                       f"- ligament {lig:g} mm)", "the pillars would stick out of the plates")
+        if r_c > 0 and rc_p - rp - lig < r_c:
+            raise _bad("carrier.center_bore_diameter_mm", self.center_bore_diameter_mm,
+                       f"must be <= {2 * (rc_p - rp - lig):.4g} mm (pillar_circle_radius_mm = {rc_p:g}, pillar_diameter_mm = "
+                       f"{self.pillar_diameter_mm:g})",
+                       "the centre bore would cut the pillars")
+        spacing = 2.0 * rc_p * math.sin(math.pi / self.pillar_count)
+        if spacing < 2.0 * rp + lig:
+            raise _bad("carrier.pillar_diameter_mm", self.pillar_diameter_mm,
+                       f"must be <= {spacing - lig:.4g} mm for pillar_count = {self.pillar_count} on pillar_circle_radius_mm = {rc_p:g}",
+                       "neighbouring pillars would overlap")
+        return self
+
+    def validate_for(self, reducer) -> None:
+        """Checks against the rest of the design (raised as ValueError naming the
+        carrier field): bores on the crank circle inside the plates, apart from each
+        other, around the support journals; pillars clear of the bores; the pillars'
+        holes in the discs (pillar radius + eccentricity) inside the disc between its
+        crank holes, centre hole and tooth root; the discs between the plates; the
+        plates inside the main bearing's inner ring."""
+        lig = MIN_LIGAMENT_MM
+        fs, ss, cs = reducer.first_stage, reducer.second_stage, reducer.crankshaft
+        a_w = fs.center_distance * 1e3
+        n = fs.n_planets
+        r_o, r_b = 0.5 * self.plate_outer_diameter_mm, 0.5 * self.crank_bore_diameter_mm
+        if self.crank_bore_diameter_mm <= cs.support_journal_diameter_mm:
+            raise _bad("carrier.crank_bore_diameter_mm", self.crank_bore_diameter_mm,
+                       f"must be > crankshaft.support_journal_diameter_mm = {cs.support_journal_diameter_mm:g} mm",
+                       "the support bearing sits between journal and bore")
+        if n > 1 and 2.0 * a_w * math.sin(math.pi / n) < 2.0 * r_b + lig:
+            raise _bad("carrier.crank_bore_diameter_mm", self.crank_bore_diameter_mm,
+                       f"must be <= {2.0 * a_w * math.sin(math.pi / n) - lig:.4g} mm for {n} bores on the crank "
+                       f"circle a_w = {a_w:.4g} mm", "neighbouring crank bores would overlap")
+        if a_w + r_b + lig > r_o:
+            raise _bad("carrier.plate_outer_diameter_mm", self.plate_outer_diameter_mm,
+                       f"must be >= {2 * (a_w + r_b + lig):.4g} mm (crank circle {a_w:.4g} mm + crank_bore_diameter_mm / 2 = "
+                       f"{r_b:g} mm + ligament {lig:g} mm)", "the crank bores would cut the plate rim")
+        if self.center_bore_diameter_mm > 0 and 0.5 * self.center_bore_diameter_mm + lig > a_w - r_b:
+            raise _bad("carrier.center_bore_diameter_mm", self.center_bore_diameter_mm,
+                       f"must be <= {2 * (a_w - r_b - lig):.4g} mm", "the centre bore would cut the crank bores")
+        rp, rc_p = 0.5 * self.pillar_diameter_mm, self.pillar_circle_radius_mm
+        e = ss.eccentricity_mm
+        r_hole = reducer.crank_hole_radius * 1e3
+        for ang in self.pillar_angles():
+            for k in range(n):
+                psi = 2.0 * math.pi * k / n
+                dist = math.sqrt(max(rc_p**2 + a_w**2 - 2.0 * rc_p * a_w * math.cos(ang - psi), 0.0))
+                if dist < rp + r_b + lig:
+                    raise _bad("carrier.pillar_circle_radius_mm", rc_p,
+                               f"a pillar (pillar_diameter_mm = {self.pillar_diameter_mm:g}) at {math.degrees(ang):.4g} deg is {dist:.4g} mm from the "
+                               f"crank bore at {math.degrees(psi):.4g} deg; need >= {rp + r_b + lig:.4g} mm",
+                               "pillar and crank bore would intersect")
+                if dist < rp + e + r_hole + lig:
+                    raise _bad("carrier.pillar_diameter_mm", self.pillar_diameter_mm,
+                               f"the pillar's hole in the disc (pillar radius + eccentricity {rp + e:.4g} mm) comes "
+                               f"within {dist - rp - e - r_hole:.3g} mm of the disc's crank hole; need >= {lig:g} mm",
+                               "pillar hole and crank hole of the disc would intersect")
+        r_root = ss.pin_circle_radius_mm - ss.pin_radius_mm - e
+        if rc_p + rp + e + lig > r_root:
+            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
+                       f"must be <= {r_root - rp - e - lig:.4g} mm: the pillar's hole in the disc (pillar_diameter_mm / 2 + "
+                       f"eccentricity = {rp + e:.4g} mm) "
+                       f"must stay inside the disc root radius {r_root:.4g} mm", "the pillars would cut the disc teeth")
+        if ss.center_hole_radius_mm > 0 and rc_p - rp - e - lig < ss.center_hole_radius_mm:
+            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
+                       f"must be >= {ss.center_hole_radius_mm + rp + e + lig:.4g} mm (disc centre hole "
+                       f"{ss.center_hole_radius_mm:g} mm, pillar_diameter_mm = {self.pillar_diameter_mm:g})", "the pillar holes would cut the disc's centre hole")
+        stack = ss.n_discs * ss.disc_width_mm
+        if self.plate_gap_mm < stack:
+            raise _bad("carrier.plate_gap_mm", self.plate_gap_mm,
+                       f"must be >= n_discs x disc_width = {stack:g} mm", "the discs run between the plates")
+        bore = reducer.main_bearing.inner_ring_bore_diameter_mm
+        if self.plate_outer_diameter_mm > bore:
+            raise _bad("carrier.plate_outer_diameter_mm", self.plate_outer_diameter_mm,
+                       f"must be <= main_bearing.inner_ring_bore_diameter_mm = {bore:g} mm",
+                       "the main bearing's inner ring sits on the plate rim")
+
+
 class Material(_Strict):
     """Isotropic linear-elastic material."""
 
@@ -483,6 +599,16 @@ class Reducer(_Strict):
     operating: OperatingPoint
     errors: ManufacturingErrors = Field(default_factory=ManufacturingErrors,
                                         description="Manufacturing and assembly errors (all zero: ideal reducer)")
+    carrier: Carrier | None = Field(default=None, description="Carrier geometry (end plates, pillars, crank bores); "
+                                                              "optional: the carrier FE needs it")
+
+    @model_serializer(mode="wrap")
+    def _omit_absent_carrier(self, handler):
+        """A design without a [carrier] table dumps without the key (TOML has no null)."""
+        data = handler(self)
+        if isinstance(data, dict) and data.get("carrier", 0) is None:
+            data.pop("carrier")
+        return data
 
     def material(self, part: str) -> Material:
         """Material of a part (``gears``, ``crankshaft``, ``cycloid_disc``, ...)."""
@@ -540,5 +666,7 @@ class Reducer(_Strict):
                        f"must be > {2 * r_crank_out:.4g} mm: the main-bearing pitch circle must lie outside the "
                        f"crank-hole circle (crank circle radius {a_w * 1e3:.4g} mm + crank hole radius "
                        f"{r_hole * 1e3:.4g} mm)", "the main bearing would sit inside the crank circle")
+        if self.carrier is not None:
+            self.carrier.validate_for(self)
         self.errors.validate_for(self)  # list lengths vs z_rp / N / n_discs, clearances, assembly interference
         return self

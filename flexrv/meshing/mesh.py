@@ -124,7 +124,8 @@ def default_max_nodes() -> int:
 
 
 def _apply_size_field(gmsh, spec, groups: dict, size: float, local: float) -> None:
-    """Global size ``size``; ``local`` on the raceway (rings) or the profile (disc)."""
+    """Global size ``size``; ``local`` on the raceway (rings), the profile (disc) or
+    the pillars (carrier)."""
     opt = gmsh.option
     opt.setNumber("Mesh.MeshSizeMax", size)
     opt.setNumber("Mesh.MeshSizeMin", 0.2 * local)
@@ -138,6 +139,9 @@ def _apply_size_field(gmsh, spec, groups: dict, size: float, local: float) -> No
     if isinstance(spec, P.RingSpec):
         fld.setNumbers(dist, "SurfacesList", groups["raceway"])
         reach = spec.groove_radius
+    elif isinstance(spec, P.CarrierSpec):
+        fld.setNumbers(dist, "SurfacesList", groups["pillar"])
+        reach = spec.pillar_radius
     else:
         curves = {t for f in groups["profile"] for _, t in gmsh.model.getBoundary([(2, f)], oriented=False)}
         fld.setNumbers(dist, "CurvesList", sorted(curves))

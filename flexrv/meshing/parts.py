@@ -9,7 +9,10 @@ surface groups ``{name: [surface tags]}``.
 Coordinate conventions (metres): the part axis is z; rings span
 z in [-width/2, width/2] about their row's ball-centre plane (one row; the model
 mirrors it for the other row); the crankshaft starts at z = 0 with the gear seat;
-the cycloid disc spans z in [-b/2, b/2] with its centre at the origin.
+the cycloid disc spans z in [-b/2, b/2] with its centre at the origin; the
+carrier's input plate spans z in [0, t_in], the plate gap [t_in, t_in + L] and the
+output (flange) plate [t_in + L, t_in + L + t_out], crank k at the angle 2 pi k / N
+on the crank circle (as the disc's crank holes).
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ import numpy as np
 
 from flexrv.errors import InputError
 
-PARTS = ("outer_ring", "inner_ring", "crankshaft", "cycloid_disc")
+PARTS = ("outer_ring", "inner_ring", "crankshaft", "cycloid_disc", "carrier")
 
 #: Tet10 nodes per unit volume ~ C / h^3 for the memory guard. gmsh 4.15 gives
 #: C = 10..14 on the ring meshes; with the refinement terms the estimate is
@@ -143,6 +146,53 @@ class CycloidDiscSpec:
         return min(size, self.tooth_pitch / 8.0)
 
 
+@dataclass(frozen=True)
+class CarrierSpec:
+    """Carrier: two end plates joined by round pillars, crank bores through both
+    plates, optional centre bore (from :class:`flexrv.design.model.Carrier`)."""
+
+    plate_radius: float
+    input_thickness: float
+    output_thickness: float
+    gap: float
+    crank_circle_radius: float
+    crank_bore_radius: float
+    n_cranks: int
+    center_bore_radius: float
+    pillar_circle_radius: float
+    pillar_radius: float
+    pillar_angles: tuple[float, ...]
+
+    @property
+    def length(self) -> float:
+        """Overall axial length [m]."""
+        return self.input_thickness + self.gap + self.output_thickness
+
+    def crank_angles(self) -> tuple[float, ...]:
+        return tuple(2.0 * math.pi * k / self.n_cranks for k in range(self.n_cranks))
+
+    def volume(self) -> float:
+        plates = (math.pi * (self.plate_radius**2 - self.center_bore_radius**2 - self.n_cranks * self.crank_bore_radius**2)
+                  * (self.input_thickness + self.output_thickness))
+        return plates + len(self.pillar_angles) * math.pi * self.pillar_radius**2 * self.gap
+
+    def default_size(self) -> float:
+        """Default global mesh size [m]: a third of the thinnest plate, at most the
+        thinnest ligament around a crank bore."""
+        return min(min(self.input_thickness, self.output_thickness) / 3.0, self.min_feature())
+
+    def pillar_size(self, size: float) -> float:
+        """Mesh size on the pillars [m]: <= half the pillar radius (beam bending
+        of the pillars is the carrier's main compliance)."""
+        return min(size, 0.5 * self.pillar_radius)
+
+    def min_feature(self) -> float:
+        """Smallest wall [m]: plate thickness, ligaments around the crank bores."""
+        lig = min(self.plate_radius - self.crank_circle_radius - self.crank_bore_radius,
+                  self.crank_circle_radius - self.crank_bore_radius - self.center_bore_radius)
+        return min(self.input_thickness, self.output_thickness, lig)
+
+
 def spec_for(reducer, part: str):
     """Geometry spec of ``part`` of ``reducer`` (SI).
 
@@ -179,6 +229,18 @@ def spec_for(reducer, part: str):
                                width=ss.disc_width, crank_circle_radius=reducer.first_stage.center_distance,
                                crank_hole_radius=reducer.crank_hole_radius, n_crank_holes=reducer.first_stage.n_planets,
                                center_hole_radius=ss.center_hole_radius)
+    if part == "carrier":
+        c = reducer.carrier
+        if c is None:
+            raise InputError(f"design {reducer.name!r} has no [carrier] table: the carrier part needs its geometry "
+                             "(plate diameter and thicknesses, gap, crank bores, pillars; see the rv40e preset)")
+        return CarrierSpec(plate_radius=0.5e-3 * c.plate_outer_diameter_mm, input_thickness=1e-3 * c.input_plate_thickness_mm,
+                           output_thickness=1e-3 * c.output_plate_thickness_mm, gap=1e-3 * c.plate_gap_mm,
+                           crank_circle_radius=reducer.first_stage.center_distance,
+                           crank_bore_radius=0.5e-3 * c.crank_bore_diameter_mm, n_cranks=reducer.first_stage.n_planets,
+                           center_bore_radius=0.5e-3 * c.center_bore_diameter_mm,
+                           pillar_circle_radius=1e-3 * c.pillar_circle_radius_mm, pillar_radius=0.5e-3 * c.pillar_diameter_mm,
+                           pillar_angles=tuple(c.pillar_angles()))
     raise InputError(f"part = {part!r} is not a known part: choose one of {', '.join(PARTS)}")
 
 
@@ -235,6 +297,15 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
         local = spec.profile_size(size)
         band = 2.0 * math.pi * spec.pin_circle_radius * spec.width * 4.0 * spec.eccentricity
         est_local = NODE_DENSITY * band / local**3
+    elif isinstance(spec, CarrierSpec):
+        limit = spec.min_feature()
+        if limit <= 0:
+            raise InputError("carrier: a crank bore cuts the plate rim or the centre bore; the geometry self-intersects")
+        if size > limit:
+            raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the carrier: must be <= "
+                             f"{limit * 1e3:.4g} mm (thinnest plate or ligament around a crank bore)")
+        local = spec.pillar_size(size)
+        est_local = NODE_DENSITY * len(spec.pillar_angles) * math.pi * spec.pillar_radius**2 * spec.gap / local**3
     else:  # pragma: no cover - spec_for guards the type
         raise InputError(f"unknown spec {type(spec).__name__}")
     est = int(NODE_DENSITY * spec.volume() / size**3 + est_local)
@@ -456,5 +527,57 @@ def _seg_dist(p, a, b):
     return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
 
 
+def build_carrier(gmsh, spec: CarrierSpec, size: float) -> dict[str, list[int]]:
+    """Input plate + pillars + output plate fused, minus the crank bores and the
+    centre bore. Groups: ``bore_in_<k>`` / ``bore_out_<k>`` (crank support-bearing
+    seats of crank k in the input / output plate), ``flange`` (outer face of the
+    output plate), ``seat_in`` / ``seat_out`` (plate rims, main-bearing seats),
+    ``pillar`` (pillar lateral faces), ``center_bore`` and ``side`` (other plane faces)."""
+    occ = gmsh.model.occ
+    t_in, gap, t_out = spec.input_thickness, spec.gap, spec.output_thickness
+    total = spec.length
+    plate_in = occ.addCylinder(0, 0, 0, 0, 0, t_in, spec.plate_radius)
+    plate_out = occ.addCylinder(0, 0, t_in + gap, 0, 0, t_out, spec.plate_radius)
+    pillars = [(3, occ.addCylinder(spec.pillar_circle_radius * math.cos(a), spec.pillar_circle_radius * math.sin(a),
+                                   t_in, 0, 0, gap, spec.pillar_radius)) for a in spec.pillar_angles]
+    occ.fuse([(3, plate_in)], [(3, plate_out)] + pillars)
+    tools = [(3, occ.addCylinder(spec.crank_circle_radius * math.cos(a), spec.crank_circle_radius * math.sin(a), -total,
+                                 0, 0, 3 * total, spec.crank_bore_radius)) for a in spec.crank_angles()]
+    if spec.center_bore_radius > 0:
+        tools.append((3, occ.addCylinder(0, 0, -total, 0, 0, 3 * total, spec.center_bore_radius)))
+    occ.cut(occ.getEntities(3)[:1], tools)
+    occ.synchronize()
+    vol = _single_volume(gmsh, "carrier")
+    cranks = [(k + 1, spec.crank_circle_radius * math.cos(a), spec.crank_circle_radius * math.sin(a))
+              for k, a in enumerate(spec.crank_angles())]
+    groups: dict[str, list[int]] = {f"bore_{p}_{k}": [] for p in ("in", "out") for k, _, _ in cranks}
+    groups.update({"flange": [], "seat_in": [], "seat_out": [], "pillar": [], "side": []})
+    if spec.center_bore_radius > 0:
+        groups["center_bore"] = []
+    tol = 1e-3 * min(t_in, gap, t_out)  # OCC bounding boxes are inflated by the geometric tolerance
+    for tag in _faces_of(gmsh, vol):
+        xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(2, tag)
+        zc = 0.5 * (zmin + zmax)
+        plate = "in" if zc < t_in + 0.5 * gap else "out"
+        if gmsh.model.getType(2, tag) == "Plane":
+            groups["flange" if abs(zmin - total) < tol and abs(zmax - total) < tol else "side"].append(tag)
+            continue
+        x, y, _ = gmsh.model.occ.getCenterOfMass(2, tag)
+        half = 0.5 * max(xmax - xmin, ymax - ymin)
+        if zmin > t_in - tol and zmax < t_in + gap + tol:
+            groups["pillar"].append(tag)
+        elif abs(half - spec.plate_radius) < 1e-3 * spec.plate_radius and math.hypot(x, y) < 0.5 * spec.plate_radius:
+            groups[f"seat_{plate}"].append(tag)
+        elif spec.center_bore_radius > 0 and math.hypot(x, y) < 0.5 * spec.center_bore_radius:
+            groups["center_bore"].append(tag)
+        else:
+            k = min(cranks, key=lambda c: math.hypot(x - c[1], y - c[2]))[0]
+            groups[f"bore_{plate}_{k}"].append(tag)
+    missing = [k for k, v in groups.items() if not v]
+    if missing:
+        raise InputError(f"carrier: surfaces {missing} not found; the plates, pillars and bores intersect wrongly")
+    return groups
+
+
 BUILDERS = {"outer_ring": build_ring, "inner_ring": build_ring, "crankshaft": build_crankshaft,
-            "cycloid_disc": build_cycloid_disc, "plain_ring": build_plain_ring, "shaft": build_crankshaft}
+            "cycloid_disc": build_cycloid_disc, "carrier": build_carrier, "plain_ring": build_plain_ring, "shaft": build_crankshaft}
