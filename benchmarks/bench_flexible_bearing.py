@@ -1,7 +1,7 @@
 """Benchmark: the main-bearing subsystem (2 rows x Z balls) in a dynamic Exudyn run.
 
 A rigid carrier frame (NodeRigidBodyRxyz) turns at the preset's output speed and
-carries seed 001's first external load case (axial 15 kN, radial 20 kN), ramped
+carries :cite:`seed001`'s first external load case (axial 15 kN, radial 20 kN), ramped
 in smoothly (a sudden 35 kN step costs ~8 Newton iterations per step); the rings
 are rigid or reduced flexible outer rings (:func:`flexrv.fem.body.reduce_part`),
 condensed into the row elements (default) or with their modal coordinates as

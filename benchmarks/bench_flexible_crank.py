@@ -1,6 +1,6 @@
 """Wall time per simulated second: rv40e with rigid vs flexible crankshafts.
 
-Runs the seed 002 drive (1215 r/min ramp, 412 N m load ramp) for ``T_END`` s with
+Runs the :cite:`seed002` drive (1215 r/min ramp, 412 N m load ramp) for ``T_END`` s with
 each model (same dt), after building the model once untimed so that the FE
 condensation of the crankshaft (cached under flexrv.cache.cache_dir()) is not in
 the figure; the cold condensation time is printed separately.
@@ -34,7 +34,7 @@ def main(t_end: float = T_END) -> dict:
         res = sim.run(t_end=t_end)
         wall = time.perf_counter() - t0
         out[label] = {"wall_s": wall, "wall_per_simulated_s": wall / t_end, "steps": int(len(res.time))}
-    print(f"rv40e, t_end = {t_end:g} s (seed 002 drive); crank FE condensation cold: {cold:.2f} s "
+    print(f"rv40e, t_end = {t_end:g} s (seed002 drive); crank FE condensation cold: {cold:.2f} s "
           f"(k_t = {comp.torsional:.4g} N m/rad, lowest clamped mode {comp.lowest_clamped_hz:.4g} Hz)")
     for label in ("rigid crank", "flexible crank"):
         o = out[label]

@@ -31,7 +31,7 @@ SECTIONS: dict[str, dict[str, str]] = {
                    "film with the reducer dynamics (RV reducer of total ratio 221; z_s = 12, z_p = 44, "
                    "z_c = 59, z_rp = 60; input 9000 deg/s). Authors not given.",
         "seed001": "Seed study 001: influence of the flexibility and lubrication of thin-walled main bearings "
-                   "on the transmission error of RV reducers (same RV reducer of ratio 221 as seed 000; "
+                   "on the transmission error of RV reducers (same RV reducer of ratio 221 as seed000; "
                    "ring deformation, oil-film thickness and pressure). Authors not given.",
         "seed002": "Seed study 002: dynamic characteristics of the rotary vector reducer by rigid-flexible "
                    "coupling: parameterised 3-D model, flexible crankshaft (modal neutral file) in a "

@@ -533,7 +533,7 @@ def _progress_callback(progress, t_end):
 def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = 0.02, settle: float = 0.005,
                    dt: float = DEFAULT_DT, torque: float | None = None, progress: bool | Callable = False,
                    save_to: str | Path | None = None, model_options: dict | None = None):
-    """Virtual torsional-stiffness test bench (seed 004): input locked, output
+    """Virtual torsional-stiffness test bench (:cite:`seed004`): input locked, output
     torque ramped 0 -> +T -> -T -> 0 (T = rated torque unless given), each
     quarter of the loop over ``quarter_time`` [s] (quasi-static: far longer than
     the output's torsional period, ~1 ms for both presets).

@@ -18,7 +18,7 @@ def rv40e_report():
 
 
 def test_report_numbers_rv40e(rv40e_report):
-    """Seed 002 Table 4 frequencies, ratio 81, torque balance of the pin loads and
+    """:cite:`seed002` Table 4 frequencies, ratio 81, torque balance of the pin loads and
     C_W = series(C_Hc, C_c) inside the report."""
     rep = rv40e_report
     f = rep["kinematics"]["frequencies_Hz"]

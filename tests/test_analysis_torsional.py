@@ -1,4 +1,4 @@
-"""Seed 004 torsional model: needle stiffness, force split, series model, meshing zone."""
+""":cite:`seed004` torsional model: needle stiffness, force split, series model, meshing zone."""
 
 import numpy as np
 import pytest
@@ -12,7 +12,7 @@ from flexrv.errors import InputError
 
 
 def test_needle_stiffness_units():
-    """K_Hc = 0.34e4 F^0.1 Z^0.9 l^0.8 [N/mm, N, mm] (seed 004): F = 1000 N, Z = 15,
+    """K_Hc = 0.34e4 F^0.1 Z^0.9 l^0.8 [N/mm, N, mm] (:cite:`seed004`): F = 1000 N, Z = 15,
     l = 10 mm -> 0.34e4 * 1000^0.1 * 15^0.9 * 10^0.8 N/mm, converted *1e3 to N/m (1e-12)."""
     ref = 0.34e4 * 1000**0.1 * 15**0.9 * 10**0.8 * 1e3
     assert np.isclose(needle_radial_stiffness(1000.0, 15, 0.010), ref, rtol=1e-12)
@@ -54,7 +54,7 @@ def test_stiffness_grows_with_pins_and_bearing_stiffness():
 
 
 def test_seed004_table_identification():
-    """Seed 004's table and target C_c = 6.24e8 N mm/rad: best 4-pin set = pins 6-9
+    """:cite:`seed004`'s table and target C_c = 6.24e8 N mm/rad: best 4-pin set = pins 6-9
     (sum 6.32e8, as the seed states); over all set sizes pins 9-15 (6.303e8) is closer."""
     z = identify_meshing_zone(SEED004_KTC_NMM, SEED004_CC_NMM, np.radians(np.arange(21) * 9.0))
     assert z.best_by_count[4][:2] == (6, 9) and np.isclose(z.best_by_count[4][2], 6.32e8)
@@ -110,8 +110,8 @@ def test_stepped_shaft_bad_input():
 def test_stiffness_budget_elements():
     """Analytic budget of rv40e at the rated torque: the elements sum to the total,
     the shares to 1; the crank-bending element is exactly 1 / (N a_w^2 k_b) with
-    the Timoshenko k_b, the pins are seed 004's C_c (tangent) of
-    second_stage_stiffness, the needles bounded by seed 004's C_Hc (see below);
+    the Timoshenko k_b, the pins are :cite:`seed004`'s C_c (tangent) of
+    second_stage_stiffness, the needles bounded by :cite:`seed004`'s C_Hc (see below);
     with the linear legacy support law (rigid crank)
     the support element is exactly 1 / (N a_w^2 2 k_sb)."""
     from flexrv.analysis.torsional import crank_bending, stiffness_budget
@@ -127,7 +127,7 @@ def test_stiffness_budget_elements():
     st = second_stage_stiffness(r, r.operating.rated_torque_Nm)
     assert b.compliances["pins"] == pytest.approx(1.0 / st.c_mesh_tangent, rel=1e-12)
     # needles without clearance: across its load a bearing is F/delta = 0.9 K_Hc stiff, so the
-    # direction-resolved element lies between seed 004's 1/C_Hc and 1/(0.9 C_Hc); the clearance softens it
+    # direction-resolved element lies between :cite:`seed004`'s 1/C_Hc and 1/(0.9 C_Hc); the clearance softens it
     tight = stiffness_budget(override(r, {"needle_bearing.radial_clearance_um": 0.0}))
     assert 1.0 / st.c_bearings < tight.compliances["needle_bearings"] < 1.0 / (0.9 * st.c_bearings)
     assert b.compliances["needle_bearings"] > tight.compliances["needle_bearings"]

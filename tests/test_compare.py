@@ -54,7 +54,7 @@ def test_compare_writes_everything_and_numbers_match_netcdf(compared):
         numbers["flexible"]["te_pp_arcsec"] - numbers["rigid"]["te_pp_arcsec"])
     text = (out / "summary.md").read_text()
     # rv40e is not the seeds' reducer (rv221): no seed TE values, no prose about them
-    assert "-25.2" not in text and "seed 000/001 TE range" not in text and "No seed reference" in text
+    assert "-25.2" not in text and "seed000/seed001 TE range" not in text and "No seed reference" in text
     assert numbers["seed"] is None
 
 

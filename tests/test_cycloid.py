@@ -1,8 +1,8 @@
 """Cycloid-disc geometry: exact pin gap, curvature, moment arms, pin stiffness.
 
 References: Litvin & Fuentes, Gear Geometry and Applied Theory (2004) ch. 19
-(conjugate action of the pin-centre epitrochoid); seed 000 (moment arm l_i,
-k_ni, k34); seed 004 (profile curvature radius, K_cj).
+(conjugate action of the pin-centre epitrochoid); :cite:`seed000` (moment arm l_i,
+k_ni, k34); :cite:`seed004` (profile curvature radius, K_cj).
 """
 
 import numpy as np
@@ -14,7 +14,7 @@ from flexrv.geometry.cycloid import (center_curve_curvature, k34, moment_arm, no
                                      profile_curvature_radius, profile_points, seed004_curvature_radius,
                                      to_disc_frame)
 
-Z, R, RP, A = 40, 0.064, 0.003, 0.0013  # RV-40E second stage (seed 002 Table 1)
+Z, R, RP, A = 40, 0.064, 0.003, 0.0013  # RV-40E second stage (:cite:`seed002` Table 1)
 
 
 def _pins(chi, z=Z, radius=R, ecc=A):
@@ -105,7 +105,7 @@ def test_equidistant_modification_clearance_pattern():
 
 
 def test_signed_arm_equals_seed000_formula():
-    """(P x n)_z of the exact normal = -l_i of seed 000 with phi_i = psi_i - chi
+    """(P x n)_z of the exact normal = -l_i of :cite:`seed000` with phi_i = psi_i - chi
     (pin angle from the eccentric direction), to 1e-12 m."""
     chi = 1.1
     pins = _pins(chi)
@@ -117,7 +117,7 @@ def test_signed_arm_equals_seed000_formula():
 
 
 def test_curvature_radius_matches_seed004():
-    """Actual profile curvature radius = -rho_i(seed 004) at theta = z_c phi
+    """Actual profile curvature radius = -rho_i(:cite:`seed004`) at theta = z_c phi
     (unmodified profile), relative 1e-9; and the curvature from a finite-difference
     circle fit of profile_points agrees (1e-4 relative) on the convex flank."""
     phi = np.linspace(0.003, 2 * np.pi / (Z - 1) - 0.003, 57)
@@ -135,7 +135,7 @@ def test_curvature_radius_matches_seed004():
 
 
 def test_pin_stiffness_models():
-    """Seed 000 k_ni = pi b E'/4 (curvature-free); seed 004 K_cj equals it on the
+    """:cite:`seed000` k_ni = pi b E'/4 (curvature-free); :cite:`seed004` K_cj equals it on the
     convex flank and is smaller (but >= 0) on the concave part."""
     e_eff = 219e9 / (1 - 0.3**2)
     b = 0.012

@@ -88,12 +88,12 @@ def test_seed_values_present():
     assert math.isclose(rv221.operating.input_speed_rpm * 6.0, 9000.0)  # 9000 deg/s
     assert (rv40e.first_stage.sun_teeth, rv40e.first_stage.planet_teeth) == (16, 32)
     assert (rv40e.second_stage.disc_teeth, rv40e.second_stage.pin_count) == (39, 40)
-    assert math.isclose(rv40e.second_stage.shortening_coefficient, 0.8125)  # seed 002 Table 1
+    assert math.isclose(rv40e.second_stage.shortening_coefficient, 0.8125)  # :cite:`seed002` Table 1
     assert rv40e.needle_bearing.roller_count == 15
 
 
 def test_physics_override_of_rv221_pin_circle_is_documented():
-    """R_p = 82.5 mm (seed 000) is rejected by validation; the preset uses 165 mm and says why."""
+    """R_p = 82.5 mm (:cite:`seed000`) is rejected by validation; the preset uses 165 mm and says why."""
     data = _set(RAW["rv221"], ("second_stage", "pin_circle_radius_mm"), 82.5)
     with pytest.raises(ConfigError, match="second_stage.pin_radius_mm"):
         from_dict(data)

@@ -13,7 +13,7 @@ from flexrv.geometry.kinematics import characteristic_frequencies, harmonics, me
 
 
 def test_ratios_exact():
-    """i = 1 + z_p z_rp / (z_s (z_rp - z_c)): 221 (seed 000/001) and 81 (seed 002), exact."""
+    """i = 1 + z_p z_rp / (z_s (z_rp - z_c)): 221 (:cite:`seed000,seed001`) and 81 (:cite:`seed002`), exact."""
     assert total_ratio(12, 44, 59, 60) == 221.0
     assert total_ratio(16, 32, 39, 40) == 81.0
     assert reducer_kinematics(load("rv221")).speeds.ratio == 221.0
@@ -21,10 +21,10 @@ def test_ratios_exact():
 
 
 def test_seed002_table4_frequencies():
-    """Seed 002 Table 4, RV-40E at 1215 r/min: input 20.25, crank rotation 10,
+    """:cite:`seed002` Table 4, RV-40E at 1215 r/min: input 20.25, crank rotation 10,
     carrier 0.25, first-stage mesh 320, cycloid mesh 390, "cycloidal gear"/"pin gear" 400 Hz
     (= pin count x crank rotation) (rel. 1e-12); a disc tooth passes the pins at 40 x 0.25 = 10 Hz.
-    Seed 002's text quotes the crank at 585 r/min: that is the absolute speed
+    :cite:`seed002`'s text quotes the crank at 585 r/min: that is the absolute speed
     (600 r/min relative to the carrier minus the 15 r/min carrier speed)."""
     kin = reducer_kinematics(load("rv40e"), 1215 * RAD_S_PER_RPM)
     f = kin.frequencies
@@ -39,9 +39,9 @@ def test_seed002_table4_frequencies():
 
 
 def test_rv221_planet_speed_vs_seed001():
-    """rv221 at 9000 deg/s: output 9000/221 = 40.724 deg/s (seed 000/001). Planet
+    """rv221 at 9000 deg/s: output 9000/221 = 40.724 deg/s (:cite:`seed000,seed001`). Planet
     speeds: relative to the carrier (9000 - 40.724) * 12/44 = 2443.4 deg/s, absolute
-    2402.7 deg/s. Seed 001 lists 2452.3 deg/s "theoretical": it matches neither;
+    2402.7 deg/s. :cite:`seed001` lists 2452.3 deg/s "theoretical": it matches neither;
     it is within 0.09 % of 9000 * 12/44 = 2454.5 deg/s, the planet speed of a
     FIXED carrier, so the seed's value ignores the carrier rotation (and is itself
     rounded oddly). We keep the exact Willis result."""

@@ -90,7 +90,7 @@ def test_crank_torsional_stiffness_converges_with_the_mesh():
 def test_crank_twist_in_the_reducer_matches_the_torque_path():
     """rv40e at rated torque (412 N m), loaded steady state: each crank transmits
     T_out / (N z_c) (the disc turns 1/z_c per crank revolution relative to the
-    carrier; seed 002 kinematics), within 5 %; the TE shift against the rigid-crank
+    carrier; :cite:`seed002` kinematics), within 5 %; the TE shift against the rigid-crank
     model equals the crank twist seen at the output, twist / z_c, within 10 %; the
     kinematic ratio stays exact in the mean."""
     from flexrv.design import load
@@ -221,7 +221,7 @@ def test_static_crank_twist_is_torque_over_stiffness(locked_runs):
 
 
 def test_stiff_crank_limit_reproduces_rigid_te_in_motion():
-    """Dynamic consistency: rv40e with the seed 002 speed ramp (0 -> 1215 r/min in
+    """Dynamic consistency: rv40e with the :cite:`seed002` speed ramp (0 -> 1215 r/min in
     0.1 s) and the rated torque ramped in over 0.02 s, TE over 0.05-0.1 s. With the
     crank stiffness scaled 1000x the flexible-crank model matches the rigid one:
     mean TE within 1e-4 relative (measured 5e-6), TE peak-to-peak within 10 %

@@ -20,7 +20,7 @@ from tests.test_fem_reduction import fe_patch_deflection
 from tests.test_model_flexible_bearing import _static_rig
 
 SIZE, LOCAL = 0.015, 0.01  # coarse rv221 rings (as tests/test_fem_reduction.py)
-#: seed 001's first external load case: 20 kN radial, 15 kN axial
+#: :cite:`seed001`'s first external load case: 20 kN radial, 15 kN axial
 SEED001_FORCE = (20000.0, 0.0, 15000.0)
 
 
@@ -55,7 +55,7 @@ def _flexible_rows(rv, out, scale=1.0, rings=("inner", "outer"), condense=True, 
 
 @pytest.mark.parametrize("condense", [True, False])
 def test_ring_deflection_under_ball_loads_matches_full_fe(rings, condense):
-    """Seed 001's 20 kN radial + 15 kN axial case: the static bearing with both
+    """:cite:`seed001`'s 20 kN radial + 15 kN axial case: the static bearing with both
     rings flexible (condensed into the row elements, or with their modal
     coordinates as system coordinates) gives ball loads and modal ring
     coordinates (a condensed ring's recovered from its contact loads); the reduced ring's
@@ -197,8 +197,7 @@ def test_stiffened_flexible_reducer_matches_rigid_ring_reducer():
 
 def test_condensed_rings_match_the_uncondensed_formulation(rings):
     """Static condensation (issue 15) against the uncondensed formulation (the
-    rings' massless modal coordinates as system coordinates, same kernel): seed
-    001's 20 kN radial + 15 kN axial case on the standalone bearing, both rings
+    rings' massless modal coordinates as system coordinates, same kernel): :cite:`seed001`'s 20 kN radial + 15 kN axial case on the standalone bearing, both rings
     flexible, both rows. Ball loads and raceway deflections at the contacts agree
     within 1e-6 of their maxima (measured 2e-9 and 2e-8: the local solve's
     tolerance 1e-13 m on ~1 um deflections, and the static solver's), the

@@ -81,7 +81,7 @@ def test_analytic_jacobians(needle):
 
 def test_roller_and_empirical_needle_agree_in_magnitude():
     """The roller-resolved needle bearing (Palmgren per roller, Harris & Kotzalas
-    2007) and the seed 004 empirical law give the same order of radial stiffness:
+    2007) and the :cite:`seed004` empirical law give the same order of radial stiffness:
     force at a 5 um journal offset within a factor 3 of each other (zero clearance)."""
     forces = []
     for needle in ("empirical", "rollers"):
@@ -101,7 +101,7 @@ def g_size(m, g):
 
 
 def test_parameters_physical():
-    """Masses/inertias positive; ratio equals seed 002/000 values (81, 221)."""
+    """Masses/inertias positive; ratio equals :cite:`seed002,seed000` values (81, 221)."""
     for name, ratio in (("rv40e", 81.0), ("rv221", 221.0)):
         p = build_model(load(name)).params
         assert p.ratio == pytest.approx(ratio)

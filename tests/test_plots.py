@@ -85,7 +85,7 @@ def test_pin_force_map_shows_every_disc_aligned(run, tmp_path, captured):
 
 
 def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captured):
-    """A 2 arcsec sine at the rv40e cycloid-mesh frequency (390 Hz at 1215 r/min, seed 002):
+    """A 2 arcsec sine at the rv40e cycloid-mesh frequency (390 Hz at 1215 r/min, :cite:`seed002`):
     the plotted peak is 2 +- 0.1 arcsec; labels are words, not snake_case; the title states
     the window (0.3 s) and resolution (1/0.3 s); the log axis spans 4 decades, not 1e-9..1."""
     import xarray as xr

@@ -22,7 +22,7 @@ def short_run():
 
 def test_results_access_by_label(short_run):
     """res["TE [arcsec]"] and res["te"] are the same DataArray with units and the
-    time coordinate; TE = theta_out - theta_in / i in arcsec (seed 000)."""
+    time coordinate; TE = theta_out - theta_in / i in arcsec (:cite:`seed000`)."""
     res = short_run
     te = res["TE [arcsec]"]
     assert te.attrs["units"] == "arcsec" and "time" in te.coords
@@ -49,7 +49,7 @@ def test_save_load_roundtrip(short_run, tmp_path):
 
 
 def test_amplitude_spectrum_of_a_sine():
-    """Hann-windowed one-sided spectrum: a 3 arcsec sine at 320 Hz (seed 002's
+    """Hann-windowed one-sided spectrum: a 3 arcsec sine at 320 Hz (:cite:`seed002`'s
     mesh frequency) on a trend shows a 3 +- 0.1 arcsec peak at 320 +- 2 Hz."""
     t = np.arange(0, 0.5, 1e-4)
     f, a = amplitude_spectrum(5.0 * t + 3.0 * np.sin(2 * np.pi * 320 * t), t)

@@ -36,7 +36,7 @@ def rv40e_quarter():
 def test_positions_resolve_the_pin_mesh():
     """K points per cycloid-mesh period: one output revolution of rv40e holds
     z_c * (crank revolutions per output revolution) = 39 * 40 = 1560 mesh
-    periods (seed 002 Table 4: 390 Hz mesh / 0.25 Hz output), so 12,480 positions
+    periods (:cite:`seed002` Table 4: 390 Hz mesh / 0.25 Hz output), so 12,480 positions
     at K = 8, spanning i = 81 input revolutions (exact)."""
     red = load("rv40e")
     th = positions_for(red, output_revolutions=1.0, points_per_mesh=8)

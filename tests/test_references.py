@@ -4,6 +4,7 @@ Citation syntax in code and docstrings: ``:cite:`key``` (several keys: ``:cite:`
 """
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -77,3 +78,27 @@ def test_no_citation_inside_runtime_strings_of_converted_modules():
                     and CITE_PATTERN.search(node.value)):
                 bad.append(f"{path.relative_to(ROOT)}:{node.lineno}")
     assert not bad, bad
+
+
+#: a bare seed citation (":cite:`seed004`", ":cite:`seed000,seed001`"): must be a key (":cite:`seed004`" in
+#: docstrings and comments, the plain key "seed004" in output text and the presets)
+BARE_SEED = re.compile(r"\b[Ss]eeds?\s+00[0-4]\b")
+PACKAGE_TEXTS = sorted(p for p in (ROOT / "flexrv").rglob("*") if p.suffix in (".py", ".toml"))
+
+
+def test_no_bare_seed_citation_in_the_package():
+    """Every seed citation in flexrv/ (code, docstrings, comments, presets) uses a reference
+    key; the pattern catches the old forms."""
+    for old in ("seed004", "seed000/seed001", "(seed002's", "seeds\n 003"):
+        assert BARE_SEED.search(old), old
+    for new in (":cite:`seed004`", "seed000/seed001", "random seed 42", "Seed study 003"):
+        assert not BARE_SEED.search(new), new
+    bare = [f"{p.relative_to(ROOT)}:{p.read_text(encoding='utf-8')[:m.start()].count(chr(10)) + 1}: {m.group(0)!r}"
+            for p in PACKAGE_TEXTS for m in BARE_SEED.finditer(p.read_text(encoding="utf-8"))]
+    assert not bare, "bare seed citations (use :cite:`seed00X` or the key seed00X):\n" + "\n".join(bare)
+
+
+def test_plain_seed_keys_exist():
+    """The plain keys of output text and presets (``seed004``) are keys of the bibliography."""
+    keys = {m.group(0) for p in PACKAGE_TEXTS for m in re.finditer(r"\bseed\d{3}\b", p.read_text(encoding="utf-8"))}
+    assert keys and keys <= set(REFERENCES), keys - set(REFERENCES)

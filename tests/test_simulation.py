@@ -2,9 +2,9 @@
 
 Sources of the reference values:
 * ratio and member speeds: Willis' equation, :mod:`flexrv.geometry.kinematics`
-  (seeds 000-002: i = 1 + z_p z_rp / (z_s (z_rp - z_c)));
+  (:cite:`seed000,seed001,seed002`: i = 1 + z_p z_rp / (z_s (z_rp - z_c)));
 * pin load distribution: initial-clearance method, :mod:`flexrv.analysis.pin_load`;
-* torsional rigidity: seed 004 series model, :mod:`flexrv.analysis.torsional`.
+* torsional rigidity: :cite:`seed004` series model, :mod:`flexrv.analysis.torsional`.
 """
 
 from __future__ import annotations
@@ -137,7 +137,7 @@ def test_failure_is_reported_with_partial_results():
 def test_torsional_rigidity_vs_series_model(name):
     """Virtual stiffness test (input locked, 0 -> +T_r -> -T_r -> 0) vs the analytic
     series model of the torque path (flexrv.analysis.torsional.stiffness_budget:
-    seed 004's C_W = C_Hc C_c / (C_Hc + C_c) with the tangent Palmgren pin stiffness
+    :cite:`seed004`'s C_W = C_Hc C_c / (C_Hc + C_c) with the tangent Palmgren pin stiffness
     at T_r, plus the crank supports, tapered-roller pairs and crank bending in
     series, with the law of the dynamic model). Ideal geometry so that the analytic
     zero-clearance assumptions hold. Tolerance 15 %: the analytic model linearises
@@ -156,11 +156,11 @@ def test_torsional_rigidity_vs_series_model(name):
 
 
 def test_roller_resolved_needle_bearing_option():
-    """needle_bearing.model = "rollers" (seed 003: per-roller Hertz line contacts
-    with clearance) vs "empirical" (seed 004 law): input locked, rated torque
+    """needle_bearing.model = "rollers" (:cite:`seed003`: per-roller Hertz line contacts
+    with clearance) vs "empirical" (:cite:`seed004` law): input locked, rated torque
     412 N m: the output wind-up agrees within 15 % (two independent stiffness
     models of the same bearing: Palmgren line contacts per roller, Harris &
-    Kotzalas 2007, vs the empirical law of seed 004); per-roller forces are
+    Kotzalas 2007, vs the empirical law of :cite:`seed004`); per-roller forces are
     reported, every loaded bearing shares its load over >= 2 rollers and no
     roller carries more than the bearing resultant."""
     from flexrv.model.loads import piecewise_torque

@@ -91,7 +91,7 @@ def _numbers(seed):
 
 
 def test_compare_reference_only_for_the_seeds_reducer():
-    """rv221 (seeds 000/001's RV-221) gets the seeds' TE ranges and periods; rv40e none, and
+    """rv221 (:cite:`seed000,seed001`'s RV-221) gets the seeds' TE ranges and periods; rv40e none, and
     its prose quotes the table's ring deflection (0.02 µm), not a fixed '~1 µm'."""
     from flexrv.design import load
     from flexrv.studies.compare import SEED_TE, seed_reference, summary_markdown

@@ -1,4 +1,4 @@
-"""Workflow 6 (seed 003, crank-bearing forces): numbers of the smoke setting.
+"""Workflow 6 (:cite:`seed003`, crank-bearing forces): numbers of the smoke setting.
 
 One short rigid run of the RV-40E at the seed's operating point (2000 r/min,
 600 N m, roller-resolved needle bearings) is shared by the tests (module fixture,

@@ -1,4 +1,4 @@
-"""Workflow 5 (seed 002, crankshaft flexibility): the spectral line picking and the
+"""Workflow 5 (:cite:`seed002`, crankshaft flexibility): the spectral line picking and the
 seed's Table 4 against flexrv's kinematics. The workflow's smoke run itself is
 tests/test_workflows.py::test_crankshaft_flexibility_smoke (not repeated here)."""
 
@@ -9,7 +9,7 @@ import pytest
 
 
 def test_amplitude_at_recovers_sine_amplitudes():
-    """TE-like signal over the steady window of seed 002 (0.6 s at 10 kHz): lines of
+    """TE-like signal over the steady window of :cite:`seed002` (0.6 s at 10 kHz): lines of
     2 arcsec at 3 x 10 Hz (crank harmonic) and 0.5 arcsec at 320 Hz (first-stage
     mesh). With the Hann-window amplitude correction of
     :func:`flexrv.post.spectra.amplitude_spectrum` a bin-centred sine shows its
@@ -26,11 +26,10 @@ def test_amplitude_at_recovers_sine_amplitudes():
 
 
 def test_table4_frequencies_follow_from_the_kinematics():
-    """Seed 002 Table 4 at 1215 r/min input (RV-40E: z_s 16, z_p 32, z_c 39, 40
+    """:cite:`seed002` Table 4 at 1215 r/min input (RV-40E: z_s 16, z_p 32, z_c 39, 40
     pins, i = 81): input 20.25 Hz; crank spin relative to the carrier
     (f_in - f_out) z_s / z_p = 10 Hz; carrier f_in / 81 = 0.25 Hz; first-stage mesh
-    z_s (f_in - f_out) = 320 Hz; cycloid mesh z_c (f_crank) = 390 Hz (Willis; seed
-    002 rounds). The workflow's table of seed numbers agrees to 1 % with these."""
+    z_s (f_in - f_out) = 320 Hz; cycloid mesh z_c (f_crank) = 390 Hz (Willis; :cite:`seed002` rounds). The workflow's table of seed numbers agrees to 1 % with these."""
     from flexrv.workflows.crankshaft_flexibility import SEED_TABLE4
 
     f_in = 1215.0 / 60.0

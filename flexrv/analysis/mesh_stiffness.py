@@ -1,5 +1,5 @@
 """Involute (first-stage) mesh stiffness and damping: ISO 6336-1 method B,
-seeds 000/001, and a time-varying mesh-stiffness function for the dynamic model.
+:cite:`seed000,seed001`, and a time-varying mesh-stiffness function for the dynamic model.
 
 Units: SI inside (stiffness per face width in N/m^2 = N/(m m)); ISO 6336 writes
 c' in N/(mm um) = 1e9 N/m^2 (converted by :data:`ISO_UNIT`).
@@ -53,7 +53,7 @@ def single_tooth_stiffness(z1, z2, x1, x2, alpha, helix_angle: float = 0.0, c_m:
     c'_th = 1/q',  c' = c'_th C_M C_R C_B cos(beta),
 
     C_M = 0.8, C_R = 1 (solid gear blanks), C_B from the basic rack
-    (:func:`basic_rack_factor`). Seed 001 writes c' = 1/q (= c'_th, without the
+    (:func:`basic_rack_factor`). :cite:`seed001` writes c' = 1/q (= c'_th, without the
     corrections); the corrected value is the ISO one.
     """
     q = min_flexibility(z1, z2, x1, x2)
@@ -63,7 +63,7 @@ def single_tooth_stiffness(z1, z2, x1, x2, alpha, helix_angle: float = 0.0, c_m:
 
 def mesh_stiffness_per_width(c_single, eps_alpha):
     """Mean mesh stiffness c_gamma_alpha = (0.75 eps_alpha + 0.25) c' [N/m^2]
-    (ISO 6336-1 eq. for c_gamma_alpha; seeds 000/001)."""
+    (ISO 6336-1 eq. for c_gamma_alpha; :cite:`seed000,seed001`)."""
     return (0.75 * np.asarray(eps_alpha, dtype=float) + 0.25) * np.asarray(c_single, dtype=float)
 
 
@@ -75,7 +75,7 @@ def mesh_damping(k, r1, r2, j1, j2, damping_ratio):
     (equivalent mass of the two gears' rotations reduced to the line of action;
     Kahraman & Singh, J. Sound Vib. 1991; Parker et al. 2000). r1, r2 are the
     BASE radii [m] (the line-of-action lever arms), J1, J2 the rotational inertias
-    [kg m^2]. Seed 001 writes c12 = 2 xi sqrt(k r1^2 r2^2 J1 J2 / (r1^2 J1 + r2^2 J2)),
+    [kg m^2]. :cite:`seed001` writes c12 = 2 xi sqrt(k r1^2 r2^2 J1 J2 / (r1^2 J1 + r2^2 J2)),
     which has units kg m^2/s (a torsional damping, with the radii misplaced);
     for J_i = m_i r_i^2 our form reduces to 2 xi sqrt(k m1 m2/(m1 + m2)) as it must.
     """

@@ -14,7 +14,7 @@ approach, here with EXACT clearances of the actual pins to the actual profile):
    (Newton steps on the exact gaps until |step| < 1e-15 rad).
 2. The initial normal clearance delta_i of pin i is its exact gap at beta0, along
    the contact normal n_i whose moment arm about the disc centre is
-   l_i = (P_i x n_i)_z (equal to seed 000's r'_c sin(phi)/sqrt(1 + K^2 - 2K cos(phi))
+   l_i = (P_i x n_i)_z (equal to :cite:`seed000`'s r'_c sin(phi)/sqrt(1 + K^2 - 2K cos(phi))
    for the unmodified profile), both taken at beta0.
 3. Under load the disc turns on by the elastic rotation beta - beta0 (of order
    1e-4 rad, so the neglected second-order term R_p (beta - beta0)^2 is below
@@ -31,7 +31,7 @@ force by several per cent.
 Contact law (documented choice): ``"palmgren"`` (default) uses the lead's
 :func:`flexrv.contact.hertz.line_contact_stiffness`, Q = K delta^(10/9)
 (Palmgren's line-contact approach, Harris & Kotzalas 2007 eq. 6.74), which is the
-physical, load-dependent law; ``"linear"`` uses seed 000's k_n = pi b E'/4 with
+physical, load-dependent law; ``"linear"`` uses :cite:`seed000`'s k_n = pi b E'/4 with
 e = 1 (curvature- and load-independent, see
 :func:`flexrv.geometry.cycloid.pin_stiffness_seed000`).
 
@@ -116,7 +116,7 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
         [rad] modifications of this disc (nominal + its errors).
     crank_angle : crank angle chi [rad] of the nominal pose
         (:func:`flexrv.geometry.cycloid.nominal_disc_pose`).
-    law : "palmgren" (Q = K w^(10/9)) or "linear" (seed 000 k_n).
+    law : "palmgren" (Q = K w^(10/9)) or "linear" (:cite:`seed000` k_n).
     pins : (z_rp, 2) actual pin centres in the housing frame [m] (default nominal).
     pin_radii : (z_rp,) actual pin radii [m] (default ``pin_radius``).
     harmonics : (H, 3) profile-error harmonics (order, amplitude [m], phase [rad])

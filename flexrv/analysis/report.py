@@ -94,7 +94,7 @@ def _cycloid(reducer) -> dict:
             "k34_ideal_pins_engaged": ideal.n_contact,
             "k34_at_load_torque_Nm_per_rad": float(k34(k_n, loaded.arms, loaded.in_contact)),
             "k34_at_load_torque_pins_engaged": loaded.n_contact,
-            "note": "k34 = sum k_n l_i^2 over engaged pins, per disc (seed 000); k_n = pi b E'/4 is curvature-free"}
+            "note": "k34 = sum k_n l_i^2 over engaged pins, per disc (seed000); k_n = pi b E'/4 is curvature-free"}
 
 
 def _modification_sweep(reducer, torque: float) -> dict:
@@ -132,7 +132,7 @@ def _torsional(reducer) -> dict:
             "C_W_palmgren_over_crank_angle_Nm_per_rad": {"min": float(cw_tan.min()), "max": float(cw_tan.max())},
             "C_W_seed004_over_crank_angle_Nm_per_rad": {"min": float(cw_seed.min()), "max": float(cw_seed.max())},
             "pins_in_contact": first.n_contact,
-            "model": "seed 004 series model: needle bearings (empirical K_Hc) in series with the pin contacts; "
+            "model": "seed004 series model: needle bearings (empirical K_Hc) in series with the pin contacts; "
                      "crankshaft, pin bending, carrier and first stage compliances are neglected"}
 
 
@@ -162,7 +162,7 @@ def _meshing_zone(reducer, bearing_c: float, measured: float) -> dict:
                          "best_angles_deg": [math.degrees(a) for a in zs.angles], "best_total_Nm_per_rad": zs.total,
                          "best_rel_error": zs.rel_error, "best_four_pins": [s4[0], s4[1]],
                          "best_four_total_Nm_per_rad": s4[2],
-                         "note": "seed 004 reports pins 6-9 (4 pins, 6.32e8 N mm/rad); over all set sizes pins 9-15 "
+                         "note": "seed004 reports pins 6-9 (4 pins, 6.32e8 N mm/rad); over all set sizes pins 9-15 "
                                  "match its own target 6.24e8 N mm/rad better (6.303e8)"}
     return out
 
@@ -266,7 +266,7 @@ def design_report(reducer) -> dict:
     tors = _torsional(reducer)
     report["torsional_stiffness"] = tors
     report["meshing_zone"] = _meshing_zone(reducer, tors["C_Hc_Nm_per_rad"], SEED004_MEASURED_CW)
-    report["meshing_zone"]["note"] = ("seed 004 procedure; the measured value is the RV-40E's (seed 004) and is "
+    report["meshing_zone"]["note"] = ("seed004 procedure; the measured value is the RV-40E's (seed004) and is "
                                       "meaningful only for rv40e")
     report["main_bearing"] = _main_bearing(reducer)
     return report

@@ -1,7 +1,7 @@
-"""Torsional stiffness of the RV reducer's second stage (seed 004 series model)
-and seed 004's meshing-zone identification from a measured stiffness.
+"""Torsional stiffness of the RV reducer's second stage (:cite:`seed004` series model)
+and :cite:`seed004`'s meshing-zone identification from a measured stiffness.
 
-Model (seed 004): the output torque passes in series through
+Model (:cite:`seed004`): the output torque passes in series through
 (1) the needle (crank) bearings between the discs and the eccentrics and
 (2) the pin-disc contacts:
 
@@ -11,11 +11,11 @@ Model (seed 004): the output torque passes in series through
 
 with the empirical needle-bearing radial stiffness
 K_Hc = 0.34e4 F_r^0.1 Z^0.9 l^0.8 cos(alpha)^1.9 [N/mm; F_r in N, l in mm].
-The first stage and the crank/carrier compliances are neglected (as in seed 004).
+The first stage and the crank/carrier compliances are neglected (as in :cite:`seed004`).
 
 Lever arm l_c: turning a disc by beta about its centre moves each crank hole by
 a_w beta tangentially (a_w = crank-circle radius = first-stage centre distance),
-so l_c = a_w. Seed 004's force split writes the couple term as F_t r'_c/(3a);
+so l_c = a_w. :cite:`seed004`'s force split writes the couple term as F_t r'_c/(3a);
 moment balance of the disc about its centre requires the hole radius a_w in that
 denominator (with the eccentricity a = 1.3 mm the bearing forces of the RV-40E
 would be ~28x too large), so a_w is used (physics over seed).
@@ -30,12 +30,12 @@ import numpy as np
 from flexrv.errors import InputError
 from flexrv.units import M_PER_MM, M_PER_UM, RAD_PER_DEG
 
-#: K_Hc [N/mm] = NEEDLE_COEFF * F^0.1 [N] * Z^0.9 * l^0.8 [mm] * cos^1.9 (seed 004).
+#: K_Hc [N/mm] = NEEDLE_COEFF * F^0.1 [N] * Z^0.9 * l^0.8 [mm] * cos^1.9 (:cite:`seed004`).
 NEEDLE_COEFF = 0.34e4
 
 
 def needle_radial_stiffness(radial_force, roller_count, roller_length, contact_angle=0.0):
-    """Empirical radial stiffness of a needle/roller bearing [N/m] (seed 004):
+    """Empirical radial stiffness of a needle/roller bearing [N/m] (:cite:`seed004`):
 
     K_Hc = 0.34e4 F_r^0.1 Z^0.9 l^0.8 cos(alpha)^1.9   in N/mm with F_r [N], l [mm].
 
@@ -67,7 +67,7 @@ def crank_hole_angles(n_cranks: int, first: float = 0.0):
 
 
 def crank_bearing_forces(pin_resultant, disc_torque, crank_circle_radius, n_cranks: int = 3, first_angle=0.0):
-    """Forces [N] on the n crank bearings of one disc (seed 004's F_A/F_B/F_C,
+    """Forces [N] on the n crank bearings of one disc (:cite:`seed004`'s F_A/F_B/F_C,
     generalised to n cranks), shape (..., n, 2):
 
         F_k = F / n + T / (n a_w) t_k,   t_k = (-sin th_k, cos th_k),
@@ -75,7 +75,7 @@ def crank_bearing_forces(pin_resultant, disc_torque, crank_circle_radius, n_cran
     the force the disc exerts on crank bearing k at hole angle th_k, with F the
     resultant of the pin forces on the disc and T their moment about the disc
     centre (= the disc torque). Equal sharing of the force and of the couple is
-    the statically determinate split of seed 004; it satisfies force and moment
+    the statically determinate split of :cite:`seed004`; it satisfies force and moment
     balance of the disc exactly: sum_k F_k = F (the t_k sum to zero) and
     sum_k a_w e_k x F_k = sum_k T/n = T (the F/n terms have no moment since
     sum_k e_k = 0 for evenly spaced holes), e_k = (cos th_k, sin th_k).
@@ -99,12 +99,12 @@ def crank_bearing_forces(pin_resultant, disc_torque, crank_circle_radius, n_cran
 
 
 def bearing_torsional_stiffness(bearing_stiffness, lever_arm, n_discs: int = 2):
-    """C_Hc = n_discs sum_k K_Hc,k l_c^2 [N m/rad] (seed 004, n_discs = 2)."""
+    """C_Hc = n_discs sum_k K_Hc,k l_c^2 [N m/rad] (:cite:`seed004`, n_discs = 2)."""
     return n_discs * np.sum(np.asarray(bearing_stiffness, dtype=float), axis=-1) * lever_arm**2
 
 
 def mesh_torsional_stiffness(pin_stiffness, arms, n_discs: int = 2, engaged=None):
-    """C_c = n_discs sum_j K_c,j L_j^2 [N m/rad] over the engaged pins (seed 004)."""
+    """C_c = n_discs sum_j K_c,j L_j^2 [N m/rad] over the engaged pins (:cite:`seed004`)."""
     c = np.asarray(pin_stiffness, dtype=float) * np.asarray(arms, dtype=float) ** 2
     if engaged is not None:
         c = np.where(engaged, c, 0.0)
@@ -112,13 +112,13 @@ def mesh_torsional_stiffness(pin_stiffness, arms, n_discs: int = 2, engaged=None
 
 
 def series_stiffness(c1, c2):
-    """Two torsional springs in series: C = C1 C2 / (C1 + C2) [N m/rad] (seed 004's C_W)."""
+    """Two torsional springs in series: C = C1 C2 / (C1 + C2) [N m/rad] (:cite:`seed004`'s C_W)."""
     c1, c2 = np.asarray(c1, dtype=float), np.asarray(c2, dtype=float)
     return c1 * c2 / (c1 + c2)
 
 
 def required_mesh_stiffness(measured, bearing):
-    """Invert the series model: C_c = 1 / (1/C_W - 1/C_Hc) [N m/rad] (seed 004).
+    """Invert the series model: C_c = 1 / (1/C_W - 1/C_Hc) [N m/rad] (:cite:`seed004`).
 
     Raises InputError if C_W >= C_Hc (no positive mesh stiffness explains the
     measurement)."""
@@ -130,7 +130,7 @@ def required_mesh_stiffness(measured, bearing):
 
 @dataclass(frozen=True)
 class MeshingZone:
-    """Result of :func:`identify_meshing_zone` (pins numbered from 1 like seed 004).
+    """Result of :func:`identify_meshing_zone` (pins numbered from 1 like :cite:`seed004`).
 
     target : required C_c [N m/rad]; first, last : best consecutive pin set;
     n_pins; total : its summed stiffness; rel_error = (total - target)/target;
@@ -149,14 +149,14 @@ class MeshingZone:
 
 
 def identify_meshing_zone(contributions, target, phase_angles=None, n_pins: int | None = None) -> MeshingZone:
-    """Seed 004's meshing-zone identification: the consecutive set of pins whose
+    """:cite:`seed004`'s meshing-zone identification: the consecutive set of pins whose
     summed single-pin contributions KTC_j (= n_discs K_cj L_j^2) best match the
     required mesh stiffness ``target`` (all consecutive sets are enumerated; with
     ``n_pins`` only sets of that size).
 
     Parameters
     ----------
-    contributions : (m,) KTC_j [N m/rad] of pins 1..m (seed 004 Table: m = 21 over 0-180 deg).
+    contributions : (m,) KTC_j [N m/rad] of pins 1..m (:cite:`seed004` Table: m = 21 over 0-180 deg).
     target : required C_c [N m/rad]; phase_angles : (m,) [rad], optional.
     """
     c = np.asarray(contributions, dtype=float)
@@ -179,11 +179,11 @@ def identify_meshing_zone(contributions, target, phase_angles=None, n_pins: int 
                        rel_error=float((totals[b] - target) / target), angles=ang, best_by_count=best_by)
 
 
-#: Seed 004 table: single-point equivalent torsional stiffness KTC_j [N mm/rad]
+#: :cite:`seed004` table: single-point equivalent torsional stiffness KTC_j [N mm/rad]
 #: of pins 1..21 at meshing phase 0, 9, ..., 180 deg (RV-40E, two discs).
 SEED004_KTC_NMM = np.array([0.0, 2.20e6, 1.97e7, 1.33e8, 1.84e8, 1.76e8, 1.66e8, 1.52e8, 1.38e8, 1.22e8, 1.06e8,
                             8.93e7, 7.33e7, 5.79e7, 4.38e7, 3.12e7, 2.03e7, 1.16e7, 5.25e6, 1.33e6, 0.0])
-#: Seed 004: measured C_W = 3.06e8 N mm/rad and derived C_c = 6.24e8 N mm/rad.
+#: :cite:`seed004`: measured C_W = 3.06e8 N mm/rad and derived C_c = 6.24e8 N mm/rad.
 SEED004_CW_NMM = 3.06e8
 SEED004_CC_NMM = 6.24e8
 
@@ -196,7 +196,7 @@ class SecondStageStiffness:
     bearing_forces : (n, 2) force on each crank bearing of one disc [N];
     bearing_loads : (n,) their magnitudes [N]; bearing_stiffness : (n,) K_Hc [N/m];
     lever_arm : l_c = a_w [m]; c_bearings : C_Hc [N m/rad];
-    c_mesh_seed : C_c with seed 004's K_cj over the loaded pins [N m/rad];
+    c_mesh_seed : C_c with :cite:`seed004`'s K_cj over the loaded pins [N m/rad];
     c_mesh_tangent : n_discs dT/dbeta of the Palmgren pin-load solution [N m/rad];
     c_w_seed, c_w_tangent : series C_W with either mesh stiffness [N m/rad];
     n_contact : loaded pins per disc.
@@ -216,10 +216,10 @@ class SecondStageStiffness:
 
 def seed004_pin_contributions(reducer, n_pins: int | None = None):
     """Single-pin equivalent torsional stiffness KTC_j = n_discs K_cj L_j^2 [N m/rad]
-    of pins j = 1..n at meshing phase (j - 1) 2 pi / z_rp (seed 004's table,
+    of pins j = 1..n at meshing phase (j - 1) 2 pi / z_rp (:cite:`seed004`'s table,
     recomputed with the design's width and E'): K_cj from
     :func:`flexrv.geometry.cycloid.pin_stiffness_seed004` with the profile radius
-    of :func:`flexrv.geometry.cycloid.seed004_curvature_radius` (seed 004 phase
+    of :func:`flexrv.geometry.cycloid.seed004_curvature_radius` (:cite:`seed004` phase
     theta = pin angle from the eccentric direction; the formula is even in theta),
     L_j from :func:`flexrv.geometry.cycloid.moment_arm`.
 
@@ -239,7 +239,7 @@ def seed004_pin_contributions(reducer, n_pins: int | None = None):
 
 def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0.0,
                            first_hole_angle: float = 0.0) -> SecondStageStiffness:
-    """Seed 004 series model evaluated for a design under ``output_torque`` [N m]:
+    """:cite:`seed004` series model evaluated for a design under ``output_torque`` [N m]:
     pin loads (initial-clearance method, :mod:`flexrv.analysis.pin_load`) give the
     pin resultant and the loaded pins; the crank-bearing forces
     (:func:`crank_bearing_forces`) give K_Hc (:func:`needle_radial_stiffness`)."""
@@ -420,14 +420,14 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     * pins: 1 / C_c with the tangent pin stiffness of the Palmgren pin-load solution
       (:func:`second_stage_stiffness`, ``c_mesh_tangent``);
     * needle_bearings: the needle bearings of all discs and cranks in parallel on
-      the lever a_w, each with the direction-resolved tangent of seed 004's
+      the lever a_w, each with the direction-resolved tangent of :cite:`seed004`'s
       empirical law as the models integrate it (F = (0.9 C delta)^(10/9),
       delta = |d| - c_r with the radial clearance c_r, K_Hc = C F^0.1): along its
       load K_Hc, across it F / |d| (the load's direction turns with d), so a
       bearing whose force F_jk (:func:`crank_bearing_forces`; disc k's pin
       resultant turned by 2 pi k / n_discs with its eccentric) makes the angle
       beta with the tangent t_j gives a_w^2 (K_Hc cos^2 beta + F/|d| sin^2 beta);
-      seed 004's C_Hc is the limit beta = 0;
+      :cite:`seed004`'s C_Hc is the limit beta = 0;
     * support_bearings and crank_bending: each crank's support carries the couple
       part of its needle forces, T / (N a_w) tangential (the discs' radial pin
       resultants, equal and opposite for two discs 180 deg apart, cancel on the

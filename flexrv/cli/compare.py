@@ -42,7 +42,7 @@ def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
 
         seed = d["seed_reference"]
         table = Table(title=f"compare {preset} ({', '.join(part_list)})", title_justify="left")
-        for col in ("quantity", "rigid", "flexible", "unit") + (("seed 000/001 rigid | flexible",) if seed else ()):
+        for col in ("quantity", "rigid", "flexible", "unit") + (("seed000/seed001 rigid | flexible",) if seed else ()):
             table.add_column(col, justify="left" if col in ("quantity", "unit") else "right")
         rows = [("TE min", "te_min_arcsec", "arcsec"), ("TE max", "te_max_arcsec", "arcsec"),
                 ("TE peak-to-peak", "te_pp_arcsec", "arcsec"), ("TE mean", "te_mean_arcsec", "arcsec"),
@@ -64,7 +64,7 @@ def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
                 table.add_row(label, "–", g(scale * nf[key]), unit, *(("–",) if seed else ()))
         console.print(table)
         if not seed:
-            console.print(f"no seed reference: seeds 000/001 simulate the rv221, not {preset}")
+            console.print(f"no seed reference: seed000/seed001 simulate the rv221, not {preset}")
         if not nr.get("steady_state", True):
             console.print(f"[bold red]NOT STEADY[/]: {nr.get('steady_note')}")
         console.print(f"wrote {d['output_dir']}")

@@ -89,7 +89,7 @@ _impact_jit = _njit(cache=True)(_impact_kernel) if _njit is not None else _impac
 
 
 def impact_force(gap, gap_rate, k, exponent, c_max, depth):
-    """Impact law on the signed gap (seeds 000/001 IMPACT function).
+    """Impact law on the signed gap (:cite:`seed000,seed001` IMPACT function).
 
     Parameters
     ----------

@@ -278,7 +278,7 @@ class NeedleBearing(_Strict):
     roller_diameter_mm: float = Field(gt=0.5, le=50.0)
     roller_length_mm: float = Field(gt=0.5, le=100.0)
     radial_clearance_um: float = Field(ge=0.0, le=100.0)
-    model: Literal["empirical", "rollers"] = Field(description="Seed 004 empirical stiffness or roller-resolved Hertz")
+    model: Literal["empirical", "rollers"] = Field(description="seed004 empirical stiffness or roller-resolved Hertz")
 
 
 class MainBearing(_Strict):

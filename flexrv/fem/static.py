@@ -1,6 +1,6 @@
 """Linear static FE solutions of a meshed part (full model, not reduced).
 
-Used for stress checks under contact loads taken from a dynamic run (seed 003's
+Used for stress checks under contact loads taken from a dynamic run (:cite:`seed003`'s
 crankshaft under the needle-roller forces): spread each roller's force over the
 raceway nodes of its angular sector, clamp the supports, solve K u = f with the
 sparse LU of the free DOFs, and recover nodal von Mises stress.

@@ -9,7 +9,7 @@ is the path of a pin centre relative to the disc (an epitrochoid with
 z_c = z_rp - 1 lobes, |C| between R - a and R + a). The tooth profile is its inward
 offset by r = r_rp + dr_rp (equidistant-modified pin radius), rotated by the
 rotation modification d_delta. Sources: Litvin & Fuentes, *Gear Geometry and
-Applied Theory* (2004), ch. 19; Li et al. seed 004 for the curvature formula.
+Applied Theory* (2004), ch. 19; Li et al. :cite:`seed004` for the curvature formula.
 """
 
 from __future__ import annotations
@@ -338,8 +338,7 @@ def profile_curvature_radius(phi, z_rp: int, pin_circle_radius: float, pin_radiu
 
     rho_profile = 1/kappa_C - (r_rp + dr_rp), kappa_C the signed curvature of the
     pin-centre curve (:func:`center_curve_curvature`); offset curves share centres
-    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of seed
-    004's rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an
+    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of :cite:`seed004`'s rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an
     unmodified profile.
     """
     kappa = center_curve_curvature(phi, z_rp, pin_circle_radius + d_radius, eccentricity)
@@ -348,7 +347,7 @@ def profile_curvature_radius(phi, z_rp: int, pin_circle_radius: float, pin_radiu
 
 
 def seed004_curvature_radius(theta, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float):
-    """Seed 004's curvature radius of the cycloid profile [m] (negative = convex):
+    """:cite:`seed004`'s curvature radius of the cycloid profile [m] (negative = convex):
 
     rho = r_p (1 + K^2 - 2 K cos th)^(3/2) / (K (z_p + 1) cos th - (1 + z_p K^2)) + r_rp,
     K = a z_p / r_p, th the meshing phase angle (= z_c phi in this module's
@@ -362,7 +361,7 @@ def seed004_curvature_radius(theta, z_rp: int, pin_circle_radius: float, pin_rad
 
 def moment_arm(phi_i, z_rp: int, pin_circle_radius: float, eccentricity: float):
     """Moment arm l_i [m] of pin i's ideal contact normal about the disc centre
-    (seed 000; Chen et al., standard cycloid-drive force analysis):
+    (:cite:`seed000`; Chen et al., standard cycloid-drive force analysis):
 
         l_i = r'_c sin(phi_i) / sqrt(1 + K^2 - 2 K cos(phi_i)),  r'_c = a z_c,
         K = a z_rp / R_p,
@@ -378,7 +377,7 @@ def moment_arm(phi_i, z_rp: int, pin_circle_radius: float, eccentricity: float):
 
 
 def pin_stiffness_seed000(width, e_eff):
-    """Seed 000's per-pin Hertz line-contact stiffness [N/m]:
+    """:cite:`seed000`'s per-pin Hertz line-contact stiffness [N/m]:
 
     k_n = pi b E rho_r rho_c / (4 (1 - mu^2)(rho_r + rho_c) rho_i), rho_i = rho_r rho_c/(rho_r + rho_c),
 
@@ -397,12 +396,12 @@ def pin_stiffness_seed000(width, e_eff):
 
 
 def pin_stiffness_seed004(rho, pin_radius: float, width, e_eff):
-    """Seed 004's per-pin stiffness K_cj [N/m] with rho from
+    """:cite:`seed004`'s per-pin stiffness K_cj [N/m] with rho from
     :func:`seed004_curvature_radius` (rho < 0 convex):
 
     K_cj = pi b E |rho| (rho - r_rp) / (4 rho (1 - mu^2)(r_rp + |rho|)), E/(1-mu^2) -> E'.
 
-    On the convex (working) flank this equals pi b E'/4 (seed 000); on the
+    On the convex (working) flank this equals pi b E'/4 (:cite:`seed000`); on the
     concave part it is reduced by (rho - r_rp)/(rho + r_rp), and it vanishes
     where the pin-centre curve has an inflection (rho = r_rp).
     """
@@ -412,7 +411,7 @@ def pin_stiffness_seed004(rho, pin_radius: float, width, e_eff):
 
 
 def k34(pin_stiffness, arms, engaged=None):
-    """Torsional mesh stiffness of one disc about its centre [N m/rad] (seed 000):
+    """Torsional mesh stiffness of one disc about its centre [N m/rad] (:cite:`seed000`):
     k34 = sum over engaged pins of k_n,i l_i^2."""
     k = np.asarray(pin_stiffness, dtype=float) * np.asarray(arms, dtype=float) ** 2
     if engaged is not None:

@@ -8,7 +8,7 @@ constant mass matrices, and one vectorised ``ObjectGenericODE2`` per force group
 * :mod:`.gear_stage` — sun–planet meshes along the line of action (time-varying
   ISO 6336 stiffness, damping, backlash; the sun angle is prescribed by the drive);
 * :mod:`.cranks_discs` — crank support bearings in the carrier; needle bearings
-  (seed 004 empirical law or roller-resolved Hertz line contacts, seed 003);
+  (:cite:`seed004` empirical law or roller-resolved Hertz line contacts, :cite:`seed003`);
 * :mod:`.pins` — every pin–disc contact (exact gap to the modified profile);
 * :mod:`.main_bearing_rigid` — linear carrier bearing (the flexible model
   replaces it, :mod:`.flexible_bearing`);

@@ -25,12 +25,12 @@ convention; e_jk, err_jk the as-built ``eccentricities`` and
 ``eccentric_phase_errors``); the hole centre is H = c_k + Rot(psi_k) h_kj. With
 d = E - H and the as-built radial clearance c_r = c_jk (``needle_clearances``):
 
-* ``empirical`` (seed 004): a radial power law on the eccentricity of the journal
+* ``empirical`` (:cite:`seed004`): a radial power law on the eccentricity of the journal
   in its hole, delta = |d| - c_r, F = K delta^(10/9) along d/|d|. The constant
-  follows from seed 004's empirical radial stiffness
+  follows from :cite:`seed004`'s empirical radial stiffness
   K_Hc = dF/d(delta) = C F^0.1 (see :func:`flexrv.analysis.torsional`); its
   integral is exactly a 10/9 power law, F = (0.9 C delta)^(10/9).
-* ``rollers`` (seed 003): each of the Z rollers is a Hertz line contact pair
+* ``rollers`` (:cite:`seed003`): each of the Z rollers is a Hertz line contact pair
   (journal–roller and roller–hole in series, Palmgren Q = K delta^(10/9),
   :func:`flexrv.contact.hertz.line_contact_stiffness`) with the radial clearance:
   delta_i = d . e_i - c_r, e_i the roller direction at gamma_c + 2 pi i / Z. The

@@ -49,7 +49,7 @@ def _members(p) -> dict[str, Member]:
 
 def empirical_needle_constant(reducer) -> float:
     """Constant K [N/m^(10/9)] of the needle-bearing law F = K delta^(10/9) that
-    integrates seed 004's empirical stiffness dF/d(delta) = C F^0.1
+    integrates :cite:`seed004`'s empirical stiffness dF/d(delta) = C F^0.1
     (:func:`flexrv.analysis.torsional.needle_radial_stiffness`, C = its value at
     F = 1 N): F^0.9 = 0.9 C delta, so K = (0.9 C)^(10/9)."""
     from flexrv.analysis.torsional import needle_radial_stiffness

@@ -511,7 +511,7 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int |
     onto a rigid carrier), ``n_eig`` fixed-interface eigenmodes and 2K+1 Fourier
     raceway load modes. K must exceed the ball count Z: Z equal ball loads excite
     the harmonics 0, Z, 2Z, ... of the local dent under each ball, and a basis
-    without them misses it. Measured (rv221, Z = 26, seed 001's 20 kN radial +
+    without them misses it. Measured (rv221, Z = 26, :cite:`seed001`'s 20 kN radial +
     15 kN axial, deflection at the loaded balls vs the full FE, see
     tests/test_model_flexible_rings.py): K = 24/40/57/80 -> -42/2.7/0.08/0.04 %.
     The default K is the reduction's patch-width rule (57 for rv221).

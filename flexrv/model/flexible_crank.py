@@ -1,6 +1,6 @@
 """Flexible crankshafts: crank torsion (and gear-seat bending) in the reducer model.
 
-Seed 002 replaces the rigid crankshafts by Abaqus modal bodies and finds crank
+:cite:`seed002` replaces the rigid crankshafts by Abaqus modal bodies and finds crank
 torsion in TE. flexrv splits each crank j of the rigid model into two planar
 members with the same (x, y, rotation) layout:
 
@@ -20,7 +20,7 @@ Mass split: planet gear + gear seat on ``planet<j>``, the rest of the shaft on
 Why a two-member Guyan model is enough: the shaft's lowest mode with all its
 interfaces clamped is > 20 kHz for both presets (``lowest_clamped_hz``; rv40e:
 176 kHz at the default mesh), more than two orders above every excitation of
-the drive (seed 002's Table 4 tops at 400 Hz),
+the drive (:cite:`seed002`'s Table 4 tops at 400 Hz),
 so the shaft's own inertia between the interfaces does not act dynamically;
 the planet's torsional vibration on the crank (sqrt(k_t / J_red), J_red the
 reduced inertia of planet and crank: ~22 kHz for rv40e) is kept. Neglected: the x/y anisotropy of the lateral stiffness (the eccentrics

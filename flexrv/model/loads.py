@@ -1,11 +1,11 @@
 """Drive and loads as in the seeds.
 
 * Input: speed-driven sun, omega_in(t) = omega_r step(t, 0, 0, t_r, 1) with the
-  cubic Adams STEP (seed 002: 0 -> 1215 r/min over 0.1 s). The angle is its exact
+  cubic Adams STEP (:cite:`seed002`: 0 -> 1215 r/min over 0.1 s). The angle is its exact
   integral: with s = t/t_r, theta = omega_r t_r (s^3 - s^4/2) for t <= t_r and
   omega_r (t - t_r/2) afterwards.
 * Output: load torque T_max step(t, t1, 0, t2, 1) on the carrier against the
-  rotation (seeds 000/002), plus optional external radial force (along +x),
+  rotation (:cite:`seed000,seed002`), plus optional external radial force (along +x),
   axial force (+z) and tilting moment (about x) on the output flange, ramped in
   with the same STEP window as the torque (a sudden 30 kN at t = 0 would only add
   a start-up transient of the bearing).

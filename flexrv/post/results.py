@@ -1,13 +1,13 @@
 """Simulation results on xarray: named, unit-tagged time series.
 
-Transmission error (seeds 000-003): TE(t) = theta_out(t) - theta_in(t) / i,
+Transmission error (:cite:`seed000,seed001,seed002,seed003`): TE(t) = theta_out(t) - theta_in(t) / i,
 reported in arcsec. Mechanism in the rigid-member model: the members are rigid,
 so TE comes only from the compliant elements and the clearances along the
 torque path sun -> planet meshes -> cranks -> needle bearings -> discs -> pins
 (and back through the crank supports to the carrier):
 
 * a *mean* wind-up under load, (load torque) / (torsional stiffness), mostly from
-  the pin–disc Hertz contacts and the needle bearings (seed 004's series model);
+  the pin–disc Hertz contacts and the needle bearings (:cite:`seed004`'s series model);
 * *fluctuations* at the first-stage mesh frequency (single/double tooth-pair
   alternation of the involute mesh stiffness, divided by the second-stage ratio
   z_rp as seen at the output) and at the cycloid mesh frequency z_c f_crank (the

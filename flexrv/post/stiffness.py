@@ -1,7 +1,7 @@
-"""Evaluation of the virtual torsional-stiffness test (seed 004 test bench):
+"""Evaluation of the virtual torsional-stiffness test (:cite:`seed004` test bench):
 input locked, output torque 0 -> +T_r -> -T_r -> 0 quasi-statically.
 
-Definitions (Nabtesco RV catalogue conventions, seed 004 "average slope of the
+Definitions (Nabtesco RV catalogue conventions, :cite:`seed004` "average slope of the
 loading and unloading curves"):
 
 * torsional rigidity [N m/arcmin]: mean of the slopes dT/dtheta of the +T_r
@@ -140,7 +140,7 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
     lines = [f"# Stiffness test {preset} ({model} model)", "",
              f"Input locked; output torque 0 -> +{f.rated_torque:.4g} -> -{f.rated_torque:.4g} -> 0 N m, each "
              f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
-             "catalogue and seed 004 (average slope of the loading and unloading curves).", "",
+             "catalogue and seed004 (average slope of the loading and unloading curves).", "",
              "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
     for name, field, units, long in _FIGURES[:7]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
@@ -152,6 +152,6 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
         lines += [f"![torque vs output rotation loop]({plot})", ""]
     lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
               "stiffness.json, config.toml.", "", "## References", "",
-              "Seed 004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "
+              "seed004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "
               "repository.", ""]
     return "\n".join(lines)

@@ -1,4 +1,4 @@
-"""Rigid vs flexible model on identical inputs (seeds 000/001's comparison).
+"""Rigid vs flexible model on identical inputs (:cite:`seed000,seed001`'s comparison).
 
 >>> from flexrv.studies.compare import run_compare                      # doctest: +SKIP
 >>> cmp = run_compare("rv221", t_end=0.4, parts=("main_bearing",))    # doctest: +SKIP
@@ -12,7 +12,7 @@ result folders (``rigid/``, ``flexible/``: NetCDF, config, PNGs, summary.md),
 ``te_overlay.png``, ``te_spectrum.png`` (characteristic frequencies marked),
 ``ball_loads.png`` and ``ring_deformation.png`` (if the flexible model has a
 ball-resolved bearing), ``summary.md`` (rigid vs flexible table in the style of
-seeds 000/001) and ``compare.json``.
+:cite:`seed000,seed001`) and ``compare.json``.
 """
 
 from __future__ import annotations
@@ -26,9 +26,9 @@ import numpy as np
 
 from flexrv.cache import atomic_write_text, to_jsonable
 
-#: the reducer seeds 000/001 simulate (their TE values are a reference for this preset only)
+#: the reducer :cite:`seed000,seed001` simulate (their TE values are a reference for this preset only)
 SEED_REDUCER = "rv221"
-#: seeds 000/001: TE range [arcsec] and period [s] of the rigid and the flexible-bearing model
+#: :cite:`seed000,seed001`: TE range [arcsec] and period [s] of the rigid and the flexible-bearing model
 SEED_TE = {"rigid": {"te_min_arcsec": -25.2, "te_max_arcsec": 21.6, "period_s": 0.15},
            "flexible": {"te_min_arcsec": -43.2, "te_max_arcsec": 45.0, "period_s": 0.28}}
 
@@ -45,7 +45,7 @@ class CompareResult:
 
 
 def seed_reference(reducer) -> dict | None:
-    """Seeds 000/001's TE ranges and periods if ``reducer`` is the reducer they simulate
+    """:cite:`seed000,seed001`'s TE ranges and periods if ``reducer`` is the reducer they simulate
     (preset :data:`SEED_REDUCER`, RV-221), else None: another design has no seed reference."""
     name = getattr(reducer, "name", reducer)
     return SEED_TE if str(name) == SEED_REDUCER else None
@@ -109,7 +109,7 @@ def period_note(periods: dict, tolerance: float = 0.1, seed: dict | None = SEED_
 
 
 def summary_markdown(reducer, parts, numbers: dict, timing: dict) -> str:
-    """summary.md: rigid vs flexible table, with seeds 000/001's values only for their
+    """summary.md: rigid vs flexible table, with :cite:`seed000,seed001`'s values only for their
     reducer (``numbers["seed"]``), and notes computed from the numbers in the table."""
     nr, nf = numbers["rigid"], numbers["flexible"]
     seed_ref = numbers.get("seed")
@@ -127,7 +127,7 @@ def summary_markdown(reducer, parts, numbers: dict, timing: dict) -> str:
     head = "| model | TE min [arcsec] | TE max [arcsec] | TE p-p [arcsec] | TE mean [arcsec] | dominant period [s] |"
     rule = "|---|---|---|---|---|---|"
     if seed_ref:
-        head += " seed 000/001 TE range [arcsec] | seed period [s] |"
+        head += " seed000/seed001 TE range [arcsec] | seed period [s] |"
         rule += "---|---|"
     lines += [head, rule]
     for name, n in (("rigid", nr), ("flexible", nf)):
@@ -168,12 +168,12 @@ def summary_markdown(reducer, parts, numbers: dict, timing: dict) -> str:
         text += (f" The ring deflection under the most-loaded ball is {1e6 * nf['max_ring_deformation_m']:.3g} µm "
                  "(outer ring) in this run.")
     if seed_ref:
-        text += (" Seeds 000/001 report TE ranges of "
+        text += (" seed000/seed001 report TE ranges of "
                  f"{seed_ref['rigid']['te_min_arcsec']} .. {seed_ref['rigid']['te_max_arcsec']} arcsec (rigid) and "
                  f"{seed_ref['flexible']['te_min_arcsec']} .. {seed_ref['flexible']['te_max_arcsec']} arcsec "
                  "(flexible main bearing) for this reducer. " + period_note(periods, seed=seed_ref))
     else:
-        text += (f" No seed reference: seeds 000/001 simulate the {SEED_REDUCER} only, "
+        text += (f" No seed reference: seed000/seed001 simulate the {SEED_REDUCER} only, "
                  f"not {reducer.name}.")
     lines += [text, "",
               f"Wall time: rigid {timing.get('rigid_s', 0):.1f} s, flexible {timing.get('flexible_s', 0):.1f} s "

@@ -32,8 +32,8 @@ REPORT_NAME = "REPORT.md"
 #: the seed studies' bibliography (written in docs/references.md, keys seed000 .. seed004)
 REFERENCES = ("## References", "",
               "Seed studies are cited by the keys of `docs/references.md` in the flexrv repository: "
-              "seed 000 = `seed000`, seed 001 = `seed001`, seed 002 = `seed002`, seed 003 = `seed003`, "
-              "seed 004 = `seed004` (full citations there).", "")
+              "`seed000`, `seed001`, `seed002`, `seed003`, "
+              "`seed004` (full citations there).", "")
 
 
 #: invisible marker closing every workflow summary: ``flexrv report`` collects only these
@@ -232,7 +232,7 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
         sr, sf = SEED_TE["rigid"], SEED_TE["flexible"]
         seed_ratio = (sf["te_max_arcsec"] - sf["te_min_arcsec"]) / (sr["te_max_arcsec"] - sr["te_min_arcsec"])
         agree = abs(ratio - seed_ratio) < 0.25 * seed_ratio
-        lines.append(f"* **Main-bearing flexibility** (rv221, seeds 000/001): steady TE "
+        lines.append(f"* **Main-bearing flexibility** (rv221, seed000/seed001): steady TE "
                      f"{r['te_min_arcsec']:.2f} .. {r['te_max_arcsec']:.2f} arcsec with the rigid model, "
                      f"{f['te_min_arcsec']:.2f} .. {f['te_max_arcsec']:.2f} arcsec with flexible rings and "
                      f"ball-resolved contacts: {d_mean:+.2f} arcsec in the mean "
@@ -249,7 +249,7 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
                 loaded["TE min, flexible [arcsec]"].values - loaded["TE min, rigid rings [arcsec]"].values,
                 loaded["TE max, flexible [arcsec]"].values - loaded["TE max, rigid rings [arcsec]"].values]))))
             pp = float(np.max(loaded["TE max, rigid rings [arcsec]"].values - loaded["TE min, rigid rings [arcsec]"].values))
-            line = (f"* **External load** (seed 001's load cases, radial "
+            line = (f"* **External load** (seed001's load cases, radial "
                     f"{float(loaded['radial [kN]'].min()):.0f} .. {float(loaded['radial [kN]'].max()):.0f} kN): "
                     f"outer-ring deflection {float(loaded['outer ring deflection [um]'].min()):.2f} .. "
                     f"{float(loaded['outer ring deflection [um]'].max()):.2f} µm (seed 0.35 .. 0.65 µm); TE range "

@@ -1,6 +1,6 @@
-"""Crank (needle) bearing forces, crankshaft stress and bearing life (seed 003, RV-40E).
+"""Crank (needle) bearing forces, crankshaft stress and bearing life (:cite:`seed003`, RV-40E).
 
-Seed 003 simulates the RV-40E at 2000 r/min input and 600 N m in ADAMS, lists the
+:cite:`seed003` simulates the RV-40E at 2000 r/min input and 600 N m in ADAMS, lists the
 15 roller forces of one crank bearing at the instant of the largest roller load
 (roller 3: 3513 N), applies them to a Nastran model of the crankshaft (max von
 Mises 463 MPa), checks a Hertz pressure (447 MPa), an L10 and an eccentricity
@@ -31,11 +31,11 @@ NAME = "crank_bearing_forces"
 PRESET = "rv40e"
 OPERATING = {"operating.input_speed_rpm": 2000.0, "operating.load_torque_Nm": 600.0,
              "needle_bearing.model": "rollers"}
-#: seed 003 numbers
+#: :cite:`seed003` numbers
 SEED = {"max_roller_force_N": 3513.0, "von_mises_MPa": 463.0, "hertz_MPa": 447.0, "L10_cycles": 1.5e7,
         "dynamic_rating_N": 5000.0, "period_s": 0.075}
 SEED_SWEEP = {1.0: (3000.0, 400.0, 4.5), 1.5: (3513.0, 463.0, 5.0), 2.0: (4200.0, 550.0, 5.8)}
-SWEEP = (1.0, 1.2, 1.3, 1.4, 1.5, 2.0)  #: seed 003's 1.0/1.5/2.0 mm plus valid values between
+SWEEP = (1.0, 1.2, 1.3, 1.4, 1.5, 2.0)  #: :cite:`seed003`'s 1.0/1.5/2.0 mm plus valid values between
 SMOKE = {"t_end": 0.02, "sweep": (1.0,), "mesh_size": 0.004}
 #: full setting: steady time after the load ramp [s], ~5 roller-load periods (0.061 s); the whole run
 #: (4 valid eccentricities, default mesh) takes ~1.5-2 min on one core
@@ -138,7 +138,7 @@ def hertz_and_life(reducer, res, max_force: float) -> dict:
 
 def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None,
         sweep=None) -> WorkflowResult:
-    """Seed 003 study; saves to ``results/crank_bearing_forces``."""
+    """:cite:`seed003` study; saves to ``results/crank_bearing_forces``."""
     import xarray as xr
 
     from flexrv.design import load
@@ -228,7 +228,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                            "TE p-p [arcsec]": float(np.ptp(te)) if te.size else None,
                            "seed force [N]": seed_f, "seed stress [MPa]": seed_s, "seed TE [arcsec]": seed_te,
                            "note": ""})
-    r.tables["eccentricity sweep (seed 003: 1.0 / 1.5 / 2.0 mm; 1.2-1.4 mm added)"] = sweep_rows
+    r.tables["eccentricity sweep (seed003: 1.0 / 1.5 / 2.0 mm; 1.2-1.4 mm added)"] = sweep_rows
     invalid = [row for row in sweep_rows if not row["valid"]]
     if invalid:
         r.text.append(
@@ -251,7 +251,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         "bearing compliances; the seed's 4.5-5.8 arcsec come from its ADAMS impact contacts (parameters not "
         "given) and cannot be reproduced from the stated data.")
     r.text.append(
-        f"Preset eccentricity for this study: {red.second_stage.eccentricity_mm} mm (seed 002's RV-40E data); "
+        f"Preset eccentricity for this study: {red.second_stage.eccentricity_mm} mm (seed002's RV-40E data); "
         f"the FE crankshaft has {stress['n_nodes']} nodes (Tet10); the roller loads of both bearings of crank 0 "
         f"(resultant {stress['resultant_N']:.0f} N) act on the eccentrics, the support journals are clamped.")
     r.numbers = {"rollers": rows, "stress": stress, "hertz_life": hl, "sweep": sweep_rows,

@@ -1,6 +1,6 @@
-"""Crankshaft flexibility and the TE spectrum (seed 002, RV-40E).
+"""Crankshaft flexibility and the TE spectrum (:cite:`seed002`, RV-40E).
 
-Seed 002 runs the RV-40E at 1215 r/min input with a 412 N m load ramp for 0.8 s,
+:cite:`seed002` runs the RV-40E at 1215 r/min input with a 412 N m load ramp for 0.8 s,
 once fully rigid and once with flexible crankshafts (and discs, pins), and finds
 in the flexible model's TE spectrum peaks at 2, 3, 4 x the crank rotation
 frequency (10 Hz), at the first-stage mesh frequency (320 Hz) and its harmonics
@@ -20,8 +20,8 @@ from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "crankshaft_flexibility"
 PRESET = "rv40e"
-T_END = 0.8  #: seed 002's run length [s]; TE evaluated over 0.2-0.8 s as in the seed
-#: seed 002 Table 4 [Hz]
+T_END = 0.8  #: :cite:`seed002`'s run length [s]; TE evaluated over 0.2-0.8 s as in the seed
+#: :cite:`seed002` Table 4 [Hz]
 SEED_TABLE4 = {"input shaft": 20.25, "crank rotation": 10.0, "carrier (crank revolution)": 0.25,
                "first-stage mesh": 320.0, "cycloid mesh": 390.0, "cycloid gear": 400.0, "pin gear": 400.0}
 SMOKE = {"t_end": 0.03, "crank_options": {"size": 0.004}}
@@ -36,7 +36,7 @@ def amplitude_at(freq, amp, f0: float, halfwidth: int = 2) -> float:
 
 
 def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None) -> WorkflowResult:
-    """Seed 002 crankshaft-flexibility study; saves to ``results/crankshaft_flexibility``."""
+    """:cite:`seed002` crankshaft-flexibility study; saves to ``results/crankshaft_flexibility``."""
     import xarray as xr
 
     from flexrv.design import load
@@ -77,7 +77,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         r.text.append(f"**{nr['steady_note']}: the spectra below are not steady-state spectra.**")
     twist = cmp.flexible.steady("crank_twist").values
     r.compare("TE, rigid model (steady)", "arcsec", "periodic, smaller",
-              f"{nr['te_min_arcsec']:.2f} .. {nr['te_max_arcsec']:.2f}", "seed 002 gives no numbers, only plots")
+              f"{nr['te_min_arcsec']:.2f} .. {nr['te_max_arcsec']:.2f}", "seed002 gives no numbers, only plots")
     r.compare("TE, flexible crankshafts (steady)", "arcsec", "periodic, larger",
               f"{nf['te_min_arcsec']:.2f} .. {nf['te_max_arcsec']:.2f}",
               f"mean shift {nf['te_mean_arcsec'] - nr['te_mean_arcsec']:+.3f} arcsec")
@@ -92,11 +92,11 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         f"{float(np.mean(twist)) / red.second_stage.disc_teeth * 180 / np.pi * 3600:.3f} arcsec — the TE mean "
         f"shift of the flexible model ({nf['te_mean_arcsec'] - nr['te_mean_arcsec']:+.3f} arcsec).")
     r.text.append(
-        "Seed 002 attributes the crank-harmonic peaks of its flexible model to crank torsion. In flexrv the crank "
+        "seed002 attributes the crank-harmonic peaks of its flexible model to crank torsion. In flexrv the crank "
         "twist is a quasi-static wind-up proportional to the crank torque; it changes the TE level by a fraction of "
         "an arcsec and the spectral lines only where the crank torque itself fluctuates (table above: the ratio "
         "flexible/rigid per line). The crank harmonics in flexrv's TE come from the needle-bearing and pin "
-        "load cycle that both models share; the first-stage mesh line is present in both. Seed 002's Table 4 "
+        "load cycle that both models share; the first-stage mesh line is present in both. seed002's Table 4 "
         "frequencies are reproduced exactly by the kinematics.")
     finite = [row for row in rows if np.isfinite(row["rigid [arcsec]"])]
     if finite:
@@ -104,7 +104,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         r.text.append(f"Largest of the marked lines in both models: {top['line']} ({top['frequency [Hz]']:.4g} Hz), "
                       f"{top['rigid [arcsec]']:.3g} arcsec rigid vs {top['flexible crank [arcsec]']:.3g} arcsec with "
                       "flexible crankshafts — the pins entering and leaving the load zone, which the crank twist does "
-                      "not change; seed 002's rigid model shows mainly the first-stage mesh, flexrv's the cycloid "
+                      "not change; seed002's rigid model shows mainly the first-stage mesh, flexrv's the cycloid "
                       "mesh (its involute mesh ripple is filtered by the second-stage ratio).")
     r.text.append(
         f"Largest TE line over the whole steady spectrum: {nr['dominant_frequency_hz']:.4g} Hz "

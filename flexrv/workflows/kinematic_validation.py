@@ -1,4 +1,4 @@
-"""Kinematic validation (seeds 000, 001, 002): rigid multibody runs of both presets
+"""Kinematic validation (:cite:`seed000,seed001,seed002`): rigid multibody runs of both presets
 against the closed-form kinematics of :mod:`flexrv.geometry.kinematics`.
 
 Run: ``python -m flexrv.workflows.kinematic_validation`` or ``flexrv workflow kinematic_validation``.
@@ -46,7 +46,7 @@ def _row(table, quantity):
 
 def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) -> WorkflowResult:
     """Simulate both presets with the rigid model and compare speeds/ratios with
-    theory and with seeds 000/001/002 (see module docstring); save to ``results/kinematic_validation``."""
+    theory and with :cite:`seed000,seed001,seed002` (see module docstring); save to ``results/kinematic_validation``."""
     from flexrv.design import load
     from flexrv.geometry.kinematics import reducer_kinematics
 
@@ -71,13 +71,13 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
                         "ratio_error_percent": ratio["error_percent"], "steady_window_s": summ["steady_window_s"],
                         "crank_relative_error_percent": _row(tab, "crank speed, relative to carrier")["error_percent"]}
 
-    # ---- seed 000 / 001: RV-221 at 9000 deg/s
+    # ---- :cite:`seed000,seed001`: RV-221 at 9000 deg/s
     red = load("rv221")
     k = reducer_kinematics(red, 9000.0 * RAD_PER_DEG)
     s = k.speeds
     out_deg = float(s.carrier) * DEG_PER_RAD
     r.compare("RV-221 input speed", "deg/s", 9000.0, float(s.input) * DEG_PER_RAD,
-              "seed 000 also writes '150 RPM': 9000 deg/s = 1500 r/min (a slip in the seed)")
+              "seed000 also writes '150 RPM': 9000 deg/s = 1500 r/min (a slip in the seed)")
     r.compare("RV-221 output speed, theory", "deg/s", "40.724", _g(out_deg), "9000/ratio")
     r.numbers["rv221_ratio_theory"] = float(s.ratio)
     r.compare("RV-221 total ratio", "-", "221.02", _g(s.ratio),
@@ -94,13 +94,13 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
     held = 9000.0 * fs.sun_teeth / fs.planet_teeth
     r.compare("RV-221 planet (crank) speed", "deg/s", "2452.3", _g(abs(float(s.crank_relative)) * DEG_PER_RAD, 5),
               f"flexrv: relative to the carrier {abs(float(s.crank_relative)) * DEG_PER_RAD:.1f}, absolute "
-              f"{abs(float(s.crank_absolute)) * DEG_PER_RAD:.1f} deg/s; seed 001's 2452.3 is within "
+              f"{abs(float(s.crank_absolute)) * DEG_PER_RAD:.1f} deg/s; seed001's 2452.3 is within "
               f"{abs(2452.3 / held - 1) * 100:.2f} % of 9000 z_s/z_p = {held:.1f} deg/s, the planet speed with the "
               "carrier HELD (sun speed not reduced by the carrier's rotation)")
     r.numbers["rv221_planet_deg_s"] = {"relative": abs(float(s.crank_relative)) * DEG_PER_RAD,
                                        "absolute": abs(float(s.crank_absolute)) * DEG_PER_RAD, "carrier_held": held}
 
-    # ---- seed 002: RV-40E at 1215 r/min
+    # ---- :cite:`seed002`: RV-40E at 1215 r/min
     red40 = load("rv40e")
     k40 = reducer_kinematics(red40, 1215.0 * RAD_S_PER_RPM)
     s40, f40 = k40.speeds, k40.frequencies
@@ -113,7 +113,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
     for key, val in seed_f.items():
         got = float(getattr(f40, key))
         freqs[key] = got
-        r.compare(f"RV-40E {key.replace('_', ' ')} frequency", "Hz", val, got, "Table 4 of seed 002")
+        r.compare(f"RV-40E {key.replace('_', ' ')} frequency", "Hz", val, got, "Table 4 of seed002")
     r.numbers["rv40e_frequencies_hz"] = freqs
     if "rv40e" in sims:
         summ = sims["rv40e"][1]

@@ -1,6 +1,6 @@
-"""Lubrication of the main bearing and TE (seeds 000/001).
+"""Lubrication of the main bearing and TE (:cite:`seed000,seed001`).
 
-Seeds 000/001 vary the "oil film thickness at the maximum-load contact" over
+:cite:`seed000,seed001` vary the "oil film thickness at the maximum-load contact" over
 0.01-0.18 mm with peak pressures 0.98-1.25 GPa and report a non-monotonic TE range
 (about -40 .. +43 arcsec). flexrv varies what sets an EHL film and a contact
 pressure in a real bearing, over physically meaningful ranges:
@@ -9,8 +9,7 @@ pressure in a real bearing, over physically meaningful ranges:
   VG 1000 at the operating temperature), EHL law ``hamrock_dowson``, plus the dry
   Hertz reference — central films of ~0.01-0.5 um at the carrier's slow
   entrainment speed;
-* **pressure**: the external radial load on the output flange, 0-30 kN (seed
-  001's range), which sets the maximum Hertz pressure.
+* **pressure**: the external radial load on the output flange, 0-30 kN (:cite:`seed001`'s range), which sets the maximum Hertz pressure.
 
 Each case runs the reducer with the flexible main bearing (``model="flexible"``)
 and records the minimum central film over the loaded balls, the maximum contact
@@ -29,7 +28,7 @@ NAME = "lubrication"
 PRESET = "rv221"
 VISCOSITIES = (0.01, 0.05, 0.15, 0.5, 1.5)  #: eta0 [Pa s]
 RADIAL_LOADS = (0.0, 10e3, 20e3, 30e3)  #: external radial force [N]
-#: seed 001's lubrication table: minimum film [mm], peak pressure [GPa], TE range [arcsec]
+#: :cite:`seed001`'s lubrication table: minimum film [mm], peak pressure [GPa], TE range [arcsec]
 SEED_TABLE = ((0.01, 0.98, (-40.5, 42.3)), (0.07, 1.13, (-38.1, 39.8)), (0.18, 1.25, (-41.7, 43.5)))
 SMOKE = {"t_end": 0.01, "viscosities": (0.05, 1.5), "radial_loads": (0.0,), "model": "balls"}
 
@@ -93,7 +92,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     r.numbers = {"film": film_rows, "pressure": pressure_rows,
                  "te_mean_spread_over_films_arcsec": float(np.ptp(te_span))}
     r.text.append(
-        "Seeds 000/001 set 'minimum film thickness' to 0.01-0.18 mm. An elastohydrodynamic film in a "
+        "seed000/seed001 set 'minimum film thickness' to 0.01-0.18 mm. An elastohydrodynamic film in a "
         "ball-raceway contact at GPa pressures is 0.01-1 um thick (Hamrock-Dowson; the numerical EHL solver of "
         "flexrv agrees within 6-11 %); a 0.1 mm film would separate the surfaces hydrodynamically and carry no "
         "GPa pressure. The seed's film values are therefore not used as films; flexrv varies the viscosity, "
@@ -112,7 +111,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
             " arcsec) — not because of the pressure or the film, but because the radial load shifts the carrier "
             "(and with it cranks and discs) against the pin ring by tens of um (see the ring_deformation "
             "workflow). At zero external load the balls carry only the preload: "
-            f"{film_rows[0]['max ball load [N]']:.0f} N dry (seed 001: steady main-bearing contact force ~93.7 N).")
+            f"{film_rows[0]['max ball load [N]']:.0f} N dry (seed001: steady main-bearing contact force ~93.7 N).")
     keys = [k for k in film_rows[0] if k != "ehl"]
     r.datasets["lubrication_film"] = xr.Dataset({k: ("case", [row[k] for row in film_rows]) for k in keys})
     keys = [k for k in pressure_rows[0] if k != "ehl"]

@@ -1,6 +1,6 @@
-"""Rigid vs flexible main bearing: TE ranges, periods and spectra (seeds 000/001, rv221).
+"""Rigid vs flexible main bearing: TE ranges, periods and spectra (:cite:`seed000,seed001`, rv221).
 
-Seeds 000/001 compare a fully rigid RV reducer model with one whose main-bearing
+:cite:`seed000,seed001` compare a fully rigid RV reducer model with one whose main-bearing
 rings are flexible (and lubricated): TE from -25.2..21.6 arcsec (period 0.15 s)
 to -43.2..45.0 arcsec (period 0.28 s). flexrv runs :func:`flexrv.studies.compare.
 run_compare` on the rv221 preset — the rigid model (5-DOF main-bearing element)
@@ -17,7 +17,7 @@ from flexrv.workflows._common import WorkflowResult
 
 NAME = "rigid_vs_flexible"
 PRESET = "rv221"
-#: seed 001: main-bearing ball contact force at start-up (< 200 N) and steady mean (93.7 N)
+#: :cite:`seed001`: main-bearing ball contact force at start-up (< 200 N) and steady mean (93.7 N)
 SEED_BALL_FORCE = {"startup_max_N": 200.0, "steady_mean_N": 93.7}
 SMOKE = {"t_end": 0.01, "flexible_options": {"ring_options": {"size": 0.015}}}
 #: full run [s]: ramps end at 0.2 s; 0.6 s of steady state resolve the crank rotation (6.8 Hz) in the spectrum
@@ -25,7 +25,7 @@ T_END = 0.8
 
 
 def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None) -> WorkflowResult:
-    """Seeds 000/001 rigid-vs-flexible comparison; saves to ``results/rigid_vs_flexible``."""
+    """:cite:`seed000,seed001` rigid-vs-flexible comparison; saves to ``results/rigid_vs_flexible``."""
     import numpy as np
 
     from flexrv.design import load
@@ -48,7 +48,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
                   f"{seed['te_min_arcsec']} .. {seed['te_max_arcsec']}" if seed else None,
                   f"{n['te_min_arcsec']:.2f} .. {n['te_max_arcsec']:.2f}",
                   "flexrv: steady window after the speed and load ramps"
-                  + ("" if seed else f"; no seed value: seeds 000/001 simulate the rv221, not {red.name}"))
+                  + ("" if seed else f"; no seed value: seed000/seed001 simulate the rv221, not {red.name}"))
         r.compare(f"TE period, {model} model", "s", seed["period_s"] if seed else None, n.get("dominant_period_s"),
                   "flexrv: period of the largest TE spectral peak")
     loads = cmp.flexible["ball_load_inner"]

@@ -1,6 +1,6 @@
-"""Main-bearing ring deformation and TE vs external load (seed 001).
+"""Main-bearing ring deformation and TE vs external load (:cite:`seed001`).
 
-Seed 001 loads the RV reducer's output flange with axial/radial forces of 15/20,
+:cite:`seed001` loads the RV reducer's output flange with axial/radial forces of 15/20,
 20/25 and 25/30 kN and reports the "elastic deformation" of the bearing rings
 (0.35/0.50/0.65 um) and a TE that grows with it. flexrv runs, per case, the
 reducer with flexible main-bearing rings (``model="flexible"``) and, as the
@@ -20,7 +20,7 @@ from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "ring_deformation"
 PRESET = "rv221"
-#: seed 001's load cases: (axial, radial) [N] and its ring deformation [um]
+#: :cite:`seed001`'s load cases: (axial, radial) [N] and its ring deformation [um]
 CASES = ((15e3, 20e3), (20e3, 25e3), (25e3, 30e3))
 SEED_DEFORMATION_UM = (0.35, 0.50, 0.65)
 #: smoke: one case, 10 ms, coarse ring meshes
@@ -29,7 +29,7 @@ SMOKE = {"t_end": 0.01, "cases": CASES[:1], "ring_options": {"size": 0.015}}
 
 def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None,
         cases=None) -> WorkflowResult:
-    """Seed 001 load cases on ``preset``; saves to ``results/ring_deformation``."""
+    """:cite:`seed001` load cases on ``preset``; saves to ``results/ring_deformation``."""
     import xarray as xr
 
     from flexrv.design import load, override
@@ -109,7 +109,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     if reference:
         ref = reference[0]
         text += (f": without external load the TE range is {ref['TE min, flexible [arcsec]']:.2f} .. "
-                 f"{ref['TE max, flexible [arcsec]']:.2f} arcsec, with seed 001's loads it moves to "
+                 f"{ref['TE max, flexible [arcsec]']:.2f} arcsec, with seed001's loads it moves to "
                  f"{rows_seed[0]['TE min, flexible [arcsec]']:.2f} .. {rows_seed[-1]['TE max, flexible [arcsec]']:.2f}"
                  " arcsec.")
     else:
@@ -122,7 +122,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     fig, ax = new_figure(1, 2, figsize=(11, 4))
     x = np.arange(len(rows))
     ax[0].bar(x - 0.2, [row["outer ring deflection [um]"] for row in rows], 0.4, label="flexrv outer ring")
-    ax[0].bar(x + 0.2, [row["seed deformation [um]"] or 0.0 for row in rows], 0.4, label="seed 001")
+    ax[0].bar(x + 0.2, [row["seed deformation [um]"] or 0.0 for row in rows], 0.4, label="seed001")
     ax[0].set_xticks(x, [f"{row['axial [kN]']:.0f}/{row['radial [kN]']:.0f}" for row in rows])
     ax[0].set_xlabel("axial/radial load [kN]")
     ax[0].set_ylabel("ring deformation [µm]")

@@ -1,4 +1,4 @@
-"""Torsional stiffness of the RV-40E second stage (seed 004): per-pin equivalent
+"""Torsional stiffness of the RV-40E second stage (:cite:`seed004`): per-pin equivalent
 torsional stiffness vs meshing phase, meshing-zone identification from the measured
 3.06e8 N mm/rad, pins in contact (analytic pin-load distribution and contact
 simulation) and the stiffness-test bench.
@@ -18,17 +18,17 @@ NMM = 1e-3  #: N m per N mm
 #: stiffness-test timing [s]: full (quasi-static) and smoke (short loop)
 FULL_TEST = {"quarter_time": 0.02, "settle": 0.005}
 SMOKE_TEST = {"quarter_time": 0.005, "settle": 0.002}
-SEED_ZONE_PINS = 4  #: seed 004 identifies a zone of four consecutive pins
+SEED_ZONE_PINS = 4  #: :cite:`seed004` identifies a zone of four consecutive pins
 
 
 def _seed_pin_number(psi, crank_angle=0.0, z_rp=40):
-    """Seed 004 pin number (1 = phase 0 deg, step 360/z_rp) of pins at housing angles ``psi`` [rad]."""
+    """:cite:`seed004` pin number (1 = phase 0 deg, step 360/z_rp) of pins at housing angles ``psi`` [rad]."""
     phase = np.abs(np.mod(np.asarray(psi) - crank_angle + np.pi, 2 * np.pi) - np.pi)
     return np.rint(phase / (2 * np.pi / z_rp)).astype(int) + 1, np.degrees(phase)
 
 
 def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=None, settle=None) -> WorkflowResult:
-    """Seed 004 torsional-stiffness study for ``preset``; saves to ``results/torsional_stiffness``."""
+    """:cite:`seed004` torsional-stiffness study for ``preset``; saves to ``results/torsional_stiffness``."""
     import xarray as xr
 
     from flexrv.analysis.pin_load import reducer_pin_loads
@@ -49,7 +49,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     seed_ktc = SEED004_KTC_NMM * NMM
     n = min(len(th), len(seed_ktc))
     r.tables["per-pin equivalent torsional stiffness KTC_j [N m/rad]"] = [
-        {"pin": j + 1, "phase [deg]": float(np.degrees(th[j])), "seed 004": float(seed_ktc[j]),
+        {"pin": j + 1, "phase [deg]": float(np.degrees(th[j])), "seed004": float(seed_ktc[j]),
          "flexrv": float(ktc[j]), "flexrv/seed": float(ktc[j] / seed_ktc[j]) if seed_ktc[j] > 0 else None}
         for j in range(n)]
     pos = seed_ktc[:n] > 0
@@ -110,7 +110,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
               f"virtual bench (input locked, +-{st.rated_torque:.0f} N m, quarter {test['quarter_time']} s); "
               "missing compliances: crankshaft bending and torsion, pin bending, carrier/flange deflection and "
               "the support (taper) bearings, which together would roughly triple the compliance (estimated)")
-    r.text.append(f"Seed 004 measured C_W = 3.06e8 N mm/rad = {c_w * to_am:.1f} N m/arcmin. flexrv's seed-type "
+    r.text.append(f"seed004 measured C_W = 3.06e8 N mm/rad = {c_w * to_am:.1f} N m/arcmin. flexrv's seed-type "
                   "series model (needle bearings in series with the pin mesh) is about ten times stiffer and the "
                   "rigid-body contact bench three times: both omit the shaft, pin, carrier and support-bearing "
                   "compliances that dominate a real reducer.")
@@ -130,7 +130,7 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
         coords={"time": ("time", res.time, {"units": "s"})})
 
     fig, (a1, a2) = new_figure(1, 2, figsize=(11, 4))
-    a1.semilogy(np.degrees(th[:n]), seed_ktc[:n], "o-", label="seed 004")
+    a1.semilogy(np.degrees(th[:n]), seed_ktc[:n], "o-", label="seed004")
     a1.semilogy(np.degrees(th[:n]), ktc[:n], "s-", label="flexrv")
     a1.axvspan(np.degrees(th[z_seed4.first - 1]), np.degrees(th[z_seed4.last - 1]), color="C0", alpha=0.2,
                label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}")
