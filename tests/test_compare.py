@@ -111,3 +111,40 @@ def test_view_time_beyond_the_run_is_an_error(compared):
 
     r = CliRunner().invoke(app, ["view", str(compared.out_dir / "flexible"), "--time", "5"])
     assert isinstance(r.exception, InputError) and "--time 5" in str(r.exception)
+
+
+def test_view_loads_the_runs_cached_body_and_never_remeshes(compared, tmp_path, monkeypatch):
+    """Issue 16: a saved flexible run records the identity (cache file + content key) of
+    each reduced ring; view loads exactly that body, verified, without meshing. Gone
+    from the cache, view refuses with how to rebuild it; ``--rebuild`` rebuilds it."""
+    import json
+    import shutil
+
+    import flexrv.fem.body as fb
+    from flexrv.post.results import load_results
+    from flexrv.viz.rings import ring_bodies
+
+    res = load_results(compared.out_dir / "flexible")
+    ids = {part: o["identity"] for part, o in json.loads(res.attrs["flexible_bodies"]).items()}
+    assert set(ids) == {"outer_ring", "inner_ring"}
+
+    def no_meshing(*args, **kwargs):
+        raise AssertionError("view re-meshed / re-reduced a ring")
+
+    monkeypatch.setattr(fb, "reduce_part", no_meshing)
+    bodies = ring_bodies(res)
+    assert bodies["outer"].path.name == ids["outer_ring"]["cache_file"]
+    # the body file gone (a cleared cache): a clear refusal naming the way back
+    cache = fb.cache_dir()
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    for f in cache.glob(ids["outer_ring"]["cache_file"] + "*"):
+        shutil.move(str(f), moved / f.name)
+    try:
+        with pytest.raises(fb.InputError, match=r"rebuild it by re-running the simulation.*--rebuild"):
+            ring_bodies(res)
+        monkeypatch.undo()
+        assert ring_bodies(res, rebuild=True)["outer"].n_modes == bodies["outer"].n_modes
+    finally:
+        for f in moved.iterdir():
+            shutil.move(str(f), cache / f.name)

@@ -18,6 +18,8 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
          every: int = typer.Option(10, "--every", help="With --vtu: every k-th record (the stride; the size "
                                                         "of the series is printed after its first frame)."),
          show: bool = typer.Option(False, "--show", help="Open an interactive window (needs a display)."),
+         rebuild: bool = typer.Option(False, "--rebuild", help="Mesh and reduce the rings again from the saved "
+                                      "design if the run's cached bodies are gone (view never re-meshes otherwise)."),
          json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     """Deformed rings (scaled) coloured by displacement or von Mises stress: PNG off-screen,
     interactive with --show, PVD/VTU time series for ParaView with --vtu."""
@@ -42,11 +44,11 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
                          if len(t) else f"--time {time:g} s: the run has no records")
     data = {"result_dir": str(result_dir)}
     if show:
-        data["interactive"] = show_rings(res, time, scale, field)
+        data["interactive"] = show_rings(res, time, scale, field, rebuild=rebuild)
         if not data["interactive"]:
             console.print("no display: writing the PNG instead", style="yellow")
     if not data.get("interactive"):
-        data["png"] = str(render_rings_png(res, png or result_dir / "rings.png", time, scale, field))
+        data["png"] = str(render_rings_png(res, png or result_dir / "rings.png", time, scale, field, rebuild=rebuild))
     if vtu is not None:
         def notice(frames, size):
             from rich.console import Console
@@ -56,7 +58,7 @@ def view(result_dir: Path = typer.Argument(..., help="Result folder of `flexrv s
                 f"(--every {every}; a larger --every writes fewer)")
             data["vtu_frames"], data["vtu_bytes_estimate"] = frames, size
 
-        data["pvd"] = str(write_pvd(res, vtu, every=every, field=field, notice=notice))
+        data["pvd"] = str(write_pvd(res, vtu, every=every, field=field, notice=notice, rebuild=rebuild))
 
     def render(d):
         console.print(kv_table("view", [(k, v, "") for k, v in d.items()]))

@@ -258,6 +258,35 @@ def build_reduced_body(mesh_result, material: dict, n_eig: int = 20, raceway: Ra
     return body
 
 
+def body_identity(body: ReducedBody) -> dict | None:
+    """What identifies a cached reduced body for a saved run: its cache file name
+    (``<part>-<content key>.cms.npz``, the key a hash of the mesh, material, settings,
+    format and library versions), or None for a body that was not cached."""
+    if body.path is None:
+        return None
+    name = Path(body.path).name
+    return {"cache_file": name, "key": name.split("-", 1)[1].split(".", 1)[0]}
+
+
+def load_cached_body(identity: dict) -> ReducedBody:
+    """The reduced body of a saved run from the cache, verified against its stored key
+    (:func:`flexrv.cache.entry_problem`); never meshes or reduces. A body that is gone or
+    does not match raises :class:`InputError` saying how to rebuild it."""
+    from flexrv.cache import entry_problem
+
+    name, key = str(identity.get("cache_file", "")), str(identity.get("key", ""))
+    if not name.endswith(".cms.npz") or "/" in name or not key:
+        raise InputError(f"flexible_bodies: {identity!r} is not a reduced-body identity")
+    path = cache_dir() / name
+    problem = entry_problem([path], key)
+    if problem is not None:
+        raise InputError(f"the reduced body {name} this run used is not usable in the cache {cache_dir()} ({problem}); "
+                         "rebuild it by re-running the simulation with the saved config.toml "
+                         "(`flexrv simulate DIR/config.toml --model flexible ...`), or let `flexrv view --rebuild` "
+                         "mesh and reduce it again")
+    return ReducedBody.load(path)
+
+
 def _reduce_uncached(mesh_result, mesh, part, material, settings, ifaces, n_eig, raceway, stress, fe, path, cache):
     """The reduction of :func:`reduce_mesh` without the cache lookup (writes ``path`` if ``cache``)."""
     t0 = time.perf_counter()

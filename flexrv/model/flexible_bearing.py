@@ -529,7 +529,7 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int |
     mode (``lowest_mode_hz``) is then the Ritz estimate of the attachment basis
     (an upper bound; measured rv221 outer ring: see the report of issue 15).
     """
-    from flexrv.fem.body import reduce_part
+    from flexrv.fem.body import body_identity, reduce_part
 
     if n_eig is None:
         n_eig = RING_EIGENMODES_QUASI_STATIC if quasi_static else RING_EIGENMODES
@@ -543,7 +543,7 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int |
         opts = dict(damping_ratio=damping_ratio, stiffness_scale=stiffness_scale, quasi_static=quasi_static,
                     condense=bool(condense))
         out[label] = [ModalRing(body, **opts), ModalRing(body, mirror=True, **opts)]
-        out["bodies"][part] = settings
+        out["bodies"][part] = {**settings, "identity": body_identity(body)}  # view loads this body, never re-meshes
         out.setdefault("lowest_mode_hz", {})[part] = float(np.sqrt(stiffness_scale) * body.frequencies_hz.min())
     return out
 

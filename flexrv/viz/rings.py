@@ -39,26 +39,45 @@ class RingState:
     von_mises: np.ndarray | None  #: (N,) [Pa] if the body has stress modes
 
 
-def ring_bodies(res, stress: bool = False) -> dict:
-    """{"outer": ReducedBody, "inner": ReducedBody} of a flexible-model result."""
-    from flexrv.fem.body import reduce_part
+def ring_bodies(res, stress: bool = False, rebuild: bool = False) -> dict:
+    """{"outer": ReducedBody, "inner": ReducedBody} of a flexible-model result.
+
+    The run stored the identity of each reduced body it used (cache file and content
+    key, :func:`flexrv.fem.body.body_identity`); the body is loaded from the cache,
+    verified, and never meshed or reduced again: if it is gone, the error says how to
+    rebuild it. ``rebuild=True`` (``flexrv view --rebuild``) meshes and reduces it from
+    the saved design instead, as does ``stress`` (the von Mises modes are not part of the
+    run's body: they are reduced from the cached mesh of the part)."""
+    from flexrv.fem.body import load_cached_body, reduce_part
 
     raw = res.attrs.get("flexible_bodies")
     if raw is None:
         raise InputError(f"result of model {res.attrs.get('model')!r} has no flexible rings to show: run "
                          "`flexrv simulate PRESET --model flexible` (main_bearing flexible)")
-    if res.reducer is None:
-        raise InputError("the result folder has no config.toml: cannot rebuild the reduced rings")
     settings = json.loads(raw) if isinstance(raw, str) else raw
-    return {part.split("_")[0]: reduce_part(res.reducer, part, stress=stress, **opts)
-            for part, opts in settings.items()}
+    out = {}
+    for part, opts in settings.items():
+        opts = dict(opts)
+        identity = opts.pop("identity", None)
+        if not (stress or rebuild):
+            if identity is None:
+                raise InputError(f"this result does not record which reduced {part} it used (saved before "
+                                 "flexrv recorded body identities): `flexrv view --rebuild` meshes and reduces it "
+                                 "again from the saved design")
+            out[part.split("_")[0]] = load_cached_body(identity)
+            continue
+        if res.reducer is None:
+            raise InputError("the result folder has no config.toml: cannot rebuild the reduced rings")
+        out[part.split("_")[0]] = reduce_part(res.reducer, part, stress=stress, **opts)
+    return out
 
 
-def ring_states(res, time: float | None = None, stress: bool = False, bodies: dict | None = None) -> list[RingState]:
+def ring_states(res, time: float | None = None, stress: bool = False, bodies: dict | None = None,
+                rebuild: bool = False) -> list[RingState]:
     """The deformed rings at the record nearest ``time`` [s] (default: last)."""
     from flexrv.geometry.bearing import BallBearingGeometry
 
-    bodies = bodies or ring_bodies(res, stress)
+    bodies = bodies or ring_bodies(res, stress, rebuild)
     t = res.time
     i = len(t) - 1 if time is None else int(np.argmin(np.abs(t - time)))
     z_rows = BallBearingGeometry.from_design(res.reducer.main_bearing).row_positions()
@@ -121,12 +140,13 @@ def auto_scale(states: list[RingState], fraction: float = 0.03) -> float:
 
 
 def render_rings_png(res, path, time: float | None = None, scale: float | None = None, field: str = "displacement",
+                     rebuild: bool = False,
                      window_size=(1000, 800)) -> Path:
     """Render the deformed rings (coloured by |u| or von Mises) off-screen to a PNG."""
     if field not in FIELDS:
         raise InputError(f"field = {field!r} is not allowed: choose one of {', '.join(FIELDS)}")
     pv = _pyvista()
-    states = ring_states(res, time, stress=field == "von_mises")
+    states = ring_states(res, time, stress=field == "von_mises", rebuild=rebuild)
     scale = auto_scale(states) if scale is None else float(scale)
     plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
     try:
@@ -145,12 +165,13 @@ def render_rings_png(res, path, time: float | None = None, scale: float | None =
         plotter.close()
 
 
-def show_rings(res, time: float | None = None, scale: float | None = None, field: str = "displacement") -> bool:
+def show_rings(res, time: float | None = None, scale: float | None = None, field: str = "displacement",
+               rebuild: bool = False) -> bool:
     """Interactive window if a display exists; False (nothing done) when headless."""
     if not os.environ.get("DISPLAY"):
         return False
     pv = _pyvista()
-    states = ring_states(res, time, stress=field == "von_mises")
+    states = ring_states(res, time, stress=field == "von_mises", rebuild=rebuild)
     scale = auto_scale(states) if scale is None else float(scale)
     plotter = pv.Plotter()
     for st in states:
@@ -159,7 +180,8 @@ def show_rings(res, time: float | None = None, scale: float | None = None, field
     return True
 
 
-def write_pvd(res, directory, every: int = 10, field: str = "displacement", notice=None) -> Path:
+def write_pvd(res, directory, every: int = 10, field: str = "displacement", notice=None,
+              rebuild: bool = False) -> Path:
     """Write the ring surfaces of every ``every``-th record as VTU files (point data
     ``displacement`` [m] and |u| [µm], undeformed coordinates: warp in ParaView) and a
     ParaView PVD collection ``rings.pvd`` with the simulation times. Atomic writes.
@@ -171,7 +193,7 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement", noti
         raise InputError(f"every = {every!r} must be >= 1")
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
-    bodies = ring_bodies(res, stress=field == "von_mises")
+    bodies = ring_bodies(res, stress=field == "von_mises", rebuild=rebuild)
     t = res.time
     entries = []
     frames = range(0, len(t), every)
