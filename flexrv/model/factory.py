@@ -217,8 +217,11 @@ def build_flexible(reducer, parts=DEFAULT_FLEXIBLE_PARTS, ring_options: dict | N
 
     * ``main_bearing`` — ball-resolved bearing with reduced flexible inner and
       outer rings of both rows (:func:`flexrv.model.flexible_bearing.flexible_rings`,
-      options ``ring_options``: harmonics, n_eig, size, damping_ratio,
-      stiffness_scale);
+      options ``ring_options``: harmonics, n_eig (default None: no fixed-interface
+      eigenmodes for the quasi-static rings, 12 for dynamic ones), size, damping_ratio,
+      stiffness_scale, quasi_static, condense (default True: the quasi-static rings'
+      modal coordinates condensed into the bearing element; False keeps them as
+      coordinates, for verification), rings; unknown options are refused);
     * ``crankshaft`` — flexible crankshafts (:mod:`flexrv.model.flexible_crank`,
       options ``crank_options``: size, stiffness_scale, damping_ratio).
     """
