@@ -253,11 +253,10 @@ class EHLPointLaw:
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT, HAMROCK_DOWSON_LOAD_EXPONENT
         elif self.mode == "map":
             hu = self._h_unit * speed**0.67
-            speed_b = np.broadcast_to(speed, np.broadcast(np.asarray(delta), speed).shape)
-            interp = self.film_map.load_interpolant(speed_b)
+            speed_c = np.maximum(speed, 1e-300)
 
             def film(q, hu=hu):
-                c, dc = interp(np.broadcast_to(q, speed_b.shape))
+                c, dc = self.film_map.log_correction(q, speed_c)
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
         return _solve(delta, delta_rate, self._k, 1.5, film, self.load_floor, self.c_max,
                       self.damping_depth, self.iterations)
