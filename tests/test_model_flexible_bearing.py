@@ -319,3 +319,18 @@ def test_jacobian_with_map_law_vs_finite_difference(map_rows):
     _, _, _, sb = m.slices()
     assert np.abs(jac[sb, sb] - ev.jac_q[sb, sb]).max() < 1e-5 * scale
     assert ev.inner.load.max() > 20.0
+
+
+def test_kernel_refuses_a_law_it_does_not_cover():
+    """A law outside the kernel (an EHL law with one radius per contact) is refused
+    with a ConfigError naming the supported contact.ehl modes."""
+    from dataclasses import replace
+
+    from flexrv.errors import ConfigError
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    row = rows_from_design(load("rv221"), ehl="hamrock_dowson")[0]
+    law = row.law_inner
+    bad = replace(row, law_inner=replace(law, rx=np.full(row.ball_count, law.rx), ry=np.full(row.ball_count, law.ry)))
+    with pytest.raises(ConfigError, match="'dry', 'hamrock_dowson' or 'map'"):
+        kernel_inputs(bad)
