@@ -23,7 +23,9 @@ Film h_c(Q, u) by ``mode``:
 * ``"hamrock_dowson"`` — Hamrock & Dowson :cite:`hamrock1977` central film for point contacts,
   Pan & Hamrock :cite:`pan1989` for line contacts (:mod:`flexrv.ehl.film`);
 * ``"map"`` — the numerical solver's h_c(Q, u) table (:mod:`flexrv.ehl.maps`),
-  interpolated in log space (point contacts only).
+  interpolated in log space by the map's one compiled function
+  (:func:`flexrv.ehl.maps.packed_log_correction`, also called by the bearing row
+  kernel; point contacts only).
 
 Below the load floor ``load_floor`` the film is frozen at h_c(load_floor): the
 steady EHL formulas diverge as Q^-0.067 for Q -> 0, which would make the law reach

@@ -9,9 +9,10 @@ the result is stored as the *correction factor* to Hamrock–Dowson,
 bilinear in (ln Q, ln u). Interpolating the ratio rather than h itself keeps the
 known power-law dependence exact between nodes, and outside the tabulated range
 the ratio is held at its edge value (constant extrapolation), so the map falls
-back to Hamrock–Dowson scaling there. The interpolation is one compiled function,
-:func:`packed_log_correction`, called by :meth:`FilmMap.log_correction` and by the
-compiled bearing row kernel on the same packed table (:meth:`FilmMap.packed`). Grid points where the solver fails (e.g. a
+back to Hamrock–Dowson scaling there. The interpolation is one compiled
+function, :func:`packed_log_correction`, called by :meth:`FilmMap.log_correction`
+and by the compiled bearing row kernel on the same packed table
+(:meth:`FilmMap.packed`). Grid points where the solver fails (e.g. a
 film the grid cannot resolve at very high load, see the solver's limits) take the
 ratio of the nearest converged point; they are flagged in ``valid``.
 
