@@ -223,3 +223,114 @@ def test_reducer_with_ball_bearing_runs_and_balances():
     assert loads.shape[1:] == (2, 38) and np.all(loads >= 0) and loads.max() > 0
     assert np.all(np.isfinite(res["TE [arcsec]"].values))
     assert abs(res["main_bearing_axial_force"].values[-1]) < 50.0
+
+
+@pytest.fixture(scope="module")
+def map_rows():
+    """rv221 rows whose ball laws are EHLPointLaw in mode "map", each with a small solver
+    map of its own contact (3 x 3 nodes, 33^2 solver grid, loads 20-500 N, speeds
+    0.02-0.2 m/s: coarse for speed; the identity tests below do not depend on the
+    map's accuracy)."""
+    from dataclasses import replace
+
+    from flexrv.ehl.maps import build_film_map
+
+    rows = rows_from_design(load("rv221"), ehl="hamrock_dowson")
+    maps = {}
+    with pytest.warns(RuntimeWarning, match="EHL map"):
+        for side in ("law_inner", "law_outer"):
+            law = getattr(rows[0], side)
+            maps[side] = replace(law, mode="map", film_map=build_film_map(
+                law.rx, law.ry, law.e_eff, law.lubricant, (20.0, 500.0), (0.02, 0.2), n_load=3, n_speed=3, grid=33))
+    return [replace(row, law_inner=maps["law_inner"], law_outer=maps["law_outer"]) for row in rows]
+
+
+@pytest.mark.parametrize("omega", [1.0, 5.0])
+def test_kernel_map_law_equals_ehl_law(map_rows, omega):
+    """EHL mode "map" in the compiled row kernel: every ball's inner and outer normal
+    load and central film equal EHLPointLaw(mode="map") evaluated directly
+    (flexrv.ehl.law, numpy Newton solve) at the approach, approach rate and
+    entrainment speed computed here from the row's geometry (rigid rings, frame
+    rotation about z only), to 1e-9 relative. Carrier speed 1 rad/s puts the
+    entrainment speed (0.077 m/s) inside the map, 5 rad/s (0.385 m/s) beyond it
+    (clamped table); the loads span the preloaded and the unloaded balls."""
+    from dataclasses import replace
+
+    from flexrv.model.bearing_kernel import N_RECORD, RECORD_FIELDS, row_kernel
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    m = map_rows[0]
+    rng = np.random.default_rng(7)
+    n = m.n_coordinates
+    q = rng.normal(scale=3e-6, size=n)
+    q[3:5] = 0.0
+    q[5] = 0.1
+    qt = rng.normal(scale=1e-3, size=n)
+    qt[3:5] = 0.0
+    qt[5] = omega
+    rec = np.zeros((m.ball_count, N_RECORD))
+    row_kernel(q, qt, *kernel_inputs(m), False, rec)
+    col = {name: i for i, name in enumerate(RECORD_FIELDS)}
+    row = m.row
+    b0 = n - 3 * m.ball_count
+    ball = m.ball_reference + q[b0:].reshape(-1, 3)
+    vel = qt[b0:].reshape(-1, 3)
+    c, s = math.cos(q[5]), math.sin(q[5])
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    local = (ball - q[:3]) @ rot
+    psi_i = np.arctan2(local[:, 1], local[:, 0])
+    centre_i = np.c_[row.inner_center_radius * np.cos(psi_i), row.inner_center_radius * np.sin(psi_i),
+                     np.full(psi_i.size, row.inner_center_z + m.z)] @ rot.T
+    e_i = ball - q[:3] - centre_i
+    w_i = vel - qt[:3] - np.cross([0.0, 0.0, omega], centre_i)
+    psi_o = np.arctan2(ball[:, 1], ball[:, 0])
+    e_o = ball - np.c_[row.outer_center_radius * np.cos(psi_o), row.outer_center_radius * np.sin(psi_o),
+                       np.full(psi_o.size, row.outer_center_z + m.z)]
+    speed = m.speed_factor * omega
+    for label, e, w, offset, law in (("inner", e_i, w_i, row.inner_offset, m.law_inner),
+                                     ("outer", e_o, vel, row.outer_offset, m.law_outer)):
+        length = np.linalg.norm(e, axis=1)
+        rate = np.sum(e * w, axis=1) / length
+        ref = law(length - offset, rate, speed)
+        loaded = ref.force > 0
+        assert loaded.sum() >= 5 and (~loaded).sum() >= 1
+        assert ref.force.max() > 20.0  # inside the map's load range
+        np.testing.assert_allclose(rec[:, col[f"load_{label}"]], ref.force, rtol=1e-9, atol=1e-9 * ref.force.max())
+        film = rec[:, col[f"film_{label}"]]
+        np.testing.assert_allclose(film, ref.film, rtol=1e-9, atol=1e-9 * ref.film.max())
+        # the map's correction is active: the film differs from Hamrock-Dowson's
+        hd = replace(law, mode="hamrock_dowson", film_map=None)(length - offset, rate, speed).film
+        assert np.abs(film[loaded] / hd[loaded] - 1).min() > 1e-3
+
+
+def test_jacobian_with_map_law_vs_finite_difference(map_rows):
+    """EHL mode "map": the row kernel's analytic Jacobian (dQ/d delta through the
+    map's d ln h / d ln Q) within 2 % of central differences (as for the dry law, the
+    frame rotation's geometric-stiffness terms are neglected by design), and the
+    ball-ball block, which holds the contact law's derivative, within 1e-5 of the
+    largest entry at the carrier speed 1 rad/s (entrainment speed inside the map)."""
+    m = map_rows[0]
+    q, qt = _random_state(m, seed=3)
+    qt[5] = 1.0
+    ev = evaluate_row(m, q, qt)
+    jac = _fd_jacobian(m, q, qt)
+    scale = np.abs(jac).max()
+    assert np.abs(jac - ev.jac_q).max() < 0.02 * scale
+    _, _, _, sb = m.slices()
+    assert np.abs(jac[sb, sb] - ev.jac_q[sb, sb]).max() < 1e-5 * scale
+    assert ev.inner.load.max() > 20.0
+
+
+def test_kernel_refuses_a_law_it_does_not_cover():
+    """A law outside the kernel (an EHL law with one radius per contact) is refused
+    with a ConfigError naming the supported contact.ehl modes."""
+    from dataclasses import replace
+
+    from flexrv.errors import ConfigError
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    row = rows_from_design(load("rv221"), ehl="hamrock_dowson")[0]
+    law = row.law_inner
+    bad = replace(row, law_inner=replace(law, rx=np.full(row.ball_count, law.rx), ry=np.full(row.ball_count, law.ry)))
+    with pytest.raises(ConfigError, match="'dry', 'hamrock_dowson' or 'map'"):
+        kernel_inputs(bad)

@@ -23,7 +23,9 @@ Film h_c(Q, u) by ``mode``:
 * ``"hamrock_dowson"`` — Hamrock & Dowson :cite:`hamrock1977` central film for point contacts,
   Pan & Hamrock :cite:`pan1989` for line contacts (:mod:`flexrv.ehl.film`);
 * ``"map"`` — the numerical solver's h_c(Q, u) table (:mod:`flexrv.ehl.maps`),
-  interpolated in log space (point contacts only).
+  interpolated in log space by the map's one compiled function
+  (:func:`flexrv.ehl.maps.packed_log_correction`, also called by the bearing row
+  kernel; point contacts only).
 
 Below the load floor ``load_floor`` the film is frozen at h_c(load_floor): the
 steady EHL formulas diverge as Q^-0.067 for Q -> 0, which would make the law reach
@@ -253,11 +255,10 @@ class EHLPointLaw:
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT, HAMROCK_DOWSON_LOAD_EXPONENT
         elif self.mode == "map":
             hu = self._h_unit * speed**0.67
-            speed_b = np.broadcast_to(speed, np.broadcast(np.asarray(delta), speed).shape)
-            interp = self.film_map.load_interpolant(speed_b)
+            speed_c = np.maximum(speed, 1e-300)
 
             def film(q, hu=hu):
-                c, dc = interp(np.broadcast_to(q, speed_b.shape))
+                c, dc = self.film_map.log_correction(q, speed_c)
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
         return _solve(delta, delta_rate, self._k, 1.5, film, self.load_floor, self.c_max,
                       self.damping_depth, self.iterations)

@@ -9,7 +9,10 @@ the result is stored as the *correction factor* to Hamrock–Dowson,
 bilinear in (ln Q, ln u). Interpolating the ratio rather than h itself keeps the
 known power-law dependence exact between nodes, and outside the tabulated range
 the ratio is held at its edge value (constant extrapolation), so the map falls
-back to Hamrock–Dowson scaling there. Grid points where the solver fails (e.g. a
+back to Hamrock–Dowson scaling there. The interpolation is one compiled
+function, :func:`packed_log_correction`, called by :meth:`FilmMap.log_correction`
+and by the compiled bearing row kernel on the same packed table
+(:meth:`FilmMap.packed`). Grid points where the solver fails (e.g. a
 film the grid cannot resolve at very high load, see the solver's limits) take the
 ratio of the nearest converged point; they are flagged in ``valid``.
 
@@ -25,6 +28,7 @@ import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numba import njit
 
 from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
 from flexrv.ehl.film import hamrock_dowson
@@ -64,80 +68,85 @@ class FilmMap:
     valid: np.ndarray
     grid: int
 
+    def __post_init__(self):
+        object.__setattr__(self, "_packed", pack_map_table(self.log_load, self.log_speed, self.log_ratio))
+
+    @property
+    def packed(self) -> np.ndarray:
+        """The table as one float array (layout :data:`PACKED_HEADER`, then ``log_ratio``
+        row-major): the input of :func:`packed_log_correction`, also inside compiled kernels."""
+        return self._packed
+
     def log_correction(self, load, speed):
-        """c(ln Q, ln u) and dc/d ln Q (vectorised bilinear interpolation, edge-clamped)."""
+        """c(ln Q, ln u) and dc/d ln Q (bilinear interpolation, edge-clamped) at loads [N]
+        and speeds [m/s] (broadcast): :func:`packed_log_correction` at each point."""
         lq = np.log(np.maximum(np.asarray(load, dtype=float), 1e-300))
         lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
-        return _bilinear(self.log_ratio, self.log_load, self.log_speed, lq, lu)
-
-    def load_interpolant(self, speed):
-        """Fix the speeds (array, one per contact) and return q -> (c, dc/d ln Q) that
-        interpolates only along ln Q (the contact law's Newton loop calls it repeatedly;
-        ``q`` must have the shape of ``speed``). Identical to :meth:`log_correction` at
-        those speeds."""
-        lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
-        shape = lu.shape
-        lu = lu.reshape(-1)
-        gy, ny = self.log_speed, self.log_speed.size
-        if ny > 1:
-            fy = np.clip((lu - gy[0]) / (gy[1] - gy[0]), 0.0, ny - 1.0)
-            iy = np.minimum(fy.astype(int), ny - 2)
-            ty = fy - iy
-            rows = self.log_ratio[:, iy] * (1 - ty) + self.log_ratio[:, iy + 1] * ty  # (n_load, contacts)
-        else:
-            rows = np.repeat(self.log_ratio[:, :1], lu.size, axis=1)
-        gx, nx = self.log_load, self.log_load.size
-        cols = np.arange(lu.size)
-        if nx == 1:
-            def interp(q):
-                return rows[0].reshape(shape), np.zeros(shape)
-            return interp
-        step = gx[1] - gx[0]
-        slopes = np.diff(rows, axis=0) / step  # (n_load - 1, contacts)
-
-        def interp(q):
-            lq = np.log(np.reshape(q, -1))
-            fx = np.clip((lq - gx[0]) / step, 0.0, nx - 1.0)
-            ix = np.minimum(fx.astype(int), nx - 2)
-            sl = slopes[ix, cols]
-            c = rows[ix, cols] + sl * step * (fx - ix)
-            dc = np.where((lq > gx[0]) & (lq < gx[-1]), sl, 0.0)
-            return c.reshape(shape), dc.reshape(shape)
-
-        return interp
+        lq, lu = np.broadcast_arrays(lq, lu)
+        c, dc = _log_correction_many(self._packed, np.ascontiguousarray(lq).reshape(-1),
+                                     np.ascontiguousarray(lu).reshape(-1))
+        return c.reshape(lq.shape), dc.reshape(lq.shape)
 
 
-def _bilinear(table, gx, gy, x, y):
-    """Bilinear interpolation on uniform grids gx, gy (clamped), and d/dx."""
-    nx, ny = gx.size, gy.size
-    x, y = np.broadcast_arrays(x, y)
+#: header of :meth:`FilmMap.packed`: node counts, first ln Q, ln Q step, last ln Q,
+#: first ln u, ln u step; the table log_ratio (n_load x n_speed, row-major) follows
+PACKED_HEADER = ("n_load", "n_speed", "log_load_first", "log_load_step", "log_load_last", "log_speed_first",
+                 "log_speed_step")
+_NH = len(PACKED_HEADER)
+
+
+def pack_map_table(log_load, log_speed, log_ratio) -> np.ndarray:
+    """One float array of a map's uniform grids and table (layout :data:`PACKED_HEADER`)."""
+    gx, gy = np.asarray(log_load, dtype=float), np.asarray(log_speed, dtype=float)
+    table = np.asarray(log_ratio, dtype=float)
+    if table.shape != (gx.size, gy.size):
+        raise InputError(f"EHL map table shape {table.shape} does not match the grids ({gx.size}, {gy.size})")
+    step_x = gx[1] - gx[0] if gx.size > 1 else 1.0
+    step_y = gy[1] - gy[0] if gy.size > 1 else 1.0
+    return np.concatenate([[gx.size, gy.size, gx[0], step_x, gx[-1], gy[0], step_y], table.reshape(-1)])
+
+
+@njit(cache=True)
+def packed_log_correction(packed, lq, lu):
+    """THE map interpolation: c = ln(h_solver / h_HD) at (ln Q, ln u) = (lq, lu) and
+    dc/d ln Q, bilinear on the uniform grids of ``packed`` (:meth:`FilmMap.packed`).
+    Outside the grid the nodes' edge values are held (clamped), and there the
+    derivative is 0 (also exactly on the first and last ln Q node). Used by
+    :meth:`FilmMap.log_correction` and by the compiled bearing row kernel
+    (flexrv.model.bearing_kernel)."""
+    nx, ny = int(packed[0]), int(packed[1])
+    ix, tx, iy, ty = 0, 0.0, 0, 0.0
+    inside = False
     if nx > 1:
-        fx = np.clip((x - gx[0]) / (gx[1] - gx[0]), 0.0, nx - 1.0)
-        ix = np.minimum(fx.astype(int), nx - 2)
+        fx = min(max((lq - packed[2]) / packed[3], 0.0), nx - 1.0)
+        ix = min(int(fx), nx - 2)
         tx = fx - ix
-        inside_x = (x > gx[0]) & (x < gx[-1])
-    else:
-        ix = np.zeros(x.shape, dtype=int)
-        tx = np.zeros(x.shape)
-        inside_x = np.zeros(x.shape, dtype=bool)
+        inside = lq > packed[2] and lq < packed[4]
     if ny > 1:
-        fy = np.clip((y - gy[0]) / (gy[1] - gy[0]), 0.0, ny - 1.0)
-        iy = np.minimum(fy.astype(int), ny - 2)
+        fy = min(max((lu - packed[5]) / packed[6], 0.0), ny - 1.0)
+        iy = min(int(fy), ny - 2)
         ty = fy - iy
-    else:
-        iy = np.zeros(y.shape, dtype=int)
-        ty = np.zeros(y.shape)
-    ix1 = np.minimum(ix + 1, nx - 1)
-    iy1 = np.minimum(iy + 1, ny - 1)
-    f00, f10 = table[ix, iy], table[ix1, iy]
-    f01, f11 = table[ix, iy1], table[ix1, iy1]
-    val = (f00 * (1 - tx) + f10 * tx) * (1 - ty) + (f01 * (1 - tx) + f11 * tx) * ty
-    if nx > 1:
-        dval = ((f10 - f00) * (1 - ty) + (f11 - f01) * ty) / (gx[1] - gx[0])
-        dval = np.where(inside_x, dval, 0.0)
-    else:
-        dval = np.zeros(x.shape)
+    ix1 = min(ix + 1, nx - 1)
+    iy1 = min(iy + 1, ny - 1)
+    f00 = packed[_NH + ix * ny + iy]
+    f10 = packed[_NH + ix1 * ny + iy]
+    f01 = packed[_NH + ix * ny + iy1]
+    f11 = packed[_NH + ix1 * ny + iy1]
+    val = (f00 * (1.0 - tx) + f10 * tx) * (1.0 - ty) + (f01 * (1.0 - tx) + f11 * tx) * ty
+    dval = 0.0
+    if inside:
+        dval = ((f10 - f00) * (1.0 - ty) + (f11 - f01) * ty) / packed[3]
     return val, dval
+
+
+@njit(cache=True)
+def _log_correction_many(packed, lq, lu):
+    """:func:`packed_log_correction` over flat arrays."""
+    c = np.empty(lq.shape[0])
+    dc = np.empty(lq.shape[0])
+    for i in range(lq.shape[0]):
+        c[i], dc[i] = packed_log_correction(packed, lq[i], lu[i])
+    return c, dc
 
 
 def _check_range(name, lo, hi, n):

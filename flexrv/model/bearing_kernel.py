@@ -42,8 +42,10 @@ condensed rings' modal amplitudes follow from the recorded ring loads by
 :func:`ring_modal_amplitudes` (q = K^-1 sum_j B_j^T g_j).
 
 Supported laws: :class:`flexrv.contact.ball_raceway.HertzLaw` and
-:class:`flexrv.ehl.law.EHLPointLaw` in mode ``dry`` / ``hamrock_dowson``
-with scalar radii (:func:`law_parameters`). The kernel takes plain arrays only
+:class:`flexrv.ehl.law.EHLPointLaw` in mode ``dry`` / ``hamrock_dowson`` / ``map``
+with scalar radii (:func:`law_parameters`); in mode ``map`` the solver map's
+table travels in the law array and is interpolated by the map's own compiled
+function (:func:`flexrv.ehl.maps.packed_log_correction`). The kernel takes plain arrays only
 (the bearing's data classes live in :mod:`flexrv.model.flexible_bearing`, which
 prepares them).
 """
@@ -55,16 +57,21 @@ import math
 import numpy as np
 from numba import njit
 
+from flexrv.ehl.maps import packed_log_correction
+
 #: law parameters: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m], load and speed
 #: exponents of the film, load floor [N], c_max [N s/m], damping depth [m], Newton steps
 LAW_FIELDS = ("k", "h_unit", "load_exponent", "speed_exponent", "load_floor", "c_max", "depth", "iterations")
+N_LAW = len(LAW_FIELDS)
 
 #: columns of the per-ball record ``rec`` (Z, len(RECORD_FIELDS)): loads [N], unit
 #: normals (global), ring azimuths [rad], contact force on each ring in the ring's
 #: own Cartesian frame [N], raceway displacement of each ring at the contact
-#: (global) [m], ball centre (global) [m]
+#: (global) [m], ball centre (global) [m], central EHL film of each contact [m] (0 dry or
+#: out of contact)
 RECORD_FIELDS = ("load_inner", "load_outer", "nix", "niy", "niz", "nox", "noy", "noz", "psi_inner", "psi_outer",
-                 "gix", "giy", "giz", "gox", "goy", "goz", "uix", "uiy", "uiz", "uox", "uoy", "uoz", "bx", "by", "bz")
+                 "gix", "giy", "giz", "gox", "goy", "goz", "uix", "uiy", "uiz", "uox", "uoy", "uoz", "bx", "by", "bz",
+                 "film_inner", "film_outer")
 N_RECORD = len(RECORD_FIELDS)
 
 #: local condensation: absolute tolerance on the contact deflections [m] and the
@@ -74,45 +81,66 @@ CONDENSE_MAXIT = 50
 
 
 def law_parameters(law) -> np.ndarray | None:
-    """Kernel parameters of a normal law (see :data:`LAW_FIELDS`), or None if the
-    kernel does not cover it."""
+    """Kernel parameters of a normal law (see :data:`LAW_FIELDS`; for an EHL law in
+    mode ``"map"`` the map's packed table, :meth:`flexrv.ehl.maps.FilmMap.packed`,
+    follows them), or None if the kernel does not cover it."""
     from flexrv.contact.ball_raceway import HertzLaw
     from flexrv.ehl.law import EHLPointLaw
     from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT
 
     if isinstance(law, HertzLaw) and np.ndim(law.k) == 0:
         return np.array([law.k, 0.0, 0.0, 0.0, 1.0, law.c_max, law.depth, 0.0])
-    if isinstance(law, EHLPointLaw) and law.mode in ("dry", "hamrock_dowson") and np.ndim(law.stiffness) == 0:
-        h_unit = float(law._h_unit) if law.mode == "hamrock_dowson" else 0.0
-        return np.array([float(law.stiffness), h_unit, HAMROCK_DOWSON_LOAD_EXPONENT, 0.67, law.load_floor,
-                         law.c_max, law.damping_depth, float(law.iterations)])
+    if isinstance(law, EHLPointLaw) and law.mode in ("dry", "hamrock_dowson", "map") and np.ndim(law.stiffness) == 0:
+        h_unit = 0.0 if law.mode == "dry" else float(law._h_unit)
+        p = np.array([float(law.stiffness), h_unit, HAMROCK_DOWSON_LOAD_EXPONENT, 0.67, law.load_floor,
+                      law.c_max, law.damping_depth, float(law.iterations)])
+        if law.mode == "map":
+            p = np.concatenate([p, law.film_map.packed])
+        return p
     return None
 
 
 @njit(cache=True)
+def _film(q, hu, lexp, lu, law):
+    """Central film h [m] and d ln h / d ln Q at load q [N] (>= the load floor):
+    Hamrock–Dowson hu q^lexp (hu: h at 1 N and the current speed), times the solver
+    map's correction exp(c(ln q, lu)) when the law carries a map
+    (flexrv.ehl.law.EHLPointLaw.film; c from flexrv.ehl.maps.packed_log_correction)."""
+    h = hu * q**lexp
+    if law.shape[0] > N_LAW:
+        c, dc = packed_log_correction(law[N_LAW:], math.log(q), lu)
+        return h * math.exp(c), lexp + dc
+    return h, lexp
+
+
+@njit(cache=True)
 def _normal_load(delta, rate, speed, law):
-    """(Q, dQ/d delta, dQ/d rate) of the EHL-corrected / dry law
-    (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2)."""
+    """(Q, dQ/d delta, dQ/d rate, film h_c [m]) of the EHL-corrected / dry law
+    (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2; the film is
+    0 out of contact, as in flexrv.ehl.law.EHLForce.film)."""
     k, h_unit, lexp, sexp, floor, c_max, depth, iters = (law[0], law[1], law[2], law[3], law[4], law[5],
                                                          law[6], int(law[7]))
     hu = h_unit * speed**sexp if h_unit > 0.0 and speed > 0.0 else 0.0
     dphi = 1.0
+    h = 0.0
     if hu == 0.0:
         s = max(delta, 0.0)
     else:
-        s = max(delta + hu * floor**lexp, 0.0)
+        lu = math.log(speed)
+        h_floor, _ = _film(floor, hu, lexp, lu, law)
+        s = max(delta + h_floor, 0.0)
         for it in range(iters + 1):
             q = k * s**1.5
-            h = hu * max(q, floor) ** lexp
+            h, slope = _film(max(q, floor), hu, lexp, lu, law)
             dphi = 1.0
             if q > floor:
-                dphi = 1.0 - 1.5 * lexp * h / max(s, 1e-300)
+                dphi = 1.0 - 1.5 * slope * h / max(s, 1e-300)
             dphi = max(dphi, 1e-3)
             if it == iters:
                 break
             s = max(s - (s - delta - h) / dphi, 0.0)
     if s <= 0.0:
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0
     force = k * s**1.5
     dforce = 1.5 * k * math.sqrt(s) / dphi
     c = 0.0
@@ -122,18 +150,18 @@ def _normal_load(delta, rate, speed, law):
         force += c * rate
         dforce += c_max * 6.0 * x * (1.0 - x) / depth / dphi * rate
     if force <= 0.0:
-        return 0.0, 0.0, 0.0
-    return force, dforce, c
+        return 0.0, 0.0, 0.0, h
+    return force, dforce, c, h
 
 
 @njit(cache=True)
 def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
     """Ball-groove contact from the ball-minus-centre vector e and relative velocity w:
-    (|e|, unit normal, Q, dQ/ddelta, dQ/drate); the force on the ball is -Q n."""
+    (|e|, unit normal, Q, dQ/ddelta, dQ/drate, film h_c); the force on the ball is -Q n."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
-    q, dq, c = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
-    return length, nx, ny, nz, q, dq, c
+    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
+    return length, nx, ny, nz, q, dq, c, h
 
 
 @njit(cache=True)
@@ -272,13 +300,13 @@ def _split_workspace(ws, nz, m):
 
 
 @njit(cache=True)
-def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, lengths):
+def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, lengths, films):
     """Contact deflections u of a condensed ring, everything in each contact's
     ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k), C_jk = W_j W_k^T
     (wl: (Z, 3, m) factors W_j = S B_j K^-1/2), g_k = Q_k n_k the force on the
     ring. ``ws``: the ring's work array (u's warm start and the last tangent, see
     :func:`condense_workspace`). Fills the contact results at the solution
-    (loads, normals, dQ/ddelta, damping coefficient, |e|); returns the number of
+    (loads, normals, dQ/ddelta, damping coefficient, |e|, film); returns the number of
     iterations (-1: not converged).
 
     Chord (Newton-type) iterations with the normal contact stiffness only:
@@ -299,9 +327,10 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
         for k in range(m):
             y[k] = 0.0
         for j in range(nz):
-            length, nx, ny, nzz, q, d, c = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1], e0[j, 2] - u[j, 2],
-                                                    w0[j, 0], w0[j, 1], w0[j, 2], offset, speed, law)
-            loads[j], dq[j], cd[j], lengths[j] = q, d, c, length
+            length, nx, ny, nzz, q, d, c, hf = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
+                                                        e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
+                                                        speed, law)
+            loads[j], dq[j], cd[j], lengths[j], films[j] = q, d, c, length, hf
             normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
             if q != 0.0:
                 g0, g1, g2 = q * nx, q * ny, q * nzz
@@ -361,8 +390,8 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
 
 
 @njit(cache=True)
-def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, du,
-                    cglobal):
+def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, films,
+                    du, cglobal):
     """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
     each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
     the compliance factors, the contact solve (:func:`_condense`, deflections u
@@ -382,7 +411,7 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
             el[j, a] = rot[j, 0, a] * e0[j, 0] + rot[j, 1, a] * e0[j, 1] + rot[j, 2, a] * e0[j, 2]
             wv[j, a] = rot[j, 0, a] * w0[j, 0] + rot[j, 1, a] * w0[j, 1] + rot[j, 2, a] * w0[j, 2]
     nl = np.empty((nz, 3))
-    its = _condense(el, wv, wl, offset, speed, law, ws, loads, nl, dq, cd, lengths)
+    its = _condense(el, wv, wl, offset, speed, law, ws, loads, nl, dq, cd, lengths, films)
     u = ws[0:3 * nz].reshape((nz, 3))
     for j in range(nz):
         for a in range(3):
@@ -549,11 +578,13 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     cd_o = np.empty(nz)
     len_i = np.empty(nz)
     len_o = np.empty(nz)
+    film_i = np.empty(nz)
+    film_o = np.empty(nz)
     cmat_i = np.zeros((3 * nz if (cond_i and jacobian) else 0, 3 * nz if (cond_i and jacobian) else 0))
     cmat_o = np.zeros((3 * nz if (cond_o and jacobian) else 0, 3 * nz if (cond_o and jacobian) else 0))
     if cond_i:
         its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i,
-                              nrm_i, dq_i, cd_i, len_i, du_i, cmat_i)
+                              nrm_i, dq_i, cd_i, len_i, film_i, du_i, cmat_i)
         state[3] += 1
         if its < 0:
             state[0] += 1
@@ -565,11 +596,11 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
                 arm[j, c] += du_i[j, c]
     else:
         for j in range(nz):
-            len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j] = _contact(
+            len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j], film_i[j] = _contact(
                 e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
     if cond_o:
         its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o,
-                              nrm_o, dq_o, cd_o, len_o, du_o, cmat_o)
+                              nrm_o, dq_o, cd_o, len_o, film_o, du_o, cmat_o)
         state[3] += 1
         if its < 0:
             state[0] += 1
@@ -578,7 +609,7 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
             state[2] += its
     else:
         for j in range(nz):
-            len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j] = _contact(
+            len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j], film_o[j] = _contact(
                 e0_o[j, 0], e0_o[j, 1], e0_o[j, 2], w0_o[j, 0], w0_o[j, 1], w0_o[j, 2], off_o, speed, law_o)
     # ---------------- pass 2: generalized forces (and Jacobian blocks)
     k_i = np.empty((3, 3))
@@ -643,6 +674,7 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
                 rec[j, 19 + c] = du_o[j, c]
                 rec[j, 22 + c] = bpos[j, c]
             rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
+            rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
             rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
             rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
         if not jacobian:

@@ -249,8 +249,9 @@ def kernel_inputs(model: RowModel) -> tuple:
         p = law_parameters(law)
         if p is None:
             mode = getattr(law, "mode", type(law).__name__)
-            raise ConfigError(f"contact.ehl = {mode!r} is not supported by the ball-resolved main bearing "
-                              f"({side} contact): choose 'dry' or 'hamrock_dowson'")
+            raise ConfigError(f"contact law {mode!r} is not supported by the ball-resolved main bearing "
+                              f"({side} contact): use contact.ehl = 'dry', 'hamrock_dowson' or 'map' "
+                              f"(one contact geometry per ring: scalar radii)")
         laws.append(p)
     tab_i, zs_i, comp_i, ws_i = _ring_arrays(model.inner, model.ball_count)
     tab_o, zs_o, comp_o, ws_o = _ring_arrays(model.outer, model.ball_count)
