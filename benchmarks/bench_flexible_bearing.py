@@ -38,7 +38,9 @@ def build(preset: str, flexible: bool, size: float | None, axial: float, radial:
         t0 = time.perf_counter()
         body = reduce_part(reducer, "outer_ring", size=size)
         t_reduce = time.perf_counter() - t0
-        outer = [ModalRing(body, condense=condense), ModalRing(body, mirror=True, condense=condense)]
+        zeta = reducer.main_bearing.ring_damping_ratio
+        outer = [ModalRing(body, damping_ratio=zeta, condense=condense),
+                 ModalRing(body, damping_ratio=zeta, mirror=True, condense=condense)]
     rows = rows_from_design(reducer, outer=outer)
     omega_c = float(reducer_kinematics(reducer).speeds.carrier)
     sc = exu.SystemContainer()

@@ -72,6 +72,17 @@ def signature_options(fn, skip: int = 0, exclude: tuple[str, ...] = ()) -> dict[
     every parameter after the first ``skip`` positional ones, except ``exclude``."""
     import inspect
 
+    def example(p):
+        if p.default is not inspect.Parameter.empty and p.default is not None:
+            return p.default
+        # no default value to compare with: the annotation's scalar type, if it names one
+        ann = p.annotation if isinstance(p.annotation, str) else getattr(p.annotation, "__name__", "")
+        kinds = [t.strip() for t in str(ann).split("|")]
+        for name, value in (("bool", False), ("int", 0), ("float", 0.0), ("str", "")):
+            if name in kinds:
+                return value
+        return None
+
     params = list(inspect.signature(fn).parameters.values())[skip:]
-    return {p.name: (None if p.default is inspect.Parameter.empty else p.default) for p in params
+    return {p.name: example(p) for p in params
             if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in exclude}

@@ -48,8 +48,9 @@ def _flexible_rows(rv, out, scale=1.0, rings=("inner", "outer"), condense=True, 
     kw = {}
     for label in rings:
         body = out[f"{label}_ring"][2]
-        kw[label] = [ModalRing(body, stiffness_scale=scale, condense=condense),
-                     ModalRing(body, stiffness_scale=scale, mirror=True, condense=condense)]
+        zeta = rv.main_bearing.ring_damping_ratio
+        kw[label] = [ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, condense=condense),
+                     ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, mirror=True, condense=condense)]
     return rows_from_design(rv, ehl=ehl, **kw)
 
 

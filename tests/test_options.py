@@ -33,8 +33,13 @@ def test_newton_options_checked_before_work(options, message):
 
 
 def test_check_options_accepts_ints_for_floats_and_any_for_none():
-    allowed = signature_options(lambda reducer, size=None, scale=1.0, n=3, flag=True: None, skip=1)
-    assert allowed == {"size": None, "scale": 1.0, "n": 3, "flag": True}
+    def fn(reducer, size=None, scale=1.0, n=3, flag=True, zeta: "float | None" = None):
+        pass
+
+    allowed = signature_options(fn, skip=1)
+    assert allowed == {"size": None, "scale": 1.0, "n": 3, "flag": True, "zeta": 0.0}
+    with pytest.raises(InputError, match=r"x.zeta = 'a' is not allowed"):
+        check_options("x", {"zeta": "a"}, allowed)
     assert check_options("x", {"size": "anything", "scale": 2, "n": 4, "flag": False}, allowed) == \
         {"size": "anything", "scale": 2, "n": 4, "flag": False}
     with pytest.raises(InputError, match=r"x.flag = 1 is not allowed"):

@@ -223,6 +223,8 @@ class Crankshaft(_Strict):
     support_bearing_axial_preload_um: float | None = Field(default=None, ge=-50.0, le=50.0, description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end play (-) [um]")
     support_bearing_radial_stiffness_N_per_m: float | None = Field(default=None, gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing (linear model only)")
     support_bearing_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
+    structural_damping_ratio: float = Field(
+        ge=0.0, le=1.0, description="Damping ratio of the flexible crankshafts' elastic coordinates")
     bending_model: Literal["timoshenko", "rigid"] = Field(
         default="timoshenko", description="Crank bending between the support journals and the eccentrics in series with the supports")
 
@@ -307,6 +309,12 @@ class MainBearing(_Strict):
         gt=1e6, le=1e12, description="Axial stiffness of the pair in the rigid main-bearing model")
     rigid_damping_ratio: float = Field(
         ge=0.0, le=1.0, description="Damping ratio of the rigid main bearing's carrier modes (c = 2 zeta sqrt(k m))")
+    cage_stiffness_N_per_m: float = Field(
+        gt=0.0, le=1e9, description="Tangential spring of each ball to its cage pocket (ball-resolved models)")
+    cage_damping_Ns_per_m: float = Field(ge=0.0, le=1e6, description="Tangential damper of each ball to its pocket")
+    pocket_stiffness_N_per_m: float = Field(
+        ge=0.0, le=1e9, description="Weak radial/axial spring of each ball to its pocket (ball-resolved models)")
+    ring_damping_ratio: float = Field(ge=0.0, le=1.0, description="Modal damping ratio of dynamic flexible rings")
 
     @model_validator(mode="after")
     def _fits(self) -> "MainBearing":

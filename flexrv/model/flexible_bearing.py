@@ -90,7 +90,7 @@ class ModalRing:
     """
 
     body: object
-    damping_ratio: float = 0.02
+    damping_ratio: float = field(kw_only=True)  #: modal damping of a dynamic ring (design main_bearing.ring_damping_ratio)
     mirror: bool = False
     stiffness_scale: float = 1.0
     quasi_static: bool = True
@@ -171,13 +171,15 @@ class RowModel:
     law_outer: object
     inner: RingModes | None = None
     outer: RingModes | None = None
-    cage_stiffness: float = 1e5
-    cage_damping: float = 50.0
+    #: tangential spring [N/m] and damper [N s/m] of each ball to its cage pocket, and the
+    #: weak radial/axial spring to the pocket [N/m]: the design's main_bearing.cage_* /
+    #: pocket_* estimates (presets, with provenance)
+    cage_stiffness: float = field(kw_only=True)
+    cage_damping: float = field(kw_only=True)
+    pocket_stiffness: float = field(kw_only=True)
     #: cage angle / frame (inner ring) angle for pure rolling with a fixed outer
-    #: ring: (1 - D cos a / d_m) / 2 (Harris & Kotzalas 2007, ch. 8)
-    cage_ratio: float = 0.5
-    #: weak radial/axial spring of each ball to its pocket [N/m]
-    pocket_stiffness: float = 1e3
+    #: ring: (1 - D cos a / d_m) / 2 (:meth:`flexrv.geometry.bearing.BallBearingGeometry.cage_speed`)
+    cage_ratio: float = field(kw_only=True)
     #: entrainment speed per unit frame (inner ring) angular speed [m]:
     #: u = (d_m/4)(1 - gamma^2)|omega| (Hamrock 1994, ch. 24)
     speed_factor: float = 0.0
@@ -400,7 +402,7 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     return pos - model.ball_reference
 
 
-def add_main_bearing(mbs, rows: list[RowModel], frame_node: int, ring_damping_ratio: float = 0.02) -> BearingHandle:
+def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandle:
     """Add balls, ring modal bodies and one contact element per row to ``mbs``.
 
     ``frame_node`` must be a ``NodeRigidBodyRxyz`` at the origin (reference
@@ -461,6 +463,7 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
     from flexrv.geometry.bearing import BallBearingGeometry
 
     geom = BallBearingGeometry.from_design(reducer.main_bearing)
+    mb = reducer.main_bearing
     ring_mat, ball_mat = reducer.material("bearing_rings"), reducer.material("rolling_elements")
     e_eff = float(effective_modulus(ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus,
                                     ball_mat.poisson_ratio))
@@ -481,7 +484,10 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
             law_i, law_o = hertz_law(row.k_inner, c_max, depth), hertz_law(row.k_outer, c_max, depth)
         else:
             law_i, law_o = laws
-        rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count, cage_ratio=0.5 * (1.0 - geom.gamma),
+        rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count,
+                             cage_ratio=float(geom.cage_speed(1.0, 0.0)),  # cage turns per frame (inner ring) turn
+                             cage_stiffness=mb.cage_stiffness_N_per_m, cage_damping=mb.cage_damping_Ns_per_m,
+                             pocket_stiffness=mb.pocket_stiffness_N_per_m,
                              ball_mass=geom.ball_mass(ball_mat.density_kg_m3), law_inner=law_i, law_outer=law_o,
                              speed_factor=speed_factor, inner_radii=(float(rx_i), float(ry_i)), e_eff=e_eff,
                              inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
@@ -499,7 +505,7 @@ RING_EIGENMODES_QUASI_STATIC = 0
 
 
 def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int | None = None, size: float | None = None,
-                   damping_ratio: float = 0.02, stiffness_scale: float = 1.0, quasi_static: bool = True,
+                   damping_ratio: float | None = None, stiffness_scale: float = 1.0, quasi_static: bool = True,
                    rings: tuple[str, ...] = ("inner", "outer"), condense: bool = True) -> dict:
     """Reduced flexible rings of a design's main bearing for both rows.
 
@@ -541,7 +547,8 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int |
         part = f"{label}_ring"
         settings = {"size": size, "n_eig": int(n_eig), "n_harmonics": None if harmonics is None else int(harmonics)}
         body = reduce_part(reducer, part, **settings)
-        opts = dict(damping_ratio=damping_ratio, stiffness_scale=stiffness_scale, quasi_static=quasi_static,
+        zeta = reducer.main_bearing.ring_damping_ratio if damping_ratio is None else float(damping_ratio)
+        opts = dict(damping_ratio=zeta, stiffness_scale=stiffness_scale, quasi_static=quasi_static,
                     condense=bool(condense))
         out[label] = [ModalRing(body, **opts), ModalRing(body, mirror=True, **opts)]
         out["bodies"][part] = {**settings, "identity": body_identity(body)}  # view loads this body, never re-meshes

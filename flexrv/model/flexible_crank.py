@@ -13,7 +13,8 @@ members with the same (x, y, rotation) layout:
 coupled by the FE crankshaft's condensed stiffness (:func:`flexrv.fem.crankshaft.
 crank_compliance`): a torsional spring k_t on (phi_planet - phi_crank) and an
 isotropic lateral spring k_l on the gear seat's offset from the crank axis, with
-stiffness-proportional damping of ratio ``damping_ratio`` on each (estimate).
+stiffness-proportional damping of ratio ``damping_ratio`` on each (default: the design's
+crankshaft.structural_damping_ratio, an estimate with provenance in the presets).
 Mass split: planet gear + gear seat on ``planet<j>``, the rest of the shaft on
 ``crank<j>`` (:func:`flexrv.model.parameters.rigid_parameters`).
 
@@ -87,7 +88,7 @@ class CrankElasticity(ForceGroup):
 
 
 def add_flexible_cranks(reducer, params, members: dict, groups: list, size: float | None = None,
-                        stiffness_scale: float = 1.0, damping_ratio: float = 0.02) -> dict:
+                        stiffness_scale: float = 1.0, damping_ratio: float | None = None) -> dict:
     """Turn the rigid cranks of a model under construction into flexible ones (see
     module doc): split the members, re-target the gear meshes, add the coupling.
 
@@ -103,6 +104,8 @@ def add_flexible_cranks(reducer, params, members: dict, groups: list, size: floa
     m_p, j_p = p.planet_mass, p.planet_inertia
     m_c, j_c = p.crank_mass - m_p, p.crank_inertia - j_p
     j_red, m_red = j_p * j_c / (j_p + j_c), m_p * m_c / (m_p + m_c)
+    if damping_ratio is None:  # the design's estimate (presets, with provenance)
+        damping_ratio = reducer.crankshaft.structural_damping_ratio
     c_t = 2.0 * damping_ratio * np.sqrt(k_t * j_red)
     c_l = 2.0 * damping_ratio * np.sqrt(k_l * m_red)
     for j in range(p.n_cranks):
