@@ -402,6 +402,43 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     return pos - model.ball_reference
 
 
+def add_row_element(mbs, row: RowModel, nodes: list[int], idx: np.ndarray | None = None,
+                    ball_reference: np.ndarray | None = None, stats: list | None = None) -> int:
+    """THE Exudyn glue of one bearing row: one ``ObjectGenericODE2`` over ``nodes`` whose
+    force and Jacobian user functions call the compiled row kernel (:func:`row_force`,
+    :func:`row_jacobian`). ``idx`` maps the row element's coordinates [frame(6), inner
+    modes, outer modes, balls(3Z)] to the nodes' coordinates (default: the same order);
+    ``ball_reference`` is subtracted from the ball coordinates when the nodes hold
+    absolute ball positions (the reducer model's ball members); ``stats`` counts the
+    force and Jacobian calls. Used by the reducer model's :class:`BallBearingGroup` and
+    by the stand-alone bearing of :func:`add_main_bearing`. Returns the object number."""
+    from exudyn.itemInterface import ObjectGenericODE2
+
+    idx = np.arange(row.n_coordinates) if idx is None else np.asarray(idx)
+    inv = np.argsort(idx)  # nodes' coordinate -> element coordinate
+    ref = np.zeros(0) if ball_reference is None else np.asarray(ball_reference, dtype=float)
+    stats = [0, 0] if stats is None else stats
+
+    def element(q, q_t):
+        qe = np.asarray(q)[idx]
+        if ref.size:
+            qe[-ref.size:] -= ref
+        return qe, np.asarray(q_t)[idx]
+
+    def force_fn(mbs_, t, item, q, q_t):
+        stats[0] += 1
+        qe, ve = element(q, q_t)
+        return row_force(row, qe, ve)[inv]
+
+    def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
+        stats[1] += 1
+        qe, ve = element(q, q_t)
+        jq, jv = row_jacobian(row, qe, ve)
+        return -(f_q * jq + f_v * jv)[np.ix_(inv, inv)]
+
+    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
+
+
 def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandle:
     """Add balls, ring modal bodies and one contact element per row to ``mbs``.
 
@@ -432,16 +469,7 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandl
         ball_nodes.append(balls)
         node_list += balls
 
-        def force_fn(mbs_, t, item, q, q_t, model=model):
-            return row_force(model, np.asarray(q), np.asarray(q_t))
-
-        def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, model=model):
-            jq, jv = row_jacobian(model, np.asarray(q), np.asarray(q_t))
-            return -(f_q * jq + f_v * jv)
-
-        obj = mbs.AddObject(ObjectGenericODE2(nodeNumbers=node_list,
-                                              forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
-        objects.append(obj)
+        objects.append(add_row_element(mbs, model, node_list))
     return BearingHandle(rows=rows, frame_node=frame_node, inner_nodes=inner_nodes, outer_nodes=outer_nodes,
                          ball_nodes=ball_nodes, contact_objects=objects)
 
@@ -603,36 +631,14 @@ class BallBearingGroup(ForceGroup):
         (instead of one over the whole group): the rows do not interact except
         through the carrier, and separate elements keep the zero row-row blocks out
         of the system Jacobian (measured: ~half the nonzeros for two flexible rows).
-        Returns the first row's object number."""
-        from exudyn.itemInterface import ObjectGenericODE2
-
+        Returns the first row's object number (:func:`add_row_element`, the one glue path)."""
         stats, objects, pos = self.stats, [], 1
         for k, row in enumerate(self.rows):
             count = 1 + len(row.ring_nodes())
             row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
             pos += count
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
-            inv = np.argsort(idx)  # local -> element coordinate
-            ref = row.ball_reference.ravel()
-
-            def element(q, q_t, idx=idx, ref=ref):
-                qe = np.asarray(q)[idx]
-                qe[-ref.size:] -= ref
-                return qe, np.asarray(q_t)[idx]
-
-            def force_fn(mbs_, t, item, q, q_t, row=row, element=element, inv=inv):
-                stats[0] += 1
-                qe, ve = element(q, q_t)
-                return row_force(row, qe, ve)[inv]
-
-            def jac_fn(mbs_, t, item, q, q_t, f_q, f_v, row=row, element=element, inv=inv):
-                stats[1] += 1
-                qe, ve = element(q, q_t)
-                jq, jv = row_jacobian(row, qe, ve)
-                return -(f_q * jq + f_v * jv)[np.ix_(inv, inv)]
-
-            objects.append(mbs.AddObject(ObjectGenericODE2(nodeNumbers=row_nodes, forceUserFunction=force_fn,
-                                                           jacobianUserFunction=jac_fn)))
+            objects.append(add_row_element(mbs, row, row_nodes, idx, row.ball_reference.ravel(), stats))
         return objects[0]
 
     @property
