@@ -429,6 +429,27 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
 
 
 @njit(cache=True)
+def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
+                   du, cmat, state):
+    """The ball contacts of one ring of a row: the condensed ring's local solve
+    (:func:`_condensed_ring`, its iteration count and failures in ``state``) or, for a
+    rigid / modal ring, each contact from its approach (:func:`_contact`)."""
+    if condensed:
+        its = _condensed_ring(psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
+                              du, cmat)
+        state[3] += 1
+        if its < 0:
+            state[0] += 1
+            state[1] = 1
+        else:
+            state[2] += its
+    else:
+        for j in range(e0.shape[0]):
+            lengths[j], normals[j, 0], normals[j, 1], normals[j, 2], loads[j], dq[j], cd[j], films[j] = _contact(
+                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, speed, law)
+
+
+@njit(cache=True)
 def _rotation_z(a, psi, out):
     """out = a Rz(psi): ring-cylindrical components at psi -> global."""
     c, s = math.cos(psi), math.sin(psi)
@@ -582,35 +603,14 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     film_o = np.empty(nz)
     cmat_i = np.zeros((3 * nz if (cond_i and jacobian) else 0, 3 * nz if (cond_i and jacobian) else 0))
     cmat_o = np.zeros((3 * nz if (cond_o and jacobian) else 0, 3 * nz if (cond_o and jacobian) else 0))
+    _ring_contacts(cond_i, psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i, nrm_i, dq_i,
+                   cd_i, len_i, film_i, du_i, cmat_i, state)
     if cond_i:
-        its = _condensed_ring(psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i,
-                              nrm_i, dq_i, cd_i, len_i, film_i, du_i, cmat_i)
-        state[3] += 1
-        if its < 0:
-            state[0] += 1
-            state[1] = 1
-        else:
-            state[2] += its
         for j in range(nz):
             for c in range(3):
                 arm[j, c] += du_i[j, c]
-    else:
-        for j in range(nz):
-            len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], load_i[j], dq_i[j], cd_i[j], film_i[j] = _contact(
-                e0_i[j, 0], e0_i[j, 1], e0_i[j, 2], w0_i[j, 0], w0_i[j, 1], w0_i[j, 2], off_i, speed, law_i)
-    if cond_o:
-        its = _condensed_ring(psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o,
-                              nrm_o, dq_o, cd_o, len_o, film_o, du_o, cmat_o)
-        state[3] += 1
-        if its < 0:
-            state[0] += 1
-            state[1] = 1
-        else:
-            state[2] += its
-    else:
-        for j in range(nz):
-            len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], load_o[j], dq_o[j], cd_o[j], film_o[j] = _contact(
-                e0_o[j, 0], e0_o[j, 1], e0_o[j, 2], w0_o[j, 0], w0_o[j, 1], w0_o[j, 2], off_o, speed, law_o)
+    _ring_contacts(cond_o, psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o, nrm_o, dq_o,
+                   cd_o, len_o, film_o, du_o, cmat_o, state)
     # ---------------- pass 2: generalized forces (and Jacobian blocks)
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
