@@ -321,3 +321,22 @@ def cached_entry(paths, key: str, load, build, enabled: bool = True):
         value = build()
         stamp_entry(paths, key)
     return value, False
+
+
+def cached_dataclass(path, key: str, cls, compute, enabled: bool = True):
+    """A dataclass of JSON-able fields (a condensed FE result, say) cached as one JSON
+    file ``path`` under ``key`` (:func:`cached_entry`: verified on read, rebuilt when
+    corrupt or foreign, built once under a lock). ``compute()`` returns the instance;
+    ``enabled=False`` computes without reading or writing the cache."""
+    from dataclasses import asdict
+
+    path = Path(path)
+
+    def build():
+        out = compute()
+        if enabled:
+            atomic_write_text(path, json.dumps(asdict(out)))
+        return out
+
+    value, _ = cached_entry([path], key, lambda: cls(**json.loads(path.read_text())), build, enabled=enabled)
+    return value

@@ -44,13 +44,12 @@ material, the load split and the library versions.
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from flexrv.cache import atomic_write_text, cache_dir, cached_entry, content_hash, library_versions
+from flexrv.cache import cache_dir, cached_dataclass, content_hash, library_versions
 from flexrv.errors import InputError
 from flexrv.units import RAD_PER_ARCMIN
 
@@ -229,13 +228,9 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
         out = CarrierCompliance(matrix=C.tolist(), labels=labels, torsional=c_t, torsional_rbe2=c_rbe2,
                                 split_input=float(split_input), crank_circle_radius=float(a_w), n_cranks=int(n),
                                 n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key)
-        if cache:
-            atomic_write_text(path, json.dumps(asdict(out)))
         return out
 
-    out, _ = cached_entry([path], key, lambda: CarrierCompliance(**json.loads(path.read_text())), _build,
-                          enabled=cache)
-    return out
+    return cached_dataclass(path, key, CarrierCompliance, _build, enabled=cache)
 
 
 def rbe2_bore_compliance(K, mesh, names: list[str]) -> np.ndarray:

@@ -31,12 +31,11 @@ material and the library versions.
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
-from flexrv.cache import atomic_write_text, cache_dir, cached_entry, content_hash, library_versions
+from flexrv.cache import cache_dir, cached_dataclass, content_hash, library_versions
 
 FORMAT_VERSION = 1
 
@@ -103,13 +102,9 @@ def crank_compliance(reducer, size: float | None = None, cache: bool = True) -> 
         f_hz, _ = eigenmodes(fe.K, fe.M, 1, fixed_nodes=fixed)
         out = CrankCompliance(torsional=float(k_t), lateral_x=float(1.0 / c_l[0, 0]), lateral_y=float(1.0 / c_l[1, 1]),
                               lowest_clamped_hz=float(f_hz[0]), n_nodes=int(d.n_nodes), mesh_key=mres.key)
-        if cache:
-            atomic_write_text(path, json.dumps(asdict(out)))
         return out
 
-    out, _ = cached_entry([path], key, lambda: CrankCompliance(**json.loads(path.read_text())), _build,
-                          enabled=cache)
-    return out
+    return cached_dataclass(path, key, CrankCompliance, _build, enabled=cache)
 
 
 @dataclass(frozen=True)

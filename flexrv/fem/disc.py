@@ -48,13 +48,12 @@ system) to 1e-8; mesh convergence with the patch fixed.
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from flexrv.cache import atomic_write_text, cache_dir, cached_entry, content_hash, library_versions
+from flexrv.cache import cache_dir, cached_dataclass, content_hash, library_versions
 from flexrv.errors import InputError
 from flexrv.units import RAD_PER_ARCMIN
 
@@ -201,13 +200,9 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
                              output_share=c_d / ss.n_discs, n_discs=int(ss.n_discs), torque=torque,
                              crank_angle=float(crank_angle), patch=patch, n_loaded=int(np.count_nonzero(f)),
                              n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key)
-        if cache:
-            atomic_write_text(path, json.dumps(asdict(out)))
         return out
 
-    out, _ = cached_entry([path], key, lambda: DiscCompliance(**json.loads(path.read_text())), _build,
-                          enabled=cache)
-    return out
+    return cached_dataclass(path, key, DiscCompliance, _build, enabled=cache)
 
 
 
@@ -271,12 +266,9 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
         out = DiscSweep(angles=angles, torsional=cd, mean=mean, output_share=mean / ss.n_discs,
                         n_discs=int(ss.n_discs), torque=torque, patch=patch, n_nodes=int(d.n_nodes),
                         size=float(d.size), mesh_key=mres.key)
-        if cache:
-            atomic_write_text(path, json.dumps(asdict(out)))
         return out
 
-    out, _ = cached_entry([path], key, lambda: DiscSweep(**json.loads(path.read_text())), _build, enabled=cache)
-    return out
+    return cached_dataclass(path, key, DiscSweep, _build, enabled=cache)
 
 
 def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
