@@ -180,18 +180,14 @@ def test_completed_jacobians_vs_central_differences(errors):
     terms' dependence on q). Measured: 1-8e-8 (the differences' round-off)."""
     from flexrv.design import load_error_set, with_errors
     from flexrv.model.assembled import group_index
+    from flexrv.model.quasi_static import StaticModel
 
     red = _variant("rv40e", "empirical")
     if errors:
         red = with_errors(red, load_error_set(errors))
     m, states = _static_states(red)
     rng = np.random.default_rng(3)
-    arm = np.ones(m.n)
-    for mem in m.members.values():
-        sl = m.slice(mem.name)
-        for k, lab in enumerate(mem.labels):
-            if lab in ("theta", "phi", "psi", "rx", "ry"):
-                arm[sl.start + k] = m.params.center_distance
+    arm = StaticModel(red).arm  # the solver's length scale per coordinate (crank-circle radius for angles)
     checked = 0
     for th, q in states:
         for v_scale in (0.0, 1e-3):
