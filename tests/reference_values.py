@@ -42,12 +42,18 @@ REFERENCE = {
                   "TE mean -124.247 -> -127.184 arcsec, p-p 53.226 -> 53.195, lost motion 0.1625 -> 0.1514 arcmin"],
     },
     "flexible_rv221": {
-        "values": {"te_mean_arcsec": -19.661810, "te_pp_arcsec": 2.7108467, "max_pin_force_N": 83.783220,
-                   "max_ball_load_N": 112.71851},
+        "values": {"te_mean_arcsec": -19.295772, "te_pp_arcsec": 3.2793867, "max_pin_force_N": 104.01218,
+                   "max_ball_load_N": 113.39841},
         "rtol": {"te_mean_arcsec": 1e-3, "te_pp_arcsec": 0.1, "max_pin_force_N": 1e-3, "max_ball_load_N": 1e-3},
         "notes": ["2026-11-23: pinned (flexible main-bearing rings, 0.02-0.04 s, inside the ramps); rv221's TE "
                   "p-p amplifies round-off (issue 15: +-0.4 arcsec at the default Newton tolerance), hence 10 %",
-                  "2026-11-24: crank supports became roller-resolved preloaded tapered-roller pairs in series with the crank's Timoshenko bending (issue 14, branch stiff) instead of one linear 5e8 N/m spring per bearing; inside the load ramp the stiffer, preloaded supports change the transient: TE mean -19.862 -> -19.662 arcsec, p-p 3.19 -> 2.71, max pin force 68.5 -> 83.8 N, max ball load 110.6 -> 112.7 N"],
+                  "2026-11-24: crank supports became roller-resolved preloaded tapered-roller pairs in series with the crank's Timoshenko bending (issue 14, branch stiff) instead of one linear 5e8 N/m spring per bearing; inside the load ramp the stiffer, preloaded supports change the transient: TE mean -19.862 -> -19.662 arcsec, p-p 3.19 -> 2.71, max pin force 68.5 -> 83.8 N, max ball load 110.6 -> 112.7 N",
+                  "2026-11-24: the quasi-static rings condensed into the bearing element (issue 15): the one modelling "
+                  "difference, the rings' own velocity left out of the contact damping, changes this start-up window "
+                  "inside the load ramp: TE mean -19.662 -> -19.296 arcsec, p-p 2.71 -> 3.28, max pin force 83.8 -> 104.0 N, "
+                  "ball load 112.7 -> 113.4 N; with ring_options condense = false the run gives -19.659 arcsec (the old "
+                  "value to 0.02 %), and in the loaded steady state (0.2-0.3 s) the two formulations agree to 0.03 % on the "
+                  "TE mean (benchmarks/bench_flexible_model.py)"],
     },
 }
 
