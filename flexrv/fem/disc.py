@@ -142,21 +142,15 @@ def held_flexibility(K, mesh, loads) -> tuple[np.ndarray, np.ndarray]:
 
 
 @dataclass(frozen=True)
-class DiscCompliance:
-    """Condensed disc (SI): ``matrix`` (z_rp x z_rp) pin-patch normal compliance
-    [m/N] relative to the held crank holes; ``torsional`` c_d [rad/(N m)] of one
-    disc under its pin load distribution; ``output_share`` = c_d / n_discs, the
-    contribution to the output twist per unit output torque."""
+class _DiscBodyResult:
+    """What every disc-body result carries: ``output_share`` [rad/(N m)], the
+    contribution to the output twist per unit output torque (c_d / n_discs), the
+    load case (``torque`` [N m], pin ``patch`` half-width [m]) and the mesh."""
 
-    matrix: list
-    forces_per_torque: list
-    torsional: float
     output_share: float
     n_discs: int
     torque: float
-    crank_angle: float
     patch: float
-    n_loaded: int
     n_nodes: int
     size: float
     mesh_key: str
@@ -164,6 +158,19 @@ class DiscCompliance:
     @property
     def output_stiffness_Nm_per_arcmin(self) -> float:
         return RAD_PER_ARCMIN / self.output_share
+
+
+@dataclass(frozen=True)
+class DiscCompliance(_DiscBodyResult):
+    """Condensed disc (SI): ``matrix`` (z_rp x z_rp) pin-patch normal compliance
+    [m/N] relative to the held crank holes; ``torsional`` c_d [rad/(N m)] of one
+    disc under its pin load distribution (see :class:`_DiscBodyResult`)."""
+
+    matrix: list
+    forces_per_torque: list
+    torsional: float
+    crank_angle: float
+    n_loaded: int
 
 
 def disc_compliance(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
@@ -207,25 +214,14 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
 
 
 @dataclass(frozen=True)
-class DiscSweep:
+class DiscSweep(_DiscBodyResult):
     """Disc body torsional compliance c_d [rad/(N m)] over crank angles (one
     factorisation, all load cases as right-hand sides): ``angles`` [rad],
-    ``torsional`` per angle, ``mean`` over them, ``output_share`` = mean / n_discs."""
+    ``torsional`` per angle, ``mean`` over them (``output_share`` = mean / n_discs)."""
 
     angles: list
     torsional: list
     mean: float
-    output_share: float
-    n_discs: int
-    torque: float
-    patch: float
-    n_nodes: int
-    size: float
-    mesh_key: str
-
-    @property
-    def output_stiffness_Nm_per_arcmin(self) -> float:
-        return RAD_PER_ARCMIN / self.output_share
 
 
 def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | None = None, size: float | None = None,
