@@ -117,3 +117,56 @@ def impact_force(gap, gap_rate, k, exponent, c_max, depth):
     out = np.empty((3, flat[0].size))
     _impact_jit(flat[0], flat[1], flat[2], float(exponent), flat[3], float(depth), out[0], out[1], out[2])
     return out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape)
+
+
+def _friction_scalar(v_slide, v_reg):
+    """Regularised Coulomb friction factor at one contact (the single implementation:
+    the pin and needle kernels call it per contact, :func:`friction_factor` over arrays):
+
+        s(v) = v / sqrt(v^2 + v_reg^2),   ds/dv = v_reg^2 / (v^2 + v_reg^2)^(3/2),
+
+    so the friction force is -mu F_n s(v_t) (along the sliding direction), smooth and
+    odd in v, |s| < 1, s -> sign(v) for |v| >> v_reg (s = 0.995 at v = 10 v_reg).
+    Below v_reg it acts as a viscous damper of coefficient mu F_n / v_reg (the
+    regularisation of e.g. Pennestri et al. 2016, "Review and comparison of dry
+    friction force models", Nonlinear Dyn. 83; algebraic form chosen over tanh for
+    its cheap, exact derivative). Returns (s, ds/dv); v_reg <= 0 gives (0, 0)
+    (friction off)."""
+    if not v_reg > 0.0:
+        return 0.0, 0.0
+    r2 = v_slide * v_slide + v_reg * v_reg
+    root = np.sqrt(r2)
+    return v_slide / root, v_reg * v_reg / (r2 * root)
+
+
+_friction_one = _njit(cache=True)(_friction_scalar) if _njit is not None else _friction_scalar
+
+
+def friction_factor(v_slide, v_reg):
+    """:func:`_friction_scalar` over an array of sliding speeds [m/s]: (s, ds/dv)."""
+    v = np.asarray(v_slide, dtype=float)
+    out = np.array([_friction_one(float(x), float(v_reg)) for x in v.ravel()]).reshape(v.shape + (2,))
+    return out[..., 0], out[..., 1]
+
+
+def effective_pin_friction(mu_disc: float, mu_seat: float) -> float:
+    """Effective Coulomb coefficient of a pin free to turn in its housing groove:
+    mu_eff = min(mu_disc, mu_seat).
+
+    Assumptions: the pin is massless (no rotary inertia: its spin follows the
+    friction balance at once), the groove radius equals the pin radius (both
+    friction forces act at the same lever arm r_pin), and the seat load equals the
+    disc load F_n (the pin is a two-force member across its diameter; the groove's
+    distributed reaction is lumped into one line contact opposite the flank
+    contact). The moment balance of the pin about its axis then gives equal
+    tangential forces f at the flank and in the seat, each bounded by its Coulomb
+    limit mu_i F_n. A pin stuck in its seat slides on the disc (f = mu_disc F_n), a
+    pin rolling on the disc slides in its seat (f = mu_seat F_n); the pin turns so
+    that sliding happens where it is cheaper, f = min(mu_disc, mu_seat) F_n, and
+    because the groove and pin radii are equal the sliding speed in the seat equals
+    the flank sliding speed v_t: the dissipated power is min(mu) F_n |v_t| either
+    way. So the pin kernel treats the pin as fixed with mu_eff (no pin spin DOF).
+    Not modelled: the pin's spin inertia (I omega_dot ~ 1e-7 N m at rv40e's pin
+    accelerations, against mu F r ~ 0.05 * 500 N * 3 mm = 0.08 N m) and
+    pin bending (the seat load then differs from F_n)."""
+    return float(min(mu_disc, mu_seat))

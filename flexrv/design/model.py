@@ -551,6 +551,18 @@ class ContactSettings(_Strict):
     needle_penetration_limit_um: float = Field(
         gt=0.0, le=1000.0, description="Needle-bearing penetration beyond which a run is stopped as failed [um] "
                                        "(at least 20 x the impact law's damping depth)")
+    # friction (issue 14): regularised Coulomb friction, flexrv.contact.laws.friction_force
+    friction: bool = Field(description="Friction at the pin-disc/pin-seat and needle contacts on (true) or off "
+                                       "(false: exactly the frictionless model)")
+    pin_friction_coefficient: float = Field(ge=0.0, le=0.5, description="Coulomb coefficient pin-disc flank [-]")
+    pin_seat_friction_coefficient: float = Field(
+        ge=0.0, le=0.5, description="Coulomb coefficient pin-housing groove [-] (the pin slides where friction is "
+                                    "lower: flexrv.contact.laws.effective_pin_friction)")
+    needle_friction_coefficient: float = Field(
+        ge=0.0, le=0.05, description="Constant friction coefficient of the needle bearings (rolling-bearing "
+                                     "model M = mu F d/2, d the journal diameter) [-]")
+    friction_velocity_mm_per_s: float = Field(
+        gt=0.0, le=100.0, description="Regularisation speed v_reg of the Coulomb law [mm/s]: s = v/sqrt(v^2+v_reg^2)")
 
 
 class OperatingPoint(_Strict):

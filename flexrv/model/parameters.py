@@ -34,6 +34,8 @@ import numpy as np
 
 from flexrv.analysis.torsional import support_constants
 from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
+from flexrv.contact.laws import effective_pin_friction
+from flexrv.units import M_PER_MM
 from flexrv.geometry.as_built import as_built
 from flexrv.geometry.kinematics import member_speeds, total_ratio
 
@@ -124,6 +126,11 @@ class RigidParameters:
     planet_runout: np.ndarray  #: (N, 2) amplitude [m], phase [rad]
     planet_phase_errors: np.ndarray  #: (N,) assembly phase error of each planet on its crank [rad]
     extra: dict = field(default_factory=dict)
+    # friction (issue 14, design [contact] friction fields; 0 = off)
+    pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
+    needle_friction: float = 0.0  #: constant friction coefficient of the needle bearings [-]
+    needle_friction_radius: float = 0.0  #: d/2 of the needle friction moment, the eccentric journal radius [m]
+    friction_velocity: float = 0.0  #: regularisation speed v_reg [m/s] (0 = friction off)
 
 
 def _cyl_mass(rho, d, length):
@@ -234,4 +241,9 @@ def rigid_parameters(reducer) -> RigidParameters:
         support_clearances=ab.support_clearances, sun_runout=ab.sun_runout, planet_runout=ab.planet_runout,
         planet_phase_errors=ab.planet_phase_errors,
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
+        pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
+        if ct.friction else 0.0,
+        needle_friction=ct.needle_friction_coefficient if ct.friction else 0.0,
+        needle_friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
+        friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,
     )

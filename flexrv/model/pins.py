@@ -58,6 +58,27 @@ above), so dQ/dq is not symmetric when harmonics are present. Verified against
 central differences in tests/test_kernel.py (1e-6 of the largest entry;
 measured 1-2e-8, the differences' round-off).
 
+Friction (issue 14): regularised Coulomb friction along the contact tangent
+t = z x n (housing frame). The disc's material point at the contact,
+X = P_i - r_i n, slides past the (fixed) pin at v_t = W . v, W = (t_x, t_y,
+((X - c_k) x t)_z) = (t, (r x t)_z - r_i) over (x, y, psi) of disc k (n x t = 1);
+the friction force on the disc is f_t t at X with f_t = -mu F s(v_t) (s the
+regularised sign :func:`flexrv.contact.laws._friction_one`, v_reg = design
+``contact.friction_velocity_mm_per_s``), so Q_f = f_t W and its power f_t v_t <= 0.
+mu is the pin's effective coefficient min(mu_pin_disc, mu_pin_seat)
+(:func:`flexrv.contact.laws.effective_pin_friction`: a massless pin free to turn
+in its groove slides where friction is lower). Exact Jacobian:
+
+    dQ_f/dv = -mu W (s dF/dg' G + F s' W)^T,
+    dQ_f/dq = -mu W (s dF/dq + F s' (dW/dq)^T v)^T + f_t dW/dq,
+
+dF/dq = dF/dg (G + b w) + dF/dg' (dG/dq v) as above and dW/dq = h N w'^T + T with
+N = (n, (r x n)_z) = -G, w' = (t, (r x t)_z) (the tangent turns with the normal,
+dt/dq = h n w'^T - n e_psi^T) and T[x, psi] = T[psi, x] = -n_x, T[y, psi] =
+T[psi, y] = -n_y, T[psi, psi] = -(r x n)_z. mu = 0 or contact.friction = false
+skips the friction code (the frictionless numbers exactly). Verified against
+central differences in tests/test_friction.py.
+
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
 that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
@@ -71,7 +92,7 @@ import functools
 import numpy as np
 from numba import njit
 
-from flexrv.contact.laws import _impact_one
+from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.errors import ConvergenceError
 from flexrv.geometry.cycloid import _FOOT, _POINT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output
@@ -131,9 +152,14 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
     pin whose bound is positive carries no force (and no Jacobian); its closest
     point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
-    P0y) of the last exact evaluation."""
-    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, ctr) = pack
+    P0y) of the last exact evaluation. Friction (module docstring): mu, v_reg in
+    sc[-2], sc[-1]; per (disc, pin) the friction force on the disc along t = z x n
+    into out_ft and its power f_t v_t (<= 0) into out_pw."""
+    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw,
+     ctr) = pack
     z_rp, R_p, r_nom, ecc, k, expo, c_max, depth = int(sc[0]), sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
+    mu, v_reg = sc[sc.shape[0] - 2], sc[sc.shape[0] - 1]  # friction: effective coefficient, regularisation speed
+    fric = mu > 0.0 and v_reg > 0.0
     max_step, tol, max_iter = sc[8], sc[9], int(sc[10])
     cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0
     skip = ctr[3] > 0
@@ -156,7 +182,7 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             if skip and not cold:
                 bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
                 if bound > 0.0:  # provably open (NaN: never skipped)
-                    out_gap[kd, i], out_f[kd, i] = bound, 0.0
+                    out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
                     continue
             start = np.nan if cold else phi[kd, i]
             ph, ok, dist, nlx, nly = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
@@ -181,6 +207,20 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             fx += force * g0
             fy += force * g1
             fp += force * g2
+            # friction (module docstring, "Friction"): tangent t = z x n, arm of the contact point P - r_i n
+            tx, ty = -ny, nx
+            wt2 = rx * ty - ry * tx - radii[i]
+            ft = sfr = dsfr = 0.0
+            if fric and force > 0.0:
+                vt = tx * v[ix] + ty * v[iy] + wt2 * v[ip]
+                sfr, dsfr = _friction_one(vt, v_reg)
+                ft = -mu * force * sfr
+                fx += ft * tx
+                fy += ft * ty
+                fp += ft * wt2
+                out_ft[kd, i], out_pw[kd, i] = ft, ft * vt
+            else:
+                out_ft[kd, i], out_pw[kd, i] = 0.0, 0.0
             if jac and (force != 0.0 or dfg != 0.0 or dfr != 0.0):
                 h, w0, w1, w2, b, s02, s12, s22 = _gap_curvature(ph, z_rp, radius, ecc, dist, nlx, nly, cr, sr, c, s,
                                                                  rx, ry, nx, ny, harm, kd)
@@ -199,6 +239,26 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
                 hv2 = wv * w2 + s02 * v[ix] + s12 * v[iy] + s22 * v[ip]
                 _add_outer3ab(jq, ix, iy, ip, dfr, g0, g1, g2, hv0, hv1, hv2)
                 _add_outer3(jv, ix, iy, ip, dfr, g0, g1, g2)
+                if ft != 0.0 or sfr != 0.0:
+                    # friction Q = f_t W, f_t = -mu F s(W . v): W (df_t/dq)^T + f_t dW/dq, W (df_t/dv)^T
+                    w2t = rx * ty - ry * tx  # W without the constant pin-radius arm
+                    nv = nx * v[ix] + ny * v[iy] + rxn * v[ip]
+                    tv0, tv1 = -nx * v[ip], -ny * v[ip]  # T v (dW/dq = h N w'^T + T, T symmetric)
+                    tv2 = -nx * v[ix] - ny * v[iy] - rxn * v[ip]
+                    a_s, a_d = -mu * sfr, -mu * force * dsfr
+                    _add_outer3ab(jq, ix, iy, ip, a_s * dfg, tx, ty, wt2, g0 + b * w0, g1 + b * w1, g2 + b * w2)
+                    _add_outer3ab(jq, ix, iy, ip, a_s * dfr, tx, ty, wt2, hv0, hv1, hv2)
+                    # d(v_t)/dq = (dW/dq)^T v = h w' (N . v) + T v
+                    _add_outer3ab(jq, ix, iy, ip, a_d, tx, ty, wt2, h * tx * nv + tv0, h * ty * nv + tv1,
+                                  h * w2t * nv + tv2)
+                    _add_outer3ab(jq, ix, iy, ip, ft * h, nx, ny, rxn, tx, ty, w2t)
+                    jq[ix, ip] -= ft * nx
+                    jq[ip, ix] -= ft * nx
+                    jq[iy, ip] -= ft * ny
+                    jq[ip, iy] -= ft * ny
+                    jq[ip, ip] -= ft * rxn
+                    _add_outer3ab(jv, ix, iy, ip, a_s * dfr, tx, ty, wt2, g0, g1, g2)
+                    _add_outer3(jv, ix, iy, ip, a_d, tx, ty, wt2)
         f[ix] += fx
         f[iy] += fy
         f[ip] += fp
@@ -262,11 +322,14 @@ class PinContacts(KernelGroup):
         self.sc = np.array([float(p.z_rp), p.pin_circle_radius, p.pin_radius, p.eccentricity, p.pin_k,
                             p.pin_exponent, p.pin_c_max, p.contact_depth,
                             *closest_point_settings(p.z_rp, p.pin_circle_radius),
-                            *np.ravel(reach)])  # sc[11 + 2 k], sc[12 + 2 k]: disc k's reach outside, inside
+                            *np.ravel(reach),  # sc[11 + 2 k], sc[12 + 2 k]: disc k's reach outside, inside
+                            p.pin_friction, p.friction_velocity])  # sc[-2], sc[-1]: friction (0: off)
+        self.mu, self.v_reg = p.pin_friction, p.friction_velocity
         z = len(self.pins)
         self.phi = np.full((self.nd, z), np.nan)
         self.gap, self.force = np.zeros((self.nd, z)), np.zeros((self.nd, z))
         self.nx, self.ny, self.rxn = np.zeros((self.nd, z)), np.zeros((self.nd, z)), np.zeros((self.nd, z))
+        self.ft, self.pw = np.zeros((self.nd, z)), np.zeros((self.nd, z))  # friction force on the disc, its power
         self.last = np.full((self.nd, z, 3), np.nan)
         #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
         self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
@@ -277,13 +340,14 @@ class PinContacts(KernelGroup):
             phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
             ctr = np.array([1, 0, 0, 0], dtype=np.int64)
         return (idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
-                self.nx, self.ny, self.rxn, ctr)
+                self.nx, self.ny, self.rxn, self.ft, self.pw, ctr)
 
     @staticmethod
     def empty_pack():
         z2 = np.zeros((0, 0))
-        return (np.zeros(0, np.int64), np.zeros(11), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
-                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, np.array([1, 0, 0, 0], dtype=np.int64))
+        return (np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
+                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
+                np.array([1, 0, 0, 0], dtype=np.int64))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ctr = pack[-1]
@@ -298,12 +362,16 @@ class PinContacts(KernelGroup):
 
     def record(self):
         return {"gap": self.gap.copy(), "force": self.force.copy(), "nx": self.nx.copy(), "ny": self.ny.copy(),
-                "rxn": self.rxn.copy()}
+                "rxn": self.rxn.copy(), "ft": self.ft.copy(), "pw": self.pw.copy()}
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
         dims = ("time", "disc", "pin")
-        return {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
+        out = {} if self.mu <= 0.0 else {
+            "pin_friction_force": Output(rec["ft"], dims, "N", "pin-disc friction force on the disc along t = z x n"),
+            "pin_friction_power": Output(-rec["pw"].sum(axis=-1), ("time", "disc"), "W",
+                                         "power dissipated by the pin-disc friction of each disc (>= 0)")}
+        return out | {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
                 "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration)"),
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
                 "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
