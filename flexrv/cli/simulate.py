@@ -137,7 +137,8 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
             "steady_window_s": s["steady_window_s"], "max_pin_force_N": s["max_pin_force_N"],
             "pins_in_contact_mean": s["pins_in_contact_mean"], "pins_in_contact_max": s["pins_in_contact_max"],
             "wall_time_s": sim.timing.get("solve_s")}
-    for key in ("max_ball_load_N", "max_ring_deformation_m", "min_film_thickness_m"):
+    for key in ("max_ball_load_N", "max_ring_deformation_m", "min_film_thickness_m", "efficiency",
+                "mean_friction_power_W"):
         if key in s:
             data[key] = s[key]
 

@@ -38,6 +38,17 @@ d = E - H and the as-built radial clearance c_r = c_jk (``needle_clearances``):
   g = D/d_m (Harris & Kotzalas 2007, ch. 8). Rollers are massless (their
   inertia is negligible against the disc's).
 
+Friction (issue 14): a constant-coefficient rolling-bearing friction moment
+between eccentric and disc hole (SKF/JTEKT model M = mu P d/2, P the radial
+load, d the bore = eccentric journal diameter; mu = design
+``contact.needle_friction_coefficient``), regularised like the pin friction:
+M = -mu F (d/2) s(omega_rel d/2) on the crank and +M on the disc, omega_rel =
+dphi_j/dt - dpsi_k/dt, F = |F| the bearing force, s
+:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian:
+dF = e^T dF-vector with the same contact tangents as the force (arm rotations
+dropped likewise) plus the exact regularisation term
+-mu F (d/2)^2 s' on (phi_j, psi_k) of dM/dv.
+
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
 Generalized forces are Q = -F d(delta)/dq (exact); analytic Jacobians keep the
 contact-stiffness terms (and, empirical law, the exact rotation term F/|d| of the
@@ -60,7 +71,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.hertz import LINE_EXPONENT
-from flexrv.contact.laws import _impact_one
+from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
 from flexrv.units import DEG_PER_RAD
@@ -193,8 +204,10 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     per-bearing force on the disc into out_fx, out_fy, roller forces and angles
     (rollers model) into out_roll, out_angle; state[0] = min gap [m], state[1 + k]
     = disc k's departure from its conjugate rotation [rad]."""
-    idx, sc, chi0, ecc, err, hx, hy, clear, roller_angles, out_fx, out_fy, out_roll, out_angle, state = pack
+    idx, sc, chi0, ecc, err, hx, hy, clear, roller_angles, out_fx, out_fy, out_roll, out_angle, out_pw, state = pack
     k_c, expo, c_max, depth, rollers, g_ratio, z_c = sc[0], sc[1], sc[2], sc[3], sc[4] > 0.5, sc[5], sc[6]
+    mu_b, r_b, v_reg = sc[7], sc[8], sc[9]  # friction moment (module docstring): coefficient, d/2, v_reg
+    fric = mu_b > 0.0 and v_reg > 0.0
     nc, nd = ecc.shape[0], ecc.shape[1]
     min_gap = np.inf
     b = np.zeros((2, 6))
@@ -263,12 +276,43 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
             f[iyd] += fy
             f[ipd] += md
             out_fx[j, kd], out_fy[j, kd] = fx, fy
+            # friction moment -mu_b F (d/2) s(omega_rel d/2) on the crank, opposite on the disc
+            fn = np.sqrt(fx * fx + fy * fy)
+            mf = sf = dsf = 0.0
+            if fric and fn > 0.0:
+                rel = v[ipc] - v[ipd]
+                sf, dsf = _friction_one(rel * r_b, v_reg)
+                mf = -mu_b * fn * r_b * sf
+                f[ipc] += mf
+                f[ipd] -= mf
+                out_pw[j, kd] = mf * rel
+            elif out_pw.shape[0] > 0:
+                out_pw[j, kd] = 0.0
             if jac:  # B = d(d)/d(crank x, y, phi; disc x, y, psi)
                 ii[0], ii[1], ii[2], ii[3], ii[4], ii[5] = ixc, iyc, ipc, ixd, iyd, ipd
                 b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4], b[0, 5] = 1.0, 0.0, epx, -1.0, 0.0, -hpx
                 b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4], b[1, 5] = 0.0, 1.0, epy, 0.0, -1.0, -hpy
                 _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
                 _add_btkb(jv, ii, b, dxx, dxy, dyy, 1.0)
+                if mf != 0.0 or sf != 0.0:
+                    # dM = -mu_b r_b (s dF_n + F_n s' r_b d(omega_rel)), dF_n = e^T (K B dq + D B dv), e = F/F_n
+                    # (the same contact tangents as the force Jacobian above, arm rotations dropped likewise)
+                    ex, ey = fx / fn, fy / fn
+                    a_s = -mu_b * r_b * sf
+                    kex, key = kxx * ex + kxy * ey, kxy * ex + kyy * ey
+                    dex, dey = dxx * ex + dxy * ey, dxy * ex + dyy * ey
+                    for r in range(6):
+                        gq = a_s * (kex * b[0, r] + key * b[1, r])
+                        gv = a_s * (dex * b[0, r] + dey * b[1, r])
+                        jq[ipc, ii[r]] += gq
+                        jq[ipd, ii[r]] -= gq
+                        jv[ipc, ii[r]] += gv
+                        jv[ipd, ii[r]] -= gv
+                    a_d = -mu_b * fn * r_b * r_b * dsf
+                    jv[ipc, ipc] += a_d
+                    jv[ipc, ipd] -= a_d
+                    jv[ipd, ipc] -= a_d
+                    jv[ipd, ipd] += a_d
     state[0] = min_gap
 
 
@@ -303,21 +347,23 @@ class NeedleBearings(KernelGroup):
             self.roller_angles = 2.0 * np.pi * np.arange(z) / z
         g = p.needle_pitch_ratio
         self.sc = np.array([self.k, LINE_EXPONENT, p.needle_c_max, p.contact_depth, float(model == "rollers"), g,
-                            float(p.z_c)])
+                            float(p.z_c), p.needle_friction, p.needle_friction_radius, p.friction_velocity])
+        self.mu = p.needle_friction if p.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
         self.fx, self.fy = np.zeros((self.nc, self.nd)), np.zeros((self.nc, self.nd))
         self.roll, self.angle = np.zeros((self.nc, self.nd, z)), np.zeros((self.nc, self.nd, z))
+        self.pw = np.zeros((self.nc, self.nd))  # friction power on crank + disc (<= 0)
         self.state = np.full(1 + self.nd, np.nan)
         self.reset()
 
     def pack(self, idx, history=False):
         return (idx, self.sc, self.chi0, self.ecc, self.err, self.hx, self.hy, self.clear, self.roller_angles,
-                self.fx, self.fy, self.roll, self.angle, self.state)
+                self.fx, self.fy, self.roll, self.angle, self.pw, self.state)
 
     @staticmethod
     def empty_pack():
         z1, z2, z3 = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0, 0))
-        return (np.zeros(0, np.int64), np.zeros(7), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, np.zeros(1))
+        return (np.zeros(0, np.int64), np.zeros(10), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, z2, np.zeros(1))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         needle_kernel(q, v, f, jq, jv, jac, pack)
@@ -328,7 +374,7 @@ class NeedleBearings(KernelGroup):
         return float(self.state[0])
 
     def record(self):
-        rec = {"fx": self.fx.copy(), "fy": self.fy.copy()}
+        rec = {"fx": self.fx.copy(), "fy": self.fy.copy(), "pw": self.pw.copy()}
         if self.model == "rollers":
             rec.update(roll=self.roll.copy(), angle=self.angle.copy())
         return rec
@@ -339,6 +385,9 @@ class NeedleBearings(KernelGroup):
         out = {"needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
                "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
                "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
+        if self.mu > 0.0:
+            out["needle_friction_power"] = Output(-rec["pw"], dims, "W",
+                                                  "power dissipated by the needle-bearing friction moment (>= 0)")
         if self.model == "rollers":
             out["roller_force"] = Output(rec["roll"], dims + ("roller",), "N", "needle roller contact force")
             out["roller_angle"] = Output(rec["angle"], dims + ("roller",), "rad",

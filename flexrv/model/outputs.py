@@ -11,6 +11,8 @@ pattern). Three kinds:
 * **derived outputs** (:data:`DERIVED_OUTPUTS`): functions of the member states and the drive
   (output angle and speed, relative crank speed, carrier tilt, input and load torque,
   kinetic energy, angular momentum);
+* **friction output** ``friction_power``: the sum of the groups' :data:`FRICTION_OUTPUTS` [W]
+  (present when friction is on);
 * **group outputs**: the named :class:`flexrv.model.base.Output` s of every force group
   (contact forces, film thickness, ...), evaluated over the time history in chunks.
 
@@ -157,6 +159,12 @@ _ORDER = ("theta_in", "theta_out", "omega_in", "omega_out", "crank_speed", "cran
           "carrier_z", "carrier_tilt")
 
 
+#: the groups' friction outputs (dissipated power [W], >= 0, issue 14): pin-disc/pin-seat friction per
+#: disc (:mod:`flexrv.model.pins`) and the needle-bearing friction moment per bearing
+#: (:mod:`flexrv.model.cranks_discs`); their sum over the groups is the output ``friction_power``
+FRICTION_OUTPUTS = ("pin_friction_power", "needle_friction_power")
+
+
 def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
     """name -> (dims, units, long_name) of the member-state and derived outputs (the group
     outputs are declared by the groups and known after a run), plus ``input_torque``."""
@@ -214,6 +222,10 @@ def model_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
         put(name)
     groups = group_outputs(model, t, q, v, chunk)
     out.update(groups)
+    fric = [o.values.reshape(len(t), -1).sum(axis=1) for name, o in groups.items() if name in FRICTION_OUTPUTS]
+    if fric:
+        out["friction_power"] = Output(np.sum(fric, axis=0), ("time",), "W",
+                                       "power dissipated by friction, all groups (pins, needle bearings)")
     w_in = out["omega_in"].values
     acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)
     sun = groups["sun_torque"].values if "sun_torque" in groups else 0.0

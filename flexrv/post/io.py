@@ -35,7 +35,11 @@ def summary_markdown(res, summ: dict) -> str:
     for key, unit in (("te_min_arcsec", "arcsec"), ("te_max_arcsec", "arcsec"), ("te_pp_arcsec", "arcsec"),
                       ("te_mean_arcsec", "arcsec"), ("te_rms_fluctuation_arcsec", "arcsec"),
                       ("max_pin_force_N", "N"), ("pins_in_contact_mean", "-"), ("pins_in_contact_max", "-"),
-                      ("mean_input_power_W", "W"), ("mean_output_power_W", "W"), ("mean_dissipation_W", "W")):
+                      ("mean_input_power_W", "W"), ("mean_output_power_W", "W"), ("mean_dissipation_W", "W"),
+                      ("efficiency", "-"), ("mean_friction_power_W", "W"), ("mean_pin_friction_power_W", "W"),
+                      ("mean_needle_friction_power_W", "W")):
+        if key not in summ:
+            continue
         lines.append(f"| {key} | {_fmt(summ.get(key))} | {unit} |")
     return "\n".join(lines) + "\n"
 

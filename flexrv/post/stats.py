@@ -86,6 +86,7 @@ def summary(res) -> dict:
         "mean_input_power_W": p_in, "mean_output_power_W": p_out,
         "mean_kinetic_energy_rate_W": dke,
         "mean_dissipation_W": balance["dissipation_W"],
+        **efficiency_summary(sel, p_in, p_out),
         "power_balance_note": balance["note"],
         "notes": ([] if steady else [str(res.attrs.get("steady_note", "NOT STEADY"))]) + [balance["note"]],
         "kinematics": table,
@@ -100,11 +101,28 @@ def summary(res) -> dict:
 _UNIT_SOURCE = {"te_min_arcsec": "te", "te_max_arcsec": "te", "te_pp_arcsec": "te", "te_mean_arcsec": "te",
                 "te_rms_fluctuation_arcsec": "te", "max_pin_force_N": "pin_force", "mean_input_power_W": "power_in",
                 "mean_output_power_W": "power_out", "mean_dissipation_W": "power_in",
+                "mean_friction_power_W": "friction_power", "mean_pin_friction_power_W": "pin_friction_power",
+                "mean_needle_friction_power_W": "needle_friction_power",
                 "mean_kinetic_energy_rate_W": "power_in", "max_ball_load_N": "ball_load_inner",
                 "max_ring_deformation_m": "ring_deformation_outer", "max_inner_ring_deformation_m":
                 "ring_deformation_inner", "max_ball_pressure_Pa": "ball_max_pressure",
                 "min_film_thickness_m": "ball_film_thickness", "pins_in_contact_mean": "pins_in_contact",
                 "pins_in_contact_max": "pins_in_contact"}
+
+
+def efficiency_summary(sel, p_in: float, p_out: float) -> dict:
+    """Efficiency of a driven run over a window ``sel`` (the steady window): eta =
+    mean output power / mean input power (both the window means of ``power_out`` and
+    ``power_in``), and the mean friction dissipation [W] per group and in total when the
+    run has friction outputs (:data:`flexrv.model.outputs.FRICTION_OUTPUTS`). eta is NaN
+    when the input does no work (P_in <= 0, e.g. a locked input)."""
+    out = {"efficiency": float(p_out / p_in) if (math.isfinite(p_in) and p_in > 0.0) else float("nan")}
+    if "friction_power" in sel and sel.sizes.get("time", 0):
+        out["mean_friction_power_W"] = float(np.mean(sel["friction_power"].values))
+        for name in ("pin_friction_power", "needle_friction_power"):
+            if name in sel:
+                out[f"mean_{name}_W"] = float(np.mean(sel[name].values.reshape(sel.sizes["time"], -1).sum(axis=1)))
+    return out
 
 
 def summary_units(res, summ: dict) -> dict:
@@ -116,7 +134,7 @@ def summary_units(res, summ: dict) -> dict:
         if key in summ and var in res.ds:
             units[key] = str(res.ds[var].attrs.get("units", ""))
     units["steady_window_s"] = str(res.ds["time"].attrs.get("units", "s"))
-    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical"):
+    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical", "efficiency"):
         units[key] = "-"
     return units
 

@@ -10,7 +10,9 @@ loading and unloading curves"):
 * lost motion [arcmin]: rotation between T = +3 % and T = -3 % of T_r on the
   mean (loading/unloading averaged) curve;
 * hysteresis [arcmin]: width of the loop at T = 0 (descending minus returning
-  branch).
+  branch);
+* hysteresis loss [J]: the energy dissipated per load cycle, the loop's area
+  oint T dtheta (:func:`loop_energy`).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ class StiffnessTest:
     lost_motion_positive_arcmin: float = float("nan")  #: mean-curve angle at +3 % T_r
     hysteresis_returning_arcmin: float = float("nan")  #: returning branch at T = 0
     hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
+    hysteresis_loss_J: float = float("nan")  #: energy dissipated per load cycle, the loop area (loop_energy)
 
 
 def _fit_slope(torque, angle, lo, hi):
@@ -53,6 +56,25 @@ def _fit_slope(torque, angle, lo, hi):
 def _angle_at(torque_branch, angle_branch, value):
     order = np.argsort(torque_branch)
     return float(np.interp(value, torque_branch[order], angle_branch[order]))
+
+
+def loop_energy(torque_down, angle_down, torque_back, angle_back, rated: float, samples: int = 2001) -> float:
+    """Energy dissipated per load cycle [J] = the area of the torque-twist loop,
+    oint T dtheta, from the descending branch (+T_r -> -T_r) and the returning branch
+    (-T_r -> 0) of the test program (angles [rad], torques [N m]):
+
+        E = 2 int_{-T_r}^{0} (theta_down(T) - theta_back(T)) dT,
+
+    the lower half of the loop, where both branches are measured, doubled by the
+    loop's point symmetry (T, theta) -> (-T, -theta) (a reducer without load-direction
+    bias; the upper half would need a second loading from the loop's centre). Trapezoid
+    rule on ``samples`` torques, each branch interpolated at them (angle as a function of
+    torque: monotone ramps). Check (tests/test_friction.py): a Coulomb element (spring
+    k, friction force F_c) gives the parallelogram's 4 F_c (T_r - F_c)/k."""
+    t = np.linspace(-rated, 0.0, samples)
+    a_d = np.array([_angle_at(torque_down, angle_down, x) for x in t])
+    a_b = np.array([_angle_at(torque_back, angle_back, x) for x in t])
+    return float(2.0 * np.trapezoid(a_d - a_b, t))
 
 
 def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
@@ -76,13 +98,15 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
     mid_p = 0.5 * (_angle_at(torque[down], a[down], d3) + _angle_at(asc_t, asc_a, d3))
     mid_n = 0.5 * (_angle_at(torque[down], a[down], -d3) + _angle_at(asc_t, asc_a, -d3))
     a_down0, a_back0 = _angle_at(torque[down], a[down], 0.0), _angle_at(torque[back], a[back], 0.0)
+    loss = loop_energy(torque[down], angle[down], torque[back], angle[back], rated)
     return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
                          rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
                          lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
                          angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
                          fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
                          lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
-                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0)
+                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0,
+                         hysteresis_loss_J=loss)
 
 
 #: (variable, StiffnessTest field, units, long name) of the saved figures
@@ -96,6 +120,8 @@ _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the 
             ("lost_motion", "lost_motion_arcmin", "arcmin",
              "lost motion: rotation between +3 % and -3 % of T_r on the mean curve"),
             ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
+            ("hysteresis_loss", "hysteresis_loss_J", "J", "hysteresis loss: energy dissipated per load cycle, "
+             "the loop area (twice the measured lower half)"),
             ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
             ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
             ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
@@ -142,7 +168,7 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
              f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
              "catalogue and seed004 (average slope of the loading and unloading curves).", "",
              "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
-    for name, field, units, long in _FIGURES[:7]:
+    for name, field, units, long in _FIGURES[:8]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
     lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
               f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
