@@ -33,7 +33,7 @@ LEGACY_SUPPORT_N_PER_M = {"rv40e": 2.0e8, "rv221": 5.0e8}
 
 
 def legacy_supports(r, name: str):
-    """Design ``r`` with the crank-support law of the references (linear, rigid crank)."""
+    """Design ``r`` with the crank-support law of the references (linear, rigid crank), no friction."""
     from flexrv.design import from_dict
 
     data = r.model_dump()
@@ -41,7 +41,10 @@ def legacy_supports(r, name: str):
           or k == "support_bearing_damping_Ns_per_m"}
     cs.update(support_bearing_model="linear", bending_model="rigid",
               support_bearing_radial_stiffness_N_per_m=LEGACY_SUPPORT_N_PER_M[name])
-    return from_dict({**data, "crankshaft": cs}, source=f"{name} with the legacy crank supports")
+    # frictionless, as when the references were written (issue 14 added friction, default on in the presets)
+    contact = dict(data["contact"], friction=False)
+    return from_dict({**data, "crankshaft": cs, "contact": contact},
+                     source=f"{name} with the legacy crank supports, frictionless")
 
 
 def short_run_reducer(name: str = "rv40e"):

