@@ -165,3 +165,78 @@ def test_friction_field_out_of_range(tmp_path, capsys, field, value):
     err = capsys.readouterr().err
     assert f"contact.{field} = {value}" in err and "allowed" in err, err
     assert "Traceback" not in err
+
+
+# ----------------------------------------------------------------------------- hysteresis
+def _coulomb_element_loop(k=1e6, f_c=100.0, t_r=1000.0, mass=1e-3, quarter=0.2, dt=1e-4, v_reg=1e-5):
+    """A mass on a spring k with friction force f_c s(v) (THE compiled law of the
+    kernels) under the stiffness-test program 0 -> +T_r -> -T_r -> 0 (each quarter over
+    ``quarter`` s), integrated by backward Euler with Newton on the velocity (exact
+    derivative ds/dv). The mass is small (1 g: natural period 0.2 ms, 2 dt) so that the
+    loading is quasi-static, as in the reducer's test (its output period ~1 ms, 5 % of a
+    quarter): backward Euler damps the element's own vibration. Returns (time, load, x, program times)."""
+    times = np.array([0.0, quarter, 3 * quarter, 4 * quarter])
+    n = int(round(times[-1] / dt))
+    t = np.arange(n + 1) * dt
+    load_ = np.interp(t, times, [0.0, t_r, -t_r, 0.0])
+    x, v = np.zeros(n + 1), 0.0
+    for i in range(n):
+        # m (v' - v)/dt = F - k (x + dt v') - f_c s(v'): r(v') increasing, one root; Newton kept
+        # inside a shrinking bracket (bisection when it leaves it: s is stiff near 0)
+        lo, hi, vn = -1.0, 1.0, v
+        for _ in range(200):
+            s, ds = _friction_one(vn, v_reg)
+            r = mass * (vn - v) / dt - load_[i + 1] + k * (x[i] + dt * vn) + f_c * s
+            if abs(r) <= 1e-12 * (f_c + t_r) or hi - lo <= 1e-16:
+                break
+            if r > 0.0:
+                hi = vn
+            else:
+                lo = vn
+            step = vn - r / (mass / dt + k * dt + f_c * ds)
+            vn = step if lo < step < hi else 0.5 * (lo + hi)
+        v = vn
+        x[i + 1] = x[i] + dt * v
+    return t, load_, x, times
+
+
+def test_coulomb_element_hysteresis_width_and_loss():
+    """Coulomb element (k = 1e6 N/m, F_c = 100 N, T_r = 1000 N, quarter 0.2 s: sliding
+    speed Fdot/k = 5 mm/s = 500 v_reg): the stiffness-test evaluation
+    (flexrv.post.stiffness) gives the analytic hysteresis width 2 F_c / k and loop area
+    4 F_c (T_r - F_c) / k (the parallelogram of two sliding branches and two stick
+    phases). Tolerance of the width: the regularised sliding force is F_c s(v),
+    1 - s = v_reg^2 / (2 v^2) = 2e-6 at 500 v_reg, and backward Euler holds the sliding
+    branch in equilibrium at every step (linear interpolation at T = 0 exact on a line):
+    1e-4 rel. allowed (measured -2.0e-6, the predicted 1 - s). Area: the stick phases creep
+    at ~v_reg (F - k x)/F_c, which rounds the parallelogram's corners: 1e-3 rel. allowed
+    (measured 1.6e-4)."""
+    from flexrv.post.stiffness import evaluate_stiffness_test
+    from flexrv.units import ARCMIN_PER_RAD
+
+    k, f_c, t_r = 1e6, 100.0, 1000.0
+    t, load_, x, times = _coulomb_element_loop(k, f_c, t_r)
+    fig = evaluate_stiffness_test(t, load_, x, times)  # x in "rad" -> arcmin in the figures
+    width = fig.hysteresis_arcmin / ARCMIN_PER_RAD
+    assert width == pytest.approx(2 * f_c / k, rel=1e-4)
+    assert fig.hysteresis_loss_J == pytest.approx(4 * f_c * (t_r - f_c) / k, rel=1e-3)
+    assert fig.rigidity_Nm_per_arcmin == pytest.approx(k / ARCMIN_PER_RAD, rel=1e-4)  # slope k on both branches
+    # no friction: no loop (width and area 0 up to the inertia's lag)
+    t, load_, x, times = _coulomb_element_loop(k, 0.0, t_r)
+    fig0 = evaluate_stiffness_test(t, load_, x, times)
+    assert abs(fig0.hysteresis_arcmin / ARCMIN_PER_RAD) <= 1e-3 * 2 * f_c / k
+    assert abs(fig0.hysteresis_loss_J) <= 1e-3 * 4 * f_c * (t_r - f_c) / k
+
+
+def test_loop_energy_closed_form():
+    """loop_energy of a parallelogram loop (branches theta = (T -+ c)/k, stick phases at
+    the reversals) = 4 c (T_r - c) / k to 1e-6 (trapezoid rule on a piecewise-linear loop
+    with 2001 samples: exact up to the kinks' cells)."""
+    from flexrv.post.stiffness import loop_energy
+
+    k, c, t_r = 2e5, 30.0, 400.0
+    td = np.linspace(t_r, -t_r, 801)
+    ad = np.minimum((td + c) / k, (t_r - c) / k)  # stick at the top, then the descending line
+    tb = np.linspace(-t_r, 0.0, 401)
+    ab = np.maximum((tb - c) / k, (-t_r + c) / k)
+    assert loop_energy(td, ad, tb, ab, t_r, samples=4001) == pytest.approx(4 * c * (t_r - c) / k, rel=1e-5)
