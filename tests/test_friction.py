@@ -240,3 +240,72 @@ def test_loop_energy_closed_form():
     tb = np.linspace(-t_r, 0.0, 401)
     ab = np.maximum((tb - c) / k, (-t_r + c) / k)
     assert loop_energy(td, ad, tb, ab, t_r, samples=4001) == pytest.approx(4 * c * (t_r - c) / k, rel=1e-5)
+
+
+# ----------------------------------------------------------------------------- driven run
+@pytest.fixture(scope="module")
+def driven():
+    """rv40e rigid, speed and load ramped in over 20 ms (tests/regression_cases.py FAST),
+    0.06 s at dt 1e-4; the window t >= 0.03 s (loaded, at speed)."""
+    from flexrv.simulation import Simulation
+
+    red = override("rv40e", {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0,
+                             "operating.load_ramp_end_s": 0.02})
+    res = Simulation(red).run(t_end=0.06, dt=1e-4)
+    return red, res, res.ds.sel(time=slice(0.03, None))
+
+
+def test_energy_balance_with_friction(driven):
+    """Driven run: mean input power = mean output power + mean friction dissipation +
+    dE_kin/dt within 1 % of the input power (asked; measured 4e-5: the rest is the contact
+    damping and the change of elastic energy over the window). Friction is ~6 % of the
+    input (pins ~2/3, needles ~1/3), so the check is not empty."""
+    _, _, ds = driven
+    t = ds.time.values
+    p_in, p_out, p_f = (float(ds[k].mean()) for k in ("power_in", "power_out", "friction_power"))
+    ke = ds["kinetic_energy"].values
+    dke = (ke[-1] - ke[0]) / (t[-1] - t[0])
+    assert 0.03 * p_in < p_f < 0.1 * p_in
+    pins = float(ds["pin_friction_power"].sum("disc").mean())
+    needles = float(ds["needle_friction_power"].sum(("crank", "disc")).mean())
+    assert pins + needles == pytest.approx(p_f, rel=1e-12) and pins > needles > 0.0
+    assert abs(p_in - p_out - p_f - dke) <= 0.01 * p_in
+
+
+def test_friction_loss_vs_kinematic_sliding_speeds(driven):
+    """Pin-mesh and needle losses against the textbook estimate from the contact loads and
+    the KINEMATIC sliding speeds (rigid conjugate action, flexrv.geometry.kinematics.
+    member_speeds): the disc rolls its pitch circle (radius z_c e) in the pins' pitch
+    circle (z_rp e), so relative to the housing it turns at omega_d about the pitch point
+    I = z_rp c_k (c_k the disc centre), the contact normal passes through I and the
+    contact point X slides at omega_d |I X|, |I X| = |I P_i| - r_i:
+    P_pins = mu_eff |omega_d| sum F_i (|I P_i| - r_i); each needle bearing slides at
+    (d/2) |omega_crank - omega_disc|: P_needles = mu_b (d/2) |omega_crank - omega_disc|
+    sum |F_jk|. Efficiency estimate eta = 1 - (P_pins + P_needles)/P_in vs the simulated
+    P_out/P_in. Tolerances: 1 % on the losses (the modified profile's normals miss the
+    pitch point by O(dR_p / R_p) and the elastic deflections change the arms by ~um of
+    ~50 mm; the regularisation matters only within ~0.1 mm of the pitch point where F ~ 0;
+    measured 1.8e-5 on the pins, 9e-7 on the needles) and 1e-3 on eta (measured 5.8e-5:
+    0.93858 estimated vs 0.93852 simulated, the rest being the contact damping)."""
+    from flexrv.geometry.kinematics import member_speeds
+    from flexrv.model.parameters import rigid_parameters
+    from flexrv.post.stats import mean_speed
+
+    red, _, ds = driven
+    p = rigid_parameters(red)
+    fs, ss = red.first_stage, red.second_stage
+    t = ds.time.values
+    sp = member_speeds(mean_speed(ds["theta_in"].values, t), fs.sun_teeth, fs.planet_teeth, ss.disc_teeth,
+                       ss.pin_count)
+    ix, iy = p.z_rp * ds["disc_x"].values, p.z_rp * ds["disc_y"].values  # pitch points (T, disc)
+    arm = np.hypot(p.pins[:, 0] - ix[..., None], p.pins[:, 1] - iy[..., None]) - p.pin_radii
+    est_pins = p.pin_friction * abs(sp.disc_rotation) * (ds["pin_force"].values * arm).sum(axis=(1, 2)).mean()
+    rel = abs(sp.crank_absolute - sp.disc_rotation)
+    est_needles = p.needle_friction * p.needle_friction_radius * rel * ds["needle_force"].values.sum(
+        axis=(1, 2)).mean()
+    sim_pins = float(ds["pin_friction_power"].sum("disc").mean())
+    sim_needles = float(ds["needle_friction_power"].sum(("crank", "disc")).mean())
+    assert est_pins == pytest.approx(sim_pins, rel=0.01)
+    assert est_needles == pytest.approx(sim_needles, rel=0.01)
+    p_in, p_out = float(ds["power_in"].mean()), float(ds["power_out"].mean())
+    assert 1.0 - (est_pins + est_needles) / p_in == pytest.approx(p_out / p_in, abs=1e-3)

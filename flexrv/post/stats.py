@@ -65,7 +65,8 @@ def summary(res) -> dict:
     dke = float((ke[-1] - ke[0]) / (tw[-1] - tw[0])) if len(te) > 1 and tw[-1] > tw[0] else 0.0
     finite = len(te) > 0
     steady = bool(int(res.attrs.get("steady", 1)))
-    balance = power_balance(p_in, p_out, dke, steady=steady)
+    fric = float(np.mean(sel["friction_power"].values)) if ("friction_power" in sel and len(te)) else None
+    balance = power_balance(p_in, p_out, dke, steady=steady, friction=fric)
     out = {
         "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
         "steady_window_s": [t0, t1],
@@ -139,13 +140,23 @@ def summary_units(res, summ: dict) -> dict:
     return units
 
 
-def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True) -> dict:
+def _split(d: float, friction: float | None) -> str:
+    """Words for the dissipation D: contact damping only, or friction + the rest."""
+    if friction is None:
+        return "contact damping"
+    return f"friction {friction:.4g} W + contact damping and elastic storage {d - friction:.3g} W"
+
+
+def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True,
+                  friction: float | None = None) -> dict:
     """Mean power balance over a window: dissipation D = P_in - P_out - dE_kin/dt [W]
     (every term the window mean; dE_kin/dt = (E_kin(t1) - E_kin(t0)) / (t1 - t0) is exactly
     the mean of the rate). ``note`` says in words what the numbers mean: D < 0 beyond
     ``tol`` P_in cannot be dissipation — energy is then released from storage the balance
     does not count (elastic energy of the contacts, e.g. while the load still ramps, or a
-    window that is not steady) or the integration error shows."""
+    window that is not steady) or the integration error shows. ``friction``: the mean
+    friction power of the run [W] (issue 14), if it has friction; the note then splits D
+    into friction and the rest (contact damping, elastic storage)."""
     d = p_in - p_out - dke_dt
     scale = max(abs(p_in), abs(p_out), 1e-12)
     if not all(map(math.isfinite, (p_in, p_out, dke_dt))):
@@ -157,7 +168,7 @@ def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, s
                 "dissipates less than that")
     elif d > 0:
         note = (f"power balance: P_in {p_in:.4g} W - P_out {p_out:.4g} W - dE_kin/dt {dke_dt:.3g} W = "
-                f"{d:.4g} W dissipated (contact damping), efficiency P_out/P_in = {p_out / p_in:.4f}"
+                f"{d:.4g} W dissipated ({_split(d, friction)}), efficiency P_out/P_in = {p_out / p_in:.4f}"
                 if p_in else f"power balance: {d:.4g} W dissipated")
     else:
         note = (f"power balance: P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W exceeds P_in {p_in:.4g} W by "
