@@ -561,7 +561,8 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     res = sim.run(t_end=float(times[-1]), dt=dt, progress=progress)
     tq = res["output_torque"].values
     angle = -res["theta_out"].values  # the load torque acts against +theta: positive torque winds the output negative
-    figures = evaluate_stiffness_test(res.time, tq, angle, times[1:])
+    figures = evaluate_stiffness_test(res.time, tq, angle, times[1:], friction_power=(
+        res["friction_power"].values if "friction_power" in res.ds else None))
     res.ds = stiffness_dataset(figures, res.time, tq, angle * ARCMIN_PER_RAD, base=res.ds)
     if save_to is not None:
         import json

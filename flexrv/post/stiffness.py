@@ -44,6 +44,7 @@ class StiffnessTest:
     hysteresis_returning_arcmin: float = float("nan")  #: returning branch at T = 0
     hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
     hysteresis_loss_J: float = float("nan")  #: energy dissipated per load cycle, the loop area (loop_energy)
+    friction_energy_J: float = 0.0  #: friction dissipation over the test program (0: no friction)
 
 
 def _fit_slope(torque, angle, lo, hi):
@@ -77,10 +78,14 @@ def loop_energy(torque_down, angle_down, torque_back, angle_back, rated: float, 
     return float(2.0 * np.trapezoid(a_d - a_b, t))
 
 
-def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
+def evaluate_stiffness_test(time, torque, angle, times, friction_power=None) -> StiffnessTest:
     """Evaluate a loop. ``times`` = (t_start, t_pos, t_neg, t_end): the program
     ramps 0 -> +T_r on [t_start, t_pos], +T_r -> -T_r on [t_pos, t_neg] and
-    -T_r -> 0 on [t_neg, t_end]; ``angle`` is the output rotation [rad]."""
+    -T_r -> 0 on [t_neg, t_end]; ``angle`` is the output rotation [rad].
+    ``friction_power`` [W] over ``time`` (the run's output ``friction_power``, if it has
+    friction): its integral over [t_start, t_end] is the friction energy of the program
+    [J], the friction part of the dissipation measured directly (trapezoid rule; 0
+    without friction)."""
     time, torque, angle = (np.asarray(a, dtype=float) for a in (time, torque, angle))
     a = angle * ARCMIN_PER_RAD
     t0, tp, tn, te = times
@@ -99,6 +104,10 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
     mid_n = 0.5 * (_angle_at(torque[down], a[down], -d3) + _angle_at(asc_t, asc_a, -d3))
     a_down0, a_back0 = _angle_at(torque[down], a[down], 0.0), _angle_at(torque[back], a[back], 0.0)
     loss = loop_energy(torque[down], angle[down], torque[back], angle[back], rated)
+    e_fric = 0.0
+    if friction_power is not None:
+        prog = (time >= t0) & (time <= te)
+        e_fric = float(np.trapezoid(np.asarray(friction_power, dtype=float)[prog], time[prog]))
     return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
                          rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
                          lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
@@ -106,7 +115,7 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
                          fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
                          lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
                          hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0,
-                         hysteresis_loss_J=loss)
+                         hysteresis_loss_J=loss, friction_energy_J=e_fric)
 
 
 #: (variable, StiffnessTest field, units, long name) of the saved figures
@@ -122,6 +131,8 @@ _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the 
             ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
             ("hysteresis_loss", "hysteresis_loss_J", "J", "hysteresis loss: energy dissipated per load cycle, "
              "the loop area (twice the measured lower half)"),
+            ("friction_energy", "friction_energy_J", "J", "energy dissipated by friction over the test program "
+             "(0 -> +T_r -> -T_r -> 0), integral of friction_power; 0 without friction"),
             ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
             ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
             ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
@@ -168,7 +179,7 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
              f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
              "catalogue and seed004 (average slope of the loading and unloading curves).", "",
              "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
-    for name, field, units, long in _FIGURES[:8]:
+    for name, field, units, long in _FIGURES[:9]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
     lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
               f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
