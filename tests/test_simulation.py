@@ -56,9 +56,9 @@ def test_kinematics_ratio_and_crank_speed(steady_run):
 
 
 def test_power_and_torque_balance(steady_run):
-    """Steady state: input power = output power + dissipation + dE_kin/dt; the
-    frictionless model dissipates only in contact dampers, so |P_in - P_out| <
-    2 % of P_in. Torque balance of the whole reducer about its axis at every
+    """Steady state: input power = output power + dissipation + dE_kin/dt; beyond the
+    friction's own dissipation (output friction_power) the model dissipates only in
+    contact dampers, so |P_in - P_out - P_friction| < 2 % of P_in. Torque balance of the whole reducer about its axis at every
     window (Euler's law for the carrier, cranks and discs): the change of their
     angular momentum equals the impulse of -load torque + sun reaction - pin
     reactions on the housing, to 1 % of the load-torque impulse."""
@@ -68,7 +68,9 @@ def test_power_and_torque_balance(steady_run):
     ke = sel["kinetic_energy"].values
     dke = (ke[-1] - ke[0]) / 0.05
     assert p_in > 0 and p_out > 0
-    assert abs(p_in - p_out - dke) < 0.02 * p_in
+    # friction (issue 14, on in the presets) dissipates its own output; the rest is contact damping
+    p_f = float(sel["friction_power"].mean()) if "friction_power" in sel else 0.0
+    assert abs(p_in - p_out - dke - p_f) < 0.02 * p_in
     # angular momentum balance about the axis: dL/dt = -T_load + T_sun - T_housing
     # (mesh forces turn the members like they load the sun; pin forces on the discs
     # are opposite to those on the housing)

@@ -376,9 +376,20 @@ class PinContacts(KernelGroup):
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
                 "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
                                           "torque of the pin forces on each disc about its centre"),
-                "housing_pin_torque": Output((f * (self.pins[:, 0] * ny - self.pins[:, 1] * nx)).sum(axis=-1),
-                                             ("time", "disc"), "N m",
-                                             "torque of each disc's pin forces on the housing about the axis")}
+                "housing_pin_torque": Output(self._housing_torque(rec), ("time", "disc"), "N m",
+                                             "torque of each disc's pin forces (normal and friction) on the "
+                                             "housing about the axis")}
+
+    def _housing_torque(self, rec):
+        """Torque of the pin forces on the housing about the axis: the normal force -F n
+        through the pin centre P, and the friction force -f_t t (t = z x n) at the contact
+        point X = P - r n (a massless pin passes its contact force on to the housing),
+        (X x t)_z = P . n - r."""
+        f, nx, ny, px, py = rec["force"], rec["nx"], rec["ny"], self.pins[:, 0], self.pins[:, 1]
+        torque = f * (px * ny - py * nx)
+        if "ft" in rec:
+            torque = torque - rec["ft"] * (px * nx + py * ny - self.radii)
+        return torque.sum(axis=-1)
 
     def reset(self):
         """Forget the closest-point warm start and the call counter."""
