@@ -375,7 +375,8 @@ class PinContacts(KernelGroup):
                 "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration)"),
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
                 "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
-                                          "torque of the pin forces on each disc about its centre"),
+                                          "torque of the pin normal forces on each disc about its centre (the friction "
+                                          "forces' torque not included)"),
                 "housing_pin_torque": Output(self._housing_torque(rec), ("time", "disc"), "N m",
                                              "torque of each disc's pin forces (normal and friction) on the "
                                              "housing about the axis")}
