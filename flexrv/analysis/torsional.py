@@ -391,6 +391,107 @@ def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
 
 
 
+# --------------------------------------------------------------------------- housing ring
+def ring_displacements(angles, radial, tangential, mean_radius: float, bending_stiffness: float,
+                       axial_stiffness: float, harmonics: int = 400):
+    """Displacements of a thin circular ring under point loads (curved-beam theory,
+    Fourier series; Timoshenko & Goodier / Roark's *Formulas for Stress and Strain*,
+    ch. 9 thin rings): loads f_r (outward) and f_t (in +theta) at ``angles`` [rad];
+    returns (w, v) radial and tangential displacements [m] there.
+
+    Harmonic n >= 2 (inextensional bending, v' = -w): with the load densities
+    q_r = sum (A_n cos n th + B_n sin n th), q_t = sum (C_n cos n th + D_n sin n th),
+    A_n = sum_j f_rj cos(n th_j) / (pi R) etc., minimum potential energy gives
+    w_n = R^4 [(A_n - D_n / n) cos n th + (B_n + C_n / n) sin n th] / (EI (n^2 - 1)^2),
+    v_n = -int w_n. Harmonic 0: hoop extension w_0 = q_r0 R^2 / (EA). Harmonic 1 and
+    the mean tangential load (the net force and torque) are rigid-body motions,
+    reacted by the ring's support (shear flow), and give no deformation. Truncated at
+    ``harmonics`` (terms fall like n^-4). Verified against Roark's diametrically
+    loaded ring (tests/test_pin_seat.py)."""
+    th = np.asarray(angles, dtype=float)
+    fr, ft = np.asarray(radial, dtype=float), np.asarray(tangential, dtype=float)
+    r = mean_radius
+    w = np.full(th.shape, np.sum(fr) / (2.0 * np.pi * r) * r * r / axial_stiffness)
+    v = np.zeros(th.shape)
+    n = np.arange(2, harmonics + 1)[:, None]
+    cn, sn = np.cos(n * th), np.sin(n * th)
+    a, b = (cn @ fr) / (np.pi * r), (sn @ fr) / (np.pi * r)
+    c, d = (cn @ ft) / (np.pi * r), (sn @ ft) / (np.pi * r)
+    scale = r**4 / (bending_stiffness * (n[:, 0] ** 2 - 1.0) ** 2)
+    wa, wb = scale * (a - d / n[:, 0]), scale * (b + c / n[:, 0])
+    w += wa @ cn + wb @ sn
+    v += (-wa / n[:, 0]) @ sn + (wb / n[:, 0]) @ cn
+    return w, v
+
+
+@dataclass(frozen=True)
+class HousingCompliance:
+    """Torsional compliance of the pin housing at the output [rad/(N m)] (SI):
+    ``ring`` the in-plane deformation of the ring under the pin loads, ``tube`` its
+    torsion as a tube, ``total`` their sum; ``max_displacement`` the largest radial
+    ring displacement at a pin [m]."""
+
+    ring: float
+    tube: float
+    total: float
+    max_displacement: float
+
+
+def housing_compliance(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> HousingCompliance:
+    """Estimate of the pin housing's torsional compliance (design ``[housing]``).
+
+    Each pin passes its disc force to its groove along the contact normal, which
+    runs through the pitch point (on the line of centres, z_rp a from the housing
+    centre; Litvin & Fuentes 2004, ch. 19): f_j = F_j (C_j - P)/|C_j - P| with the
+    pin forces F_j of :func:`flexrv.analysis.pin_load.reducer_pin_loads`. Disc k loads
+    its own slice of the ring (axial length L / n_discs, radial section from the pin
+    circle R_p to the outer radius, mean radius the centre of the section): in-plane
+    ring deformation by :func:`ring_displacements` (each disc's slice on its own, no
+    axial coupling between the slices: an upper bound), and the energy gives the
+    compliance at the output, C_ring = sum_j f_j . u_j / T^2 (Clapeyron: the
+    strain energy sum f.u / 2 = C T^2 / 2). The torque then passes axially through
+    the ring as a tube (polar moment pi (r_o^4 - R_p^4)/2) over its length L to the
+    fixture: C_tube = L / (G J). Thin-ring theory on a ring whose thickness is ~0.4 of
+    its radius and the slice length are estimates (stated in the budget's notes)."""
+    from flexrv.analysis.pin_load import reducer_pin_loads
+    from flexrv.geometry.as_built import as_built
+    from flexrv.geometry.cycloid import nominal_disc_pose
+
+    h = reducer.housing
+    if h is None:
+        return HousingCompliance(0.0, 0.0, 0.0, 0.0)
+    ss = reducer.second_stage
+    torque = reducer.operating.rated_torque_Nm if output_torque is None else float(output_torque)
+    mat = reducer.material("housing")
+    e_mod, nu = mat.youngs_modulus, mat.poisson_ratio
+    r_i, r_o = ss.pin_circle_radius, 0.5e-3 * h.ring_outer_diameter_mm
+    length = 1e-3 * h.ring_length_mm
+    width = length / ss.n_discs
+    thick = r_o - r_i
+    ei, ea = e_mod * width * thick**3 / 12.0, e_mod * width * thick
+    r_mean = 0.5 * (r_i + r_o)
+    ab = as_built(reducer)
+    pins = np.asarray(ab.pins, dtype=float)
+    th = np.arctan2(pins[:, 1], pins[:, 0])
+    e_r = pins / np.linalg.norm(pins, axis=1)[:, None]
+    e_t = np.stack([-e_r[:, 1], e_r[:, 0]], axis=1)
+    energy, w_max = 0.0, 0.0
+    for k in range(ss.n_discs):
+        res = reducer_pin_loads(reducer, torque, crank_angle, disc=k)
+        center, _ = nominal_disc_pose(ss.pin_count, ss.eccentricity, crank_angle + float(ab.chi0[k]))
+        pitch = ss.pin_count * np.asarray(center)
+        u = pins - pitch
+        f = res.forces[:, None] * u / np.linalg.norm(u, axis=1)[:, None]
+        fr, ft = np.sum(f * e_r, axis=1), np.sum(f * e_t, axis=1)
+        w, v = ring_displacements(th, fr, ft, r_mean, ei, ea)
+        energy += float(np.sum(fr * w + ft * v))
+        w_max = max(w_max, float(np.max(np.abs(w[res.forces > 0])))) if np.any(res.forces > 0) else w_max
+    g_mod = e_mod / (2.0 * (1.0 + nu))
+    tube = length / (g_mod * 0.5 * np.pi * (r_o**4 - r_i**4))
+    ring = energy / torque**2
+    return HousingCompliance(ring=ring, tube=float(tube), total=ring + float(tube), max_displacement=w_max)
+
+
 @dataclass(frozen=True)
 class StiffnessBudget:
     """Analytic series model of the torsional compliance at the output (SI).
