@@ -10,7 +10,15 @@ loading and unloading curves"):
 * lost motion [arcmin]: rotation between T = +3 % and T = -3 % of T_r on the
   mean (loading/unloading averaged) curve;
 * hysteresis [arcmin]: width of the loop at T = 0 (descending minus returning
-  branch).
+  branch), the "hysteresis loss" of the catalogues (angle);
+* low-torque rigidity [N m/arcmin]: the same mean of the two branches' least-squares
+  slopes over |T| in [3 %, 50 %] of T_r, from the edge of the lost-motion band to the
+  start of the catalogue range: the lower of the piecewise-linear torsional stiffness
+  regions that Harmonic Drive catalogues give as K1/K2 (the RV catalogue gives the
+  50-100 % slope only; the low range here is flexrv's definition, stated with its
+  bounds in the figures);
+* hysteresis energy [J]: energy dissipated per loop, the loop area closed-integral
+  T d(theta) (theta in rad).
 """
 
 from __future__ import annotations
@@ -41,6 +49,9 @@ class StiffnessTest:
     lost_motion_positive_arcmin: float = float("nan")  #: mean-curve angle at +3 % T_r
     hysteresis_returning_arcmin: float = float("nan")  #: returning branch at T = 0
     hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
+    rigidity_low_Nm_per_arcmin: float = float("nan")  #: mean branch slope over |T| in [3 %, 50 %] T_r
+    low_range_low_Nm: float = float("nan")  #: low-torque fit over |T| in [low_range_low, fit_range_low]
+    hysteresis_energy_J: float = float("nan")  #: loop area, energy dissipated per loop
 
 
 def _fit_slope(torque, angle, lo, hi):
@@ -76,13 +87,17 @@ def evaluate_stiffness_test(time, torque, angle, times) -> StiffnessTest:
     mid_p = 0.5 * (_angle_at(torque[down], a[down], d3) + _angle_at(asc_t, asc_a, d3))
     mid_n = 0.5 * (_angle_at(torque[down], a[down], -d3) + _angle_at(asc_t, asc_a, -d3))
     a_down0, a_back0 = _angle_at(torque[down], a[down], 0.0), _angle_at(torque[back], a[back], 0.0)
+    k_low = 0.5 * (_fit_slope(torque[up], a[up], d3, 0.5 * rated) + _fit_slope(torque[neg], a[neg], d3, 0.5 * rated))
+    loop = (time >= t0) & (time <= te)
+    energy = abs(float(np.trapezoid(torque[loop], angle[loop])))
     return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
                          rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
                          lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
                          angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
                          fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
                          lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
-                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0)
+                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0,
+                         rigidity_low_Nm_per_arcmin=k_low, low_range_low_Nm=d3, hysteresis_energy_J=energy)
 
 
 #: (variable, StiffnessTest field, units, long name) of the saved figures
@@ -96,6 +111,9 @@ _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the 
             ("lost_motion", "lost_motion_arcmin", "arcmin",
              "lost motion: rotation between +3 % and -3 % of T_r on the mean curve"),
             ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
+            ("torsional_rigidity_low", "rigidity_low_Nm_per_arcmin", "N m/arcmin",
+             "low-torque rigidity, mean of the +T_r and -T_r branch slopes over 3 % T_r <= abs(T) <= T_r/2"),
+            ("hysteresis_energy", "hysteresis_energy_J", "J", "energy dissipated per loop (loop area)"),
             ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
             ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
             ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
@@ -133,7 +151,7 @@ def stiffness_json(figures: StiffnessTest) -> dict:
 
 
 def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, quarter_time: float,
-                               dt: float, plot: str | None = "hysteresis.png") -> str:
+                               dt: float, plot: str | None = "hysteresis.png", budget: dict | None = None) -> str:
     """summary.md of a stiffness test (not the time-simulation template): the program,
     the figures with units and how each is read, the loop plot, References."""
     f = figures
@@ -142,7 +160,7 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
              f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
              "catalogue and seed004 (average slope of the loading and unloading curves).", "",
              "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
-    for name, field, units, long in _FIGURES[:7]:
+    for name, field, units, long in _FIGURES[:9]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
     lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
               f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
@@ -150,6 +168,21 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
               f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
     if plot:
         lines += [f"![torque vs output rotation loop]({plot})", ""]
+    if budget:
+        from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+        comp = budget["compliances"]
+        total = sum(comp.values())
+        lines += [f"## Stiffness budget at {budget['torque']:.4g} N m", "",
+                  "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
+                  "stiffness_test_budget), the same elements as `flexrv te` and `flexrv design`.", "",
+                  "| element | compliance [arcsec/(N m)] | share [%] |", "|---|---|---|"]
+        for name, c in sorted(comp.items(), key=lambda kv: -kv[1]):
+            lines.append(f"| {name.replace('_', ' ')} | {c * ARCSEC_PER_RAD:.4g} | {100 * c / total:.3g} |")
+        lines += [f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |", "",
+                  f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
+                  f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin."]
+        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
     lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
               "stiffness.json, config.toml.", "", "## References", "",
               "seed004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "
