@@ -538,8 +538,9 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
     reached by torque continuation from the kinematic pose), mapped to the budget's
     elements by :func:`flexrv.analysis.torsional.budget_from_group_shares` (the mapping
     of ``flexrv te``). Returns {"compliances" [rad/(N m)], "tangent_rigidity"
-    [N m/rad], "torque" [N m], "notes"}."""
-    from flexrv.analysis.torsional import budget_from_group_shares
+    [N m/rad], "torque" [N m], "notes", "unmodelled": the elements of the budget that
+    the models do not contain (the housing), [rad/(N m)]}."""
+    from flexrv.analysis.torsional import UNMODELLED_ELEMENTS, budget_from_group_shares
     from flexrv.model.quasi_static import StaticModel, ramp_to
 
     sm = StaticModel(reducer)
@@ -556,7 +557,8 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
         if o and "crank_bending_fraction" in o:
             frac = float(np.nanmean(np.asarray(o["crank_bending_fraction"].values, dtype=float)))
     comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
-    return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes)}
+    return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes),
+            "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS}}
 
 
 def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = 0.02, settle: float = 0.005,
@@ -598,6 +600,9 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
 
     budget = stiffness_test_budget(reducer, t_r)
     budget["measured_rigidity"] = figures.rigidity_Nm_per_arcmin * ARCMIN_PER_RAD
+    #: the loop's rigidity with the elements the model lacks (housing) in series
+    budget["measured_with_unmodelled_rigidity"] = 1.0 / (1.0 / budget["measured_rigidity"]
+                                                         + sum(budget["unmodelled"].values()))
     budget["model"] = model
     res.ds.attrs["stiffness_budget"] = json.dumps(budget)
     if save_to is not None:

@@ -515,6 +515,8 @@ BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending
                    "housing")
 #: the housing enters the budget where its estimate exceeds this fraction of the total (issue 14)
 HOUSING_THRESHOLD = 0.01
+#: budget elements that the dynamic and quasi-static models do not contain (:func:`unmodelled_elements`)
+UNMODELLED_ELEMENTS = ("housing",)
 
 
 def split_pin_path(compliances: dict, reducer) -> dict:

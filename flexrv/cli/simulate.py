@@ -185,7 +185,9 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
         b = d["stiffness_budget"]
         console.print(budget_table(f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
                                    f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
-                                   f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin", b))
+                                   f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
+                                   f"({b['measured_with_unmodelled_Nm_per_arcmin']:.4g} with the unmodelled "
+                                   "elements in series)", b))
 
     emit(data, json, render)
 
@@ -203,6 +205,7 @@ def _budget(res) -> dict:
     out = budget_dict(b["compliances"], b["torque"])
     out["measured_rigidity_Nm_per_arcmin"] = b["measured_rigidity"] * RAD_PER_ARCMIN
     out["tangent_rigidity_Nm_per_arcmin"] = b["tangent_rigidity"] * RAD_PER_ARCMIN
+    out["measured_with_unmodelled_Nm_per_arcmin"] = b["measured_with_unmodelled_rigidity"] * RAD_PER_ARCMIN
     if b.get("notes"):
         out["notes"] = b["notes"]
     return out

@@ -59,6 +59,7 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
                 (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
                 ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
                 ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+                ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
                 ("max pin force", d.get("max_pin_force_N"), "N"), ("positions", d["positions"], "-"),
                 ("solve time", d["solve_time_s"], "s"), ("output", d["output_dir"], "")]
         console.print(kv_table(f"quasi-static TE {reducer.name} at {d['torque_Nm']:.6g} N m", rows))

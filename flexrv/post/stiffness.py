@@ -181,7 +181,9 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
             lines.append(f"| {name.replace('_', ' ')} | {c * ARCSEC_PER_RAD:.4g} | {100 * c / total:.3g} |")
         lines += [f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |", "",
                   f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
-                  f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin."]
+                  f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin, "
+                  f"{budget['measured_with_unmodelled_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin with the elements "
+                  f"the model does not contain ({', '.join(budget['unmodelled']) or 'none'}) in series."]
         lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
     lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
               "stiffness.json, config.toml.", "", "## References", "",
