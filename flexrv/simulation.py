@@ -548,14 +548,11 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
     q = ramp_to(sm, theta_in, sm.kinematic_pose(theta_in), torque, steps=8)
     k_t = sm.tangent_rigidity(theta_in, q)
     shares = sm.compliance_budget(theta_in, q)
-    frac = 0.0
-    zero = np.zeros((1, sm.n))
-    for group in sm.model.groups:
-        group.reset()
-        _, o = group.evaluate(np.array([theta_in]), sm.model.group_state(group, q[None]),
-                              sm.model.group_state(group, zero), want_outputs=True)
-        if o and "crank_bending_fraction" in o:
-            frac = float(np.nanmean(np.asarray(o["crank_bending_fraction"].values, dtype=float)))
+    from flexrv.model.outputs import model_outputs
+
+    outs = model_outputs(sm.model, np.array([theta_in]), q[None], np.zeros((1, sm.n)))
+    bend = outs.get("crank_bending_fraction")
+    frac = float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0
     comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
     return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes),
             "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS}}

@@ -66,7 +66,7 @@ def test_pin_loads_vs_analytic_distribution():
     torque from the solve. Tolerance: same pins in contact within +-1 and max
     pin force within 5 % (the solver lets the disc centre move on its compliant
     needle bearings, which the analytic method does not)."""
-    from flexrv.analysis.pin_load import pin_load_distribution, disc_effective_modulus
+    from flexrv.analysis.pin_load import disc_effective_modulus, pin_contact_constant, pin_load_distribution
 
     red = load("rv40e")
     r = loaded_te(red, crank_revolutions=0.01, points_per_mesh=8, catalog_positions=1)
@@ -75,7 +75,8 @@ def test_pin_loads_vs_analytic_distribution():
     ss = red.second_stage
     ref = pin_load_distribution(t_disc, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
                                 ss.disc_width, disc_effective_modulus(red), ss.modification_shift,
-                                ss.modification_equidistant, ss.modification_rotation, 0.0, "palmgren")
+                                ss.modification_equidistant, ss.modification_rotation, 0.0, "palmgren",
+                                stiffness_constant=pin_contact_constant(red).k)  # pin path with the seats (issue 14)
     assert abs(int((f > 0).sum()) - ref.n_contact) <= 1
     assert f.max() == pytest.approx(ref.max_force, rel=0.05)
     # static torque balance about the axis (exact at equilibrium): the pins' reaction on the
