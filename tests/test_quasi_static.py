@@ -134,8 +134,9 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
     the continuous one. The TE has cusps where the first-stage mesh stiffness
     switches between one and two tooth pairs (order 3840 of rv40e, 2.46 per
     cycloid-mesh period), which coarse sampling can miss: the error against
-    K = 64 measured 2.8 %, 2.2 %, 0.0 % at K = 8, 16, 32; required: no doubling
-    raises it, K = 8 within 5 % and K = 32 within 0.5 %.
+    K = 64 measured 7.2 %, 3.0 %, 0.01 % at K = 8, 16, 32 (2026-11-24, with the pin
+    seats in series, issue 14; 2.8 %, 2.2 %, 0.0 % with the stiffer pin law before);
+    required: no doubling raises it, K = 8 within 10 % and K = 32 within 0.5 %.
     Tightening the force tolerance 100x changes no TE sample by more than
     1e-4 arcsec."""
     red = load("rv40e")
@@ -148,7 +149,7 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
     assert pp[8] <= pp[16] + 1e-5 and pp[16] <= pp[32] + 1e-5 and pp[32] <= pp[64] + 1e-5  # nested, up to solver tolerance
     err = {k: (pp[64] - pp[k]) / pp[64] for k in (8, 16, 32)}
     assert err[8] >= err[16] >= err[32] - 1e-9
-    assert err[8] < 0.05 and err[32] < 0.005
+    assert err[8] < 0.10 and err[32] < 0.005
     a = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1)
     b = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1,
                   options={"force_tol": 1e-8})
@@ -272,9 +273,10 @@ def test_single_pin_tangential_error_bump_height():
     falls by t l_j / R_p (l_j its moment arm), so while it is the first contact the
     disc turns t / R_p earlier and the kinematic TE rises by t / R_p (1 - 1/i) =
     6.366 arcsec (closed form, independent of l_j). The no-load curve holds the
-    elastic part at its torque, which falls like T^0.9: measured 76 % of the
-    closed form at 1 % of the rated torque and 97.5 % at 0.1 %; required >= 70 %
-    and within 4 % respectively. Moved the other way, the pin only opens its
+    elastic part at its torque, which falls like T^0.9: measured 65 % of the
+    closed form at 1 % of the rated torque and 96.7 % at 0.1 % (2026-11-24, with the
+    pin seats in series, issue 14, the softer pin path holds more elastic part; 76 %
+    and 97.5 % before); required >= 60 % and within 4 % respectively. Moved the other way, the pin only opens its
     gap: no bump (< 0.2 arcsec)."""
     base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
     z = base.second_stage.pin_count
@@ -287,7 +289,7 @@ def test_single_pin_tangential_error_bump_height():
         t[5] = 2.0 * sign
         d = loaded_te(_pins(base, "pin_tangential_position_um", t), **kw).te_no_load - r0.te_no_load
         if check == "default":
-            assert 0.70 * expected < d.max() < expected
+            assert 0.60 * expected < d.max() < expected
         elif check == "small":
             assert d.max() == pytest.approx(expected, rel=0.04)
         else:
