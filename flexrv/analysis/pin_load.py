@@ -259,6 +259,13 @@ def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, l
                                  stiffness_constant=stiffness_constant)
 
 
+def shear_coefficient(nu: float) -> float:
+    """Timoshenko shear coefficient of a solid circular section, Cowper (1966):
+    kappa = 6 (1 + nu) / (7 + 6 nu) (pins here, crankshaft journals in
+    :func:`flexrv.analysis.torsional.stepped_shaft_bending`)."""
+    return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+
+
 def pin_bending_stiffness(span: float, radius: float, youngs_modulus: float, poisson_ratio: float) -> float:
     """Lateral stiffness [N/m] of a pin (solid circle of ``radius``) spanning ``span``
     [m] between two groove lands, simply supported there, under the disc's load at
@@ -268,8 +275,6 @@ def pin_bending_stiffness(span: float, radius: float, youngs_modulus: float, poi
         delta / Q = L^3 / (48 E I) + L / (4 kappa G A),   I = pi r^4 / 4, A = pi r^2.
 
     ``span`` = 0 (a fully supported pin) gives inf."""
-    from flexrv.analysis.torsional import _shear_coefficient
-
     if not (np.isfinite(span) and span >= 0 and radius > 0 and youngs_modulus > 0 and 0 <= poisson_ratio < 0.5):
         raise InputError(f"span = {span!r} m must be >= 0, radius = {radius!r} m and youngs_modulus > 0, "
                          f"0 <= poisson_ratio < 0.5")
@@ -277,7 +282,7 @@ def pin_bending_stiffness(span: float, radius: float, youngs_modulus: float, poi
         return float("inf")
     g_mod = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
     area, inertia = np.pi * radius**2, 0.25 * np.pi * radius**4
-    return 1.0 / (span**3 / (48.0 * youngs_modulus * inertia) + span / (4.0 * _shear_coefficient(poisson_ratio) * g_mod * area))
+    return 1.0 / (span**3 / (48.0 * youngs_modulus * inertia) + span / (4.0 * shear_coefficient(poisson_ratio) * g_mod * area))
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexrv.analysis.pin_load import shear_coefficient
 from flexrv.errors import InputError
 from flexrv.units import M_PER_MM, M_PER_UM, RAD_PER_DEG
 
@@ -292,10 +293,8 @@ class CrankBending:
     positions: tuple[float, float, float, float]
 
 
-def _shear_coefficient(nu: float) -> float:
-    """Timoshenko shear coefficient of a solid circular section, Cowper (1966):
-    kappa = 6 (1 + nu) / (7 + 6 nu)."""
-    return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+#: Timoshenko shear coefficient of a solid circle (Cowper 1966), one executor in pin_load
+_shear_coefficient = shear_coefficient
 
 
 def stepped_shaft_bending(segments, youngs_modulus: float, poisson_ratio: float) -> CrankBending:
