@@ -133,3 +133,40 @@ def test_quasi_static_budget_splits_the_crank_supports():
     assert b["elements"]["support_bearings"]["share_percent"] == pytest.approx(24.0, rel=1e-12)
     assert b["elements"]["pins"]["compliance_arcsec_per_Nm"] == pytest.approx(0.1 * total, rel=1e-12)
     assert b["rigidity_Nm_per_arcmin"] == pytest.approx(250.0, rel=1e-12)
+
+
+def test_low_torque_rigidity_and_loop_energy_on_a_synthetic_loop():
+    """:func:`flexrv.post.stiffness.evaluate_stiffness_test` on a piecewise-linear
+    loop with known slopes: k_low = 100 N m/arcmin below T_r/2 and k = 200 above on
+    the loading branches, a hysteresis offset h between the branches; the low-torque
+    figure is 100 (fit over 3-50 % T_r, rel 1e-6), the catalog figure 200, the
+    hysteresis h, and the loop energy the closed form of the program's integral of
+    T d(theta) (rel 5e-4: the branch jumps fall between two samples)."""
+    import numpy as np
+
+    from flexrv.post.stiffness import evaluate_stiffness_test
+    from flexrv.units import ARCMIN_PER_RAD
+
+    t_r, h = 400.0, 0.2  # N m, arcmin
+
+    def curve(torque):  # angle [arcmin] of the mean curve
+        a = np.abs(torque)
+        return np.sign(torque) * np.where(a <= t_r / 2, a / 100.0, t_r / 200.0 + (a - t_r / 2) / 200.0)
+
+    n = 4001
+    up = np.linspace(0.0, t_r, n)
+    down = np.linspace(t_r, -t_r, 2 * n - 1)[1:]
+    back = np.linspace(-t_r, 0.0, n)[1:]
+    torque = np.r_[up, down, back]
+    # loading up and back along the mean curve - h/2, descending along + h/2 (a parallelogram-like loop)
+    angle = np.r_[curve(up) - 0.5 * h * up / t_r, curve(down) + 0.5 * h, curve(back) - 0.5 * h]
+    angle[:n] = curve(up)  # the virgin branch starts at the origin
+    time = np.arange(len(torque), dtype=float)
+    f = evaluate_stiffness_test(time, torque, angle / ARCMIN_PER_RAD, (0.0, n - 1.0, 3.0 * n - 3.0, len(torque) - 1.0))
+    assert f.rigidity_low_Nm_per_arcmin == pytest.approx(100.0, rel=1e-6)
+    assert f.rigidity_positive_Nm_per_arcmin == pytest.approx(200.0, rel=1e-9)
+    # closed form of the program's integral T d(theta): virgin branch +U, jump at +T_r T_r h/2, descending
+    # branch -2U (the curve is odd), jump at -T_r T_r h, returning branch +U: 1.5 T_r h [N m arcmin]
+    # (the jumps fall between two samples T_r/4000 apart: rel 1.25e-4 of the area)
+    assert f.hysteresis_energy_J == pytest.approx(1.5 * t_r * h / ARCMIN_PER_RAD, rel=5e-4)
+    assert f.hysteresis_arcmin == pytest.approx(h, rel=1e-9)

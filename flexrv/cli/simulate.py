@@ -183,6 +183,10 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
         rows = [(*_label_unit(k), v) for k, v in d.items() if k != "stiffness_budget"]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
         b = d["stiffness_budget"]
+        if not b["elements"]:
+            for note in b.get("notes", []):
+                console.print(f"note: {note}", style="yellow")
+            return
         console.print(budget_table(f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
                                    f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
                                    f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
@@ -202,6 +206,9 @@ def _budget(res) -> dict:
     from flexrv.units import RAD_PER_ARCMIN
 
     b = json.loads(res.attrs["stiffness_budget"])
+    if not b["compliances"]:
+        return {"elements": {}, "torque_Nm": b["torque"], "notes": b.get("notes", []),
+                "measured_rigidity_Nm_per_arcmin": b["measured_rigidity"] * RAD_PER_ARCMIN}
     out = budget_dict(b["compliances"], b["torque"])
     out["measured_rigidity_Nm_per_arcmin"] = b["measured_rigidity"] * RAD_PER_ARCMIN
     out["tangent_rigidity_Nm_per_arcmin"] = b["tangent_rigidity"] * RAD_PER_ARCMIN

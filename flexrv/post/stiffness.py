@@ -168,7 +168,9 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
               f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
     if plot:
         lines += [f"![torque vs output rotation loop]({plot})", ""]
-    if budget:
+    if budget and not budget.get("compliances"):
+        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
+    elif budget:
         from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
         comp = budget["compliances"]
