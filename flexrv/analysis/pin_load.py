@@ -323,8 +323,9 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     radius-free; the seat is conformal (groove radius r + c), and its Hertz
     half-width (:func:`flexrv.contact.hertz.conformal_line_contact`) at the largest
     pin load is reported as ``seat_semi_angle``: where it is not small against the
-    pin radius the seat spreads over an arc and is stiffer than Palmgren's law, which
-    then bounds the seat's compliance from above. A linear bending spring in series
+    pin radius the seat spreads over an arc and is expected stiffer than Palmgren's
+    law, which is then a conservative (compliant) estimate (rv40e: 0.27 pin radii at
+    597 N). A linear bending spring in series
     has no exact power-law form: the path's constant is matched to the series
     deflection at the reference load Q_ref (the largest pin force at the rated
     torque): K = Q_ref / (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).

@@ -568,17 +568,24 @@ def budget_from_group_shares(shares: dict, total: float, bending_fraction: float
 def unmodelled_elements(reducer, model_total: float, torque: float | None = None) -> tuple[dict, tuple]:
     """Budget elements that the dynamic and quasi-static models do not contain (their
     housing is rigid): the housing estimate (:func:`housing_compliance`) where it is
-    more than HOUSING_THRESHOLD of the total with it, else a note. Returns
-    (compliances, notes); every budget (analytic, quasi-static, dynamic) adds the same."""
+    more than HOUSING_THRESHOLD of the total with it, else a note; and a note on the
+    pin seats' conformity. Returns (compliances, notes); every budget (analytic,
+    quasi-static, dynamic) adds the same."""
+    from flexrv.analysis.pin_load import pin_contact_constant
+
     if reducer.housing is None:
-        return {}, ("housing: no [housing] table, rigid housing",)
+        return {}, ("housing: no [housing] table, pins rigidly seated, rigid housing",)
+    pc = pin_contact_constant(reducer)
+    seat = (f"pin seats: Palmgren line contact in series with the pin-disc contact; the groove's Hertz half-width "
+            f"is {pc.seat_semi_angle:.2g} pin radii at the largest pin load ({pc.reference_load:.4g} N): a conformal "
+            "seat spreads wider and is expected stiffer, so the element is a conservative (compliant) estimate")
     hc = housing_compliance(reducer, torque)
     share = hc.total / (model_total + hc.total)
     if share > HOUSING_THRESHOLD:
         return {"housing": hc.total}, (f"housing: thin-ring estimate {100 * share:.3g} % of the total, not in the "
-                                       "dynamic or quasi-static model (rigid housing there); added in series",)
+                                       "dynamic or quasi-static model (rigid housing there); added in series", seat)
     return {}, (f"housing: thin-ring estimate {100 * share:.3g} % of the total (< {100 * HOUSING_THRESHOLD:g} %), "
-                "left out",)
+                "left out", seat)
 
 
 def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> StiffnessBudget:

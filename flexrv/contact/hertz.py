@@ -245,9 +245,11 @@ def conformal_line_contact(load, length, pin_radius, groove_radius, e_eff):
     of the contact arc on the pin. Hertz's half-space idealisation needs b << r
     (Johnson 1985, sec. 4.1: the contact small against the radii); where b / r is not
     small (a close-fitting groove) the contact spreads over an arc (Persson 1964;
-    Johnson 1985, sec. 5.3) and is stiffer than a Hertz/Palmgren line contact of the
-    same length, whose radius-free approach then bounds the seat's compliance from
-    above. Callers report ``semi_angle`` so the bound is visible.
+    Johnson 1985, sec. 5.3), and the 2-D approach, whose logarithmic term
+    ln(4 r / b) falls as b grows (Johnson 1985, sec. 5.6), is expected smaller than a
+    Hertz/Palmgren line contact's of the same length: the radius-free Palmgren
+    approach is then a conservative (compliant) estimate of the seat. Callers report
+    ``semi_angle`` so the range is visible.
 
     Parameters
     ----------
