@@ -74,7 +74,12 @@ def test_design_te_and_stiffness_test_totals_agree(tmp_path):
     r = load("rv40e")
     design = analytic_budget(r)["rigidity_Nm_per_arcmin"]
     res = loaded_te(r, crank_revolutions=0.05, points_per_mesh=4, catalog_positions=2)
-    te = quasi_static_budget(te_summary(te_dataset(res, r)), res.outputs, r)["rigidity_Nm_per_arcmin"]
+    summary = te_summary(te_dataset(res, r))
+    te = quasi_static_budget(summary, res.outputs, r)["rigidity_Nm_per_arcmin"]
+    # te's low-torque secant (3-50 % rated) lies below the catalog one (the Palmgren laws stiffen with load
+    # and the contacts close in the low range): measured 2026-11-24
+    assert 0.5 * summary["catalog_rigidity_Nm_per_arcmin"] < summary["low_torque_rigidity_Nm_per_arcmin"] \
+        < summary["catalog_rigidity_Nm_per_arcmin"]
     fig, run = stiffness_test("rv40e", save_to=tmp_path)
     import json
 
