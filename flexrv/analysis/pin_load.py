@@ -48,6 +48,7 @@ from scipy.optimize import brentq
 
 from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact, line_contact_stiffness
 from flexrv.errors import ConvergenceError, InputError
+from flexrv.units import M_PER_MM
 from flexrv.geometry.as_built import as_built, as_built_pin_gap
 from flexrv.geometry.cycloid import (nominal_disc_pose, pin_positions, pin_stiffness_seed000, profile_curvature_radius,
                                      to_disc_frame)
@@ -341,12 +342,12 @@ def pin_contact_constant(reducer) -> PinContactConstant:
                                   shares={"pins": 1.0, "pin_seats": 0.0, "pin_bending": 0.0})
     mp, mh = reducer.material("pins"), reducer.material("housing")
     e_seat = float(effective_modulus(mp.youngs_modulus, mp.poisson_ratio, mh.youngs_modulus, mh.poisson_ratio))
-    length = 1e-3 * h.pin_seat_length_mm / ss.n_discs
+    length = M_PER_MM * h.pin_seat_length_mm / ss.n_discs
     k_seat = float(line_contact_stiffness(length, e_seat))
     k_contacts = float(series_stiffness(k_disc, k_seat, n))
     q_ref = reducer_pin_loads(reducer, reducer.operating.rated_torque_Nm, stiffness_constant=k_contacts).max_force
     _, semi = conformal_line_contact(q_ref, length, ss.pin_radius, ss.pin_radius + h.pin_seat_clearance, e_seat)
-    k_bend = pin_bending_stiffness(1e-3 * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus,
+    k_bend = pin_bending_stiffness(M_PER_MM * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus,
                                    mp.poisson_ratio)
     # tangent compliances at Q_ref: power law delta / (n Q), linear spring 1 / k
     d_disc, d_seat = (q_ref / k_disc) ** (1.0 / n), (q_ref / k_seat) ** (1.0 / n)

@@ -19,7 +19,7 @@ from pydantic import Field, model_serializer, model_validator
 
 from flexrv.design._base import _bad, _Strict
 
-from flexrv.units import RAD_PER_DEG
+from flexrv.units import M_PER_UM, RAD_PER_DEG
 
 
 
@@ -495,7 +495,7 @@ class Housing(_Strict):
     @property
     def pin_seat_clearance(self) -> float:
         """Groove radius - pin radius [m]."""
-        return self.pin_seat_clearance_um * 1e-6
+        return self.pin_seat_clearance_um * M_PER_UM
 
     def validate_for(self, reducer) -> None:
         """The ring encloses the pins by at least a ligament; the seat and the unsupported span fit the ring."""
