@@ -40,7 +40,7 @@ from typing import Callable
 import numpy as np
 
 from flexrv.design import load
-from flexrv.errors import InputError, SimulationError, check_options
+from flexrv.errors import ConvergenceError, InputError, SimulationError, check_options
 from flexrv.viz.plots import PlottedResults as Results  # re-exported: flexrv.Results (saves its PNGs)
 from flexrv.units import ARCMIN_PER_RAD
 
@@ -530,6 +530,34 @@ def _progress_callback(progress, t_end):
     return rep
 
 
+def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict:
+    """Stiffness budget of the stiffness test (SI): the quasi-static model's
+    strain-energy budget (:meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`,
+    the same force groups and laws as the dynamic rigid model) at the test's pose, the
+    input locked at ``theta_in`` and the output at +``torque`` (static equilibrium
+    reached by torque continuation from the kinematic pose), mapped to the budget's
+    elements by :func:`flexrv.analysis.torsional.budget_from_group_shares` (the mapping
+    of ``flexrv te``). Returns {"compliances" [rad/(N m)], "tangent_rigidity"
+    [N m/rad], "torque" [N m], "notes", "unmodelled": the elements of the budget that
+    the models do not contain (the housing), [rad/(N m)]}."""
+    from flexrv.analysis.torsional import UNMODELLED_ELEMENTS, budget_from_group_shares
+    from flexrv.model.quasi_static import StaticModel, ramp_to
+
+    sm = StaticModel(reducer)
+    sm.torque = 0.0
+    q = ramp_to(sm, theta_in, sm.kinematic_pose(theta_in), torque, steps=8)
+    k_t = sm.tangent_rigidity(theta_in, q)
+    shares = sm.compliance_budget(theta_in, q)
+    from flexrv.model.outputs import model_outputs
+
+    outs = model_outputs(sm.model, np.array([theta_in]), q[None], np.zeros((1, sm.n)))
+    bend = outs.get("crank_bending_fraction")
+    frac = float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0
+    comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
+    return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes),
+            "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS}}
+
+
 def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = 0.02, settle: float = 0.005,
                    dt: float = DEFAULT_DT, torque: float | None = None, progress: bool | Callable = False,
                    save_to: str | Path | None = None, model_options: dict | None = None):
@@ -540,7 +568,9 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
 
     Returns (:class:`flexrv.post.stiffness.StiffnessTest`, Results); the Results'
     dataset carries the figures as scalar variables with units (rigidity, lost motion,
-    hysteresis, ...) and the loop (``loop_torque``, ``loop_angle``). Written to
+    hysteresis, ...) and the loop (``loop_torque``, ``loop_angle``), and in its attribute
+    ``stiffness_budget`` (JSON, SI) the budget of :func:`stiffness_test_budget` at +T
+    with the loop's measured rigidity (``measured_rigidity`` [N m/rad]). Written to
     ``save_to`` if given: ``results.nc`` (that dataset), ``stiffness.json``,
     ``config.toml``, the test's own ``summary.md`` and ``hysteresis.png`` (loop with the
     rigidity fit range, lost motion and hysteresis marked).
@@ -564,8 +594,24 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     figures = evaluate_stiffness_test(res.time, tq, angle, times[1:], friction_power=(
         res["friction_power"].values if "friction_power" in res.ds else None))
     res.ds = stiffness_dataset(figures, res.time, tq, angle * ARCMIN_PER_RAD, base=res.ds)
+    import json
+
+    try:
+        budget = stiffness_test_budget(reducer, t_r)
+    except ConvergenceError as exc:  # the figures stand without it
+        budget = {"compliances": {}, "tangent_rigidity": float("nan"), "torque": float(t_r), "unmodelled": {},
+                  "notes": [f"stiffness budget not available: the quasi-static equilibrium at +{t_r:g} N m did "
+                            f"not converge ({exc})"]}
+    if model != "rigid":
+        budget["notes"].append(f"budget of the rigid quasi-static model at the test's pose (the loop ran the "
+                               f"{model} model)")
+    budget["measured_rigidity"] = figures.rigidity_Nm_per_arcmin * ARCMIN_PER_RAD
+    #: the loop's rigidity with the elements the model lacks (housing) in series
+    budget["measured_with_unmodelled_rigidity"] = 1.0 / (1.0 / budget["measured_rigidity"]
+                                                         + sum(budget["unmodelled"].values()))
+    budget["model"] = model
+    res.ds.attrs["stiffness_budget"] = json.dumps(budget)
     if save_to is not None:
-        import json
 
         from flexrv.cache import atomic_path, atomic_write_text
         from flexrv.design import to_toml
@@ -578,9 +624,9 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
         atomic_write_text(d / "config.toml", to_toml(reducer))
         atomic_write_text(d / "stiffness.json", json.dumps(
             {"preset": reducer.name, "model": model, "quarter_time_s": quarter_time, "dt_s": dt,
-             "figures": stiffness_json(figures)}, indent=2))
+             "figures": stiffness_json(figures), "stiffness_budget_SI": budget}, indent=2))
         plot_hysteresis(angle * ARCMIN_PER_RAD, tq, d / "hysteresis.png", figures=figures,
                         title=f"{reducer.name} stiffness test ({model} model)")
         atomic_write_text(d / "summary.md", stiffness_summary_markdown(figures, reducer.name, model,
-                                                                       quarter_time, dt))
+                                                                       quarter_time, dt, budget=budget))
     return figures, res

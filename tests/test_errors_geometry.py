@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from flexrv.analysis.pin_load import disc_effective_modulus, pin_load_distribution, reducer_pin_loads
+from flexrv.analysis.pin_load import disc_effective_modulus, pin_contact_constant, pin_load_distribution, reducer_pin_loads
 from flexrv.cli import app
 from flexrv.design import from_dict, load, loads, to_toml
 from flexrv.design import error_set_names, load_error_set, with_errors
@@ -93,7 +93,8 @@ def test_zero_errors_pin_loads_unchanged():
         ref = pin_load_distribution(412.0 / ss.n_discs, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
                                     ss.eccentricity, ss.disc_width, disc_effective_modulus(r),
                                     ss.modification_shift, ss.modification_equidistant, ss.modification_rotation,
-                                    0.1 + 2.0 * np.pi * k / ss.n_discs)
+                                    0.1 + 2.0 * np.pi * k / ss.n_discs,
+                                    stiffness_constant=pin_contact_constant(r).k)  # the design's pin path (issue 14)
         np.testing.assert_array_equal(res.forces, ref.forces)
         np.testing.assert_array_equal(res.clearance, ref.clearance)
         assert res.rotation == ref.rotation and res.max_pressure == ref.max_pressure

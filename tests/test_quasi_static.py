@@ -66,7 +66,7 @@ def test_pin_loads_vs_analytic_distribution():
     torque from the solve. Tolerance: same pins in contact within +-1 and max
     pin force within 5 % (the solver lets the disc centre move on its compliant
     needle bearings, which the analytic method does not)."""
-    from flexrv.analysis.pin_load import pin_load_distribution, disc_effective_modulus
+    from flexrv.analysis.pin_load import disc_effective_modulus, pin_contact_constant, pin_load_distribution
 
     red = load("rv40e")
     r = loaded_te(red, crank_revolutions=0.01, points_per_mesh=8, catalog_positions=1)
@@ -75,7 +75,8 @@ def test_pin_loads_vs_analytic_distribution():
     ss = red.second_stage
     ref = pin_load_distribution(t_disc, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
                                 ss.disc_width, disc_effective_modulus(red), ss.modification_shift,
-                                ss.modification_equidistant, ss.modification_rotation, 0.0, "palmgren")
+                                ss.modification_equidistant, ss.modification_rotation, 0.0, "palmgren",
+                                stiffness_constant=pin_contact_constant(red).k)  # pin path with the seats (issue 14)
     assert abs(int((f > 0).sum()) - ref.n_contact) <= 1
     assert f.max() == pytest.approx(ref.max_force, rel=0.05)
     # static torque balance about the axis (exact at equilibrium): the pins' reaction on the
@@ -133,8 +134,9 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
     the continuous one. The TE has cusps where the first-stage mesh stiffness
     switches between one and two tooth pairs (order 3840 of rv40e, 2.46 per
     cycloid-mesh period), which coarse sampling can miss: the error against
-    K = 64 measured 2.8 %, 2.2 %, 0.0 % at K = 8, 16, 32; required: no doubling
-    raises it, K = 8 within 5 % and K = 32 within 0.5 %.
+    K = 64 measured 7.2 %, 3.0 %, 0.01 % at K = 8, 16, 32 (2026-11-24, with the pin
+    seats in series, issue 14; 2.8 %, 2.2 %, 0.0 % with the stiffer pin law before);
+    required: no doubling raises it, K = 8 within 10 % and K = 32 within 0.5 %.
     Tightening the force tolerance 100x changes no TE sample by more than
     1e-4 arcsec."""
     red = load("rv40e")
@@ -147,7 +149,7 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
     assert pp[8] <= pp[16] + 1e-5 and pp[16] <= pp[32] + 1e-5 and pp[32] <= pp[64] + 1e-5  # nested, up to solver tolerance
     err = {k: (pp[64] - pp[k]) / pp[64] for k in (8, 16, 32)}
     assert err[8] >= err[16] >= err[32] - 1e-9
-    assert err[8] < 0.05 and err[32] < 0.005
+    assert err[8] < 0.10 and err[32] < 0.005
     a = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1)
     b = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1,
                   options={"force_tol": 1e-8})
@@ -272,9 +274,10 @@ def test_single_pin_tangential_error_bump_height():
     falls by t l_j / R_p (l_j its moment arm), so while it is the first contact the
     disc turns t / R_p earlier and the kinematic TE rises by t / R_p (1 - 1/i) =
     6.366 arcsec (closed form, independent of l_j). The no-load curve holds the
-    elastic part at its torque, which falls like T^0.9: measured 76 % of the
-    closed form at 1 % of the rated torque and 97.5 % at 0.1 %; required >= 70 %
-    and within 4 % respectively. Moved the other way, the pin only opens its
+    elastic part at its torque, which falls like T^0.9: measured 65 % of the
+    closed form at 1 % of the rated torque and 96.7 % at 0.1 % (2026-11-24, with the
+    pin seats in series, issue 14, the softer pin path holds more elastic part; 76 %
+    and 97.5 % before); required >= 60 % and within 4 % respectively. Moved the other way, the pin only opens its
     gap: no bump (< 0.2 arcsec)."""
     base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
     z = base.second_stage.pin_count
@@ -287,7 +290,7 @@ def test_single_pin_tangential_error_bump_height():
         t[5] = 2.0 * sign
         d = loaded_te(_pins(base, "pin_tangential_position_um", t), **kw).te_no_load - r0.te_no_load
         if check == "default":
-            assert 0.70 * expected < d.max() < expected
+            assert 0.60 * expected < d.max() < expected
         elif check == "small":
             assert d.max() == pytest.approx(expected, rel=0.04)
         else:

@@ -48,6 +48,7 @@ from scipy.optimize import brentq
 
 from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact, line_contact_stiffness
 from flexrv.errors import ConvergenceError, InputError
+from flexrv.units import M_PER_MM
 from flexrv.geometry.as_built import as_built, as_built_pin_gap
 from flexrv.geometry.cycloid import (nominal_disc_pose, pin_positions, pin_stiffness_seed000, profile_curvature_radius,
                                      to_disc_frame)
@@ -100,7 +101,7 @@ def _law(law: str, width: float, e_eff: float):
 def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
                           width: float, e_eff: float, d_radius: float = 0.0, d_pin_radius: float = 0.0,
                           d_rotation: float = 0.0, crank_angle: float = 0.0, law: str = "palmgren", *,
-                          pins=None, pin_radii=None, harmonics=None) -> PinLoadResult:
+                          pins=None, pin_radii=None, harmonics=None, stiffness_constant: float | None = None) -> PinLoadResult:
     """Pin forces of one disc under the disc torque ``torque`` [N m] (see module
     docstring for the method and the laws).
 
@@ -121,6 +122,9 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
     pin_radii : (z_rp,) actual pin radii [m] (default ``pin_radius``).
     harmonics : (H, 3) profile-error harmonics (order, amplitude [m], phase [rad])
         of this disc (:func:`flexrv.geometry.as_built.profile_deviation`).
+    stiffness_constant : K [N/m^(10/9)] of the whole pin path for the palmgren law
+        (:func:`pin_contact_constant`: disc contact, pin seat and pin bending in
+        series); default the disc contact alone, :func:`flexrv.contact.hertz.line_contact_stiffness`.
 
     Raises
     ------
@@ -133,6 +137,10 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
     if width <= 0 or e_eff <= 0:
         raise InputError(f"width = {width!r} and e_eff = {e_eff!r} must be > 0")
     k, e = _law(law, width, e_eff)
+    if stiffness_constant is not None:
+        if law != "palmgren" or not (np.isfinite(stiffness_constant) and stiffness_constant > 0):
+            raise InputError(f"stiffness_constant = {stiffness_constant!r} needs law 'palmgren' and a value > 0")
+        k = float(stiffness_constant)
     pins_h = pin_positions(z_rp, pin_circle_radius) if pins is None else np.asarray(pins, dtype=float)
     radii = np.full(z_rp, float(pin_radius)) if pin_radii is None else np.asarray(pin_radii, dtype=float)
     if pins_h.shape != (z_rp, 2) or radii.shape != (z_rp,):
@@ -223,7 +231,8 @@ def disc_effective_modulus(reducer) -> float:
 
 
 def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, law: str = "palmgren",
-                      d_pin_radius: float | None = None, disc: int = 0) -> PinLoadResult:
+                      d_pin_radius: float | None = None, disc: int = 0,
+                      stiffness_constant: float | None = None) -> PinLoadResult:
     """Pin load distribution of disc ``disc`` of a design under the OUTPUT torque
     [N m], shared equally by the n_discs discs (rigid cranks): T_disc = T / n_discs.
 
@@ -232,8 +241,12 @@ def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, l
     profile-error harmonics; the disc sits at its nominal pose for the crank angle
     ``crank_angle`` + chi0_disc (disc k's eccentric leads by 2 pi k / n_discs).
     ``d_pin_radius`` overrides the design's nominal equidistant modification [m]
-    (the disc's equidistant error is kept on top of it)."""
+    (the disc's equidistant error is kept on top of it). The palmgren law uses the
+    design's whole pin path (:func:`pin_contact_constant`: disc contact, pin seat,
+    pin bending) unless ``stiffness_constant`` is given."""
     ss = reducer.second_stage
+    if law == "palmgren" and stiffness_constant is None:
+        stiffness_constant = pin_contact_constant(reducer).k
     if not 0 <= disc < ss.n_discs:
         raise InputError(f"disc = {disc!r} must be within 0..{ss.n_discs - 1}")
     ab = as_built(reducer)
@@ -243,4 +256,104 @@ def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, l
     return pin_load_distribution(output_torque / ss.n_discs, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
                                  ss.eccentricity, ss.disc_width, disc_effective_modulus(reducer),
                                  d_radius, dr, d_rot, crank_angle + float(ab.chi0[disc]), law,
-                                 pins=ab.pins, pin_radii=ab.pin_radii, harmonics=ab.profile_harmonics[disc])
+                                 pins=ab.pins, pin_radii=ab.pin_radii, harmonics=ab.profile_harmonics[disc],
+                                 stiffness_constant=stiffness_constant)
+
+
+def shear_coefficient(nu: float) -> float:
+    """Timoshenko shear coefficient of a solid circular section, Cowper (1966):
+    kappa = 6 (1 + nu) / (7 + 6 nu) (pins here, crankshaft journals in
+    :func:`flexrv.analysis.torsional.stepped_shaft_bending`)."""
+    return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+
+
+def pin_bending_stiffness(span: float, radius: float, youngs_modulus: float, poisson_ratio: float) -> float:
+    """Lateral stiffness [N/m] of a pin (solid circle of ``radius``) spanning ``span``
+    [m] between two groove lands, simply supported there, under the disc's load at
+    mid-span (Timoshenko beam; Timoshenko & Gere, *Mechanics of Materials*, ch. 9;
+    shear coefficient of a solid circle kappa = 6 (1 + nu)/(7 + 6 nu), Cowper 1966):
+
+        delta / Q = L^3 / (48 E I) + L / (4 kappa G A),   I = pi r^4 / 4, A = pi r^2.
+
+    ``span`` = 0 (a fully supported pin) gives inf."""
+    if not (np.isfinite(span) and span >= 0 and radius > 0 and youngs_modulus > 0 and 0 <= poisson_ratio < 0.5):
+        raise InputError(f"span = {span!r} m must be >= 0, radius = {radius!r} m and youngs_modulus > 0, "
+                         f"0 <= poisson_ratio < 0.5")
+    if span == 0:
+        return float("inf")
+    g_mod = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
+    area, inertia = np.pi * radius**2, 0.25 * np.pi * radius**4
+    return 1.0 / (span**3 / (48.0 * youngs_modulus * inertia) + span / (4.0 * shear_coefficient(poisson_ratio) * g_mod * area))
+
+
+@dataclass(frozen=True)
+class PinContactConstant:
+    """Constant of the pin law Q = K delta^(10/9) of a design's whole pin path
+    (:func:`pin_contact_constant`), its parts and their shares (SI).
+
+    k : constant of the path [N/m^(10/9)]; exponent : 10/9; k_disc, k_seat :
+    Palmgren constants of the pin-disc and pin-seat contacts (k_seat inf without a
+    housing); k_bending : linear pin-bending stiffness [N/m] (inf: fully supported);
+    reference_load : pin load [N] at which the bending is matched (largest pin force
+    at the rated torque); seat_semi_angle : Hertz half-width / pin radius of the
+    seat at that load [rad] (:func:`flexrv.contact.hertz.conformal_line_contact`);
+    shares : element -> fraction of the path's tangent compliance at the reference
+    load ("pins" the disc contact, "pin_seats", "pin_bending"; they sum to 1).
+    """
+
+    k: float
+    exponent: float
+    k_disc: float
+    k_seat: float
+    k_bending: float
+    reference_load: float
+    seat_semi_angle: float
+    shares: dict
+
+
+def pin_contact_constant(reducer) -> PinContactConstant:
+    """The pin law's constant of a design: the load passes from the disc into the
+    pin (pin-disc line contact over the disc width b) and from the pin into its
+    groove in the housing (pin-seat line contact over the seat length per disc
+    L_s = ``housing.pin_seat_length_mm`` / n_discs), and, where the pin spans
+    ``housing.pin_unsupported_length_mm`` between lands, through its bending
+    (:func:`pin_bending_stiffness`). The two contacts are Palmgren line contacts
+    (:func:`flexrv.contact.hertz.line_contact_stiffness`; E' of disc/pin and of
+    pin/housing) in series (:func:`flexrv.contact.hertz.series_stiffness`, exact
+    for equal exponents: delta = delta_disc + delta_seat). Palmgren's approach is
+    radius-free; the seat is conformal (groove radius r + c), and its Hertz
+    half-width (:func:`flexrv.contact.hertz.conformal_line_contact`) at the largest
+    pin load is reported as ``seat_semi_angle``: where it is not small against the
+    pin radius the seat spreads over an arc and is expected stiffer than Palmgren's
+    law, which is then a conservative (compliant) estimate (rv40e: 0.27 pin radii at
+    597 N). A linear bending spring in series
+    has no exact power-law form: the path's constant is matched to the series
+    deflection at the reference load Q_ref (the largest pin force at the rated
+    torque): K = Q_ref / (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
+    Without a [housing] table the pins are rigidly seated: K = k_disc."""
+    from flexrv.contact.hertz import conformal_line_contact, effective_modulus, series_stiffness
+
+    ss, h = reducer.second_stage, reducer.housing
+    n = LINE_EXPONENT
+    k_disc = float(line_contact_stiffness(ss.disc_width, disc_effective_modulus(reducer)))
+    if h is None:
+        return PinContactConstant(k=k_disc, exponent=n, k_disc=k_disc, k_seat=float("inf"), k_bending=float("inf"),
+                                  reference_load=float("nan"), seat_semi_angle=float("nan"),
+                                  shares={"pins": 1.0, "pin_seats": 0.0, "pin_bending": 0.0})
+    mp, mh = reducer.material("pins"), reducer.material("housing")
+    e_seat = float(effective_modulus(mp.youngs_modulus, mp.poisson_ratio, mh.youngs_modulus, mh.poisson_ratio))
+    length = M_PER_MM * h.pin_seat_length_mm / ss.n_discs
+    k_seat = float(line_contact_stiffness(length, e_seat))
+    k_contacts = float(series_stiffness(k_disc, k_seat, n))
+    q_ref = reducer_pin_loads(reducer, reducer.operating.rated_torque_Nm, stiffness_constant=k_contacts).max_force
+    _, semi = conformal_line_contact(q_ref, length, ss.pin_radius, ss.pin_radius + h.pin_seat_clearance, e_seat)
+    k_bend = pin_bending_stiffness(M_PER_MM * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus,
+                                   mp.poisson_ratio)
+    # tangent compliances at Q_ref: power law delta / (n Q), linear spring 1 / k
+    d_disc, d_seat = (q_ref / k_disc) ** (1.0 / n), (q_ref / k_seat) ** (1.0 / n)
+    c = {"pins": d_disc / (n * q_ref), "pin_seats": d_seat / (n * q_ref), "pin_bending": 1.0 / k_bend}
+    k = k_contacts if np.isinf(k_bend) else q_ref / (d_disc + d_seat + q_ref / k_bend) ** n
+    total = sum(c.values())
+    return PinContactConstant(k=float(k), exponent=n, k_disc=k_disc, k_seat=k_seat, k_bending=float(k_bend),
+                              reference_load=float(q_ref), seat_semi_angle=float(semi),
+                              shares={key: v / total for key, v in c.items()})

@@ -135,7 +135,10 @@ def analytic_budget(reducer, torque: float | None = None) -> dict:
     from flexrv.analysis.torsional import stiffness_budget
 
     b = stiffness_budget(reducer, torque)
-    return budget_dict(b.compliances, b.torque)
+    out = budget_dict(b.compliances, b.torque)
+    if b.notes:
+        out["notes"] = list(b.notes)
+    return out
 
 
 def budget_table(title: str, budget: dict) -> Table:
@@ -151,6 +154,8 @@ def budget_table(title: str, budget: dict) -> Table:
         table.add_row("analytic series model (flexrv design) [N m/arcmin]",
                       fmt(budget["analytic_rigidity_Nm_per_arcmin"]),
                       f"{budget['analytic_difference_percent']:+.3g} % total")
+    if budget.get("notes"):
+        table.caption = "; ".join(budget["notes"])
     return table
 
 

@@ -171,18 +171,52 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     out = check_output_dir(out or _default_out(preset, model, "stiffness"), "--out", overwrite=overwrite)
     bar = _bar(not json)
     try:
-        fig, _ = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out,
-                                model_options=options)
+        fig, res = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out,
+                                  model_options=options)
     finally:
         if bar:
             bar.stop()
-    data = {"output_dir": str(out), **asdict(fig)}
+    data = {"output_dir": str(out), **asdict(fig), "stiffness_budget": _budget(res)}
 
     def render(d):
-        rows = [(*_label_unit(k), v) for k, v in d.items()]
+        from flexrv.cli.design import budget_table
+
+        rows = [(*_label_unit(k), v) for k, v in d.items() if k != "stiffness_budget"]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
+        b = d["stiffness_budget"]
+        if not b["elements"]:
+            for note in b.get("notes", []):
+                console.print(f"note: {note}", style="yellow")
+            return
+        console.print(budget_table(f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
+                                   f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
+                                   f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
+                                   f"({b['measured_with_unmodelled_Nm_per_arcmin']:.4g} with the unmodelled "
+                                   "elements in series)", b))
 
     emit(data, json, render)
+
+
+def _budget(res) -> dict:
+    """The stiffness test's budget (Results attribute ``stiffness_budget``,
+    :func:`flexrv.simulation.stiffness_test_budget`) in the units of ``flexrv design``
+    (:func:`flexrv.cli.design.budget_dict`), with the loop's measured rigidity."""
+    import json
+
+    from flexrv.cli.design import budget_dict
+    from flexrv.units import RAD_PER_ARCMIN
+
+    b = json.loads(res.attrs["stiffness_budget"])
+    if not b["compliances"]:
+        return {"elements": {}, "torque_Nm": b["torque"], "notes": b.get("notes", []),
+                "measured_rigidity_Nm_per_arcmin": b["measured_rigidity"] * RAD_PER_ARCMIN}
+    out = budget_dict(b["compliances"], b["torque"])
+    out["measured_rigidity_Nm_per_arcmin"] = b["measured_rigidity"] * RAD_PER_ARCMIN
+    out["tangent_rigidity_Nm_per_arcmin"] = b["tangent_rigidity"] * RAD_PER_ARCMIN
+    out["measured_with_unmodelled_Nm_per_arcmin"] = b["measured_with_unmodelled_rigidity"] * RAD_PER_ARCMIN
+    if b.get("notes"):
+        out["notes"] = b["notes"]
+    return out
 
 
 def _label_unit(key: str) -> tuple[str, str]:

@@ -46,7 +46,7 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     save_te(ds, summary, reducer, out)
     te_plots(ds, summary, out)
     data = {"output_dir": str(out), **summary}
-    data["stiffness_budget"] = quasi_static_budget(summary, result.outputs)
+    data["stiffness_budget"] = quasi_static_budget(summary, result.outputs, reducer)
     analytic = analytic_budget(reducer, summary["torque_Nm"])
     data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
     data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
@@ -59,6 +59,7 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
                 (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
                 ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
                 ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+                ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
                 ("max pin force", d.get("max_pin_force_N"), "N"), ("positions", d["positions"], "-"),
                 ("solve time", d["solve_time_s"], "s"), ("output", d["output_dir"], "")]
         console.print(kv_table(f"quasi-static TE {reducer.name} at {d['torque_Nm']:.6g} N m", rows))
@@ -70,30 +71,29 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     emit(data, json, render)
 
 
-def quasi_static_budget(summary: dict, outputs: dict) -> dict:
+def quasi_static_budget(summary: dict, outputs: dict, reducer=None) -> dict:
     """Stiffness budget of the quasi-static solution in the elements of ``flexrv
     design`` (:func:`flexrv.cli.design.budget_dict`): each force group's share of the
     tangent compliance 1 / k_t (strain-energy fractions,
     :meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`) times 1 / k_t;
     the crank-support group (bearings and crank bending in series, one element) is
     split by its bending share of the tangential compliance (output
-    ``crank_bending_fraction``, mean over positions and cranks)."""
+    ``crank_bending_fraction``, mean over positions and cranks); with the ``reducer``,
+    the pin path split and the unmodelled housing added
+    (:func:`flexrv.analysis.torsional.budget_from_group_shares`)."""
+    from flexrv.analysis.torsional import budget_from_group_shares
     from flexrv.cli.design import budget_dict
     from flexrv.units import RAD_PER_ARCMIN
 
     total = RAD_PER_ARCMIN / summary["torsional_rigidity_Nm_per_arcmin"]
-    shares = dict(summary.get("compliance_budget_percent", {}))
-    comp = {}
+    shares = {k: 0.01 * v for k, v in summary.get("compliance_budget_percent", {}).items()}
     bend = outputs.get("crank_bending_fraction")
     frac = float(np.nanmean(bend.values)) if bend is not None else 0.0
-    for name, pct in shares.items():
-        c = 0.01 * pct * total
-        if name == "crank_supports":
-            comp["support_bearings"] = (1.0 - frac) * c
-            comp["crank_bending"] = frac * c
-        else:
-            comp[name] = c
-    return budget_dict(comp, summary["torque_Nm"])
+    comp, notes = budget_from_group_shares(shares, total, frac, reducer, summary["torque_Nm"])
+    out = budget_dict(comp, summary["torque_Nm"])
+    if notes:
+        out["notes"] = list(notes)
+    return out
 
 
 def register(app: typer.Typer) -> None:

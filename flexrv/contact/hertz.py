@@ -231,3 +231,35 @@ def line_contact_stiffness(length, e_eff):
     length = _positive("length", length)
     e_eff = _positive("e_eff", e_eff)
     return e_eff * (length**0.8 / _PALMGREN_C) ** (1.0 / 0.9)
+
+
+def conformal_line_contact(load, length, pin_radius, groove_radius, e_eff):
+    """Hertz line contact of a pin of radius r in a concave cylindrical seat
+    (groove) of radius R_g > r, and how conformal it is.
+
+    Reduced radius of the conformal pair (Johnson 1985, sec. 4.3, concave radius
+    negative): 1/R = 1/r - 1/R_g, R = r R_g / (R_g - r); the half-width, pressure
+    and (Palmgren) approach are those of :func:`line_contact` with that R.
+
+    Returns (LineContact, semi_angle) with semi_angle = b / r [rad], the half-angle
+    of the contact arc on the pin. Hertz's half-space idealisation needs b << r
+    (Johnson 1985, sec. 4.1: the contact small against the radii); where b / r is not
+    small (a close-fitting groove) the contact spreads over an arc (Persson 1964;
+    Johnson 1985, sec. 5.3), and the 2-D approach, whose logarithmic term
+    ln(4 r / b) falls as b grows (Johnson 1985, sec. 5.6), is expected smaller than a
+    Hertz/Palmgren line contact's of the same length: the radius-free Palmgren
+    approach is then a conservative (compliant) estimate of the seat. Callers report
+    ``semi_angle`` so the range is visible.
+
+    Parameters
+    ----------
+    load : normal load W [N] (>= 0); length : seat length L [m];
+    pin_radius : r [m]; groove_radius : R_g [m] (> r); e_eff : E' [Pa].
+    """
+    r = _positive("pin_radius", pin_radius)
+    rg = _positive("groove_radius", groove_radius)
+    if np.any(rg <= r):
+        raise InputError(f"groove_radius = {groove_radius!r} m must be > pin_radius = {pin_radius!r} m "
+                         "(a seat with clearance)")
+    contact = line_contact(load, length, r * rg / (rg - r), e_eff)
+    return contact, contact.half_width / r

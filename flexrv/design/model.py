@@ -19,7 +19,7 @@ from pydantic import Field, model_serializer, model_validator
 
 from flexrv.design._base import _bad, _Strict
 
-from flexrv.units import RAD_PER_DEG
+from flexrv.units import M_PER_UM, RAD_PER_DEG
 
 
 
@@ -478,6 +478,42 @@ class Carrier(_Strict):
                        "the main bearing's inner ring sits on the plate rim")
 
 
+class Housing(_Strict):
+    """Pin housing (pin gear ring): the pins lie in semicircular grooves of the
+    housing bore on the pin circle R_p; each pin's groove (seat) is a concave
+    cylinder of radius r_rp + clearance. Where the groove is interrupted (lands
+    only), a pin spans ``pin_unsupported_length_mm`` between two lands at each
+    disc. The ring section around the pins (outer diameter, axial length) carries
+    the pin loads to the housing's fixture."""
+
+    pin_seat_clearance_um: float = Field(gt=0.0, le=500.0, description="Radial clearance of a pin in its groove, groove radius - pin radius [um]")
+    pin_seat_length_mm: float = Field(gt=0.0, le=2000.0, description="Length of a pin's groove seat that carries the disc loads (all discs) [mm]")
+    pin_unsupported_length_mm: float = Field(ge=0.0, le=2000.0, description="Span of a pin between groove lands at each disc [mm]; 0 = fully supported")
+    ring_outer_diameter_mm: float = Field(gt=1.0, le=5000.0, description="Outer diameter of the housing ring around the pins [mm]")
+    ring_length_mm: float = Field(gt=0.0, le=2000.0, description="Axial length of the housing ring section that carries the pin loads [mm]")
+
+    @property
+    def pin_seat_clearance(self) -> float:
+        """Groove radius - pin radius [m]."""
+        return self.pin_seat_clearance_um * M_PER_UM
+
+    def validate_for(self, reducer) -> None:
+        """The ring encloses the pins by at least a ligament; the seat and the unsupported span fit the ring."""
+        ss = reducer.second_stage
+        r_groove = ss.pin_circle_radius_mm + ss.pin_radius_mm
+        if 0.5 * self.ring_outer_diameter_mm < r_groove + MIN_LIGAMENT_MM:
+            raise _bad("housing.ring_outer_diameter_mm", self.ring_outer_diameter_mm,
+                       f"must be >= {2 * (r_groove + MIN_LIGAMENT_MM):.4g} mm (pin circle {ss.pin_circle_radius_mm:g} mm + "
+                       f"pin radius {ss.pin_radius_mm:g} mm + ligament {MIN_LIGAMENT_MM:g} mm)",
+                       "the pin grooves would cut through the ring")
+        if self.pin_seat_length_mm > self.ring_length_mm:
+            raise _bad("housing.pin_seat_length_mm", self.pin_seat_length_mm,
+                       f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm", "the grooves lie in the ring")
+        if self.pin_unsupported_length_mm > self.ring_length_mm:
+            raise _bad("housing.pin_unsupported_length_mm", self.pin_unsupported_length_mm,
+                       f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm", "the span lies in the ring")
+
+
 class Material(_Strict):
     """Isotropic linear-elastic material."""
 
@@ -621,13 +657,18 @@ class Reducer(_Strict):
                                         description="Manufacturing and assembly errors (all zero: ideal reducer)")
     carrier: Carrier | None = Field(default=None, description="Carrier geometry (end plates, pillars, crank bores); "
                                                               "optional: the carrier FE needs it")
+    housing: Housing | None = Field(default=None, description="Pin housing: pin seats (grooves), pin supports and the "
+                                                              "ring around the pins; optional: without it the pins "
+                                                              "are rigidly seated and the housing rigid")
 
     @model_serializer(mode="wrap")
     def _omit_absent_carrier(self, handler):
         """A design without a [carrier] table dumps without the key (TOML has no null)."""
         data = handler(self)
-        if isinstance(data, dict) and data.get("carrier", 0) is None:
-            data.pop("carrier")
+        if isinstance(data, dict):
+            for key in ("carrier", "housing"):
+                if key in data and data[key] is None:
+                    data.pop(key)
         return data
 
     def material(self, part: str) -> Material:
@@ -688,5 +729,7 @@ class Reducer(_Strict):
                        f"{r_hole * 1e3:.4g} mm)", "the main bearing would sit inside the crank circle")
         if self.carrier is not None:
             self.carrier.validate_for(self)
+        if self.housing is not None:
+            self.housing.validate_for(self)
         self.errors.validate_for(self)  # list lengths vs z_rp / N / n_discs, clearances, assembly interference
         return self

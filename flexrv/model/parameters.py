@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexrv.analysis.pin_load import pin_contact_constant
 from flexrv.analysis.torsional import support_constants
 from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
 from flexrv.contact.laws import effective_pin_friction
@@ -188,10 +189,9 @@ def rigid_parameters(reducer) -> RigidParameters:
     m_hole = rho_d * math.pi * r_h**2 * b
     disc_mass = m_ann - n * m_hole
     disc_inertia = 0.5 * m_ann * (r_out**2 + r_in**2) - n * m_hole * (0.5 * r_h**2 + a_w**2)
-    # contact constants
-    e_pin = effective_modulus(reducer.material("cycloid_disc").youngs_modulus, reducer.material("cycloid_disc").poisson_ratio,
-                              reducer.material("pins").youngs_modulus, reducer.material("pins").poisson_ratio)
-    k_line = float(line_contact_stiffness(b, e_pin))
+    # contact constants: the pin path = pin-disc contact, pin seat and pin bending in series
+    # (flexrv.analysis.pin_load.pin_contact_constant, the one constant of every model)
+    k_line = pin_contact_constant(reducer).k
     depth = ct.impact_damping_depth_mm * 1e-3
     if ct.pin_law == "hertz_line":
         pin_k, pin_e = k_line, LINE_EXPONENT

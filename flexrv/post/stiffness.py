@@ -10,7 +10,13 @@ loading and unloading curves"):
 * lost motion [arcmin]: rotation between T = +3 % and T = -3 % of T_r on the
   mean (loading/unloading averaged) curve;
 * hysteresis [arcmin]: width of the loop at T = 0 (descending minus returning
-  branch);
+  branch), the "hysteresis loss" angle of the catalogues;
+* low-torque rigidity [N m/arcmin]: the same mean of the two branches' least-squares
+  slopes over |T| in [3 %, 50 %] of T_r, from the edge of the lost-motion band to the
+  start of the catalogue range: the lower of the piecewise-linear torsional stiffness
+  regions that Harmonic Drive catalogues give as K1/K2 (the RV catalogue gives the
+  50-100 % slope only; the low range here is flexrv's definition, stated with its
+  bounds in the figures);
 * hysteresis loss [J]: the energy dissipated per load cycle, the loop's area
   oint T dtheta (:func:`loop_energy`).
 """
@@ -45,6 +51,8 @@ class StiffnessTest:
     hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
     hysteresis_loss_J: float = float("nan")  #: energy dissipated per load cycle, the loop area (loop_energy)
     friction_energy_J: float = 0.0  #: friction dissipation over the test program (0: no friction)
+    rigidity_low_Nm_per_arcmin: float = float("nan")  #: mean branch slope over |T| in [3 %, 50 %] T_r
+    low_range_low_Nm: float = float("nan")  #: low-torque fit over |T| in [low_range_low, fit_range_low]
 
 
 def _fit_slope(torque, angle, lo, hi):
@@ -108,6 +116,7 @@ def evaluate_stiffness_test(time, torque, angle, times, friction_power=None) -> 
     if friction_power is not None:
         prog = (time >= t0) & (time <= te)
         e_fric = float(np.trapezoid(np.asarray(friction_power, dtype=float)[prog], time[prog]))
+    k_low = 0.5 * (_fit_slope(torque[up], a[up], d3, 0.5 * rated) + _fit_slope(torque[neg], a[neg], d3, 0.5 * rated))
     return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
                          rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
                          lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
@@ -115,7 +124,8 @@ def evaluate_stiffness_test(time, torque, angle, times, friction_power=None) -> 
                          fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
                          lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
                          hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0,
-                         hysteresis_loss_J=loss, friction_energy_J=e_fric)
+                         hysteresis_loss_J=loss, friction_energy_J=e_fric,
+                         rigidity_low_Nm_per_arcmin=k_low, low_range_low_Nm=d3)
 
 
 #: (variable, StiffnessTest field, units, long name) of the saved figures
@@ -133,6 +143,8 @@ _FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the 
              "the loop area (twice the measured lower half)"),
             ("friction_energy", "friction_energy_J", "J", "energy dissipated by friction over the test program "
              "(0 -> +T_r -> -T_r -> 0), integral of friction_power; 0 without friction"),
+            ("torsional_rigidity_low", "rigidity_low_Nm_per_arcmin", "N m/arcmin",
+             "low-torque rigidity, mean of the +T_r and -T_r branch slopes over 3 % T_r <= abs(T) <= T_r/2"),
             ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
             ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
             ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
@@ -170,7 +182,7 @@ def stiffness_json(figures: StiffnessTest) -> dict:
 
 
 def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, quarter_time: float,
-                               dt: float, plot: str | None = "hysteresis.png") -> str:
+                               dt: float, plot: str | None = "hysteresis.png", budget: dict | None = None) -> str:
     """summary.md of a stiffness test (not the time-simulation template): the program,
     the figures with units and how each is read, the loop plot, References."""
     f = figures
@@ -187,6 +199,25 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
               f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
     if plot:
         lines += [f"![torque vs output rotation loop]({plot})", ""]
+    if budget and not budget.get("compliances"):
+        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
+    elif budget:
+        from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+        comp = budget["compliances"]
+        total = sum(comp.values())
+        lines += [f"## Stiffness budget at {budget['torque']:.4g} N m", "",
+                  "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
+                  "stiffness_test_budget), the same elements as `flexrv te` and `flexrv design`.", "",
+                  "| element | compliance [arcsec/(N m)] | share [%] |", "|---|---|---|"]
+        for name, c in sorted(comp.items(), key=lambda kv: -kv[1]):
+            lines.append(f"| {name.replace('_', ' ')} | {c * ARCSEC_PER_RAD:.4g} | {100 * c / total:.3g} |")
+        lines += [f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |", "",
+                  f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
+                  f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin, "
+                  f"{budget['measured_with_unmodelled_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin with the elements "
+                  f"the model does not contain ({', '.join(budget['unmodelled']) or 'none'}) in series."]
+        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
     lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
               "stiffness.json, config.toml.", "", "## References", "",
               "seed004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "

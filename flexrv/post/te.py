@@ -120,6 +120,8 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
             (f"backlash (±{s['no_load_torque_Nm']:.3g} N m)", s["backlash_arcmin"], "arcmin"),
             ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
             ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+            ("torsional rigidity, 3–50 % rated (low torque)", s.get("low_torque_rigidity_Nm_per_arcmin", float("nan")),
+             "N m/arcmin"),
             ("max pin force", s.get("max_pin_force_N"), "N"),
             ("max needle-bearing force", s.get("max_needle_force_N"), "N"),
             ("max crank-support force", s.get("max_support_force_N"), "N"),

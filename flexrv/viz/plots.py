@@ -154,7 +154,8 @@ def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteres
     """Torque vs output rotation loop of the stiffness test; with ``figures``
     (:class:`flexrv.post.stiffness.StiffnessTest`) the rigidity fit range (shaded
     bands and the fitted slope), the lost motion (at +-3 % T_r on the mean curve) and
-    the hysteresis (loop width at T = 0) are marked and stated in the legend."""
+    the hysteresis (loop width at T = 0, and the loop's energy) and the low-torque
+    fit range (3-50 % T_r) with its slope are marked and stated in the legend."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 5))
     a, tq = np.asarray(angle_arcmin, dtype=float), np.asarray(torque, dtype=float)
@@ -166,11 +167,18 @@ def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteres
             ax.axhspan(sgn * lo, sgn * hi, color="C2", alpha=0.12, lw=0)
         ax.plot([], [], color="C2", alpha=0.4, lw=6,
                 label=f"rigidity fit |T| {lo:.3g}..{hi:.3g} N m: {f.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
+        low = getattr(f, "low_range_low_Nm", float("nan"))
+        if np.isfinite(low):
+            for sgn in (1, -1):
+                ax.axhspan(sgn * low, sgn * lo, color="C4", alpha=0.10, lw=0)
+            ax.plot([], [], color="C4", alpha=0.4, lw=6,
+                    label=f"low-torque fit |T| {low:.3g}..{lo:.3g} N m: {f.rigidity_low_Nm_per_arcmin:.4g} N m/arcmin")
         ax.plot([f.lost_motion_negative_arcmin, f.lost_motion_positive_arcmin],
                 [-f.lost_motion_torque_Nm, f.lost_motion_torque_Nm], "o-", color="C3", ms=4,
                 label=f"lost motion (±3 % T_r): {f.lost_motion_arcmin:.3g} arcmin")
         ax.plot([f.hysteresis_returning_arcmin, f.hysteresis_descending_arcmin], [0.0, 0.0], "s-", color="C1",
-                ms=4, label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin")
+                ms=4, label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin, "
+                f"loss {getattr(f, "hysteresis_loss_J", float("nan")):.3g} J per cycle")
         ax.axhline(0, color="0.6", lw=0.5)
         ax.axvline(0, color="0.6", lw=0.5)
         ax.legend(loc="upper left", fontsize=8)

@@ -33,10 +33,14 @@ LEGACY_SUPPORT_N_PER_M = {"rv40e": 2.0e8, "rv221": 5.0e8}
 
 
 def legacy_supports(r, name: str):
-    """Design ``r`` with the crank-support law of the references (linear, rigid crank), no friction."""
+    """Design ``r`` with the crank-support law of the references (linear, rigid crank)
+    and, like them, rigidly seated pins (no [housing] table: issue 14 put the pin seats
+    in series with the pin-disc contact; the references keep the pin law they were
+    written with), and no friction."""
     from flexrv.design import from_dict
 
     data = r.model_dump()
+    data.pop("housing", None)
     cs = {k: v for k, v in data["crankshaft"].items() if not k.startswith("support_bearing_")
           or k == "support_bearing_damping_Ns_per_m"}
     cs.update(support_bearing_model="linear", bending_model="rigid",
