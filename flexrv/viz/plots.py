@@ -178,7 +178,7 @@ def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteres
                 label=f"lost motion (±3 % T_r): {f.lost_motion_arcmin:.3g} arcmin")
         ax.plot([f.hysteresis_returning_arcmin, f.hysteresis_descending_arcmin], [0.0, 0.0], "s-", color="C1",
                 ms=4, label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin, "
-                f"loss {getattr(f, "hysteresis_loss_J", float("nan")):.3g} J per cycle")
+                f"loss {getattr(f, 'hysteresis_loss_J', float('nan')):.3g} J per cycle")
         ax.axhline(0, color="0.6", lw=0.5)
         ax.axvline(0, color="0.6", lw=0.5)
         ax.legend(loc="upper left", fontsize=8)
