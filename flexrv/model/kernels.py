@@ -58,6 +58,27 @@ def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, ma
     loads_kernel(q, v, f, jq, jv, jac, loads)
 
 
+@njit(cache=True)
+def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needles, pins, main_bearing, loads, src,
+                  dst):
+    """:func:`fused_kernel` at every sample i of a time history (qs, vs: (T, n);
+    tsun, wsun: (T,) sun angle and speed; loads_t: (T, len(load)) the loads group's
+    load vector, written into its pack before each call), without Jacobians;
+    after each call the per-contact result arrays ``src`` (flat views of the
+    groups' :meth:`~flexrv.model.base.KernelGroup.record_sources`) are copied into
+    row i of ``dst`` (T, size). Exactly the per-sample calls of the groups'
+    evaluate, in one compiled loop (issue 15: the Python loop over samples cost
+    ~50 us per sample)."""
+    load = loads[1]
+    for i in range(qs.shape[0]):
+        if load.shape[0] > 0:
+            load[:] = loads_t[i]
+        fused_kernel(qs[i], vs[i], f, jq, jv, False, tsun[i], wsun[i], gear, supports, needles, pins, main_bearing,
+                     loads)
+        for r in range(len(src)):
+            dst[r][i, :] = src[r]
+
+
 _F8 = np.dtype(np.float64)
 
 
@@ -125,14 +146,14 @@ class FusedForces:
         self.index = np.concatenate([np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n)
                                      for m in names]).astype(np.int64) if names else np.zeros(0, np.int64)
         self.is_full = self.n == model.n and np.array_equal(self.index, np.arange(model.n))
-        self.packs = []
+        #: each kind's group and the positions of its local coordinates in the element's vector
+        self.slots = []
         for kind, cls in KINDS:
             g = by_kind.get(kind)
-            if g is None:
-                self.packs.append(cls.empty_pack())
-            else:
-                idx = np.concatenate([np.arange(local[m], local[m] + model.members[m].n) for m in g.members])
-                self.packs.append(g.pack(idx.astype(np.int64)))
+            idx = None if g is None else np.concatenate(
+                [np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(np.int64)
+            self.slots.append((cls, g, idx))
+        self.packs = self._packs(history=False)
         self.gear, self.loads = by_kind.get("gear"), by_kind.get("loads")
         self.pins = by_kind.get("pins")
         self.f = np.zeros(self.n)
@@ -140,6 +161,49 @@ class FusedForces:
         self.stats = [0, 0]
         #: compiled entry point of fused_kernel for this element's argument types (set on the first call)
         self._entry = None
+
+    def _packs(self, history: bool) -> list:
+        """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
+        return [cls.empty_pack() if g is None else g.pack(idx, history=history) for cls, g, idx in self.slots]
+
+    def history(self, t, q, v) -> dict:
+        """Per-sample records of every group of this element over a time history t (T,),
+        q, v (T, n) on the element's coordinates: {group: {key: (T, *shape)}}, as the
+        groups' own evaluate of the history would stack them (the same kernels on the
+        same inputs, bit for bit: fresh history packs, the vectorised time inputs), in
+        one compiled loop (:func:`fused_history`)."""
+        t = np.ascontiguousarray(t, dtype=float)
+        nt = len(t)
+        packs = self._packs(history=True)
+        gear = self.gear
+        drive = gear.time_inputs_many(t) if gear is not None else np.zeros((nt, 2))
+        drive = np.ascontiguousarray(np.broadcast_to(drive, (nt, 2)))
+        load = packs[[k for k, _ in KINDS].index("loads")][1]
+        loads_t = (np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
+                   if self.loads is not None else np.zeros((nt, 0)))
+        srcs, dsts, keys = [], [], []
+        for g in self.groups:
+            for key, a in g.record_sources().items():
+                if a.dtype != np.float64 or not a.flags.c_contiguous:
+                    raise TypeError(f"{g.name}.record_sources()[{key!r}] must be float64 and C-contiguous")
+                srcs.append(a.reshape(-1))
+                dsts.append(np.empty((nt, a.size)))
+                keys.append((g, key, a.shape))
+        f = np.zeros(self.n)
+        pin_ctr = packs[[k for k, _ in KINDS].index("pins")][-1]
+        before = int(pin_ctr[2])
+        if nt and srcs:
+            fused_history(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
+                          np.ascontiguousarray(drive[:, 0]), np.ascontiguousarray(drive[:, 1]), loads_t, f, self.jq,
+                          self.jv, *packs, tuple(srcs), tuple(dsts))
+        if int(pin_ctr[2]) != before:
+            from flexrv.errors import ConvergenceError
+
+            raise ConvergenceError("pin gap: closest-point iteration did not converge")
+        out = {g: {} for g in self.groups}
+        for (g, key, shape), d in zip(keys, dsts):
+            out[g][key] = d.reshape((nt,) + shape)
+        return out
 
     def _call(self, t, q, v, jac):
         ts, ws = self.gear.time_inputs(t) if self.gear is not None else (0.0, 0.0)

@@ -172,10 +172,30 @@ def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
 
 def group_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
     """The named outputs of every force group over the history (T,), (T, n), (T, n),
-    evaluated in chunks of ``chunk`` samples."""
+    evaluated in chunks of ``chunk`` samples. The groups of the model's fused compiled
+    element (:class:`flexrv.model.kernels.FusedForces`) are evaluated together, one
+    compiled loop over the samples of a chunk (:meth:`~flexrv.model.kernels.FusedForces.history`:
+    the same kernels on the same inputs as their own evaluate, bit for bit); the
+    others by their own evaluate."""
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
+    fused = getattr(model, "fused", None)
+    fused_groups = set(fused.groups) if fused is not None else set()
+    records: list[dict] = []
+    if fused_groups:
+        ix = fused.index
+        qf, vf = q[:, ix], v[:, ix]
+        for a in range(0, len(t), chunk):
+            b = min(a + chunk, len(t))
+            records.append(fused.history(t[a:b], qf[a:b], vf[a:b]))
     for g in model.groups:
+        if g in fused_groups:
+            for i, a in enumerate(range(0, len(t), chunk)):
+                b = min(a + chunk, len(t))
+                for name, o in g.outputs(np.asarray(t[a:b], dtype=float), records[i][g]).items():
+                    outs.setdefault(name, []).append(np.asarray(o.values))
+                    meta[name] = (o.dims, o.units, o.long_name)
+            continue
         qg_all = model.group_state(g, q)
         vg_all = model.group_state(g, v)
         for a in range(0, len(t), chunk):

@@ -296,9 +296,8 @@ class PinContacts(KernelGroup):
     def min_gap(self) -> float:
         return float(self.gap.min()) if self.ctr[0] > 0 else np.inf
 
-    def record(self):
-        return {"gap": self.gap.copy(), "force": self.force.copy(), "nx": self.nx.copy(), "ny": self.ny.copy(),
-                "rxn": self.rxn.copy()}
+    def record_sources(self):
+        return {"gap": self.gap, "force": self.force, "nx": self.nx, "ny": self.ny, "rxn": self.rxn}
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
