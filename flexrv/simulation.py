@@ -268,6 +268,11 @@ class Simulation:
         ti = ss.timeIntegration
         ti.verboseMode = 0
         ti.newton.useModifiedNewton = True
+        # small dense systems (the rigid model): a fresh Jacobian at the start of every step. The
+        # contact stiffness changes from step to step, so a reused Jacobian needed 3.7-4.6 Newton
+        # iterations per step (rv40e / rv221), a fresh one 1.3-1.9: fewer residual calls, whose Python
+        # round trip is most of a step (issue 15; benchmarks/bench_rigid.py, tests/test_time_step.py)
+        ti.newton.modifiedNewtonJacUpdatePerStep = model.n <= SPARSE_ABOVE
         ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
         ti.generalizedAlpha.spectralRadius = spectral_radius
         for key, value in newton_options.items():

@@ -260,9 +260,13 @@ class FusedForces:
         def force_fn(mbs_, t, item, q, q_t):
             return self.residual(t, np.asarray(q), np.asarray(q_t))
 
+        out, tmp = np.empty((self.n, self.n)), np.empty((self.n, self.n))
+
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
             dq, dv = self.jacobian(t, np.asarray(q), np.asarray(q_t))
-            return -(f_q * dq + f_v * dv)
+            np.multiply(dq, -f_q, out=out)  # -(f_q dq + f_v dv) without temporaries (Exudyn copies it)
+            np.multiply(dv, f_v, out=tmp)
+            return np.subtract(out, tmp, out=out)
 
         return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
                                                jacobianUserFunction=jac_fn))
