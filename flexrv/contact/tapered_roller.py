@@ -42,7 +42,9 @@ Timoshenko stepped shaft, verified against the FE condensation of
 :func:`flexrv.fem.crankshaft.crank_bending_compliance`). For a given d the inner
 equation R(b) = F(b) + k_bend (d - b) = 0 is solved by Newton's method (R is the
 gradient of a strictly convex energy, so Newton with step halving converges); the
-tangent is exact by the implicit-function theorem:
+tangent is exact by the implicit-function theorem (the roller directions u_i are
+computed once per call, the inner solve keeping gamma fixed; its tolerance is
+relative to the summed roller load, see :func:`crank_support_force`):
 
     -df/dd = K_s = K_b (K_b + k_bend I)^-1 k_bend,
     df/dgamma = k_bend (K_b + k_bend I)^-1 dF/dgamma.

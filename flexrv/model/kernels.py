@@ -10,9 +10,19 @@ Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 Groups of other kinds (ball bearing, flexible crank) keep their own elements.
 
 Python work per call: Exudyn's argument lists to arrays (``np.asarray``), the
-drive angle and load vector at t (cached per time), one dispatch of the compiled
-function (about 8 us of unboxing the ~45 pack arrays; the compiled work is 6-9 us
-on rv40e/rv221). Measured in benchmarks/bench_rigid.py.
+drive angle and load vector at t (cached per time), one call of the compiled entry
+point (1.8 us of unboxing the 51 pack arrays, measured against an empty kernel of
+the same arguments; the compiled work is 7 us at a fixed loaded state and ~15 us
+in a run, where the closest points and the supports' inner solves move). Measured
+in benchmarks/bench_rigid.py.
+
+Outputs: :meth:`FusedForces.history` evaluates the same kernels over a recorded
+time history in ONE compiled loop (:func:`fused_history`), copying each group's
+per-contact arrays (:meth:`~flexrv.model.base.KernelGroup.record_sources`) per
+sample: bit for bit the groups' own per-sample evaluate, without its ~50 us of
+Python per sample. What remains (~22-28 us per sample) is the kernels' own work,
+mostly the exact gap of every pin (the solver skips provably open pins; the
+outputs do not, so ``pin_gap`` stays exact for every pin).
 
 Numba's on-disk cache (``cache=True``) keys each function on its OWN source file
 only: after editing a kernel that other modules' compiled functions call (e.g.
@@ -77,6 +87,13 @@ def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needle
                      loads)
         for r in range(len(src)):
             dst[r][i, :] = src[r]
+
+
+@njit(cache=True)
+def copy_records(src, dst, k):
+    """Row k of every history buffer ``dst`` (T, size) from the flat live arrays ``src``."""
+    for r in range(len(src)):
+        dst[r][k, :] = src[r]
 
 
 _F8 = np.dtype(np.float64)
@@ -161,6 +178,9 @@ class FusedForces:
         self.stats = [0, 0]
         #: compiled entry point of fused_kernel for this element's argument types (set on the first call)
         self._entry = None
+        #: (t, q, v) of the last call: the state the groups' live records belong to (HistoryRecorder)
+        self.memo_t = np.nan
+        self.memo_q, self.memo_v = np.empty(self.n), np.empty(self.n)
 
     def _packs(self, history: bool) -> list:
         """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
@@ -182,13 +202,10 @@ class FusedForces:
         loads_t = (np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
                    if self.loads is not None else np.zeros((nt, 0)))
         srcs, dsts, keys = [], [], []
-        for g in self.groups:
-            for key, a in g.record_sources().items():
-                if a.dtype != np.float64 or not a.flags.c_contiguous:
-                    raise TypeError(f"{g.name}.record_sources()[{key!r}] must be float64 and C-contiguous")
-                srcs.append(a.reshape(-1))
-                dsts.append(np.empty((nt, a.size)))
-                keys.append((g, key, a.shape))
+        for g, key, a in self.record_entries():
+            srcs.append(a.reshape(-1))
+            dsts.append(np.empty((nt, a.size)))
+            keys.append((g, key, a.shape))
         f = np.zeros(self.n)
         pin_ctr = packs[[k for k, _ in KINDS].index("pins")][-1]
         before = int(pin_ctr[2])
@@ -218,10 +235,23 @@ class FusedForces:
             fused_kernel(*args)
             if entry is None:
                 self._entry = _entry_point(args)
+        self.memo_t = t
+        self.memo_q[:] = q
+        self.memo_v[:] = v
         if self.pins is not None and self.pins.ctr[2] != before:
             from flexrv.errors import ConvergenceError
 
             raise ConvergenceError("pin gap: closest-point iteration did not converge")
+
+    def record_entries(self) -> list:
+        """(group, key, live array) of every per-contact record of this element's groups, in order."""
+        out = []
+        for g in self.groups:
+            for key, a in g.record_sources().items():
+                if a.dtype != np.float64 or not a.flags.c_contiguous:
+                    raise TypeError(f"{g.name}.record_sources()[{key!r}] must be float64 and C-contiguous")
+                out.append((g, key, a))
+        return out
 
     def residual(self, t, q, v) -> np.ndarray:
         """Generalized force on the element's coordinates (a view, overwritten by the next call)."""
@@ -270,3 +300,58 @@ class FusedForces:
 
         return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
                                                jacobianUserFunction=jac_fn))
+
+
+class HistoryRecorder:
+    """The fused element's per-contact records at every recorded sample of a run, taken
+    from what the integrator computed (issue 15): at each recorded state the last call
+    of the element (:attr:`FusedForces.memo_t` / ``memo_q`` / ``memo_v``) is, in Exudyn's
+    Newton iteration, the residual at the accepted state; if (t, q, v) are exactly those
+    of the record, the groups' live arrays are copied into row k (one compiled copy) and
+    the row is ``valid``, else it is left to the outputs' history pass
+    (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.1 s): 1000 of 1000 and 1010
+    of 1012 records matched (the others: segment starts and repeated steps).
+
+    Same numbers as the history pass to the solvers' own tolerances (the crank supports'
+    inner solve, the closest points' warm starts), with one difference: a pin the solver
+    proved open (:func:`flexrv.model.pins.pin_kernel`'s bound > 0: no force, no Jacobian)
+    keeps that positive lower bound of its gap in ``pin_gap`` instead of the exact gap;
+    every pin within reach of contact, every force and every other record is the exact
+    evaluation at the recorded state."""
+
+    def __init__(self, fused: FusedForces, n_out: int):
+        self.fused = fused
+        self.entries = [(g, key, a.shape) for g, key, a in fused.record_entries()]
+        self.src = tuple(a.reshape(-1) for _, _, a in fused.record_entries())
+        self.dst = tuple(np.empty((n_out, a.size)) for a in self.src)
+        self.valid = np.zeros(n_out, dtype=bool)
+
+    def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
+        """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
+        f = self.fused
+        ok = (f.memo_t == t and np.array_equal(f.memo_q, q if f.is_full else q[f.index])
+              and np.array_equal(f.memo_v, v if f.is_full else v[f.index]))
+        if ok and self.src:
+            copy_records(self.src, self.dst, k)
+        self.valid[k] = ok
+        return ok
+
+    def fill(self, k0: int, arrays: list, valid: np.ndarray) -> None:
+        """Rows 0..k0-1 from a checkpoint (:meth:`arrays` of the interrupted run)."""
+        if len(arrays) != len(self.dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, self.dst)):
+            return  # another model's records: those rows are left to the history pass
+        for a, d in zip(arrays, self.dst):
+            d[:k0] = a[:k0]
+        self.valid[:k0] = valid[:k0]
+
+    def arrays(self, k: int) -> tuple[list, np.ndarray]:
+        """(buffers, valid) of rows 0..k-1, for a checkpoint."""
+        return [d[:k] for d in self.dst], self.valid[:k]
+
+    def records(self, k: int) -> dict:
+        """Rows 0..k-1: {"valid": (k,), "data": {group: {key: (k, *shape)}}} for
+        :func:`flexrv.model.outputs.group_outputs`."""
+        data: dict = {}
+        for (g, key, shape), d in zip(self.entries, self.dst):
+            data.setdefault(g, {})[key] = d[:k].reshape((k,) + shape)
+        return {"valid": self.valid[:k], "data": data}

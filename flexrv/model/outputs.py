@@ -170,31 +170,42 @@ def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
     return out
 
 
-def group_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
+def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None) -> dict[str, Output]:
     """The named outputs of every force group over the history (T,), (T, n), (T, n),
     evaluated in chunks of ``chunk`` samples. The groups of the model's fused compiled
     element (:class:`flexrv.model.kernels.FusedForces`) are evaluated together, one
     compiled loop over the samples of a chunk (:meth:`~flexrv.model.kernels.FusedForces.history`:
     the same kernels on the same inputs as their own evaluate, bit for bit); the
-    others by their own evaluate."""
+    others by their own evaluate. ``records`` (:meth:`flexrv.model.kernels.HistoryRecorder.records`
+    of the run): the fused groups' records the integrator computed at the samples, used
+    where ``valid`` (the history pass fills the other samples; see the recorder for
+    what differs)."""
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
     fused = getattr(model, "fused", None)
-    fused_groups = set(fused.groups) if fused is not None else set()
-    records: list[dict] = []
+    fused_groups = list(fused.groups) if fused is not None else []
+    fused_recs: dict = {}
     if fused_groups:
-        ix = fused.index
-        qf, vf = q[:, ix], v[:, ix]
-        for a in range(0, len(t), chunk):
-            b = min(a + chunk, len(t))
-            records.append(fused.history(t[a:b], qf[a:b], vf[a:b]))
+        nt = len(t)
+        todo = np.arange(nt) if records is None else np.flatnonzero(~np.asarray(records["valid"], dtype=bool))
+        if records is not None:
+            fused_recs = {g: {k: np.array(a) for k, a in records["data"][g].items()} for g in fused_groups}
+        if len(todo):
+            ix = fused.index
+            for a in range(0, len(todo), chunk):
+                rows = todo[a:a + chunk]
+                part = fused.history(t[rows], q[rows][:, ix], v[rows][:, ix])
+                for g in fused_groups:
+                    dst = fused_recs.setdefault(g, {})
+                    for key, val in part[g].items():
+                        if key not in dst:
+                            dst[key] = np.empty((nt,) + val.shape[1:])
+                        dst[key][rows] = val
     for g in model.groups:
-        if g in fused_groups:
-            for i, a in enumerate(range(0, len(t), chunk)):
-                b = min(a + chunk, len(t))
-                for name, o in g.outputs(np.asarray(t[a:b], dtype=float), records[i][g]).items():
-                    outs.setdefault(name, []).append(np.asarray(o.values))
-                    meta[name] = (o.dims, o.units, o.long_name)
+        if g in fused_recs:
+            for name, o in g.outputs(np.asarray(t, dtype=float), fused_recs[g]).items():
+                outs.setdefault(name, []).append(np.asarray(o.values))
+                meta[name] = (o.dims, o.units, o.long_name)
             continue
         qg_all = model.group_state(g, q)
         vg_all = model.group_state(g, v)
@@ -212,11 +223,11 @@ def group_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
     return result
 
 
-def model_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
+def model_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None) -> dict[str, Output]:
     """Every declared output of ``model`` on the recorded history t (T,), q, v (T, n), by name,
     in result order: drive and member outputs, group outputs, ``input_torque`` (the sun's
     torque from the gear-stage group plus J_in d(omega_in)/dt), ``output_torque``,
-    ``kinetic_energy``, ``angular_momentum``."""
+    ``kinetic_energy``, ``angular_momentum``. ``records``: see :func:`group_outputs`."""
     t = np.asarray(t, dtype=float)
     declared = declared_outputs()
     computed: dict[str, np.ndarray] = {}
@@ -232,7 +243,7 @@ def model_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
 
     for name in _ORDER:
         put(name)
-    groups = group_outputs(model, t, q, v, chunk)
+    groups = group_outputs(model, t, q, v, chunk, records)
     out.update(groups)
     w_in = out["omega_in"].values
     acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)

@@ -303,7 +303,8 @@ class PinContacts(KernelGroup):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
         dims = ("time", "disc", "pin")
         return {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
-                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration)"),
+                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration); "
+                                  "of a pin proved open by the solver: a positive lower bound"),
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
                 "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
                                           "torque of the pin forces on each disc about its centre"),
