@@ -342,7 +342,7 @@ class Simulation:
                     for g in model.groups:
                         g.reset()
                     if recorder is not None:  # the groups' records were reset: not those of the last call
-                        model.fused.memo_t = np.nan
+                        model.fused.memo = None
                     solver = exu.MainSolverImplicitSecondOrder()
                     try:
                         ok = solver.SolveSystem(mbs, ss)

@@ -178,9 +178,10 @@ class FusedForces:
         self.stats = [0, 0]
         #: compiled entry point of fused_kernel for this element's argument types (set on the first call)
         self._entry = None
-        #: (t, q, v) of the last call: the state the groups' live records belong to (HistoryRecorder)
-        self.memo_t = np.nan
-        self.memo_q, self.memo_v = np.empty(self.n), np.empty(self.n)
+        #: (t, q, v) of the last solver call (residual / jacobian), the state the groups' live records
+        #: belong to (HistoryRecorder), or None. References, not copies: Exudyn passes every call fresh
+        #: arrays it never reuses (checked: 127 calls, none changed afterwards)
+        self.memo = None
 
     def _packs(self, history: bool) -> list:
         """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
@@ -235,9 +236,6 @@ class FusedForces:
             fused_kernel(*args)
             if entry is None:
                 self._entry = _entry_point(args)
-        self.memo_t = t
-        self.memo_q[:] = q
-        self.memo_v[:] = v
         if self.pins is not None and self.pins.ctr[2] != before:
             from flexrv.errors import ConvergenceError
 
@@ -256,18 +254,23 @@ class FusedForces:
     def residual(self, t, q, v) -> np.ndarray:
         """Generalized force on the element's coordinates (a view, overwritten by the next call)."""
         self.stats[0] += 1
+        self.memo = None  # until the call has filled the records
         self._call(t, q, v, False)
+        self.memo = (t, q, v)
         return self.f
 
     def jacobian(self, t, q, v):
         """(dF/dq, dF/dv) on the element's coordinates (views, overwritten by the next call)."""
         self.stats[1] += 1
+        self.memo = None  # until the call has filled the records
         self._call(t, q, v, True)
+        self.memo = (t, q, v)
         return self.jq, self.jv
 
     def full(self, t, q, v, jacobian: bool = True):
         """Force and Jacobians on the MODEL's full vector (copies), for static solvers."""
         n_model = len(q)
+        self.memo = None  # the caller may change its arrays afterwards
         if self.is_full:
             self._call(float(t), q, v, jacobian)
             return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
@@ -305,12 +308,12 @@ class FusedForces:
 class HistoryRecorder:
     """The fused element's per-contact records at every recorded sample of a run, taken
     from what the integrator computed (issue 15): at each recorded state the last call
-    of the element (:attr:`FusedForces.memo_t` / ``memo_q`` / ``memo_v``) is, in Exudyn's
+    of the element (:attr:`FusedForces.memo`) is, in Exudyn's
     Newton iteration, the residual at the accepted state; if (t, q, v) are exactly those
     of the record, the groups' live arrays are copied into row k (one compiled copy) and
     the row is ``valid``, else it is left to the outputs' history pass
-    (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.1 s): 1000 of 1000 and 1010
-    of 1012 records matched (the others: segment starts and repeated steps).
+    (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.2 s): 1999 of 2001 and 1997
+    of 2001 records matched (the others: segment starts and repeated steps).
 
     Same numbers as the history pass to the solvers' own tolerances (the crank supports'
     inner solve, the closest points' warm starts), with one difference: a pin the solver
@@ -328,9 +331,9 @@ class HistoryRecorder:
 
     def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
         """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
-        f = self.fused
-        ok = (f.memo_t == t and np.array_equal(f.memo_q, q if f.is_full else q[f.index])
-              and np.array_equal(f.memo_v, v if f.is_full else v[f.index]))
+        f, memo = self.fused, self.fused.memo
+        ok = (memo is not None and memo[0] == t and np.array_equal(memo[1], q if f.is_full else q[f.index])
+              and np.array_equal(memo[2], v if f.is_full else v[f.index]))
         if ok and self.src:
             copy_records(self.src, self.dst, k)
         self.valid[k] = ok
