@@ -90,10 +90,20 @@ def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needle
 
 
 @njit(cache=True)
-def copy_records(src, dst, k):
-    """Row k of every history buffer ``dst`` (T, size) from the flat live arrays ``src``."""
+def copy_records_if_same(q0, q, v0, v, src, dst, k):
+    """If q0 == q and v0 == v exactly: row k of every history buffer ``dst`` (T, size)
+    from the flat live arrays ``src``; returns whether it copied."""
+    if q0.shape[0] != q.shape[0] or v0.shape[0] != v.shape[0]:
+        return False
+    for i in range(q.shape[0]):
+        if q0[i] != q[i]:
+            return False
+    for i in range(v.shape[0]):
+        if v0[i] != v[i]:
+            return False
     for r in range(len(src)):
         dst[r][k, :] = src[r]
+    return True
 
 
 _F8 = np.dtype(np.float64)
@@ -310,7 +320,7 @@ class HistoryRecorder:
     from what the integrator computed (issue 15): at each recorded state the last call
     of the element (:attr:`FusedForces.memo`) is, in Exudyn's
     Newton iteration, the residual at the accepted state; if (t, q, v) are exactly those
-    of the record, the groups' live arrays are copied into row k (one compiled copy) and
+    of the record, the groups' live arrays are copied into row k (one compiled call) and
     the row is ``valid``, else it is left to the outputs' history pass
     (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.2 s): 1999 of 2001 and 1997
     of 2001 records matched (the others: segment starts and repeated steps).
@@ -332,10 +342,10 @@ class HistoryRecorder:
     def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
         """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
         f, memo = self.fused, self.fused.memo
-        ok = (memo is not None and memo[0] == t and np.array_equal(memo[1], q if f.is_full else q[f.index])
-              and np.array_equal(memo[2], v if f.is_full else v[f.index]))
-        if ok and self.src:
-            copy_records(self.src, self.dst, k)
+        ok = memo is not None and memo[0] == t and bool(self.src)
+        if ok:  # one compiled call: compare (q, v) exactly, copy the records
+            ok = copy_records_if_same(memo[1], q if f.is_full else q[f.index], memo[2], v if f.is_full else v[f.index],
+                                      self.src, self.dst, k)
         self.valid[k] = ok
         return ok
 
