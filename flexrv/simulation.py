@@ -6,13 +6,16 @@
 
 Integration: Exudyn's implicit generalized-alpha (spectral radius 0.5 to damp
 the stiff contact modes numerically) with modified Newton and analytic group
-Jacobians; adaptive step reduction on Newton failure. A run is integrated in
+Jacobians (for the small dense systems of the rigid model a fresh Jacobian at
+every step); adaptive step reduction on Newton failure. A run is integrated in
 segments of :data:`SEGMENT_STEPS` steps, the integrator restarted at every
 boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
 cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
 mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
-``output_every`` steps, so a run that fails (Newton failure, NaN, penetration
+``output_every`` steps (with the compiled force groups' per-contact results of the
+integrator's last call at that state, :class:`flexrv.model.kernels.HistoryRecorder`),
+so a run that fails (Newton failure, NaN, penetration
 beyond the physical limit, a disc that skipped a pin) or is interrupted (Ctrl-C,
 SIGTERM) still returns the results up to that time:
 :class:`flexrv.errors.SimulationError` carries them as ``exc.results`` (and saves
@@ -24,9 +27,12 @@ verified in tests/test_time_step.py against a 4x finer step with a 100x tighter
 tolerance (rv40e: TE mean within 1e-4 arcsec, lines up to the cycloid mesh within
 0.1 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
 its 200-300 Hz lines depend on the start-up history at the Newton-tolerance level
--- two steady responses, see that module). Cost (benchmarks/bench_rigid.py):
-~3.6-4.4 Newton iterations per step, ~9 us per compiled residual call plus ~7 us
-of Exudyn/Python glue; real-time factor of the solve ~1.2-1.3.
+-- two steady responses, see that module). Cost (benchmarks/bench_rigid.py, CPU,
+0.3 s simulated, paired runs on a loaded machine): 1.3 / 2.0 Newton iterations
+per step with a fresh Jacobian per step (rv40e / rv221; 3.6 / 4.6 with the
+Jacobian reused), ~10-15 us per compiled residual call plus ~7 us of
+Exudyn/Python glue; real-time factor (solve + outputs) 1.26-1.40 / 1.29-1.41
+(before: 1.75 / 2.29).
 """
 
 from __future__ import annotations
