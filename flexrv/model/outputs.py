@@ -12,7 +12,9 @@ pattern). Three kinds:
   (output angle and speed, relative crank speed, carrier tilt, input and load torque,
   kinetic energy, angular momentum);
 * **group outputs**: the named :class:`flexrv.model.base.Output` s of every force group
-  (contact forces, film thickness, ...), evaluated over the time history in chunks.
+  (contact forces, film thickness, ...), evaluated over the time history in chunks
+  (the compiled groups' taken from what the integrator computed where the run recorded
+  it, else in one compiled loop over the samples; see :func:`group_outputs`).
 
 :func:`model_outputs` evaluates all of them on a recorded history; :func:`declared_outputs`
 lists the names, units and long names of the member-state and derived outputs without a run.
