@@ -21,8 +21,12 @@ time history in ONE compiled loop (:func:`fused_history`), copying each group's
 per-contact arrays (:meth:`~flexrv.model.base.KernelGroup.record_sources`) per
 sample: bit for bit the groups' own per-sample evaluate, without its ~50 us of
 Python per sample. What remains (~22-28 us per sample) is the kernels' own work,
-mostly the exact gap of every pin (the solver skips provably open pins; the
-outputs do not, so ``pin_gap`` stays exact for every pin).
+mostly the exact gap of every pin (the solver skips provably open pins; this pass
+does not, so its ``pin_gap`` is exact for every pin). A simulation records the
+same arrays from the integrator's own calls instead (:class:`HistoryRecorder`, ~2
+us per sample; ``pin_gap`` of a pin the solver proved open is then a positive
+lower bound) and uses this pass only where that record is missing or with
+``Simulation.run(record_outputs=False)``.
 
 Numba's on-disk cache (``cache=True``) keys each function on its OWN source file
 only: after editing a kernel that other modules' compiled functions call (e.g.
