@@ -165,6 +165,11 @@ class FusedForces:
                 raise ValueError(f"two kernel groups of kind {g.kind!r} in one fused element")
             by_kind[g.kind] = g
         self.groups = list(groups)
+        from flexrv.model.base import KernelGroup
+
+        #: the groups whose records are their record_sources (live arrays the kernel fills); a group
+        #: that overrides record() itself is left to its own evaluate for the outputs
+        self.recorded = [g for g in self.groups if type(g).record is KernelGroup.record]
         #: the model's groups outside this element (own elements; added by generalized_forces)
         self.others = [g for g in model.groups if g not in self.groups]
         names = [name for name in model.members if any(name in g.members for g in groups)]
@@ -232,7 +237,7 @@ class FusedForces:
             from flexrv.errors import ConvergenceError
 
             raise ConvergenceError("pin gap: closest-point iteration did not converge")
-        out = {g: {} for g in self.groups}
+        out = {g: {} for g in self.recorded}
         for (g, key, shape), d in zip(keys, dsts):
             out[g][key] = d.reshape((nt,) + shape)
         return out
@@ -258,7 +263,7 @@ class FusedForces:
     def record_entries(self) -> list:
         """(group, key, live array) of every per-contact record of this element's groups, in order."""
         out = []
-        for g in self.groups:
+        for g in self.recorded:
             for key, a in g.record_sources().items():
                 if a.dtype != np.float64 or not a.flags.c_contiguous:
                     raise TypeError(f"{g.name}.record_sources()[{key!r}] must be float64 and C-contiguous")

@@ -185,7 +185,7 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
     fused = getattr(model, "fused", None)
-    fused_groups = list(fused.groups) if fused is not None else []
+    fused_groups = list(fused.recorded) if fused is not None else []
     fused_recs: dict = {}
     if fused_groups:
         nt = len(t)
