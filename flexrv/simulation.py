@@ -31,7 +31,7 @@ its 200-300 Hz lines depend on the start-up history at the Newton-tolerance leve
 0.3 s simulated, paired runs on a loaded machine): 1.3 / 2.0 Newton iterations
 per step with a fresh Jacobian per step (rv40e / rv221; 3.6 / 4.6 with the
 Jacobian reused), ~10-15 us per compiled residual call plus ~7 us of
-Exudyn/Python glue; real-time factor (solve + outputs) 1.26-1.40 / 1.29-1.41
+Exudyn/Python glue; real-time factor (solve + outputs) 1.26-1.40 / 1.29-1.47
 (before: 1.75 / 2.29).
 """
 
