@@ -6,13 +6,16 @@
 
 Integration: Exudyn's implicit generalized-alpha (spectral radius 0.5 to damp
 the stiff contact modes numerically) with modified Newton and analytic group
-Jacobians; adaptive step reduction on Newton failure. A run is integrated in
+Jacobians (for the small dense systems of the rigid model a fresh Jacobian at
+every step); adaptive step reduction on Newton failure. A run is integrated in
 segments of :data:`SEGMENT_STEPS` steps, the integrator restarted at every
 boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
 cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
 mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
-``output_every`` steps, so a run that fails (Newton failure, NaN, penetration
+``output_every`` steps (with the compiled force groups' per-contact results of the
+integrator's last call at that state, :class:`flexrv.model.kernels.HistoryRecorder`),
+so a run that fails (Newton failure, NaN, penetration
 beyond the physical limit, a disc that skipped a pin) or is interrupted (Ctrl-C,
 SIGTERM) still returns the results up to that time:
 :class:`flexrv.errors.SimulationError` carries them as ``exc.results`` (and saves
@@ -24,9 +27,12 @@ verified in tests/test_time_step.py against a 4x finer step with a 100x tighter
 tolerance (rv40e: TE mean within 1e-4 arcsec, lines up to the cycloid mesh within
 0.1 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
 its 200-300 Hz lines depend on the start-up history at the Newton-tolerance level
--- two steady responses, see that module). Cost (benchmarks/bench_rigid.py):
-~3.6-4.4 Newton iterations per step, ~9 us per compiled residual call plus ~7 us
-of Exudyn/Python glue; real-time factor of the solve ~1.2-1.3.
+-- two steady responses, see that module). Cost (benchmarks/bench_rigid.py, CPU,
+0.3 s simulated, paired runs on a loaded machine): 1.3 / 2.0 Newton iterations
+per step with a fresh Jacobian per step (rv40e / rv221; 3.6 / 4.6 with the
+Jacobian reused), ~10-15 us per compiled residual call plus ~7 us of
+Exudyn/Python glue; real-time factor (solve + outputs) 1.26-1.40 / 1.29-1.47
+(before: 1.75 / 2.29).
 """
 
 from __future__ import annotations
@@ -135,7 +141,7 @@ class Simulation:
             output_every: int = 1, save_to: str | Path | None = None, spectral_radius: float = 0.5,
             newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE, newton_options: dict | None = None,
             checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, segment_steps: int = SEGMENT_STEPS,
-            restart: dict | None = None):
+            restart: dict | None = None, record_outputs: bool = True):
         """Integrate to ``t_end`` [s] with step ``dt`` [s]; return :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
@@ -170,7 +176,15 @@ class Simulation:
 
         ``restart``: a checkpoint's content (:meth:`resume`): records ``t``, ``q``,
         ``v`` before the boundary, the boundary state ``q_b``, ``v_b``, ``a_b`` and
-        its step index ``step``.
+        its step index ``step`` (and the compiled groups' ``records``).
+
+        ``record_outputs`` (default True): the compiled force groups' outputs (contact
+        forces, ...) are those the integrator computed at each recorded state
+        (:class:`flexrv.model.kernels.HistoryRecorder`; the same numbers as evaluating
+        them again, to the solvers' tolerances, except that ``pin_gap`` of a pin the
+        solver proved open is a positive lower bound of its gap); False: every output
+        evaluated again from the recorded states, every pin gap exact (rv40e: +0.2-0.3
+        s CPU per simulated s).
         """
 
         op = self.reducer.operating
@@ -217,11 +231,20 @@ class Simulation:
             ts[:k0], qs[:k0], vs[:k0] = (np.asarray(restart[key], dtype=float) for key in ("t", "q", "v"))
             q_b, v_b, a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
             state["k"] = k0
+        # the compiled groups' records at every sample, from the integrator's own calls (issue 15)
+        recorder = None
+        if model.fused is not None and record_outputs:
+            from flexrv.model.kernels import HistoryRecorder
+
+            recorder = HistoryRecorder(model.fused, n_out)
+            if restart is not None and restart.get("records") is not None:
+                recorder.fill(k0, *restart["records"])
         checkpoint = None
         if save_to is not None and checkpoint_s is not None and checkpoint_s > 0:
             checkpoint = _Checkpointer(self, Path(save_to), t_end, dt, output_every, seg, float(checkpoint_s))
             checkpoint.meta.update(newton_tolerance=list(newton_tolerance), spectral_radius=spectral_radius,
                                    newton_options=dict(newton_options or {}))
+            checkpoint.recorder = recorder
         report = _progress_callback(progress, t_end)
         sd = mbs.systemData
 
@@ -245,6 +268,8 @@ class Simulation:
                 ts[k] = t
                 qs[k] = q
                 vs[k] = sd.GetODE2Coordinates_t()
+                if recorder is not None:
+                    recorder.store(k, t, q, vs[k])
                 state["k"] = k + 1
             state["step"] += 1
             if not math.isfinite(q.sum()):
@@ -268,6 +293,11 @@ class Simulation:
         ti = ss.timeIntegration
         ti.verboseMode = 0
         ti.newton.useModifiedNewton = True
+        # small dense systems (the rigid model): a fresh Jacobian at the start of every step. The
+        # contact stiffness changes from step to step, so a reused Jacobian needed 3.7-4.6 Newton
+        # iterations per step (rv40e / rv221), a fresh one 1.3-1.9: fewer residual calls, whose Python
+        # round trip is most of a step (issue 15; benchmarks/bench_rigid.py, tests/test_time_step.py)
+        ti.newton.modifiedNewtonJacUpdatePerStep = model.n <= SPARSE_ABOVE
         ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
         ti.generalizedAlpha.spectralRadius = spectral_radius
         for key, value in newton_options.items():
@@ -317,6 +347,8 @@ class Simulation:
                     ti.startTime, ti.endTime, ti.numberOfSteps = t_of(j), t_of(j_next), j_next - j
                     for g in model.groups:
                         g.reset()
+                    if recorder is not None:  # the groups' records were reset: not those of the last call
+                        model.fused.memo = None
                     solver = exu.MainSolverImplicitSecondOrder()
                     try:
                         ok = solver.SolveSystem(mbs, ss)
@@ -344,6 +376,8 @@ class Simulation:
         k = state["k"]
         if ok and j >= n_total and k < n_out and (k == 0 or t_end > ts[k - 1]):  # final state
             ts[k], qs[k], vs[k] = t_end, q_b, v_b
+            if recorder is not None:
+                recorder.store(k, t_end, q_b, v_b)
             k += 1
         self.timing.update(solve_s=wall, solve_cpu_s=cpu, steps=state["step"], simulated_s=float(ts[k - 1]) if k else 0.0,
                            newton_iterations=counts["newton"], jacobians=counts["jacobians"],
@@ -359,7 +393,7 @@ class Simulation:
         from flexrv.post.results import results_from_states
 
         res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=dt, status=status, timing=self.timing,
-                                  cls=Results)
+                                  cls=Results, records=recorder.records(k) if recorder is not None else None)
         if state["signal"] is not None:
             res.attrs["signal"] = state["signal"]
         if checkpoint is not None:  # the last boundary (the complete run: a resume of it is refused as complete)
@@ -420,7 +454,7 @@ class Simulation:
         run_options.setdefault("newton_options", meta.get("newton_options") or None)
         t, q, v = ck["t"], ck["q"], ck["v"]
         restart = {"t": t[:-1], "q": q[:-1], "v": v[:-1], "q_b": q[-1], "v_b": v[-1], "a_b": ck["a"],
-                   "step": int(meta["step"])}
+                   "step": int(meta["step"]), "records": ck.get("records")}
         res = sim.run(t_end=meta["t_end"], dt=meta["dt"], progress=progress, output_every=meta["output_every"],
                       save_to=directory, checkpoint_s=checkpoint_s, segment_steps=int(meta["segment_steps"]),
                       restart=restart, **run_options)
@@ -443,6 +477,8 @@ class _Checkpointer:
                      "t_end": t_end, "dt": dt, "output_every": output_every, "segment_steps": segment_steps}
         self.custom = sim.drive != "ramp" or sim.torque is not None  # not resumable from files
         self.next_at = _time.perf_counter() + interval
+        #: the run's HistoryRecorder (its records before a boundary go into the checkpoint), or None
+        self.recorder = None
         self.count = 0
         self.spent = 0.0
 
@@ -457,7 +493,8 @@ class _Checkpointer:
             from flexrv.post.results import results_from_states
 
             res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=self.meta["dt"], status="running",
-                                      timing=self.sim.timing)
+                                      timing=self.sim.timing,
+                                      records=self.recorder.records(k) if self.recorder is not None else None)
             save_partial(res, self.directory)
         except Exception as exc:  # a full disk (or any save error) must not kill the run; the next one retries
             import warnings
@@ -480,7 +517,8 @@ class _Checkpointer:
         meta = dict(self.meta, resumable=not self.custom, step=int(j))
         t_b = self.meta["t_end"] if j >= max(int(round(self.meta["t_end"] / self.meta["dt"])), 1) else j * self.meta["dt"]
         save_checkpoint(self.directory, np.append(ts[:k], t_b), np.vstack([qs[:k], q_b[None]]),
-                        np.vstack([vs[:k], v_b[None]]), meta, self.sim.reducer, a_b)
+                        np.vstack([vs[:k], v_b[None]]), meta, self.sim.reducer, a_b,
+                        records=self.recorder.arrays(k) if self.recorder is not None else None)
         self.spent += _time.perf_counter() - t0
 
 

@@ -42,7 +42,9 @@ Timoshenko stepped shaft, verified against the FE condensation of
 :func:`flexrv.fem.crankshaft.crank_bending_compliance`). For a given d the inner
 equation R(b) = F(b) + k_bend (d - b) = 0 is solved by Newton's method (R is the
 gradient of a strictly convex energy, so Newton with step halving converges); the
-tangent is exact by the implicit-function theorem:
+tangent is exact by the implicit-function theorem (the roller directions u_i are
+computed once per call, the inner solve keeping gamma fixed; its tolerance is
+relative to the summed roller load, see :func:`crank_support_force`):
 
     -df/dd = K_s = K_b (K_b + k_bend I)^-1 k_bend,
     df/dgamma = k_bend (K_b + k_bend I)^-1 dF/dgamma.
@@ -58,9 +60,23 @@ SC_LINEAR, SC_K_ROLLER, SC_COS_A, SC_DELTA0, SC_K_BEND, SC_EXPONENT, SC_G = rang
 
 
 @njit(cache=True)
-def _bearing(bx, by, gam, clear, sc, angles, is_linear):
+def _roller_directions(gam, angles):
+    """Unit vectors u_i = (cos psi_i, sin psi_i), psi_i = gamma + angles[i], of the
+    rollers at cage angle gamma: computed once per support evaluation (the inner
+    Newton keeps gamma fixed), not once per bearing evaluation."""
+    z = angles.shape[0]
+    ux, uy = np.empty(z), np.empty(z)
+    for i in range(z):
+        psi = gam + angles[i]
+        ux[i], uy[i] = np.cos(psi), np.sin(psi)
+    return ux, uy
+
+
+@njit(cache=True)
+def _bearing(bx, by, clear, sc, ux, uy, is_linear):
     """Bearing force F (on the crank) at inner-ring displacement b, its tangent
-    K_b = -dF/db (kxx, kxy, kyy), dF/dgamma (gx, gy) and the summed roller load."""
+    K_b = -dF/db (kxx, kxy, kyy), dF/dgamma (gx, gy) and the summed roller load;
+    (ux, uy): the roller directions (:func:`_roller_directions`)."""
     if is_linear:
         k = sc[SC_LINEAR]
         dist = np.sqrt(bx * bx + by * by)
@@ -74,24 +90,23 @@ def _bearing(bx, by, gam, clear, sc, angles, is_linear):
         return -sk * bx, -sk * by, sk + w * ux * ux, w * ux * uy, sk + w * uy * uy, 0.0, 0.0, sk * dist
     kr, ca, d0, n = sc[SC_K_ROLLER], sc[SC_COS_A], sc[SC_DELTA0], sc[SC_EXPONENT]
     fx = fy = kxx = kxy = kyy = gx = gy = qsum = 0.0
-    for i in range(angles.shape[0]):
-        psi = gam + angles[i]
-        ux, uy = np.cos(psi), np.sin(psi)
-        delta = d0 + ca * (bx * ux + by * uy - clear)
+    for i in range(ux.shape[0]):
+        cx, cy = ux[i], uy[i]
+        delta = d0 + ca * (bx * cx + by * cy - clear)
         if delta <= 0.0:
             continue
         q = kr * delta**n
         dq = n * q / delta
         qsum += q
-        fx -= 2.0 * ca * q * ux
-        fy -= 2.0 * ca * q * uy
-        kxx += 2.0 * ca * ca * dq * ux * ux
-        kxy += 2.0 * ca * ca * dq * ux * uy
-        kyy += 2.0 * ca * ca * dq * uy * uy
+        fx -= 2.0 * ca * q * cx
+        fy -= 2.0 * ca * q * cy
+        kxx += 2.0 * ca * ca * dq * cx * cx
+        kxy += 2.0 * ca * ca * dq * cx * cy
+        kyy += 2.0 * ca * ca * dq * cy * cy
         # d/dgamma: u' = (-uy, ux); d(delta)/dgamma = ca b . u'
-        dd = ca * (-bx * uy + by * ux)
-        gx -= 2.0 * ca * (dq * dd * ux - q * uy)
-        gy -= 2.0 * ca * (dq * dd * uy + q * ux)
+        dd = ca * (-bx * cy + by * cx)
+        gx -= 2.0 * ca * (dq * dd * cx - q * cy)
+        gy -= 2.0 * ca * (dq * dd * cy + q * cx)
     return fx, fy, kxx, kxy, kyy, gx, gy, 2.0 * qsum
 
 
@@ -101,15 +116,25 @@ def crank_support_force(dx, dy, gam, clear, sc, angles, is_linear, b0x, b0y):
     on the crank at the crank-centre displacement d relative to its bore (module
     docstring), its tangent K_s = -df/dd (kxx, kxy, kyy), df/dgamma (gx, gy), the
     bearing displacement (bx, by) and the summed roller load. (b0x, b0y): Newton
-    start for b (the previous solution; any value converges)."""
+    start for b (the previous solution; any value converges). The inner equation is
+    solved to |R|_1 <= 1e-13 (k_bend |d|_1 + |F|_1 + summed roller load), or to its
+    round-off floor (a Newton step that no longer lowers |R|), i.e. b to ~1e-19 m."""
     kb = sc[SC_K_BEND]
+    if is_linear:
+        ux = uy = angles[:0]
+    else:
+        ux, uy = _roller_directions(gam, angles)
     if kb <= 0.0:  # rigid crank: b = d
-        fx, fy, kxx, kxy, kyy, gx, gy, qs = _bearing(dx, dy, gam, clear, sc, angles, is_linear)
+        fx, fy, kxx, kxy, kyy, gx, gy, qs = _bearing(dx, dy, clear, sc, ux, uy, is_linear)
         return fx, fy, kxx, kxy, kyy, gx, gy, dx, dy, qs
     bx, by = b0x, b0y
-    fx, fy, kxx, kxy, kyy, gx, gy, qs = _bearing(bx, by, gam, clear, sc, angles, is_linear)
+    fx, fy, kxx, kxy, kyy, gx, gy, qs = _bearing(bx, by, clear, sc, ux, uy, is_linear)
     rx, ry = fx + kb * (dx - bx), fy + kb * (dy - by)
-    scale = abs(kb) * (abs(dx) + abs(dy)) + abs(fx) + abs(fy) + 1e-300
+    # tolerance relative to the largest terms of R: the shaft force, the net bearing force and the
+    # summed roller loads qs (with preload the roller forces cancel in F, whose round-off is ~eps qs;
+    # without qs the scale of a nearly unloaded support, ~0.01-0.1 N, lay below that floor and the
+    # loop ran to its limit: 100 iterations of 20 halvings in ~6 % of the quasi-static solver's calls)
+    scale = abs(kb) * (abs(dx) + abs(dy)) + abs(fx) + abs(fy) + qs + 1e-300
     for _ in range(100):
         if abs(rx) + abs(ry) <= 1e-13 * scale:
             break
@@ -121,11 +146,13 @@ def crank_support_force(dx, dy, gam, clear, sc, angles, is_linear, b0x, b0y):
         lam = 1.0
         for _h in range(40):  # step halving on |R|_1 (R is the gradient of a convex energy)
             nbx, nby = bx + lam * sx, by + lam * sy
-            f2 = _bearing(nbx, nby, gam, clear, sc, angles, is_linear)
+            f2 = _bearing(nbx, nby, clear, sc, ux, uy, is_linear)
             nrx, nry = f2[0] + kb * (dx - nbx), f2[1] + kb * (dy - nby)
             if abs(nrx) + abs(nry) < r0 or lam < 1e-6:
                 break
             lam *= 0.5
+        if not abs(nrx) + abs(nry) < r0:  # no decrease along the Newton direction: R is at its round-off floor
+            break
         bx, by = nbx, nby
         fx, fy, kxx, kxy, kyy, gx, gy, qs = f2
         rx, ry = nrx, nry

@@ -150,7 +150,7 @@ class KernelGroup(ForceGroup):
     kernel over the samples.
 
     Subclasses set ``kind`` (their slot in the fused kernel) and implement
-    :meth:`pack`, :meth:`run`, :meth:`record` and :meth:`outputs`.
+    :meth:`pack`, :meth:`run`, :meth:`record_sources` and :meth:`outputs`.
     """
 
     analytic_jacobian = True
@@ -175,9 +175,16 @@ class KernelGroup(ForceGroup):
         ``inputs``: precomputed time inputs at t (else :meth:`time_inputs`)."""
         raise NotImplementedError
 
+    def record_sources(self) -> dict:
+        """The per-contact result arrays the kernel fills through the pack (live, not
+        copies), by record key: float64, C-contiguous, fixed shapes. :meth:`record`
+        copies them after one call; the compiled history pass of the fused element
+        (:meth:`flexrv.model.kernels.FusedForces.history`) copies them per sample."""
+        return {}
+
     def record(self) -> dict:
         """Copies of the per-contact results of the last kernel call."""
-        return {}
+        return {k: a.copy() for k, a in self.record_sources().items()}
 
     def outputs(self, t, rec: dict) -> dict:
         """Named outputs from stacked records (leading axis time)."""

@@ -544,25 +544,34 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         ly = dx * a[0, 1] + dy * a[1, 1] + dz * a[2, 1]
         psi = math.atan2(ly, lx)
         psi_i[j] = psi
-        p = np.array([ci_r * math.cos(psi), ci_r * math.sin(psi), ci_z + z_row])
-        pv = np.zeros(3)
-        if m_i > 0:
-            _basis(tab_i, zs_i, psi, bas_i)
-            dp = bas_i @ q[6:6 + m_i]
-            p += dp
-            pv = bas_i @ qt[6:6 + m_i]
-            du_i[j] = a @ dp
-            if jacobian:
-                bas_i_all[j] = bas_i
-        if cond_i:
-            _rotation_z(a, psi, rot_i[j])
-        ap = a @ p
-        arm[j] = ap
-        apv = a @ pv
-        e0_i[j, 0], e0_i[j, 1], e0_i[j, 2] = bx - q[0] - ap[0], by - q[1] - ap[1], bz - q[2] - ap[2]
-        w0_i[j, 0] = vx - (qt[0] + om[1] * ap[2] - om[2] * ap[1] + apv[0])
-        w0_i[j, 1] = vy - (qt[1] + om[2] * ap[0] - om[0] * ap[2] + apv[1])
-        w0_i[j, 2] = vz - (qt[2] + om[0] * ap[1] - om[1] * ap[0] + apv[2])
+        if m_i > 0 or cond_i:
+            p = np.array([ci_r * math.cos(psi), ci_r * math.sin(psi), ci_z + z_row])
+            pv = np.zeros(3)
+            if m_i > 0:
+                _basis(tab_i, zs_i, psi, bas_i)
+                dp = bas_i @ q[6:6 + m_i]
+                p += dp
+                pv = bas_i @ qt[6:6 + m_i]
+                du_i[j] = a @ dp
+                if jacobian:
+                    bas_i_all[j] = bas_i
+            if cond_i:
+                _rotation_z(a, psi, rot_i[j])
+            ap = a @ p
+            apv = a @ pv
+            ap0, ap1, ap2, apv0, apv1, apv2 = ap[0], ap[1], ap[2], apv[0], apv[1], apv[2]
+        else:  # rigid inner ring: A p by hand (no array, no BLAS call per ball; the groove centre has no velocity
+            # relative to the frame)
+            p0, p1, p2 = ci_r * math.cos(psi), ci_r * math.sin(psi), ci_z + z_row
+            ap0 = a[0, 0] * p0 + a[0, 1] * p1 + a[0, 2] * p2
+            ap1 = a[1, 0] * p0 + a[1, 1] * p1 + a[1, 2] * p2
+            ap2 = a[2, 0] * p0 + a[2, 1] * p1 + a[2, 2] * p2
+            apv0 = apv1 = apv2 = 0.0
+        arm[j, 0], arm[j, 1], arm[j, 2] = ap0, ap1, ap2
+        e0_i[j, 0], e0_i[j, 1], e0_i[j, 2] = bx - q[0] - ap0, by - q[1] - ap1, bz - q[2] - ap2
+        w0_i[j, 0] = vx - (qt[0] + om[1] * ap2 - om[2] * ap1 + apv0)
+        w0_i[j, 1] = vy - (qt[1] + om[2] * ap0 - om[0] * ap2 + apv1)
+        w0_i[j, 2] = vz - (qt[2] + om[0] * ap1 - om[1] * ap0 + apv2)
         # ---- outer ring (housing)
         psi = math.atan2(by, bx)
         psi_o[j] = psi

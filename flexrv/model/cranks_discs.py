@@ -186,8 +186,8 @@ class CrankSupports(KernelGroup):
         self.bstate[:] = 0.0
         super().reset()
 
-    def record(self):
-        return {"fx": self.fx.copy(), "fy": self.fy.copy(), "bend": self.bend.copy()}
+    def record_sources(self):
+        return {"fx": self.fx, "fy": self.fy, "bend": self.bend}
 
     def outputs(self, t, rec):
         out = {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
@@ -373,10 +373,10 @@ class NeedleBearings(KernelGroup):
         """Smallest gap [m] of the last evaluation (negative: penetration)."""
         return float(self.state[0])
 
-    def record(self):
-        rec = {"fx": self.fx.copy(), "fy": self.fy.copy(), "pw": self.pw.copy()}
+    def record_sources(self):
+        rec = {"fx": self.fx, "fy": self.fy, "pw": self.pw}
         if self.model == "rollers":
-            rec.update(roll=self.roll.copy(), angle=self.angle.copy())
+            rec.update(roll=self.roll, angle=self.angle)
         return rec
 
     def outputs(self, t, rec):

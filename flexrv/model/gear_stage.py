@@ -186,8 +186,8 @@ class GearMeshes(KernelGroup):
         ts, ws = self.time_inputs(t) if inputs is None else inputs
         gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack)
 
-    def record(self):
-        return {"force": self.force.copy(), "deflection": self.deflection.copy(), "stiffness": self.stiffness.copy()}
+    def record_sources(self):
+        return {"force": self.force, "deflection": self.deflection, "stiffness": self.stiffness}
 
     def outputs(self, t, rec):
         force = rec["force"]

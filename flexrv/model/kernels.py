@@ -10,9 +10,23 @@ Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 Groups of other kinds (ball bearing, flexible crank) keep their own elements.
 
 Python work per call: Exudyn's argument lists to arrays (``np.asarray``), the
-drive angle and load vector at t (cached per time), one dispatch of the compiled
-function (about 8 us of unboxing the ~45 pack arrays; the compiled work is 6-9 us
-on rv40e/rv221). Measured in benchmarks/bench_rigid.py.
+drive angle and load vector at t (cached per time), one call of the compiled entry
+point (1.8 us of unboxing the 51 pack arrays, measured against an empty kernel of
+the same arguments; the compiled work is 7 us at a fixed loaded state and ~15 us
+in a run, where the closest points and the supports' inner solves move). Measured
+in benchmarks/bench_rigid.py.
+
+Outputs: :meth:`FusedForces.history` evaluates the same kernels over a recorded
+time history in ONE compiled loop (:func:`fused_history`), copying each group's
+per-contact arrays (:meth:`~flexrv.model.base.KernelGroup.record_sources`) per
+sample: bit for bit the groups' own per-sample evaluate, without its ~50 us of
+Python per sample. What remains (~22-28 us per sample) is the kernels' own work,
+mostly the exact gap of every pin (the solver skips provably open pins; this pass
+does not, so its ``pin_gap`` is exact for every pin). A simulation records the
+same arrays from the integrator's own calls instead (:class:`HistoryRecorder`, ~2
+us per sample; ``pin_gap`` of a pin the solver proved open is then a positive
+lower bound) and uses this pass only where that record is missing or with
+``Simulation.run(record_outputs=False)``.
 
 Numba's on-disk cache (``cache=True``) keys each function on its OWN source file
 only: after editing a kernel that other modules' compiled functions call (e.g.
@@ -56,6 +70,44 @@ def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, ma
     pin_kernel(q, v, f, jq, jv, jac, pins)
     main_bearing_kernel(q, v, f, jq, jv, jac, main_bearing)
     loads_kernel(q, v, f, jq, jv, jac, loads)
+
+
+@njit(cache=True)
+def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needles, pins, main_bearing, loads, src,
+                  dst):
+    """:func:`fused_kernel` at every sample i of a time history (qs, vs: (T, n);
+    tsun, wsun: (T,) sun angle and speed; loads_t: (T, len(load)) the loads group's
+    load vector, written into its pack before each call), without Jacobians;
+    after each call the per-contact result arrays ``src`` (flat views of the
+    groups' :meth:`~flexrv.model.base.KernelGroup.record_sources`) are copied into
+    row i of ``dst`` (T, size). Exactly the per-sample calls of the groups'
+    evaluate, in one compiled loop (issue 15: the Python loop over samples cost
+    ~50 us per sample)."""
+    load = loads[1]
+    for i in range(qs.shape[0]):
+        if load.shape[0] > 0:
+            load[:] = loads_t[i]
+        fused_kernel(qs[i], vs[i], f, jq, jv, False, tsun[i], wsun[i], gear, supports, needles, pins, main_bearing,
+                     loads)
+        for r in range(len(src)):
+            dst[r][i, :] = src[r]
+
+
+@njit(cache=True)
+def copy_records_if_same(q0, q, v0, v, src, dst, k):
+    """If q0 == q and v0 == v exactly: row k of every history buffer ``dst`` (T, size)
+    from the flat live arrays ``src``; returns whether it copied."""
+    if q0.shape[0] != q.shape[0] or v0.shape[0] != v.shape[0]:
+        return False
+    for i in range(q.shape[0]):
+        if q0[i] != q[i]:
+            return False
+    for i in range(v.shape[0]):
+        if v0[i] != v[i]:
+            return False
+    for r in range(len(src)):
+        dst[r][k, :] = src[r]
+    return True
 
 
 _F8 = np.dtype(np.float64)
@@ -113,6 +165,11 @@ class FusedForces:
                 raise ValueError(f"two kernel groups of kind {g.kind!r} in one fused element")
             by_kind[g.kind] = g
         self.groups = list(groups)
+        from flexrv.model.base import KernelGroup
+
+        #: the groups whose records are their record_sources (live arrays the kernel fills); a group
+        #: that overrides record() itself is left to its own evaluate for the outputs
+        self.recorded = [g for g in self.groups if type(g).record is KernelGroup.record]
         #: the model's groups outside this element (own elements; added by generalized_forces)
         self.others = [g for g in model.groups if g not in self.groups]
         names = [name for name in model.members if any(name in g.members for g in groups)]
@@ -125,14 +182,14 @@ class FusedForces:
         self.index = np.concatenate([np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n)
                                      for m in names]).astype(np.int64) if names else np.zeros(0, np.int64)
         self.is_full = self.n == model.n and np.array_equal(self.index, np.arange(model.n))
-        self.packs = []
+        #: each kind's group and the positions of its local coordinates in the element's vector
+        self.slots = []
         for kind, cls in KINDS:
             g = by_kind.get(kind)
-            if g is None:
-                self.packs.append(cls.empty_pack())
-            else:
-                idx = np.concatenate([np.arange(local[m], local[m] + model.members[m].n) for m in g.members])
-                self.packs.append(g.pack(idx.astype(np.int64)))
+            idx = None if g is None else np.concatenate(
+                [np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(np.int64)
+            self.slots.append((cls, g, idx))
+        self.packs = self._packs(history=False)
         self.gear, self.loads = by_kind.get("gear"), by_kind.get("loads")
         self.pins = by_kind.get("pins")
         self.f = np.zeros(self.n)
@@ -140,6 +197,50 @@ class FusedForces:
         self.stats = [0, 0]
         #: compiled entry point of fused_kernel for this element's argument types (set on the first call)
         self._entry = None
+        #: (t, q, v) of the last solver call (residual / jacobian), the state the groups' live records
+        #: belong to (HistoryRecorder), or None. References, not copies: Exudyn passes every call fresh
+        #: arrays it never reuses (checked: 127 calls, none changed afterwards)
+        self.memo = None
+
+    def _packs(self, history: bool) -> list:
+        """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
+        return [cls.empty_pack() if g is None else g.pack(idx, history=history) for cls, g, idx in self.slots]
+
+    def history(self, t, q, v) -> dict:
+        """Per-sample records of every group of this element over a time history t (T,),
+        q, v (T, n) on the element's coordinates: {group: {key: (T, *shape)}}, as the
+        groups' own evaluate of the history would stack them (the same kernels on the
+        same inputs, bit for bit: fresh history packs, the vectorised time inputs), in
+        one compiled loop (:func:`fused_history`)."""
+        t = np.ascontiguousarray(t, dtype=float)
+        nt = len(t)
+        packs = self._packs(history=True)
+        gear = self.gear
+        drive = gear.time_inputs_many(t) if gear is not None else np.zeros((nt, 2))
+        drive = np.ascontiguousarray(np.broadcast_to(drive, (nt, 2)))
+        load = packs[[k for k, _ in KINDS].index("loads")][1]
+        loads_t = (np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
+                   if self.loads is not None else np.zeros((nt, 0)))
+        srcs, dsts, keys = [], [], []
+        for g, key, a in self.record_entries():
+            srcs.append(a.reshape(-1))
+            dsts.append(np.empty((nt, a.size)))
+            keys.append((g, key, a.shape))
+        f = np.zeros(self.n)
+        pin_ctr = packs[[k for k, _ in KINDS].index("pins")][-1]
+        before = int(pin_ctr[2])
+        if nt and srcs:
+            fused_history(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
+                          np.ascontiguousarray(drive[:, 0]), np.ascontiguousarray(drive[:, 1]), loads_t, f, self.jq,
+                          self.jv, *packs, tuple(srcs), tuple(dsts))
+        if int(pin_ctr[2]) != before:
+            from flexrv.errors import ConvergenceError
+
+            raise ConvergenceError("pin gap: closest-point iteration did not converge")
+        out = {g: {} for g in self.recorded}
+        for (g, key, shape), d in zip(keys, dsts):
+            out[g][key] = d.reshape((nt,) + shape)
+        return out
 
     def _call(self, t, q, v, jac):
         ts, ws = self.gear.time_inputs(t) if self.gear is not None else (0.0, 0.0)
@@ -159,21 +260,36 @@ class FusedForces:
 
             raise ConvergenceError("pin gap: closest-point iteration did not converge")
 
+    def record_entries(self) -> list:
+        """(group, key, live array) of every per-contact record of this element's groups, in order."""
+        out = []
+        for g in self.recorded:
+            for key, a in g.record_sources().items():
+                if a.dtype != np.float64 or not a.flags.c_contiguous:
+                    raise TypeError(f"{g.name}.record_sources()[{key!r}] must be float64 and C-contiguous")
+                out.append((g, key, a))
+        return out
+
     def residual(self, t, q, v) -> np.ndarray:
         """Generalized force on the element's coordinates (a view, overwritten by the next call)."""
         self.stats[0] += 1
+        self.memo = None  # until the call has filled the records
         self._call(t, q, v, False)
+        self.memo = (t, q, v)
         return self.f
 
     def jacobian(self, t, q, v):
         """(dF/dq, dF/dv) on the element's coordinates (views, overwritten by the next call)."""
         self.stats[1] += 1
+        self.memo = None  # until the call has filled the records
         self._call(t, q, v, True)
+        self.memo = (t, q, v)
         return self.jq, self.jv
 
     def full(self, t, q, v, jacobian: bool = True):
         """Force and Jacobians on the MODEL's full vector (copies), for static solvers."""
         n_model = len(q)
+        self.memo = None  # the caller may change its arrays afterwards
         if self.is_full:
             self._call(float(t), q, v, jacobian)
             return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
@@ -196,9 +312,68 @@ class FusedForces:
         def force_fn(mbs_, t, item, q, q_t):
             return self.residual(t, np.asarray(q), np.asarray(q_t))
 
+        out, tmp = np.empty((self.n, self.n)), np.empty((self.n, self.n))
+
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
             dq, dv = self.jacobian(t, np.asarray(q), np.asarray(q_t))
-            return -(f_q * dq + f_v * dv)
+            np.multiply(dq, -f_q, out=out)  # -(f_q dq + f_v dv) without temporaries (Exudyn copies it)
+            np.multiply(dv, f_v, out=tmp)
+            return np.subtract(out, tmp, out=out)
 
         return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
                                                jacobianUserFunction=jac_fn))
+
+
+class HistoryRecorder:
+    """The fused element's per-contact records at every recorded sample of a run, taken
+    from what the integrator computed (issue 15): at each recorded state the last call
+    of the element (:attr:`FusedForces.memo`) is, in Exudyn's
+    Newton iteration, the residual at the accepted state; if (t, q, v) are exactly those
+    of the record, the groups' live arrays are copied into row k (one compiled call) and
+    the row is ``valid``, else it is left to the outputs' history pass
+    (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.2 s): 1999 of 2001 and 1997
+    of 2001 records matched (the others: segment starts and repeated steps).
+
+    Same numbers as the history pass to the solvers' own tolerances (the crank supports'
+    inner solve, the closest points' warm starts), with one difference: a pin the solver
+    proved open (:func:`flexrv.model.pins.pin_kernel`'s bound > 0: no force, no Jacobian)
+    keeps that positive lower bound of its gap in ``pin_gap`` instead of the exact gap;
+    every pin within reach of contact, every force and every other record is the exact
+    evaluation at the recorded state."""
+
+    def __init__(self, fused: FusedForces, n_out: int):
+        self.fused = fused
+        self.entries = [(g, key, a.shape) for g, key, a in fused.record_entries()]
+        self.src = tuple(a.reshape(-1) for _, _, a in fused.record_entries())
+        self.dst = tuple(np.empty((n_out, a.size)) for a in self.src)
+        self.valid = np.zeros(n_out, dtype=bool)
+
+    def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
+        """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
+        f, memo = self.fused, self.fused.memo
+        ok = memo is not None and memo[0] == t and bool(self.src)
+        if ok:  # one compiled call: compare (q, v) exactly, copy the records
+            ok = copy_records_if_same(memo[1], q if f.is_full else q[f.index], memo[2], v if f.is_full else v[f.index],
+                                      self.src, self.dst, k)
+        self.valid[k] = ok
+        return ok
+
+    def fill(self, k0: int, arrays: list, valid: np.ndarray) -> None:
+        """Rows 0..k0-1 from a checkpoint (:meth:`arrays` of the interrupted run)."""
+        if len(arrays) != len(self.dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, self.dst)):
+            return  # another model's records: those rows are left to the history pass
+        for a, d in zip(arrays, self.dst):
+            d[:k0] = a[:k0]
+        self.valid[:k0] = valid[:k0]
+
+    def arrays(self, k: int) -> tuple[list, np.ndarray]:
+        """(buffers, valid) of rows 0..k-1, for a checkpoint."""
+        return [d[:k] for d in self.dst], self.valid[:k]
+
+    def records(self, k: int) -> dict:
+        """Rows 0..k-1: {"valid": (k,), "data": {group: {key: (k, *shape)}}} for
+        :func:`flexrv.model.outputs.group_outputs`."""
+        data: dict = {}
+        for (g, key, shape), d in zip(self.entries, self.dst):
+            data.setdefault(g, {})[key] = d[:k].reshape((k,) + shape)
+        return {"valid": self.valid[:k], "data": data}

@@ -149,8 +149,8 @@ class OutputLoads(KernelGroup):
         self.load[:] = self.time_inputs(t) if inputs is None else inputs
         loads_kernel(q, v, f, jq, jv, jac, pack)
 
-    def record(self):
-        return {"load": self.load.copy()}
+    def record_sources(self):
+        return {"load": self.load}
 
     def outputs(self, t, rec):
         return {"load_torque": Output(-rec["load"][..., 2], ("time",), "N m", "load torque on the output")}

@@ -55,8 +55,8 @@ class RigidMainBearing(KernelGroup):
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         main_bearing_kernel(q, v, f, jq, jv, jac, pack)
 
-    def record(self):
-        return {"f": self.force.copy()}
+    def record_sources(self):
+        return {"f": self.force}
 
     def outputs(self, t, rec):
         f = rec["f"]

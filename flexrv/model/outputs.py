@@ -14,7 +14,9 @@ pattern). Three kinds:
 * **friction output** ``friction_power``: the sum of the groups' :data:`FRICTION_OUTPUTS` [W]
   (present when friction is on);
 * **group outputs**: the named :class:`flexrv.model.base.Output` s of every force group
-  (contact forces, film thickness, ...), evaluated over the time history in chunks.
+  (contact forces, film thickness, ...), evaluated over the time history in chunks
+  (the compiled groups' taken from what the integrator computed where the run recorded
+  it, else in one compiled loop over the samples; see :func:`group_outputs`).
 
 :func:`model_outputs` evaluates all of them on a recorded history; :func:`declared_outputs`
 lists the names, units and long names of the member-state and derived outputs without a run.
@@ -178,12 +180,43 @@ def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
     return out
 
 
-def group_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
+def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None) -> dict[str, Output]:
     """The named outputs of every force group over the history (T,), (T, n), (T, n),
-    evaluated in chunks of ``chunk`` samples."""
+    evaluated in chunks of ``chunk`` samples. The groups of the model's fused compiled
+    element (:class:`flexrv.model.kernels.FusedForces`) are evaluated together, one
+    compiled loop over the samples of a chunk (:meth:`~flexrv.model.kernels.FusedForces.history`:
+    the same kernels on the same inputs as their own evaluate, bit for bit); the
+    others by their own evaluate. ``records`` (:meth:`flexrv.model.kernels.HistoryRecorder.records`
+    of the run): the fused groups' records the integrator computed at the samples, used
+    where ``valid`` (the history pass fills the other samples; see the recorder for
+    what differs)."""
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
+    fused = getattr(model, "fused", None)
+    fused_groups = list(fused.recorded) if fused is not None else []
+    fused_recs: dict = {}
+    if fused_groups:
+        nt = len(t)
+        todo = np.arange(nt) if records is None else np.flatnonzero(~np.asarray(records["valid"], dtype=bool))
+        if records is not None:
+            fused_recs = {g: {k: np.array(a) for k, a in records["data"][g].items()} for g in fused_groups}
+        if len(todo):
+            ix = fused.index
+            for a in range(0, len(todo), chunk):
+                rows = todo[a:a + chunk]
+                part = fused.history(t[rows], q[rows][:, ix], v[rows][:, ix])
+                for g in fused_groups:
+                    dst = fused_recs.setdefault(g, {})
+                    for key, val in part[g].items():
+                        if key not in dst:
+                            dst[key] = np.empty((nt,) + val.shape[1:])
+                        dst[key][rows] = val
     for g in model.groups:
+        if g in fused_recs:
+            for name, o in g.outputs(np.asarray(t, dtype=float), fused_recs[g]).items():
+                outs.setdefault(name, []).append(np.asarray(o.values))
+                meta[name] = (o.dims, o.units, o.long_name)
+            continue
         qg_all = model.group_state(g, q)
         vg_all = model.group_state(g, v)
         for a in range(0, len(t), chunk):
@@ -200,11 +233,11 @@ def group_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
     return result
 
 
-def model_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
+def model_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None) -> dict[str, Output]:
     """Every declared output of ``model`` on the recorded history t (T,), q, v (T, n), by name,
     in result order: drive and member outputs, group outputs, ``input_torque`` (the sun's
     torque from the gear-stage group plus J_in d(omega_in)/dt), ``output_torque``,
-    ``kinetic_energy``, ``angular_momentum``."""
+    ``kinetic_energy``, ``angular_momentum``. ``records``: see :func:`group_outputs`."""
     t = np.asarray(t, dtype=float)
     declared = declared_outputs()
     computed: dict[str, np.ndarray] = {}
@@ -220,7 +253,7 @@ def model_outputs(model, t, q, v, chunk: int = 1000) -> dict[str, Output]:
 
     for name in _ORDER:
         put(name)
-    groups = group_outputs(model, t, q, v, chunk)
+    groups = group_outputs(model, t, q, v, chunk, records)
     out.update(groups)
     fric = [o.values.reshape(len(t), -1).sum(axis=1) for name, o in groups.items() if name in FRICTION_OUTPUTS]
     if fric:

@@ -360,9 +360,9 @@ class PinContacts(KernelGroup):
     def min_gap(self) -> float:
         return float(self.gap.min()) if self.ctr[0] > 0 else np.inf
 
-    def record(self):
-        return {"gap": self.gap.copy(), "force": self.force.copy(), "nx": self.nx.copy(), "ny": self.ny.copy(),
-                "rxn": self.rxn.copy(), "ft": self.ft.copy(), "pw": self.pw.copy()}
+    def record_sources(self):
+        return {"gap": self.gap, "force": self.force, "nx": self.nx, "ny": self.ny, "rxn": self.rxn,
+                "ft": self.ft, "pw": self.pw}
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
@@ -372,7 +372,8 @@ class PinContacts(KernelGroup):
             "pin_friction_power": Output(-rec["pw"].sum(axis=-1), ("time", "disc"), "W",
                                          "power dissipated by the pin-disc friction of each disc (>= 0)")}
         return out | {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
-                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration)"),
+                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration); "
+                                  "of a pin proved open by the solver: a positive lower bound"),
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
                 "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
                                           "torque of the pin normal forces on each disc about its centre (the friction "

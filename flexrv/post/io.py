@@ -82,16 +82,22 @@ def save_partial(res, directory) -> Path:
 CHECKPOINT = "checkpoint.npz"
 
 
-def save_checkpoint(directory, t, q, v, meta: dict, reducer, a_last=None) -> Path:
+def save_checkpoint(directory, t, q, v, meta: dict, reducer, a_last=None, records=None) -> Path:
     """Write the recorded states (t, q, v) of a run, its run options ``meta`` and
-    its design atomically to ``<directory>/checkpoint.npz``."""
+    its design atomically to ``<directory>/checkpoint.npz``; ``records``: (list of
+    arrays, valid) of the compiled groups' records at the samples before the last row
+    (:meth:`flexrv.model.kernels.HistoryRecorder.arrays`)."""
     from flexrv.cache import atomic_write_bytes, to_jsonable
     from flexrv.design import to_toml
 
+    extra = {} if a_last is None else {"a": np.asarray(a_last, dtype=float)}
+    if records is not None:
+        arrays, valid = records
+        extra["rec_valid"] = np.asarray(valid, dtype=bool)
+        extra.update({f"rec_{i}": np.asarray(a, dtype=float) for i, a in enumerate(arrays)})
     buf = io.BytesIO()
     np.savez(buf, t=np.asarray(t, dtype=float), q=np.asarray(q, dtype=float), v=np.asarray(v, dtype=float),
-             meta=np.array(json.dumps(to_jsonable(meta))), config=np.array(to_toml(reducer)),
-             **({} if a_last is None else {"a": np.asarray(a_last, dtype=float)}))
+             meta=np.array(json.dumps(to_jsonable(meta))), config=np.array(to_toml(reducer)), **extra)
     return atomic_write_bytes(Path(directory) / CHECKPOINT, buf.getvalue())
 
 
@@ -109,7 +115,10 @@ def load_checkpoint(directory) -> dict:
     try:
         with np.load(path, allow_pickle=False) as z:
             data = {"t": z["t"], "q": z["q"], "v": z["v"], "meta": json.loads(str(z["meta"])),
-                    "config": str(z["config"]), "a": z["a"] if "a" in z.files else None}
+                    "config": str(z["config"]), "a": z["a"] if "a" in z.files else None, "records": None}
+            if "rec_valid" in z.files:
+                n_rec = sum(1 for f in z.files if f.startswith("rec_") and f != "rec_valid")
+                data["records"] = ([z[f"rec_{i}"] for i in range(n_rec)], z["rec_valid"])
     except Exception as exc:  # truncated / foreign file
         raise InputError(f"--resume {directory}: {CHECKPOINT} is unreadable ({type(exc).__name__}: {exc})") from None
     if not data["meta"].get("resumable", True):

@@ -200,12 +200,14 @@ def steady_window_for(reducer, t_end: float, input_speed: float | None = None,
 
 
 def results_from_states(model, t, q, v, dt: float, status: str = "completed", timing: dict | None = None,
-                        chunk: int = 1000, cls: type[Results] = Results) -> Results:
+                        chunk: int = 1000, cls: type[Results] = Results, records: dict | None = None) -> Results:
     """Build :class:`Results` (or the subclass ``cls``) from recorded states (T,), (T, n), (T, n).
 
     The variables are the model's declared outputs (:func:`flexrv.model.outputs.model_outputs`,
     read by name: this module never sees the state layout or the member names), plus
-    TE = (theta_out - theta_in / i) in arcsec and the input and output power."""
+    TE = (theta_out - theta_in / i) in arcsec and the input and output power. ``records``:
+    the compiled groups' records the integrator computed at the T samples
+    (:meth:`flexrv.model.kernels.HistoryRecorder.records`), used where valid."""
     from flexrv.geometry.kinematics import member_speeds
     from flexrv.model.outputs import model_outputs
 
@@ -214,8 +216,11 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     if len(t) > 1:  # keep the last record of any repeated time (adaptive step reduction)
         keep = np.r_[np.diff(t) > 0, True]
         t, q, v = t[keep], q[keep], v[keep]
+        if records is not None:
+            records = {"valid": np.asarray(records["valid"])[keep],
+                       "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
     data: dict[str, xr.Variable] = {}
-    for name, o in model_outputs(model, t, q, v, chunk=chunk).items():
+    for name, o in model_outputs(model, t, q, v, chunk=chunk, records=records).items():
         data[name] = _var(o.values, o.dims, o.units, o.long_name)
         if name == "omega_out":
             th_in, th_out = data["theta_in"].values, data["theta_out"].values
