@@ -832,3 +832,31 @@ def ring_modal_amplitudes(psi, g_local, table, zsign, compliance_diag):
     for k in range(m):
         out[k] *= compliance_diag[k]
     return out
+
+
+@njit(cache=True)
+def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                state, recs):
+    """:func:`row_kernel` over a recorded history (the outputs pass, one compiled loop):
+    element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
+    per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
+    condensed ring's local solve warm-started from the previous sample (as one
+    call per sample would)."""
+    nt = qs.shape[0]
+    out = np.zeros(qs.shape)
+    for i in range(nt):
+        f, _, _ = row_kernel(qs[i], vts[i], ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i,
+                             comp_o, ws_i, ws_o, state, False, recs[i])
+        out[i] = f
+    return out
+
+
+@njit(cache=True)
+def ring_modal_history(psi, g_local, table, zsign, compliance_diag):
+    """:func:`ring_modal_amplitudes` of every sample: psi (T, Z), g_local (T, Z, 3)
+    -> (T, m)."""
+    nt = psi.shape[0]
+    out = np.empty((nt, table.shape[2]))
+    for i in range(nt):
+        out[i] = ring_modal_amplitudes(psi[i], g_local[i], table, zsign, compliance_diag)
+    return out
