@@ -132,15 +132,7 @@ def _law_speed(speed, law):
 
 
 @njit(cache=True)
-def _normal_load(delta, rate, speed, law):
-    """(Q, dQ/d delta, dQ/d rate, film h_c [m]) of the EHL-corrected / dry law at the
-    entrainment speed ``speed`` (:func:`_law_speed` then :func:`_normal_load_at`)."""
-    hu, lu, h_floor = _law_speed(speed, law)
-    return _normal_load_at(delta, rate, hu, lu, h_floor, law)
-
-
-@njit(cache=True)
-def _normal_load_at(delta, rate, hu, lu, h_floor, law):
+def _normal_load(delta, rate, hu, lu, h_floor, law):
     """(Q, dQ/d delta, dQ/d rate, film h_c [m]) of the EHL-corrected / dry law
     (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2; the film is
     0 out of contact, as in flexrv.ehl.law.EHLForce.film) with the speed terms
@@ -184,19 +176,13 @@ def _normal_load_at(delta, rate, hu, lu, h_floor, law):
 
 
 @njit(cache=True)
-def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
-    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w:
+def _contact(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law):
+    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w,
+    with the law's speed terms (hu, lu, h_floor) of :func:`_law_speed`:
     (|e|, unit normal, Q, dQ/ddelta, dQ/drate, film h_c); the force on the ball is -Q n."""
-    hu, lu, h_floor = _law_speed(speed, law)
-    return _contact_at(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law)
-
-
-@njit(cache=True)
-def _contact_at(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law):
-    """:func:`_contact` with the law's speed terms (:func:`_law_speed`) given."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
-    q, dq, c, h = _normal_load_at(length - offset, nx * wx + ny * wy + nz * wz, hu, lu, h_floor, law)
+    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, hu, lu, h_floor, law)
     return length, nx, ny, nz, q, dq, c, h
 
 
@@ -364,7 +350,7 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
         for k in range(m):
             y[k] = 0.0
         for j in range(nz):
-            length, nx, ny, nzz, q, d, c, hf = _contact_at(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
+            length, nx, ny, nzz, q, d, c, hf = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
                                                            e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
                                                            hu, lu, h_floor, law)
             loads[j], dq[j], cd[j], lengths[j], films[j] = q, d, c, length, hf
@@ -481,9 +467,10 @@ def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, l
         else:
             state[2] += its
     else:
+        hu, lu, h_floor = _law_speed(speed, law)
         for j in range(e0.shape[0]):
             lengths[j], normals[j, 0], normals[j, 1], normals[j, 2], loads[j], dq[j], cd[j], films[j] = _contact(
-                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, speed, law)
+                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law)
 
 
 @njit(cache=True)
