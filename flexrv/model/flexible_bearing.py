@@ -45,7 +45,7 @@ from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
 from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
-                                         ring_modal_amplitudes, ring_modal_history, row_force_kernel, row_history,
+                                         ring_modal_amplitudes, row_force_kernel, row_history,
                                          row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
@@ -354,8 +354,8 @@ def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEv
         return np.asarray(q)[si if label == "inner" else so].copy()
     st = getattr(ev, label)
     zs = -1.0 if ring.mirror else 1.0
-    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth), np.ascontiguousarray(st.ring_load),
-                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))
+    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth)[None], np.ascontiguousarray(st.ring_load)[None],
+                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))[0]
 
 
 # ---------------------------------------------------------------------------- Exudyn
@@ -771,7 +771,7 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
             if _is_condensed(ring):
                 zs = -1.0 if ring.mirror else 1.0
                 g_local = np.ascontiguousarray(recs[:, :, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]])
-                modal[label][k][:] = ring_modal_history(np.ascontiguousarray(recs[:, :, _REC[f"psi_{label}"]]),
+                modal[label][k][:] = ring_modal_amplitudes(np.ascontiguousarray(recs[:, :, _REC[f"psi_{label}"]]),
                                                         g_local, ring.table, zs,
                                                         np.ascontiguousarray(ring.compliance_diag))
             else:
