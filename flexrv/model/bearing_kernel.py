@@ -828,15 +828,25 @@ def ring_modal_amplitudes(psi, g_local, table, zsign, compliance_diag):
     """Modal amplitudes q = K^-1 sum_j B(psi_j)^T g_j of a condensed ring from its
     contact loads g in the ring's own Cartesian frame at azimuths psi, for every
     sample of a history: psi (T, Z), g_local (T, Z, 3) -> (T, m)
-    (K diagonal: ``compliance_diag`` = 1 / diag K)."""
-    m = table.shape[2]
-    bas = np.empty((3, m))
+    (K diagonal: ``compliance_diag`` = 1 / diag K). B^T g is accumulated tap by
+    tap of the periodic cubic (:func:`_taps`) from the load's cylindrical
+    components (the transpose of :func:`_basis`)."""
+    ng, m = table.shape[0], table.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
     out = np.zeros((psi.shape[0], m))
     for i in range(psi.shape[0]):
         for j in range(psi.shape[1]):
-            _basis(table, zsign, psi[i, j], bas)
-            for k in range(m):
-                out[i, k] += bas[0, k] * g_local[i, j, 0] + bas[1, k] * g_local[i, j, 1] + bas[2, k] * g_local[i, j, 2]
+            ph = psi[i, j]
+            _taps(ph, ng, idx, w)
+            c, s = math.cos(ph), math.sin(ph)
+            gx, gy = g_local[i, j, 0], g_local[i, j, 1]
+            gr, gt, gz = c * gx + s * gy, -s * gx + c * gy, zsign * g_local[i, j, 2]
+            for t in range(4):
+                ar, at, az = w[t] * gr, w[t] * gt, w[t] * gz
+                row = table[idx[t]]
+                for k in range(m):
+                    out[i, k] += ar * row[0, k] + at * row[1, k] + az * row[2, k]
         for k in range(m):
             out[i, k] *= compliance_diag[k]
     return out
