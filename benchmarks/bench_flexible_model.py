@@ -38,7 +38,12 @@ rv40e  54.0, 51.7 -> 34.0, 34.5  -134.3837 / -134.3837"             0.3110 / 0.3
 =====  ======================  ===================================  ============================
 
 (rv40e: max inner ball load 19.80 N and ring deflection 0.0198 um both, 3.66/3.67
-Newton iterations per step, 1029/1015 Jacobians.) Every row call agrees with the
+Newton iterations per step, 1029/1015 Jacobians.) Final code (one-pass modal
+amplitudes added), ``--models balls,flexible``, paired again: flexible rv221
+27.8, 25.1 -> 16.4, 14.7; rv40e 55.1, 55.3 -> 31.7, 33.2 s/s (same TE as above);
+the ball model (rigid rings, whose contacts share the normal law's speed terms)
+rv221 12.5, 11.8 -> 8.8, 8.8 and rv40e 16.5, 16.5 -> 13.6, 13.6 s/s (rv40e TE mean
+-134.3837 / -134.3836", p-p 0.3106" both, max ball load 20.49 N both). Every row call agrees with the
 previous kernel within 2e-13 relative (ball loads, forces; Jacobian 5e-15), but
 the integrator's Newton tolerance (1e-3 relative) carries such differences into
 the trajectory: rv221 at its preset 20 N m has two steady responses chosen by
