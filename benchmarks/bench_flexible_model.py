@@ -26,11 +26,39 @@ rv221  64.8 -> 27.1 s/s     650 -> 174         -20.4392 / -20.4446"    2.9228 / 
 rv40e  363.3 -> 55.3 s/s    989 -> 249         -131.4744 / -131.4744"  0.3147 / 0.3154"
 =====  ===================  =================  ======================  ======================
 
-(max inner ball load 105.30 / 107.43 N and 19.74 / 19.75 N, outer-ring
-deflection 0.0448 / 0.0454 um and 0.0197 / 0.0197 um). The goal is not reached:
-the bearing rows are ~60 % of the remaining solve (two row residuals of ~115 us
-(rv221) / ~255 us (rv40e) per Newton iteration, Jacobians 0.7 / 1.4 ms per row,
-0.3-1 per step).
+Row-kernel speed (issue 15, commits after fa2019e), paired runs of this script on
+the same machine, base = fa2019e (tapered-roller crank supports), CPU of run()
+per simulated s, two runs each:
+
+=====  ======================  ===================================  ============================
+preset CPU before -> after     TE mean before / after               TE p-p before / after
+=====  ======================  ===================================  ============================
+rv221  25.2, 25.3 -> 16.6, 16.3  -20.2155 / -20.2978"               3.7491 / 3.2266"
+rv40e  54.0, 51.7 -> 34.0, 34.5  -134.3837 / -134.3837"             0.3110 / 0.3110"
+=====  ======================  ===================================  ============================
+
+(rv40e: max inner ball load 19.80 N and ring deflection 0.0198 um both, 3.66/3.67
+Newton iterations per step, 1029/1015 Jacobians.) Final code (one-pass modal
+amplitudes added), ``--models balls,flexible``, paired again: flexible rv221
+27.8, 25.1 -> 16.4, 14.7; rv40e 55.1, 55.3 -> 31.7, 33.2 s/s (same TE as above);
+the ball model (rigid rings, whose contacts share the normal law's speed terms)
+rv221 12.5, 11.8 -> 8.8, 8.8 and rv40e 16.5, 16.5 -> 13.6, 13.6 s/s (rv40e TE mean
+-134.3837 / -134.3836", p-p 0.3106" both, max ball load 20.49 N both). Every row call agrees with the
+previous kernel within 2e-13 relative (ball loads, forces; Jacobian 5e-15), but
+the integrator's Newton tolerance (1e-3 relative) carries such differences into
+the trajectory: rv221 at its preset 20 N m has two steady responses chosen by
+tolerance-level differences of the start-up (tests/test_time_step.py), so its
+TE p-p moves between runs of equivalent code (3.04-3.75"). Loaded, where the
+response is unique (rv221 at 3000 N m, same script's settings): TE mean
+-82.644858 / -82.644868", p-p 2.7197 / 2.7202", max inner ball load 105.1828 /
+105.1905 N. Where the time goes (cProfile, rv40e, 0.1 s): row residuals
+~25 % (~115 us per row call, was ~255), row Jacobians ~25 % (~0.95 ms per row,
+was ~1.4; 1 per 3 steps), Exudyn's own work (sparse LU, assembly) ~20 %, the
+fused kernel of the other groups ~6 %, the outputs pass ~9 %; rv221: row residuals
+~42 % (~55 us per row call, was ~110). Fewer Jacobians do not pay: Exudyn's
+modifiedNewtonContractivity 0.8 (0.95 with 12 modified iterations) cut them to
+725 (432) but raised the iterations to 5.6 (6.6) per step: 39.8 (36.4) against
+34.2 s/s. The goal (15 s/s) is not reached.
 """
 
 from __future__ import annotations

@@ -46,7 +46,7 @@ REFERENCE = {
     },
     "flexible_rv221": {
         "values": {"te_mean_arcsec": -18.900992, "te_pp_arcsec": 5.5207166, "max_pin_force_N": 67.997198, "max_ball_load_N": 117.0556},
-        "rtol": {"te_mean_arcsec": 1e-3, "te_pp_arcsec": 0.1, "max_pin_force_N": 1e-3, "max_ball_load_N": 1e-3},
+        "rtol": {"te_mean_arcsec": 3e-3, "te_pp_arcsec": 0.1, "max_pin_force_N": 1e-3, "max_ball_load_N": 1e-3},
         "notes": ["2026-11-23: pinned (flexible main-bearing rings, 0.02-0.04 s, inside the ramps); rv221's TE "
                   "p-p amplifies round-off (issue 15: +-0.4 arcsec at the default Newton tolerance), hence 10 %",
                   "2026-11-24: crank supports became roller-resolved preloaded tapered-roller pairs in series with the crank's Timoshenko bending (issue 14, branch stiff) instead of one linear 5e8 N/m spring per bearing; inside the load ramp the stiffer, preloaded supports change the transient: TE mean -19.862 -> -19.662 arcsec, p-p 3.19 -> 2.71, max pin force 68.5 -> 83.8 N, max ball load 110.6 -> 112.7 N",
@@ -59,7 +59,13 @@ REFERENCE = {
                   "2026-11-24: friction on in the presets (issue 14, branch fric: pins mu_eff 0.05, needles 0.0025, "
                   "v_reg 0.01 mm/s); inside the load ramp of this start-up window the friction changes the transient: "
                   "TE mean -19.296 -> -18.982 arcsec, p-p 3.28 -> 4.99, max pin force 104.0 -> 111.5 N, ball load "
-                  "113.4 -> 115.1 N"],
+                  "113.4 -> 115.1 N",
+                  "2026-11-24: row-kernel speed-ups (issue 15, branch flexspeed): every row call agrees with the previous "
+                  "kernel within 2e-13 relative, but this window inside the load ramp amplifies round-off in the TE mean "
+                  "(the disc's position in the first-stage backlash at 20 N m): TE mean -19.2958 -> -19.2590 arcsec, p-p "
+                  "3.279387 -> 3.279394, max pin force 104.0122 -> 104.0118 N, ball load 113.39841 -> 113.39844 N; the same "
+                  "code with the condensation's vectorised sums off (another round-off pattern) gives -19.2689 arcsec, so "
+                  "the TE mean tolerance is 3e-3 (the measured spread 1.9e-3)"],
     },
 }
 

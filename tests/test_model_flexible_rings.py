@@ -281,3 +281,129 @@ def test_condensed_row_jacobian_vs_finite_difference(rings, ehl):
         jv = _fd(row, q, qt, 1, 1e-6)
         keep = np.arange(n) != 5  # the film's entrainment-speed dependence on the frame spin is not in the tangent
         assert np.abs(ev.jac_v - jv)[:, keep].max() < 0.02 * np.abs(jv[:, keep]).max()
+
+
+def _loaded_history(rv, out, n_samples=12, ehl="hamrock_dowson"):
+    """Rows with both rings condensed and a short history of element states around
+    :cite:`seed001`'s loaded static state (sub-um ball and frame perturbations, a
+    turning frame): (rows, [(q (T, n), q_t (T, n)) per row])."""
+    rows, _, _, qs = _static_rig(rv, SEED001_FORCE, rows=_flexible_rows(rv, out, ehl=ehl), coordinates=True)
+    rng = np.random.default_rng(11)
+    hist = []
+    for q0 in qs:
+        q = q0 + rng.normal(scale=2e-8, size=(n_samples, q0.size))
+        q[:, 5] = q0[5] + 0.01 * np.arange(n_samples)
+        qt = rng.normal(scale=1e-4, size=q.shape)
+        qt[:, 5] = 1.2
+        hist.append((q, qt))
+    return rows, hist
+
+
+def test_output_pass_equals_per_sample_kernel_calls(rings):
+    """The outputs pass (issue 15: one compiled loop per row over the samples,
+    :func:`flexrv.model.bearing_kernel.row_history`) returns exactly (bit for bit)
+    the forces and per-ball records of one :func:`row_kernel` call per sample in
+    the same order (same warm starts of the condensed rings' local solves); and
+    the condensed rings' modal amplitudes recovered from the records
+    (:func:`ring_modal_amplitudes`) equal K^-1 sum_j B(psi_j)^T g_j computed here
+    with the reduced body's own raceway basis (numpy,
+    :meth:`flexrv.fem.body.ReducedBody.raceway_matrix`) within 1e-10 of their
+    largest entry."""
+    from flexrv.model.bearing_kernel import N_RECORD, RECORD_FIELDS, ring_modal_amplitudes, row_history, row_kernel
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    rv, out = rings
+    rows, hist = _loaded_history(rv, out)
+    col = {name: i for i, name in enumerate(RECORD_FIELDS)}
+    for row, (q, qt) in zip(rows, hist):
+        inputs = kernel_inputs(row)
+        ws = [inputs[10].copy(), inputs[11].copy()]
+        recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
+        forces = row_history(q, qt, *inputs, recs)
+        inputs[10][:], inputs[11][:] = ws
+        for i in range(q.shape[0]):
+            rec = np.zeros((row.ball_count, N_RECORD))
+            f, _, _ = row_kernel(q[i], qt[i], *inputs, False, rec)
+            np.testing.assert_array_equal(forces[i], f)
+            np.testing.assert_array_equal(recs[i], rec)
+        assert recs[:, :, col["load_outer"]].max() > 1000.0
+        for label in ("inner", "outer"):
+            ring = getattr(row, label)
+            s = label[0]
+            psi = recs[:, :, col[f"psi_{label}"]]
+            g = np.ascontiguousarray(recs[:, :, [col[f"g{s}x"], col[f"g{s}y"], col[f"g{s}z"]]])
+            got = ring_modal_amplitudes(np.ascontiguousarray(psi), g, ring.table, -1.0 if ring.mirror else 1.0,
+                                        np.ascontiguousarray(ring.compliance_diag))
+            ref = np.stack([ring.compliance_diag * np.einsum("jcm,jc->m", ring.groove_basis(psi[i]), g[i])
+                            for i in range(psi.shape[0])])
+            np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+def test_condensed_tangent_equals_direct_solve():
+    """The condensed contact stiffness and damping of :func:`_contact_matrix`
+    (issue 15: one inverse of I - K C, then block products with K and the
+    normals) equal the direct solutions (I - K C)^-1 K and -(I - K C)^-1 N diag(c)
+    N^T (numpy.linalg.solve) within 1e-12 of their largest entries, for 9 balls
+    with random symmetric contact blocks, one unloaded (zero block and damping),
+    and a random symmetric positive semi-definite compliance C = W W^T of rank
+    below 3Z."""
+    from flexrv.model.bearing_kernel import _contact_matrix
+
+    rng = np.random.default_rng(5)
+    nz, m = 9, 20
+    n = rng.normal(size=(nz, 3))
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    cd = rng.uniform(10.0, 100.0, nz)
+    blocks = np.zeros((3 * nz, 3))
+    for j in range(nz):
+        a = rng.normal(size=(3, 3))
+        blocks[3 * j:3 * j + 3] = -1e8 * (a @ a.T + 3.0 * np.outer(n[j], n[j]))
+    blocks[6:9] = 0.0
+    cd[2] = 0.0
+    damp = np.vstack([-c * np.outer(v, v) for c, v in zip(cd, n)])
+    w = 1e-5 * rng.normal(size=(3 * nz, m))
+    cmat = w @ w.T
+    kq, kv = _contact_matrix(blocks, damp, cmat, True, n, cd)
+    k = np.zeros((3 * nz, 3 * nz))
+    nn = np.zeros((3 * nz, nz))
+    for j in range(nz):
+        k[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks[3 * j:3 * j + 3]
+        nn[3 * j:3 * j + 3, j] = n[j]
+    a = np.eye(3 * nz) - k @ cmat
+    ref_q = np.linalg.solve(a, k)
+    ref_v = -np.linalg.solve(a, nn) @ np.diag(cd) @ nn.T
+    assert np.abs(k @ cmat).max() > 0.1  # the ring compliance matters
+    np.testing.assert_allclose(kq, ref_q, rtol=0, atol=1e-12 * np.abs(ref_q).max())
+    np.testing.assert_allclose(kv, ref_v, rtol=0, atol=1e-12 * np.abs(ref_v).max())
+
+
+@pytest.mark.parametrize("speed", [0.0, 0.08, 0.4])
+def test_kernel_normal_law_equals_ehl_law(speed):
+    """The row kernel's normal law (issue 15: speed terms once per ring and call,
+    :func:`_law_speed`; the film Newton stops at its bit-exact fixed point;
+    s^1.5 as s sqrt(s)) equals EHLPointLaw(mode="hamrock_dowson") of
+    flexrv.ehl.law (numpy, all ``iterations`` Newton steps) within 1e-12 relative
+    in load and film, and its approach derivative dQ/d delta within 1e-5 of
+    central differences of that law (step 1e-12 m: round-off limited), from out of contact through the load
+    floor to 5 um approach, with approach rates of both signs (contact damping).
+    At speed 0 the law is dry Hertz."""
+    from flexrv.model.bearing_kernel import _law_speed, _normal_load, law_parameters
+
+    rv = load("rv221")
+    law = rows_from_design(rv, ehl="hamrock_dowson")[0].law_inner
+    p = law_parameters(law)
+    delta = np.concatenate([np.linspace(-2e-6, 1e-8, 7), np.geomspace(1e-9, 5e-6, 30)])
+    rate = np.where(np.arange(delta.size) % 2 == 0, 1e-4, -2e-4)
+    terms = _law_speed(speed, p)
+    got = np.array([_normal_load(d, r, *terms, p) for d, r in zip(delta, rate)])
+    ref = law(delta, rate, speed)
+    assert (ref.force > 0).sum() > 25 and (ref.force == 0).sum() >= 5
+    np.testing.assert_allclose(got[:, 0], ref.force, rtol=1e-12, atol=1e-12 * ref.force.max())
+    if speed > 0:
+        assert ref.film.max() > 1e-8
+        loaded = ref.force > 0
+        np.testing.assert_allclose(got[loaded, 3], ref.film[loaded], rtol=1e-12)
+    h = 1e-12
+    loaded = delta > 1e-7
+    d_ref = (law(delta + h, rate, speed).force - law(delta - h, rate, speed).force) / (2 * h)
+    np.testing.assert_allclose(got[loaded, 1], d_ref[loaded], rtol=1e-5)

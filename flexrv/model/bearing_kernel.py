@@ -79,6 +79,11 @@ N_RECORD = len(RECORD_FIELDS)
 CONDENSE_TOL = 1e-13
 CONDENSE_MAXIT = 50
 
+#: LLVM flags of the condensation's dense loops: reassociated sums (vectorised dot
+#: products over the ring's modes) and fused multiply-adds; changes only the
+#: round-off (measured <= 1e-13 relative on the ball loads), no NaN/Inf assumptions
+_REASSOC = {"reassoc", "contract"}
+
 
 def law_parameters(law) -> np.ndarray | None:
     """Kernel parameters of a normal law (see :data:`LAW_FIELDS`; for an EHL law in
@@ -114,23 +119,36 @@ def _film(q, hu, lexp, lu, law):
 
 
 @njit(cache=True)
-def _normal_load(delta, rate, speed, law):
+def _law_speed(speed, law):
+    """Speed terms of the law, shared by all contacts of a row at one entrainment
+    speed u [m/s]: (h at 1 N and u [m] (0: dry / at rest), ln u, film at the load
+    floor [m])."""
+    if not (law[1] > 0.0 and speed > 0.0):
+        return 0.0, 0.0, 0.0
+    hu = law[1] * speed**law[3]
+    lu = math.log(speed)
+    h_floor, _ = _film(law[4], hu, law[2], lu, law)
+    return hu, lu, h_floor
+
+
+@njit(cache=True)
+def _normal_load(delta, rate, hu, lu, h_floor, law):
     """(Q, dQ/d delta, dQ/d rate, film h_c [m]) of the EHL-corrected / dry law
     (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2; the film is
-    0 out of contact, as in flexrv.ehl.law.EHLForce.film)."""
-    k, h_unit, lexp, sexp, floor, c_max, depth, iters = (law[0], law[1], law[2], law[3], law[4], law[5],
-                                                         law[6], int(law[7]))
-    hu = h_unit * speed**sexp if h_unit > 0.0 and speed > 0.0 else 0.0
+    0 out of contact, as in flexrv.ehl.law.EHLForce.film) with the speed terms
+    (hu, lu, h_floor) of :func:`_law_speed`. The film offset s = delta + h(k s^1.5)
+    takes at most ``iterations`` Newton steps; they stop early at a fixed point
+    (s unchanged to the bit), after which every further step would repeat the
+    last one exactly — so the result equals that of all the steps."""
+    k, lexp, floor, c_max, depth, iters = law[0], law[2], law[4], law[5], law[6], int(law[7])
     dphi = 1.0
     h = 0.0
     if hu == 0.0:
         s = max(delta, 0.0)
     else:
-        lu = math.log(speed)
-        h_floor, _ = _film(floor, hu, lexp, lu, law)
         s = max(delta + h_floor, 0.0)
         for it in range(iters + 1):
-            q = k * s**1.5
+            q = k * s * math.sqrt(s)
             h, slope = _film(max(q, floor), hu, lexp, lu, law)
             dphi = 1.0
             if q > floor:
@@ -138,10 +156,13 @@ def _normal_load(delta, rate, speed, law):
             dphi = max(dphi, 1e-3)
             if it == iters:
                 break
-            s = max(s - (s - delta - h) / dphi, 0.0)
+            s_next = max(s - (s - delta - h) / dphi, 0.0)
+            if s_next == s:
+                break
+            s = s_next
     if s <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
-    force = k * s**1.5
+    force = k * s * math.sqrt(s)
     dforce = 1.5 * k * math.sqrt(s) / dphi
     c = 0.0
     if c_max > 0.0:
@@ -155,12 +176,13 @@ def _normal_load(delta, rate, speed, law):
 
 
 @njit(cache=True)
-def _contact(ex, ey, ez, wx, wy, wz, offset, speed, law):
-    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w:
+def _contact(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law):
+    """Ball-groove contact from the ball-minus-centre vector e and relative velocity w,
+    with the law's speed terms (hu, lu, h_floor) of :func:`_law_speed`:
     (|e|, unit normal, Q, dQ/ddelta, dQ/drate, film h_c); the force on the ball is -Q n."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
-    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, speed, law)
+    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, hu, lu, h_floor, law)
     return length, nx, ny, nz, q, dq, c, h
 
 
@@ -299,7 +321,7 @@ def _split_workspace(ws, nz, m):
     return u, valid, sq, nf, p, smat
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=_REASSOC)
 def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, lengths, films):
     """Contact deflections u of a condensed ring, everything in each contact's
     ring-cylindrical components: u_j = sum_k C_jk g_k(e0_k - u_k), C_jk = W_j W_k^T
@@ -323,13 +345,14 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
     y = np.empty(m)
     rhs = np.empty(nz)
     err_prev = 0.0
+    hu, lu, h_floor = _law_speed(speed, law)
     for it in range(CONDENSE_MAXIT + 1):
         for k in range(m):
             y[k] = 0.0
         for j in range(nz):
             length, nx, ny, nzz, q, d, c, hf = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
-                                                        e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
-                                                        speed, law)
+                                                           e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
+                                                           hu, lu, h_floor, law)
             loads[j], dq[j], cd[j], lengths[j], films[j] = q, d, c, length, hf
             normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
             if q != 0.0:
@@ -444,9 +467,10 @@ def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, l
         else:
             state[2] += its
     else:
+        hu, lu, h_floor = _law_speed(speed, law)
         for j in range(e0.shape[0]):
             lengths[j], normals[j, 0], normals[j, 1], normals[j, 2], loads[j], dq[j], cd[j], films[j] = _contact(
-                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, speed, law)
+                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law)
 
 
 @njit(cache=True)
@@ -746,7 +770,7 @@ def _contact_matrix(blocks_q, blocks_v, cmat, condensed, normals, cd):
     the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D
     (K block diagonal, so I - K C is formed block row by block row; the damping
     blocks are -c n n^T, so (I - K C)^-1 D = -[(I - K C)^-1 N] diag(c) N^T: one
-    LU with 3Z + Z right-hand sides)."""
+    inverse of I - K C, then block products)."""
     n3 = blocks_q.shape[0]
     nz = n3 // 3
     kq = np.zeros((n3, n3))
@@ -757,26 +781,28 @@ def _contact_matrix(blocks_q, blocks_v, cmat, condensed, normals, cd):
     if not condensed:
         return kq, kv
     m = np.empty((n3, n3))
-    rhs = np.zeros((n3, n3 + nz))
     for j in range(nz):
         blk = blocks_q[3 * j:3 * j + 3]
         m[3 * j:3 * j + 3] = -(blk @ cmat[3 * j:3 * j + 3])
         for a in range(3):
             m[3 * j + a, 3 * j + a] += 1.0
+    # (I - K C)^-1 once (LU + inverse: ~half the work of solving for the 4Z right-hand
+    # sides [K, N]), then the block-diagonal products with K and N
+    inv = np.linalg.inv(m)
+    kq = np.empty((n3, n3))
+    for i in range(n3):
+        for j in range(nz):
+            c0 = 3 * j
+            x0, x1, x2 = inv[i, c0], inv[i, c0 + 1], inv[i, c0 + 2]
             for b in range(3):
-                rhs[3 * j + a, 3 * j + b] = blk[a, b]
-            rhs[3 * j + a, n3 + j] = normals[j, a]
-    sol = np.linalg.solve(m, rhs)
-    kq = np.ascontiguousarray(sol[:, :n3])
-    for j in range(n3):
-        for k in range(nz):
-            x = -sol[j, n3 + k] * cd[k]
-            if x != 0.0:
+                kq[i, c0 + b] = x0 * blocks_q[c0, b] + x1 * blocks_q[c0 + 1, b] + x2 * blocks_q[c0 + 2, b]
+            sn = -(x0 * normals[j, 0] + x1 * normals[j, 1] + x2 * normals[j, 2]) * cd[j]
+            if sn != 0.0:
                 for b in range(3):
-                    kv[j, 3 * k + b] = x * normals[k, b]
+                    kv[i, c0 + b] = sn * normals[j, b]
             else:
                 for b in range(3):
-                    kv[j, 3 * k + b] = 0.0
+                    kv[i, c0 + b] = 0.0
     return kq, kv
 
 
@@ -790,17 +816,46 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
+def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                state, recs):
+    """:func:`row_kernel` over a recorded history (the outputs pass, one compiled loop):
+    element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
+    per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
+    condensed ring's local solve warm-started from the previous sample (as one
+    call per sample would)."""
+    nt = qs.shape[0]
+    out = np.zeros(qs.shape)
+    for i in range(nt):
+        f, _, _ = row_kernel(qs[i], vts[i], ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i,
+                             comp_o, ws_i, ws_o, state, False, recs[i])
+        out[i] = f
+    return out
+
+
+@njit(cache=True)
 def ring_modal_amplitudes(psi, g_local, table, zsign, compliance_diag):
     """Modal amplitudes q = K^-1 sum_j B(psi_j)^T g_j of a condensed ring from its
-    contact loads g (Z, 3) in the ring's own Cartesian frame at azimuths psi (Z,)
-    (K diagonal: ``compliance_diag`` = 1 / diag K)."""
-    m = table.shape[2]
-    bas = np.empty((3, m))
-    out = np.zeros(m)
-    for j in range(psi.shape[0]):
-        _basis(table, zsign, psi[j], bas)
+    contact loads g in the ring's own Cartesian frame at azimuths psi, for every
+    sample of a history: psi (T, Z), g_local (T, Z, 3) -> (T, m)
+    (K diagonal: ``compliance_diag`` = 1 / diag K). B^T g is accumulated tap by
+    tap of the periodic cubic (:func:`_taps`) from the load's cylindrical
+    components (the transpose of :func:`_basis`)."""
+    ng, m = table.shape[0], table.shape[2]
+    idx = np.empty(4, np.int64)
+    w = np.empty(4)
+    out = np.zeros((psi.shape[0], m))
+    for i in range(psi.shape[0]):
+        for j in range(psi.shape[1]):
+            ph = psi[i, j]
+            _taps(ph, ng, idx, w)
+            c, s = math.cos(ph), math.sin(ph)
+            gx, gy = g_local[i, j, 0], g_local[i, j, 1]
+            gr, gt, gz = c * gx + s * gy, -s * gx + c * gy, zsign * g_local[i, j, 2]
+            for t in range(4):
+                ar, at, az = w[t] * gr, w[t] * gt, w[t] * gz
+                row = table[idx[t]]
+                for k in range(m):
+                    out[i, k] += ar * row[0, k] + at * row[1, k] + az * row[2, k]
         for k in range(m):
-            out[k] += bas[0, k] * g_local[j, 0] + bas[1, k] * g_local[j, 1] + bas[2, k] * g_local[j, 2]
-    for k in range(m):
-        out[k] *= compliance_diag[k]
+            out[i, k] *= compliance_diag[k]
     return out

@@ -45,7 +45,8 @@ from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
 from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
-                                         ring_modal_amplitudes, row_force_kernel, row_kernel)
+                                         ring_modal_amplitudes, row_force_kernel, row_history,
+                                         row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -353,8 +354,8 @@ def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEv
         return np.asarray(q)[si if label == "inner" else so].copy()
     st = getattr(ev, label)
     zs = -1.0 if ring.mirror else 1.0
-    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth), np.ascontiguousarray(st.ring_load),
-                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))
+    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth)[None], np.ascontiguousarray(st.ring_load)[None],
+                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))[0]
 
 
 # ---------------------------------------------------------------------------- Exudyn
@@ -689,22 +690,20 @@ class BallBearingGroup(ForceGroup):
         return f
 
     def evaluate(self, t, q, v, want_outputs: bool = False):
-        """Generalized forces for one state (n,) or a history (T, n)."""
+        """Generalized forces for one state (n,) or a history (T, n) (one compiled
+        loop per row over the samples, :func:`flexrv.model.bearing_kernel.row_history`)."""
         q = np.asarray(q, dtype=float)
         v = np.asarray(v, dtype=float)
         if q.ndim == 1:
             return self._force(q, v), None
         forces = np.zeros_like(q)
         history = []
-        for i in range(q.shape[0]):
-            evals = []
-            for k, row in enumerate(self.rows):
-                qe, ve, idx = self._element_state(q[i], v[i], k)
-                ev = evaluate_row(row, qe, ve, jacobian=False)
-                forces[i, idx] += ev.force
-                if want_outputs:
-                    evals.append((ev, qe))
-            history.append(evals)
+        for k, row in enumerate(self.rows):
+            qe, ve, idx = self._element_state(q, v, k)
+            recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
+            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), *kernel_inputs(row),
+                                          recs)
+            history.append((recs, qe))
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
 
@@ -743,7 +742,7 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     EHL h_c(Q, u) of the contact law at the entrainment speed of the carrier's
     rotation; the pressure is the Hertz p_max of the load (the EHL pressure spike
     is not resolved by the law, see :mod:`flexrv.ehl.law`).
-    ``history[i][k]`` is (row evaluation, element coordinates) of sample i, row k.
+    ``history[k]`` is (per-ball records (T, Z, N_RECORD), element coordinates (T, n)) of row k.
     """
     from flexrv.contact.hertz import point_contact
 
@@ -755,16 +754,29 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     defl = {"inner": np.zeros((n_t, n_r)), "outer": np.zeros((n_t, n_r))}
     modal = {label: [np.zeros((n_t, getattr(row, label).stiffness.shape[0])) if getattr(row, label) is not None
                      else None for row in rows] for label in ("inner", "outer")}
-    for i, evals in enumerate(history):
-        for k, (row, (ev, qe)) in enumerate(zip(rows, evals)):
-            load_i[i, k], load_o[i, k], angle[i, k] = ev.inner.load, ev.outer.load, ev.inner.contact_angle
-            for label in ("inner", "outer"):
-                if getattr(row, label) is None:
-                    continue
-                st = getattr(ev, label)
-                j = int(np.argmax(st.load))
-                defl[label][i, k] = float(st.displacement[j] @ st.normal[j])
-                modal[label][k][i] = ring_modal_coordinates(row, label, qe, ev)
+    rt = np.arange(n_t)
+    for k, (row, (recs, qe)) in enumerate(zip(rows, history)):
+        load_i[:, k], load_o[:, k] = recs[:, :, _REC["load_inner"]], recs[:, :, _REC["load_outer"]]
+        angle[:, k] = np.arctan2(np.abs(recs[:, :, _REC["niz"]]), np.hypot(recs[:, :, _REC["nix"]],
+                                                                        recs[:, :, _REC["niy"]]))
+        for label in ("inner", "outer"):
+            ring = getattr(row, label)
+            if ring is None:
+                continue
+            s = label[0]
+            normal = recs[:, :, [_REC[f"n{s}x"], _REC[f"n{s}y"], _REC[f"n{s}z"]]]
+            disp = recs[:, :, [_REC[f"u{s}x"], _REC[f"u{s}y"], _REC[f"u{s}z"]]]
+            j = np.argmax(recs[:, :, _REC[f"load_{label}"]], axis=1)
+            defl[label][:, k] = np.einsum("tc,tc->t", disp[rt, j], normal[rt, j])
+            if _is_condensed(ring):
+                zs = -1.0 if ring.mirror else 1.0
+                g_local = np.ascontiguousarray(recs[:, :, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]])
+                modal[label][k][:] = ring_modal_amplitudes(np.ascontiguousarray(recs[:, :, _REC[f"psi_{label}"]]),
+                                                        g_local, ring.table, zs,
+                                                        np.ascontiguousarray(ring.compliance_diag))
+            else:
+                _, si, so, _ = row.slices()
+                modal[label][k][:] = qe[:, si if label == "inner" else so]
     carrier_speed = np.abs(v[:, 2])
     for k, row in enumerate(rows):
         speed = (row.speed_factor * carrier_speed)[:, None]

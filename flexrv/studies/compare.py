@@ -202,11 +202,14 @@ def run_compare(preset_or_reducer, t_end: float | None = None, parts=("main_bear
     runs, timing = {}, {}
     flex_opts = {"parts": parts, **(flexible_options or {})}
     for name, model, options in (("rigid", "rigid", {}), ("flexible", "flexible", flex_opts)):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         sim = Simulation(reducer, model=model, model_options=options)
         res = sim.run(t_end=t_end, dt=dt, progress=progress, save_to=out / name)
         res.save(out / name)
         timing[f"{name}_s"] = time.perf_counter() - t0
+        timing[f"{name}_cpu_s"] = time.process_time() - c0  # this process's CPU (BLAS pinned to one thread)
+        for key in ("build_s", "solve_s", "solve_cpu_s"):  # model build (meshing + CMS if not cached), integration
+            timing[f"{name}_{key}"] = float(sim.timing.get(key, 0.0))
         runs[name] = res
     numbers = compare_numbers(runs["rigid"], runs["flexible"], seed=seed_reference(reducer))
     numbers["parts"] = list(parts)
