@@ -409,10 +409,11 @@ class StiffnessBudget:
 
 
 #: budget element names, shared with the quasi-static model's force groups where they coincide
-BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending")
+BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending", "carrier", "cycloid_disc")
 
 
-def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> StiffnessBudget:
+def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
+                     bodies: dict | None = None) -> StiffnessBudget:
     """Torsional compliance of each element of the torque path, in series
     (output carrier held against the housing through the path carrier -> crank
     supports -> crank shaft -> eccentrics -> needle bearings -> discs -> pins):
@@ -437,10 +438,17 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
       k_bend in series per crank, the N cranks in parallel on the lever a_w:
       1 / (a_w^2 sum_j t_j . K_b,j t_j) and 1 / (N a_w^2 k_bend).
 
+    * carrier and cycloid_disc (issue 14): the elastic bodies' torsional compliances
+      at the output, passed in ``bodies`` ({"carrier": c, "cycloid_disc": c} [rad/(N m)],
+      e.g. from :func:`flexrv.fem.disc.body_compliances`: the FE lives in a layer above
+      this module, so the caller computes it); an element absent from ``bodies`` (or
+      None) is rigid and not listed. The carrier's g^T C g (bore forces per unit
+      torque, flange held) and the discs' mean f^T C f / n_discs are series terms.
+
     Neglected (stated): the first stage (its mesh compliance reaches the output
     only through the eccentricity's lever, < 0.1 % in the quasi-static budget), the
-    crank torsion, the carrier, the housing and the main bearing (not in the torque
-    path of the rigid model either).
+    crank torsion, the housing and the main bearing (not in the torque path of the
+    rigid model either).
     """
     from flexrv.analysis.pin_load import reducer_pin_loads
     from flexrv.contact.tapered_roller import SC_K_BEND, crank_support_force, support_deflection
@@ -478,6 +486,12 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     comp = {"pins": float(1.0 / st.c_mesh_tangent), "needle_bearings": float(1.0 / k_needle),
             "support_bearings": float(1.0 / (a_w**2 * k_bear)),
             "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0}
+    for name in ("carrier", "cycloid_disc"):
+        value = (bodies or {}).get(name)
+        if value is not None:
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ValueError(f"bodies[{name!r}] = {value!r} must be a finite compliance >= 0 [rad/(N m)]")
+            comp[name] = float(value)
     total = float(sum(comp.values()))
     return StiffnessBudget(compliances=comp, total=total, rigidity=1.0 / total,
                            shares={k: v / total for k, v in comp.items()}, torque=torque,

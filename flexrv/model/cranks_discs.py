@@ -106,7 +106,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
 
     Elastic carrier (module docstring, "Carrier"): the support points move by
     u = -C_h f_s(d0 - u), C_h = R(theta) C R(theta)^T, solved by a local Newton
-    (R(u) = u + C_h f_s, dR/du = I + C_h K, step halving on |R|, to 1e-13 m) from
+    (R(u) = u + C_h f_s, dR/du = I + C_h K, step halving on |R|, to 1e-10 of u, at most 1e-13 m) from
     the previous solution; the condensed tangent is df_s = M (-K dd0 + H dgamma) -
     M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
@@ -150,7 +150,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         res = u + ch @ fs
         r0 = np.max(np.abs(res))
         for _ in range(60):
-            if r0 <= 1e-13:
+            if r0 <= max(1e-15, 1e-10 * np.max(np.abs(u))):  # 1e-13 m or better
                 break
             step = np.linalg.solve(eye + ch @ kk, res)
             lam = 1.0
@@ -160,9 +160,11 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
                 res = u + ch @ fs
                 r1 = np.max(np.abs(res))
-                if r1 < r0 or lam < 1e-6:
+                if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
                     break
                 lam *= 0.5
+            if r1 >= r0 and r0 <= 1e-12:
+                break
             r0 = r1
         for j in range(n):
             ustate[j, 0], ustate[j, 1] = u[2 * j], u[2 * j + 1]
