@@ -238,10 +238,17 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     b = np.zeros((2, 5))
     ii = np.zeros(5, np.int64)
     for j in range(n):  # the damper on the rigid relative velocity: B = d(d0)/d(crank x, y; carrier x, y, theta)
+        if damp[j] == 0.0:
+            continue
         ii[0], ii[1], ii[2], ii[3], ii[4] = gi[3 + 3 * j], gi[4 + 3 * j], gi[0], gi[1], gi[2]
         b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4] = 1.0, 0.0, -1.0, 0.0, ry[j]
         b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4] = 0.0, 1.0, 0.0, -1.0, -rx[j]
-        _add_btkb(jv, ii, b, 1.0, 0.0, 1.0, damp[j])
+        # rows: the generalized force of F_d = -c B v on crank, carrier and, with the arm r + u, the
+        # carrier's moment (its row weight (u_y, -u_x) beyond B's rigid arm)
+        for col in range(5):
+            for a_ in range(4):
+                jv[ii[a_], ii[col]] -= damp[j] * (b[0, a_] * b[0, col] + b[1, a_] * b[1, col])
+            jv[ii[4], ii[col]] -= damp[j] * ((ry[j] + u[2 * j + 1]) * b[0, col] - (rx[j] + u[2 * j]) * b[1, col])
 
 
 class CrankSupports(KernelGroup):
