@@ -270,29 +270,38 @@ def _qs_compliance(red):
     sm = StaticModel(red)
     sm.torque = 0.0
     q = ramp_to(sm, 0.0, sm.kinematic_pose(0.0), red.operating.rated_torque_Nm)
-    return 1.0 / sm.tangent_rigidity(0.0, q), sm.compliance_budget(0.0, q)
+    c = 1.0 / sm.tangent_rigidity(0.0, q)
+    budget = sm.compliance_budget(0.0, q)
+    pins = next(g for g in sm.model.groups if g.name == "pins")
+    pins.evaluate(0.0, sm.model.group_state(pins, q), np.zeros(3 * pins.nd))
+    disc_torque = -(pins.force * pins.rxn).sum(axis=-1)  # the pins' torque on each disc about its centre
+    return c, budget, disc_torque
 
 
-@pytest.mark.slow
 def test_quasi_static_carrier_and_disc_add_their_fe_compliance():
-    """Quasi-static tangent torsional compliance at the rated torque (crank angle 0):
-    with the carrier alone minus with no elastic body = g^T C g of the FE carrier
-    within 1 % (series element; the load sharing between the cranks shifts a
-    little); with the discs alone minus none = c_d / n_discs within 1 % ... of the
-    disc's compliance at this crank angle band (the mean over the hole period is
-    used at every angle). The budget's carrier / cycloid_disc shares times the
-    compliance reproduce the same differences within 2 %."""
+    """Quasi-static tangent torsional compliance at the rated torque (crank angle 0,
+    ~10 s): with the carrier alone minus with no elastic body = g^T C g of the FE
+    carrier within 1 % (series element; measured 0.1 %, the load sharing between
+    the cranks shifting a little). With the discs alone minus none = c_d sum_k
+    (M_k / T)^2 within 1 % (measured < 0.1 %): the rim's twist is c_d M_k, M_k the
+    pins' torque on disc k about its centre, which the model finds at 0.964 T /
+    n_discs on the rv40e (the first stage carries the rest of the output torque to
+    the carrier), so the disc's share is 7 % below the analytic budget's c_d /
+    n_discs, which takes M_k = T / n_discs. The budget's carrier / cycloid_disc
+    shares times the compliance reproduce the same differences within 1 %."""
     from flexrv.fem.disc import body_compliances
 
     r = load("rv40e")
+    torque = r.operating.rated_torque_Nm
     fe = body_compliances(r)
-    c_none, _ = _qs_compliance(with_bodies(r, []))
-    c_car, b_car = _qs_compliance(with_bodies(r, ["carrier"]))
-    c_disc, b_disc = _qs_compliance(with_bodies(r, ["cycloid_disc"]))
+    c_none, _, _ = _qs_compliance(with_bodies(r, []))
+    c_car, b_car, _ = _qs_compliance(with_bodies(r, ["carrier"]))
+    c_disc, b_disc, m_disc = _qs_compliance(with_bodies(r, ["cycloid_disc"]))
     g_c = fe["carrier"]["compliance_rad_per_Nm"]
-    g_d = fe["cycloid_disc"]["compliance_rad_per_Nm"]
+    g_d = fe["cycloid_disc"]["compliance_one_disc_rad_per_Nm"] * float(np.sum((m_disc / torque) ** 2))
+    assert np.all(np.abs(m_disc / (torque / 2) - 0.964) < 0.01)
     assert c_car - c_none == pytest.approx(g_c, rel=0.01)
     assert c_disc - c_none == pytest.approx(g_d, rel=0.01)
-    assert b_car["carrier"] * c_car == pytest.approx(g_c, rel=0.02)
-    assert b_disc["cycloid_disc"] * c_disc == pytest.approx(g_d, rel=0.02)
+    assert b_car["carrier"] * c_car == pytest.approx(g_c, rel=0.01)
+    assert b_disc["cycloid_disc"] * c_disc == pytest.approx(g_d, rel=0.01)
     assert sum(b_car.values()) == pytest.approx(1.0, abs=1e-9)
