@@ -305,3 +305,21 @@ def test_quasi_static_carrier_and_disc_add_their_fe_compliance():
     assert b_car["carrier"] * c_car == pytest.approx(g_c, rel=0.01)
     assert b_disc["cycloid_disc"] * c_disc == pytest.approx(g_d, rel=0.01)
     assert sum(b_car.values()) == pytest.approx(1.0, abs=1e-9)
+
+
+# ------------------------------------------------------------------ bad input
+def test_self_intersecting_disc_and_bad_switch_name_the_field():
+    """A disc whose crank holes would cut the teeth or be cut by the centre hole,
+    planets that would overlap on the crank circle, and an unknown body model: ConfigError naming the field (the carrier's
+    own cases: tests/test_fem_carrier.py::test_carrier_design_errors_name_the_field)."""
+    from flexrv.design import override
+    from flexrv.errors import ConfigError
+
+    cases = [({"second_stage.center_hole_radius_mm": 30.0}, "second_stage.center_hole_radius_mm"),
+             ({"first_stage.module_mm": 2.2}, "first_stage.module_mm"),
+             ({"first_stage.n_planets": 6}, "first_stage.n_planets"),
+             ({"second_stage.disc_body_model": "flexible"}, "disc_body_model"),
+             ({"carrier.body_model": "modal"}, "body_model")]
+    for ov, field in cases:
+        with pytest.raises(ConfigError, match=field):
+            override("rv40e", ov)

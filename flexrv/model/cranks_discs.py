@@ -18,6 +18,24 @@ carrier's moment, (r . f) on (theta, theta); the terms of the bore's rotation wi
 theta in the damper are dropped, and for the linear law also in the spring (its
 Jacobian is kept as in tests/data/force_reference.npz).
 
+Carrier (issue 14; design ``carrier.body_model = "condensed_fe"``): the carrier's
+end plates and pillars are elastic. Its FE condensation
+(:func:`flexrv.fem.carrier.crank_support_compliance`) gives the (2N x 2N)
+compliance C of the cranks' support points (each crank's force split over its two
+bores, input/output plate) relative to the output flange, in the carrier frame;
+the flange is the carrier member's rigid body (main bearing, load). The support
+points move by u = -C_h f_s(d0 - u) (C_h = R C R^T turned with the carrier, f_s
+the support springs' forces on the cranks at d = d0 - u, d0 = p_j - h_j the
+rigid-bore displacement): the carrier is in series with the supports and couples
+the cranks. :func:`crank_support_kernel` condenses it (local Newton on u,
+warm-started), its tangent being (I + K C_h)^-1 K plus the terms of C_h's turn
+with the carrier; the carrier's moment takes the deflected arm r + u (the
+element is conservative: its energy is W(d) + u.C^-1 u / 2). The damper acts on the
+rigid relative velocity (the carrier's elastic rate is left out, as the bodies are
+massless in this condensation). With C = 0 the element is the rigid-carrier one.
+Verified in tests/test_bodies.py (explicit unknowns u solved by a root finder to
+1e-9, central differences to 1e-6, QS torsional compliance + g^T C g to 1 %).
+
 Needle bearings (group ``needle_bearings``, members cranks + discs): the journal
 centre of crank j under disc k is E = p_j + e_jk (sin chi, cos chi), chi = chi0_k +
 err_jk - phi_j (clockwise eccentric angle, :mod:`flexrv.geometry.cycloid`

@@ -58,6 +58,16 @@ above), so dQ/dq is not symmetric when harmonics are present. Verified against
 central differences in tests/test_kernel.py (1e-6 of the largest entry;
 measured 1-2e-8, the differences' round-off).
 
+Disc body (issue 14; design ``second_stage.disc_body_model = "condensed_fe"``): the
+pins act on the disc's rim (tooth region) whose pose is q_r = q_hub + delta, the
+needle bearings on its hub (the disc member's coordinates); delta = C_d Q(q_r),
+C_d the (3 x 3) rim compliance relative to the crank holes from the disc FE
+(:func:`flexrv.fem.disc.rim_compliance`: the torsional compliance under the
+rated pin-load pattern, its choice and error stated there). :func:`pin_body_kernel`
+wraps :func:`pin_kernel` (unchanged) in a local Newton on delta per disc with the
+condensed Jacobians (I - J C_d)^-1 J and (I - J C_d)^-1 J_v. With C_d = 0 it is
+the plain pin kernel. Verified in tests/test_bodies.py.
+
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
 that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
