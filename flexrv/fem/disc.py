@@ -280,7 +280,8 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
     ``{"compliance_rad_per_Nm": None, "source": <why>}`` for the carrier.
     ``output_torque`` (default rated) sets the disc's pin load distribution; the
     disc value is the mean over ``disc_angles`` crank angles
-    (:func:`disc_compliance_sweep`), its range in ``compliance_one_disc_range_rad_per_Nm``.
+    (:func:`disc_compliance_sweep`), its range in ``compliance_one_disc_range_rad_per_Nm``;
+    the disc's load case is taken on the :func:`nominal_design` (errors removed).
     """
     from flexrv.fem.carrier import carrier_compliance
 
@@ -297,7 +298,8 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
                                      f"{c.size * 1e3:.3g} mm; flange held, crank bores RBE3, tangential crank forces "
                                      f"T/(N a_w) split {c.split_input:g}/{1 - c.split_input:g} input/output plate"),
                           "n_nodes": c.n_nodes, "mesh_size_m": c.size}
-    d = disc_compliance_sweep(reducer, n_angles=disc_angles, output_torque=output_torque, size=disc_size, cache=cache)
+    d = disc_compliance_sweep(nominal_design(reducer), n_angles=disc_angles, output_torque=output_torque,
+                              size=disc_size, cache=cache)
     out["cycloid_disc"] = {"compliance_rad_per_Nm": d.output_share,
                            "stiffness_Nm_per_arcmin": d.output_stiffness_Nm_per_arcmin,
                            "compliance_one_disc_rad_per_Nm": d.mean,
@@ -329,5 +331,16 @@ def rim_compliance(reducer, size: float | None = None, n_angles: int = 6, cache:
     variation of c_d with the crank angle (+-20 % on the rv40e, the sweep's range;
     the mean is used at every angle), so the TE ripple from the disc body's
     anisotropy is not modelled."""
-    d = disc_compliance_sweep(reducer, n_angles=n_angles, size=size, cache=cache)
+    d = disc_compliance_sweep(nominal_design(reducer), n_angles=n_angles, size=size, cache=cache)
     return np.diag([0.0, 0.0, float(d.mean)])
+
+
+def nominal_design(reducer):
+    """The design without its manufacturing errors: the elastic bodies' FE load
+    cases (the pin-load pattern) are taken on the nominal geometry, so every error
+    set and tolerance sample of a design shares one cached FE solve (the errors move
+    the pin loads by far less than the +-20 % the disc's compliance varies over the
+    crank angle)."""
+    from flexrv.design.manufacturing import ManufacturingErrors
+
+    return reducer.model_copy(update={"errors": ManufacturingErrors()})
