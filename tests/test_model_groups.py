@@ -11,7 +11,9 @@ from flexrv.model.factory import build_model
 
 
 def _variant(name, needle="empirical", ideal=False):
-    r = load(name)
+    from flexrv.model.parameters import with_bodies
+
+    r = with_bodies(load(name), [])  # rigid carrier and discs (the elastic bodies: tests/test_bodies.py)
     upd = {"needle_bearing": r.needle_bearing.model_copy(update={"model": needle})}
     if ideal:
         upd["second_stage"] = r.second_stage.model_copy(update={"modification_equidistant_mm": 0.0})

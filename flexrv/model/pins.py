@@ -225,7 +225,8 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     The pins act on the rim pose q_r = q_hub + delta with delta = C_d Q(q_r), Q the
     pins' generalized force on the disc; a local Newton on delta, R = delta - C_d Q,
     dR/d(delta) = I - C_d J (J = dQ/dq from :func:`pin_kernel`), step halving on
-    max|R| (x, y [m]; psi times R_p), to 1e-10 of delta (at most 1e-13 m, at least 1e-15 m). The condensed Jacobians follow
+    max|R| (x, y [m]; psi times R_p), to 1e-10 of delta (at most 1e-13 m, at least 1e-15 m), and the
+    last correction applied linearised (Q + J d(delta), exact to O(|R|^2)). The condensed Jacobians follow
     from Q_eff(q, v) = Q(q + delta(q, v), v): dQ_eff/dq = (I - J C_d)^-1 J,
     dQ_eff/dv = (I - J C_d)^-1 J_v (the rim's velocity is the hub's: the rate of
     delta is left out of the contact damping)."""
@@ -283,11 +284,18 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
             base[kd] = delta[kd]
             step[kd] = np.linalg.solve(eye - cd[kd] @ jk[kd], res[kd])
         lam = 1.0
+    for kd in range(nd):
+        # the last Newton correction, linearised (O(|R|^2) exact): the result is smooth in q and v down
+        # to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
+        ii = idx[3 * kd:3 * kd + 3]
+        corr = -np.linalg.solve(eye - cd[kd] @ jk[kd], res[kd])
+        dq_ = jk[kd] @ corr
+        for a in range(3):
+            delta[kd, a] += corr[a]
+            f[ii[a]] += fs[ii[a]] + dq_[a]
     dstate[:, :] = delta
     for kd in range(nd):
         ii = idx[3 * kd:3 * kd + 3]
-        for a in range(3):
-            f[ii[a]] += fs[ii[a]]
         if jac:
             jvk = np.empty((3, 3))
             for a in range(3):
