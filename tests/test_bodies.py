@@ -336,3 +336,48 @@ def test_self_intersecting_disc_and_bad_switch_name_the_field():
     for ov, field in cases:
         with pytest.raises(ConfigError, match=field):
             override("rv40e", ov)
+
+
+def test_parts_semantics_and_cli_errors():
+    """--parts names the elastic parts of the run: carrier / cycloid_disc with any
+    model (option ``bodies``), main_bearing / crankshaft only with --model flexible;
+    a wrong combination or name is a ConfigError naming it (exit 2 through
+    flexrv.cli.main), before any run."""
+    from typer.testing import CliRunner
+
+    from flexrv.cli import app
+    from flexrv.errors import ConfigError
+    from flexrv.model.factory import parts_options
+
+    assert parts_options("rigid", None) == {}
+    assert parts_options("rigid", "carrier,cycloid_disc") == {"bodies": ("carrier", "cycloid_disc")}
+    assert parts_options("balls", "carrier") == {"bodies": ("carrier",)}
+    assert parts_options("flexible", "main_bearing,cycloid_disc") == {"parts": ("main_bearing", "cycloid_disc")}
+    with pytest.raises(ConfigError, match="main_bearing needs --model flexible"):
+        parts_options("rigid", "main_bearing")
+    for args, words in ((["simulate", "rv40e", "--parts", "crankshaft"], "needs --model flexible"),
+                        (["stiffness-test", "rv40e", "--parts", "housing"], "parts = housing is not allowed")):
+        res = CliRunner().invoke(app, args)
+        assert isinstance(res.exception, ConfigError) and words in str(res.exception), res.output
+
+
+def test_model_info_names_the_elastic_bodies():
+    """The assembled model records its elastic bodies (info ``elastic_bodies``) from
+    the design's switches or the ``bodies`` option; the declared outputs carry the
+    carrier's support-point deflection [m] and the discs' rim twist [rad]."""
+    from flexrv.model.factory import build_model
+
+    r = load("rv40e")
+    assert build_model(r, exudyn=False).info["elastic_bodies"] == ["carrier", "cycloid_disc"]
+    assert build_model(r, exudyn=False, bodies=("carrier",)).info["elastic_bodies"] == ["carrier"]
+    assert build_model(r, "balls", exudyn=False, bodies=()).info["elastic_bodies"] == []
+    m = build_model(r, exudyn=False)
+    sup = next(g for g in m.groups if g.name == "crank_supports")
+    pins = next(g for g in m.groups if g.name == "pins")
+    q = m.q0.copy()
+    for k in range(m.params.n_discs):
+        q[m.slice(f"disc{k}").start + 2] -= 3e-4
+    _, out = pins.evaluate(0.0, m.group_state(pins, q), np.zeros(3 * pins.nd), want_outputs=True)
+    assert out["disc_rim_rotation"].units == "rad" and np.all(out["disc_rim_rotation"].values != 0.0)
+    _, out = sup.evaluate(0.0, _support_state(m.params), np.zeros(6 + 3 * m.params.n_cranks), want_outputs=True)
+    assert out["carrier_bore_deflection"].units == "m" and np.all(out["carrier_bore_deflection"].values > 1e-7)
