@@ -125,7 +125,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     Elastic carrier (module docstring, "Carrier"): the support points move by
     u = -C_h f_s(d0 - u), C_h = R(theta) C R(theta)^T, solved by a local Newton
     (R(u) = u + C_h f_s, dR/du = I + C_h K, step halving on |R|, to 1e-10 of u, at most 1e-13 m) from
-    the previous solution; the condensed tangent is df_s = M (-K dd0 + H dgamma) -
+    the previous solution, its last correction applied linearised (f_s + K du, exact to O(|R|^2)); the condensed tangent is df_s = M (-K dd0 + H dgamma) -
     M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
     arm r + u."""
@@ -184,6 +184,11 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             if r1 >= r0 and r0 <= 1e-12:
                 break
             r0 = r1
+        # the last Newton correction, linearised (O(|R|^2) exact): the result is smooth in q down to
+        # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
+        corr = -np.linalg.solve(eye + ch @ kk, res)
+        u = u + corr
+        fs = fs + kk @ corr
         for j in range(n):
             ustate[j, 0], ustate[j, 1] = u[2 * j], u[2 * j + 1]
             ustate[j, 2], ustate[j, 3] = c * u[2 * j] + s * u[2 * j + 1], -s * u[2 * j] + c * u[2 * j + 1]
