@@ -357,6 +357,7 @@ def test_parts_semantics_and_cli_errors():
     assert parts_options("rigid", "carrier,cycloid_disc") == {"bodies": ("carrier", "cycloid_disc")}
     assert parts_options("balls", "carrier") == {"bodies": ("carrier",)}
     assert parts_options("flexible", "main_bearing,cycloid_disc") == {"parts": ("main_bearing", "cycloid_disc")}
+    assert parts_options("rigid", "none") == {"bodies": ()} and parts_options("flexible", "none") == {"parts": ()}
     with pytest.raises(ConfigError, match="main_bearing needs --model flexible"):
         parts_options("rigid", "main_bearing")
     for args, words in ((["simulate", "rv40e", "--parts", "crankshaft"], "needs --model flexible"),

@@ -45,7 +45,7 @@ MODEL_HELP = ("Model name: rigid (5-DOF main-bearing element), balls (ball-resol
 PARTS_HELP = ("Elastic parts of the run, comma-separated (the others rigid): carrier, cycloid_disc (FE bodies, "
               "any --model) and, with --model flexible, main_bearing (flexible rings of both rows), crankshaft. "
               "Default: the design's carrier.body_model / second_stage.disc_body_model (and main_bearing for "
-              "--model flexible).")
+              "--model flexible); none: every part rigid.")
 
 
 def model_options(model: str, parts: str | None) -> dict:

@@ -234,10 +234,13 @@ def parts_options(model: str, parts) -> dict:
 
 
 def parse_parts(parts) -> tuple[str, ...]:
-    """Validate a list (or comma-separated string) of flexible part names."""
+    """Validate a list (or comma-separated string) of flexible part names; ``none``
+    alone: no elastic part (every body rigid)."""
     if isinstance(parts, str):
         parts = [p.strip() for p in parts.split(",") if p.strip()]
     parts = tuple(parts)
+    if parts == ("none",):
+        return ()
     bad = [p for p in parts if p not in FLEXIBLE_PARTS]
     if bad or not parts:
         raise ConfigError(f"parts = {','.join(parts) or '(empty)'} is not allowed: choose one or more of "
