@@ -443,7 +443,10 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
       e.g. from :func:`flexrv.fem.disc.body_compliances`: the FE lives in a layer above
       this module, so the caller computes it); an element absent from ``bodies`` (or
       None) is rigid and not listed. The carrier's g^T C g (bore forces per unit
-      torque, flange held) and the discs' mean f^T C f / n_discs are series terms.
+      torque, flange held) and the discs' mean f^T C f / n_discs are series terms
+      (the disc's with T / n_discs per disc; in the models the pins carry 0.964 of
+      it on the rv40e, the first stage the rest, so the quasi-static disc share is
+      7 % lower, tests/test_bodies.py).
 
     Neglected (stated): the first stage (its mesh compliance reaches the output
     only through the eccentricity's lever, < 0.1 % in the quasi-static budget), the
