@@ -173,7 +173,9 @@ def test_body_compliances_for_the_budget():
     c = carrier_compliance(rv, size=0.008)
     d = disc_compliance(rv, size=0.008)
     assert b["carrier"]["compliance_rad_per_Nm"] == c.torsional
-    assert b["cycloid_disc"]["compliance_rad_per_Nm"] == pytest.approx(d.torsional / rv.second_stage.n_discs)
+    # the budget's disc: patch compliances of the unmodified body (flexrv.fem.disc.disc_torsion_sweep, keyed on
+    # geometry) under the design's pin loads; the modified mesh's own solve differs by the 5 um modification (< 0.5 %)
+    assert b["cycloid_disc"]["compliance_rad_per_Nm"] == pytest.approx(d.torsional / rv.second_stage.n_discs, rel=5e-3)
     for entry in b.values():
         assert entry["stiffness_Nm_per_arcmin"] == pytest.approx(RAD_PER_ARCMIN / entry["compliance_rad_per_Nm"])
         assert "FE condensation" in entry["source"]

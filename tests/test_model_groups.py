@@ -11,7 +11,9 @@ from flexrv.model.factory import build_model
 
 
 def _variant(name, needle="empirical", ideal=False):
-    r = load(name)
+    from flexrv.model.parameters import with_bodies
+
+    r = with_bodies(load(name), [])  # rigid carrier and discs (the elastic bodies: tests/test_bodies.py)
     upd = {"needle_bearing": r.needle_bearing.model_copy(update={"model": needle})}
     if ideal:
         upd["second_stage"] = r.second_stage.model_copy(update={"modification_equidistant_mm": 0.0})
@@ -187,7 +189,7 @@ def test_crank_support_jacobian_exact(clearance_um):
     from flexrv.model.cranks_discs import CrankSupports
     from flexrv.model.parameters import rigid_parameters
 
-    p = rigid_parameters(load("rv40e"))
+    p = rigid_parameters(_variant("rv40e"))
     p = dataclasses.replace(p, support_clearances=np.full(p.n_cranks, clearance_um * 1e-6))
     g = CrankSupports(p)
     q, v = _support_state(p, g)
@@ -214,7 +216,7 @@ def test_crank_support_forces_balance_and_bending_share():
     from flexrv.model.cranks_discs import CrankSupports
     from flexrv.model.parameters import rigid_parameters
 
-    p = rigid_parameters(load("rv40e"))
+    p = rigid_parameters(_variant("rv40e"))
     g = CrankSupports(p)
     q, _ = _support_state(p, g, seed=3)
     f, out = g.evaluate(0.0, q, np.zeros_like(q), want_outputs=True)
@@ -234,7 +236,7 @@ def test_linear_support_option_is_the_legacy_spring():
     from flexrv.model.parameters import rigid_parameters
     from tests.data.make_force_reference import legacy_supports
 
-    p = rigid_parameters(legacy_supports(load("rv40e"), "rv40e"))
+    p = rigid_parameters(legacy_supports(_variant("rv40e"), "rv40e"))
     assert p.support_linear and p.support_stiffness == 4e8
     g = CrankSupports(p)
     q, _ = _support_state(p, g, seed=5)

@@ -346,10 +346,15 @@ def test_solver_jacobian_equals_finite_differences(errors):
     the grade-5 error set): the pins' and gear meshes' Jacobians are complete, so
     the solver needs no finite-difference fallback. The extrapolation removes the
     differences' O(h^2 / delta^2) error at a pin compressed by only delta = 1.9 nm
-    (1.3e-6 of the largest entry with h = 1e-10 alone, 2e-3 with h = 1e-9)."""
+    (1.3e-6 of the largest entry with h = 1e-10 alone, 2e-3 with h = 1e-9). Rigid
+    carrier and discs: the elastic bodies' condensed Jacobians are checked in
+    tests/test_bodies.py (their local Newton's round-off, ~5e-8 N, is at this test's
+    noise floor with steps of 5e-11 m; with 2e-10 / 4e-10 m they agree to 1e-8)."""
     from flexrv.design import load_error_set, with_errors
+    from flexrv.model.parameters import with_bodies
 
     red = load("rv40e") if errors is None else with_errors("rv40e", load_error_set(errors))
+    red = with_bodies(red, [])
     sm = StaticModel(red)
     th = 0.37
     sm.torque = red.operating.rated_torque_Nm

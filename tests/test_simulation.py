@@ -148,10 +148,11 @@ def test_torsional_rigidity_vs_series_model(name):
     bearings then share the load unevenly; the quasi-static tangent of rv40e is 4 %
     below the analytic figure, issue 14)."""
     from flexrv.analysis.torsional import stiffness_budget
+    from flexrv.cli.design import elastic_body_compliances
 
     r = ideal(load(name))
     fig, _ = stiffness_test(r, quarter_time=0.01)
-    c_w = stiffness_budget(r).rigidity
+    c_w = stiffness_budget(r, bodies=elastic_body_compliances(r)).rigidity  # with the FE carrier and discs
     arcmin = np.pi / 180 / 60
     assert fig.rigidity_Nm_per_arcmin == pytest.approx(c_w * arcmin, rel=0.15)
     assert abs(fig.lost_motion_arcmin) < 0.2  # ideal geometry: no clearance to take up

@@ -517,7 +517,7 @@ class StiffnessBudget:
 
 #: budget element names, shared with the quasi-static model's force groups where they coincide
 BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending", "pin_seats", "pin_bending",
-                   "housing")
+                   "housing", "carrier", "cycloid_disc")
 #: the housing enters the budget where its estimate exceeds this fraction of the total (issue 14)
 HOUSING_THRESHOLD = 0.01
 #: budget elements that the dynamic and quasi-static models do not contain (:func:`unmodelled_elements`)
@@ -594,7 +594,8 @@ def unmodelled_elements(reducer, model_total: float, torque: float | None = None
                 "left out", seat)
 
 
-def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0) -> StiffnessBudget:
+def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
+                     bodies: dict | None = None) -> StiffnessBudget:
     """Torsional compliance of each element of the torque path, in series
     (output carrier held against the housing through the path carrier -> crank
     supports -> crank shaft -> eccentrics -> needle bearings -> discs -> pins):
@@ -617,17 +618,25 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
       quasi-static models (:func:`flexrv.contact.tapered_roller.support_deflection`
       with :func:`support_constants`): the bearings' tangent K_b and the shaft's
       k_bend in series per crank, the N cranks in parallel on the lever a_w:
-      1 / (a_w^2 sum_j t_j . K_b,j t_j) and 1 / (N a_w^2 k_bend).
-
+      1 / (a_w^2 sum_j t_j . K_b,j t_j) and 1 / (N a_w^2 k_bend);
     * pins, pin_seats, pin_bending: the pin path's compliance (disc contact, seat,
       bending in series, :func:`flexrv.analysis.pin_load.pin_contact_constant`) split
       by :func:`split_pin_path`;
     * housing: the pin housing ring and tube (:func:`housing_compliance`), where it
-      exceeds 1 % of the total (:func:`unmodelled_elements`; else in ``notes``).
+      exceeds 1 % of the total (:func:`unmodelled_elements`; else in ``notes``);
+    * carrier and cycloid_disc (issue 14): the elastic bodies' torsional compliances
+      at the output, passed in ``bodies`` ({"carrier": c, "cycloid_disc": c} [rad/(N m)],
+      e.g. from :func:`flexrv.fem.disc.body_compliances`: the FE lives in a layer above
+      this module, so the caller computes it); an element absent from ``bodies`` (or
+      None) is rigid and not listed. The carrier's g^T C g (bore forces per unit
+      torque, flange held) and the discs' mean f^T C f / n_discs are series terms
+      (the disc's with T / n_discs per disc; in the models the pins carry 0.964 of
+      it on the rv40e, the first stage the rest, so the quasi-static disc share is
+      7 % lower, tests/test_bodies.py).
 
     Neglected (stated): the first stage (its mesh compliance reaches the output
     only through the eccentricity's lever, < 0.1 % in the quasi-static budget), the
-    crank torsion, the carrier and the main bearing (not in the torque path of the
+    crank torsion and the main bearing (not in the torque path of the
     rigid model either).
     """
     from flexrv.analysis.pin_load import reducer_pin_loads
@@ -666,6 +675,12 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     comp = {"pins": float(1.0 / st.c_mesh_tangent), "needle_bearings": float(1.0 / k_needle),
             "support_bearings": float(1.0 / (a_w**2 * k_bear)),
             "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0}
+    for name in ("carrier", "cycloid_disc"):
+        value = (bodies or {}).get(name)
+        if value is not None:
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ValueError(f"bodies[{name!r}] = {value!r} must be a finite compliance >= 0 [rad/(N m)]")
+            comp[name] = float(value)
     comp = split_pin_path(comp, reducer)
     extra, notes = unmodelled_elements(reducer, float(sum(comp.values())), torque)
     comp.update(extra)

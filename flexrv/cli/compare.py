@@ -13,7 +13,8 @@ from flexrv.cli.design import PRESET_HELP
 def compare(preset: str = typer.Argument(..., help=PRESET_HELP),
             t_end: float = typer.Option(None, "--t-end", help="End time in s (default: end of the speed and load ramps + 0.2 s)."),
             parts: str = typer.Option("main_bearing", "--parts",
-                                      help="Flexible parts, comma-separated: main_bearing, crankshaft."),
+                                      help="Elastic parts of the flexible run, comma-separated: main_bearing, "
+                                           "crankshaft, carrier, cycloid_disc (the rigid reference has none)."),
             dt: float = typer.Option(1e-4, "--dt", help="Time step in s."),
             out: Path = typer.Option(None, "--out", help="Output directory (default results/<preset>_compare_<time>/)."),
             overwrite: bool = typer.Option(False, "--overwrite", help="Allow an existing non-empty --out directory."),

@@ -134,10 +134,30 @@ def analytic_budget(reducer, torque: float | None = None) -> dict:
     ``torque`` [N m] (default: the rated torque)."""
     from flexrv.analysis.torsional import stiffness_budget
 
-    b = stiffness_budget(reducer, torque)
+    b = stiffness_budget(reducer, torque, bodies=elastic_body_compliances(reducer))
     out = budget_dict(b.compliances, b.torque)
     if b.notes:
         out["notes"] = list(b.notes)
+    return out
+
+
+def elastic_body_compliances(reducer) -> dict:
+    """Torsional compliances [rad/(N m)] at the output of the design's elastic bodies
+    (issue 14), per its switches (``carrier.body_model``, ``second_stage.disc_body_model``
+    = "condensed_fe"): the FE condensations of :func:`flexrv.fem.disc.body_compliances`
+    (cached); a rigid body is left out."""
+    from flexrv.fem.disc import body_compliances
+
+    carrier = reducer.carrier is not None and reducer.carrier.body_model == "condensed_fe"
+    disc = reducer.second_stage.disc_body_model == "condensed_fe"
+    if not (carrier or disc):
+        return {}
+    fe = body_compliances(reducer)
+    out = {}
+    if carrier:
+        out["carrier"] = fe["carrier"]["compliance_rad_per_Nm"]
+    if disc:
+        out["cycloid_disc"] = fe["cycloid_disc"]["compliance_rad_per_Nm"]
     return out
 
 

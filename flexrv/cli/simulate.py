@@ -42,20 +42,18 @@ def _bar(enabled: bool):
 
 MODEL_HELP = ("Model name: rigid (5-DOF main-bearing element), balls (ball-resolved main bearing, rigid rings) "
               "or flexible (reduced flexible parts, see --parts).")
-PARTS_HELP = ("Flexible parts of --model flexible, comma-separated: main_bearing (flexible rings of both rows), "
-              "crankshaft. Default: main_bearing.")
+PARTS_HELP = ("Elastic parts of the run, comma-separated (the others rigid): carrier, cycloid_disc (FE bodies, "
+              "any --model) and, with --model flexible, main_bearing (flexible rings of both rows), crankshaft. "
+              "Default: the design's carrier.body_model / second_stage.disc_body_model (and main_bearing for "
+              "--model flexible); none: every part rigid.")
 
 
 def model_options(model: str, parts: str | None) -> dict:
-    """Builder options of a model from the CLI's --parts (only for ``flexible``)."""
-    from flexrv.errors import InputError
-    from flexrv.model.factory import parse_parts
+    """Builder options of a model from the CLI's --parts
+    (:func:`flexrv.model.factory.parts_options`)."""
+    from flexrv.model.factory import parts_options
 
-    if parts is None:
-        return {}
-    if model != "flexible":
-        raise InputError(f"--parts {parts} is only allowed with --model flexible (got --model {model})")
-    return {"parts": parse_parts(parts)}
+    return parts_options(model, parts)
 
 
 def _default_out(preset: str, model: str, kind: str) -> Path:

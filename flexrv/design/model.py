@@ -133,6 +133,9 @@ class SecondStage(_Strict):
     modification_rotation_deg: float = Field(ge=-1.0, le=1.0, description="Rotation modification d_delta [deg]")
     center_hole_radius_mm: float = Field(ge=0.0, le=500.0, description="Radius of the disc's centre hole [mm]")
     mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Pin-disc contact damping ratio xi_34 [-]")
+    disc_body_model: Literal["condensed_fe", "rigid"] = Field(
+        default="condensed_fe", description="Cycloid-disc body between the crank holes and the tooth region: "
+        "'condensed_fe' (FE condensation, flexrv.fem.disc, in series in every model) or 'rigid'")
 
     @property
     def pin_circle_radius(self) -> float:
@@ -386,6 +389,10 @@ class Carrier(_Strict):
     pillar_count: int = Field(ge=2, le=12, description="Number of pillars N_p [-]")
     pillar_circle_radius_mm: float = Field(gt=1.0, le=1500.0, description="Radius of the pillar-centre circle [mm]")
     pillar_diameter_mm: float = Field(gt=1.0, le=600.0, description="Diameter of a (round) pillar [mm]")
+    body_model: Literal["condensed_fe", "rigid"] = Field(
+        default="condensed_fe", description="Carrier body between the crank bores and the output flange: "
+        "'condensed_fe' (FE condensation, flexrv.fem.carrier, in series with the crank supports in every model) "
+        "or 'rigid'")
 
     def pillar_angles(self) -> list[float]:
         """Angles [rad] of the pillar centres."""

@@ -284,3 +284,24 @@ def rigid_plate_frame_stiffness(K, mesh, spec) -> float:
     x = factorize(0.5 * (Kr + Kr.T))(rhs)
     return float(1.0 / x[starts[0] + 5])
 
+
+
+def crank_support_compliance(reducer, size: float | None = None, cache: bool = True) -> np.ndarray:
+    """(2N x 2N) compliance [m/N] of the cranks' support points in the carrier frame
+    (x, y per crank, crank k at 2 pi k / N), relative to the held flange: each crank's
+    support force f_k reaches its two bores split s_in : (1 - s_in) (input / output
+    plate, :attr:`CarrierCompliance.split_input`), i.e. the bore forces are S f with
+    S = [s_in I; (1 - s_in) I] (4N x 2N), and the crank's support point moves by the
+    split-weighted mean of its bores' displacements, S^T u (work-conjugate), so
+    C_eff = S^T C S with C the bore compliance of :func:`carrier_compliance`.
+
+    With the torque load vector g_c per unit output torque (tangential T / (N a_w)
+    per crank), g_c^T C_eff g_c equals the FE torsional compliance
+    :attr:`CarrierCompliance.torsional` (identity, tests/test_bodies.py)."""
+    c = carrier_compliance(reducer, size=size, cache=cache)
+    n = c.n_cranks
+    s = c.split_input
+    S = np.vstack([s * np.eye(2 * n), (1.0 - s) * np.eye(2 * n)])
+    C = np.asarray(c.matrix, dtype=float)
+    out = S.T @ C @ S
+    return 0.5 * (out + out.T)

@@ -18,6 +18,24 @@ carrier's moment, (r . f) on (theta, theta); the terms of the bore's rotation wi
 theta in the damper are dropped, and for the linear law also in the spring (its
 Jacobian is kept as in tests/data/force_reference.npz).
 
+Carrier (issue 14; design ``carrier.body_model = "condensed_fe"``): the carrier's
+end plates and pillars are elastic. Its FE condensation
+(:func:`flexrv.fem.carrier.crank_support_compliance`) gives the (2N x 2N)
+compliance C of the cranks' support points (each crank's force split over its two
+bores, input/output plate) relative to the output flange, in the carrier frame;
+the flange is the carrier member's rigid body (main bearing, load). The support
+points move by u = -C_h f_s(d0 - u) (C_h = R C R^T turned with the carrier, f_s
+the support springs' forces on the cranks at d = d0 - u, d0 = p_j - h_j the
+rigid-bore displacement): the carrier is in series with the supports and couples
+the cranks. :func:`crank_support_kernel` condenses it (local Newton on u,
+warm-started), its tangent being (I + K C_h)^-1 K plus the terms of C_h's turn
+with the carrier; the carrier's moment takes the deflected arm r + u (the
+element is conservative: its energy is W(d) + u.C^-1 u / 2). The damper acts on the
+rigid relative velocity (the carrier's elastic rate is left out, as the bodies are
+massless in this condensation). With C = 0 the element is the rigid-carrier one.
+Verified in tests/test_bodies.py (explicit unknowns u solved by a root finder to
+1e-9, central differences to 1e-6, QS torsional compliance + g^T C g to 1 %).
+
 Needle bearings (group ``needle_bearings``, members cranks + discs): the journal
 centre of crank j under disc k is E = p_j + e_jk (sin chi, cos chi), chi = chi0_k +
 err_jk - phi_j (clockwise eccentric angle, :mod:`flexrv.geometry.cycloid`
@@ -90,60 +108,181 @@ def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
 
 
 @njit(cache=True)
+def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs):
+    """Spring force of every crank support at d = d0 - u (housing frame): fs (2N,)
+    on the cranks, the block-diagonal tangent kk = -dfs/dd (2N, 2N), hh (2N, N)
+    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts."""
+    for j in range(d0x.shape[0]):
+        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1],
+                                                                       gam[j], clear[j], sc, angles, linear,
+                                                                       bstate[j, 0], bstate[j, 1])
+        bstate[j, 0], bstate[j, 1] = bx, by
+        fs[2 * j], fs[2 * j + 1] = fx, fy
+        kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j], kk[2 * j + 1, 2 * j + 1] = kxx, kxy, kxy, kyy
+        hh[2 * j, j], hh[2 * j + 1, j] = hx, hy
+        qs[j] = qj
+
+
+@njit(cache=True)
 def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     """Crank supports (module docstring): Q into f[idx], Jacobians into jq, jv; the
     force on each crank into out_fx, out_fy, the bearing displacement into bstate
-    (the next call's Newton start) and the bending share of each support's
-    tangential compliance into out_bend."""
-    idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend = pack
+    (the next call's Newton start), the bending share of each support's
+    tangential compliance into out_bend and, with an elastic carrier (``cc``, the
+    (2N, 2N) support-point compliance in the carrier frame; (0, 0): rigid), the
+    support points' deflection into ``ustate`` (N, 4): housing-frame x, y (the next
+    call's Newton start) and carrier-frame x, y.
+
+    Elastic carrier (module docstring, "Carrier"): the support points move by
+    u = -C_h f_s(d0 - u), C_h = R(theta) C R(theta)^T, solved by a local Newton
+    (R(u) = u + C_h f_s, dR/du = I + C_h K, step halving on |R|, to 1e-10 of u, at most 1e-13 m) from
+    the previous solution, its last correction applied linearised (f_s + K du, exact to O(|R|^2)); the condensed tangent is df_s = M (-K dd0 + H dgamma) -
+    M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
+    C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
+    arm r + u."""
+    idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend, cc, ustate = pack
     cd, linear = dc[0], dc[1] > 0.5
     kb, g = sc[SC_K_BEND], sc[SC_G]
     th, om = q[idx[2]], v[idx[2]]
     c, s = np.cos(th), np.sin(th)
-    b = np.zeros((2, 5))
-    ii = np.zeros(5, np.int64)
-    for j in range(bores.shape[0]):
+    n = bores.shape[0]
+    n2 = 2 * n
+    elastic = n > 0 and cc.shape[0] == n2
+    rx, ry = np.empty(n), np.empty(n)
+    d0x, d0y, dvx, dvy, gam = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for j in range(n):
         lx, ly = bores[j, 0], bores[j, 1]
-        rx, ry = c * lx - s * ly, s * lx + c * ly
+        rx[j], ry[j] = c * lx - s * ly, s * lx + c * ly
         jx, jy, jp = idx[6 + 3 * j], idx[7 + 3 * j], idx[8 + 3 * j]
-        dx = q[jx] - q[idx[0]] - rx
-        dy = q[jy] - q[idx[1]] - ry
-        dvx = v[jx] - v[idx[0]] + om * ry
-        dvy = v[jy] - v[idx[1]] - om * rx
-        gam = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
-        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qs = crank_support_force(dx, dy, gam, clear[j], sc, angles, linear,
-                                                                       bstate[j, 0], bstate[j, 1])
-        bstate[j, 0], bstate[j, 1] = bx, by
-        damp = cd if (qs > 0.0 or kxx + kyy > 0.0) else 0.0
-        fx -= damp * dvx  # on the crank
-        fy -= damp * dvy
+        d0x[j] = q[jx] - q[idx[0]] - rx[j]
+        d0y[j] = q[jy] - q[idx[1]] - ry[j]
+        dvx[j] = v[jx] - v[idx[0]] + om * ry[j]
+        dvy[j] = v[jy] - v[idx[1]] - om * rx[j]
+        gam[j] = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
+    fs, u, qs = np.zeros(n2), np.zeros(n2), np.zeros(n)
+    kk, hh = np.zeros((n2, n2)), np.zeros((n2, n))
+    ch = np.zeros((n2, n2))
+    if elastic:
+        for a in range(n):  # C_h = R C R^T, blockwise
+            for b in range(n):
+                c00, c01 = cc[2 * a, 2 * b], cc[2 * a, 2 * b + 1]
+                c10, c11 = cc[2 * a + 1, 2 * b], cc[2 * a + 1, 2 * b + 1]
+                t00, t01 = c * c00 - s * c10, c * c01 - s * c11  # R C
+                t10, t11 = s * c00 + c * c10, s * c01 + c * c11
+                ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
+                ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
+        for j in range(n):
+            u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    if elastic:
+        eye = np.eye(n2)
+        res = u + ch @ fs
+        r0 = np.max(np.abs(res))
+        for _ in range(60):
+            if r0 <= max(1e-15, 1e-10 * np.max(np.abs(u))):  # 1e-13 m or better
+                break
+            step = np.linalg.solve(eye + ch @ kk, res)
+            lam = 1.0
+            u0 = u.copy()
+            for _h in range(40):  # step halving on max|R| (R is the gradient of a convex energy)
+                u = u0 - lam * step
+                _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+                res = u + ch @ fs
+                r1 = np.max(np.abs(res))
+                if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
+                    break
+                lam *= 0.5
+            if r1 >= r0 and r0 <= 1e-12:
+                break
+            r0 = r1
+        # the last Newton correction, linearised (O(|R|^2) exact): the result is smooth in q down to
+        # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
+        corr = -np.linalg.solve(eye + ch @ kk, res)
+        u = u + corr
+        fs = fs + kk @ corr
+        for j in range(n):
+            ustate[j, 0], ustate[j, 1] = u[2 * j], u[2 * j + 1]
+            ustate[j, 2], ustate[j, 3] = c * u[2 * j] + s * u[2 * j + 1], -s * u[2 * j] + c * u[2 * j + 1]
+    damp = np.zeros(n)
+    for j in range(n):
+        jx, jy = idx[6 + 3 * j], idx[7 + 3 * j]
+        kxx, kxy, kyy = kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j + 1]
+        damp[j] = cd if (qs[j] > 0.0 or kxx + kyy > 0.0) else 0.0
+        fx = fs[2 * j] - damp[j] * dvx[j]  # on the crank
+        fy = fs[2 * j + 1] - damp[j] * dvy[j]
+        ax, ay = rx[j] + u[2 * j], ry[j] + u[2 * j + 1]  # the bore's arm (elastic carrier: deflected)
         f[idx[0]] -= fx
         f[idx[1]] -= fy
-        f[idx[2]] -= rx * fy - ry * fx
+        f[idx[2]] -= ax * fy - ay * fx
         f[jx] += fx
         f[jy] += fy
         out_fx[j], out_fy[j] = fx, fy
         # bending share of the tangential compliance: |K_s t|^2 / (k_bend t.K_s t) (module docstring
         # of flexrv.contact.tapered_roller: the shaft deflection is K_s dd / k_bend)
-        rr = np.sqrt(rx * rx + ry * ry) + 1e-300
-        tx, ty = -ry / rr, rx / rr
+        rr = np.sqrt(rx[j] * rx[j] + ry[j] * ry[j]) + 1e-300
+        tx, ty = -ry[j] / rr, rx[j] / rr
         ktx, kty = kxx * tx + kxy * ty, kxy * tx + kyy * ty
         ktt = tx * ktx + ty * kty
         out_bend[j] = (ktx * ktx + kty * kty) / (kb * ktt) if (kb > 0.0 and ktt > 0.0) else 0.0
-        if jac:  # B = d(d)/d(crank x, y; carrier x, y, theta)
-            ii[0], ii[1], ii[2], ii[3], ii[4] = jx, jy, idx[0], idx[1], idx[2]
-            b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4] = 1.0, 0.0, -1.0, 0.0, ry
-            b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4] = 0.0, 1.0, 0.0, -1.0, -rx
-            _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
-            _add_btkb(jv, ii, b, 1.0, 0.0, 1.0, damp)
-            if not linear:  # the bore's rotation in the carrier's moment: d(ry fx - rx fy)/dtheta at fixed f
-                # (the linear legacy law keeps its Jacobian of tests/data/force_reference.npz, without it)
-                jq[idx[2], idx[2]] += rx * (fx + damp * dvx) + ry * (fy + damp * dvy)
-            # the cage angle gamma(phi_j, theta): Q = B^T f, df/dgamma = h
-            for r in range(5):
-                bh = b[0, r] * hx + b[1, r] * hy
-                jq[ii[r], jp] += 0.5 * (1.0 - g) * bh
-                jq[ii[r], idx[2]] += 0.5 * (1.0 + g) * bh
+    if not jac:
+        return
+    # local coordinates: carrier x, y, theta, then crank j's x, y, phi
+    m = 3 + 3 * n
+    gi = np.empty(m, np.int64)
+    gi[0], gi[1], gi[2] = idx[0], idx[1], idx[2]
+    d0 = np.zeros((n2, m))  # d(d0)/dq
+    gg = np.zeros((n, m))  # d(gamma)/dq
+    for j in range(n):
+        gi[3 + 3 * j], gi[4 + 3 * j], gi[5 + 3 * j] = idx[6 + 3 * j], idx[7 + 3 * j], idx[8 + 3 * j]
+        d0[2 * j, 0], d0[2 * j, 2], d0[2 * j, 3 + 3 * j] = -1.0, ry[j], 1.0
+        d0[2 * j + 1, 1], d0[2 * j + 1, 2], d0[2 * j + 1, 4 + 3 * j] = -1.0, -rx[j], 1.0
+        gg[j, 2], gg[j, 5 + 3 * j] = 0.5 * (1.0 + g), 0.5 * (1.0 - g)
+    df = -kk @ d0 + hh @ gg  # dfs/dq (rigid carrier)
+    zf = np.empty(n2)
+    for j in range(n):
+        zf[2 * j], zf[2 * j + 1] = -fs[2 * j + 1], fs[2 * j]  # Z fs
+    arm_term = 0.0  # d(arm)/dtheta x fs: the bore's rotation in the carrier's moment
+    for j in range(n):
+        arm_term += rx[j] * fs[2 * j] + ry[j] * fs[2 * j + 1]
+    wc = np.zeros(n2)  # extra row weight of the elastic carrier: C_h Z fs
+    if elastic:
+        a = np.empty(n2)
+        cu = ch @ zf
+        for j in range(n):
+            a[2 * j], a[2 * j + 1] = u[2 * j + 1] - cu[2 * j], -u[2 * j] - cu[2 * j + 1]  # -Z u - C_h Z fs
+        mm = np.linalg.inv(eye + kk @ ch)
+        df = mm @ df
+        mka = mm @ (kk @ a)
+        for r in range(n2):
+            df[r, 2] -= mka[r]
+        wc = cu
+        arm_term -= zf @ a
+    # rows: crank j (x, y) += df; carrier (x, y) -= sum df; carrier theta -= (Z (r + u) + C_h Z fs) . df
+    for j in range(n):
+        for col in range(m):
+            jq[gi[3 + 3 * j], gi[col]] += df[2 * j, col]
+            jq[gi[4 + 3 * j], gi[col]] += df[2 * j + 1, col]
+            jq[gi[0], gi[col]] -= df[2 * j, col]
+            jq[gi[1], gi[col]] -= df[2 * j + 1, col]
+            wx = -(ry[j] + u[2 * j + 1]) + wc[2 * j]
+            wy = rx[j] + u[2 * j] + wc[2 * j + 1]
+            jq[gi[2], gi[col]] -= wx * df[2 * j, col] + wy * df[2 * j + 1, col]
+    if elastic or not linear:  # (the linear legacy law keeps its Jacobian of tests/data/force_reference.npz)
+        jq[gi[2], gi[2]] += arm_term
+    b = np.zeros((2, 5))
+    ii = np.zeros(5, np.int64)
+    for j in range(n):  # the damper on the rigid relative velocity: B = d(d0)/d(crank x, y; carrier x, y, theta)
+        if damp[j] == 0.0:
+            continue
+        ii[0], ii[1], ii[2], ii[3], ii[4] = gi[3 + 3 * j], gi[4 + 3 * j], gi[0], gi[1], gi[2]
+        b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4] = 1.0, 0.0, -1.0, 0.0, ry[j]
+        b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4] = 0.0, 1.0, 0.0, -1.0, -rx[j]
+        # rows: the generalized force of F_d = -c B v on crank, carrier and, with the arm r + u, the
+        # carrier's moment (its row weight (u_y, -u_x) beyond B's rigid arm)
+        for col in range(5):
+            for a_ in range(4):
+                jv[ii[a_], ii[col]] -= damp[j] * (b[0, a_] * b[0, col] + b[1, a_] * b[1, col])
+            jv[ii[4], ii[col]] -= damp[j] * ((ry[j] + u[2 * j + 1]) * b[0, col] - (rx[j] + u[2 * j]) * b[1, col])
 
 
 class CrankSupports(KernelGroup):
@@ -168,14 +307,25 @@ class CrankSupports(KernelGroup):
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
+        #: (2N, 2N) support-point compliance of the elastic carrier, carrier frame [m/N]; (0, 0): rigid
+        self.carrier_c = np.ascontiguousarray(getattr(p, "carrier_compliance", np.zeros((0, 0))), dtype=float)
+        if self.carrier_c.size and self.carrier_c.shape != (2 * self.n, 2 * self.n):
+            raise ValueError(f"carrier_compliance has shape {self.carrier_c.shape}, expected {(2 * self.n,) * 2}")
+        self.ustate = np.zeros((self.n, 4))
+
+    @property
+    def elastic_carrier(self) -> bool:
+        return self.carrier_c.size > 0
 
     def pack(self, idx, history=False):
-        return (idx, self.sc, self.dc, self.bores, self.clear, self.angles, self.fx, self.fy, self.bstate, self.bend)
+        return (idx, self.sc, self.dc, self.bores, self.clear, self.angles, self.fx, self.fy, self.bstate, self.bend,
+                self.carrier_c, self.ustate)
 
     @staticmethod
     def empty_pack():
         z = np.zeros(0)
-        return (np.zeros(6, np.int64), np.zeros(7), np.zeros(2), np.zeros((0, 2)), z, z, z, z, np.zeros((0, 2)), z)
+        return (np.zeros(6, np.int64), np.zeros(7), np.zeros(2), np.zeros((0, 2)), z, z, z, z, np.zeros((0, 2)), z,
+                np.zeros((0, 0)), np.zeros((0, 4)))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         crank_support_kernel(q, v, f, jq, jv, jac, pack)
@@ -184,10 +334,11 @@ class CrankSupports(KernelGroup):
         """Forget the bearing displacements of earlier evaluations (the inner Newton's
         start; the solution does not depend on it beyond its 1e-13 tolerance)."""
         self.bstate[:] = 0.0
+        self.ustate[:] = 0.0
         super().reset()
 
     def record_sources(self):
-        return {"fx": self.fx, "fy": self.fy, "bend": self.bend}
+        return {"fx": self.fx, "fy": self.fy, "bend": self.bend, "u": self.ustate}
 
     def outputs(self, t, rec):
         out = {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
@@ -195,6 +346,16 @@ class CrankSupports(KernelGroup):
         if self.sc[SC_K_BEND] > 0.0:  # elastic crank
             out["crank_bending_fraction"] = Output(rec["bend"], ("time", "crank"), "1",
                                                    "share of crank bending in the crank support's tangential compliance")
+        if self.elastic_carrier:
+            u = rec["u"][..., 2:]  # (T, N, 2) carrier frame (ustate columns 2, 3)
+            out["carrier_bore_deflection"] = Output(np.hypot(u[..., 0], u[..., 1]), ("time", "crank"), "m",
+                                                    "deflection of each crank's support point (split-weighted bores) "
+                                                    "in the elastic carrier relative to the output flange")
+            t = np.asarray(self.bores, dtype=float)
+            t = np.stack([-t[:, 1], t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+            out["carrier_bore_deflection_tangential"] = Output((u * t).sum(axis=-1), ("time", "crank"), "m",
+                                                               "tangential (torque-direction) component of "
+                                                               "carrier_bore_deflection")
         return out
 
 

@@ -61,7 +61,7 @@ def empirical_needle_constant(reducer) -> float:
 
 def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
                 crankshaft: str = "rigid", ring_options: dict | None = None, crank_options: dict | None = None,
-                model_name: str = "rigid", exudyn: bool = True) -> AssembledModel:
+                model_name: str = "rigid", exudyn: bool = True, bodies=None) -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
     ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
@@ -71,15 +71,27 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     ``crankshaft``: ``"rigid"`` or ``"flexible"`` (:mod:`flexrv.model.flexible_crank`,
     options ``crank_options``). ``model_name`` labels the results of a non-rigid
     variant. ``exudyn=False`` returns the members and force groups without an Exudyn
-    system (the quasi-static solver evaluates the same groups directly)."""
+    system (the quasi-static solver evaluates the same groups directly).
+
+    ``bodies``: the elastic bodies of the run among :data:`BODY_PARTS` (``carrier``:
+    the FE carrier condensed into the crank supports; ``cycloid_disc``: the FE disc
+    body around the pins, :mod:`flexrv.model.cranks_discs`, :mod:`flexrv.model.pins`);
+    None takes the design's switches (``carrier.body_model``,
+    ``second_stage.disc_body_model``), a list sets them (named: ``condensed_fe``,
+    others ``rigid``; :func:`flexrv.model.parameters.with_bodies`)."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
     from flexrv.model.loads import OutputLoads, locked_drive, position_drive, ramp_drive, step_torque
     from flexrv.model.main_bearing_rigid import RigidMainBearing
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.parameters import rigid_parameters, with_bodies
     from flexrv.model.pins import PinContacts
 
+    if bodies is not None:
+        bad = [b for b in bodies if b not in BODY_PARTS]
+        if bad:
+            raise ConfigError(f"bodies = {','.join(bad)} is not allowed: choose from {', '.join(BODY_PARTS)}")
+        reducer = with_bodies(reducer, bodies)
     p = rigid_parameters(reducer)
     if drive == "ramp":
         theta, omega = ramp_drive(p.input_speed, p.speed_ramp_time)
@@ -128,7 +140,9 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
             "crank_options", crank_options, signature_options(add_flexible_cranks, skip=4))))
     elif crankshaft != "rigid":
         raise ConfigError(f"crankshaft = {crankshaft!r} is not allowed: choose 'rigid' or 'flexible'")
-    info.update(main_bearing=main_bearing, crankshaft=crankshaft)
+    info.update(main_bearing=main_bearing, crankshaft=crankshaft,
+                elastic_bodies=[b for b, on in (("carrier", p.carrier_compliance.size > 0),
+                                                ("cycloid_disc", p.disc_compliance.size > 0)) if on])
     name = "rigid" if (main_bearing, crankshaft) == ("rigid", "rigid") else model_name
     model = AssembledModel(name=name, reducer=reducer, params=p, members=members, groups=groups, input_angle=theta,
                            input_speed=omega, load_torque=torque, info=info)
@@ -194,16 +208,39 @@ def build_balls(reducer, **kwargs) -> AssembledModel:
     return build_rigid(reducer, main_bearing="balls", model_name="balls", **kwargs)
 
 
-#: parts that :func:`build_flexible` can make flexible
-FLEXIBLE_PARTS = ("main_bearing", "crankshaft")
+#: elastic bodies condensed into the force elements of every model (rigid, balls, flexible)
+BODY_PARTS = ("carrier", "cycloid_disc")
+#: parts that :func:`build_flexible` can make flexible (the last two: :data:`BODY_PARTS`)
+FLEXIBLE_PARTS = ("main_bearing", "crankshaft") + BODY_PARTS
 DEFAULT_FLEXIBLE_PARTS = ("main_bearing",)
 
 
+def parts_options(model: str, parts) -> dict:
+    """Builder options from a ``--parts`` list (CLI semantics): ``--parts`` names the
+    elastic parts of the run, the others are rigid. ``carrier`` and ``cycloid_disc``
+    work with every model (option ``bodies``); ``main_bearing`` and ``crankshaft``
+    need ``--model flexible``. None (no ``--parts``): {} (the design's switches for
+    the bodies; ``flexible``: main_bearing flexible)."""
+    if parts is None:
+        return {}
+    parts = parse_parts(parts)
+    if model == "flexible":
+        return {"parts": parts}
+    own = [x for x in parts if x not in BODY_PARTS]
+    if own:
+        raise ConfigError(f"parts = {','.join(own)} needs --model flexible (got --model {model}); with --model "
+                          f"{model} --parts names elastic bodies only: {', '.join(BODY_PARTS)}")
+    return {"bodies": parts}
+
+
 def parse_parts(parts) -> tuple[str, ...]:
-    """Validate a list (or comma-separated string) of flexible part names."""
+    """Validate a list (or comma-separated string) of flexible part names; ``none``
+    alone: no elastic part (every body rigid)."""
     if isinstance(parts, str):
         parts = [p.strip() for p in parts.split(",") if p.strip()]
     parts = tuple(parts)
+    if parts == ("none",):
+        return ()
     bad = [p for p in parts if p not in FLEXIBLE_PARTS]
     if bad or not parts:
         raise ConfigError(f"parts = {','.join(parts) or '(empty)'} is not allowed: choose one or more of "
@@ -211,9 +248,11 @@ def parse_parts(parts) -> tuple[str, ...]:
     return parts
 
 
-def build_flexible(reducer, parts=DEFAULT_FLEXIBLE_PARTS, ring_options: dict | None = None,
+def build_flexible(reducer, parts=None, ring_options: dict | None = None,
                    crank_options: dict | None = None, **kwargs) -> AssembledModel:
-    """Rigid model with the named parts flexible (:data:`FLEXIBLE_PARTS`):
+    """Rigid model with the named parts flexible (:data:`FLEXIBLE_PARTS`; None: the
+    main bearing, with the design's elastic bodies; a list: exactly the named parts,
+    ``carrier`` / ``cycloid_disc`` included or rigid):
 
     * ``main_bearing`` — ball-resolved bearing with reduced flexible inner and
       outer rings of both rows (:func:`flexrv.model.flexible_bearing.flexible_rings`,
@@ -225,10 +264,15 @@ def build_flexible(reducer, parts=DEFAULT_FLEXIBLE_PARTS, ring_options: dict | N
     * ``crankshaft`` — flexible crankshafts (:mod:`flexrv.model.flexible_crank`,
       options ``crank_options``: size, stiffness_scale, damping_ratio).
     """
-    parts = parse_parts(parts)
+    bodies = None
+    if parts is None:
+        parts = DEFAULT_FLEXIBLE_PARTS
+    else:
+        parts = parse_parts(parts)
+        bodies = tuple(x for x in parts if x in BODY_PARTS)
     return build_rigid(reducer, main_bearing="flexible" if "main_bearing" in parts else "rigid",
                        crankshaft="flexible" if "crankshaft" in parts else "rigid", ring_options=ring_options,
-                       crank_options=crank_options, model_name="flexible", **kwargs)
+                       crank_options=crank_options, model_name="flexible", bodies=bodies, **kwargs)
 
 
 #: model name -> builder(reducer, drive=..., torque=..., **options) -> AssembledModel
@@ -243,7 +287,7 @@ def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
     builder = MODELS[model]
     allowed = signature_options(builder, skip=1, exclude=("model_name",))
     if builder is not build_rigid:  # build_balls / build_flexible pass the rest on to build_rigid
-        set_here = ("main_bearing", "crankshaft") if builder is build_flexible else ("main_bearing",)
+        set_here = ("main_bearing", "crankshaft", "bodies") if builder is build_flexible else ("main_bearing",)
         allowed = {**signature_options(build_rigid, skip=1, exclude=("model_name",) + set_here), **allowed}
         allowed.pop("kwargs", None)
     opts = check_options(f"model options of {model!r}", {k: v for k, v in kwargs.items() if k not in ("drive", "torque")},

@@ -47,7 +47,7 @@ from flexrv.model.cranks_discs import CrankSupports, NeedleBearings, crank_suppo
 from flexrv.model.gear_stage import GearMeshes, gear_stage_kernel
 from flexrv.model.loads import OutputLoads, loads_kernel
 from flexrv.model.main_bearing_rigid import RigidMainBearing, main_bearing_kernel
-from flexrv.model.pins import PinContacts, pin_kernel
+from flexrv.model.pins import PinContacts, pin_body_kernel
 
 #: slots of the fused kernel, in call order, and the group class of each
 KINDS = (("gear", GearMeshes), ("supports", CrankSupports), ("needles", NeedleBearings), ("pins", PinContacts),
@@ -67,7 +67,7 @@ def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, ma
     gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, gear)
     crank_support_kernel(q, v, f, jq, jv, jac, supports)
     needle_kernel(q, v, f, jq, jv, jac, needles)
-    pin_kernel(q, v, f, jq, jv, jac, pins)
+    pin_body_kernel(q, v, f, jq, jv, jac, pins)
     main_bearing_kernel(q, v, f, jq, jv, jac, main_bearing)
     loads_kernel(q, v, f, jq, jv, jac, loads)
 

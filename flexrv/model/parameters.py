@@ -126,6 +126,12 @@ class RigidParameters:
     sun_runout: np.ndarray  #: (2,) amplitude [m] along the lines of action, phase [rad]
     planet_runout: np.ndarray  #: (N, 2) amplitude [m], phase [rad]
     planet_phase_errors: np.ndarray  #: (N,) assembly phase error of each planet on its crank [rad]
+    #: (2N, 2N) compliance [m/N] of the cranks' support points in the carrier frame (FE carrier,
+    #: :func:`flexrv.fem.carrier.crank_support_compliance`); (0, 0): rigid carrier (``carrier.body_model``)
+    carrier_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    #: (n_discs, 3, 3) compliance of each disc's rim pose (x, y, psi) relative to its hub per unit pin force
+    #: (:func:`flexrv.fem.disc.rim_compliance`); (0, 3, 3): rigid discs (``second_stage.disc_body_model``)
+    disc_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
     extra: dict = field(default_factory=dict)
     # friction (issue 14, design [contact] friction fields; 0 = off)
     pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
@@ -136,6 +142,46 @@ class RigidParameters:
 
 def _cyl_mass(rho, d, length):
     return rho * math.pi * 0.25 * d * d * length
+
+
+def body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
+    """The elastic bodies' matrices of the models (issue 14), per the design's switches:
+    the carrier's (2N, 2N) support-point compliance if ``carrier.body_model =
+    "condensed_fe"`` (and the design has a ``[carrier]`` table), else (0, 0); the
+    discs' (n_discs, 3, 3) rim compliance if ``second_stage.disc_body_model =
+    "condensed_fe"``, else (0, 3, 3). From the cached FE condensations
+    (:mod:`flexrv.fem.carrier`, :mod:`flexrv.fem.disc`; cold: about a minute each)."""
+    carrier_c = np.zeros((0, 0))
+    cr = reducer.carrier
+    if cr is not None and cr.body_model == "condensed_fe":
+        from flexrv.fem.carrier import crank_support_compliance
+
+        carrier_c = crank_support_compliance(reducer)
+    disc_c = np.zeros((0, 3, 3))
+    if reducer.second_stage.disc_body_model == "condensed_fe":
+        from flexrv.fem.disc import rim_compliance
+
+        disc_c = np.repeat(rim_compliance(reducer)[None], reducer.second_stage.n_discs, axis=0)
+    return np.ascontiguousarray(carrier_c, dtype=float), np.ascontiguousarray(disc_c, dtype=float)
+
+
+def with_bodies(reducer, bodies) -> object:
+    """The design with its elastic-body switches set from ``bodies`` (names among
+    ``carrier``, ``cycloid_disc``): a named body becomes ``condensed_fe``, an unnamed
+    one ``rigid`` (the one parameter route of ``--parts``: the switches are design
+    fields)."""
+    bodies = set(bodies)
+    ss = reducer.second_stage.model_copy(update={"disc_body_model": "condensed_fe" if "cycloid_disc" in bodies
+                                                 else "rigid"})
+    update = {"second_stage": ss}
+    if reducer.carrier is not None:
+        update["carrier"] = reducer.carrier.model_copy(
+            update={"body_model": "condensed_fe" if "carrier" in bodies else "rigid"})
+    elif "carrier" in bodies:
+        from flexrv.errors import ConfigError
+
+        raise ConfigError("parts = carrier needs the design's [carrier] table (carrier geometry); this design has none")
+    return reducer.model_copy(update=update)
 
 
 def rigid_parameters(reducer) -> RigidParameters:
@@ -211,6 +257,7 @@ def rigid_parameters(reducer) -> RigidParameters:
     kmb = np.array([k_r, k_r, mb.rigid_axial_stiffness_N_per_m, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
     cmb = 2.0 * mb.rigid_damping_ratio * np.sqrt(kmb * np.array([reducer.inertia.carrier_mass_kg] * 3
                                               + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2))
+    carrier_c, disc_c = body_compliance_matrices(reducer)
     return RigidParameters(
         n_cranks=n, n_discs=nd, z_s=z_s, z_p=z_p, z_c=z_c, z_rp=z_rp, ratio=ratio,
         base_radius_sun=rb_s, base_radius_planet=rb_p, center_distance=a_w, working_pressure_angle=alpha_w,
@@ -239,7 +286,7 @@ def rigid_parameters(reducer) -> RigidParameters:
         eccentricities=ab.eccentricities, eccentric_phase_errors=ab.eccentric_phase_errors,
         crank_bores=ab.crank_bores, needle_clearances=ab.needle_clearances,
         support_clearances=ab.support_clearances, sun_runout=ab.sun_runout, planet_runout=ab.planet_runout,
-        planet_phase_errors=ab.planet_phase_errors,
+        planet_phase_errors=ab.planet_phase_errors, carrier_compliance=carrier_c, disc_compliance=disc_c,
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
         pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
         if ct.friction else 0.0,

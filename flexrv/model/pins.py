@@ -79,6 +79,16 @@ T[psi, y] = -n_y, T[psi, psi] = -(r x n)_z. mu = 0 or contact.friction = false
 skips the friction code (the frictionless numbers exactly). Verified against
 central differences in tests/test_friction.py.
 
+Disc body (issue 14; design ``second_stage.disc_body_model = "condensed_fe"``): the
+pins act on the disc's rim (tooth region) whose pose is q_r = q_hub + delta, the
+needle bearings on its hub (the disc member's coordinates); delta = C_d Q(q_r),
+C_d the (3 x 3) rim compliance relative to the crank holes from the disc FE
+(:func:`flexrv.fem.disc.rim_compliance`: the torsional compliance under the
+rated pin-load pattern, its choice and error stated there). :func:`pin_body_kernel`
+wraps :func:`pin_kernel` (unchanged) in a local Newton on delta per disc with the
+condensed Jacobians (I - J C_d)^-1 J and (I - J C_d)^-1 J_v. With C_d = 0 it is
+the plain pin kernel. Verified in tests/test_bodies.py.
+
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
 that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
@@ -264,6 +274,101 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         f[ip] += fp
 
 
+@njit(cache=True)
+def pin_body_kernel(q, v, f, jq, jv, jac, pack):
+    """The pins' kernel with elastic disc bodies (wrapper around :func:`pin_kernel`;
+    module docstring, "Disc body"). ``pack`` = (pin_kernel's pack, cd, dstate): cd
+    (n_discs, 3, 3) the rim compliance of each disc (empty: rigid discs, a plain
+    :func:`pin_kernel` call), dstate (n_discs, 3) the rim offsets delta (x, y, psi)
+    of the last call (Newton start, output).
+
+    The pins act on the rim pose q_r = q_hub + delta with delta = C_d Q(q_r), Q the
+    pins' generalized force on the disc; a local Newton on delta, R = delta - C_d Q,
+    dR/d(delta) = I - C_d J (J = dQ/dq from :func:`pin_kernel`), step halving on
+    max|R| (x, y [m]; psi times R_p), to 1e-10 of delta (at most 1e-13 m, at least 1e-15 m), and the
+    last correction applied linearised (Q + J d(delta), exact to O(|R|^2)). The condensed Jacobians follow
+    from Q_eff(q, v) = Q(q + delta(q, v), v): dQ_eff/dq = (I - J C_d)^-1 J,
+    dQ_eff/dv = (I - J C_d)^-1 J_v (the rim's velocity is the hub's: the rate of
+    delta is left out of the contact damping)."""
+    pins, cd, dstate = pack
+    nd = cd.shape[0]
+    if nd == 0:
+        pin_kernel(q, v, f, jq, jv, jac, pins)
+        return
+    idx = pins[0]
+    r_p = pins[1][1]
+    n = q.shape[0]
+    qr = q.copy()
+    fs = np.zeros(n)
+    js, jvs = np.zeros((n, n)), np.zeros((n, n))
+    delta = dstate.copy()
+    res = np.zeros((nd, 3))
+    jk = np.zeros((nd, 3, 3))
+    eye = np.eye(3)
+    r0 = np.inf
+    lam = 1.0
+    step = np.zeros((nd, 3))
+    base = dstate.copy()
+    for it in range(80):
+        for kd in range(nd):
+            for a in range(3):
+                delta[kd, a] = base[kd, a] - lam * step[kd, a]
+                qr[idx[3 * kd + a]] = q[idx[3 * kd + a]] + delta[kd, a]
+        fs[:] = 0.0
+        js[:, :] = 0.0
+        jvs[:, :] = 0.0
+        pin_kernel(qr, v, fs, js, jvs, True, pins)
+        r1 = 0.0
+        for kd in range(nd):
+            for a in range(3):
+                acc = delta[kd, a]
+                for b in range(3):
+                    acc -= cd[kd, a, b] * fs[idx[3 * kd + b]]
+                    jk[kd, a, b] = js[idx[3 * kd + a], idx[3 * kd + b]]
+                res[kd, a] = acc
+                r1 = max(r1, abs(acc) * (r_p if a == 2 else 1.0))
+        scale = 0.0
+        for kd in range(nd):
+            scale = max(scale, abs(delta[kd, 0]), abs(delta[kd, 1]), abs(delta[kd, 2]) * r_p)
+        tol = max(1e-15, 1e-10 * scale)  # 1e-13 m or better (round-off of the gap: ~1e-17 m)
+        if it > 0 and r1 >= r0:
+            if r0 <= 100.0 * tol:  # at round-off: accept
+                break
+            if lam > 1e-6:  # step halving on max|R| (R: gradient of a convex energy)
+                lam *= 0.5
+                continue
+        r0 = r1
+        if r1 <= tol:
+            break
+        for kd in range(nd):  # Newton step from here
+            base[kd] = delta[kd]
+            step[kd] = np.linalg.solve(eye - cd[kd] @ jk[kd], res[kd])
+        lam = 1.0
+    for kd in range(nd):
+        # the last Newton correction, linearised (O(|R|^2) exact): the result is smooth in q and v down
+        # to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
+        ii = idx[3 * kd:3 * kd + 3]
+        corr = -np.linalg.solve(eye - cd[kd] @ jk[kd], res[kd])
+        dq_ = jk[kd] @ corr
+        for a in range(3):
+            delta[kd, a] += corr[a]
+            f[ii[a]] += fs[ii[a]] + dq_[a]
+    dstate[:, :] = delta
+    for kd in range(nd):
+        ii = idx[3 * kd:3 * kd + 3]
+        if jac:
+            jvk = np.empty((3, 3))
+            for a in range(3):
+                for b in range(3):
+                    jvk[a, b] = jvs[ii[a], ii[b]]
+            mk = np.linalg.inv(eye - jk[kd] @ cd[kd])
+            jc, jvc = mk @ jk[kd], mk @ jvk
+            for a in range(3):
+                for b in range(3):
+                    jq[ii[a], ii[b]] += jc[a, b]
+                    jv[ii[a], ii[b]] += jvc[a, b]
+
+
 @functools.lru_cache(maxsize=64)
 def _curve_reach(z_rp: int, radius: float, eccentricity: float, samples: int = 400) -> tuple[float, float]:
     """Lower estimates of the reach of the pin-centre curve C on its outer side
@@ -333,26 +438,37 @@ class PinContacts(KernelGroup):
         self.last = np.full((self.nd, z, 3), np.nan)
         #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
         self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
+        #: (n_discs, 3, 3) rim compliance of the elastic discs (pin_body_kernel); (0, 3, 3): rigid discs
+        self.disc_c = np.ascontiguousarray(getattr(p, "disc_compliance", np.zeros((0, 3, 3))), dtype=float)
+        if self.disc_c.size and self.disc_c.shape != (self.nd, 3, 3):
+            raise ValueError(f"disc_compliance has shape {self.disc_c.shape}, expected {(self.nd, 3, 3)}")
+        if not self.disc_c.size:
+            self.disc_c = np.zeros((0, 3, 3))
+        self.dstate = np.zeros((self.nd, 3))
+
+    @property
+    def elastic_discs(self) -> bool:
+        return self.disc_c.shape[0] > 0
 
     def pack(self, idx, history=False):
         phi, last, ctr = self.phi, self.last, self.ctr
         if history:  # post-processing: cold start at the first sample, then warm; every gap exact
             phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
             ctr = np.array([1, 0, 0, 0], dtype=np.int64)
-        return (idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
-                self.nx, self.ny, self.rxn, self.ft, self.pw, ctr)
+        return ((idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
+                 self.nx, self.ny, self.rxn, self.ft, self.pw, ctr), self.disc_c, self.dstate)
 
     @staticmethod
     def empty_pack():
         z2 = np.zeros((0, 0))
-        return (np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
-                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
-                np.array([1, 0, 0, 0], dtype=np.int64))
+        return ((np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
+                 np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
+                 np.array([1, 0, 0, 0], dtype=np.int64)), np.zeros((0, 3, 3)), np.zeros((0, 3)))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        ctr = pack[-1]
+        ctr = pack[0][-1]
         before = ctr[2]
-        pin_kernel(q, v, f, jq, jv, jac, pack)
+        pin_body_kernel(q, v, f, jq, jv, jac, pack)
         if ctr[2] != before:
             raise ConvergenceError("pin gap: closest-point iteration did not converge")
 
@@ -362,7 +478,7 @@ class PinContacts(KernelGroup):
 
     def record_sources(self):
         return {"gap": self.gap, "force": self.force, "nx": self.nx, "ny": self.ny, "rxn": self.rxn,
-                "ft": self.ft, "pw": self.pw}
+                "ft": self.ft, "pw": self.pw, "rim": self.dstate}
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
@@ -371,7 +487,7 @@ class PinContacts(KernelGroup):
             "pin_friction_force": Output(rec["ft"], dims, "N", "pin-disc friction force on the disc along t = z x n"),
             "pin_friction_power": Output(-rec["pw"].sum(axis=-1), ("time", "disc"), "W",
                                          "power dissipated by the pin-disc friction of each disc (>= 0)")}
-        return out | {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
+        out = out | {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
                 "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration); "
                                   "of a pin proved open by the solver: a positive lower bound"),
                 "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
@@ -381,6 +497,14 @@ class PinContacts(KernelGroup):
                 "housing_pin_torque": Output(self._housing_torque(rec), ("time", "disc"), "N m",
                                              "torque of each disc's pin forces (normal and friction) on the "
                                              "housing about the axis")}
+        if self.elastic_discs:
+            rim = rec["rim"]
+            out["disc_rim_rotation"] = Output(rim[..., 2], ("time", "disc"), "rad",
+                                              "rotation of each disc's tooth region (rim) relative to its crank "
+                                              "holes (hub): the elastic disc body's twist")
+            out["disc_rim_offset"] = Output(np.hypot(rim[..., 0], rim[..., 1]), ("time", "disc"), "m",
+                                            "translation of each disc's rim relative to its hub")
+        return out
 
     def _housing_torque(self, rec):
         """Torque of the pin forces on the housing about the axis: the normal force -F n
@@ -399,6 +523,7 @@ class PinContacts(KernelGroup):
         self.last[:] = np.nan
         self.ctr[0] = 0
         self.gap[:] = 0.0
+        self.dstate[:] = 0.0
 
     def check(self) -> str | None:
         if self.min_gap < -self.limit:

@@ -346,7 +346,11 @@ class StaticModel:
         displacement u = K^-1 e_theta under a unit output torque, the compliance is
         C = e_theta . u = u . K u and group g's share is its strain energy
         u . K_g u / C. The shares sum to 1; for elements in series each share is the
-        element's part of the total compliance (Castigliano)."""
+        element's part of the total compliance (Castigliano). An elastic carrier or
+        disc body condensed into the crank supports or the pins (issue 14) gets its
+        own share ``carrier`` / ``cycloid_disc``: df . C df / C with df the group's
+        force increment on the body's interface (the support points, the rim) and C
+        the body's compliance; the group keeps the rest."""
         from flexrv.model.assembled import group_index
 
         m = self.model
@@ -366,7 +370,27 @@ class StaticModel:
         e[self.i_theta] = 1.0
         u = np.linalg.solve(k_total, e)
         c = float(u[self.i_theta])
-        return {name: float(u @ k @ u) / c for name, k in parts.items()}
+        out = {name: float(u @ k @ u) / c for name, k in parts.items()}
+        # elastic bodies condensed into a group (issue 14): their strain energy split out of it. With the
+        # group's condensed force increment df = -K_g u on the body's interface, the body stores df.C.df
+        # (series element: its part of u.K_g.u), the contact/bearing the rest.
+        for g in m.groups:
+            if g.name == "crank_supports" and getattr(g, "elastic_carrier", False):
+                df = np.concatenate([-(parts[g.name] @ u)[m.slice(f"crank{j}")][:2] for j in range(g.n)])
+                th = float(q[self.i_theta])
+                c_, s_ = np.cos(th), np.sin(th)
+                rot = np.kron(np.eye(g.n), np.array([[c_, -s_], [s_, c_]]))
+                e_body = float(df @ (rot @ g.carrier_c @ rot.T) @ df) / c
+                out["carrier"] = e_body
+                out[g.name] -= e_body
+            if g.name == "pins" and getattr(g, "elastic_discs", False):
+                e_body = 0.0
+                for k in range(g.nd):
+                    dq = -(parts[g.name] @ u)[m.slice(f"disc{k}")]
+                    e_body += float(dq @ g.disc_c[k] @ dq) / c
+                out["cycloid_disc"] = e_body
+                out[g.name] -= e_body
+        return out
 
 
 @dataclass

@@ -54,8 +54,9 @@ def legacy_supports(r, name: str):
 def short_run_reducer(name: str = "rv40e"):
     """Preset with speed and load ramps shortened to 5 ms (steady after ~0.02 s)."""
     from flexrv.design import load
+    from flexrv.model.parameters import with_bodies
 
-    r = legacy_supports(load(name), name)
+    r = with_bodies(legacy_supports(load(name), name), [])  # rigid carrier and discs (issue 14: tests/test_bodies.py)
     op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
     return r.model_copy(update={"operating": op})
 
@@ -76,8 +77,9 @@ def variant(name: str, needle: str):
     0..4 ms and external radial/axial force and tilting moment (so the loads group
     is exercised at the sampled times)."""
     from flexrv.design import load
+    from flexrv.model.parameters import with_bodies
 
-    r = legacy_supports(load(name), name)
+    r = with_bodies(legacy_supports(load(name), name), [])  # rigid carrier and discs (issue 14: tests/test_bodies.py)
     op = r.operating.model_copy(update={"load_ramp_start_s": 0.0, "load_ramp_end_s": 0.004,
                                         "external_radial_force_N": 5000.0, "external_axial_force_N": 2000.0,
                                         "tilting_moment_Nm": 300.0})
