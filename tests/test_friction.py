@@ -89,7 +89,7 @@ def test_pin_friction_jacobian_vs_central_differences(v_scale):
     assert g.mu == 0.05 and g.v_reg == pytest.approx(1e-5)
     q, v = _loaded_state(m, v_scale)
     jq, jv, nq, nv = _group_fd(m, g, q, v, hv=1e-9 if v_scale < 1e-4 else 1e-8)
-    assert np.abs(nq).max() > 1e9
+    assert np.abs(nq).max() > 5e8  # pins in contact (with the pin seats in series: 9.6e8 N/m on rv40e)
     if v_scale < 1e-4:
         assert np.abs(nv).max() > 1e5
     assert g.pw.sum() < 0.0 and np.all(g.pw <= 0.0)

@@ -227,7 +227,7 @@ class FusedForces:
             dsts.append(np.empty((nt, a.size)))
             keys.append((g, key, a.shape))
         f = np.zeros(self.n)
-        pin_ctr = packs[[k for k, _ in KINDS].index("pins")][-1]
+        pin_ctr = packs[[k for k, _ in KINDS].index("pins")][0][-1]  # (pin pack, rim compliance, rim state)
         before = int(pin_ctr[2])
         if nt and srcs:
             fused_history(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
