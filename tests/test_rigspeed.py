@@ -118,9 +118,16 @@ def test_integrator_records_match_the_history_pass(name):
     run: nearly every sample is recorded (the rest, segment starts and repeated
     steps, come from the history pass); every output but pin_gap agrees within 1e-9
     of its largest value (measured <= 1.5e-10: the closest points' warm starts and
-    the supports' inner solves converge to their tolerances from other starts);
-    pin_gap agrees where the solver evaluated the pin, and elsewhere holds a
-    positive lower bound of the exact gap on a pin without force."""
+    the supports' inner solves converge to their tolerances from other starts;
+    measured 2026-11-24 after the merge with the disc bodies: <= 1e-9, the pin forces
+    6.7e-10 on rv221: the rim Newton of pins.pin_body_kernel starts from the solver's
+    last rim offsets in the run and from delta = 0 in the history pass, and converges
+    to 1e-10 of delta), except disc_rim_offset, which is round-off on both paths (the
+    rim compliance C_d of flexrv.fem.disc.rim_compliance is torsional, so the rim
+    translation is ~1e-31 m), compared with the rim Newton's absolute floor,
+    1e-15 m (pins.pin_body_kernel); pin_gap agrees where the solver evaluated the
+    pin, and elsewhere holds a positive lower bound of the exact gap on a pin without
+    force."""
     from flexrv.model.outputs import model_outputs
     from flexrv.post import results as post_results
     from flexrv.simulation import Simulation
@@ -147,7 +154,9 @@ def test_integrator_records_match_the_history_pass(name):
         a, b = np.asarray(fast[key].values, dtype=float), np.asarray(exact[key].values, dtype=float)
         if key == "pin_gap":
             continue
-        assert np.max(np.abs(a - b), initial=0.0) <= 1e-9 * max(np.max(np.abs(b), initial=0.0), 1e-300), key
+        floor = 1e-15 if key == "disc_rim_offset" else 0.0  # [m] the rim Newton's absolute tolerance
+        assert np.max(np.abs(a - b), initial=0.0) <= max(1e-9 * max(np.max(np.abs(b), initial=0.0), 1e-300),
+                                                         floor), key
     gap, gap_exact, force = fast["pin_gap"].values, exact["pin_gap"].values, exact["pin_force"].values
     bound = np.abs(gap - gap_exact) > 1e-12
     assert np.all(force[bound] == 0.0) and np.all(gap[bound] > 0.0) and np.all(gap[bound] <= gap_exact[bound])

@@ -455,6 +455,10 @@ class PinContacts(KernelGroup):
         if history:  # post-processing: cold start at the first sample, then warm; every gap exact
             phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
             ctr = np.array([1, 0, 0, 0], dtype=np.int64)
+            # the rim Newton too starts cold (delta = 0) at the first sample: the history pass and a group's
+            # own evaluate of the same samples are then bit-identical whatever ran before. In place: dstate is
+            # also the rim record (record_sources "rim"); the solver's next call merely starts its Newton cold
+            self.dstate[:] = 0.0
         return ((idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
                  self.nx, self.ny, self.rxn, self.ft, self.pw, ctr), self.disc_c, self.dstate)
 
