@@ -230,10 +230,14 @@ def test_condensed_disc_jacobian_central_differences(params):
     central differences of the group's force within 1e-6 of the largest entry (h =
     1e-9 m for q; h = 1e-4 m/s for v at 1 mm/s, where the contact damping acts: the
     force is linear in v there, and a smaller step meets the round-off of the rim's
-    Newton, ~1e-8 N)."""
+    Newton, ~1e-8 N). Without friction (pin_friction = 0): the step 1e-4 m/s is ten
+    times the friction's regularisation speed, so the regularised Coulomb force is not
+    linear over it; the condensation with friction is checked at smaller steps in
+    tests/test_friction.py::test_pin_friction_jacobian_with_disc_rim_condensation."""
     from flexrv.model.pins import PinContacts
 
-    g = PinContacts(params)
+    g = PinContacts(dataclasses.replace(params, pin_friction=0.0))
+    assert g.mu == 0.0
     q = _disc_state(params)
     v = np.zeros_like(q)
     jq, _ = g.jacobian(0.0, q, v)
