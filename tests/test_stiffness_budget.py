@@ -48,11 +48,12 @@ def test_stiffness_test_budget_matches_design_budget():
     path (pins + seats) within 10 % (measured -4.4 %), the housing element within 10 % (the model's
     own strain-energy share c_h (M_h / T)^2 against c_h: nothing unmodelled is added), elements
     sum to the model's tangent compliance."""
+    from flexrv.cli.design import elastic_body_compliances
     from flexrv.simulation import stiffness_test_budget
 
     r = load("rv40e")
     dyn = stiffness_test_budget(r, r.operating.rated_torque_Nm)
-    ana = stiffness_budget(r)
+    ana = stiffness_budget(r, bodies=elastic_body_compliances(r))  # the preset's FE carrier and disc bodies
     comp = dyn["compliances"]
     assert set(ana.compliances) <= set(comp)
     assert sum(comp.values()) == pytest.approx(ana.total, rel=0.10)
