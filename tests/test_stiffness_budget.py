@@ -67,12 +67,12 @@ def test_stiffness_test_budget_matches_design_budget():
 def test_design_te_and_stiffness_test_totals_agree(tmp_path):
     """Issue 14: the totals of ``flexrv design`` (analytic), ``flexrv te``
     (quasi-static, strain energy over the catalog positions) and ``flexrv
-    stiffness-test`` (dynamic: the loop's measured 50-100 % rigidity with the
-    unmodelled housing in series, and the budget printed with it) agree within 10 %
-    on rv40e (measured 2026-11-24 against design's 251.3 N m/arcmin: te budget 241.0
-    (-4.1 %), stiffness-test budget 241.2 (-4.0 %), the loop's 252.0 with the housing
-    in series 235.3 (-6.4 %; the loop's secant over 50-100 % rated against the
-    tangents at rated)). Runs the dynamic test and a short te range (9 s wall, 5 s CPU on the
+    stiffness-test`` (dynamic: the loop's measured 50-100 % rigidity, the housing
+    inside the model since the housing branch, nothing unmodelled added, and the
+    budget printed with it) agree within 10 % on rv40e (measured 2026-11-24 with the
+    CLI against design's 208.6 N m/arcmin: te budget 202.3 (-3.0 %), stiffness-test
+    budget 202.6 (-2.9 %), the loop's 199.6 (-4.3 %; the loop's secant over 50-100 %
+    rated against the tangents at rated)). Runs the dynamic test and a short te range (9 s wall, 5 s CPU on the
     shared machine with warm numba caches: not marked slow)."""
     from flexrv.cli.design import analytic_budget
     from flexrv.cli.te import quasi_static_budget
