@@ -577,7 +577,7 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
     elements by :func:`flexrv.analysis.torsional.budget_from_group_shares` (the mapping
     of ``flexrv te``). Returns {"compliances" [rad/(N m)], "tangent_rigidity"
     [N m/rad], "torque" [N m], "notes", "unmodelled": the elements of the budget that
-    the models do not contain (the housing), [rad/(N m)]}."""
+    the models do not contain, [rad/(N m)] (none since the housing is in the models)}."""
     from flexrv.analysis.torsional import UNMODELLED_ELEMENTS, budget_from_group_shares
     from flexrv.model.quasi_static import StaticModel, ramp_to
 
@@ -593,7 +593,7 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
     frac = float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0
     comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
     return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes),
-            "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS}}
+            "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS and k not in shares}}
 
 
 def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = 0.02, settle: float = 0.005,
@@ -644,7 +644,7 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
         budget["notes"].append(f"budget of the rigid quasi-static model at the test's pose (the loop ran the "
                                f"{model} model)")
     budget["measured_rigidity"] = figures.rigidity_Nm_per_arcmin * ARCMIN_PER_RAD
-    #: the loop's rigidity with the elements the model lacks (housing) in series
+    #: the loop's rigidity with the elements the model lacks in series (none: the housing is in the model)
     budget["measured_with_unmodelled_rigidity"] = 1.0 / (1.0 / budget["measured_rigidity"]
                                                          + sum(budget["unmodelled"].values()))
     budget["model"] = model

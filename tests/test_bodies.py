@@ -23,7 +23,8 @@ from flexrv.model.parameters import rigid_parameters, with_bodies
 
 @pytest.fixture(scope="module")
 def params():
-    return rigid_parameters(load("rv40e"))
+    # rigid housing: the disc and carrier bodies on their own (the housing: tests/test_housing.py)
+    return dataclasses.replace(rigid_parameters(load("rv40e")), housing_compliance=0.0)
 
 
 def _rigid_carrier(p):

@@ -497,6 +497,22 @@ def housing_compliance(reducer, output_torque: float | None = None, crank_angle:
     return HousingCompliance(ring=ring, tube=float(tube), total=ring + float(tube), max_displacement=w_max)
 
 
+def housing_model_compliance(reducer) -> float:
+    """The pin housing's torsional compliance c_h in the models and every budget
+    [rad/(N m)] (issue 14): :func:`housing_compliance` ``total`` (ring bending under
+    the pin loads + tube torsion, an energy equivalent: the ring's ovalisation enters
+    only through its strain energy) at the rated torque and crank angle 0, if the
+    design has a ``[housing]`` table with ``body_model = "ring_estimate"``; else 0
+    (rigid housing). One constant: the ring estimate is linear in the load (its
+    pin-load pattern changes it only through the pins in mesh). The dynamic and
+    quasi-static models turn the pin ring by phi_h = c_h M_h
+    (:func:`flexrv.model.pins.pin_body_kernel`), the analytic budget adds c_h in series."""
+    h = reducer.housing
+    if h is None or h.body_model != "ring_estimate":
+        return 0.0
+    return float(housing_compliance(reducer).total)
+
+
 @dataclass(frozen=True)
 class StiffnessBudget:
     """Analytic series model of the torsional compliance at the output (SI).
@@ -518,10 +534,9 @@ class StiffnessBudget:
 #: budget element names, shared with the quasi-static model's force groups where they coincide
 BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending", "pin_seats", "pin_bending",
                    "housing", "carrier", "cycloid_disc")
-#: the housing enters the budget where its estimate exceeds this fraction of the total (issue 14)
-HOUSING_THRESHOLD = 0.01
-#: budget elements that the dynamic and quasi-static models do not contain (:func:`unmodelled_elements`)
-UNMODELLED_ELEMENTS = ("housing",)
+#: budget elements that the dynamic and quasi-static models may lack (:func:`unmodelled_elements`): none since
+#: the housing entered the models (``housing.body_model``); kept for the budgets' "unmodelled" entry
+UNMODELLED_ELEMENTS = ()
 
 
 def split_pin_path(compliances: dict, reducer) -> dict:
@@ -572,11 +587,14 @@ def budget_from_group_shares(shares: dict, total: float, bending_fraction: float
 
 
 def unmodelled_elements(reducer, model_total: float, torque: float | None = None) -> tuple[dict, tuple]:
-    """Budget elements that the dynamic and quasi-static models do not contain (their
-    housing is rigid): the housing estimate (:func:`housing_compliance`) where it is
-    more than HOUSING_THRESHOLD of the total with it, else a note; and a note on the
-    pin seats' conformity. Returns (compliances, notes); every budget (analytic,
-    quasi-static, dynamic) adds the same."""
+    """Budget elements that the dynamic and quasi-static models do not contain, and
+    the budget notes on the housing and the pin seats. Since the housing is in the
+    models (``housing.body_model = "ring_estimate"``: the elastic pin-ring rotation,
+    :func:`housing_model_compliance`, the quasi-static budget's own ``housing``
+    share) or rigid everywhere (``"rigid"``: left out of every budget, its estimate
+    in a note), nothing is added: returns ({}, notes). Every budget (analytic,
+    quasi-static, dynamic) gets the same notes; ``model_total`` [rad/(N m)] is the
+    total the housing estimate's share refers to."""
     from flexrv.analysis.pin_load import pin_contact_constant
 
     if reducer.housing is None:
@@ -585,13 +603,14 @@ def unmodelled_elements(reducer, model_total: float, torque: float | None = None
     seat = (f"pin seats: Palmgren line contact in series with the pin-disc contact; the groove's Hertz half-width "
             f"is {pc.seat_semi_angle:.2g} pin radii at the largest pin load ({pc.reference_load:.4g} N): a conformal "
             "seat spreads wider and is expected stiffer, so the element is a conservative (compliant) estimate")
+    if reducer.housing.body_model == "ring_estimate":
+        return {}, ("housing: elastic rotation of the pin ring about the axis in every model (thin-ring + tube "
+                    "estimate, energy-equivalent torsional compliance: the ring's ovalisation enters only through "
+                    "its strain energy)", seat)
     hc = housing_compliance(reducer, torque)
     share = hc.total / (model_total + hc.total)
-    if share > HOUSING_THRESHOLD:
-        return {"housing": hc.total}, (f"housing: thin-ring estimate {100 * share:.3g} % of the total, not in the "
-                                       "dynamic or quasi-static model (rigid housing there); added in series", seat)
-    return {}, (f"housing: thin-ring estimate {100 * share:.3g} % of the total (< {100 * HOUSING_THRESHOLD:g} %), "
-                "left out", seat)
+    return {}, (f"housing: rigid (housing.body_model = 'rigid'); its thin-ring estimate would be {100 * share:.3g} % "
+                "of the total", seat)
 
 
 def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
@@ -622,8 +641,9 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     * pins, pin_seats, pin_bending: the pin path's compliance (disc contact, seat,
       bending in series, :func:`flexrv.analysis.pin_load.pin_contact_constant`) split
       by :func:`split_pin_path`;
-    * housing: the pin housing ring and tube (:func:`housing_compliance`), where it
-      exceeds 1 % of the total (:func:`unmodelled_elements`; else in ``notes``);
+    * housing: the pin housing ring and tube, c_h of the models
+      (:func:`housing_model_compliance`, rated torque; ``housing.body_model =
+      "rigid"``: left out, its estimate in ``notes``);
     * carrier and cycloid_disc (issue 14): the elastic bodies' torsional compliances
       at the output, passed in ``bodies`` ({"carrier": c, "cycloid_disc": c} [rad/(N m)],
       e.g. from :func:`flexrv.fem.disc.body_compliances`: the FE lives in a layer above
@@ -682,6 +702,9 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
                 raise ValueError(f"bodies[{name!r}] = {value!r} must be a finite compliance >= 0 [rad/(N m)]")
             comp[name] = float(value)
     comp = split_pin_path(comp, reducer)
+    c_h = housing_model_compliance(reducer)
+    if c_h > 0.0:
+        comp["housing"] = c_h
     extra, notes = unmodelled_elements(reducer, float(sum(comp.values())), torque)
     comp.update(extra)
     total = float(sum(comp.values()))

@@ -498,6 +498,10 @@ class Housing(_Strict):
     pin_unsupported_length_mm: float = Field(ge=0.0, le=2000.0, description="Span of a pin between groove lands at each disc [mm]; 0 = fully supported")
     ring_outer_diameter_mm: float = Field(gt=1.0, le=5000.0, description="Outer diameter of the housing ring around the pins [mm]")
     ring_length_mm: float = Field(gt=0.0, le=2000.0, description="Axial length of the housing ring section that carries the pin loads [mm]")
+    body_model: Literal["ring_estimate", "rigid"] = Field(
+        default="ring_estimate", description="Pin housing in the models: 'ring_estimate' (elastic rotation of the pin "
+        "ring about the axis with the thin-ring + tube compliance, flexrv.analysis.torsional.housing_compliance, in "
+        "every model and budget) or 'rigid' (left out of every model and budget)")
 
     @property
     def pin_seat_clearance(self) -> float:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexrv.analysis.pin_load import pin_contact_constant
-from flexrv.analysis.torsional import support_constants
+from flexrv.analysis.torsional import housing_model_compliance, support_constants
 from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
 from flexrv.contact.laws import effective_pin_friction
 from flexrv.units import M_PER_MM
@@ -132,6 +132,9 @@ class RigidParameters:
     #: (n_discs, 3, 3) compliance of each disc's rim pose (x, y, psi) relative to its hub per unit pin force
     #: (:func:`flexrv.fem.disc.rim_compliance`); (0, 3, 3): rigid discs (``second_stage.disc_body_model``)
     disc_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
+    #: torsional compliance of the pin housing about the axis [rad/(N m)]
+    #: (:func:`flexrv.analysis.torsional.housing_model_compliance`, design ``housing.body_model``); 0: rigid
+    housing_compliance: float = 0.0
     extra: dict = field(default_factory=dict)
     # friction (issue 14, design [contact] friction fields; 0 = off)
     pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
@@ -287,6 +290,7 @@ def rigid_parameters(reducer) -> RigidParameters:
         crank_bores=ab.crank_bores, needle_clearances=ab.needle_clearances,
         support_clearances=ab.support_clearances, sun_runout=ab.sun_runout, planet_runout=ab.planet_runout,
         planet_phase_errors=ab.planet_phase_errors, carrier_compliance=carrier_c, disc_compliance=disc_c,
+        housing_compliance=housing_model_compliance(reducer),
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
         pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
         if ct.friction else 0.0,

@@ -89,6 +89,25 @@ wraps :func:`pin_kernel` (unchanged) in a local Newton on delta per disc with th
 condensed Jacobians (I - J C_d)^-1 J and (I - J C_d)^-1 J_v. With C_d = 0 it is
 the plain pin kernel. Verified in tests/test_bodies.py.
 
+Housing (issue 14; design ``housing.body_model = "ring_estimate"``): the pin ring
+turns elastically about the reducer axis by phi_h = c_h M_h, shared by all discs,
+M_h the torque of all pin forces on the housing about the axis and c_h the
+housing's energy-equivalent torsional compliance
+(:func:`flexrv.analysis.torsional.housing_compliance`, ``total``: ring bending
+under the pin loads + tube torsion; the ring's ovalisation enters only through
+this energy equivalent, not as a pin-position pattern). A ring rotation phi_h is
+a rotation of every disc rim by -phi_h about the axis, to first order a rim pose
+change -phi_h a_k with a_k = (-y_k, x_k, 1) (hub centre c_k = (x_k, y_k)). The
+torque of the pins' forces Q_k on disc k about the axis is a_k . Q_k (the force
+acts at c_k + r: (c_k x F)_z + (r x F)_z), so M_h = -sum_k a_k . Q_k (action and
+reaction; the generalized force conjugate to phi_h) and the rim offsets over all
+discs are delta = C Q with C = blockdiag(C_d,k) + c_h A A^T (A stacks the a_k).
+:func:`_pin_housing_kernel` solves this coupled (3 n_discs) local Newton as the
+per-disc one; as a_k follows the hub centre, the condensed Jacobian is
+(I - J C)^-1 J (I + D) with D = d(C Q)/dq at fixed Q = c_h (dA/dq (A^T Q) + A
+(dA/dq)^T Q). c_h = 0 is the per-disc code unchanged. Verified in
+tests/test_housing.py.
+
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
 that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
@@ -277,10 +296,12 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
 @njit(cache=True)
 def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     """The pins' kernel with elastic disc bodies (wrapper around :func:`pin_kernel`;
-    module docstring, "Disc body"). ``pack`` = (pin_kernel's pack, cd, dstate): cd
+    module docstring, "Disc body"). ``pack`` = (pin_kernel's pack, cd, dstate, hs): cd
     (n_discs, 3, 3) the rim compliance of each disc (empty: rigid discs, a plain
     :func:`pin_kernel` call), dstate (n_discs, 3) the rim offsets delta (x, y, psi)
-    of the last call (Newton start, output).
+    of the last call (Newton start, output), hs the housing's (c_h, phi_h, ...):
+    c_h > 0 couples all discs through the elastic housing (:func:`_pin_housing_kernel`,
+    module docstring "Housing").
 
     The pins act on the rim pose q_r = q_hub + delta with delta = C_d Q(q_r), Q the
     pins' generalized force on the disc; a local Newton on delta, R = delta - C_d Q,
@@ -290,7 +311,10 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     from Q_eff(q, v) = Q(q + delta(q, v), v): dQ_eff/dq = (I - J C_d)^-1 J,
     dQ_eff/dv = (I - J C_d)^-1 J_v (the rim's velocity is the hub's: the rate of
     delta is left out of the contact damping)."""
-    pins, cd, dstate = pack
+    pins, cd, dstate, hs = pack
+    if hs.shape[0] > 0 and hs[0] > 0.0:  # elastic housing: all discs coupled
+        _pin_housing_kernel(q, v, f, jq, jv, jac, pins, cd, dstate, hs)
+        return
     nd = cd.shape[0]
     if nd == 0:
         pin_kernel(q, v, f, jq, jv, jac, pins)
@@ -369,6 +393,116 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
                     jv[ii[a], ii[b]] += jvc[a, b]
 
 
+@njit(cache=True)
+def _pin_housing_kernel(q, v, f, jq, jv, jac, pins, cd, dstate, hs):
+    """:func:`pin_body_kernel` with the elastic housing (module docstring, "Housing"):
+    the coupled local Newton on the rim offsets of all discs, delta = C(q) Q(q_r),
+    C = blockdiag(C_d,k) + c_h A A^T (cd empty: rigid disc bodies), A stacking
+    a_k = (-y_k, x_k, 1) at the hub centres. hs = (c_h, phi_h, then per disc the
+    housing's part -phi_h a_k of the rim offset (x, y)): phi_h, the parts written."""
+    idx = pins[0]
+    r_p = pins[1][1]
+    nd = pins[4].shape[0]
+    m = 3 * nd
+    ch = hs[0]
+    n = q.shape[0]
+    a = np.zeros(m)
+    cmat = np.zeros((m, m))
+    for kd in range(nd):
+        a[3 * kd] = -q[idx[3 * kd + 1]]
+        a[3 * kd + 1] = q[idx[3 * kd]]
+        a[3 * kd + 2] = 1.0
+        if cd.shape[0] > 0:
+            for r in range(3):
+                for c in range(3):
+                    cmat[3 * kd + r, 3 * kd + c] = cd[kd, r, c]
+    for r in range(m):
+        for c in range(m):
+            cmat[r, c] += ch * a[r] * a[c]
+    qr = q.copy()
+    fs = np.zeros(n)
+    js, jvs = np.zeros((n, n)), np.zeros((n, n))
+    delta = np.zeros(m)
+    base = np.zeros(m)
+    for kd in range(nd):
+        for r in range(3):
+            base[3 * kd + r] = dstate[kd, r]
+    step = np.zeros(m)
+    res = np.zeros(m)
+    qv = np.zeros(m)
+    jk = np.zeros((m, m))
+    eye = np.eye(m)
+    r0 = np.inf
+    lam = 1.0
+    for it in range(80):
+        for r in range(m):
+            delta[r] = base[r] - lam * step[r]
+            qr[idx[r]] = q[idx[r]] + delta[r]
+        fs[:] = 0.0
+        js[:, :] = 0.0
+        jvs[:, :] = 0.0
+        pin_kernel(qr, v, fs, js, jvs, True, pins)
+        for r in range(m):
+            qv[r] = fs[idx[r]]
+            for c in range(m):
+                jk[r, c] = js[idx[r], idx[c]]
+        res[:] = delta - cmat @ qv
+        r1 = 0.0
+        scale = 0.0
+        for r in range(m):
+            w = r_p if r % 3 == 2 else 1.0
+            r1 = max(r1, abs(res[r]) * w)
+            scale = max(scale, abs(delta[r]) * w)
+        tol = max(1e-15, 1e-10 * scale)
+        if it > 0 and r1 >= r0:
+            if r0 <= 100.0 * tol:
+                break
+            if lam > 1e-6:
+                lam *= 0.5
+                continue
+        r0 = r1
+        if r1 <= tol:
+            break
+        base[:] = delta
+        step[:] = np.linalg.solve(eye - cmat @ jk, res)
+        lam = 1.0
+    # the last Newton correction, linearised (as pin_body_kernel)
+    corr = -np.linalg.solve(eye - cmat @ jk, res)
+    qf = qv + jk @ corr
+    s = a @ qf  # torque of the pins on the discs about the axis = -(their torque on the housing)
+    phi = -ch * s  # housing rotation phi_h = c_h M_h, M_h = -s
+    hs[1] = phi
+    for kd in range(nd):
+        hs[2 + 2 * kd] = -phi * a[3 * kd]
+        hs[3 + 2 * kd] = -phi * a[3 * kd + 1]
+    for r in range(m):
+        delta[r] += corr[r]
+        f[idx[r]] += qf[r]
+    for kd in range(nd):
+        for r in range(3):
+            dstate[kd, r] = delta[3 * kd + r]
+    if jac:
+        jvk = np.empty((m, m))
+        for r in range(m):
+            for c in range(m):
+                jvk[r, c] = jvs[idx[r], idx[c]]
+        # a_k moves with the hub centre: d(C Q)/dq at fixed Q, D = c_h (dA/dq (A^T Q) + A (dA/dq)^T Q)
+        dm = eye.copy()
+        for kd in range(nd):
+            cx, cy = 3 * kd, 3 * kd + 1
+            dm[cy, cx] += ch * s
+            dm[cx, cy] -= ch * s
+            for r in range(m):
+                dm[r, cx] += ch * a[r] * qf[cy]
+                dm[r, cy] -= ch * a[r] * qf[cx]
+        mk = np.linalg.inv(eye - jk @ cmat)
+        jc, jvc = mk @ (jk @ dm), mk @ jvk
+        for r in range(m):
+            for c in range(m):
+                jq[idx[r], idx[c]] += jc[r, c]
+                jv[idx[r], idx[c]] += jvc[r, c]
+
+
 @functools.lru_cache(maxsize=64)
 def _curve_reach(z_rp: int, radius: float, eccentricity: float, samples: int = 400) -> tuple[float, float]:
     """Lower estimates of the reach of the pin-centre curve C on its outer side
@@ -445,6 +579,17 @@ class PinContacts(KernelGroup):
         if not self.disc_c.size:
             self.disc_c = np.zeros((0, 3, 3))
         self.dstate = np.zeros((self.nd, 3))
+        #: housing (module docstring, "Housing"): (c_h [rad/(N m)], phi_h [rad], per disc the housing's part
+        #: -phi_h a_k of the rim offset (x, y) [m]); c_h = 0: rigid housing
+        c_h = float(getattr(p, "housing_compliance", 0.0))
+        if not (np.isfinite(c_h) and c_h >= 0.0):
+            raise ValueError(f"housing_compliance = {c_h!r} must be a finite compliance >= 0 [rad/(N m)]")
+        self.hstate = np.zeros(2 + 2 * self.nd)
+        self.hstate[0] = c_h
+
+    @property
+    def elastic_housing(self) -> bool:
+        return self.hstate[0] > 0.0
 
     @property
     def elastic_discs(self) -> bool:
@@ -460,14 +605,14 @@ class PinContacts(KernelGroup):
             # also the rim record (record_sources "rim"); the solver's next call merely starts its Newton cold
             self.dstate[:] = 0.0
         return ((idx, self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
-                 self.nx, self.ny, self.rxn, self.ft, self.pw, ctr), self.disc_c, self.dstate)
+                 self.nx, self.ny, self.rxn, self.ft, self.pw, ctr), self.disc_c, self.dstate, self.hstate)
 
     @staticmethod
     def empty_pack():
         z2 = np.zeros((0, 0))
         return ((np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
                  np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
-                 np.array([1, 0, 0, 0], dtype=np.int64)), np.zeros((0, 3, 3)), np.zeros((0, 3)))
+                 np.array([1, 0, 0, 0], dtype=np.int64)), np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(2))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ctr = pack[0][-1]
@@ -482,7 +627,7 @@ class PinContacts(KernelGroup):
 
     def record_sources(self):
         return {"gap": self.gap, "force": self.force, "nx": self.nx, "ny": self.ny, "rxn": self.rxn,
-                "ft": self.ft, "pw": self.pw, "rim": self.dstate}
+                "ft": self.ft, "pw": self.pw, "rim": self.dstate, "housing": self.hstate}
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
@@ -501,8 +646,19 @@ class PinContacts(KernelGroup):
                 "housing_pin_torque": Output(self._housing_torque(rec), ("time", "disc"), "N m",
                                              "torque of each disc's pin forces (normal and friction) on the "
                                              "housing about the axis")}
+        if self.elastic_housing:
+            hs = rec["housing"]
+            out["housing_rotation"] = Output(hs[..., 1], ("time",), "rad",
+                                             "elastic rotation phi_h of the pin housing about the axis (c_h times "
+                                             "the pins' torque on the housing)")
         if self.elastic_discs:
             rim = rec["rim"]
+            if "housing" in rec and self.elastic_housing:  # the disc body's part: the housing's -phi_h a_k removed
+                hs = rec["housing"]
+                rim = rim.copy()
+                rim[..., 2] += hs[..., 1][..., None]
+                rim[..., 0] -= hs[..., 2::2]
+                rim[..., 1] -= hs[..., 3::2]
             out["disc_rim_rotation"] = Output(rim[..., 2], ("time", "disc"), "rad",
                                               "rotation of each disc's tooth region (rim) relative to its crank "
                                               "holes (hub): the elastic disc body's twist")
@@ -528,6 +684,7 @@ class PinContacts(KernelGroup):
         self.ctr[0] = 0
         self.gap[:] = 0.0
         self.dstate[:] = 0.0
+        self.hstate[1:] = 0.0
 
     def check(self) -> str | None:
         if self.min_gap < -self.limit:

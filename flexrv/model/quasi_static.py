@@ -350,7 +350,9 @@ class StaticModel:
         disc body condensed into the crank supports or the pins (issue 14) gets its
         own share ``carrier`` / ``cycloid_disc``: df . C df / C with df the group's
         force increment on the body's interface (the support points, the rim) and C
-        the body's compliance; the group keeps the rest."""
+        the body's compliance; the group keeps the rest. The elastic housing condensed
+        into the pins (``housing``): c_h dM_h^2 / C, dM_h the pins' torque increment on
+        the housing about the axis (1/2 c_h M_h^2 its strain energy)."""
         from flexrv.model.assembled import group_index
 
         m = self.model
@@ -390,6 +392,17 @@ class StaticModel:
                     e_body += float(dq @ g.disc_c[k] @ dq) / c
                 out["cycloid_disc"] = e_body
                 out[g.name] -= e_body
+            if g.name == "pins" and getattr(g, "elastic_housing", False):
+                # the housing (flexrv.model.pins, "Housing"): the rim compliance's c_h A A^T part stores
+                # c_h dM_h^2, dM_h = -sum_k a_k . dQ_k the pins' torque increment on the housing
+                dm_h = 0.0
+                for k in range(g.nd):
+                    qk = q[m.slice(f"disc{k}")]
+                    dq = -(parts[g.name] @ u)[m.slice(f"disc{k}")]
+                    dm_h -= float(-qk[1] * dq[0] + qk[0] * dq[1] + dq[2])
+                e_h = float(g.hstate[0]) * dm_h**2 / c
+                out["housing"] = e_h
+                out[g.name] -= e_h
         return out
 
 
