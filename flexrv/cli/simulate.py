@@ -152,7 +152,9 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
 
 def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
                        model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
-                       quarter_time: float = typer.Option(0.02, "--quarter-time", help="Duration of each quarter of the torque loop [s]."),
+                       quarter_time: float = typer.Option(None, "--quarter-time", help="Duration of each quarter of the torque loop [s] "
+                                                          "(default flexrv.simulation.DEFAULT_QUARTER_TIME = 0.08 s: "
+                                                          "the branches are quasi-static on both presets)."),
                        dt: float = typer.Option(None, "--dt", help=DT_HELP),
                        parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
@@ -162,9 +164,10 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     torsional rigidity, lost motion, hysteresis loop PNG."""
     from dataclasses import asdict
 
-    from flexrv.simulation import DEFAULT_DT, stiffness_test
+    from flexrv.simulation import DEFAULT_DT, DEFAULT_QUARTER_TIME, stiffness_test
 
     dt = DEFAULT_DT if dt is None else dt
+    quarter_time = DEFAULT_QUARTER_TIME if quarter_time is None else quarter_time
     options = model_options(model, parts)
     out = check_output_dir(out or _default_out(preset, model, "stiffness"), "--out", overwrite=overwrite)
     bar = _bar(not json)

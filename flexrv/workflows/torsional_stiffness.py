@@ -16,7 +16,7 @@ NAME = "torsional_stiffness"
 PRESET = "rv40e"
 NMM = 1e-3  #: N m per N mm
 #: stiffness-test timing [s]: full (quasi-static) and smoke (short loop)
-FULL_TEST = {"quarter_time": 0.02, "settle": 0.005}
+FULL_TEST = {"quarter_time": 0.08, "settle": 0.005}  # flexrv.simulation.DEFAULT_QUARTER_TIME
 SMOKE_TEST = {"quarter_time": 0.005, "settle": 0.002}
 SEED_ZONE_PINS = 4  #: :cite:`seed004` identifies a zone of four consecutive pins
 
