@@ -30,8 +30,8 @@ def cantilever(tmp_path_factory):
     tip = m.node_set("gear_seat")
     f = sector_loads(m.nodes, tip, (0.0, 0.0), [0.0], [[1000.0, 0.0, 0.0]], np.pi)
     u = solve_static(fe.K, m.node_set("eccentric_1"), f)
-    yield m, u, f, dict(r=r, span=span, a=a)
-    del os.environ["FLEXRV_CACHE"]
+    del os.environ["FLEXRV_CACHE"]  # the private cache only while the fixture builds
+    return m, u, f, dict(r=r, span=span, a=a)
 
 
 def test_sector_loads_keep_the_resultant(cantilever):

@@ -33,8 +33,11 @@ def shafts(tmp_path_factory):
     import os
 
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
-    yield {span: _shaft_compliance(span) for span in (0.06, 0.12)}
-    del os.environ["FLEXRV_CACHE"]
+    try:  # the private cache only while the fixture builds (later tests share the session's cache)
+        shafts = {span: _shaft_compliance(span) for span in (0.06, 0.12)}
+    finally:
+        del os.environ["FLEXRV_CACHE"]
+    return shafts
 
 
 def test_condensed_torsion_matches_saint_venant(shafts):

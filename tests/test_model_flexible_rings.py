@@ -40,8 +40,8 @@ def rings(tmp_path_factory):
         spec = raceway_spec_for(spec_for(rv, part), None, RING_HARMONICS)
         body = build_reduced_body(mres, mat, n_eig=RING_EIGENMODES_QUASI_STATIC, raceway=spec, fe=fe)
         out[part] = (mres, fe, body)
-    yield rv, out
-    del os.environ["FLEXRV_CACHE"]
+    del os.environ["FLEXRV_CACHE"]  # the private cache only while the fixture builds (the runs below
+    return rv, out  # share the session's cache, e.g. the preset's FE carrier and disc bodies)
 
 
 def _flexible_rows(rv, out, scale=1.0, rings=("inner", "outer"), condense=True, ehl="dry"):

@@ -137,8 +137,11 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
              "te_no_load_all_errors": ("position", full.te_no_load * ARCSEC_PER_RAD, {"units": "arcsec"})},
             coords={"output_angle": ("position", x, {"units": "deg"})})
     r.text.append("Why the result can differ from a measurement: one sampled reducer is not a batch (the "
-                  "tolerance study gives the distribution); the model has rigid discs, crankshafts, carrier and "
-                  "housing and constant-stiffness crank supports, so the error TE is almost purely kinematic; "
+                  "tolerance study gives the distribution); the quasi-static model's compliances (tapered-roller "
+                  "crank supports, crank bending, needles, pins in their seats, and the FE carrier, disc and "
+                  "housing as condensed series compliances) are small against the errors' geometry, so the error "
+                  "TE is mostly kinematic (ideal geometry gives well under 1 % of it), and the bodies' local "
+                  "deformation under an error's load is only represented through those condensed compliances; "
                   "and a bench measures under its own load and speed. No value of the error set was adjusted "
                   "to approach the measured range.")
     fig.tight_layout()
