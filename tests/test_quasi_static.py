@@ -304,8 +304,13 @@ def test_uniform_pin_circle_radius_error_is_a_shift_modification():
     the shift-modified design's: mean, p-p and lost motion within 1e-3
     (measured 4e-5); it is an offset and a backlash change (lost motion +0.16
     arcmin), and adds no variation over the output revolution beyond the changed
-    mesh ripple (TE p-p +0.044 arcsec, required < 0.1)."""
-    base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0})
+    mesh ripple (TE p-p +0.044 arcsec, required < 0.1). The disc body and the housing
+    are rigid here: their compliance constants are design-level, evaluated on the
+    design without errors (flexrv.design.manufacturing.nominal_design), so the error
+    keeps the base design's constants while the modification gets its own; the
+    equivalence is one of the contact geometry."""
+    base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0, "second_stage.disc_body_model": "rigid",
+                              "housing.body_model": "rigid"})
     kw = dict(crank_revolutions=0.25, points_per_mesh=8, catalog_positions=1)
     r0 = loaded_te(base, **kw)
     r1 = loaded_te(_pins(base, "pin_radial_position_um", 2.0), **kw)

@@ -501,16 +501,19 @@ def housing_model_compliance(reducer) -> float:
     """The pin housing's torsional compliance c_h in the models and every budget
     [rad/(N m)] (issue 14): :func:`housing_compliance` ``total`` (ring bending under
     the pin loads + tube torsion, an energy equivalent: the ring's ovalisation enters
-    only through its strain energy) at the rated torque and crank angle 0, if the
+    only through its strain energy) at the rated torque and crank angle 0 of the design without its errors
+    (:func:`flexrv.design.manufacturing.nominal_design`), if the
     design has a ``[housing]`` table with ``body_model = "ring_estimate"``; else 0
     (rigid housing). One constant: the ring estimate is linear in the load (its
     pin-load pattern changes it only through the pins in mesh). The dynamic and
     quasi-static models turn the pin ring by phi_h = c_h M_h
     (:func:`flexrv.model.pins.pin_body_kernel`), the analytic budget adds c_h in series."""
+    from flexrv.design.manufacturing import nominal_design
+
     h = reducer.housing
     if h is None or h.body_model != "ring_estimate":
         return 0.0
-    return float(housing_compliance(reducer).total)
+    return float(housing_compliance(nominal_design(reducer)).total)
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from flexrv.cache import cache_dir, cached_dataclass, content_hash, library_versions
+from flexrv.design.manufacturing import nominal_design
 from flexrv.errors import InputError
 from flexrv.units import RAD_PER_ARCMIN
 
@@ -351,24 +352,13 @@ def rim_compliance(reducer, size: float | None = None, n_angles: int = 6, cache:
     return np.diag([0.0, 0.0, float(d.mean)])
 
 
-def nominal_design(reducer):
-    """The design without its manufacturing errors: the elastic bodies' FE load
-    cases (the pin-load pattern) are taken on the nominal geometry, so every error
-    set and tolerance sample of a design shares one cached FE solve (the errors move
-    the pin loads by far less than the +-20 % the disc's compliance varies over the
-    crank angle)."""
-    from flexrv.design.manufacturing import ManufacturingErrors
-
-    return reducer.model_copy(update={"errors": ManufacturingErrors()})
-
-
 def body_design(reducer):
     """The disc body's geometry for its FE: the design without errors and profile
     modifications. The modifications (a few um) and the errors change neither the
     mesh's resolution of the body nor the patch positions (1.5 mm half-width) in
     any measurable way, but they would key a new mesh and FE solve per design
-    variant (sweeps, tolerance samples, tests); the load pattern, which they do
-    change, is applied afterwards (:func:`disc_torsion_sweep`)."""
+    variant (sweeps, tolerance samples, tests); the load pattern, which the
+    modifications do change, is applied afterwards (:func:`disc_torsion_sweep`)."""
     ss = reducer.second_stage.model_copy(update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0,
                                                  "modification_rotation_deg": 0.0})
     return nominal_design(reducer).model_copy(update={"second_stage": ss})
@@ -460,23 +450,18 @@ def disc_torsion_sweep(reducer, n_angles: int = 6, output_torque: float | None =
     """Disc body torsional compliance c_d = f^T C f over crank angles, as
     :func:`disc_compliance_sweep`, with C the cached patch compliances of the disc
     body (:func:`disc_patch_sweep`, geometry only) and f the design's own as-built
-    pin loads per unit disc torque at each angle (:func:`pin_contact_case`,
-    analytic, ~3 ms each; where the pin-load solver finds no no-load pose for an
-    error set, those of the :func:`nominal_design`). The value of the models and the
-    budget: a change of the modifications, the torque or the errors costs no FE
-    solve, and an error equivalent to a modification (a uniform pin-circle error and
-    the shift modification) gives the same disc compliance."""
+    pin loads per unit disc torque at each angle of the design without its errors
+    (:func:`flexrv.design.manufacturing.nominal_design`, modifications kept;
+    :func:`pin_contact_case`, analytic, ~3 ms each). The value of the models and the
+    budget: a change of the modifications or the torque costs no FE solve, and every
+    error set of a design shares the value (the errors act through the models' pin
+    contacts)."""
     ss = reducer.second_stage
     torque = float(reducer.operating.rated_torque_Nm if output_torque is None else output_torque)
     if not (np.isfinite(torque) and torque != 0.0):
         raise InputError(f"output_torque = {output_torque!r} must be finite and non-zero")
-    from flexrv.errors import ConvergenceError
-
     ps = disc_patch_sweep(reducer, n_angles=n_angles, size=size, patch=patch, local_size=local_size, cache=cache)
-    try:  # the as-built pin loads (errors included: the model's geometry)
-        cases = [pin_contact_case(reducer, torque, a) for a in ps.angles]
-    except ConvergenceError:  # an error set whose no-load pose the pin-load solver cannot find: nominal loads
-        cases = [pin_contact_case(nominal_design(reducer), torque, a) for a in ps.angles]
+    cases = [pin_contact_case(nominal_design(reducer), torque, a) for a in ps.angles]  # the design's pattern
     cd = []
     for case, C in zip(cases, ps.matrices):
         f = case.forces / abs(case.disc_torque)
