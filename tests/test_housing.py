@@ -17,6 +17,7 @@ from scipy.optimize import root
 
 from flexrv.design import load
 from flexrv.model.parameters import rigid_parameters, with_bodies
+from tests.test_bodies import _central  # one central-difference helper for the condensed groups
 
 
 @pytest.fixture(scope="module")
@@ -32,15 +33,6 @@ def _disc_state(p, turn=3e-4):
     q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.n_discs)])
     q[2::3] -= turn
     return q
-
-
-def _central(g, q, v, h):
-    out = np.zeros((len(q), len(q)))
-    for i in range(len(q)):
-        e = np.zeros_like(q)
-        e[i] = h
-        out[:, i] = (g.evaluate(0.0, q + e, v)[0] - g.evaluate(0.0, q - e, v)[0]) / (2 * h)
-    return out
 
 
 def _axis_arms(q):

@@ -233,6 +233,18 @@ class DiscSweep(_DiscBodyResult):
     mean: float
 
 
+def _sweep_angles(reducer, n_angles, patch) -> tuple[float, list]:
+    """Checked (patch half-width [m], default half the pin radius; crank angles over one
+    hole period, 2 pi / n_cranks, in n_angles steps) of the disc sweeps."""
+    if not (isinstance(n_angles, int) and 1 <= n_angles <= 64):
+        raise InputError(f"n_angles = {n_angles!r} must be an integer in 1..64")
+    patch = float(0.5 * reducer.second_stage.pin_radius if patch is None else patch)
+    if not patch > 0:
+        raise InputError(f"patch = {patch!r} m must be > 0")
+    n = reducer.first_stage.n_planets
+    return patch, [2.0 * np.pi * k / (n * n_angles) for k in range(n_angles)]
+
+
 def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | None = None, size: float | None = None,
                           patch: float | None = None, local_size: float | None = None, cache: bool = True) -> DiscSweep:
     """c_d at ``n_angles`` crank angles 2 pi k / (N n_angles), k = 0..n-1, over one
@@ -243,16 +255,10 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
     from flexrv.meshing import build_mesh
 
     ss = reducer.second_stage
-    if not (isinstance(n_angles, int) and 1 <= n_angles <= 64):
-        raise InputError(f"n_angles = {n_angles!r} must be an integer in 1..64")
     torque = float(reducer.operating.rated_torque_Nm if output_torque is None else output_torque)
     if not (np.isfinite(torque) and torque != 0.0):
         raise InputError(f"output_torque = {output_torque!r} must be finite and non-zero")
-    patch = float(0.5 * ss.pin_radius if patch is None else patch)
-    if not patch > 0:
-        raise InputError(f"patch = {patch!r} m must be > 0")
-    n = reducer.first_stage.n_planets
-    angles = [2.0 * np.pi * k / (n * n_angles) for k in range(n_angles)]
+    patch, angles = _sweep_angles(reducer, n_angles, patch)
     mres = build_mesh(reducer, "cycloid_disc", size, local_size=local_size, cache=cache)
     mat = material_dict(reducer, "cycloid_disc")
     cases = [pin_contact_case(reducer, torque, a) for a in angles]
@@ -410,14 +416,7 @@ def disc_patch_sweep(reducer, n_angles: int = 6, size: float | None = None, patc
     from flexrv.meshing import build_mesh
 
     body = body_design(reducer)
-    ss = body.second_stage
-    if not (isinstance(n_angles, int) and 1 <= n_angles <= 64):
-        raise InputError(f"n_angles = {n_angles!r} must be an integer in 1..64")
-    patch = float(0.5 * ss.pin_radius if patch is None else patch)
-    if not patch > 0:
-        raise InputError(f"patch = {patch!r} m must be > 0")
-    n = body.first_stage.n_planets
-    angles = [2.0 * np.pi * k / (n * n_angles) for k in range(n_angles)]
+    patch, angles = _sweep_angles(body, n_angles, patch)
     mres = build_mesh(body, "cycloid_disc", size, local_size=local_size, cache=cache)
     mat = material_dict(body, "cycloid_disc")
     geo = [contact_geometry(body, a) for a in angles]
