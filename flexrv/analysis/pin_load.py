@@ -329,7 +329,7 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     597 N). A linear bending spring in series
     has no exact power-law form: the path's constant is matched to the series
     deflection at the reference load Q_ref (the largest pin force at the rated
-    torque): K = Q_ref / (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
+    torque, of the design without its errors, :func:`flexrv.design.manufacturing.nominal_design`): K = Q_ref / (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
     Without a [housing] table the pins are rigidly seated: K = k_disc."""
     from flexrv.contact.hertz import conformal_line_contact, effective_modulus, series_stiffness
 
@@ -345,7 +345,11 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     length = M_PER_MM * h.pin_seat_length_mm / ss.n_discs
     k_seat = float(line_contact_stiffness(length, e_seat))
     k_contacts = float(series_stiffness(k_disc, k_seat, n))
-    q_ref = reducer_pin_loads(reducer, reducer.operating.rated_torque_Nm, stiffness_constant=k_contacts).max_force
+    from flexrv.design.manufacturing import nominal_design
+
+    # Q_ref of the design without its errors (a design-level constant, shared by every error set)
+    q_ref = reducer_pin_loads(nominal_design(reducer), reducer.operating.rated_torque_Nm,
+                              stiffness_constant=k_contacts).max_force
     _, semi = conformal_line_contact(q_ref, length, ss.pin_radius, ss.pin_radius + h.pin_seat_clearance, e_seat)
     k_bend = pin_bending_stiffness(M_PER_MM * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus,
                                    mp.poisson_ratio)

@@ -163,7 +163,9 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
                     para += "."
         r.text.append(para)
     r.text.append("Why the numbers can differ from a measurement: the range is one crank revolution (cost: the "
-                  "output revolution is 24x dearer per sample), the discs, crankshafts and housing are rigid, "
+                  "output revolution is 24x dearer per sample), the elastic bodies (carrier, discs, housing) enter as "
+                  "design-level condensed compliances shared by every sample, not with their local deformation "
+                  "under each sample's errors, "
                   "the tolerance set is a stated ISO grade (not a measured process), and a bench measures under its "
                   "own load and speed. Nothing is tuned to the published values.")
     # figures: the two distributions with the published values, the what-if bars
