@@ -115,6 +115,7 @@ def test_map_mode(tmp_path, monkeypatch):
     it stays within 25 % of Hamrock-Dowson (solver/HD ratio at 33^2: 1.12-1.20); the map is
     cached on disk and reloaded identically. The 33^2 map grid (for speed) is too coarse for
     the 2 % grid tolerance, which the build reports as one warning."""
+    monkeypatch.delenv("FLEXRV_CACHE_DIR", raising=False)  # it takes precedence over FLEXRV_CACHE
     monkeypatch.setenv("FLEXRV_CACHE", str(tmp_path))
     kw = dict(n_load=2, n_speed=2, grid=33)
     with pytest.warns(RuntimeWarning, match="EHL map: at [1-4] of 4 nodes"):
