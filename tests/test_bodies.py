@@ -286,7 +286,9 @@ def test_with_bodies_sets_the_design_switches():
 
 
 # ------------------------------------------------------------------ quasi-static torsional compliance
-def _qs_compliance(red):
+def _qs_loaded(red):
+    """Quasi-static equilibrium at the rated torque (crank angle 0): (tangent torsional
+    compliance, compliance budget, the pins group evaluated at that state)."""
     from flexrv.model.quasi_static import StaticModel, ramp_to
 
     sm = StaticModel(red)
@@ -296,6 +298,11 @@ def _qs_compliance(red):
     budget = sm.compliance_budget(0.0, q)
     pins = next(g for g in sm.model.groups if g.name == "pins")
     pins.evaluate(0.0, sm.model.group_state(pins, q), np.zeros(3 * pins.nd))
+    return c, budget, pins
+
+
+def _qs_compliance(red):
+    c, budget, pins = _qs_loaded(red)
     disc_torque = -(pins.force * pins.rxn).sum(axis=-1)  # the pins' torque on each disc about its centre
     return c, budget, disc_torque
 

@@ -17,7 +17,7 @@ from scipy.optimize import root
 
 from flexrv.design import load
 from flexrv.model.parameters import rigid_parameters, with_bodies
-from tests.test_bodies import _central  # one central-difference helper for the condensed groups
+from tests.test_bodies import _central, _qs_loaded  # one central-difference helper for the condensed groups
 
 
 @pytest.fixture(scope="module")
@@ -163,16 +163,7 @@ def test_tiny_housing_reproduces_per_disc_wrapper(params):
 
 
 def _qs(red):
-    from flexrv.model.quasi_static import StaticModel, ramp_to
-
-    sm = StaticModel(red)
-    sm.torque = 0.0
-    q = ramp_to(sm, 0.0, sm.kinematic_pose(0.0), red.operating.rated_torque_Nm)
-    c = 1.0 / sm.tangent_rigidity(0.0, q)
-    budget = sm.compliance_budget(0.0, q)
-    pins = next(g for g in sm.model.groups if g.name == "pins")
-    qp = sm.model.group_state(pins, q)
-    pins.evaluate(0.0, qp, np.zeros(3 * pins.nd))
+    c, budget, pins = _qs_loaded(red)
     rec = pins.record()
     m_h = float(np.sum(pins._housing_torque({k: x[None] for k, x in rec.items()})))
     return c, budget, m_h, float(pins.hstate[1])
