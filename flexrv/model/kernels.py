@@ -113,16 +113,22 @@ def copy_records_if_same(q0, q, v0, v, src, dst, k):
 _F8 = np.dtype(np.float64)
 
 
-def _entry_point(args):
-    """The compiled function of :func:`fused_kernel` for the types of ``args``, to
-    be called directly (None if not found). Skips numba's dispatch, i.e. typing
-    the ~50 arguments on every call (~1.7 us of a ~9 us call, measured); valid
-    while the arguments keep their types, which :meth:`FusedForces._call` checks
-    for the only ones that change (q, v: float64, C-contiguous; the packs are
-    fixed at construction, jac / ts / ws are converted to bool / float)."""
+def _f8c(a) -> bool:
+    """float64 and C-contiguous: the types the compiled entry points were found for."""
+    return a.dtype is _F8 and a.flags.c_contiguous
+
+
+def _entry_point(fn, args):
+    """The compiled function of the numba dispatcher ``fn`` (:func:`fused_kernel`,
+    :func:`copy_records_if_same`) for the types of ``args``, to be called directly
+    (None if not found). Skips numba's dispatch, i.e. typing the ~50 arguments on
+    every call (~1.7 us of a ~9 us call, measured); valid while the arguments keep
+    their types, which the callers check for the only ones that change (q, v:
+    float64, C-contiguous; the packs and record buffers are fixed at construction,
+    jac / ts / ws are bool / float)."""
     from numba import typeof
 
-    cres = fused_kernel.overloads.get(tuple(typeof(a) for a in args))
+    cres = fn.overloads.get(tuple(typeof(a) for a in args))
     return None if cres is None else cres.entry_point
 
 
@@ -192,6 +198,10 @@ class FusedForces:
         self.packs = self._packs(history=False)
         self.gear, self.loads = by_kind.get("gear"), by_kind.get("loads")
         self.pins = by_kind.get("pins")
+        #: the pins' counters (ctr[2]: closest-point failures), None without pins
+        self._pin_ctr = self.pins.ctr if self.pins is not None else None
+        #: the time inputs of the last call: sun angle and speed, the loads group's load vector (its cache object)
+        self._ts, self._ws, self._load = 0.0, 0.0, None
         self.f = np.zeros(self.n)
         self.jq, self.jv = np.zeros((self.n, self.n)), np.zeros((self.n, self.n))
         self.stats = [0, 0]
@@ -243,19 +253,24 @@ class FusedForces:
         return out
 
     def _call(self, t, q, v, jac):
-        ts, ws = self.gear.time_inputs(t) if self.gear is not None else (0.0, 0.0)
+        if self.gear is not None:  # the groups cache their time inputs per time
+            self._ts, self._ws = self.gear.time_inputs(t)
         if self.loads is not None:
-            self.loads.load[:] = self.loads.time_inputs(t)
-        before = self.pins.ctr[2] if self.pins is not None else 0
-        args = (q, v, self.f, self.jq, self.jv, bool(jac), float(ts), float(ws), *self.packs)
+            load = self.loads.time_inputs(t)
+            if load is not self._load:  # a new load vector (new time, or the group was reset)
+                self.loads.load[:] = load
+                self._load = load
+        ctr = self._pin_ctr
+        before = ctr[2] if ctr is not None else 0
         entry = self._entry
-        if entry is not None and q.dtype is _F8 and v.dtype is _F8 and q.flags.c_contiguous and v.flags.c_contiguous:
-            entry(*args)
+        if entry is not None and _f8c(q) and _f8c(v):
+            entry(q, v, self.f, self.jq, self.jv, jac, self._ts, self._ws, *self.packs)
         else:
+            args = (q, v, self.f, self.jq, self.jv, bool(jac), float(self._ts), float(self._ws), *self.packs)
             fused_kernel(*args)
             if entry is None:
-                self._entry = _entry_point(args)
-        if self.pins is not None and self.pins.ctr[2] != before:
+                self._entry = _entry_point(fused_kernel, args)
+        if ctr is not None and ctr[2] != before:
             from flexrv.errors import ConvergenceError
 
             raise ConvergenceError("pin gap: closest-point iteration did not converge")
@@ -291,10 +306,10 @@ class FusedForces:
         n_model = len(q)
         self.memo = None  # the caller may change its arrays afterwards
         if self.is_full:
-            self._call(float(t), q, v, jacobian)
+            self._call(float(t), q, v, bool(jacobian))
             return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
         ix = self.index
-        self._call(float(t), np.ascontiguousarray(q[ix]), np.ascontiguousarray(v[ix]), jacobian)
+        self._call(float(t), np.ascontiguousarray(q[ix]), np.ascontiguousarray(v[ix]), bool(jacobian))
         f = np.zeros(n_model)
         f[ix] = self.f
         dq = dv = None
@@ -347,14 +362,23 @@ class HistoryRecorder:
         self.src = tuple(a.reshape(-1) for _, _, a in fused.record_entries())
         self.dst = tuple(np.empty((n_out, a.size)) for a in self.src)
         self.valid = np.zeros(n_out, dtype=bool)
+        #: compiled entry point of copy_records_if_same for these buffers (set on the first call)
+        self._entry = None
 
     def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
         """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
         f, memo = self.fused, self.fused.memo
         ok = memo is not None and memo[0] == t and bool(self.src)
         if ok:  # one compiled call: compare (q, v) exactly, copy the records
-            ok = copy_records_if_same(memo[1], q if f.is_full else q[f.index], memo[2], v if f.is_full else v[f.index],
-                                      self.src, self.dst, k)
+            args = (memo[1], q if f.is_full else q[f.index], memo[2], v if f.is_full else v[f.index], self.src,
+                    self.dst, k)
+            if self._entry is None:
+                ok = copy_records_if_same(*args)
+                self._entry = _entry_point(copy_records_if_same, args)
+            elif _f8c(args[0]) and _f8c(args[1]) and _f8c(args[2]) and _f8c(args[3]):
+                ok = self._entry(*args)  # the compiled function directly: no typing of the 40+ record arrays
+            else:
+                ok = copy_records_if_same(*args)
         self.valid[k] = ok
         return ok
 
