@@ -45,7 +45,7 @@ from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
 from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
-                                         ring_modal_amplitudes, row_force_kernel, row_history,
+                                         ring_modal_amplitudes, row_element, row_force_kernel, row_history,
                                          row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
@@ -403,39 +403,80 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     return pos - model.ball_reference
 
 
+class RowElement:
+    """THE Exudyn glue of one bearing row (issue 15): one compiled call
+    (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
+    evaluation into arrays preallocated here — the gather of the element
+    coordinates from the nodes' (``idx``; ``absolute``: the nodes hold absolute ball
+    positions, the reference is subtracted), the row kernel, and the result in the
+    nodes' order (for the Jacobian Exudyn's -(f_q dF/dq + f_v dF/dq_t)). The
+    returned arrays are reused by the next call (Exudyn copies them). The compiled
+    entry point is called directly after the first call (skips numba's typing of
+    the arguments, whose types never change: :meth:`_call`). ``stats`` counts the
+    force and Jacobian calls."""
+
+    def __init__(self, row: RowModel, idx: np.ndarray | None = None, absolute: bool = False,
+                 stats: list | None = None):
+        n = row.n_coordinates
+        self.row = row
+        self.idx = np.ascontiguousarray(np.arange(n) if idx is None else idx, dtype=np.int64)
+        self.absolute = bool(absolute)
+        self.stats = [0, 0] if stats is None else stats
+        self._qe, self._ve, self._f = np.zeros(n), np.zeros(n), np.zeros(n)
+        self._jq, self._jv = np.zeros((n, n)), np.zeros((n, n))
+        self._rec = np.zeros((0, N_RECORD))
+        self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
+        self._entry = None
+
+    def _call(self, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
+        args = (np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64), self.idx, self.absolute, jacobian,
+                f_q, f_v, self._qe, self._ve, self._f, self._jq, self._jv, self._rec, self.out_f, self.out_j,
+                *kernel_inputs(self.row))
+        if self._entry is not None:
+            self._entry(*args)
+            return
+        row_element(*args)
+        from numba import typeof
+
+        cres = row_element.overloads.get(tuple(typeof(x) for x in args))
+        self._entry = None if cres is None else cres.entry_point
+
+    def force(self, q, q_t) -> np.ndarray:
+        """Generalized force in the nodes' coordinate order (q, q_t: the nodes' coordinates)."""
+        self.stats[0] += 1
+        self._call(q, q_t, False, 0.0, 0.0)
+        return self.out_f
+
+    def jacobian(self, q, q_t, f_q, f_v) -> np.ndarray:
+        """Exudyn's -(f_q dF/dq + f_v dF/dq_t) in the nodes' coordinate order."""
+        self.stats[1] += 1
+        self._call(q, q_t, True, float(f_q), float(f_v))
+        return self.out_j
+
+
 def add_row_element(mbs, row: RowModel, nodes: list[int], idx: np.ndarray | None = None,
                     ball_reference: np.ndarray | None = None, stats: list | None = None) -> int:
-    """THE Exudyn glue of one bearing row: one ``ObjectGenericODE2`` over ``nodes`` whose
-    force and Jacobian user functions call the compiled row kernel (:func:`row_force`,
-    :func:`row_jacobian`). ``idx`` maps the row element's coordinates [frame(6), inner
-    modes, outer modes, balls(3Z)] to the nodes' coordinates (default: the same order);
-    ``ball_reference`` is subtracted from the ball coordinates when the nodes hold
-    absolute ball positions (the reducer model's ball members); ``stats`` counts the
-    force and Jacobian calls. Used by the reducer model's :class:`BallBearingGroup` and
-    by the stand-alone bearing of :func:`add_main_bearing`. Returns the object number."""
+    """Add one bearing row to ``mbs``: one ``ObjectGenericODE2`` over ``nodes`` whose
+    force and Jacobian user functions are a :class:`RowElement` (the compiled row
+    kernel). ``idx`` maps the row element's coordinates [frame(6), inner modes,
+    outer modes, balls(3Z)] to the nodes' coordinates (default: the same order);
+    ``ball_reference`` (the row's reference ball centres) is given when the nodes
+    hold absolute ball positions (the reducer model's ball members); ``stats``
+    counts the force and Jacobian calls. Used by the reducer model's
+    :class:`BallBearingGroup` and by the stand-alone bearing of
+    :func:`add_main_bearing`. Returns the object number."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    idx = np.arange(row.n_coordinates) if idx is None else np.asarray(idx)
-    inv = np.argsort(idx)  # nodes' coordinate -> element coordinate
-    ref = np.zeros(0) if ball_reference is None else np.asarray(ball_reference, dtype=float)
-    stats = [0, 0] if stats is None else stats
-
-    def element(q, q_t):
-        qe = np.asarray(q)[idx]
-        if ref.size:
-            qe[-ref.size:] -= ref
-        return qe, np.asarray(q_t)[idx]
+    absolute = ball_reference is not None and np.size(ball_reference) > 0
+    if absolute and not np.array_equal(np.ravel(ball_reference), row.ball_reference.ravel()):
+        raise ValueError("ball_reference must be the row's reference ball centres")
+    element = RowElement(row, idx, absolute, stats)
 
     def force_fn(mbs_, t, item, q, q_t):
-        stats[0] += 1
-        qe, ve = element(q, q_t)
-        return row_force(row, qe, ve)[inv]
+        return element.force(q, q_t)
 
     def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-        stats[1] += 1
-        qe, ve = element(q, q_t)
-        jq, jv = row_jacobian(row, qe, ve)
-        return -(f_q * jq + f_v * jv)[np.ix_(inv, inv)]
+        return element.jacobian(q, q_t, f_q, f_v)
 
     return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
 
