@@ -558,6 +558,30 @@ def _add_block_jacobian(jac, kb, t, b, x0, nx):
 
 
 @njit(cache=True)
+def _add_speed_column(jac, kb, t, b, x0, nx, col, dx, dy, dz):
+    """Add to column ``col`` of ``jac`` the response to the ball displacement d (3,)
+    of one contact with block kb and T (see :func:`_add_block_jacobian`):
+    d f_ball = kb d, d g_x = -T^T kb d (the film-speed term of :func:`row_eval`)."""
+    k0 = kb[0, 0] * dx + kb[0, 1] * dy + kb[0, 2] * dz
+    k1 = kb[1, 0] * dx + kb[1, 1] * dy + kb[1, 2] * dz
+    k2 = kb[2, 0] * dx + kb[2, 1] * dy + kb[2, 2] * dz
+    jac[b, col] += k0
+    jac[b + 1, col] += k1
+    jac[b + 2, col] += k2
+    for c in range(nx):
+        jac[x0 + c, col] -= t[0, c] * k0 + t[1, c] * k1 + t[2, c] * k2
+
+
+@njit(cache=True)
+def _film_speed_gain(law, speed, film):
+    """d h_c / d u [s] of a contact's film at entrainment speed u > 0 (Hamrock-Dowson
+    h ~ u^0.67; a map's own speed dependence is left out: Jacobian only)."""
+    if speed <= 0.0 or law[1] <= 0.0:
+        return 0.0
+    return law[3] * film / speed
+
+
+@njit(cache=True)
 def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
              state, jacobian, rec, f, jq, jv):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
@@ -748,6 +772,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     kbo_q = np.empty((nco, 3))
     kbo_v = np.empty((nco, 3))
     record = rec.shape[0] == nz
+    # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
+    # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
+    dudw = speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
     for j in range(nz):
         bj = b0 + 3 * j
         bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
@@ -837,6 +864,10 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         else:
             _add_block_jacobian(jq, k_i, t_i, bj, 0, nx_i)
             _add_block_jacobian(jv, d_i, t_i, bj, 0, nx_i)
+            gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
+            if gain != 0.0:
+                _add_speed_column(jv, k_i, t_i, bj, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1],
+                                  gain * nrm_i[j, 2])
         if cond_o:
             for r in range(3):
                 for c in range(3):
@@ -846,6 +877,10 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             bo = bas_o_all[j] if m_o > 0 else bas_o
             _add_block_jacobian(jq, k_o, bo, bj, 6 + m_i, m_o)
             _add_block_jacobian(jv, d_o, bo, bj, 6 + m_i, m_o)
+            gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
+            if gain != 0.0:
+                _add_speed_column(jv, k_o, bo, bj, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1],
+                                  gain * nrm_o[j, 2])
     if jacobian and (cond_i or cond_o):
         ball = slice(b0, b0 + 3 * nz)
         if cond_i:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
@@ -857,10 +892,27 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
                 tk = ti_all.T @ km
                 jac[0:nx_i, ball] -= tk
                 jac[0:nx_i, 0:nx_i] += tk @ ti_all
+            kd = kim[0] @ _film_displacements(law_i, speed, film_i, nrm_i, dudw)
+            jv[ball, 5] += kd
+            jv[0:nx_i, 5] -= ti_all.T @ kd
         if cond_o:  # outer ring in the housing: ball-ball only (m_o = 0)
             kom = _contact_matrix(kbo_q, kbo_v, cmat_o, True, nrm_o, cd_o)
             jq[ball, ball] += kom[0]
             jv[ball, ball] += kom[1]
+            jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
+
+
+@njit(cache=True)
+def _film_displacements(law, speed, films, normals, dudw):
+    """(3Z,) ball displacements n_j dh_j/du du/dq_t[5] equivalent to the films'
+    speed dependence (see :func:`row_eval`)."""
+    nz = films.shape[0]
+    out = np.zeros(3 * nz)
+    for j in range(nz):
+        gain = _film_speed_gain(law, speed, films[j]) * dudw
+        for c in range(3):
+            out[3 * j + c] = gain * normals[j, c]
+    return out
 
 
 @njit(cache=True)
