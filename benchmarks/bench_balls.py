@@ -40,6 +40,20 @@ def _timed(obj, attr, acc, key):
     setattr(obj, attr, timed)
 
 
+def _timed_method(cls, attr, acc, key):
+    """Accumulate CPU time and calls of the method cls.attr (every instance) in acc[key]."""
+    fn = getattr(cls, attr)
+
+    def timed(self, *args, **kw):
+        c0 = time.process_time()
+        r = fn(self, *args, **kw)
+        acc[key][0] += time.process_time() - c0
+        acc[key][1] += 1
+        return r
+
+    setattr(cls, attr, timed)
+
+
 def bench(name: str, t_end: float, newton: dict | None) -> dict:
     from flexrv.simulation import Simulation
 
@@ -48,18 +62,18 @@ def bench(name: str, t_end: float, newton: dict | None) -> dict:
     # numba load/compile, not timed (5-step segments: the segment starts take the outputs' history pass)
     sim.run(t_end=0.002, newton_options=newton, segment_steps=5)
     acc = {"row": [0.0, 0], "row_jac": [0.0, 0], "fused": [0.0, 0], "fused_jac": [0.0, 0]}
-    from flexrv.model import flexible_bearing  # the row elements call its row_force / row_jacobian
+    from flexrv.model.flexible_bearing import RowElement  # the row elements' user functions (glue + kernel)
 
-    saved = flexible_bearing.row_force, flexible_bearing.row_jacobian
-    _timed(flexible_bearing, "row_force", acc, "row")
-    _timed(flexible_bearing, "row_jacobian", acc, "row_jac")
+    saved = RowElement.force, RowElement.jacobian
+    _timed_method(RowElement, "force", acc, "row")
+    _timed_method(RowElement, "jacobian", acc, "row_jac")
     if model.fused is not None:
         _timed(model.fused, "residual", acc, "fused")
         _timed(model.fused, "jacobian", acc, "fused_jac")
     c0 = time.process_time()
     res = sim.run(t_end=t_end, newton_options=newton)
     cpu = time.process_time() - c0
-    flexible_bearing.row_force, flexible_bearing.row_jacobian = saved
+    RowElement.force, RowElement.jacobian = saved
     tm = sim.timing
     te = res["te"]
     sel = te.values[te["time"].values >= 0.5 * t_end]
