@@ -389,3 +389,39 @@ def test_film_speed_jacobian_vs_finite_difference():
     dry = rows_from_design(load("rv40e"), ehl="dry")[0]
     cage = evaluate_row(dry, q, qt, jacobian=True).jac_v[:, 5]
     assert np.abs(fd - cage).max() > 0.5 * np.abs(fd).max()
+
+
+def test_two_rows_one_element():
+    """Both rows in one element (issue 15: the reducer model's one Python round trip
+    per residual): the force and Exudyn Jacobian are the sums of the rows' own
+    (:func:`evaluate_row`) scattered to the shared carrier and each row's balls,
+    equal to round-off (1e-14 of the largest entry; the carrier entries are sums
+    of two terms), and the row-row blocks are exact zeros."""
+    from flexrv.model.flexible_bearing import _PERM, RowElement
+
+    rows = rows_from_design(load("rv221"), ehl="hamrock_dowson")
+    nb = [r.n_coordinates - 6 for r in rows]
+    n = 6 + sum(nb)
+    idxs = [np.concatenate([_PERM, np.arange(6, 6 + nb[0])]), np.concatenate([_PERM, np.arange(6 + nb[0], n)])]
+    rng = np.random.default_rng(7)
+    carrier_q, carrier_v = rng.normal(scale=1e-6, size=6), rng.normal(scale=1e-3, size=6)
+    carrier_q[3:6] = rng.normal(scale=1e-5, size=3)
+    carrier_v[2] = 0.9
+    qn, vn = np.zeros(n), np.zeros(n)
+    qn[:6], vn[:6] = carrier_q, carrier_v
+    ref_f, ref_j, states = np.zeros(n), np.zeros((n, n)), []
+    f_q, f_v = 0.5, 2e3
+    for r, idx in zip(rows, idxs):
+        q, qt = _random_state(r, seed=11)
+        q[:6], qt[:6] = carrier_q[_PERM], carrier_v[_PERM]
+        qn[idx[6:]] = q[6:] + r.ball_reference.ravel()
+        vn[idx[6:]] = qt[6:]
+        ev = evaluate_row(r, q, qt, jacobian=True)
+        ref_f[idx] += ev.force
+        ref_j[np.ix_(idx, idx)] += -(f_q * ev.jac_q + f_v * ev.jac_v)
+    element = RowElement(rows, idxs, absolute=True)
+    force = element.force(list(qn), list(vn))
+    jac = element.jacobian(list(qn), list(vn), f_q, f_v)
+    np.testing.assert_allclose(force, ref_f, rtol=0, atol=1e-14 * np.abs(ref_f).max())
+    np.testing.assert_allclose(jac, ref_j, rtol=0, atol=1e-14 * np.abs(ref_j).max())
+    assert not jac[6:6 + nb[0], 6 + nb[0]:].any() and not jac[6 + nb[0]:, 6:6 + nb[0]].any()

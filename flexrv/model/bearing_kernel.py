@@ -970,35 +970,52 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
-def row_element(qn, vn, idx, absolute, jacobian, f_q, f_v, qe, ve, f, jq, jv, rec, out_f, out_j, ball_ref, geometry,
-                tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, state):
-    """One call of a row's Exudyn element (the glue of
+def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
+    """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
-    arrays): the element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
+    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, then the
+    row's kernel inputs, :func:`flexrv.model.flexible_bearing.kernel_inputs`). Per
+    row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
     vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
-    reference ``ball_ref`` is subtracted), then :func:`row_eval`, and the result in
-    the nodes' coordinate order: the force out_f[idx[e]] = f[e], or with
-    ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j."""
-    n = idx.shape[0]
-    nz = ball_ref.shape[0]
-    b0 = n - 3 * nz
-    for e in range(n):
-        qe[e] = qn[idx[e]]
-        ve[e] = vn[idx[e]]
-    if absolute:
-        for j in range(nz):
-            for c in range(3):
-                qe[b0 + 3 * j + c] -= ball_ref[j, c]
-    row_eval(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-             state, jacobian, rec, f, jq, jv)
-    if jacobian:
-        for r in range(n):
-            ir = idx[r]
-            for c in range(n):
-                out_j[ir, idx[c]] = -(f_q * jq[r, c] + f_v * jv[r, c])
-    else:
+    reference ``ball_ref`` is subtracted), then :func:`row_eval`; the rows'
+    results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
+    f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
+    (entries no row touches stay zero: the rows interact only through the
+    carrier, so the row-row blocks are exact zeros, which Exudyn's sparse
+    assembly skips)."""
+    for part in parts:  # zero what the rows write
+        idx = part[0]
+        n = idx.shape[0]
+        if jacobian:
+            for r in range(n):
+                for c in range(n):
+                    out_j[idx[r], idx[c]] = 0.0
+        else:
+            for e in range(n):
+                out_f[idx[e]] = 0.0
+    for part in parts:
+        (idx, qe, ve, f, jq, jv, rec, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
+         ws_i, ws_o, state) = part
+        n = idx.shape[0]
+        nz = ball_ref.shape[0]
+        b0 = n - 3 * nz
         for e in range(n):
-            out_f[idx[e]] = f[e]
+            qe[e] = qn[idx[e]]
+            ve[e] = vn[idx[e]]
+        if absolute:
+            for j in range(nz):
+                for c in range(3):
+                    qe[b0 + 3 * j + c] -= ball_ref[j, c]
+        row_eval(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                 state, jacobian, rec, f, jq, jv)
+        if jacobian:
+            for r in range(n):
+                ir = idx[r]
+                for c in range(n):
+                    out_j[ir, idx[c]] += -(f_q * jq[r, c] + f_v * jv[r, c])
+        else:
+            for e in range(n):
+                out_f[idx[e]] += f[e]
 
 
 @njit(cache=True)

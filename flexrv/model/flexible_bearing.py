@@ -404,34 +404,45 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
 
 
 class RowElement:
-    """THE Exudyn glue of one bearing row (issue 15): one compiled call
+    """THE Exudyn glue of the bearing rows (issue 15): one Exudyn element for one or
+    more rows (the reducer model's two rows share one: one Python round trip per
+    residual instead of two), one compiled call
     (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
-    evaluation into arrays preallocated here — the gather of the element
-    coordinates from the nodes' (``idx``; ``absolute``: the nodes hold absolute ball
-    positions, the reference is subtracted), the row kernel, and the result in the
-    nodes' order (for the Jacobian Exudyn's -(f_q dF/dq + f_v dF/dq_t)). The
-    returned arrays are reused by the next call (Exudyn copies them). The compiled
-    entry point is called directly after the first call (skips numba's typing of
-    the arguments, whose types never change: :meth:`_call`). ``stats`` counts the
-    force and Jacobian calls."""
+    evaluation into arrays preallocated here — per row the gather of its element
+    coordinates from the nodes' (``idx``: row element coordinate -> nodes'
+    coordinate; ``absolute``: the nodes hold absolute ball positions, the reference
+    is subtracted), the row kernel, and the sum over the rows in the nodes' order
+    (for the Jacobian Exudyn's -(f_q dF/dq + f_v dF/dq_t)). The returned arrays are
+    reused by the next call (Exudyn copies them). The compiled entry point is
+    called directly after the first call (skips numba's typing of the arguments,
+    whose types never change: :meth:`_call`). ``stats`` counts the force and
+    Jacobian calls."""
 
-    def __init__(self, row: RowModel, idx: np.ndarray | None = None, absolute: bool = False,
-                 stats: list | None = None):
-        n = row.n_coordinates
-        self.row = row
-        self.idx = np.ascontiguousarray(np.arange(n) if idx is None else idx, dtype=np.int64)
+    def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None):
+        rows = [rows] if isinstance(rows, RowModel) else list(rows)
+        idxs = [idx] if (idx is None or np.ndim(idx) == 1 and len(rows) == 1 and not isinstance(idx, list)) else list(idx)
+        if len(idxs) != len(rows):
+            raise ValueError("one coordinate map per row")
+        self.rows = rows
+        self.idx = [np.ascontiguousarray(np.arange(r.n_coordinates) if i is None else i, dtype=np.int64)
+                    for r, i in zip(rows, idxs)]
+        n = 1 + max(int(i.max()) for i in self.idx)
         self.absolute = bool(absolute)
         self.stats = [0, 0] if stats is None else stats
-        self._qe, self._ve, self._f = np.zeros(n), np.zeros(n), np.zeros(n)
-        self._jq, self._jv = np.zeros((n, n)), np.zeros((n, n))
-        self._rec = np.zeros((0, N_RECORD))
+        self._work = []
+        for r, i in zip(rows, self.idx):
+            m = r.n_coordinates
+            if i.shape != (m,):
+                raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
+            self._work.append((i, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, m)), np.zeros((m, m)),
+                               np.zeros((0, N_RECORD))))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
 
     def _call(self, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
-        args = (np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64), self.idx, self.absolute, jacobian,
-                f_q, f_v, self._qe, self._ve, self._f, self._jq, self._jv, self._rec, self.out_f, self.out_j,
-                *kernel_inputs(self.row))
+        parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
+        args = (np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64), self.absolute, jacobian, f_q, f_v,
+                self.out_f, self.out_j, parts)
         if self._entry is not None:
             self._entry(*args)
             return
@@ -454,23 +465,19 @@ class RowElement:
         return self.out_j
 
 
-def add_row_element(mbs, row: RowModel, nodes: list[int], idx: np.ndarray | None = None,
-                    ball_reference: np.ndarray | None = None, stats: list | None = None) -> int:
-    """Add one bearing row to ``mbs``: one ``ObjectGenericODE2`` over ``nodes`` whose
+def add_row_element(mbs, rows, nodes: list[int], idx=None, absolute: bool = False, stats: list | None = None) -> int:
+    """Add bearing rows to ``mbs`` as ONE ``ObjectGenericODE2`` over ``nodes`` whose
     force and Jacobian user functions are a :class:`RowElement` (the compiled row
-    kernel). ``idx`` maps the row element's coordinates [frame(6), inner modes,
-    outer modes, balls(3Z)] to the nodes' coordinates (default: the same order);
-    ``ball_reference`` (the row's reference ball centres) is given when the nodes
+    kernel). ``rows``: a :class:`RowModel` or a list; ``idx``: per row, its element
+    coordinates [frame(6), inner modes, outer modes, balls(3Z)] -> the nodes'
+    coordinates (default for one row: the same order); ``absolute``: the nodes
     hold absolute ball positions (the reducer model's ball members); ``stats``
     counts the force and Jacobian calls. Used by the reducer model's
-    :class:`BallBearingGroup` and by the stand-alone bearing of
-    :func:`add_main_bearing`. Returns the object number."""
+    :class:`BallBearingGroup` (both rows) and by the stand-alone bearing of
+    :func:`add_main_bearing` (one element per row). Returns the object number."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    absolute = ball_reference is not None and np.size(ball_reference) > 0
-    if absolute and not np.array_equal(np.ravel(ball_reference), row.ball_reference.ravel()):
-        raise ValueError("ball_reference must be the row's reference ball centres")
-    element = RowElement(row, idx, absolute, stats)
+    element = RowElement(rows, idx, absolute, stats)
 
     def force_fn(mbs_, t, item, q, q_t):
         return element.force(q, q_t)
@@ -669,19 +676,18 @@ class BallBearingGroup(ForceGroup):
         self._n = int(sum(sizes))
 
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
-        """One Exudyn element per row over [carrier, the row's modal rings, its balls]
-        (instead of one over the whole group): the rows do not interact except
-        through the carrier, and separate elements keep the zero row-row blocks out
-        of the system Jacobian (measured: ~half the nonzeros for two flexible rows).
-        Returns the first row's object number (:func:`add_row_element`, the one glue path)."""
-        stats, objects, pos = self.stats, [], 1
-        for k, row in enumerate(self.rows):
-            count = 1 + len(row.ring_nodes())
-            row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
-            pos += count
-            idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
-            objects.append(add_row_element(mbs, row, row_nodes, idx, row.ball_reference.ravel(), stats))
-        return objects[0]
+        """ONE Exudyn element over the group's nodes [carrier, per row: its modal rings,
+        its balls] for both rows (:func:`add_row_element`, the one glue path): one
+        Python round trip per residual and Jacobian instead of one per row
+        (issue 15). The rows interact only through the carrier; their zero row-row
+        blocks are exact zeros, which Exudyn's sparse assembly skips, so the system
+        Jacobian has the nonzeros of one element per row. Returns the object number."""
+        idxs, pos = [], 6
+        for row in self.rows:
+            m = row.n_coordinates - 6
+            idxs.append(np.concatenate([_PERM, np.arange(pos, pos + m)]))  # row element coordinate -> group's
+            pos += m
+        return add_row_element(mbs, self.rows, list(nodes), idxs, True, self.stats)
 
     @property
     def flexible(self) -> bool:
