@@ -392,8 +392,8 @@ def test_film_speed_jacobian_vs_finite_difference():
 
 
 def test_two_rows_one_element():
-    """Both rows in one element (issue 15: the reducer model's one Python round trip
-    per residual): the force and Exudyn Jacobian are the sums of the rows' own
+    """Both rows in one element (the glue's multi-row form, :class:`RowElement`): the
+    force and Exudyn Jacobian are the sums of the rows' own
     (:func:`evaluate_row`) scattered to the shared carrier and each row's balls,
     equal to round-off (1e-14 of the largest entry; the carrier entries are sums
     of two terms), and the row-row blocks are exact zeros."""
