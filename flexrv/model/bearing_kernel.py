@@ -148,8 +148,9 @@ def _normal_load(delta, rate, hu, lu, h_floor, law):
     h ~ s^p (p = 1.5 d ln h/d ln Q <= 0), phi''/(2 phi') s <= |p - 1|/2 <= 0.75,
     so the relative error of the new iterate is <= 0.75 (step/s)^2 (< 1e-16); the
     film and phi' are carried to it to first order in the step (error
-    O(step^2)). Typically 2 film evaluations (powers) per contact instead of
-    4-5; the result equals all ``iterations`` steps within round-off
+    O(step^2)). Measured (rv40e law, 0.05-0.2 m/s): 3 film evaluations (powers)
+    per loaded contact instead of 4-5, the relative steps being ~3e-2, ~2e-5,
+    ~1e-11; the result equals all ``iterations`` steps within round-off
     (tests/test_model_flexible_rings.py::test_kernel_normal_law_equals_ehl_law)."""
     k, lexp, floor, c_max, depth, iters = law[0], law[2], law[4], law[5], law[6], int(law[7])
     dphi = 1.0
