@@ -59,6 +59,30 @@ fused kernel of the other groups ~6 %, the outputs pass ~9 %; rv221: row residua
 modifiedNewtonContractivity 0.8 (0.95 with 12 modified iterations) cut them to
 725 (432) but raised the iterations to 5.6 (6.6) per step: 39.8 (36.4) against
 34.2 s/s. The goal (15 s/s) is not reached.
+
+Row glue and kernel (branch rowspeed, 2026-11-24): paired runs alternating the
+code before (4db34e6) and after, CPU of run() per simulated s (solve in
+brackets), 0.1 s from rest, ``--models flexible``:
+
+=====  ===================================  ===================================  =====================
+preset before                               after                                Newton/step, Jacobians
+=====  ===================================  ===================================  =====================
+rv221  15.46, 15.49 (solve 13.25, 13.44)     14.31, 14.05 (solve 12.36, 12.12)     5.19 / 49 -> 5.25 / 51
+rv40e  36.98, 37.49 (solve 32.87, 33.53)     30.22, 30.92 (solve 26.53, 26.96)     3.62 / 602 -> 3.50 / 472
+=====  ===================================  ===================================  =====================
+
+(this script, one pair on a more loaded machine: rv221 20.4 -> 18.5, rv40e 47.3 -> 37.3 s/s.)
+What changed: the element glue is one compiled call into preallocated arrays;
+the inner ring's groove geometry is computed per ball without small BLAS calls
+and allocations; the condensed rings' local factors and solve scratch live in
+their work arrays (the 165 kB factor array was allocated, page-faulted and zeroed
+on every call); the film Newton stops once its step is below 1e-8; the films'
+speed term is in d f/d q_t; Exudyn no longer differentiates the member objects
+numerically (factory). rv221 meets the goal; rv40e does not: each row residual
+is ~100 us (two condensed rings of 38 balls and 165/181 modes: the factor
+interpolation and the local solve), each row Jacobian ~1-2 ms (the dense
+(I - K C)^-1 K of 114 x 114 per ring), and 3.5 Newton iterations per step with a
+Jacobian every second step.
 """
 
 from __future__ import annotations

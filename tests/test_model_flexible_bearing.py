@@ -334,3 +334,94 @@ def test_kernel_refuses_a_law_it_does_not_cover():
     bad = replace(row, law_inner=replace(law, rx=np.full(row.ball_count, law.rx), ry=np.full(row.ball_count, law.ry)))
     with pytest.raises(ConfigError, match="'dry', 'hamrock_dowson' or 'map'"):
         kernel_inputs(bad)
+
+
+def test_row_element_glue_equals_kernel():
+    """The compiled element glue (issue 15, :class:`RowElement`: gather from the nodes'
+    order, reference subtracted from absolute ball positions, kernel, scatter, and
+    Exudyn's -(f_q dF/dq + f_v dF/dq_t)) returns exactly (bit for bit) what
+    :func:`evaluate_row` gives for the same element state, permuted to the nodes'
+    order of the reducer model (frame coordinates reordered as the carrier's);
+    its output arrays are reused by the next call, as Exudyn copies them."""
+    from flexrv.model.flexible_bearing import _PERM, RowElement
+
+    model = rows_from_design(load("rv40e"), ehl="hamrock_dowson")[1]
+    q, qt = _random_state(model, seed=3)
+    qt[5] = 1.3  # carrier spin: the films see an entrainment speed
+    idx = np.concatenate([_PERM, np.arange(6, model.n_coordinates)])
+    inv = np.argsort(idx)
+    qn = q.copy()
+    qn[6:] += model.ball_reference.ravel()  # absolute ball positions
+    qn, vn = qn[inv], qt[inv]  # the nodes' order: element coordinate e is node coordinate idx[e]
+    element = RowElement(model, idx, absolute=True)
+    ev = evaluate_row(model, q, qt, jacobian=True)
+    f_q, f_v = 0.37, 1.9e3
+    for _ in range(2):  # second call: entry point, reused arrays
+        force = element.force(list(qn), list(vn))
+        np.testing.assert_array_equal(force, ev.force[inv])
+        jac = element.jacobian(list(qn), list(vn), f_q, f_v)
+        np.testing.assert_array_equal(jac, (-(f_q * ev.jac_q + f_v * ev.jac_v))[np.ix_(inv, inv)])
+    assert element.stats == [2, 2]
+    assert np.abs(ev.force).max() > 1.0
+
+
+def test_film_speed_jacobian_vs_finite_difference():
+    """d force / d q_t includes the films' entrainment-speed term (issue 15): the
+    Hamrock-Dowson film grows as u^0.67 with u = speed_factor |omega_z|, so every
+    loaded contact's load depends on the carrier's spin rate. The column of
+    omega_z (element coordinate 5) matches central differences of the force
+    within 1e-5 of its largest entry (it was missing before: 98 % error), and
+    the film term is most of that column (the cage's share is checked apart)."""
+    model = rows_from_design(load("rv40e"), ehl="hamrock_dowson")[0]
+    q, qt = _random_state(model, seed=4)
+    q[6:] = 0.0
+    q[6 + 2::3] = -2e-7  # axial preload side: every ball loaded
+    qt[:] = 0.0
+    qt[5] = 1.1
+    ev = evaluate_row(model, q, qt, jacobian=True)
+    h = 1e-6
+    up, dn = qt.copy(), qt.copy()
+    up[5] += h
+    dn[5] -= h
+    fd = (evaluate_row(model, q, up, False).force - evaluate_row(model, q, dn, False).force) / (2 * h)
+    assert np.abs(ev.jac_v[:, 5] - fd).max() < 1e-5 * np.abs(fd).max()
+    # the cage's tangential damper alone (a dry law has no film): a much smaller column
+    dry = rows_from_design(load("rv40e"), ehl="dry")[0]
+    cage = evaluate_row(dry, q, qt, jacobian=True).jac_v[:, 5]
+    assert np.abs(fd - cage).max() > 0.5 * np.abs(fd).max()
+
+
+def test_two_rows_one_element():
+    """Both rows in one element (the glue's multi-row form, :class:`RowElement`): the
+    force and Exudyn Jacobian are the sums of the rows' own
+    (:func:`evaluate_row`) scattered to the shared carrier and each row's balls,
+    equal to round-off (1e-14 of the largest entry; the carrier entries are sums
+    of two terms), and the row-row blocks are exact zeros."""
+    from flexrv.model.flexible_bearing import _PERM, RowElement
+
+    rows = rows_from_design(load("rv221"), ehl="hamrock_dowson")
+    nb = [r.n_coordinates - 6 for r in rows]
+    n = 6 + sum(nb)
+    idxs = [np.concatenate([_PERM, np.arange(6, 6 + nb[0])]), np.concatenate([_PERM, np.arange(6 + nb[0], n)])]
+    rng = np.random.default_rng(7)
+    carrier_q, carrier_v = rng.normal(scale=1e-6, size=6), rng.normal(scale=1e-3, size=6)
+    carrier_q[3:6] = rng.normal(scale=1e-5, size=3)
+    carrier_v[2] = 0.9
+    qn, vn = np.zeros(n), np.zeros(n)
+    qn[:6], vn[:6] = carrier_q, carrier_v
+    ref_f, ref_j, states = np.zeros(n), np.zeros((n, n)), []
+    f_q, f_v = 0.5, 2e3
+    for r, idx in zip(rows, idxs):
+        q, qt = _random_state(r, seed=11)
+        q[:6], qt[:6] = carrier_q[_PERM], carrier_v[_PERM]
+        qn[idx[6:]] = q[6:] + r.ball_reference.ravel()
+        vn[idx[6:]] = qt[6:]
+        ev = evaluate_row(r, q, qt, jacobian=True)
+        ref_f[idx] += ev.force
+        ref_j[np.ix_(idx, idx)] += -(f_q * ev.jac_q + f_v * ev.jac_v)
+    element = RowElement(rows, idxs, absolute=True)
+    force = element.force(list(qn), list(vn))
+    jac = element.jacobian(list(qn), list(vn), f_q, f_v)
+    np.testing.assert_allclose(force, ref_f, rtol=0, atol=1e-14 * np.abs(ref_f).max())
+    np.testing.assert_allclose(jac, ref_j, rtol=0, atol=1e-14 * np.abs(ref_j).max())
+    assert not jac[6:6 + nb[0], 6 + nb[0]:].any() and not jac[6 + nb[0]:, 6:6 + nb[0]].any()

@@ -45,7 +45,7 @@ from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
 from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
-                                         ring_modal_amplitudes, row_force_kernel, row_history,
+                                         ring_modal_amplitudes, row_element, row_force_kernel, row_history,
                                          row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
@@ -403,39 +403,87 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     return pos - model.ball_reference
 
 
-def add_row_element(mbs, row: RowModel, nodes: list[int], idx: np.ndarray | None = None,
-                    ball_reference: np.ndarray | None = None, stats: list | None = None) -> int:
-    """THE Exudyn glue of one bearing row: one ``ObjectGenericODE2`` over ``nodes`` whose
-    force and Jacobian user functions call the compiled row kernel (:func:`row_force`,
-    :func:`row_jacobian`). ``idx`` maps the row element's coordinates [frame(6), inner
-    modes, outer modes, balls(3Z)] to the nodes' coordinates (default: the same order);
-    ``ball_reference`` is subtracted from the ball coordinates when the nodes hold
-    absolute ball positions (the reducer model's ball members); ``stats`` counts the
-    force and Jacobian calls. Used by the reducer model's :class:`BallBearingGroup` and
-    by the stand-alone bearing of :func:`add_main_bearing`. Returns the object number."""
+class RowElement:
+    """THE Exudyn glue of the bearing rows (issue 15): one Exudyn element for one or
+    more rows (the reducer model uses one per row, see
+    :meth:`BallBearingGroup.add_to`), one compiled call
+    (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
+    evaluation into arrays preallocated here — per row the gather of its element
+    coordinates from the nodes' (``idx``: row element coordinate -> nodes'
+    coordinate; ``absolute``: the nodes hold absolute ball positions, the reference
+    is subtracted), the row kernel, and the sum over the rows in the nodes' order
+    (for the Jacobian Exudyn's -(f_q dF/dq + f_v dF/dq_t)). The returned arrays are
+    reused by the next call (Exudyn copies them). The compiled entry point is
+    called directly after the first call (skips numba's typing of the arguments,
+    whose types never change: :meth:`_call`). ``stats`` counts the force and
+    Jacobian calls."""
+
+    def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None):
+        rows = [rows] if isinstance(rows, RowModel) else list(rows)
+        idxs = [idx] if (idx is None or np.ndim(idx) == 1 and len(rows) == 1 and not isinstance(idx, list)) else list(idx)
+        if len(idxs) != len(rows):
+            raise ValueError("one coordinate map per row")
+        self.rows = rows
+        self.idx = [np.ascontiguousarray(np.arange(r.n_coordinates) if i is None else i, dtype=np.int64)
+                    for r, i in zip(rows, idxs)]
+        n = 1 + max(int(i.max()) for i in self.idx)
+        self.absolute = bool(absolute)
+        self.stats = [0, 0] if stats is None else stats
+        self._work = []
+        for r, i in zip(rows, self.idx):
+            m = r.n_coordinates
+            if i.shape != (m,):
+                raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
+            self._work.append((i, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, m)), np.zeros((m, m)),
+                               np.zeros((0, N_RECORD))))
+        self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
+        self._entry = None
+
+    def _call(self, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
+        parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
+        args = (np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64), self.absolute, jacobian, f_q, f_v,
+                self.out_f, self.out_j, parts)
+        if self._entry is not None:
+            self._entry(*args)
+            return
+        row_element(*args)
+        from numba import typeof
+
+        cres = row_element.overloads.get(tuple(typeof(x) for x in args))
+        self._entry = None if cres is None else cres.entry_point
+
+    def force(self, q, q_t) -> np.ndarray:
+        """Generalized force in the nodes' coordinate order (q, q_t: the nodes' coordinates)."""
+        self.stats[0] += 1
+        self._call(q, q_t, False, 0.0, 0.0)
+        return self.out_f
+
+    def jacobian(self, q, q_t, f_q, f_v) -> np.ndarray:
+        """Exudyn's -(f_q dF/dq + f_v dF/dq_t) in the nodes' coordinate order."""
+        self.stats[1] += 1
+        self._call(q, q_t, True, float(f_q), float(f_v))
+        return self.out_j
+
+
+def add_row_element(mbs, rows, nodes: list[int], idx=None, absolute: bool = False, stats: list | None = None) -> int:
+    """Add bearing rows to ``mbs`` as ONE ``ObjectGenericODE2`` over ``nodes`` whose
+    force and Jacobian user functions are a :class:`RowElement` (the compiled row
+    kernel). ``rows``: a :class:`RowModel` or a list; ``idx``: per row, its element
+    coordinates [frame(6), inner modes, outer modes, balls(3Z)] -> the nodes'
+    coordinates (default for one row: the same order); ``absolute``: the nodes
+    hold absolute ball positions (the reducer model's ball members); ``stats``
+    counts the force and Jacobian calls. Used by the reducer model's
+    :class:`BallBearingGroup` and by the stand-alone bearing of
+    :func:`add_main_bearing` (one element per row). Returns the object number."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    idx = np.arange(row.n_coordinates) if idx is None else np.asarray(idx)
-    inv = np.argsort(idx)  # nodes' coordinate -> element coordinate
-    ref = np.zeros(0) if ball_reference is None else np.asarray(ball_reference, dtype=float)
-    stats = [0, 0] if stats is None else stats
-
-    def element(q, q_t):
-        qe = np.asarray(q)[idx]
-        if ref.size:
-            qe[-ref.size:] -= ref
-        return qe, np.asarray(q_t)[idx]
+    element = RowElement(rows, idx, absolute, stats)
 
     def force_fn(mbs_, t, item, q, q_t):
-        stats[0] += 1
-        qe, ve = element(q, q_t)
-        return row_force(row, qe, ve)[inv]
+        return element.force(q, q_t)
 
     def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-        stats[1] += 1
-        qe, ve = element(q, q_t)
-        jq, jv = row_jacobian(row, qe, ve)
-        return -(f_q * jq + f_v * jv)[np.ix_(inv, inv)]
+        return element.jacobian(q, q_t, f_q, f_v)
 
     return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
 
@@ -629,17 +677,19 @@ class BallBearingGroup(ForceGroup):
 
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
         """One Exudyn element per row over [carrier, the row's modal rings, its balls]
-        (instead of one over the whole group): the rows do not interact except
-        through the carrier, and separate elements keep the zero row-row blocks out
-        of the system Jacobian (measured: ~half the nonzeros for two flexible rows).
-        Returns the first row's object number (:func:`add_row_element`, the one glue path)."""
+        (:func:`add_row_element`, the one glue path). One element for both rows
+        would save one Python round trip per residual (~6 us, measured), but Exudyn
+        converts, copies and scans the element's dense Jacobian, which grows as
+        (6 + 6Z)^2 instead of 2 (6 + 3Z)^2: on two dense 120-coordinate blocks (the
+        condensed rows of rv40e) a synthetic system took 1.86 s instead of 1.31 s
+        for 1000 Jacobians (issue 15). Returns the first row's object number."""
         stats, objects, pos = self.stats, [], 1
-        for k, row in enumerate(self.rows):
+        for row in self.rows:
             count = 1 + len(row.ring_nodes())
             row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
             pos += count
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
-            objects.append(add_row_element(mbs, row, row_nodes, idx, row.ball_reference.ravel(), stats))
+            objects.append(add_row_element(mbs, row, row_nodes, idx, True, stats))
         return objects[0]
 
     @property
