@@ -270,6 +270,9 @@ class Simulation:
             while k > 0 and ts[k - 1] >= t - 1e-12 * dt:  # a step was repeated (adaptive step reduction)
                 k -= 1
             state["k"] = k
+            if not math.isfinite(q.sum()):  # before recording: a failed run's results hold finite states only
+                state["fail"] = (t, "the state became NaN/inf")
+                return False
             if (k == 0 or t >= ts[k - 1] + output_every * dt * (1 - 1e-9)) and k < n_out:
                 ts[k] = t
                 qs[k] = q
@@ -278,9 +281,6 @@ class Simulation:
                     recorder.store(k, t, q, vs[k])
                 state["k"] = k + 1
             state["step"] += 1
-            if not math.isfinite(q.sum()):
-                state["fail"] = (t, "the state became NaN/inf")
-                return False
             for g in steppers:
                 g.new_step()
             for g in checkers:

@@ -133,6 +133,7 @@ def test_failure_is_reported_with_partial_results():
     assert "t = " in str(info.value) and "dt" in str(info.value)
     res = info.value.results
     assert res.attrs["status"] == "failed" and len(res.time) > 2
+    assert np.isfinite(res["te"].values).all()  # a non-finite state stops the run before it is recorded
 
 
 @pytest.mark.parametrize("name", ["rv40e", "rv221"])

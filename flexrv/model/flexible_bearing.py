@@ -832,7 +832,9 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
         speed = (row.speed_factor * carrier_speed)[:, None]
         film[:, k] = _law_film(row.law_inner, load_i[:, k], speed)
         if row.inner_radii is not None:
-            p_max[:, k] = point_contact(load_i[:, k], *row.inner_radii, row.e_eff).p_max
+            ok = np.isfinite(load_i[:, k]).all(axis=-1)  # (a failed run's last samples may not be)
+            p_max[:, k] = np.nan
+            p_max[ok, k] = point_contact(load_i[ok, k], *row.inner_radii, row.e_eff).p_max
     fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
     dims = ("time", "bearing_row", "ball")
     out = {"main_bearing_radial_force": Output(np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N",

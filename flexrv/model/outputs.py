@@ -117,7 +117,10 @@ def _kinetic_energy(model, t, q, v):
     ke = np.zeros_like(t)
     for m in model.members.values():
         vm = v[:, model.slice(m.name)]
-        ke += 0.5 * np.einsum("ti,ij,tj->t", vm, m.mass_matrix, vm)
+        if m.kind == "points":  # point masses: a diagonal mass matrix (the einsum over (3Z)^2 cost ~0.5 s/s)
+            ke += 0.5 * (vm * vm) @ np.diag(m.mass_matrix)
+        else:
+            ke += 0.5 * np.einsum("ti,ij,tj->t", vm, m.mass_matrix, vm)
     return ke + 0.5 * model.params.input_inertia * _input_speed(model, t) ** 2
 
 
