@@ -198,7 +198,7 @@ def carrier_material(reducer) -> dict:
 
 def carrier_compliance(reducer, size: float | None = None, split_input: float = 0.5,
                        local_size: float | None = None, rigid_bound: bool = True,
-                       cache: bool = True) -> CarrierCompliance:
+                       cache: bool = True, edge_size: float | None = None) -> CarrierCompliance:
     """Condensed bore compliance and torsional compliance of a design's carrier
     (module doc). ``size``: global mesh size [m] (part default if None), ``local_size``
     the pillar mesh size [m] (part default if None); ``rigid_bound`` also
@@ -206,7 +206,7 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
     from flexrv.fem.body import _assemble
     from flexrv.meshing import build_mesh
 
-    mres = build_mesh(reducer, "carrier", size, local_size=local_size, cache=cache)
+    mres = build_mesh(reducer, "carrier", size, local_size=local_size, edge_size=edge_size, cache=cache)
     mat = carrier_material(reducer)
     key = content_hash(mres.key, mat, float(split_input), bool(rigid_bound), FORMAT_VERSION,
                        library_versions("scikit-fem", "scipy", "numpy"))
@@ -217,7 +217,7 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
         n = reducer.first_stage.n_planets
         a_w = reducer.first_stage.center_distance
         names = bore_groups(n)
-        fe = _assemble(d, mat)
+        fe = _assemble(d, mat, mass=False)
         flange = d.node_set("flange")
         W = rbe3_loads(d.nodes, [d.faces(g) for g in names])
         C, _ = clamped_flexibility(fe.K, flange, W)
