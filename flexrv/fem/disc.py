@@ -30,9 +30,19 @@ adds the body's compliance below the contact zone. What the FE still counts of
 the near field between b and the patch width is the logarithmic half-plane term
 ~ 2 F (1 - nu^2) ln(patch / b) / (pi E L) per pin, stated as the remaining
 overlap with the contact law (Johnson, Contact Mechanics 1985, sec. 2.8).
-Measured on the rv40e disc (default mesh, crank angle 0): patch half-width 0.75,
-1.5, 3 mm give c_d = 1.470, 1.357, 1.278e-7 rad/(N m) (+8 % / -6 % about the
-default): the body value carries this +-8 % modelling band.
+Measured on the rv40e disc (crank angle 0; the former 1.29 mm flank mesh and
+lumped patch loads, 2026-11-23): patch half-width 0.75, 1.5, 3 mm give c_d =
+1.470, 1.357, 1.278e-7 rad/(N m) (+8 % / -6 % about the default): the body value
+carries this +-8 % modelling band.
+
+Mesh: the flank mesh size defaults to r_rp
+(:meth:`flexrv.meshing.parts.CycloidDiscSpec.profile_size`, with its convergence
+study: the default is within 0.8 % (rv40e) / 0.5 % (rv221) of the converged
+compliance). The patch loads are consistent (work-equivalent) loads of a uniform
+traction, integrated on sub-triangles (:func:`pin_patch_loads`), so they converge
+with the mesh; the former lumped form (nodal areas of the profile nodes inside the
+patch) scattered by +-0.4 % from mesh to mesh and read 1.6 % high on the former
+1.29 mm flank mesh (rv40e 1.4982e-7 against the converged 1.474e-7).
 
 Not modelled: the pillar holes of the disc (the ``cycloid_disc`` part has none;
 they make the real disc softer), needle bearing ovalisation of the crank holes
@@ -51,7 +61,8 @@ change of the modifications, the torque or the errors costs no FE solve, and
 
 Verification (tests/test_fem_disc.py): the condensed C reproduces the full FE
 solve of the same load case (Lagrange-multiplier solve of the constrained
-system) to 1e-8; mesh convergence with the patch fixed.
+system) to 1e-8; mesh convergence with the patch fixed (tests/test_convergence.py,
+coarse, and the slow study in tests/test_fem_disc.py).
 """
 
 from __future__ import annotations
@@ -393,7 +404,8 @@ def rim_compliance(reducer, size: float | None = None, n_angles: int = 6, cache:
     loaded patches per unit disc torque is (1.34 um, -0.008 um, 2.63e-5 rad), whose
     translational and rotational work terms per unit torque squared, +2.647e-5 and
     -2.632e-5 rad/(N m), cancel to the 1.36e-7 rad/(N m) of the FE energy: a 3 x 3
-    compliance fitted to it would be ill-conditioned, while the one generalized
+    compliance fitted to it would be ill-conditioned (measured with the former
+    lumped patch loads and 1.29 mm flank mesh), while the one generalized
     compliance on the torque path carries the energy exactly."""
     d = disc_torsion_sweep(reducer, n_angles=n_angles, size=size, cache=cache)
     return np.diag([0.0, 0.0, float(d.mean)])

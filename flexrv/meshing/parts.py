@@ -144,19 +144,24 @@ class CycloidDiscSpec:
     def profile_size(self, size: float) -> float:
         """Mesh size at the tooth flanks [m]: <= the pin radius r_rp, i.e. twice the
         pin patch half-width r_rp / 2 of :mod:`flexrv.fem.disc` (about a third of the
-        tooth pitch on the presets).
+        tooth pitch on the presets; before 2026-11-24 an eighth of it).
 
-        Chosen from the convergence study of the disc body's torsional compliance
-        (mean of :func:`flexrv.fem.disc.disc_torsion_sweep`, 2026-11-24, flank sizes
-        in ratio sqrt 2 at the default global size): rv40e 4.24 / 3 / 2.12 / 1.5 /
-        1.29 mm (11.3k-66.7k nodes) give 1.5230 / 1.5011 / 1.5122 / 1.5022 /
-        1.4982e-7 rad/(N m); rv221 see :data:`DISC_PROFILE_STUDY`. The sequence is
-        not monotonic (the RBE3 pin patches gather the profile nodes within r_rp / 2
-        of the contact line, a set that jumps with the mesh): it scatters by
-        +-0.4 % about its mean from 3 mm on, so no Richardson rate exists and the
-        default's discretisation error is that scatter, 0.2 % from the finest
-        meshes (rv40e: +0.19 % against the former default r_rp... tooth pitch / 8,
-        1.29 mm), for 10x less CPU and 4x less memory."""
+        Chosen from a convergence study of the disc body's torsional compliance as
+        the models and the budget use it (mean over six crank angles of
+        :func:`flexrv.fem.disc.disc_torsion_sweep`, consistent patch loads, default
+        global size, flank sizes in ratio sqrt 2; 2026-11-24):
+
+        * rv40e, 4.24 / 3 / 2.12 mm (11.3k / 16.9k / 28.8k nodes): 1.45218 /
+          1.46257 / 1.46803e-7 rad/(N m), observed order 1.86, Richardson value
+          1.4741e-7: the default (3 mm) is 0.8 % below it (1.4 % with the order 0.88
+          of the coarser triple at 8 mm global size);
+        * rv221, 7.07 / 5 / 3.54 / 2.5 mm (21.1k / 32.5k / 47.7k / 81.4k nodes):
+          2.27175 / 2.27992 / 2.28140 / 2.28413e-8, not in the asymptotic range
+          (differences 8.2e-11, 1.5e-11, 2.7e-11); the default (5 mm) is 0.18 %
+          below the finest and 0.5 % below its order-1 extrapolation.
+
+        The former default (rv40e 1.29 mm, 66.7k nodes; rv221 2.2 mm, 107k nodes)
+        cost 120 / 189 s CPU and 4.0 / 5.6 GB for the sweep (benchmarks/bench_bodies.py)."""
         return min(size, self.pin_radius)
 
 
