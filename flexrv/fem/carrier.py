@@ -297,8 +297,10 @@ def crank_support_compliance(reducer, size: float | None = None, cache: bool = T
 
     With the torque load vector g_c per unit output torque (tangential T / (N a_w)
     per crank), g_c^T C_eff g_c equals the FE torsional compliance
-    :attr:`CarrierCompliance.torsional` (identity, tests/test_bodies.py)."""
-    c = carrier_compliance(reducer, size=size, cache=cache)
+    :attr:`CarrierCompliance.torsional` (identity, tests/test_bodies.py). The
+    rigid-bore bound (a second factorisation, ~5 s CPU of the ~20 s cold build on
+    the presets, used by no model) is not computed here."""
+    c = carrier_compliance(reducer, size=size, rigid_bound=False, cache=cache)
     n = c.n_cranks
     s = c.split_input
     S = np.vstack([s * np.eye(2 * n), (1.0 - s) * np.eye(2 * n)])

@@ -335,7 +335,8 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
 
 
 def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
-                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True) -> dict:
+                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True,
+                     rigid_bound: bool = False) -> dict:
     """Torsional compliances [rad/(N m)] at the output of the carrier and the
     cycloid disc bodies, from the FE condensations (for the stiffness budget).
 
@@ -343,7 +344,8 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
     ``compliance_rad_per_Nm`` (the value to add in series), ``stiffness_Nm_per_arcmin``,
     ``source`` (method and interfaces, for the budget's provenance column) and the
     mesh facts; the carrier entry also ``compliance_rbe2_rad_per_Nm`` (rigid
-    bores, the stiff bound). A design without a ``[carrier]`` table gives
+    bores, the stiff bound; computed only with ``rigid_bound``, a second
+    factorisation the budget does not use, else None). A design without a ``[carrier]`` table gives
     ``{"compliance_rad_per_Nm": None, "source": <why>}`` for the carrier.
     ``output_torque`` (default rated) sets the disc's pin load distribution; the
     disc value is the mean over ``disc_angles`` crank angles
@@ -357,7 +359,7 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
         out["carrier"] = {"compliance_rad_per_Nm": None, "stiffness_Nm_per_arcmin": None,
                           "source": "no [carrier] table in the design: carrier compliance not computed"}
     else:
-        c = carrier_compliance(reducer, size=carrier_size, cache=cache)
+        c = carrier_compliance(reducer, size=carrier_size, rigid_bound=rigid_bound, cache=cache)
         out["carrier"] = {"compliance_rad_per_Nm": c.torsional,
                           "stiffness_Nm_per_arcmin": c.torsional_stiffness_Nm_per_arcmin,
                           "compliance_rbe2_rad_per_Nm": c.torsional_rbe2,
