@@ -182,7 +182,8 @@ def test_pillars_between_rigid_plates_match_the_built_in_frame():
 
 @pytest.mark.slow
 def test_carrier_compliance_cached_and_consistent():
-    """carrier_compliance: JSON cache hit gives identical numbers; torsional =
+    """carrier_compliance: JSON cache hit gives identical numbers (also asked without the
+    rigid-bore bound, a cached result with it is reused); torsional =
     g^T C g of the stored matrix; RBE2 bound stiffer; rv40e carrier stiffness at the
     coarse mesh between 500 and 10000 N m/arcmin (plausibility band around the
     1780 N m/arcmin of the default mesh: the flange-held pillars-and-plates frame)."""
@@ -190,6 +191,11 @@ def test_carrier_compliance_cached_and_consistent():
     a = carrier_compliance(rv, size=COARSE, local_size=COARSE)
     b = carrier_compliance(rv, size=COARSE, local_size=COARSE)
     assert a == b
+    # without the bound: the cached result with the bound is reused as it is (no second build),
+    # and a fresh build without it gives the same matrix with no bound
+    assert carrier_compliance(rv, size=COARSE, local_size=COARSE, rigid_bound=False) == a
+    lean = carrier_compliance(rv, size=COARSE, local_size=COARSE, rigid_bound=False, cache=False)
+    assert lean.torsional_rbe2 is None and lean.matrix == a.matrix
     g = torque_load_vector(a.n_cranks, a.crank_circle_radius, a.split_input)
     assert a.torsional == pytest.approx(float(g @ np.array(a.matrix) @ g), rel=1e-12)
     assert a.torsional_rbe2 < a.torsional
