@@ -205,10 +205,11 @@ class ReducedBody:
                        info=json.loads(str(z["info"])), path=Path(path), stress_modes=stress)
 
 
-def _assemble(mesh, material: dict):
+def _assemble(mesh, material: dict, mass: bool = True):
+    """K (and M unless ``mass`` is False) of a mesh (:func:`flexrv.fem.assembly.assemble`)."""
     from flexrv.fem.assembly import assemble
 
-    return assemble(mesh.nodes, mesh.tets, material["E"], material["nu"], material["rho"])
+    return assemble(mesh.nodes, mesh.tets, material["E"], material["nu"], material["rho"], mass=mass)
 
 
 def material_dict(reducer, part: str) -> dict:

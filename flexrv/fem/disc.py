@@ -30,9 +30,19 @@ adds the body's compliance below the contact zone. What the FE still counts of
 the near field between b and the patch width is the logarithmic half-plane term
 ~ 2 F (1 - nu^2) ln(patch / b) / (pi E L) per pin, stated as the remaining
 overlap with the contact law (Johnson, Contact Mechanics 1985, sec. 2.8).
-Measured on the rv40e disc (default mesh, crank angle 0): patch half-width 0.75,
-1.5, 3 mm give c_d = 1.470, 1.357, 1.278e-7 rad/(N m) (+8 % / -6 % about the
-default): the body value carries this +-8 % modelling band.
+Measured on the rv40e disc (crank angle 0; the former 1.29 mm flank mesh and
+lumped patch loads, 2026-11-23): patch half-width 0.75, 1.5, 3 mm give c_d =
+1.470, 1.357, 1.278e-7 rad/(N m) (+8 % / -6 % about the default): the body value
+carries this +-8 % modelling band.
+
+Mesh: the flank mesh size defaults to r_rp
+(:meth:`flexrv.meshing.parts.CycloidDiscSpec.profile_size`, with its convergence
+study: the default is within 0.8 % (rv40e) / 0.5 % (rv221) of the converged
+compliance). The patch loads are consistent (work-equivalent) loads of a uniform
+traction, integrated on sub-triangles (:func:`pin_patch_loads`), so they converge
+with the mesh; the former lumped form (nodal areas of the profile nodes inside the
+patch) scattered by +-0.4 % from mesh to mesh and read 1.6 % high on the former
+1.29 mm flank mesh (rv40e 1.4982e-7 against the converged 1.474e-7).
 
 Not modelled: the pillar holes of the disc (the ``cycloid_disc`` part has none;
 they make the real disc softer), needle bearing ovalisation of the crank holes
@@ -51,7 +61,8 @@ change of the modifications, the torque or the errors costs no FE solve, and
 
 Verification (tests/test_fem_disc.py): the condensed C reproduces the full FE
 solve of the same load case (Lagrange-multiplier solve of the constrained
-system) to 1e-8; mesh convergence with the patch fixed.
+system) to 1e-8; mesh convergence with the patch fixed (tests/test_convergence.py,
+coarse, and the slow study in tests/test_fem_disc.py).
 """
 
 from __future__ import annotations
@@ -66,7 +77,7 @@ from flexrv.design.manufacturing import nominal_design
 from flexrv.errors import InputError
 from flexrv.units import RAD_PER_ARCMIN
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: consistent pin-patch loads (2026-11-24)
 
 #: held components of a crank-hole master: x, y, z, rx, ry (rz free)
 HELD = (0, 1, 2, 3, 4)
@@ -109,26 +120,67 @@ def pin_contact_case(reducer, output_torque: float, crank_angle: float = 0.0, di
                           disc_torque=float(res.torque))
 
 
-def pin_patch_loads(mesh, case: PinContactCase, patch: float) -> sp.csc_matrix:
-    """(3N, z_rp) unit RBE3 loads of the pin patches (module doc)."""
-    from flexrv.fem.reduction import nodal_areas
+#: sub-triangles per edge of a profile face for the patch-load quadrature (n^2 equal
+#: sub-triangles, one point each at their centroids)
+PATCH_SUBDIVISION = 8
 
+
+def _subtriangle_points(n: int) -> np.ndarray:
+    """Barycentric centroids (n^2, 3) of the n^2 equal sub-triangles of a triangle
+    divided n times along each edge (midpoint-type rule, equal weights 1 / n^2)."""
+    pts = []
+    for i in range(n):
+        for j in range(n - i):
+            pts.append(((i + 1 / 3) / n, (j + 1 / 3) / n))  # upright sub-triangle
+            if i + j < n - 1:
+                pts.append(((i + 2 / 3) / n, (j + 2 / 3) / n))  # inverted one
+    a = np.array(pts)
+    return np.column_stack([1.0 - a.sum(axis=1), a])
+
+
+def _tri6_shape(bary: np.ndarray) -> np.ndarray:
+    """Tri6 shape functions (q, 6) at barycentric points (q, 3), node order corners
+    0, 1, 2 then mid-nodes 01, 12, 20."""
+    l0, l1, l2 = bary.T
+    return np.column_stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), 4 * l0 * l1, 4 * l1 * l2,
+                            4 * l2 * l0])
+
+
+def pin_patch_loads(mesh, case: PinContactCase, patch: float) -> sp.csc_matrix:
+    """(3N, z_rp) unit RBE3 loads of the pin patches (module doc): a uniform
+    traction along the pin's force direction on the profile within ``patch`` of the
+    contact line (distance in the disc plane), resultant 1, as its consistent
+    (work-equivalent) nodal load: sum over the profile faces of
+    integral N_j t dA, by a midpoint rule on :data:`PATCH_SUBDIVISION`^2
+    sub-triangles per face (flat-face area, quadratic geometry map). The patch edge
+    cuts the faces, so the rule, not the mesh, resolves it: the load converges with
+    the mesh, where the former lumped form (the profile nodes within ``patch``,
+    weighted by their nodal area) jumped with the node set (+-0.4 % scatter of the
+    rv40e disc compliance between meshes)."""
     prof = mesh.faces("profile")
-    a = nodal_areas(mesh.nodes, prof)
-    pn = np.flatnonzero(a)
-    xy = mesh.nodes[pn, :2]
+    bary = _subtriangle_points(PATCH_SUBDIVISION)
+    shape = _tri6_shape(bary)  # (q, 6)
+    xy = mesh.nodes[prof][:, :, :2]  # (F, 6, 2)
+    corner = mesh.nodes[prof[:, :3]]
+    area = 0.5 * np.linalg.norm(np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0]), axis=1)
+    reach = np.max(np.linalg.norm(xy - xy.mean(axis=1, keepdims=True), axis=2), axis=1)
     rows, cols, vals = [], [], []
     for i, (c, d) in enumerate(zip(case.points, case.directions)):
-        sel = np.linalg.norm(xy - c, axis=1) <= patch
-        if not np.any(sel):
-            raise InputError(f"pin patch of half-width {patch * 1e3:.3g} mm at pin {i} finds no profile node; "
+        near = np.flatnonzero(np.linalg.norm(xy.mean(axis=1) - c, axis=1) <= patch + 2.0 * reach)
+        q = np.einsum("qk,fkc->fqc", shape, xy[near])  # (f, q, 2) points
+        inside = np.linalg.norm(q - c, axis=2) <= patch  # (f, q)
+        w = (inside[:, :, None] * shape[None]).sum(axis=1) * (area[near] / len(bary))[:, None]  # (f, 6)
+        total = float(np.sum(inside.sum(axis=1) * area[near]) / len(bary))
+        if total <= 0.0:
+            raise InputError(f"pin patch of half-width {patch * 1e3:.3g} mm at pin {i} finds no profile face; "
                              "refine the disc mesh or widen the patch")
-        idx = pn[sel]
-        w = a[idx] / a[idx].sum()
+        nodes = prof[near].ravel()
+        wv = w.ravel() / total
+        keep = wv != 0.0
         for comp in (0, 1):
-            rows.append(3 * idx + comp)
-            cols.append(np.full(idx.size, i))
-            vals.append(w * d[comp])
+            rows.append(3 * nodes[keep] + comp)
+            cols.append(np.full(int(keep.sum()), i))
+            vals.append(wv[keep] * d[comp])
     n = 3 * mesh.n_nodes
     return sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(n, len(case.points)))
@@ -207,7 +259,7 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
 
     def _build() -> DiscCompliance:
         d = mres.data
-        fe = _assemble(d, mat)
+        fe = _assemble(d, mat, mass=False)
         W = pin_patch_loads(d, case, patch)
         C, _ = held_flexibility(fe.K, d, W)
         f = case.forces / abs(case.disc_torque)
@@ -268,7 +320,7 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
 
     def _build() -> DiscSweep:
         d = mres.data
-        fe = _assemble(d, mat)
+        fe = _assemble(d, mat, mass=False)
         F = sp.hstack([pin_patch_loads(d, c, patch) @ sp.csc_matrix((c.forces / abs(c.disc_torque))[:, None])
                        for c in cases]).tocsc()
         C, _ = held_flexibility(fe.K, d, F)
@@ -283,7 +335,8 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
 
 
 def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
-                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True) -> dict:
+                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True,
+                     rigid_bound: bool = False) -> dict:
     """Torsional compliances [rad/(N m)] at the output of the carrier and the
     cycloid disc bodies, from the FE condensations (for the stiffness budget).
 
@@ -291,7 +344,8 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
     ``compliance_rad_per_Nm`` (the value to add in series), ``stiffness_Nm_per_arcmin``,
     ``source`` (method and interfaces, for the budget's provenance column) and the
     mesh facts; the carrier entry also ``compliance_rbe2_rad_per_Nm`` (rigid
-    bores, the stiff bound). A design without a ``[carrier]`` table gives
+    bores, the stiff bound; computed only with ``rigid_bound``, a second
+    factorisation the budget does not use, else None). A design without a ``[carrier]`` table gives
     ``{"compliance_rad_per_Nm": None, "source": <why>}`` for the carrier.
     ``output_torque`` (default rated) sets the disc's pin load distribution; the
     disc value is the mean over ``disc_angles`` crank angles
@@ -305,7 +359,7 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
         out["carrier"] = {"compliance_rad_per_Nm": None, "stiffness_Nm_per_arcmin": None,
                           "source": "no [carrier] table in the design: carrier compliance not computed"}
     else:
-        c = carrier_compliance(reducer, size=carrier_size, cache=cache)
+        c = carrier_compliance(reducer, size=carrier_size, rigid_bound=rigid_bound, cache=cache)
         out["carrier"] = {"compliance_rad_per_Nm": c.torsional,
                           "stiffness_Nm_per_arcmin": c.torsional_stiffness_Nm_per_arcmin,
                           "compliance_rbe2_rad_per_Nm": c.torsional_rbe2,
@@ -352,7 +406,8 @@ def rim_compliance(reducer, size: float | None = None, n_angles: int = 6, cache:
     loaded patches per unit disc torque is (1.34 um, -0.008 um, 2.63e-5 rad), whose
     translational and rotational work terms per unit torque squared, +2.647e-5 and
     -2.632e-5 rad/(N m), cancel to the 1.36e-7 rad/(N m) of the FE energy: a 3 x 3
-    compliance fitted to it would be ill-conditioned, while the one generalized
+    compliance fitted to it would be ill-conditioned (measured with the former
+    lumped patch loads and 1.29 mm flank mesh), while the one generalized
     compliance on the torque path carries the energy exactly."""
     d = disc_torsion_sweep(reducer, n_angles=n_angles, size=size, cache=cache)
     return np.diag([0.0, 0.0, float(d.mean)])
@@ -426,7 +481,7 @@ def disc_patch_sweep(reducer, n_angles: int = 6, size: float | None = None, patc
 
     def _build() -> DiscPatchSweep:
         d = mres.data
-        fe = _assemble(d, mat)
+        fe = _assemble(d, mat, mass=False)
         Z, _ = rigid_master_transform(fe.K.shape[0], d.nodes, hole_masters(d))
         Kr = sp.csc_matrix(Z.T @ (sp.csr_matrix(fe.K) @ Z))
         solve = factorize(0.5 * (Kr + Kr.T))

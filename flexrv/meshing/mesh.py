@@ -123,18 +123,35 @@ def default_max_nodes() -> int:
     return int(mem / 25e3)
 
 
-def _apply_size_field(gmsh, spec, groups: dict, size: float, local: float) -> None:
+def _apply_size_field(gmsh, spec, groups: dict, size: float, local: float, edge: float | None = None) -> None:
     """Global size ``size``; ``local`` on the raceway (rings), the profile (disc) or
-    the pillars (carrier)."""
+    the pillars (carrier); ``edge`` (carrier only, None: off) at the pillar roots,
+    the re-entrant edges where the pillars meet the plates, graded linearly to
+    ``size`` (:meth:`flexrv.meshing.parts.CarrierSpec.root_size`)."""
     opt = gmsh.option
     opt.setNumber("Mesh.MeshSizeMax", size)
-    opt.setNumber("Mesh.MeshSizeMin", 0.2 * local)
+    opt.setNumber("Mesh.MeshSizeMin", 0.2 * min(local, edge or local))
     opt.setNumber("Mesh.MeshSizeFromPoints", 0)
     opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
     opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    if local >= size:
-        return
     fld = gmsh.model.mesh.field
+    fields = []
+    if edge is not None and edge < size and isinstance(spec, P.CarrierSpec):
+        curves = {t for f in groups["pillar"] for _, t in gmsh.model.getBoundary([(2, f)], oriented=False)}
+        droot = fld.add("Distance")
+        fld.setNumbers(droot, "CurvesList", sorted(curves))
+        fld.setNumber(droot, "Sampling", 200)
+        troot = fld.add("Threshold")
+        fld.setNumber(troot, "InField", droot)
+        fld.setNumber(troot, "SizeMin", edge)
+        fld.setNumber(troot, "SizeMax", size)
+        fld.setNumber(troot, "DistMin", 0.0)
+        fld.setNumber(troot, "DistMax", (size - edge) / P.CarrierSpec.ROOT_GRADING)
+        fields.append(troot)
+    if local >= size:
+        if fields:
+            fld.setAsBackgroundMesh(fields[0])
+        return
     dist = fld.add("Distance")
     if isinstance(spec, P.RingSpec):
         fld.setNumbers(dist, "SurfacesList", groups["raceway"])
@@ -153,7 +170,13 @@ def _apply_size_field(gmsh, spec, groups: dict, size: float, local: float) -> No
     fld.setNumber(thr, "SizeMax", size)
     fld.setNumber(thr, "DistMin", 0.25 * reach)
     fld.setNumber(thr, "DistMax", 1.5 * reach)
-    fld.setAsBackgroundMesh(thr)
+    fields.append(thr)
+    if len(fields) > 1:
+        both = fld.add("Min")
+        fld.setNumbers(both, "FieldsList", fields)
+        fld.setAsBackgroundMesh(both)
+    else:
+        fld.setAsBackgroundMesh(thr)
 
 
 def _extract(gmsh, groups: dict[str, list[int]]) -> tuple:
@@ -182,13 +205,17 @@ def _extract(gmsh, groups: dict[str, list[int]]) -> tuple:
     return nodes, lookup[tet], np.concatenate(tris), np.concatenate(gid), names
 
 
-def mesh_key(spec, size: float, local: float) -> str:
-    """Cache key of a mesh: geometry spec, sizes, format version, library versions."""
-    return content_hash(P.spec_dict(spec), size, local, MESH_FORMAT_VERSION, library_versions("gmsh", "meshio"))
+def mesh_key(spec, size: float, local: float, edge: float | None = None) -> str:
+    """Cache key of a mesh: geometry spec, sizes, format version, library versions
+    (the edge size only where a part has one, so the other parts keep their keys)."""
+    extra = () if edge is None else (("edge", edge),)
+    return content_hash(P.spec_dict(spec), size, local, *extra, MESH_FORMAT_VERSION,
+                        library_versions("gmsh", "meshio"))
 
 
 def generate_mesh(spec, part: str, size: float | None = None, *, local_size: float | None = None,
-                  max_nodes: int | None = None, cache: bool = True, threads: int = 1) -> MeshResult:
+                  edge_size: float | None = None, max_nodes: int | None = None, cache: bool = True,
+                  threads: int = 1) -> MeshResult:
     """Mesh a part spec with Tet10 elements and cache the result.
 
     Parameters
@@ -215,7 +242,12 @@ def generate_mesh(spec, part: str, size: float | None = None, *, local_size: flo
         if not (0 < local_size <= size):
             raise InputError(f"local mesh size = {local_size!r} m must be in (0, size = {size:g} m]")
         chk["local_size"] = float(local_size)
-    key = mesh_key(spec, size, chk["local_size"])
+    if edge_size is not None:
+        if not (0 < edge_size <= size):
+            raise InputError(f"edge mesh size = {edge_size!r} m must be in (0, size = {size:g} m]")
+        chk["edge_size"] = float(edge_size)
+    edge = chk.get("edge_size")
+    key = mesh_key(spec, size, chk["local_size"], edge)
     folder = cache_dir()
     stem = f"{part}-{key}"
     msh, vtu, npz = (folder / f"{stem}{ext}" for ext in (".msh", ".vtu", ".npz"))
@@ -228,7 +260,7 @@ def generate_mesh(spec, part: str, size: float | None = None, *, local_size: flo
                 gmsh.model.addPhysicalGroup(2, faces, name=name)
             vol = gmsh.model.getEntities(3)[0][1]
             gmsh.model.addPhysicalGroup(3, [vol], name=part)
-            _apply_size_field(gmsh, spec, groups, size, chk["local_size"])
+            _apply_size_field(gmsh, spec, groups, size, chk["local_size"], edge)
             gmsh.option.setNumber("Mesh.ElementOrder", 2)
             gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
             gmsh.option.setNumber("Mesh.HighOrderOptimize", 0)
@@ -239,7 +271,7 @@ def generate_mesh(spec, part: str, size: float | None = None, *, local_size: flo
             except Exception as exc:  # gmsh raises a bare Exception
                 raise InputError(f"meshing {part} with size {size * 1e3:.4g} mm failed: {exc}") from None
             t2 = time.perf_counter()
-            info = {"local_size": chk["local_size"], "estimated_nodes": chk["estimated_nodes"],
+            info = {"local_size": chk["local_size"], "edge_size": edge, "estimated_nodes": chk["estimated_nodes"],
                     "t_geometry_s": t1 - t0, "t_mesh_s": t2 - t1}
             if isinstance(spec, P.CycloidDiscSpec):
                 info["profile_deviation_m"] = P.profile_deviation(gmsh, spec)

@@ -142,8 +142,27 @@ class CycloidDiscSpec:
         return min(self.width / 2.0, self.crank_hole_radius / 2.0)
 
     def profile_size(self, size: float) -> float:
-        """Mesh size at the tooth flanks [m]: <= 1/8 of the tooth pitch."""
-        return min(size, self.tooth_pitch / 8.0)
+        """Mesh size at the tooth flanks [m]: <= the pin radius r_rp, i.e. twice the
+        pin patch half-width r_rp / 2 of :mod:`flexrv.fem.disc` (about a third of the
+        tooth pitch on the presets; before 2026-11-24 an eighth of it).
+
+        Chosen from a convergence study of the disc body's torsional compliance as
+        the models and the budget use it (mean over six crank angles of
+        :func:`flexrv.fem.disc.disc_torsion_sweep`, consistent patch loads, default
+        global size, flank sizes in ratio sqrt 2; 2026-11-24):
+
+        * rv40e, 4.24 / 3 / 2.12 mm (11.3k / 16.9k / 28.8k nodes): 1.45218 /
+          1.46257 / 1.46803e-7 rad/(N m), observed order 1.86, Richardson value
+          1.4741e-7: the default (3 mm) is 0.8 % below it (1.4 % with the order 0.88
+          of the coarser triple at 8 mm global size);
+        * rv221, 7.07 / 5 / 3.54 / 2.5 mm (21.1k / 32.5k / 47.7k / 81.4k nodes):
+          2.27175 / 2.27992 / 2.28140 / 2.28413e-8, not in the asymptotic range
+          (differences 8.2e-11, 1.5e-11, 2.7e-11); the default (5 mm) is 0.18 %
+          below the finest and 0.5 % below its order-1 extrapolation.
+
+        The former default (rv40e 1.29 mm, 66.7k nodes; rv221 2.2 mm, 107k nodes)
+        cost 120 / 189 s CPU and 4.0 / 5.6 GB for the sweep (benchmarks/bench_bodies.py)."""
+        return min(size, self.pin_radius)
 
 
 @dataclass(frozen=True)
@@ -180,6 +199,13 @@ class CarrierSpec:
         """Default global mesh size [m]: a third of the thinnest plate, at most the
         thinnest ligament around a crank bore."""
         return min(min(self.input_thickness, self.output_thickness) / 3.0, self.min_feature())
+
+    #: growth of the mesh size away from the pillar roots (size increase per unit distance)
+    ROOT_GRADING = 0.5
+
+    def root_size(self, size: float) -> float | None:
+        """Mesh size at the pillar roots [m] (None: no extra refinement)."""
+        return None
 
     def pillar_size(self, size: float) -> float:
         """Mesh size on the pillars [m]: <= half the pillar radius (beam bending
@@ -305,14 +331,18 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
             raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the carrier: must be <= "
                              f"{limit * 1e3:.4g} mm (thinnest plate or ligament around a crank bore)")
         local = spec.pillar_size(size)
+        edge = spec.root_size(size)
         est_local = NODE_DENSITY * len(spec.pillar_angles) * math.pi * spec.pillar_radius**2 * spec.gap / local**3
     else:  # pragma: no cover - spec_for guards the type
         raise InputError(f"unknown spec {type(spec).__name__}")
     est = int(NODE_DENSITY * spec.volume() / size**3 + est_local)
+    out = {"size": size, "local_size": local, "estimated_nodes": est}
+    if isinstance(spec, CarrierSpec) and edge is not None:
+        out["edge_size"] = edge
     if est > max_nodes:
         raise InputError(f"mesh size = {size * 1e3:.4g} mm is too fine: about {est:,} nodes estimated, more than "
                          f"the memory limit of {max_nodes:,} nodes; use a larger size")
-    return {"size": size, "local_size": local, "estimated_nodes": est}
+    return out
 
 
 def profile_is_simple(points: np.ndarray) -> bool:
