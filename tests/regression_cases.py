@@ -12,11 +12,18 @@ import numpy as np
 FAST = {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0, "operating.load_ramp_end_s": 0.02}
 
 
+#: Newton tolerance (relative, absolute [N]) of the dynamic cases
+NEWTON_TOLERANCE = (1e-5, 1e-3)
+
+
 def _dynamic(preset: str, model: str, t_end: float) -> dict:
     from flexrv.design import override
     from flexrv.simulation import Simulation
 
-    res = Simulation(override(preset, FAST), model=model).run(t_end=t_end, dt=1e-4)
+    # a converged Newton tolerance: the pinned numbers are the model's answer, not the path a default-tolerance
+    # (1e-3) Newton took to it (which a faster but equivalent residual changes: balls_rv40e's TE p-p was 0.4026
+    # and 0.3759 arcsec at the default tolerance before and after the row-kernel rewrite, 0.3616 converged)
+    res = Simulation(override(preset, FAST), model=model).run(t_end=t_end, dt=1e-4, newton_tolerance=NEWTON_TOLERANCE)
     sel = res.ds.sel(time=slice(0.5 * t_end, None))
     out = {"te_mean_arcsec": float(sel["te"].mean()), "te_pp_arcsec": float(np.ptp(sel["te"].values)),
            "max_pin_force_N": float(sel["pin_force"].max())}
