@@ -236,6 +236,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 for r in range(n2):
                     u[r] += step[r]
             kest = st[1]
+    kobs = kest
     _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     if elastic:
         r0 = 0.0
@@ -266,7 +267,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 umax = max(umax, abs(u[r]))
             tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
             exact_j = r0 <= tol or kest * cn <= 1e-7
-            if r0 <= tol or (10.0 * kest * cn * cn <= tol and (exact_j or not jac)):
+            if r0 <= tol or (1e3 * kest * cn * cn <= tol and (exact_j or not jac)):
                 break
             lam = 1.0
             for r in range(n2):
@@ -287,7 +288,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                     break
                 lam *= 0.5
             if lam == 1.0 and cn > 0.0:  # Newton's constant from this full step: |R_new| ~ K |c|^2
-                kest = r1 / (cn * cn)
+                kobs = r1 / (cn * cn)  # for the next call (this one stops on its own K only if warm)
             stop = r1 >= r0 and r0 <= 1e-12
             r0 = r1
             if stop:  # at round-off: the correction from this last evaluation, then stop
@@ -393,7 +394,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             su[r, 2] -= av[r]
         for col in range(m):
             qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
-        st[0], st[1] = 1.0, kest
+        st[0], st[1] = 1.0, kobs
     if not jac:
         return
     # rows: crank j (x, y) += df; carrier (x, y) -= sum df; carrier theta -= (Z (r + u) + C_h Z fs) . df

@@ -476,6 +476,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
         for r in range(m):
             step[r] = 0.0
         kest = st[1]
+    kobs = kest
     r0 = np.inf
     lam = 1.0
     cn = 0.0
@@ -509,7 +510,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
                 lam *= 0.5
                 continue
         if it > 0 and lam == 1.0 and cn > 0.0:  # Newton's constant from this full step: |R_new| ~ K |c|^2
-            kest = r1 / (cn * cn)
+            kobs = r1 / (cn * cn)  # for the next call (this one stops on its own K only if warm)
         r0 = r1
         # N = (I - C J)^-1 and the Newton correction N R from here
         matmul_small(cm, jl, tmp)
@@ -526,7 +527,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             cn = max(cn, abs(acc) * (r_p if r % 3 == 2 else 1.0))
         fresh = True
         exact_j = r1 <= tol or kest * cn <= 1e-7
-        if r1 <= tol or (10.0 * kest * cn * cn <= tol and (exact_j or not jac)):
+        if r1 <= tol or (1e3 * kest * cn * cn <= tol and (exact_j or not jac)):
             break
         for r in range(m):
             base[r] = delta[r]
@@ -593,7 +594,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
         qp[r], vp[r] = qh[r], vh[r]
         for c in range(m):
             sq[r, c] += dd[r, c]
-    st[0], st[1], st[2] = 1.0, kest, 1.0 if exact_j else 0.0
+    st[0], st[1], st[2] = 1.0, kobs, 1.0 if exact_j else 0.0
     if jac:
         for r in range(m):
             for c in range(m):
