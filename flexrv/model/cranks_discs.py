@@ -206,8 +206,6 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             kk[r, k] = 0.0
         for k in range(n):
             hh[r, k] = 0.0
-    kest = np.inf
-    exact_j = True
     if elastic:
         for a in range(n):  # C_h = R C R^T, blockwise
             for b in range(n):
@@ -235,8 +233,6 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             if pmax <= 0.1 * umax:
                 for r in range(n2):
                     u[r] += step[r]
-            kest = st[1]
-    kobs = kest
     _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     if elastic:
         r0 = 0.0
@@ -246,7 +242,6 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 acc += ch[r, k] * fs[k]
             res[r] = acc
             r0 = max(r0, abs(acc))
-        cn = 0.0
         lam = 1.0
         for _ in range(60):
             # Newton correction from here: (I + C_h K)^-1 R
@@ -254,20 +249,16 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             for r in range(n2):
                 tmp[r, r] += 1.0
             inv_small(tmp, mm)
-            cprev = cn
-            cn = 0.0
             for r in range(n2):
                 acc = 0.0
                 for k in range(n2):
                     acc += mm[r, k] * res[k]
                 step[r] = acc
-                cn = max(cn, abs(acc))
             umax = 0.0
             for r in range(n2):
                 umax = max(umax, abs(u[r]))
             tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
-            exact_j = r0 <= tol or kest * cn <= 1e-7
-            if r0 <= tol or (1e3 * kest * cn * cn <= tol and (exact_j or not jac)):
+            if r0 <= tol:
                 break
             lam = 1.0
             for r in range(n2):
@@ -287,8 +278,6 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
                     break
                 lam *= 0.5
-            if lam == 1.0 and cn > 0.0:  # Newton's constant from this full step: |R_new| ~ K |c|^2
-                kobs = r1 / (cn * cn)  # for the next call (this one stops on its own K only if warm)
             stop = r1 >= r0 and r0 <= 1e-12
             r0 = r1
             if stop:  # at round-off: the correction from this last evaluation, then stop
@@ -301,7 +290,6 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                     for k in range(n2):
                         acc += mm[r, k] * res[k]
                     step[r] = acc
-                exact_j = True
                 break
         # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
         # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
@@ -394,7 +382,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             su[r, 2] -= av[r]
         for col in range(m):
             qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
-        st[0], st[1] = 1.0, kobs
+        st[0] = 1.0
     if not jac:
         return
     # rows: crank j (x, y) += df; carrier (x, y) -= sum df; carrier theta -= (Z (r + u) + C_h Z fs) . df

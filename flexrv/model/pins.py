@@ -437,7 +437,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             if qh[r] != qp[r] or vh[r] != vp[r]:
                 same = False
                 break
-        if same and (st[2] > 0.0 or not jac):  # the previous call's state: its result
+        if same:  # the previous call's state: its result
             for r in range(m):
                 f[idx[r]] += qfc[r]
             if jac:
@@ -456,7 +456,6 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             for r in range(3):
                 for c in range(3):
                     cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
-    kest = np.inf
     for r in range(m):
         base[r] = dstate[r // 3, r % 3]
         step[r] = 0.0
@@ -475,13 +474,9 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
                 base[r] += step[r]
         for r in range(m):
             step[r] = 0.0
-        kest = st[1]
-    kobs = kest
     r0 = np.inf
     lam = 1.0
-    cn = 0.0
     fresh = False
-    exact_j = False
     for it in range(80):
         for r in range(m):
             delta[r] = base[r] - lam * step[r]
@@ -509,8 +504,6 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             if lam > 1e-6:  # step halving on max|R| (R: gradient of a convex energy)
                 lam *= 0.5
                 continue
-        if it > 0 and lam == 1.0 and cn > 0.0:  # Newton's constant from this full step: |R_new| ~ K |c|^2
-            kobs = r1 / (cn * cn)  # for the next call (this one stops on its own K only if warm)
         r0 = r1
         # N = (I - C J)^-1 and the Newton correction N R from here
         matmul_small(cm, jl, tmp)
@@ -518,22 +511,18 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             for c in range(m):
                 tmp[r, c] = (1.0 if r == c else 0.0) - tmp[r, c]
         inv_small(tmp, nm)
-        cn = 0.0
         for r in range(m):
             acc = 0.0
             for c in range(m):
                 acc += nm[r, c] * res[c]
             step[r] = acc
-            cn = max(cn, abs(acc) * (r_p if r % 3 == 2 else 1.0))
         fresh = True
-        exact_j = r1 <= tol or kest * cn <= 1e-7
-        if r1 <= tol or (1e3 * kest * cn * cn <= tol and (exact_j or not jac)):
+        if r1 <= tol:
             break
         for r in range(m):
             base[r] = delta[r]
         lam = 1.0
     if not fresh:  # stopped on a halved step at round-off: the correction from the last evaluation
-        exact_j = True
         matmul_small(cm, jl, tmp)
         for r in range(m):
             for c in range(m):
@@ -594,7 +583,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
         qp[r], vp[r] = qh[r], vh[r]
         for c in range(m):
             sq[r, c] += dd[r, c]
-    st[0], st[1], st[2] = 1.0, kobs, 1.0 if exact_j else 0.0
+    st[0] = 1.0
     if jac:
         for r in range(m):
             for c in range(m):
