@@ -410,15 +410,15 @@ def _moving_sequence(q0, big, small, n=30):
 def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     """Issue 15: the rim condensation (pins, elastic discs + elastic housing + friction,
     rv40e) and the carrier condensation (crank supports) start each call from a
-    first-order predictor of the previous call and may stop on Newton's error estimate
-    K |c|^2 (flexrv.model.pins._pin_condensed_kernel). Along a moving sequence of
-    states (load growing ~10 % over 15 steps, Newton-like corrections between) their
-    forces equal those of cold starts (state reset before every call, the residual
-    rule) within 1e-9 of the largest entry and their Jacobians within 1e-6 (the
-    explicit-unknowns and central-difference bounds of the tests above; measured
-    2026-11-24: pins 2e-12 / 4e-9, supports 3e-14 / 4e-11), and the predictor makes
-    the pins cheaper: at most 2 pin-kernel evaluations per call on average against
-    at least 3 from cold starts (measured 1.5 and 4)."""
+    first-order predictor of the previous call (flexrv.model.pins._pin_condensed_kernel,
+    flexrv.model.cranks_discs.crank_support_kernel). Along a moving sequence of states
+    (load growing ~10 % over 15 steps, Newton-like corrections between) their forces
+    equal those of cold starts (state reset before every call) within 1e-9 of the
+    largest entry and their Jacobians within 1e-6 (the explicit-unknowns and
+    central-difference bounds of the tests above; measured 2026-11-24: pins 9e-13 /
+    2e-11, supports 5e-14 / 6e-15), and the predictor makes the pins cheaper: at most
+    2 pin-kernel evaluations per call on average against at least 3 from cold starts
+    (measured 1.6 and 5.0)."""
     from flexrv.model.cranks_discs import CrankSupports
     from flexrv.model.pins import PinContacts
 
@@ -444,7 +444,6 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
         n_warm += warm.ctr[0] - c0
         n_cold += cold.ctr[0]
     assert np.abs(fc).max() > 1e3 and np.abs(warm.hstate[1]) > 0.0 and np.abs(warm.dstate[:, 2]).max() > 1e-6
-    print("pins", err_f, err_j, n_warm / 30, n_cold / 30)
     assert err_f <= 1e-9 and err_j <= 1e-6, (err_f, err_j)
     assert n_warm / 30 <= 2.0 and n_cold / 30 >= 3.0, (n_warm / 30, n_cold / 30)
 
@@ -465,6 +464,5 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
         else:
             fw, fc = warm.evaluate(0.0, q, v)[0], cold.evaluate(0.0, q, v)[0]
             err_f = max(err_f, np.abs(fw - fc).max() / np.abs(fc).max())
-    print("supports", err_f, err_j, np.abs(warm.ustate).max())
     assert np.abs(fc).max() > 1e3 and np.abs(warm.ustate).max() > 1e-7
     assert err_f <= 1e-9 and err_j <= 1e-6, (err_f, err_j)

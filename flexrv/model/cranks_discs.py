@@ -149,10 +149,10 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     M (-K dd0 + H dgamma) - M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
     arm r + u. Cost (issue 15): the Newton starts from the first-order predictor u_prev + S (q - q_prev),
-    S = du/dq = -C_h df_s - a e_theta^T of the previous call, and stops, as the pins' rim condensation
-    (:func:`flexrv.model.pins._pin_condensed_kernel`), when max|R| <= tol or when the error left after
-    the linearised correction, ~K |c|^2, is below tol / 10 (K measured at the last full Newton step);
-    a call asking for the Jacobian also needs K |c| <= 1e-7 (the tangent's relative error)."""
+    S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
+    tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
+    LAPACK (:func:`flexrv.model.pins.inv_small`) and nothing is allocated per call (measured on rv40e, a
+    run's calls replayed: 16.8 -> 10.2 us per call including the Python dispatch, 5.1 us compiled)."""
     idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend, cc, ustate, wk = pack
     cd, linear = dc[0], dc[1] > 0.5
     kb, g = sc[SC_K_BEND], sc[SC_G]
