@@ -355,16 +355,17 @@ def pin_work_size(m: int) -> int:
 def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     """The pins' kernel with elastic disc bodies and/or the elastic housing (module
     docstring, "Disc body", "Housing"). ``pack`` = (pin_kernel's pack, cd, dstate, hs,
-    pin_kernel's pack on the local rim coordinates, wk): cd (n_discs, 3, 3) the rim
+    idx_rim = 0..3 n_discs - 1, wk): cd (n_discs, 3, 3) the rim
     compliance of each disc (empty: rigid discs), dstate (n_discs, 3) the rim
     offsets delta (x, y, psi) of the last call (output), hs the housing's (c_h,
     phi_h, ...), wk the condensation's work array (:func:`_pin_condensed_kernel`).
     Rigid discs and a rigid housing (c_h = 0): a plain :func:`pin_kernel` call."""
-    pins, cd, dstate, hs, pins_loc, wk = pack
+    pins, cd, dstate, hs, idx_rim, wk = pack
     if cd.shape[0] == 0 and not (hs.shape[0] > 0 and hs[0] > 0.0):
         pin_kernel(q, v, f, jq, jv, jac, pins)
         return
-    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, wk)
+    # the pin kernel's pack on the local rim coordinates (built here: one array to unbox, not sixteen)
+    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, (idx_rim,) + pins[1:], cd, dstate, hs, wk)
 
 
 @njit(cache=True)
@@ -710,7 +711,7 @@ class PinContacts(KernelGroup):
         work = np.zeros_like(self.work) if history else self.work
         rest = (self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
                 self.nx, self.ny, self.rxn, self.ft, self.pw, ctr)
-        return (idx, *rest), self.disc_c, self.dstate, self.hstate, (self.idx_rim, *rest), work
+        return (idx, *rest), self.disc_c, self.dstate, self.hstate, self.idx_rim, work
 
     @staticmethod
     def empty_pack():
@@ -718,7 +719,7 @@ class PinContacts(KernelGroup):
         pins = (np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
                 np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
                 np.array([1, 0, 0, 0], dtype=np.int64))
-        return pins, np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(2), pins, np.zeros(pin_work_size(0))
+        return pins, np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(2), np.zeros(0, np.int64), np.zeros(pin_work_size(0))
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ctr = pack[0][-1]
