@@ -127,7 +127,7 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk,
 def support_work_size(n: int) -> int:
     """Length of :func:`crank_support_kernel`'s work array for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
-    return 4 + 2 * m + n2 * m + n2 + 9 * n + 8 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+    return 4 + m + n2 * m + n2 + 9 * n + 8 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
 
 
 @njit(cache=True)
@@ -165,8 +165,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     st = wk[0:4]
     o = 4
     qp = wk[o:o + m]
-    vp = wk[o + m:o + 2 * m]
-    o += 2 * m
+    o += m
     su = wk[o:o + n2 * m].reshape((n2, m))
     o += n2 * m
     ulast = wk[o:o + n2]
@@ -201,62 +200,87 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         dvx[j] = v[jx] - v[idx[0]] + om * ry[j]
         dvy[j] = v[jy] - v[idx[1]] - om * rx[j]
         gam[j] = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
-    # the previous call's state (the solver's Jacobian after its residual): its results are in wk
-    cached = st[0] > 0.0
-    for col in range(m):
-        gc = idx[col] if col < 3 else idx[col + 3]
-        if q[gc] != qp[col] or v[gc] != vp[col]:
-            cached = False
+    for r in range(n2):
+        fs[r], u[r] = 0.0, 0.0
+        for k in range(n2):
+            kk[r, k] = 0.0
+        for k in range(n):
+            hh[r, k] = 0.0
     if elastic:
-        for r in range(n2):
-            if ustate[r // 2, r % 2] != ulast[r]:
-                cached = False
-    if not cached:
-        for r in range(n2):
-            fs[r], u[r] = 0.0, 0.0
-            for k in range(n2):
-                kk[r, k] = 0.0
-            for k in range(n):
-                hh[r, k] = 0.0
-        if elastic:
-            for a in range(n):  # C_h = R C R^T, blockwise
-                for b in range(n):
-                    c00, c01 = cc[2 * a, 2 * b], cc[2 * a, 2 * b + 1]
-                    c10, c11 = cc[2 * a + 1, 2 * b], cc[2 * a + 1, 2 * b + 1]
-                    t00, t01 = c * c00 - s * c10, c * c01 - s * c11  # R C
-                    t10, t11 = s * c00 + c * c10, s * c01 + c * c11
-                    ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
-                    ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
-            valid = st[0] > 0.0
-            for j in range(n):
-                u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
-                if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
-                    valid = False  # set from outside (reset, history pass): start from it
-            if valid:  # first-order predictor from the previous call, within a tenth of the deflections' size
-                umax, pmax = 0.0, 0.0
-                for r in range(n2):
-                    acc = 0.0
-                    for col in range(m):
-                        qc = q[idx[col]] if col < 3 else q[idx[col + 3]]
-                        acc += su[r, col] * (qc - qp[col])
-                    step[r] = acc
-                    umax = max(umax, abs(u[r]))
-                    pmax = max(pmax, abs(acc))
-                if pmax <= 0.1 * umax:
-                    for r in range(n2):
-                        u[r] += step[r]
-        _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
-        if elastic:
-            r0 = 0.0
+        for a in range(n):  # C_h = R C R^T, blockwise
+            for b in range(n):
+                c00, c01 = cc[2 * a, 2 * b], cc[2 * a, 2 * b + 1]
+                c10, c11 = cc[2 * a + 1, 2 * b], cc[2 * a + 1, 2 * b + 1]
+                t00, t01 = c * c00 - s * c10, c * c01 - s * c11  # R C
+                t10, t11 = s * c00 + c * c10, s * c01 + c * c11
+                ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
+                ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
+        valid = st[0] > 0.0
+        for j in range(n):
+            u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
+            if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
+                valid = False  # set from outside (reset, history pass): start from it
+        if valid:  # first-order predictor from the previous call, within a tenth of the deflections' size
+            umax, pmax = 0.0, 0.0
             for r in range(n2):
-                acc = u[r]
+                acc = 0.0
+                for col in range(m):
+                    qc = q[idx[col]] if col < 3 else q[idx[col + 3]]
+                    acc += su[r, col] * (qc - qp[col])
+                step[r] = acc
+                umax = max(umax, abs(u[r]))
+                pmax = max(pmax, abs(acc))
+            if pmax <= 0.1 * umax:
+                for r in range(n2):
+                    u[r] += step[r]
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    if elastic:
+        r0 = 0.0
+        for r in range(n2):
+            acc = u[r]
+            for k in range(n2):
+                acc += ch[r, k] * fs[k]
+            res[r] = acc
+            r0 = max(r0, abs(acc))
+        lam = 1.0
+        for _ in range(60):
+            # Newton correction from here: (I + C_h K)^-1 R
+            matmul_small(ch, kk, tmp)
+            for r in range(n2):
+                tmp[r, r] += 1.0
+            inv_small(tmp, mm)
+            for r in range(n2):
+                acc = 0.0
                 for k in range(n2):
-                    acc += ch[r, k] * fs[k]
-                res[r] = acc
-                r0 = max(r0, abs(acc))
+                    acc += mm[r, k] * res[k]
+                step[r] = acc
+            umax = 0.0
+            for r in range(n2):
+                umax = max(umax, abs(u[r]))
+            tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
+            if r0 <= tol:
+                break
             lam = 1.0
-            for _ in range(60):
-                # Newton correction from here: (I + C_h K)^-1 R
+            for r in range(n2):
+                u0[r] = u[r]
+            r1 = r0
+            for _h in range(40):  # step halving on max|R| (R is the gradient of a convex energy)
+                for r in range(n2):
+                    u[r] = u0[r] - lam * step[r]
+                _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+                r1 = 0.0
+                for r in range(n2):
+                    acc = u[r]
+                    for k in range(n2):
+                        acc += ch[r, k] * fs[k]
+                    res[r] = acc
+                    r1 = max(r1, abs(acc))
+                if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
+                    break
+                lam *= 0.5
+            stop = r1 >= r0 and r0 <= 1e-12
+            r0 = r1
+            if stop:  # at round-off: the correction from this last evaluation, then stop
                 matmul_small(ch, kk, tmp)
                 for r in range(n2):
                     tmp[r, r] += 1.0
@@ -266,60 +290,21 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                     for k in range(n2):
                         acc += mm[r, k] * res[k]
                     step[r] = acc
-                umax = 0.0
-                for r in range(n2):
-                    umax = max(umax, abs(u[r]))
-                tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
-                if r0 <= tol:
-                    break
-                lam = 1.0
-                for r in range(n2):
-                    u0[r] = u[r]
-                r1 = r0
-                for _h in range(40):  # step halving on max|R| (R is the gradient of a convex energy)
-                    for r in range(n2):
-                        u[r] = u0[r] - lam * step[r]
-                    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
-                    r1 = 0.0
-                    for r in range(n2):
-                        acc = u[r]
-                        for k in range(n2):
-                            acc += ch[r, k] * fs[k]
-                        res[r] = acc
-                        r1 = max(r1, abs(acc))
-                    if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
-                        break
-                    lam *= 0.5
-                stop = r1 >= r0 and r0 <= 1e-12
-                r0 = r1
-                if stop:  # at round-off: the correction from this last evaluation, then stop
-                    matmul_small(ch, kk, tmp)
-                    for r in range(n2):
-                        tmp[r, r] += 1.0
-                    inv_small(tmp, mm)
-                    for r in range(n2):
-                        acc = 0.0
-                        for k in range(n2):
-                            acc += mm[r, k] * res[k]
-                        step[r] = acc
-                    break
-            # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
-            # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
-            for r in range(n2):
-                acc = 0.0
-                for k in range(n2):
-                    acc -= kk[r, k] * step[k]
-                u[r] -= step[r]
-                res[r] = acc  # K du
-            for r in range(n2):
-                fs[r] += res[r]  # fs + K du with du = -step (kk = -dfs/dd = dfs/du)
-            for j in range(n):
-                ustate[j, 0], ustate[j, 1] = u[2 * j], u[2 * j + 1]
-                ulast[2 * j], ulast[2 * j + 1] = u[2 * j], u[2 * j + 1]
-                ustate[j, 2], ustate[j, 3] = c * u[2 * j] + s * u[2 * j + 1], -s * u[2 * j] + c * u[2 * j + 1]
-        for col in range(m):
-            gc = idx[col] if col < 3 else idx[col + 3]
-            qp[col], vp[col] = q[gc], v[gc]
+                break
+        # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
+        # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
+        for r in range(n2):
+            acc = 0.0
+            for k in range(n2):
+                acc -= kk[r, k] * step[k]
+            u[r] -= step[r]
+            res[r] = acc  # K du
+        for r in range(n2):
+            fs[r] += res[r]  # fs + K du with du = -step (kk = -dfs/dd = dfs/du)
+        for j in range(n):
+            ustate[j, 0], ustate[j, 1] = u[2 * j], u[2 * j + 1]
+            ulast[2 * j], ulast[2 * j + 1] = u[2 * j], u[2 * j + 1]
+            ustate[j, 2], ustate[j, 3] = c * u[2 * j] + s * u[2 * j + 1], -s * u[2 * j] + c * u[2 * j + 1]
     for j in range(n):
         jx, jy = idx[6 + 3 * j], idx[7 + 3 * j]
         kxx, kxy, kyy = kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j + 1]
@@ -340,66 +325,64 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         ktx, kty = kxx * tx + kxy * ty, kxy * tx + kyy * ty
         ktt = tx * ktx + ty * kty
         out_bend[j] = (ktx * ktx + kty * kty) / (kb * ktt) if (kb > 0.0 and ktt > 0.0) else 0.0
-    st[0] = 1.0
     if not (jac or elastic):
         return
-    if cached and elastic:
-        arm_term = st[2]  # df, wc, u of the previous call are still in wk
-    else:
-        # d(d0)/dq and d(gamma)/dq over the local coordinates
+    # d(d0)/dq and d(gamma)/dq over the local coordinates
+    for r in range(n2):
+        for col in range(m):
+            d0[r, col] = 0.0
+    for j in range(n):
+        for col in range(m):
+            gg[j, col] = 0.0
+        d0[2 * j, 0], d0[2 * j, 2], d0[2 * j, 3 + 3 * j] = -1.0, ry[j], 1.0
+        d0[2 * j + 1, 1], d0[2 * j + 1, 2], d0[2 * j + 1, 4 + 3 * j] = -1.0, -rx[j], 1.0
+        gg[j, 2], gg[j, 5 + 3 * j] = 0.5 * (1.0 + g), 0.5 * (1.0 - g)
+    matmul_small(kk, d0, df)
+    matmul_small(hh, gg, t2)
+    for r in range(n2):
+        for col in range(m):
+            df[r, col] = t2[r, col] - df[r, col]  # dfs/dq (rigid carrier)
+    for j in range(n):
+        zf[2 * j], zf[2 * j + 1] = -fs[2 * j + 1], fs[2 * j]  # Z fs
+    arm_term = 0.0  # d(arm)/dtheta x fs: the bore's rotation in the carrier's moment
+    for j in range(n):
+        arm_term += rx[j] * fs[2 * j] + ry[j] * fs[2 * j + 1]
+    for r in range(n2):
+        wc[r] = 0.0  # extra row weight of the elastic carrier: C_h Z fs
+    if elastic:
+        for r in range(n2):
+            acc = 0.0
+            for k in range(n2):
+                acc += ch[r, k] * zf[k]
+            wc[r] = acc
+        for j in range(n):  # -Z u - C_h Z fs
+            av[2 * j], av[2 * j + 1] = u[2 * j + 1] - wc[2 * j], -u[2 * j] - wc[2 * j + 1]
+        matmul_small(kk, ch, tmp)
+        for r in range(n2):
+            tmp[r, r] += 1.0
+        inv_small(tmp, mm)  # M = (I + K C_h)^-1
+        matmul_small(mm, df, t2)
+        for r in range(n2):
+            acc = 0.0  # M K a
+            for k in range(n2):
+                acc2 = 0.0
+                for l in range(n2):
+                    acc2 += kk[k, l] * av[l]
+                acc += mm[r, k] * acc2
+            for col in range(m):
+                df[r, col] = t2[r, col]
+            df[r, 2] -= acc
+        for r in range(n2):
+            arm_term -= zf[r] * av[r]
+        # the predictor's sensitivity S = du/dq = -C_h df - a e_theta^T (u = -C_h f_s, C_h turning with theta)
+        matmul_small(ch, df, su)
         for r in range(n2):
             for col in range(m):
-                d0[r, col] = 0.0
-        for j in range(n):
-            for col in range(m):
-                gg[j, col] = 0.0
-            d0[2 * j, 0], d0[2 * j, 2], d0[2 * j, 3 + 3 * j] = -1.0, ry[j], 1.0
-            d0[2 * j + 1, 1], d0[2 * j + 1, 2], d0[2 * j + 1, 4 + 3 * j] = -1.0, -rx[j], 1.0
-            gg[j, 2], gg[j, 5 + 3 * j] = 0.5 * (1.0 + g), 0.5 * (1.0 - g)
-        matmul_small(kk, d0, df)
-        matmul_small(hh, gg, t2)
-        for r in range(n2):
-            for col in range(m):
-                df[r, col] = t2[r, col] - df[r, col]  # dfs/dq (rigid carrier)
-        for j in range(n):
-            zf[2 * j], zf[2 * j + 1] = -fs[2 * j + 1], fs[2 * j]  # Z fs
-        arm_term = 0.0  # d(arm)/dtheta x fs: the bore's rotation in the carrier's moment
-        for j in range(n):
-            arm_term += rx[j] * fs[2 * j] + ry[j] * fs[2 * j + 1]
-        for r in range(n2):
-            wc[r] = 0.0  # extra row weight of the elastic carrier: C_h Z fs
-        if elastic:
-            for r in range(n2):
-                acc = 0.0
-                for k in range(n2):
-                    acc += ch[r, k] * zf[k]
-                wc[r] = acc
-            for j in range(n):  # -Z u - C_h Z fs
-                av[2 * j], av[2 * j + 1] = u[2 * j + 1] - wc[2 * j], -u[2 * j] - wc[2 * j + 1]
-            matmul_small(kk, ch, tmp)
-            for r in range(n2):
-                tmp[r, r] += 1.0
-            inv_small(tmp, mm)  # M = (I + K C_h)^-1
-            matmul_small(mm, df, t2)
-            for r in range(n2):
-                acc = 0.0  # M K a
-                for k in range(n2):
-                    acc2 = 0.0
-                    for l in range(n2):
-                        acc2 += kk[k, l] * av[l]
-                    acc += mm[r, k] * acc2
-                for col in range(m):
-                    df[r, col] = t2[r, col]
-                df[r, 2] -= acc
-            for r in range(n2):
-                arm_term -= zf[r] * av[r]
-            # the predictor's sensitivity S = du/dq = -C_h df - a e_theta^T (u = -C_h f_s, C_h turning with theta)
-            matmul_small(ch, df, su)
-            for r in range(n2):
-                for col in range(m):
-                    su[r, col] = -su[r, col]
-                su[r, 2] -= av[r]
-        st[2] = arm_term
+                su[r, col] = -su[r, col]
+            su[r, 2] -= av[r]
+        for col in range(m):
+            qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
+        st[0] = 1.0
     if not jac:
         return
     # rows: crank j (x, y) += df; carrier (x, y) -= sum df; carrier theta -= (Z (r + u) + C_h Z fs) . df
