@@ -151,8 +151,12 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     arm r + u. Cost (issue 15): the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
     tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
-    LAPACK (:func:`flexrv.model.pins.inv_small`) and nothing is allocated per call (measured on rv40e, a
-    run's calls replayed: 16.8 -> 10.2 us per call including the Python dispatch, 5.1 us compiled)."""
+    LAPACK (:func:`flexrv.model.pins.inv_small`) and nothing is allocated per call. Measured on rv40e
+    (a run's 4,000 solver calls replayed, CPU per call, paired with the code before, loaded machine,
+    2026-11-24): 9.1-11.7 -> 6.5-6.7 us compiled (11.0-11.2 -> 8.2-8.3 us called from Python); with
+    ``carrier.body_model = "rigid"`` 3.0 -> 2.6 us. The elastic carrier's extra cost before was its
+    Newton (two or more support evaluations per call), LAPACK/BLAS calls on 6 x 6 matrices and ~20
+    array allocations per call."""
     idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend, cc, ustate, wk = pack
     cd, linear = dc[0], dc[1] > 0.5
     kb, g = sc[SC_K_BEND], sc[SC_G]
