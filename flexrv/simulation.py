@@ -57,6 +57,25 @@ SPARSE_ABOVE = 100
 #: TE mean and lines converged to the issue-15 criterion on rv40e (tests/test_time_step.py)
 DEFAULT_DT = 1e-4
 
+#: default step of the models that are converged at a larger one [s] (the others use DEFAULT_DT).
+#: The ball model (rigid rings) at 2e-4 s: TE mean within 1e-4 arcsec and lines up to the cycloid
+#: mesh within 1.3 % of a 2.5e-5 s reference on rv40e (tests/test_time_step.py); the rigid model gains
+#: little there (its Newton takes ~3 iterations per step and rejects steps), the flexible rings
+#: diverge on rv40e (disc skips a pin at t = 0.07 s)
+MODEL_DT = {"balls": 2e-4}
+
+#: Exudyn Newton settings per model (under the user's newton_options). The ball model's Jacobian,
+#: reused across steps, goes stale within a step as lightly loaded balls enter and leave contact: a
+#: new one when the residual contracts worse than 0.25 per iteration (Exudyn's default 0.5) took
+#: rv221 from 5.0 to 2.9 Newton iterations per step (benchmarks/bench_balls.py); it makes the
+#: flexible rings slower (rv221 14.2 -> 15.7 s per simulated s) and is not used there
+MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
+
+
+def default_dt(model: str) -> float:
+    """The default time step [s] of ``model`` (:data:`MODEL_DT`, else :data:`DEFAULT_DT`)."""
+    return MODEL_DT.get(model, DEFAULT_DT)
+
 #: largest number of time steps of one run (~1.5 h of wall time for the rigid model
 #: at ~2.5 ms per step); more is refused before any work with a step-count estimate
 MAX_STEPS = 2_000_000
@@ -143,12 +162,13 @@ class Simulation:
         self.timing["build_s"] = _time.perf_counter() - t0
         return self.model
 
-    def run(self, t_end: float | None = None, dt: float = DEFAULT_DT, progress: bool | Callable = False,
+    def run(self, t_end: float | None = None, dt: float | None = None, progress: bool | Callable = False,
             output_every: int = 1, save_to: str | Path | None = None, spectral_radius: float = 0.5,
             newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE, newton_options: dict | None = None,
             checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, segment_steps: int = SEGMENT_STEPS,
             restart: dict | None = None, record_outputs: bool = True):
-        """Integrate to ``t_end`` [s] with step ``dt`` [s]; return :class:`flexrv.post.Results`.
+        """Integrate to ``t_end`` [s] with step ``dt`` [s] (default :func:`default_dt` of the
+        model); return :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
         Default ``t_end``: load ramp end + 0.2 s (steady window after the ramps).
@@ -198,6 +218,8 @@ class Simulation:
             t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
         if not (math.isfinite(t_end) and t_end > 0):
             raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
+        if dt is None:
+            dt = default_dt(self.model_name)
         if not (math.isfinite(dt) and 0 < dt <= t_end):
             raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
         if dt > 5e-4:
@@ -218,6 +240,7 @@ class Simulation:
         import exudyn as exu
 
         newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
 
         model = self.model if self.model is not None else self.build()
         from flexrv.model.kernel_cache import announce_compile
