@@ -245,7 +245,9 @@ class Simulation:
         model = self.model if self.model is not None else self.build()
         from flexrv.model.kernel_cache import announce_compile
 
-        announce_compile()  # one line on stderr if the numba kernels compile now (first run)
+        kinds = (["fused"] if model.fused is not None else []) + (
+            ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else [])
+        announce_compile(kinds=kinds)  # one line on stderr if the numba kernels compile now (first run)
         mbs = model.mbs
         n_steps = check_step_count(t_end, dt, output_every, model.n, t_start=t_start)
         k0 = 0 if restart is None else len(restart["t"])

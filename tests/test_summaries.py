@@ -188,6 +188,15 @@ def test_first_compile_notice(tmp_path):
     assert uncached_kernels(modules) == ["cycloid._PIN_GAP"] and not announce_compile(io.StringIO(), modules)
     helper_index.write_bytes(b"")
     assert uncached_kernels(modules) == [] and not announce_compile(io.StringIO(), modules)
+    # a model kernel a run does not call directly (the rows' row_kernel: tests, quasi-static path) is
+    # no reason either; a run with ball-bearing rows announces their uncached entry point
+    row_index, row = dispatcher("bearing_kernel.row_kernel")
+    elem_index, elem = dispatcher("bearing_kernel.row_element")
+    modules["flexrv.model.bearing_kernel"] = SimpleNamespace(row_kernel=row, row_element=elem)
+    assert not announce_compile(io.StringIO(), modules, kinds=["fused"])
+    assert announce_compile(io.StringIO(), modules, kinds=["fused", "rows"])
+    elem_index.write_bytes(b"")
+    assert not announce_compile(io.StringIO(), modules, kinds=["fused", "rows"])
 
 
 def test_power_balance_not_steady_says_storage():
