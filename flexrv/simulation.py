@@ -57,55 +57,12 @@ SPARSE_ABOVE = 100
 #: TE mean and lines converged to the issue-15 criterion on rv40e (tests/test_time_step.py)
 DEFAULT_DT = 1e-4
 
-#: default step of the models that are converged at a larger one [s] (the others use DEFAULT_DT).
-#: The ball model (rigid rings) at 2e-4 s: TE mean within 1e-4 arcsec and lines up to the cycloid
-#: mesh within 1.3 % of a 2.5e-5 s reference on rv40e (tests/test_time_step.py); the rigid model gains
-#: little there (its Newton takes ~3 iterations per step and rejects steps), the flexible rings
-#: diverge on rv40e (disc skips a pin at t = 0.07 s)
-MODEL_DT = {"balls": 2e-4}
-
 #: Exudyn Newton settings per model (under the user's newton_options). The ball model's Jacobian,
 #: reused across steps, goes stale within a step as lightly loaded balls enter and leave contact: a
 #: new one when the residual contracts worse than 0.25 per iteration (Exudyn's default 0.5) took
 #: rv221 from 5.0 to 2.9 Newton iterations per step (benchmarks/bench_balls.py); it makes the
 #: flexible rings slower (rv221 14.2 -> 15.7 s per simulated s) and is not used there
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
-
-
-def default_dt(model: str) -> float:
-    """The default time step [s] of ``model`` (:data:`MODEL_DT`, else :data:`DEFAULT_DT`)."""
-    return MODEL_DT.get(model, DEFAULT_DT)
-
-#: largest number of time steps of one run (~1.5 h of wall time for the rigid model
-#: at ~2.5 ms per step); more is refused before any work with a step-count estimate
-MAX_STEPS = 2_000_000
-
-#: largest memory of the recorded states (time, coordinates, velocities) [bytes];
-#: the derived result arrays need a few times more
-MAX_RECORD_BYTES = 2 * 1024**3
-
-#: default Newton tolerances (relative, absolute [N per coordinate]) of Exudyn's solver
-DEFAULT_NEWTON_TOLERANCE = (1e-3, 1e-1)
-#: duration [s] of each quarter of the stiffness test's torque loop. Quasi-static means the
-#: loop's branches do not depend on it: on rv221 (rated 3000 N m, heavy output side) 0.02 s left
-#: the branches 2043 / 1767 N m/arcmin apart (output ringing after the clearance crossing),
-#: 0.08 s gives 2147 / 2132 against the quasi-static 2113 catalog slope; rv40e moves by < 1 %
-#: (2026-11-24, tests/test_stiffness_budget.py::test_default_loop_is_quasi_static)
-DEFAULT_QUARTER_TIME = 0.08
-
-#: default wall-time interval between two checkpoints of a run saved to a directory [s]
-CHECKPOINT_INTERVAL_S = 10.0
-
-#: steps per integrator segment: the integrator restarts from the reached state at
-#: every multiple of this step index, so a checkpoint (always at such a boundary)
-#: resumes bit-identically (:meth:`Simulation.run`). 1000 (0.1 s at the default
-#: step; ~0.1 s of CPU for the rigid model, ~12 s for the flexible rings): a restart
-#: is a small perturbation (see run), so fewer are better; a kill loses at most one
-#: checkpoint interval plus one segment
-SEGMENT_STEPS = 1000
-
-#: signal numbers that stop a run gracefully (partial results kept): Ctrl-C, kill
-STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
 
 def check_step_count(t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None,
@@ -167,8 +124,8 @@ class Simulation:
             newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE, newton_options: dict | None = None,
             checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, segment_steps: int = SEGMENT_STEPS,
             restart: dict | None = None, record_outputs: bool = True):
-        """Integrate to ``t_end`` [s] with step ``dt`` [s] (default :func:`default_dt` of the
-        model); return :class:`flexrv.post.Results`.
+        """Integrate to ``t_end`` [s] with step ``dt`` [s] (default :data:`DEFAULT_DT`); return
+        :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
         Default ``t_end``: load ramp end + 0.2 s (steady window after the ramps).
@@ -219,7 +176,7 @@ class Simulation:
         if not (math.isfinite(t_end) and t_end > 0):
             raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
         if dt is None:
-            dt = default_dt(self.model_name)
+            dt = DEFAULT_DT
         if not (math.isfinite(dt) and 0 < dt <= t_end):
             raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
         if dt > 5e-4:

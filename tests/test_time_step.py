@@ -45,8 +45,11 @@ rv221     20 (preset)  1e-4         0.0039              0.07 % (13.6 Hz)
 rv221     20 (preset)  2e-4         0.0016              0.21 %
 ========  ===========  ===========  ==================  ====================
 
-so its default step is 2e-4 s (flexrv.simulation.MODEL_DT; CPU per simulated s -30 to -45 %).
-The flexible rings at 2e-4 s diverge on rv40e (a disc skips a pin at t = 0.07 s): they keep 1e-4 s.
+2e-4 s met the criterion in this study (CPU per simulated s -30 to -45 %), but it is not robust:
+after the disc's mesh change (issue 15, branch fecold: a 2.4 % softer disc) the same rv40e run at
+2e-4 s failed in the speed ramp (disc 1 skipped a pin at t = 0.074 s), as the flexible rings at 2e-4
+s do (t = 0.07 s). Every model therefore keeps DEFAULT_DT = 1e-4 s; the ball model's case at 1e-4 s
+is asserted below.
 
 So the default (1e-4 s, 1e-3 / 0.1 N) meets the criterion on rv40e with a wide
 margin (2e-4 s would too; TE p-p, 0.29-0.51 arcsec, is not converged in dt, as
@@ -80,7 +83,7 @@ import pytest
 from flexrv.design import load
 from flexrv.geometry.kinematics import characteristic_frequencies
 from flexrv.post.spectra import amplitude_spectrum
-from flexrv.simulation import DEFAULT_DT, DEFAULT_NEWTON_TOLERANCE, MODEL_NEWTON, Simulation, default_dt
+from flexrv.simulation import DEFAULT_DT, DEFAULT_NEWTON_TOLERANCE, MODEL_NEWTON, Simulation
 from flexrv.units import RAD_S_PER_RPM
 
 GRID = 2e-4  #: common sampling of the compared TE signals [s]
@@ -166,28 +169,26 @@ def test_default_step_and_tolerance_against_fine_reference(name, torque):
         assert abs(a[i] - a0[i]) < 0.02 * a0[i]
 
 
-def test_model_default_steps():
-    """The ball model runs at its own default step (2e-4 s, module table) with its Newton
-    setting; the others at DEFAULT_DT."""
-    assert default_dt("rigid") == DEFAULT_DT == default_dt("flexible")
-    assert default_dt("balls") == 2e-4
-    assert MODEL_NEWTON["balls"] == {"modifiedNewtonContractivity": 0.25}
+def test_ball_model_newton_setting():
+    """The ball model runs with its own Newton setting (flexrv.simulation.MODEL_NEWTON), the
+    user's newton_options on top; the others with Exudyn's defaults."""
+    assert MODEL_NEWTON == {"balls": {"modifiedNewtonContractivity": 0.25}}
     sim = Simulation("rv40e", model="balls")
     res = sim.run(t_end=0.004)
-    assert sim.timing["steps"] == 20 and res.attrs["status"] == "completed"
+    assert sim.timing["steps"] == 40 and res.attrs["status"] == "completed"
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name, torque", [("rv40e", None), ("rv221", 3000.0)])
 def test_ball_model_default_step_against_fine_reference(name, torque):
-    """Ball model at its default step and Newton settings against the fine reference
+    """Ball model at the default step with its Newton setting against the fine reference
     (dt 2.5e-5 s, tolerance 1e-5 / 1e-3 N), default ramps, t_end 0.4 s: the full
-    criterion (module table: rv40e mean 1e-4 arcsec, lines 1.3 %; rv221 at 3000 N m
-    2e-4 arcsec, 0.02 %). ~40 s each."""
+    criterion (module table: rv40e mean 1e-4 arcsec, lines 1.1 %; rv221 at 3000 N m
+    2e-4 arcsec, 0.03 %). ~40 s each."""
     r = load(name)
     if torque is not None:
         r = r.model_copy(update={"operating": r.operating.model_copy(update={"load_torque_Nm": torque})})
-    run = te_signal(r, 0.4, default_dt("balls"), DEFAULT_NEWTON_TOLERANCE, model="balls")
+    run = te_signal(r, 0.4, DEFAULT_DT, DEFAULT_NEWTON_TOLERANCE, model="balls")
     ref = te_signal(r, 0.4, 2.5e-5, (1e-5, 1e-3), model="balls")
     d_mean, d_lines, freqs = deviations(r, run, ref)
     assert d_mean < 0.05

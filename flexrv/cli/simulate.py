@@ -61,9 +61,8 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-DT_HELP = ("Time step [s] (default flexrv.simulation.default_dt(model): 1e-4 s, 2e-4 s for --model balls; TE mean and "
-           "lines within 0.05 arcsec / 2 % of a 2.5e-5 s reference on rv40e, tests/test_time_step.py).")
-STIFFNESS_DT_HELP = "Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s, every model)."
+DT_HELP = ("Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s: TE mean and lines within 0.05 arcsec / "
+           "2 % of a 2.5e-5 s reference on rv40e, rigid and ball models, tests/test_time_step.py).")
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
 
 
@@ -93,9 +92,9 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
     import math
 
     from flexrv.errors import InputError
-    from flexrv.simulation import Simulation, default_dt
+    from flexrv.simulation import DEFAULT_DT, Simulation
 
-    dt = default_dt(model) if dt is None else dt
+    dt = DEFAULT_DT if dt is None else dt
     if not (math.isfinite(checkpoint) and checkpoint >= 0):
         raise InputError(f"--checkpoint-s {checkpoint}: must be a finite number >= 0 s")
     bar = _bar(not json)
@@ -156,7 +155,7 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
                        quarter_time: float = typer.Option(None, "--quarter-time", help="Duration of each quarter of the torque loop [s] "
                                                           "(default flexrv.simulation.DEFAULT_QUARTER_TIME = 0.08 s: "
                                                           "the branches are quasi-static on both presets)."),
-                       dt: float = typer.Option(None, "--dt", help=STIFFNESS_DT_HELP),
+                       dt: float = typer.Option(None, "--dt", help=DT_HELP),
                        parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
                        out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
                        overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
