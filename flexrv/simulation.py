@@ -65,6 +65,38 @@ DEFAULT_DT = 1e-4
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
 
+#: largest number of time steps of one run (~1.5 h of wall time for the rigid model
+#: at ~2.5 ms per step); more is refused before any work with a step-count estimate
+MAX_STEPS = 2_000_000
+
+#: largest memory of the recorded states (time, coordinates, velocities) [bytes];
+#: the derived result arrays need a few times more
+MAX_RECORD_BYTES = 2 * 1024**3
+
+#: default Newton tolerances (relative, absolute [N per coordinate]) of Exudyn's solver
+DEFAULT_NEWTON_TOLERANCE = (1e-3, 1e-1)
+#: duration [s] of each quarter of the stiffness test's torque loop. Quasi-static means the
+#: loop's branches do not depend on it: on rv221 (rated 3000 N m, heavy output side) 0.02 s left
+#: the branches 2043 / 1767 N m/arcmin apart (output ringing after the clearance crossing),
+#: 0.08 s gives 2147 / 2132 against the quasi-static 2113 catalog slope; rv40e moves by < 1 %
+#: (2026-11-24, tests/test_stiffness_budget.py::test_default_loop_is_quasi_static)
+DEFAULT_QUARTER_TIME = 0.08
+
+#: default wall-time interval between two checkpoints of a run saved to a directory [s]
+CHECKPOINT_INTERVAL_S = 10.0
+
+#: steps per integrator segment: the integrator restarts from the reached state at
+#: every multiple of this step index, so a checkpoint (always at such a boundary)
+#: resumes bit-identically (:meth:`Simulation.run`). 1000 (0.1 s at the default
+#: step; ~0.1 s of CPU for the rigid model, ~12 s for the flexible rings): a restart
+#: is a small perturbation (see run), so fewer are better; a kill loses at most one
+#: checkpoint interval plus one segment
+SEGMENT_STEPS = 1000
+
+#: signal numbers that stop a run gracefully (partial results kept): Ctrl-C, kill
+STOP_SIGNALS = ("SIGINT", "SIGTERM")
+
+
 def check_step_count(t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None,
                      t_start: float = 0.0) -> int:
     """Number of steps of a run; InputError (naming --dt/--t-end and the estimate)
