@@ -72,7 +72,8 @@ def ellipse_parameter(ratio):
         f = np.log(_curvature_ratio_of(mm)) - lr
         h = 1e-7 * np.maximum(mm, 1e-6)
         df = (np.log(_curvature_ratio_of(np.minimum(mm + h, 1 - 1e-15))) - np.log(_curvature_ratio_of(mm))) / h
-        m = np.where(small, m, np.clip(mm - f / df, 1e-12, 1.0 - 1e-15))
+        with np.errstate(divide="ignore", invalid="ignore"):  # df = 0 only where `small` selects m anyway
+            m = np.where(small, m, np.clip(mm - f / df, 1e-12, 1.0 - 1e-15))
     return np.where(ratio <= 1.0, 0.0, m)
 
 
