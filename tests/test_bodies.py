@@ -147,6 +147,28 @@ def test_condensed_carrier_equals_explicit_bore_unknowns(params):
     assert np.abs(f_rigid - f).max() > 0.1 * np.abs(f).max()
 
 
+def _warm_against_cold(warm, cold, states, v, before=None, after=None):
+    """Largest relative force and Jacobian differences of ``warm`` (called along the
+    sequence, keeping its predictor) against ``cold`` (reset before every call); every
+    third state compares Jacobians, the others forces. Returns (err_f, err_j, last cold
+    force). ``before``/``after``: called around each pair of calls."""
+    err_f = err_j = 0.0
+    fc = None
+    for k, q in enumerate(states):
+        if before is not None:
+            before()
+        cold.reset()  # (also sets a pin group's counter to 0)
+        if k % 3 == 2:
+            jw, jc = warm.jacobian(0.0, q, v)[0], cold.jacobian(0.0, q, v)[0]
+            err_j = max(err_j, np.abs(jw - jc).max() / np.abs(jc).max())
+        else:
+            fw, fc = warm.evaluate(0.0, q, v)[0], cold.evaluate(0.0, q, v)[0]
+            err_f = max(err_f, np.abs(fw - fc).max() / np.abs(fc).max())
+        if after is not None:
+            after()
+    return err_f, err_j, fc
+
+
 @pytest.mark.parametrize("theta", [0.3, 2.1])
 def test_condensed_carrier_jacobian_central_differences(params, theta):
     """Condensed tangent (I + K C_h)^-1 K with the turn of C_h with the carrier and
@@ -430,19 +452,17 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     v[0::3], v[1::3], v[2::3] = 2e-4, -1e-4, 1e-2  # sliding: the friction forces act
     big = np.zeros_like(q0)
     big[0::3], big[1::3], big[2::3] = 3e-8, -2e-8, -2e-6
-    err_f = err_j = 0.0
-    n_warm = n_cold = 0
-    for k, q in enumerate(_moving_sequence(q0, big, 1e-3 * big)):
-        c0 = warm.ctr[0]
-        cold.reset()  # (also sets its counter to 0)
-        if k % 3 == 2:
-            jw, jc = warm.jacobian(0.0, q, v)[0], cold.jacobian(0.0, q, v)[0]
-            err_j = max(err_j, np.abs(jw - jc).max() / np.abs(jc).max())
-        else:
-            fw, fc = warm.evaluate(0.0, q, v)[0], cold.evaluate(0.0, q, v)[0]
-            err_f = max(err_f, np.abs(fw - fc).max() / np.abs(fc).max())
-        n_warm += warm.ctr[0] - c0
-        n_cold += cold.ctr[0]
+    counts = {"warm": 0, "cold": 0}
+
+    def count():  # pin-kernel evaluations of this call (the cold group's counter restarts at its reset)
+        counts["warm"] += warm.ctr[0] - counts.setdefault("c0", 0)
+        counts["cold"] += cold.ctr[0]
+
+    def mark():
+        counts["c0"] = warm.ctr[0]
+
+    err_f, err_j, fc = _warm_against_cold(warm, cold, _moving_sequence(q0, big, 1e-3 * big), v, mark, count)
+    n_warm, n_cold = counts["warm"], counts["cold"]
     assert np.abs(fc).max() > 1e3 and np.abs(warm.hstate[1]) > 0.0 and np.abs(warm.dstate[:, 2]).max() > 1e-6
     assert err_f <= 1e-9 and err_j <= 1e-6, (err_f, err_j)
     assert n_warm / 30 <= 2.0 and n_cold / 30 >= 3.0, (n_warm / 30, n_cold / 30)
@@ -455,14 +475,6 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     big[2] = 1e-6  # the carrier turns against the cranks, which roll on (cage angles move)
     big[8::3] = 1e-3
     big[6::3] = 1e-8
-    err_f = err_j = 0.0
-    for k, q in enumerate(_moving_sequence(q0, big, 1e-3 * big)):
-        cold.reset()
-        if k % 3 == 2:
-            jw, jc = warm.jacobian(0.0, q, v)[0], cold.jacobian(0.0, q, v)[0]
-            err_j = max(err_j, np.abs(jw - jc).max() / np.abs(jc).max())
-        else:
-            fw, fc = warm.evaluate(0.0, q, v)[0], cold.evaluate(0.0, q, v)[0]
-            err_f = max(err_f, np.abs(fw - fc).max() / np.abs(fc).max())
+    err_f, err_j, fc = _warm_against_cold(warm, cold, _moving_sequence(q0, big, 1e-3 * big), v)
     assert np.abs(fc).max() > 1e3 and np.abs(warm.ustate).max() > 1e-7
     assert err_f <= 1e-9 and err_j <= 1e-6, (err_f, err_j)

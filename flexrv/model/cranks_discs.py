@@ -94,7 +94,7 @@ from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
-from flexrv.model.pins import inv_small, matmul_small
+from flexrv.model.pins import condensed_step, inv_small, matmul_small
 from flexrv.units import DEG_PER_RAD
 
 
@@ -250,16 +250,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             r0 = max(r0, abs(acc))
         lam = 1.0
         for _ in range(60):
-            # Newton correction from here: (I + C_h K)^-1 R
-            matmul_small(ch, kk, tmp)
-            for r in range(n2):
-                tmp[r, r] += 1.0
-            inv_small(tmp, mm)
-            for r in range(n2):
-                acc = 0.0
-                for k in range(n2):
-                    acc += mm[r, k] * res[k]
-                step[r] = acc
+            condensed_step(ch, kk, 1.0, res, tmp, mm, step)  # Newton correction from here: (I + C_h K)^-1 R
             umax = 0.0
             for r in range(n2):
                 umax = max(umax, abs(u[r]))
@@ -287,15 +278,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
             stop = r1 >= r0 and r0 <= 1e-12
             r0 = r1
             if stop:  # at round-off: the correction from this last evaluation, then stop
-                matmul_small(ch, kk, tmp)
-                for r in range(n2):
-                    tmp[r, r] += 1.0
-                inv_small(tmp, mm)
-                for r in range(n2):
-                    acc = 0.0
-                    for k in range(n2):
-                        acc += mm[r, k] * res[k]
-                    step[r] = acc
+                condensed_step(ch, kk, 1.0, res, tmp, mm, step)
                 break
         # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
         # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)

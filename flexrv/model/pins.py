@@ -345,6 +345,25 @@ def matmul_small(a, b, out):
             out[r, c] = acc
 
 
+@njit(cache=True)
+def condensed_step(c, j, sign, res, tmp, inv, step):
+    """step = (I + sign C J)^-1 res: the Newton correction of the condensations' local
+    solves (the rim offsets, sign -1: R = delta - C Q(q + delta); the carrier's support
+    points, sign +1: R = u + C f_s(d0 - u)); inv = the inverse (kept for the condensed
+    tangent), tmp: scratch. All (m, m) / (m,), no allocation."""
+    m = res.shape[0]
+    matmul_small(c, j, tmp)
+    for r in range(m):
+        for k in range(m):
+            tmp[r, k] = (1.0 if r == k else 0.0) + sign * tmp[r, k]
+    inv_small(tmp, inv)
+    for r in range(m):
+        acc = 0.0
+        for k in range(m):
+            acc += inv[r, k] * res[k]
+        step[r] = acc
+
+
 def pin_work_size(m: int) -> int:
     """Length of the rim condensation's work array (:func:`_pin_condensed_kernel`)
     for m = 3 n_discs local coordinates."""
@@ -517,17 +536,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
                 lam *= 0.5
                 continue
         r0 = r1
-        # N = (I - C J)^-1 and the Newton correction N R from here
-        matmul_small(cm, jl, tmp)
-        for r in range(m):
-            for c in range(m):
-                tmp[r, c] = (1.0 if r == c else 0.0) - tmp[r, c]
-        inv_small(tmp, nm)
-        for r in range(m):
-            acc = 0.0
-            for c in range(m):
-                acc += nm[r, c] * res[c]
-            step[r] = acc
+        condensed_step(cm, jl, -1.0, res, tmp, nm, step)  # N = (I - C J)^-1, the Newton correction N R
         fresh = True
         if r1 <= tol:
             break
@@ -535,16 +544,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             base[r] = delta[r]
         lam = 1.0
     if not fresh:  # stopped on a halved step at round-off: the correction from the last evaluation
-        matmul_small(cm, jl, tmp)
-        for r in range(m):
-            for c in range(m):
-                tmp[r, c] = (1.0 if r == c else 0.0) - tmp[r, c]
-        inv_small(tmp, nm)
-        for r in range(m):
-            acc = 0.0
-            for c in range(m):
-                acc += nm[r, c] * res[c]
-            step[r] = acc
+        condensed_step(cm, jl, -1.0, res, tmp, nm, step)
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
