@@ -133,6 +133,19 @@ def support_work_size(n: int) -> int:
 
 
 @njit(cache=True)
+def _carrier_residual(u, ch, fs, res):
+    """res = u + C_h fs (the elastic carrier's local residual); returns max|res|."""
+    r0 = 0.0
+    for r in range(u.shape[0]):
+        acc = u[r]
+        for k in range(u.shape[0]):
+            acc += ch[r, k] * fs[k]
+        res[r] = acc
+        r0 = max(r0, abs(acc))
+    return r0
+
+
+@njit(cache=True)
 def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     """Crank supports (module docstring): Q into f[idx], Jacobians into jq, jv; the
     force on each crank into out_fx, out_fy, the bearing displacement into bstate
@@ -241,13 +254,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                     u[r] += step[r]
     _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     if elastic:
-        r0 = 0.0
-        for r in range(n2):
-            acc = u[r]
-            for k in range(n2):
-                acc += ch[r, k] * fs[k]
-            res[r] = acc
-            r0 = max(r0, abs(acc))
+        r0 = _carrier_residual(u, ch, fs, res)
         lam = 1.0
         for _ in range(60):
             condensed_step(ch, kk, 1.0, res, tmp, mm, step)  # Newton correction from here: (I + C_h K)^-1 R
@@ -265,13 +272,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 for r in range(n2):
                     u[r] = u0[r] - lam * step[r]
                 _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
-                r1 = 0.0
-                for r in range(n2):
-                    acc = u[r]
-                    for k in range(n2):
-                        acc += ch[r, k] * fs[k]
-                    res[r] = acc
-                    r1 = max(r1, abs(acc))
+                r1 = _carrier_residual(u, ch, fs, res)
                 if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
                     break
                 lam *= 0.5
