@@ -507,6 +507,7 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     nc, nd = ecc.shape[0], ecc.shape[1]
     min_gap = np.inf
     b = np.zeros((2, 6))
+    gmat = np.zeros((2, 6))
     ii = np.zeros(6, np.int64)
     for kd in range(nd):
         acc = 0.0
@@ -531,7 +532,10 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
             dvx = v[ixc] + epx * v[ipc] - v[ixd] - hpx * v[ipd]
             dvy = v[iyc] + epy * v[ipc] - v[iyd] - hpy * v[ipd]
             fx = fy = mc = md = 0.0
-            kxx = kxy = kyy = dxx = dxy = dyy = 0.0
+            # dF/dq = K B + D W + cg gq_row (module docstring): K (2 x 2, not symmetric for the empirical
+            # law's damper) the contact tangent, D = dF/d(dv) the damping tangent, W = d(dv)/dq the arms'
+            # rotation in the relative velocity, cg the rollers' turn with the cage angle
+            kxx = kxy = kyx = kyy = dxx = dxy = dyy = cgx = cgy = 0.0
             if not rollers:
                 r = np.sqrt(dx * dx + dy * dy + 1e-30)
                 ux, uy = dx / r, dy / r
@@ -543,7 +547,13 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                 kq, kv = -dfg, -dfr
                 if fr > 0.0 or kq > 0.0:
                     w = fr / r
-                    kxx, kxy, kyy = kq * ux * ux + w * (1.0 - ux * ux), (kq - w) * ux * uy, kq * uy * uy + w * (1.0 - uy * uy)
+                    # P dv / r (P = I - u u^T): the damper's rate turns with the direction u = d/|d|
+                    pvx = (dvx - ux * (ux * dvx + uy * dvy)) / r
+                    pvy = (dvy - uy * (ux * dvx + uy * dvy)) / r
+                    kxx = kq * ux * ux + w * (1.0 - ux * ux) + kv * ux * pvx
+                    kxy = (kq - w) * ux * uy + kv * ux * pvy
+                    kyx = (kq - w) * ux * uy + kv * uy * pvx
+                    kyy = kq * uy * uy + w * (1.0 - uy * uy) + kv * uy * pvy
                     dxx, dxy, dyy = kv * ux * ux, kv * ux * uy, kv * uy * uy
             else:
                 gam0 = 0.5 * ((1.0 - g_ratio) * phc + (1.0 + g_ratio) * psd)
@@ -565,6 +575,11 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                     dxx += kv * ux * ux
                     dxy += kv * ux * uy
                     dyy += kv * uy * uy
+                    # the roller direction turns with the cage: d(delta)/dgam = d . t, t = du/dgam
+                    cf = kq * (-dx * uy + dy * ux) + kv * (-dvx * uy + dvy * ux)
+                    cgx += cf * ux - fr * uy
+                    cgy += cf * uy + fr * ux
+                kyx = kxy
             f[ixc] -= fx
             f[iyc] -= fy
             f[ipc] -= mc
@@ -588,22 +603,43 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                 ii[0], ii[1], ii[2], ii[3], ii[4], ii[5] = ixc, iyc, ipc, ixd, iyd, ipd
                 b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4], b[0, 5] = 1.0, 0.0, epx, -1.0, 0.0, -hpx
                 b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4], b[1, 5] = 0.0, 1.0, epy, 0.0, -1.0, -hpy
-                _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
+                # G = dF/dq (2 x 6): K B + D W + cg g; W = d(dv)/dq has the columns phi: -(E - p) dphi/dt
+                # and psi: (H - c) dpsi/dt; g = d(cage angle)/dq ((1 -+ g)/2 on phi, psi; rollers only)
+                for col in range(6):
+                    gmat[0, col] = kxx * b[0, col] + kxy * b[1, col]
+                    gmat[1, col] = kyx * b[0, col] + kyy * b[1, col]
+                ax, ay = e * sch, e * cch
+                wx, wy = -ax * v[ipc], -ay * v[ipc]
+                gmat[0, 2] += dxx * wx + dxy * wy
+                gmat[1, 2] += dxy * wx + dyy * wy
+                wx, wy = rhx * v[ipd], rhy * v[ipd]
+                gmat[0, 5] += dxx * wx + dxy * wy
+                gmat[1, 5] += dxy * wx + dyy * wy
+                if rollers:
+                    gmat[0, 2] += cgx * 0.5 * (1.0 - g_ratio)
+                    gmat[1, 2] += cgy * 0.5 * (1.0 - g_ratio)
+                    gmat[0, 5] += cgx * 0.5 * (1.0 + g_ratio)
+                    gmat[1, 5] += cgy * 0.5 * (1.0 + g_ratio)
+                # Q = -B^T F: dQ/dq = -B^T G - (dB^T/dq) F (the arms' rotation: phi, phi: (E - p) . F;
+                # psi, psi: -(H - c) . F)
+                for a_ in range(6):
+                    for col in range(6):
+                        jq[ii[a_], ii[col]] -= b[0, a_] * gmat[0, col] + b[1, a_] * gmat[1, col]
+                jq[ipc, ipc] += ax * fx + ay * fy
+                jq[ipd, ipd] -= rhx * fx + rhy * fy
                 _add_btkb(jv, ii, b, dxx, dxy, dyy, 1.0)
                 if mf != 0.0 or sf != 0.0:
-                    # dM = -mu_b r_b (s dF_n + F_n s' r_b d(omega_rel)), dF_n = e^T (K B dq + D B dv), e = F/F_n
-                    # (the same contact tangents as the force Jacobian above, arm rotations dropped likewise)
+                    # dM = -mu_b r_b (s dF_n + F_n s' r_b d(omega_rel)), dF_n = e^T (G dq + D B dv), e = F/F_n
                     ex, ey = fx / fn, fy / fn
                     a_s = -mu_b * r_b * sf
-                    kex, key = kxx * ex + kxy * ey, kxy * ex + kyy * ey
                     dex, dey = dxx * ex + dxy * ey, dxy * ex + dyy * ey
-                    for r in range(6):
-                        gq = a_s * (kex * b[0, r] + key * b[1, r])
-                        gv = a_s * (dex * b[0, r] + dey * b[1, r])
-                        jq[ipc, ii[r]] += gq
-                        jq[ipd, ii[r]] -= gq
-                        jv[ipc, ii[r]] += gv
-                        jv[ipd, ii[r]] -= gv
+                    for col in range(6):
+                        gq = a_s * (ex * gmat[0, col] + ey * gmat[1, col])
+                        gv = a_s * (dex * b[0, col] + dey * b[1, col])
+                        jq[ipc, ii[col]] += gq
+                        jq[ipd, ii[col]] -= gq
+                        jv[ipc, ii[col]] += gv
+                        jv[ipd, ii[col]] -= gv
                     a_d = -mu_b * fn * r_b * r_b * dsf
                     jv[ipc, ipc] += a_d
                     jv[ipc, ipd] -= a_d
