@@ -133,10 +133,11 @@ def test_fused_jacobian_vs_central_differences(name, needle):
     """dF/dq and dF/dv of the fused kernel vs central differences (h = 1e-10) of
     its own force at a loaded state (with speeds): within 1e-3 of the largest entry
     (measured 3e-8 with the roller needle model, 3e-5 / 1e-4 on rv40e / rv221 with
-    the empirical one). The pin and gear-mesh Jacobians are complete (see
+    the empirical one, before the needle Jacobian's completion). The pin,
+    gear-mesh and needle-bearing Jacobians are complete (see
     test_completed_jacobians_vs_central_differences); still dropped by design
     (modified Newton converges on the exact residual): the rotation of the
-    empirical needle arms (~F e) and of the support bores in the damper (~c omega)."""
+    support bores in the damper (~c omega)."""
     m = build_model(_variant(name, needle), exudyn=False)
     q, v = _loaded(m)
     t = 0.002

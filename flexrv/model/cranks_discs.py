@@ -62,15 +62,24 @@ load, d the bore = eccentric journal diameter; mu = design
 ``contact.needle_friction_coefficient``), regularised like the pin friction:
 M = -mu F (d/2) s(omega_rel d/2) on the crank and +M on the disc, omega_rel =
 dphi_j/dt - dpsi_k/dt, F = |F| the bearing force, s
-:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian:
-dF = e^T dF-vector with the same contact tangents as the force (arm rotations
-dropped likewise) plus the exact regularisation term
+:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact): dF = e^T dF-vector, e = F-vector/F,
+with the complete force tangents below, plus the regularisation term
 -mu F (d/2)^2 s' on (phi_j, psi_k) of dM/dv.
 
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
-Generalized forces are Q = -F d(delta)/dq (exact); analytic Jacobians keep the
-contact-stiffness terms (and, empirical law, the exact rotation term F/|d| of the
-direction d/|d|) and drop the others (rotation of the eccentric and hole arms).
+Generalized forces are Q = -B^T F (B = dd/dq over crank x, y, phi and disc x, y,
+psi; F the bearing force on the disc). The analytic Jacobian is the exact
+derivative of Q as computed (issue 15: with the arm rotations dropped, Newton
+converged only linearly at running speeds): dQ/dq = -B^T G - (dB^T/dq) F with
+G = dF/dq = K B + D W + c g, K the contact tangent (empirical law: spring,
+rotation F/|d| of the direction d/|d| and the damper's rate turning with it,
+c_d u (P dd/dt)^T/|d|, P = I - u u^T), D = dF/d(dd/dt) the damping tangent, W =
+d(dd/dt)/dq the arms' rotation in the relative velocity (phi column
+-(E - p) dphi/dt, psi column (H - c) dpsi/dt), c g the rollers' turn with the cage
+angle (rollers law); (dB^T/dq) F puts (E - p) . F on (phi, phi) and -(H - c) . F
+on (psi, psi). dQ/dv = -B^T D B. Verified against central differences of the
+kernel's own forces to 1e-6 of the largest entry (tests/test_kernel.py::
+test_completed_jacobians_vs_central_differences).
 
 Skipped pin: disc k's rotation must stay at its conjugate value psi_k =
 chi_jk / z_c (mean over the cranks, :func:`flexrv.geometry.cycloid.nominal_disc_pose`)
