@@ -62,15 +62,24 @@ load, d the bore = eccentric journal diameter; mu = design
 ``contact.needle_friction_coefficient``), regularised like the pin friction:
 M = -mu F (d/2) s(omega_rel d/2) on the crank and +M on the disc, omega_rel =
 dphi_j/dt - dpsi_k/dt, F = |F| the bearing force, s
-:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian:
-dF = e^T dF-vector with the same contact tangents as the force (arm rotations
-dropped likewise) plus the exact regularisation term
+:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact): dF = e^T dF-vector, e = F-vector/F,
+with the complete force tangents below, plus the regularisation term
 -mu F (d/2)^2 s' on (phi_j, psi_k) of dM/dv.
 
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
-Generalized forces are Q = -F d(delta)/dq (exact); analytic Jacobians keep the
-contact-stiffness terms (and, empirical law, the exact rotation term F/|d| of the
-direction d/|d|) and drop the others (rotation of the eccentric and hole arms).
+Generalized forces are Q = -B^T F (B = dd/dq over crank x, y, phi and disc x, y,
+psi; F the bearing force on the disc). The analytic Jacobian is the exact
+derivative of Q as computed (issue 15: with the arm rotations dropped, Newton
+converged only linearly at running speeds): dQ/dq = -B^T G - (dB^T/dq) F with
+G = dF/dq = K B + D W + c g, K the contact tangent (empirical law: spring,
+rotation F/|d| of the direction d/|d| and the damper's rate turning with it,
+c_d u (P dd/dt)^T/|d|, P = I - u u^T), D = dF/d(dd/dt) the damping tangent, W =
+d(dd/dt)/dq the arms' rotation in the relative velocity (phi column
+-(E - p) dphi/dt, psi column (H - c) dpsi/dt), c g the rollers' turn with the cage
+angle (rollers law); (dB^T/dq) F puts (E - p) . F on (phi, phi) and -(H - c) . F
+on (psi, psi). dQ/dv = -B^T D B. Verified against central differences of the
+kernel's own forces to 1e-6 of the largest entry (tests/test_kernel.py::
+test_completed_jacobians_vs_central_differences).
 
 Skipped pin: disc k's rotation must stay at its conjugate value psi_k =
 chi_jk / z_c (mean over the cranks, :func:`flexrv.geometry.cycloid.nominal_disc_pose`)
@@ -493,6 +502,7 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     nc, nd = ecc.shape[0], ecc.shape[1]
     min_gap = np.inf
     b = np.zeros((2, 6))
+    gmat = np.zeros((2, 6))
     ii = np.zeros(6, np.int64)
     for kd in range(nd):
         acc = 0.0
@@ -517,7 +527,10 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
             dvx = v[ixc] + epx * v[ipc] - v[ixd] - hpx * v[ipd]
             dvy = v[iyc] + epy * v[ipc] - v[iyd] - hpy * v[ipd]
             fx = fy = mc = md = 0.0
-            kxx = kxy = kyy = dxx = dxy = dyy = 0.0
+            # dF/dq = K B + D W + cg gq_row (module docstring): K (2 x 2, not symmetric for the empirical
+            # law's damper) the contact tangent, D = dF/d(dv) the damping tangent, W = d(dv)/dq the arms'
+            # rotation in the relative velocity, cg the rollers' turn with the cage angle
+            kxx = kxy = kyx = kyy = dxx = dxy = dyy = cgx = cgy = 0.0
             if not rollers:
                 r = np.sqrt(dx * dx + dy * dy + 1e-30)
                 ux, uy = dx / r, dy / r
@@ -529,7 +542,13 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                 kq, kv = -dfg, -dfr
                 if fr > 0.0 or kq > 0.0:
                     w = fr / r
-                    kxx, kxy, kyy = kq * ux * ux + w * (1.0 - ux * ux), (kq - w) * ux * uy, kq * uy * uy + w * (1.0 - uy * uy)
+                    # P dv / r (P = I - u u^T): the damper's rate turns with the direction u = d/|d|
+                    pvx = (dvx - ux * (ux * dvx + uy * dvy)) / r
+                    pvy = (dvy - uy * (ux * dvx + uy * dvy)) / r
+                    kxx = kq * ux * ux + w * (1.0 - ux * ux) + kv * ux * pvx
+                    kxy = (kq - w) * ux * uy + kv * ux * pvy
+                    kyx = (kq - w) * ux * uy + kv * uy * pvx
+                    kyy = kq * uy * uy + w * (1.0 - uy * uy) + kv * uy * pvy
                     dxx, dxy, dyy = kv * ux * ux, kv * ux * uy, kv * uy * uy
             else:
                 gam0 = 0.5 * ((1.0 - g_ratio) * phc + (1.0 + g_ratio) * psd)
@@ -551,6 +570,11 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                     dxx += kv * ux * ux
                     dxy += kv * ux * uy
                     dyy += kv * uy * uy
+                    # the roller direction turns with the cage: d(delta)/dgam = d . t, t = du/dgam
+                    cf = kq * (-dx * uy + dy * ux) + kv * (-dvx * uy + dvy * ux)
+                    cgx += cf * ux - fr * uy
+                    cgy += cf * uy + fr * ux
+                kyx = kxy
             f[ixc] -= fx
             f[iyc] -= fy
             f[ipc] -= mc
@@ -574,22 +598,43 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                 ii[0], ii[1], ii[2], ii[3], ii[4], ii[5] = ixc, iyc, ipc, ixd, iyd, ipd
                 b[0, 0], b[0, 1], b[0, 2], b[0, 3], b[0, 4], b[0, 5] = 1.0, 0.0, epx, -1.0, 0.0, -hpx
                 b[1, 0], b[1, 1], b[1, 2], b[1, 3], b[1, 4], b[1, 5] = 0.0, 1.0, epy, 0.0, -1.0, -hpy
-                _add_btkb(jq, ii, b, kxx, kxy, kyy, 1.0)
+                # G = dF/dq (2 x 6): K B + D W + cg g; W = d(dv)/dq has the columns phi: -(E - p) dphi/dt
+                # and psi: (H - c) dpsi/dt; g = d(cage angle)/dq ((1 -+ g)/2 on phi, psi; rollers only)
+                for col in range(6):
+                    gmat[0, col] = kxx * b[0, col] + kxy * b[1, col]
+                    gmat[1, col] = kyx * b[0, col] + kyy * b[1, col]
+                ax, ay = e * sch, e * cch
+                wx, wy = -ax * v[ipc], -ay * v[ipc]
+                gmat[0, 2] += dxx * wx + dxy * wy
+                gmat[1, 2] += dxy * wx + dyy * wy
+                wx, wy = rhx * v[ipd], rhy * v[ipd]
+                gmat[0, 5] += dxx * wx + dxy * wy
+                gmat[1, 5] += dxy * wx + dyy * wy
+                if rollers:
+                    gmat[0, 2] += cgx * 0.5 * (1.0 - g_ratio)
+                    gmat[1, 2] += cgy * 0.5 * (1.0 - g_ratio)
+                    gmat[0, 5] += cgx * 0.5 * (1.0 + g_ratio)
+                    gmat[1, 5] += cgy * 0.5 * (1.0 + g_ratio)
+                # Q = -B^T F: dQ/dq = -B^T G - (dB^T/dq) F (the arms' rotation: phi, phi: (E - p) . F;
+                # psi, psi: -(H - c) . F)
+                for a_ in range(6):
+                    for col in range(6):
+                        jq[ii[a_], ii[col]] -= b[0, a_] * gmat[0, col] + b[1, a_] * gmat[1, col]
+                jq[ipc, ipc] += ax * fx + ay * fy
+                jq[ipd, ipd] -= rhx * fx + rhy * fy
                 _add_btkb(jv, ii, b, dxx, dxy, dyy, 1.0)
                 if mf != 0.0 or sf != 0.0:
-                    # dM = -mu_b r_b (s dF_n + F_n s' r_b d(omega_rel)), dF_n = e^T (K B dq + D B dv), e = F/F_n
-                    # (the same contact tangents as the force Jacobian above, arm rotations dropped likewise)
+                    # dM = -mu_b r_b (s dF_n + F_n s' r_b d(omega_rel)), dF_n = e^T (G dq + D B dv), e = F/F_n
                     ex, ey = fx / fn, fy / fn
                     a_s = -mu_b * r_b * sf
-                    kex, key = kxx * ex + kxy * ey, kxy * ex + kyy * ey
                     dex, dey = dxx * ex + dxy * ey, dxy * ex + dyy * ey
-                    for r in range(6):
-                        gq = a_s * (kex * b[0, r] + key * b[1, r])
-                        gv = a_s * (dex * b[0, r] + dey * b[1, r])
-                        jq[ipc, ii[r]] += gq
-                        jq[ipd, ii[r]] -= gq
-                        jv[ipc, ii[r]] += gv
-                        jv[ipd, ii[r]] -= gv
+                    for col in range(6):
+                        gq = a_s * (ex * gmat[0, col] + ey * gmat[1, col])
+                        gv = a_s * (dex * b[0, col] + dey * b[1, col])
+                        jq[ipc, ii[col]] += gq
+                        jq[ipd, ii[col]] -= gq
+                        jv[ipc, ii[col]] += gv
+                        jv[ipd, ii[col]] -= gv
                     a_d = -mu_b * fn * r_b * r_b * dsf
                     jv[ipc, ipc] += a_d
                     jv[ipc, ipd] -= a_d
