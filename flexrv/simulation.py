@@ -25,14 +25,14 @@ them if ``save_to`` was given); an interrupted run returns results with
 Default step and Newton tolerances (:data:`DEFAULT_DT`, :data:`DEFAULT_NEWTON_TOLERANCE`):
 verified in tests/test_time_step.py against a 4x finer step with a 100x tighter
 tolerance (rv40e: TE mean within 1e-4 arcsec, lines up to the cycloid mesh within
-0.1 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
+1.6 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
 its 200-300 Hz lines depend on the start-up history at the Newton-tolerance level
--- two steady responses, see that module). Cost (benchmarks/bench_rigid.py, CPU,
-0.3 s simulated, paired runs on a loaded machine): 1.3 / 2.0 Newton iterations
-per step with a fresh Jacobian per step (rv40e / rv221; 3.6 / 4.6 with the
-Jacobian reused), ~10-15 us per compiled residual call plus ~7 us of
-Exudyn/Python glue; real-time factor (solve + outputs) 1.26-1.40 / 1.29-1.47
-(before: 1.75 / 2.29).
+-- two steady responses, see that module), the ball model too (with its Newton
+setting :data:`MODEL_NEWTON`). Cost (benchmarks/bench_rigid.py, CPU, 0.3 s
+simulated, 2026-11-24): 1.3 / 2.0 Newton iterations per step with a fresh Jacobian
+per step (rv40e / rv221), 45-47 / 35-36 us per fused residual call (the condensed
+FE bodies' local Newtons) plus ~1.4 us of Python glue; real-time factor (solve +
+outputs) 1.95-1.97 / 1.94-1.96.
 """
 
 from __future__ import annotations
