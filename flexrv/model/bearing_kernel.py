@@ -582,6 +582,23 @@ def _film_speed_gain(law, speed, film):
     return law[3] * film / speed
 
 
+
+@njit(cache=True)
+def _modal_sums(bas, q, qt, off, m):
+    """The ring's displacement and velocity at a ball (3 + 3 values): sum_k bas[:, k] q[off + k]
+    and sum_k bas[:, k] qt[off + k] over its m modal coordinates."""
+    d0 = d1 = d2 = 0.0
+    v0 = v1 = v2 = 0.0
+    for k in range(m):
+        qk, vk = q[off + k], qt[off + k]
+        d0 += bas[0, k] * qk
+        d1 += bas[1, k] * qk
+        d2 += bas[2, k] * qk
+        v0 += bas[0, k] * vk
+        v1 += bas[1, k] * vk
+        v2 += bas[2, k] * vk
+    return d0, d1, d2, v0, v1, v2
+
 @njit(cache=True)
 def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
              state, jacobian, rec, f, jq, jv):
@@ -677,16 +694,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         apv0 = apv1 = apv2 = 0.0  # velocity of the groove centre relative to the frame (modal ring)
         if m_i > 0:
             _basis(tab_i, zs_i, psi, bas_i)
-            dp0 = dp1 = dp2 = 0.0
-            pv0 = pv1 = pv2 = 0.0
-            for k in range(m_i):
-                qk, vk = q[6 + k], qt[6 + k]
-                dp0 += bas_i[0, k] * qk
-                dp1 += bas_i[1, k] * qk
-                dp2 += bas_i[2, k] * qk
-                pv0 += bas_i[0, k] * vk
-                pv1 += bas_i[1, k] * vk
-                pv2 += bas_i[2, k] * vk
+            dp0, dp1, dp2, pv0, pv1, pv2 = _modal_sums(bas_i, q, qt, 6, m_i)
             p0, p1, p2 = p0 + dp0, p1 + dp1, p2 + dp2
             for r in range(3):
                 du_i[j, r] = a[r, 0] * dp0 + a[r, 1] * dp1 + a[r, 2] * dp2
@@ -714,15 +722,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         ovx = ovy = ovz = 0.0
         if m_o > 0:
             _basis(tab_o, zs_o, psi, bas_o)
-            ux = uy = uz = 0.0
-            for k in range(m_o):
-                qk, vk = q[6 + m_i + k], qt[6 + m_i + k]
-                ux += bas_o[0, k] * qk
-                uy += bas_o[1, k] * qk
-                uz += bas_o[2, k] * qk
-                ovx += bas_o[0, k] * vk
-                ovy += bas_o[1, k] * vk
-                ovz += bas_o[2, k] * vk
+            ux, uy, uz, ovx, ovy, ovz = _modal_sums(bas_o, q, qt, 6 + m_i, m_o)
             du_o[j, 0], du_o[j, 1], du_o[j, 2] = ux, uy, uz
             ox, oy, oz = ox + ux, oy + uy, oz + uz
             if jacobian:
