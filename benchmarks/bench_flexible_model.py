@@ -99,6 +99,9 @@ import numpy as np
 def run(preset: str, model: str, t_end: float, options: dict, window: float | None = None) -> dict:
     from flexrv.simulation import Simulation
 
+    # warm-up: numba cache loads and one-time imports of the outputs path (xarray's first DataArray
+    # imports its duck-array modules, ~0.36 s, which a 0.1 s run would count as 3.6 s per simulated s)
+    Simulation(preset, model=model, model_options=options).run(t_end=2e-3)
     sim = Simulation(preset, model=model, model_options=options)
     t0 = time.perf_counter()
     m = sim.build()
