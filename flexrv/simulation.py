@@ -151,13 +151,12 @@ class Simulation:
         self.timing["build_s"] = _time.perf_counter() - t0
         return self.model
 
-    def run(self, t_end: float | None = None, dt: float | None = None, progress: bool | Callable = False,
+    def run(self, t_end: float | None = None, dt: float = DEFAULT_DT, progress: bool | Callable = False,
             output_every: int = 1, save_to: str | Path | None = None, spectral_radius: float = 0.5,
             newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE, newton_options: dict | None = None,
             checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, segment_steps: int = SEGMENT_STEPS,
             restart: dict | None = None, record_outputs: bool = True):
-        """Integrate to ``t_end`` [s] with step ``dt`` [s] (default :data:`DEFAULT_DT`); return
-        :class:`flexrv.post.Results`.
+        """Integrate to ``t_end`` [s] with step ``dt`` [s]; return :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
         Default ``t_end``: load ramp end + 0.2 s (steady window after the ramps).
@@ -207,8 +206,6 @@ class Simulation:
             t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
         if not (math.isfinite(t_end) and t_end > 0):
             raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
-        if dt is None:
-            dt = DEFAULT_DT
         if not (math.isfinite(dt) and 0 < dt <= t_end):
             raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
         if dt > 5e-4:
