@@ -192,7 +192,8 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     others by their own evaluate. ``records`` (:meth:`flexrv.model.kernels.HistoryRecorder.records`
     of the run): the fused groups' records the integrator computed at the samples, used
     where ``valid`` (the history pass fills the other samples; see the recorder for
-    what differs)."""
+    what differs); its arrays are filled in place at the rows not valid and may be
+    referenced by the outputs."""
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
     fused = getattr(model, "fused", None)
@@ -201,8 +202,8 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     if fused_groups:
         nt = len(t)
         todo = np.arange(nt) if records is None else np.flatnonzero(~np.asarray(records["valid"], dtype=bool))
-        if records is not None:
-            fused_recs = {g: {k: np.array(a) for k, a in records["data"][g].items()} for g in fused_groups}
+        if records is not None:  # used in place (the history pass below fills the rows not valid)
+            fused_recs = {g: dict(records["data"][g]) for g in fused_groups}
         if len(todo):
             ix = fused.index
             for a in range(0, len(todo), chunk):

@@ -215,8 +215,10 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     t = np.asarray(t, dtype=float)
     if len(t) > 1:  # keep the last record of any repeated time (adaptive step reduction)
         keep = np.r_[np.diff(t) > 0, True]
-        t, q, v = t[keep], q[keep], v[keep]
-        if records is not None:
+        repeated = not keep.all()  # else (the usual case) no copies of the states and records
+        if repeated:
+            t, q, v = t[keep], q[keep], v[keep]
+        if records is not None and repeated:
             records = {"valid": np.asarray(records["valid"])[keep],
                        "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
     data: dict[str, xr.Variable] = {}
