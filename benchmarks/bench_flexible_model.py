@@ -83,6 +83,19 @@ is ~100 us (two condensed rings of 38 balls and 165/181 modes: the factor
 interpolation and the local solve), each row Jacobian ~1-2 ms (the dense
 (I - K C)^-1 K of 114 x 114 per ring), and 3.5 Newton iterations per step with a
 Jacobian every second step.
+
+Condensed tangent through a 2Z x 2Z inverse (2026-11-24, evening): the contact
+blocks factored as K_j = -V_j V_j^T (rank 2: the normal and the geometric term,
+``bearing_kernel._contact_factors``), so (I - K C)^-1 K = -V S^-1 V^T with
+S = I + P P^T, P = V^T W: no 114 x 114 Gram matrix or inverse. Per ring and
+Jacobian 360 -> 190 us (rv40e), row Jacobian 800 -> 560 us; the Jacobian equals
+the old one within 5.5e-11 (jq) / 1.4e-10 (jv) of its largest entry at a running
+state. This script, same session: rv40e 30.7 -> 28.5, rv221 13.2 -> 12.9 s/s.
+Its TE over the start-up window moved (rv40e mean -21.16 -> -21.18", p-p 14.28 ->
+15.02"; rv221 mean 9.57 -> 9.90", p-p 22.44 -> 22.02"): Newton-tolerance scatter,
+since a Jacobian change of 5e-11 changes which iterations the modified Newton
+takes; at the regression table's converged tolerance (flexible_rv221) the two
+give the same answer to 9e-6" (mean) and 1.1e-6" (p-p).
 """
 
 from __future__ import annotations

@@ -25,7 +25,8 @@ the housing, the balls are point masses held by a kinematic cage. A ring is
   the iteration converges linearly to the exact solution (tolerance
   ``CONDENSE_TOL``). The element Jacobian uses the condensed tangent
   (I - K C)^-1 K of the contacts in series with the ring (dense over the
-  balls of the row; :func:`_contact_matrix`). Measured: a cheaper tangent that
+  balls of the row; :func:`_condensed_contact_matrix`, through a 2Z x 2Z inverse of the rank-2
+  contact blocks). Measured: a cheaper tangent that
   condenses only the normal stiffness (Z x Z solve through N^T C N, 4x cheaper)
   moved rv40e's TE mean by 0.5 arcsec and its p-p by 2 arcsec over 0.05-0.1 s
   (the integrator's Newton tolerance lets the tangent shape the answer), so the
@@ -262,6 +263,24 @@ def _contact_blocks(q_load, dq, c, length, nx, ny, nz, etx, ety, stiff, damp):
 
 
 @njit(cache=True)
+def _contact_factors(q_load, dq, length, nx, ny, nz, etx, ety, out):
+    """Factor V (3 x 2, its rows into ``out`` (2, 3)) of the contact stiffness block
+    of :func:`_contact_blocks`, K = -V V^T: V = [sqrt(dQ/d delta) n, sqrt(Q/L) b]
+    with b = n x e_t / |n x e_t|. Since I - n n^T - e_t e_t^T = b b^T for n normal
+    to e_t, this is the block itself when the normal lies in the ball's meridian
+    plane (the groove centre follows the ball's azimuth); a ring's tangential
+    deflection tilts it by n.e_t ~ u_t / L (~1e-5), which changes the geometric
+    term Q/L (itself ~1e-2 of dQ/d delta) by that fraction: the tangent of the
+    condensed rings (:func:`_condensed_contact_matrix`), not the force."""
+    bx, by, bz = -nz * ety, nz * etx, nx * ety - ny * etx  # n x e_t, e_t = (etx, ety, 0)
+    bn = math.sqrt(bx * bx + by * by + bz * bz)
+    sa = math.sqrt(max(dq, 0.0))
+    sb = math.sqrt(max(q_load / length, 0.0)) / bn if (bn > 0.0 and length > 0.0) else 0.0
+    out[0, 0], out[0, 1], out[0, 2] = sa * nx, sa * ny, sa * nz
+    out[1, 0], out[1, 1], out[1, 2] = sb * bx, sb * by, sb * bz
+
+
+@njit(cache=True)
 def _local_factors(psi, wtab, zsign, out):
     """Compliance factors (Z, 3, m) of a condensed ring at the contact azimuths psi:
     out[j] = S B_cyl(psi_j) K^-1/2 in the ring's cylindrical components at contact j
@@ -455,15 +474,15 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
 
 @njit(cache=True)
 def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                    du, cglobal):
+                    du, wglobal):
     """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
     each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
     the compliance factors, the contact solve (:func:`_condense`, deflections u
     kept in these local frames in the work array ``ws`` as the next call's warm
     start), and back to global
-    normals and raceway displacements du. With ``cglobal`` of shape (3Z, 3Z) the
-    global compliance matrix C_jk = R_j W_j W_k^T R_k^T (for the Jacobian).
-    Returns the iteration count."""
+    normals and raceway displacements du. With ``wglobal`` of shape (3Z, m) the
+    global compliance factors R_j W_j stacked (C_jk = R_j W_j W_k^T R_k^T: for the
+    Jacobian, :func:`_condensed_contact_matrix`). Returns the iteration count."""
     nz = psi.shape[0]
     m = wtab.shape[2]
     wl, el, wv, nl, _, _, _ = _split_scratch(ws, nz, m)
@@ -478,26 +497,24 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
         for a in range(3):
             normals[j, a] = rot[j, a, 0] * nl[j, 0] + rot[j, a, 1] * nl[j, 1] + rot[j, a, 2] * nl[j, 2]
             du[j, a] = rot[j, a, 0] * u[j, 0] + rot[j, a, 1] * u[j, 1] + rot[j, a, 2] * u[j, 2]
-    if cglobal.shape[0] == 3 * nz:
-        wg = np.empty((3 * nz, m))  # R_j W_j stacked
+    if wglobal.shape[0] == 3 * nz:
         for j in range(nz):
             for a in range(3):
                 for k in range(m):
-                    wg[3 * j + a, k] = rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] \
+                    wglobal[3 * j + a, k] = rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] \
                         + rot[j, a, 2] * wl[j, 2, k]
-        cglobal[:, :] = wg @ wg.T
     return its
 
 
 @njit(cache=True)
 def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                   du, cmat, state):
+                   du, wglobal, state):
     """The ball contacts of one ring of a row: the condensed ring's local solve
     (:func:`_condensed_ring`, its iteration count and failures in ``state``) or, for a
     rigid / modal ring, each contact from its approach (:func:`_contact`)."""
     if condensed:
         its = _condensed_ring(psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                              du, cmat)
+                              du, wglobal)
         state[3] += 1
         if its < 0:
             state[0] += 1
@@ -619,7 +636,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
     and K the contact stiffness — block diagonal for rigid and modal rings
     (added ball by ball, :func:`_add_block_jacobian`), the dense condensed
-    (I - K C)^-1 K for condensed rings (:func:`_contact_matrix`; geometric-stiffness
+    (I - K C)^-1 K for condensed rings (:func:`_condensed_contact_matrix`; geometric-stiffness
     terms of the frame rotation are dropped; the modified Newton iteration
     converges on the residual, which is exact). The azimuths' cosines and sines
     are the normalised in-plane coordinates (no sin/cos of the atan2)."""
@@ -749,16 +766,16 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     film_o = np.empty(nz)
     nci = 3 * nz if (cond_i and jacobian) else 0
     nco = 3 * nz if (cond_o and jacobian) else 0
-    cmat_i = np.empty((nci, nci))
-    cmat_o = np.empty((nco, nco))
+    wg_i = np.empty((nci, comp_i.shape[2]))  # condensed rings' global compliance factors (Jacobian only)
+    wg_o = np.empty((nco, comp_o.shape[2]))
     _ring_contacts(cond_i, psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i, nrm_i, dq_i,
-                   cd_i, len_i, film_i, du_i, cmat_i, state)
+                   cd_i, len_i, film_i, du_i, wg_i, state)
     if cond_i:
         for j in range(nz):
             for c in range(3):
                 arm[j, c] += du_i[j, c]
     _ring_contacts(cond_o, psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o, nrm_o, dq_o,
-                   cd_o, len_o, film_o, du_o, cmat_o, state)
+                   cd_o, len_o, film_o, du_o, wg_o, state)
     # ---------------- pass 2: generalized forces (and Jacobian blocks)
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
@@ -767,11 +784,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     t_i = np.zeros((3, nx_i))
     for r in range(3):
         t_i[r, r] = 1.0
-    ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact blocks of every ball, stacked
-    kbi_q = np.empty((nci, 3))
-    kbi_v = np.empty((nci, 3))
-    kbo_q = np.empty((nco, 3))
-    kbo_v = np.empty((nco, 3))
+    ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
+    vf_i = np.empty((nci // 3, 2, 3))
+    vf_o = np.empty((nco // 3, 2, 3))
     record = rec.shape[0] == nz
     # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
     # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
@@ -859,9 +874,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             for r in range(3):
                 for c in range(nx_i):
                     ti_all[3 * j + r, c] = t_i[r, c]
-                for c in range(3):
-                    kbi_q[3 * j + r, c] = k_i[r, c]
-                    kbi_v[3 * j + r, c] = d_i[r, c]
+            _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
         else:
             _add_block_jacobian(jq, k_i, t_i, bj, 0, nx_i)
             _add_block_jacobian(jv, d_i, t_i, bj, 0, nx_i)
@@ -870,10 +883,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
                 _add_speed_column(jv, k_i, t_i, bj, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1],
                                   gain * nrm_i[j, 2])
         if cond_o:
-            for r in range(3):
-                for c in range(3):
-                    kbo_q[3 * j + r, c] = k_o[r, c]
-                    kbo_v[3 * j + r, c] = d_o[r, c]
+            _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
         else:
             bo = bas_o_all[j] if m_o > 0 else bas_o
             _add_block_jacobian(jq, k_o, bo, bj, 6 + m_i, m_o)
@@ -885,7 +895,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     if jacobian and (cond_i or cond_o):
         ball = slice(b0, b0 + 3 * nz)
         if cond_i:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
-            kim = _contact_matrix(kbi_q, kbi_v, cmat_i, True, nrm_i, cd_i)
+            kim = _condensed_contact_matrix(vf_i, nrm_i, cd_i, wg_i)
             for jac, km in ((jq, kim[0]), (jv, kim[1])):
                 jac[ball, ball] += km
                 kt = km @ ti_all
@@ -897,7 +907,7 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             jv[ball, 5] += kd
             jv[0:nx_i, 5] -= ti_all.T @ kd
         if cond_o:  # outer ring in the housing: ball-ball only (m_o = 0)
-            kom = _contact_matrix(kbo_q, kbo_v, cmat_o, True, nrm_o, cd_o)
+            kom = _condensed_contact_matrix(vf_o, nrm_o, cd_o, wg_o)
             jq[ball, ball] += kom[0]
             jv[ball, ball] += kom[1]
             jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
@@ -917,45 +927,55 @@ def _film_displacements(law, speed, films, normals, dudw):
 
 
 @njit(cache=True)
-def _contact_matrix(blocks_q, blocks_v, cmat, condensed, normals, cd):
-    """(3Z, 3Z) contact stiffness and damping of one ring's contacts: block
-    diagonal from the per-ball blocks (stacked (3Z, 3)), or for a condensed ring
-    the contacts in series with the ring, (I - K C)^-1 K and (I - K C)^-1 D
-    (K block diagonal, so I - K C is formed block row by block row; the damping
-    blocks are -c n n^T, so (I - K C)^-1 D = -[(I - K C)^-1 N] diag(c) N^T: one
-    inverse of I - K C, then block products)."""
-    n3 = blocks_q.shape[0]
-    nz = n3 // 3
-    kq = np.zeros((n3, n3))
-    kv = np.zeros((n3, n3))
+def _condensed_contact_matrix(factors, normals, cd, wg):
+    """(3Z, 3Z) contact stiffness and damping of a condensed ring's contacts in
+    series with the ring: (I - K C)^-1 K and (I - K C)^-1 D, with the compliance
+    C = W W^T (``wg``: the stacked global factors W, (3Z, m)), the contact blocks
+    K_j = -V_j V_j^T of :func:`_contact_factors` (``factors`` (Z, 2, 3): the rows of
+    V_j^T) and the damping blocks D_j = -c_j n_j n_j^T.
+
+    By the push-through identity (I + V V^T C)^-1 V = V S^-1 with the SPD 2Z x 2Z
+    matrix S = I + P P^T, P = V^T W: (I - K C)^-1 K = -V S^-1 V^T, and by Woodbury
+    (I - K C)^-1 N = N - V S^-1 P (W^T N), so one 2Z x 2Z inverse and BLAS products
+    of 2Z x m and m x Z replace the 3Z x 3Z Gram matrix W W^T and the inverse of
+    I - K C (issue 15: rv40e's rings, Z = 38, m = 165-181: 360 -> ~70 us per ring
+    and Jacobian, benchmarks/bench_flexible_model.py). Exact for the rank-2 blocks;
+    tests/test_model_flexible_rings.py checks it against the direct solution."""
+    nz = normals.shape[0]
+    n3 = 3 * nz
+    n2 = 2 * nz
+    m = wg.shape[1]
+    p = np.empty((n2, m))  # P = V^T W (V block sparse: three entries per column)
+    g = np.empty((m, nz))  # W^T N
     for j in range(nz):
-        kq[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_q[3 * j:3 * j + 3]
-        kv[3 * j:3 * j + 3, 3 * j:3 * j + 3] = blocks_v[3 * j:3 * j + 3]
-    if not condensed:
-        return kq, kv
-    m = np.empty((n3, n3))
-    for j in range(nz):
-        blk = blocks_q[3 * j:3 * j + 3]
-        m[3 * j:3 * j + 3] = -(blk @ cmat[3 * j:3 * j + 3])
-        for a in range(3):
-            m[3 * j + a, 3 * j + a] += 1.0
-    # (I - K C)^-1 once (LU + inverse: ~half the work of solving for the 4Z right-hand
-    # sides [K, N]), then the block-diagonal products with K and N
-    inv = np.linalg.inv(m)
+        for k in range(m):
+            w0, w1, w2 = wg[3 * j, k], wg[3 * j + 1, k], wg[3 * j + 2, k]
+            p[2 * j, k] = factors[j, 0, 0] * w0 + factors[j, 0, 1] * w1 + factors[j, 0, 2] * w2
+            p[2 * j + 1, k] = factors[j, 1, 0] * w0 + factors[j, 1, 1] * w1 + factors[j, 1, 2] * w2
+            g[k, j] = normals[j, 0] * w0 + normals[j, 1] * w1 + normals[j, 2] * w2
+    s = p @ p.T
+    for i in range(n2):
+        s[i, i] += 1.0
+    sinv = np.linalg.inv(s)
+    r = sinv @ (p @ g)  # S^-1 P W^T N (2Z, Z)
     kq = np.empty((n3, n3))
-    for i in range(n3):
-        for j in range(nz):
-            c0 = 3 * j
-            x0, x1, x2 = inv[i, c0], inv[i, c0 + 1], inv[i, c0 + 2]
+    kv = np.empty((n3, n3))
+    for j in range(nz):
+        for lb in range(nz):
+            s00, s01 = sinv[2 * j, 2 * lb], sinv[2 * j, 2 * lb + 1]
+            s10, s11 = sinv[2 * j + 1, 2 * lb], sinv[2 * j + 1, 2 * lb + 1]
             for b in range(3):
-                kq[i, c0 + b] = x0 * blocks_q[c0, b] + x1 * blocks_q[c0 + 1, b] + x2 * blocks_q[c0 + 2, b]
-            sn = -(x0 * normals[j, 0] + x1 * normals[j, 1] + x2 * normals[j, 2]) * cd[j]
-            if sn != 0.0:
+                x0 = s00 * factors[lb, 0, b] + s01 * factors[lb, 1, b]  # (S^-1 V^T)[2j, 3l+b]
+                x1 = s10 * factors[lb, 0, b] + s11 * factors[lb, 1, b]
+                for a in range(3):
+                    kq[3 * j + a, 3 * lb + b] = -(factors[j, 0, a] * x0 + factors[j, 1, a] * x1)
+            for a in range(3):
+                y = -(factors[j, 0, a] * r[2 * j, lb] + factors[j, 1, a] * r[2 * j + 1, lb])
+                if j == lb:
+                    y += normals[j, a]
+                y *= -cd[lb]
                 for b in range(3):
-                    kv[i, c0 + b] = sn * normals[j, b]
-            else:
-                for b in range(3):
-                    kv[i, c0 + b] = 0.0
+                    kv[3 * j + a, 3 * lb + b] = y * normals[lb, b]
     return kq, kv
 
 
