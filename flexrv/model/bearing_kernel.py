@@ -848,8 +848,10 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         if not jacobian:
             continue
         # ---- Jacobian blocks
-        _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-        _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
+        if not cond_i:  # (condensed rings: the blocks' factors below)
+            _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+        if not cond_o:
+            _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
         et = (etx, ety, 0.0)
         for c1 in range(3):
             for c2 in range(3):
@@ -938,7 +940,7 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
     matrix S = I + P P^T, P = V^T W: (I - K C)^-1 K = -V S^-1 V^T, and by Woodbury
     (I - K C)^-1 N = N - V S^-1 P (W^T N), so one 2Z x 2Z inverse and BLAS products
     of 2Z x m and m x Z replace the 3Z x 3Z Gram matrix W W^T and the inverse of
-    I - K C (issue 15: rv40e's rings, Z = 38, m = 165-181: 360 -> ~70 us per ring
+    I - K C (issue 15: rv40e's rings, Z = 38, m = 165-181: 360 -> 190 us per ring
     and Jacobian, benchmarks/bench_flexible_model.py). Exact for the rank-2 blocks;
     tests/test_model_flexible_rings.py checks it against the direct solution."""
     nz = normals.shape[0]
