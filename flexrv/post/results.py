@@ -215,12 +215,11 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     t = np.asarray(t, dtype=float)
     if len(t) > 1:  # keep the last record of any repeated time (adaptive step reduction)
         keep = np.r_[np.diff(t) > 0, True]
-        repeated = not keep.all()  # else (the usual case) no copies of the states and records
-        if repeated:
+        if not keep.all():  # else (the usual case) no copies of the states and records
             t, q, v = t[keep], q[keep], v[keep]
-        if records is not None and repeated:
-            records = {"valid": np.asarray(records["valid"])[keep],
-                       "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
+            if records is not None:
+                records = {"valid": np.asarray(records["valid"])[keep],
+                           "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
     data: dict[str, xr.Variable] = {}
     for name, o in model_outputs(model, t, q, v, chunk=chunk, records=records).items():
         data[name] = _var(o.values, o.dims, o.units, o.long_name)
