@@ -31,6 +31,11 @@ goal is not reached: the steps need 5.0 (rv221) / 3.6 (rv40e) Newton iterations
 with a Jacobian that goes stale within a step (contact stiffness of lightly
 loaded balls); ``--newton '{"modifiedNewtonContractivity": 0.25}'`` gives rv221
 5.5-5.7 s/s (2.9 Newton/step, 272 Jacobians) and leaves rv40e unchanged.
+Later the same day (paired against f6e224e, two runs each): the rows' outputs
+recorded from the integrator's calls (flexrv.model.kernels.HistoryRecorder)
+instead of a history pass: rv221 5.48, 5.49 -> 5.36, 5.34; rv40e 8.75, 8.65 ->
+8.51, 8.69 (outputs 0.048 -> 0.017 s and 0.100 -> 0.058 s per 0.1 s; the solve
++3 %: the per-step copy of the records into fresh pages). Same TE statistics.
 TE statistics in this start-up window move at the Newton-tolerance level
 (default 1e-3); converged (tolerance 1e-5) the code before and after agree
 (tests/reference_values.py, balls_rv40e note).

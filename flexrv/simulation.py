@@ -13,8 +13,9 @@ boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
 cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
 mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
-``output_every`` steps (with the compiled force groups' per-contact results of the
-integrator's last call at that state, :class:`flexrv.model.kernels.HistoryRecorder`),
+``output_every`` steps (with the per-contact results of the integrator's last call
+at that state: the compiled force groups' and the bearing rows',
+:class:`flexrv.model.kernels.HistoryRecorder`),
 so a run that fails (Newton failure, NaN, penetration
 beyond the physical limit, a disc that skipped a pin) or is interrupted (Ctrl-C,
 SIGTERM) still returns the results up to that time:
@@ -190,10 +191,10 @@ class Simulation:
 
         ``restart``: a checkpoint's content (:meth:`resume`): records ``t``, ``q``,
         ``v`` before the boundary, the boundary state ``q_b``, ``v_b``, ``a_b`` and
-        its step index ``step`` (and the compiled groups' ``records``).
+        its step index ``step`` (and the recording elements' ``records``).
 
-        ``record_outputs`` (default True): the compiled force groups' outputs (contact
-        forces, ...) are those the integrator computed at each recorded state
+        ``record_outputs`` (default True): the compiled force groups' and the bearing
+        rows' outputs (contact forces, ball loads, ...) are those the integrator computed at each recorded state
         (:class:`flexrv.model.kernels.HistoryRecorder`; the same numbers as evaluating
         them again, to the solvers' tolerances, except that ``pin_gap`` of a pin the
         solver proved open is a positive lower bound of its gap); False: every output
@@ -248,13 +249,15 @@ class Simulation:
             ts[:k0], qs[:k0], vs[:k0] = (np.asarray(restart[key], dtype=float) for key in ("t", "q", "v"))
             q_b, v_b, a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
             state["k"] = k0
-        # the compiled groups' records at every sample, from the integrator's own calls (issue 15)
+        # the recording elements' records at every sample, from the integrator's own calls (issue 15)
         recorder = None
-        if model.fused is not None and record_outputs:
+        if record_outputs:
             from flexrv.model.kernels import HistoryRecorder
 
-            recorder = HistoryRecorder(model.fused, n_out)
-            if restart is not None and restart.get("records") is not None:
+            recorder = HistoryRecorder(model, n_out)
+            if not recorder.sources:
+                recorder = None
+            elif restart is not None and restart.get("records") is not None:
                 recorder.fill(k0, *restart["records"])
         checkpoint = None
         if save_to is not None and checkpoint_s is not None and checkpoint_s > 0:
@@ -365,7 +368,7 @@ class Simulation:
                     for g in model.groups:
                         g.reset()
                     if recorder is not None:  # the groups' records were reset: not those of the last call
-                        model.fused.memo = None
+                        recorder.forget()
                     solver = exu.MainSolverImplicitSecondOrder()
                     try:
                         ok = solver.SolveSystem(mbs, ss)

@@ -416,9 +416,17 @@ class RowElement:
     reused by the next call (Exudyn copies them). The compiled entry point is
     called directly after the first call (skips numba's typing of the arguments,
     whose types never change: :meth:`_call`). ``stats`` counts the force and
-    Jacobian calls."""
+    Jacobian calls.
 
-    def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None):
+    ``record``: every call also fills each row's per-ball records (:attr:`records`,
+    (Z, N_RECORD), :data:`flexrv.model.bearing_kernel.RECORD_FIELDS`) and keeps its
+    element force (:meth:`frame_force`: the frame's six, element order), and
+    :attr:`memo` = (t, q, q_t) of the call they belong to, so a run records the
+    bearing's outputs from the integrator's own calls
+    (:class:`flexrv.model.kernels.HistoryRecorder`) instead of evaluating the rows
+    again per sample (issue 15: ~23 us per row and sample)."""
+
+    def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None, record: bool = False):
         rows = [rows] if isinstance(rows, RowModel) else list(rows)
         idxs = [idx] if (idx is None or np.ndim(idx) == 1 and len(rows) == 1 and not isinstance(idx, list)) else list(idx)
         if len(idxs) != len(rows):
@@ -435,34 +443,62 @@ class RowElement:
             if i.shape != (m,):
                 raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
             self._work.append((i, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, m)), np.zeros((m, m)),
-                               np.zeros((0, N_RECORD))))
+                               np.zeros((r.ball_count if record else 0, N_RECORD))))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
+        #: (t, q, q_t) of the last call (the nodes' coordinates, copies), None during a call
+        self.memo = None
 
-    def _call(self, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
+    @property
+    def records(self) -> list[np.ndarray]:
+        """Per row, the live per-ball records (Z, N_RECORD) of the last call (``record``)."""
+        return [w[6] for w in self._work]
+
+    def frame_force(self, k: int) -> np.ndarray:
+        """Live view of row k's generalized force on the frame coordinates (element
+        order x, y, z, rx, ry, rz) of the last call."""
+        return self._work[k][3][:6]
+
+    def _call(self, t, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
+        self.memo = None  # until the call has filled the records
         parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
-        args = (np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64), self.absolute, jacobian, f_q, f_v,
-                self.out_f, self.out_j, parts)
+        qn, vn = np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64)
+        args = (qn, vn, self.absolute, jacobian, f_q, f_v, self.out_f, self.out_j, parts)
         if self._entry is not None:
             self._entry(*args)
-            return
-        row_element(*args)
-        from numba import typeof
+        else:
+            row_element(*args)
+            from numba import typeof
 
-        cres = row_element.overloads.get(tuple(typeof(x) for x in args))
-        self._entry = None if cres is None else cres.entry_point
+            cres = row_element.overloads.get(tuple(typeof(x) for x in args))
+            self._entry = None if cres is None else cres.entry_point
+        self.memo = (t, qn, vn)
 
-    def force(self, q, q_t) -> np.ndarray:
+    def force(self, q, q_t, t: float = 0.0) -> np.ndarray:
         """Generalized force in the nodes' coordinate order (q, q_t: the nodes' coordinates)."""
         self.stats[0] += 1
-        self._call(q, q_t, False, 0.0, 0.0)
+        self._call(t, q, q_t, False, 0.0, 0.0)
         return self.out_f
 
-    def jacobian(self, q, q_t, f_q, f_v) -> np.ndarray:
+    def jacobian(self, q, q_t, f_q, f_v, t: float = 0.0) -> np.ndarray:
         """Exudyn's -(f_q dF/dq + f_v dF/dq_t) in the nodes' coordinate order."""
         self.stats[1] += 1
-        self._call(q, q_t, True, float(f_q), float(f_v))
+        self._call(t, q, q_t, True, float(f_q), float(f_v))
         return self.out_j
+
+    def add_to(self, mbs, nodes: list[int]) -> int:
+        """Add this element to ``mbs`` as ONE ``ObjectGenericODE2`` over ``nodes`` whose
+        force and Jacobian user functions call it; returns the object number."""
+        from exudyn.itemInterface import ObjectGenericODE2
+
+        def force_fn(mbs_, t, item, q, q_t):
+            return self.force(q, q_t, t)
+
+        def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
+            return self.jacobian(q, q_t, f_q, f_v, t)
+
+        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
+                                               jacobianUserFunction=jac_fn))
 
 
 def add_row_element(mbs, rows, nodes: list[int], idx=None, absolute: bool = False, stats: list | None = None) -> int:
@@ -471,21 +507,11 @@ def add_row_element(mbs, rows, nodes: list[int], idx=None, absolute: bool = Fals
     kernel). ``rows``: a :class:`RowModel` or a list; ``idx``: per row, its element
     coordinates [frame(6), inner modes, outer modes, balls(3Z)] -> the nodes'
     coordinates (default for one row: the same order); ``absolute``: the nodes
-    hold absolute ball positions (the reducer model's ball members); ``stats``
-    counts the force and Jacobian calls. Used by the reducer model's
-    :class:`BallBearingGroup` and by the stand-alone bearing of
-    :func:`add_main_bearing` (one element per row). Returns the object number."""
-    from exudyn.itemInterface import ObjectGenericODE2
-
-    element = RowElement(rows, idx, absolute, stats)
-
-    def force_fn(mbs_, t, item, q, q_t):
-        return element.force(q, q_t)
-
-    def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-        return element.jacobian(q, q_t, f_q, f_v)
-
-    return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn))
+    hold absolute ball positions; ``stats`` counts the force and Jacobian calls.
+    The stand-alone bearing of :func:`add_main_bearing` (one element per row; the
+    reducer model's :class:`BallBearingGroup` adds its recording elements by
+    :meth:`RowElement.add_to` itself). Returns the object number."""
+    return RowElement(rows, idx, absolute, stats).add_to(mbs, nodes)
 
 
 def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandle:
@@ -684,13 +710,25 @@ class BallBearingGroup(ForceGroup):
         condensed rows of rv40e) a synthetic system took 1.86 s instead of 1.31 s
         for 1000 Jacobians (issue 15). Returns the first row's object number."""
         stats, objects, pos = self.stats, [], 1
-        for row in self.rows:
+        self.elements, self._element_members = [], []
+        for k, row in enumerate(self.rows):
             count = 1 + len(row.ring_nodes())
             row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
+            self._element_members.append([self.members[0]] + list(self.members[pos:pos + count]))
             pos += count
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
-            objects.append(add_row_element(mbs, row, row_nodes, idx, True, stats))
+            element = RowElement(row, idx, True, stats, record=True)
+            self.elements.append(element)
+            objects.append(element.add_to(mbs, row_nodes))
         return objects[0]
+
+    def recorded_elements(self) -> list:
+        """(element, its nodes' member names, [(group, key, live record array)]) per row
+        element (:class:`flexrv.model.kernels.HistoryRecorder`): row k's per-ball
+        records ``balls<k>`` and its force on the frame ``frame<k>`` (element order)."""
+        return [(e, members, [(self, f"balls{k}", e.records[0]), (self, f"frame{k}", e.frame_force(0))])
+                for k, (e, members) in enumerate(zip(getattr(self, "elements", ()), getattr(self, "_element_members",
+                                                                                                ())))]
 
     @property
     def flexible(self) -> bool:
@@ -699,7 +737,8 @@ class BallBearingGroup(ForceGroup):
     def check(self) -> str | None:
         """Failure message if a condensed ring's local contact solve did not converge
         in the last evaluation (the accepted state of the step)."""
-        if any(int(kernel_inputs(r)[-1][1]) for r in self.rows if hasattr(r, "_kernel_inputs")):
+        if any(int(kernel_inputs(r)[-1][1]) for r in self.rows if hasattr(r, "_kernel_inputs")
+               and (_is_condensed(r.inner) or _is_condensed(r.outer))):  # (rigid and modal rings: no local solve)
             return "main bearing: the condensed rings' contact deflections did not converge"
         return None
 
@@ -756,6 +795,31 @@ class BallBearingGroup(ForceGroup):
             history.append((recs, qe))
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
+
+    def recorded_outputs(self, t, q, v, rec: dict, valid: np.ndarray) -> dict:
+        """Named outputs over a history (T,), (T, n), (T, n) (local coordinates) from the
+        run's records ``rec`` (:meth:`recorded_elements`' keys, (T, ...)), which are
+        filled in place at the samples not ``valid`` by the history pass
+        (:func:`~flexrv.model.bearing_kernel.row_history`) and are the same numbers
+        as :meth:`evaluate` to the condensed rings' local tolerance (the warm starts
+        differ). Only the carrier's force enters :func:`bearing_outputs` (the
+        ``forces`` argument is (T, 6) here)."""
+        q = np.asarray(q, dtype=float)
+        v = np.asarray(v, dtype=float)
+        todo = np.flatnonzero(~np.asarray(valid, dtype=bool))
+        fc = np.zeros((q.shape[0], 6))
+        history = []
+        for k, row in enumerate(self.rows):
+            recs, frame = rec[f"balls{k}"], rec[f"frame{k}"]
+            qe, ve, _ = self._element_state(q, v, k)
+            if len(todo):
+                part = np.zeros((len(todo), row.ball_count, N_RECORD))
+                frame[todo] = row_history(np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]),
+                                          *kernel_inputs(row), part)[:, :6]
+                recs[todo] = part
+            fc[:, _PERM] += frame
+            history.append((recs, qe))
+        return bearing_outputs(self, q, v, fc, history)
 
     def jacobian(self, t, q, v):
         q = np.asarray(q, dtype=float)

@@ -94,16 +94,17 @@ def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needle
 
 
 @njit(cache=True)
-def copy_records_if_same(q0, q, v0, v, src, dst, k):
-    """If q0 == q and v0 == v exactly: row k of every history buffer ``dst`` (T, size)
-    from the flat live arrays ``src``; returns whether it copied."""
-    if q0.shape[0] != q.shape[0] or v0.shape[0] != v.shape[0]:
+def copy_records_if_same(q0, q, v0, v, index, src, dst, k):
+    """If q0 == q[index] and v0 == v[index] exactly (``index`` empty: q0 == q, v0 == v):
+    row k of every history buffer ``dst`` (T, size) from the flat live arrays ``src``;
+    returns whether it copied."""
+    full = index.shape[0] == 0
+    n = q0.shape[0]
+    if (q.shape[0] if full else index.shape[0]) != n or v0.shape[0] != n or v.shape[0] != q.shape[0]:
         return False
-    for i in range(q.shape[0]):
-        if q0[i] != q[i]:
-            return False
-    for i in range(v.shape[0]):
-        if v0[i] != v[i]:
+    for i in range(n):
+        j = i if full else index[i]
+        if q0[i] != q[j] or v0[i] != v[j]:
             return False
     for r in range(len(src)):
         dst[r][k, :] = src[r]
@@ -340,64 +341,96 @@ class FusedForces:
 
 
 class HistoryRecorder:
-    """The fused element's per-contact records at every recorded sample of a run, taken
-    from what the integrator computed (issue 15): at each recorded state the last call
-    of the element (:attr:`FusedForces.memo`) is, in Exudyn's
-    Newton iteration, the residual at the accepted state; if (t, q, v) are exactly those
-    of the record, the groups' live arrays are copied into row k (one compiled call) and
-    the row is ``valid``, else it is left to the outputs' history pass
-    (:meth:`FusedForces.history`). Measured (rv40e / rv221, 0.2 s): 1999 of 2001 and 1997
-    of 2001 records matched (the others: segment starts and repeated steps).
+    """The per-contact records at every recorded sample of a run, taken from what the
+    integrator computed (issue 15), for every recording element of a model: the fused
+    element (:class:`FusedForces`) and the groups' own (``recorded_elements()``, e.g.
+    the bearing rows of :class:`flexrv.model.flexible_bearing.BallBearingGroup`). At
+    each recorded state an element's last call (its ``memo`` = (t, q, v) on its own
+    coordinates) is, in Exudyn's Newton iteration, the residual at the accepted
+    state; if (t, q, v) are exactly those of the record, the element's live arrays
+    are copied into row k (one compiled call) and the row is ``valid`` for that
+    element, else it is left to the outputs' history pass
+    (:meth:`FusedForces.history`, the groups' ``recorded_outputs``). Measured
+    (rv40e / rv221, 0.2 s, fused element): 1999 of 2001 and 1997 of 2001 records
+    matched (the others: segment starts and repeated steps).
 
     Same numbers as the history pass to the solvers' own tolerances (the crank supports'
-    inner solve, the closest points' warm starts), with one difference: a pin the solver
+    inner solve, the closest points' and the condensed rings' warm starts), with one
+    difference: a pin the solver
     proved open (:func:`flexrv.model.pins.pin_kernel`'s bound > 0: no force, no Jacobian)
     keeps that positive lower bound of its gap in ``pin_gap`` instead of the exact gap;
     every pin within reach of contact, every force and every other record is the exact
     evaluation at the recorded state."""
 
-    def __init__(self, fused: FusedForces, n_out: int):
-        self.fused = fused
-        self.entries = [(g, key, a.shape) for g, key, a in fused.record_entries()]
-        self.src = tuple(a.reshape(-1) for _, _, a in fused.record_entries())
-        self.dst = tuple(np.empty((n_out, a.size)) for a in self.src)
-        self.valid = np.zeros(n_out, dtype=bool)
-        #: compiled entry point of copy_records_if_same for these buffers (set on the first call)
-        self._entry = None
+    def __init__(self, model, n_out: int):
+        #: per element: (element, index of its coordinates in the model's vector (empty: all),
+        #: [(group, key, shape)], flat live arrays, history buffers (n_out, size))
+        self.sources = []
+        elements = [] if model.fused is None else [(model.fused, model.fused.member_names,
+                                                   model.fused.record_entries())]
+        for g in model.groups:
+            elements += list(getattr(g, "recorded_elements", lambda: [])())
+        for element, members, entries in elements:
+            if not entries:
+                continue
+            for g, key, a in entries:
+                if a.dtype != np.float64 or not a.flags.c_contiguous:
+                    raise TypeError(f"{g.name} record {key!r} must be float64 and C-contiguous")
+            index = np.concatenate([np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n)
+                                    for m in members]).astype(np.int64)
+            if np.array_equal(index, np.arange(model.n)):
+                index = np.zeros(0, np.int64)  # all of the model's coordinates, in order
+            src = tuple(a.reshape(-1) for _, _, a in entries)
+            self.sources.append((element, index, [(g, key, a.shape) for g, key, a in entries], src,
+                                 tuple(np.empty((n_out, a.size)) for a in src)))
+        self.valid = np.zeros((len(self.sources), n_out), dtype=bool)
+        #: compiled entry point of copy_records_if_same per element (set on the first call)
+        self._entry = [None] * len(self.sources)
 
-    def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> bool:
-        """Record row k from the element's last call if it was at (t, q, v) (full model vectors)."""
-        f, memo = self.fused, self.fused.memo
-        ok = memo is not None and memo[0] == t and bool(self.src)
-        if ok:  # one compiled call: compare (q, v) exactly, copy the records
-            args = (memo[1], q if f.is_full else q[f.index], memo[2], v if f.is_full else v[f.index], self.src,
-                    self.dst, k)
-            if self._entry is None:
-                ok = copy_records_if_same(*args)
-                self._entry = _entry_point(copy_records_if_same, args)
-            elif _f8c(args[0]) and _f8c(args[1]) and _f8c(args[2]) and _f8c(args[3]):
-                ok = self._entry(*args)  # the compiled function directly: no typing of the 40+ record arrays
-            else:
-                ok = copy_records_if_same(*args)
-        self.valid[k] = ok
-        return ok
+    def store(self, k: int, t: float, q: np.ndarray, v: np.ndarray) -> None:
+        """Record row k from each element's last call if it was at (t, q, v) (full model vectors)."""
+        for i, (element, index, _, src, dst) in enumerate(self.sources):
+            memo = element.memo
+            ok = memo is not None and memo[0] == t
+            if ok:  # one compiled call: compare (q, v) exactly, copy the records
+                args = (memo[1], q, memo[2], v, index, src, dst, k)
+                entry = self._entry[i]
+                if entry is None:
+                    ok = copy_records_if_same(*args)
+                    self._entry[i] = _entry_point(copy_records_if_same, args)
+                elif _f8c(args[0]) and _f8c(q) and _f8c(args[2]) and _f8c(v):
+                    ok = entry(*args)  # the compiled function directly: no typing of the record arrays
+                else:
+                    ok = copy_records_if_same(*args)
+            self.valid[i, k] = ok
+
+    def forget(self) -> None:
+        """The elements' last calls no longer match their records (the groups were reset)."""
+        for element, *_ in self.sources:
+            element.memo = None
 
     def fill(self, k0: int, arrays: list, valid: np.ndarray) -> None:
         """Rows 0..k0-1 from a checkpoint (:meth:`arrays` of the interrupted run)."""
-        if len(arrays) != len(self.dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, self.dst)):
+        dst = [d for *_, ds in self.sources for d in ds]
+        valid = np.asarray(valid)
+        if (len(arrays) != len(dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, dst))
+                or valid.shape[0] != len(self.sources) or valid.ndim != 2):
             return  # another model's records: those rows are left to the history pass
-        for a, d in zip(arrays, self.dst):
+        for a, d in zip(arrays, dst):
             d[:k0] = a[:k0]
-        self.valid[:k0] = valid[:k0]
+        self.valid[:, :k0] = valid[:, :k0]
 
     def arrays(self, k: int) -> tuple[list, np.ndarray]:
-        """(buffers, valid) of rows 0..k-1, for a checkpoint."""
-        return [d[:k] for d in self.dst], self.valid[:k]
+        """(buffers, valid (elements, k)) of rows 0..k-1, for a checkpoint."""
+        return [d[:k] for *_, ds in self.sources for d in ds], self.valid[:, :k]
 
     def records(self, k: int) -> dict:
-        """Rows 0..k-1: {"valid": (k,), "data": {group: {key: (k, *shape)}}} for
-        :func:`flexrv.model.outputs.group_outputs`."""
+        """Rows 0..k-1: {"valid": {group: (k,)}, "data": {group: {key: (k, *shape)}}} for
+        :func:`flexrv.model.outputs.group_outputs` (a group's mask: its element's)."""
         data: dict = {}
-        for (g, key, shape), d in zip(self.entries, self.dst):
-            data.setdefault(g, {})[key] = d[:k].reshape((k,) + shape)
-        return {"valid": self.valid[:k], "data": data}
+        valid: dict = {}
+        for i, (_, _, entries, _, dst) in enumerate(self.sources):
+            for (g, key, shape), d in zip(entries, dst):
+                data.setdefault(g, {})[key] = d[:k].reshape((k,) + shape)
+                valid[g] = self.valid[i, :k]
+        return {"valid": valid, "data": data}

@@ -190,20 +190,24 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     compiled loop over the samples of a chunk (:meth:`~flexrv.model.kernels.FusedForces.history`:
     the same kernels on the same inputs as their own evaluate, bit for bit); the
     others by their own evaluate. ``records`` (:meth:`flexrv.model.kernels.HistoryRecorder.records`
-    of the run): the fused groups' records the integrator computed at the samples, used
-    where ``valid`` (the history pass fills the other samples; see the recorder for
-    what differs); its arrays are filled in place at the rows not valid and may be
-    referenced by the outputs."""
+    of the run): the groups' records the integrator computed at the samples, used
+    where their ``valid`` mask is set (the history pass fills the other samples; see
+    the recorder for what differs) -- the fused groups' and those of groups with
+    recording elements (``recorded_outputs``); the arrays are filled in place at the
+    rows not valid and may be referenced by the outputs."""
     outs: dict[str, list] = {}
     meta: dict[str, tuple] = {}
     fused = getattr(model, "fused", None)
     fused_groups = list(fused.recorded) if fused is not None else []
     fused_recs: dict = {}
+    rec_data = records["data"] if records is not None else {}
+    rec_valid = records["valid"] if records is not None else {}
     if fused_groups:
         nt = len(t)
-        todo = np.arange(nt) if records is None else np.flatnonzero(~np.asarray(records["valid"], dtype=bool))
-        if records is not None:  # used in place (the history pass below fills the rows not valid)
-            fused_recs = {g: dict(records["data"][g]) for g in fused_groups}
+        have = all(g in rec_data for g in fused_groups)
+        todo = np.flatnonzero(~np.asarray(rec_valid[fused_groups[0]], dtype=bool)) if have else np.arange(nt)
+        if have:  # used in place (the history pass below fills the rows not valid)
+            fused_recs = {g: dict(rec_data[g]) for g in fused_groups}
         if len(todo):
             ix = fused.index
             for a in range(0, len(todo), chunk):
@@ -215,20 +219,25 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
                         if key not in dst:
                             dst[key] = np.empty((nt,) + val.shape[1:])
                         dst[key][rows] = val
+
+    def put(out):
+        for name, o in (out or {}).items():
+            outs.setdefault(name, []).append(np.asarray(o.values))
+            meta[name] = (o.dims, o.units, o.long_name)
+
     for g in model.groups:
         if g in fused_recs:
-            for name, o in g.outputs(np.asarray(t, dtype=float), fused_recs[g]).items():
-                outs.setdefault(name, []).append(np.asarray(o.values))
-                meta[name] = (o.dims, o.units, o.long_name)
+            put(g.outputs(np.asarray(t, dtype=float), fused_recs[g]))
             continue
         qg_all = model.group_state(g, q)
         vg_all = model.group_state(g, v)
+        if g in rec_data:  # a group recorded from its own elements
+            put(g.recorded_outputs(np.asarray(t, dtype=float), qg_all, vg_all, dict(rec_data[g]), rec_valid[g]))
+            continue
         for a in range(0, len(t), chunk):
             b = min(a + chunk, len(t))
             _, out = g.evaluate(t[a:b], qg_all[a:b], vg_all[a:b], want_outputs=True)
-            for name, o in (out or {}).items():
-                outs.setdefault(name, []).append(np.asarray(o.values))
-                meta[name] = (o.dims, o.units, o.long_name)
+            put(out)
     result = {}
     for name, parts in outs.items():
         dims, units, long_name = meta[name]

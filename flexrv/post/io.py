@@ -85,7 +85,7 @@ CHECKPOINT = "checkpoint.npz"
 def save_checkpoint(directory, t, q, v, meta: dict, reducer, a_last=None, records=None) -> Path:
     """Write the recorded states (t, q, v) of a run, its run options ``meta`` and
     its design atomically to ``<directory>/checkpoint.npz``; ``records``: (list of
-    arrays, valid) of the compiled groups' records at the samples before the last row
+    arrays, valid (elements, samples)) of the recording elements' records at the samples before the last row
     (:meth:`flexrv.model.kernels.HistoryRecorder.arrays`)."""
     from flexrv.cache import atomic_write_bytes, to_jsonable
     from flexrv.design import to_toml

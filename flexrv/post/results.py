@@ -206,7 +206,7 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     The variables are the model's declared outputs (:func:`flexrv.model.outputs.model_outputs`,
     read by name: this module never sees the state layout or the member names), plus
     TE = (theta_out - theta_in / i) in arcsec and the input and output power. ``records``:
-    the compiled groups' records the integrator computed at the T samples
+    the groups' records the integrator computed at the T samples
     (:meth:`flexrv.model.kernels.HistoryRecorder.records`), used where valid."""
     from flexrv.geometry.kinematics import member_speeds
     from flexrv.model.outputs import model_outputs
@@ -218,7 +218,7 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         if not keep.all():  # else (the usual case) no copies of the states and records
             t, q, v = t[keep], q[keep], v[keep]
             if records is not None:
-                records = {"valid": np.asarray(records["valid"])[keep],
+                records = {"valid": {g: np.asarray(m)[keep] for g, m in records["valid"].items()},
                            "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
     data: dict[str, xr.Variable] = {}
     for name, o in model_outputs(model, t, q, v, chunk=chunk, records=records).items():
