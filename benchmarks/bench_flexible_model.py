@@ -91,14 +91,15 @@ S = I + P P^T, P = V^T W: no 114 x 114 Gram matrix or inverse. Per ring and
 Jacobian 360 -> 190 us (rv40e), row Jacobian 800 -> 560 us; the Jacobian equals
 the old one within 5.5e-11 (jq) / 1.4e-10 (jv) of its largest entry at a running
 state. This script, same session: rv40e 30.7 -> 28.5, rv221 13.2 -> 12.9 s/s.
-Then the rows' outputs recorded from the integrator's calls (no history pass of
-the rows; paired against f6e224e, two runs each): rv221 13.0, 12.9 -> 12.5, 12.7;
-rv40e 30.3, 27.3 -> 25.8, 25.3 s/s; TE statistics unchanged to the printed digits.
 Its TE over the start-up window moved (rv40e mean -21.16 -> -21.18", p-p 14.28 ->
 15.02"; rv221 mean 9.57 -> 9.90", p-p 22.44 -> 22.02"): Newton-tolerance scatter,
 since a Jacobian change of 5e-11 changes which iterations the modified Newton
 takes; at the regression table's converged tolerance (flexible_rv221) the two
 give the same answer to 9e-6" (mean) and 1.1e-6" (p-p).
+
+Then the rows' outputs recorded from the integrator's calls (no history pass of
+the rows; paired against f6e224e, two runs each): rv221 13.0, 12.9 -> 12.5, 12.7;
+rv40e 30.3, 27.3 -> 25.8, 25.3 s/s; TE statistics unchanged to the printed digits.
 """
 
 from __future__ import annotations
