@@ -93,6 +93,20 @@ class ForceGroup:
         """Return a failure message if the last evaluated state is unphysical."""
         return None
 
+    def recorded_elements(self) -> list:
+        """The group's own Exudyn elements that keep their per-contact results of the last
+        call (:class:`flexrv.model.kernels.HistoryRecorder`): (element with ``memo`` =
+        (t, q, v) of that call, the member names of its coordinates, [(group, key, live
+        float64 array)]). None by default (the fused kernel groups record through
+        :class:`flexrv.model.kernels.FusedForces`)."""
+        return []
+
+    def recorded_outputs(self, t, q, v, rec: dict, valid) -> dict:
+        """Named outputs over a history (local coordinates) from the run's records of
+        :meth:`recorded_elements` (``rec``: key -> (T, ...); samples not ``valid`` to be
+        evaluated here); groups that record must implement it."""
+        raise NotImplementedError
+
     def new_step(self) -> None:
         """Hook called at the start of every time step (e.g. to drop caches)."""
 

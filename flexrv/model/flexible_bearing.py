@@ -700,6 +700,8 @@ class BallBearingGroup(ForceGroup):
         self.sizes = sizes
         self._index = index  # per row: element coordinates in the group's local vector
         self._n = int(sum(sizes))
+        #: the rows' Exudyn elements and their nodes' member names (set by add_to)
+        self.elements, self._element_members = [], []
 
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
         """One Exudyn element per row over [carrier, the row's modal rings, its balls]
@@ -727,8 +729,7 @@ class BallBearingGroup(ForceGroup):
         element (:class:`flexrv.model.kernels.HistoryRecorder`): row k's per-ball
         records ``balls<k>`` and its force on the frame ``frame<k>`` (element order)."""
         return [(e, members, [(self, f"balls{k}", e.records[0]), (self, f"frame{k}", e.frame_force(0))])
-                for k, (e, members) in enumerate(zip(getattr(self, "elements", ()), getattr(self, "_element_members",
-                                                                                                ())))]
+                for k, (e, members) in enumerate(zip(self.elements, self._element_members))]
 
     @property
     def flexible(self) -> bool:

@@ -369,7 +369,7 @@ class HistoryRecorder:
         elements = [] if model.fused is None else [(model.fused, model.fused.member_names,
                                                    model.fused.record_entries())]
         for g in model.groups:
-            elements += list(getattr(g, "recorded_elements", lambda: [])())
+            elements += g.recorded_elements()
         for element, members, entries in elements:
             if not entries:
                 continue
@@ -414,7 +414,7 @@ class HistoryRecorder:
         dst = [d for *_, ds in self.sources for d in ds]
         valid = np.asarray(valid)
         if (len(arrays) != len(dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, dst))
-                or valid.shape[0] != len(self.sources) or valid.ndim != 2):
+                or valid.ndim != 2 or valid.shape[0] != len(self.sources)):
             return  # another model's records: those rows are left to the history pass
         for a, d in zip(arrays, dst):
             d[:k0] = a[:k0]
