@@ -225,14 +225,15 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
             outs.setdefault(name, []).append(np.asarray(o.values))
             meta[name] = (o.dims, o.units, o.long_name)
 
+    tf = np.asarray(t, dtype=float)
     for g in model.groups:
         if g in fused_recs:
-            put(g.outputs(np.asarray(t, dtype=float), fused_recs[g]))
+            put(g.outputs(tf, fused_recs[g]))
             continue
         qg_all = model.group_state(g, q)
         vg_all = model.group_state(g, v)
         if g in rec_data:  # a group recorded from its own elements
-            put(g.recorded_outputs(np.asarray(t, dtype=float), qg_all, vg_all, dict(rec_data[g]), rec_valid[g]))
+            put(g.recorded_outputs(tf, qg_all, vg_all, dict(rec_data[g]), rec_valid[g]))
             continue
         for a in range(0, len(t), chunk):
             b = min(a + chunk, len(t))
