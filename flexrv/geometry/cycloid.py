@@ -166,12 +166,14 @@ def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol
     descent step where g'' <= 0. The single implementation (numba-compiled): the
     pin-contact kernel and :func:`pin_gap` call it.
 
-    Returns (phi, converged, residual, s, nx, ny, dist2) at the LAST EVALUATED
-    parameter phi (the next Newton step from it is below ``tol`` [rad] when
-    converged, so phi is the foot point to O(tol)): the first-order residual
-    |(P - C).C'|/|C'| [m], the signed distance s(P) = (P - C).n_out (> 0 outside,
-    away from the disc centre) with the unit outward normal n_out = C'/|C'| turned
-    by +90 deg (clockwise traversal), and |P - C|^2."""
+    Returns (phi, converged, residual, s, nx, ny, dist2, cx, cy, d1x, d1y, d2x, d2y)
+    at the LAST EVALUATED parameter phi (the next Newton step from it is below
+    ``tol`` [rad] when converged, so phi is the foot point to O(tol)): the
+    first-order residual |(P - C).C'|/|C'| [m], the signed distance s(P) = (P -
+    C).n_out (> 0 outside, away from the disc centre) with the unit outward normal
+    n_out = C'/|C'| turned by +90 deg (clockwise traversal), |P - C|^2, and C, C',
+    C'' at phi (:func:`_center_curve_point`; the callers' curvature terms reuse them
+    instead of evaluating the curve again)."""
     for _ in range(max_iter):
         cx, cy, d1x, d1y, d2x, d2y = _POINT(phi, z_rp, radius, eccentricity)
         rx, ry = px - cx, py - cy
@@ -186,13 +188,13 @@ def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol
             break
         phi = phi + step
     else:
-        cx, cy, d1x, d1y, _, _ = _POINT(phi, z_rp, radius, eccentricity)
+        cx, cy, d1x, d1y, d2x, d2y = _POINT(phi, z_rp, radius, eccentricity)
         rx, ry = px - cx, py - cy
         step = np.inf
     inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
     nx, ny = -d1y * inv, d1x * inv
     residual = abs(rx * d1x + ry * d1y) * inv
-    return phi, abs(step) < tol, residual, rx * nx + ry * ny, nx, ny, rx * rx + ry * ry
+    return phi, abs(step) < tol, residual, rx * nx + ry * ny, nx, ny, rx * rx + ry * ry, cx, cy, d1x, d1y, d2x, d2y
 
 
 _NEWTON = _jit(_closest_point_newton)
@@ -208,22 +210,30 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     can reach another lobe's local minimum) from seven starts across the lobe
     around theta, keeping the nearest converged foot point. A start counts as
     converged when the step fell below ``tol`` or the first-order residual is below
-    1e-12 m. Returns (phi, ok, s, nx, ny) (see :func:`_closest_point_newton`)."""
+    1e-12 m. Returns (phi, ok, s, nx, ny, d1x, d1y, d2x, d2y) (see
+    :func:`_closest_point_newton`; C' and C'' at phi, NaN when not ok).
+
+    The warm start's half-lobe test needs no arctangent: with theta = atan2(px,
+    py), |phi - theta| (mod 2 pi) <= lobe/2 is cos(phi - theta) |P| = px sin(phi)
+    + py cos(phi) >= cos(lobe/2) |P|, and sin(phi), cos(phi) follow from C and C'
+    at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (issue
+    15: the arctangent was 1.5 % of a rigid run)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
-    theta = np.arctan2(px, py)
     if np.isfinite(phi0):
-        phi, conv, res, sd, nx, ny, _ = _NEWTON(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter)
-        off = phi - theta
-        off -= 2.0 * np.pi * np.rint(off / (2.0 * np.pi))
-        if (conv or res <= 1e-12) and abs(off) <= 0.5 * lobe:
-            return phi, True, sd, nx, ny
-    best = (theta, False, np.nan, np.nan, np.nan)
+        phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(px, py, phi0, z_rp, radius,
+                                                                            eccentricity, max_step, tol, max_iter)
+        if conv or res <= 1e-12:
+            along = px * (z_rp * cx + d1y) + py * (z_rp * cy - d1x)  # R (z - 1) |P| cos(phi - theta)
+            if along >= np.cos(0.5 * lobe) * radius * (z_rp - 1) * np.sqrt(px * px + py * py):
+                return phi, True, sd, nx, ny, d1x, d1y, d2x, d2y
+    theta = np.arctan2(px, py)
+    best = (theta, False, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan)
     best_d2 = np.inf
     for k in range(_COLD_STARTS.shape[0]):
-        phi, conv, res, sd, nx, ny, d2 = _NEWTON(px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius,
-                                                 eccentricity, max_step, tol, max_iter)
+        phi, conv, res, sd, nx, ny, d2, _, _, d1x, d1y, d2x, d2y = _NEWTON(
+            px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius, eccentricity, max_step, tol, max_iter)
         if (conv or res <= 1e-12) and d2 < best_d2:
-            best, best_d2 = (phi, True, sd, nx, ny), d2
+            best, best_d2 = (phi, True, sd, nx, ny, d1x, d1y, d2x, d2y), d2
     return best
 
 
@@ -235,8 +245,8 @@ def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max
     arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
     failed = 0
     for i in range(px.shape[0]):
-        phi, ok, out[0, i], out[1, i], out[2, i] = _FOOT(px[i], py[i], phi0[i], z_rp, radius, eccentricity,
-                                                         max_step, tol, max_iter)
+        phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _ = _FOOT(px[i], py[i], phi0[i], z_rp, radius,
+                                                                     eccentricity, max_step, tol, max_iter)
         failed += not ok
         out[3, i] = phi
     return failed
