@@ -120,7 +120,7 @@ reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`): the same numbers bit for bit, the
 pins' part of a rv40e solver call 42.9 -> 40.0 us (first call of a step) and
-22.6 -> 20.8 us (later calls), replayed calls, 2026-11-25.
+22.6 -> 20.8 us (later calls), replayed calls, 2026-11-24.
 
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
