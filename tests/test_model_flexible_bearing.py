@@ -339,10 +339,13 @@ def test_kernel_refuses_a_law_it_does_not_cover():
 def test_row_element_glue_equals_kernel():
     """The compiled element glue (issue 15, :class:`RowElement`: gather from the nodes'
     order, reference subtracted from absolute ball positions, kernel, scatter, and
-    Exudyn's -(f_q dF/dq + f_v dF/dq_t)) returns exactly (bit for bit) what
-    :func:`evaluate_row` gives for the same element state, permuted to the nodes'
-    order of the reducer model (frame coordinates reordered as the carrier's);
-    its output arrays are reused by the next call, as Exudyn copies them."""
+    Exudyn's -(f_q dF/dq + f_v dF/dq_t)) returns what :func:`evaluate_row` gives for
+    the same element state, permuted to the nodes' order of the reducer model (frame
+    coordinates reordered as the carrier's), within 1e-13 of the largest entry: the
+    calls share the row's film warm starts (:func:`flexrv.model.bearing_kernel._normal_load`),
+    so each starts the film iteration from the previous call's films and their loads
+    agree to round-off, not bit for bit (a glue error would be O(1)); its output
+    arrays are reused by the next call, as Exudyn copies them."""
     from flexrv.model.flexible_bearing import _PERM, RowElement
 
     model = rows_from_design(load("rv40e"), ehl="hamrock_dowson")[1]
@@ -356,11 +359,12 @@ def test_row_element_glue_equals_kernel():
     element = RowElement(model, idx, absolute=True)
     ev = evaluate_row(model, q, qt, jacobian=True)
     f_q, f_v = 0.37, 1.9e3
+    ref_j = (-(f_q * ev.jac_q + f_v * ev.jac_v))[np.ix_(inv, inv)]
     for _ in range(2):  # second call: entry point, reused arrays
         force = element.force(list(qn), list(vn))
-        np.testing.assert_array_equal(force, ev.force[inv])
+        np.testing.assert_allclose(force, ev.force[inv], rtol=0, atol=1e-13 * np.abs(ev.force).max())
         jac = element.jacobian(list(qn), list(vn), f_q, f_v)
-        np.testing.assert_array_equal(jac, (-(f_q * ev.jac_q + f_v * ev.jac_v))[np.ix_(inv, inv)])
+        np.testing.assert_allclose(jac, ref_j, rtol=0, atol=1e-13 * np.abs(ref_j).max())
     assert element.stats == [2, 2]
     assert np.abs(ev.force).max() > 1.0
 

@@ -137,7 +137,7 @@ def _law_speed(speed, law):
 
 
 @njit(cache=True)
-def _normal_load(delta, rate, hu, lu, h_floor, law):
+def _normal_load(delta, rate, hu, lu, h_floor, law, h_start=0.0):
     """(Q, dQ/d delta, dQ/d rate, film h_c [m]) of the EHL-corrected / dry law
     (flexrv.ehl.law._solve and flexrv.contact.laws.impact_force, n = 3/2; the film is
     0 out of contact, as in flexrv.ehl.law.EHLForce.film) with the speed terms
@@ -152,14 +152,22 @@ def _normal_load(delta, rate, hu, lu, h_floor, law):
     O(step^2)). Measured (rv40e law, 0.05-0.2 m/s): 3 film evaluations (powers)
     per loaded contact instead of 4-5, the relative steps being ~3e-2, ~2e-5,
     ~1e-11; the result equals all ``iterations`` steps within round-off
-    (tests/test_model_flexible_rings.py::test_kernel_normal_law_equals_ehl_law)."""
+    (tests/test_model_flexible_rings.py::test_kernel_normal_law_equals_ehl_law).
+
+    ``h_start`` > 0 (the contact's film of the previous call, kept by the row kernel:
+    the last Z entries of a ring's work array, :func:`condense_workspace`) starts the
+    iteration at s = delta + h_start instead of delta + h_floor: within a time step
+    the film moves by ~1e-6 of itself, so the first step is already below
+    FILM_STEP_STOP and ONE film evaluation gives the same fixed point (the error
+    bound above holds from any start; measured: the same loads within ~1e-15
+    relative, tests/test_model_flexible_rings.py::test_film_warm_start_same_fixed_point)."""
     k, lexp, floor, c_max, depth, iters = law[0], law[2], law[4], law[5], law[6], int(law[7])
     dphi = 1.0
     h = 0.0
     if hu == 0.0:
         s = max(delta, 0.0)
     else:
-        s = max(delta + h_floor, 0.0)
+        s = max(delta + (h_start if h_start > 0.0 else h_floor), 0.0)
         for it in range(iters + 1):
             q = k * s * math.sqrt(s)
             above = q > floor
@@ -197,13 +205,14 @@ def _normal_load(delta, rate, hu, lu, h_floor, law):
 
 
 @njit(cache=True)
-def _contact(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law):
+def _contact(ex, ey, ez, wx, wy, wz, offset, hu, lu, h_floor, law, h_start):
     """Ball-groove contact from the ball-minus-centre vector e and relative velocity w,
-    with the law's speed terms (hu, lu, h_floor) of :func:`_law_speed`:
+    with the law's speed terms (hu, lu, h_floor) of :func:`_law_speed` and the film
+    iteration's start ``h_start`` (:func:`_normal_load`):
     (|e|, unit normal, Q, dQ/ddelta, dQ/drate, film h_c); the force on the ball is -Q n."""
     length = math.sqrt(ex * ex + ey * ey + ez * ez)
     nx, ny, nz = ex / length, ey / length, ez / length
-    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, hu, lu, h_floor, law)
+    q, dq, c, h = _normal_load(length - offset, nx * wx + ny * wy + nz * wz, hu, lu, h_floor, law, h_start)
     return length, nx, ny, nz, q, dq, c, h
 
 
@@ -336,10 +345,29 @@ def _cholesky_solve(m, b):
 
 def condense_workspace(ball_count: int, n_modes: int) -> np.ndarray:
     """Persistent work array of a condensed ring in a row (see :func:`_split_workspace`):
-    the contact deflections (warm start), the last Newton tangent, and the scratch
-    of the local solve (:func:`_split_scratch`: no allocation per call)."""
+    the contact deflections (warm start), the last Newton tangent, the scratch
+    of the local solve (:func:`_split_scratch`: no allocation per call) and, as for
+    every ring (:func:`film_workspace`), the contacts' films of the last call in the
+    last Z entries (the film iteration's warm start, :func:`_normal_load`)."""
     z, m = int(ball_count), int(n_modes)
-    return np.zeros(3 * z + 1 + z + 3 * z + z * m + z * z + 3 * z * m + 4 * 3 * z + m + z)
+    return np.zeros(3 * z + 1 + z + 3 * z + z * m + z * z + 3 * z * m + 4 * 3 * z + m + z + z)
+
+
+def film_workspace(ball_count: int) -> np.ndarray:
+    """Work array of a rigid or modal ring in a row: the contacts' films of the last
+    call (Z,), the film iteration's warm start (:func:`_normal_load`; zero: from the
+    load floor's film)."""
+    return np.zeros(int(ball_count))
+
+
+@njit(cache=True)
+def _films(ws, nz):
+    """The films' warm starts of a ring's contacts: the last Z entries of its work
+    array (:func:`condense_workspace`, :func:`film_workspace`), or fresh zeros (a
+    cold start every call) for a work array without them."""
+    if ws.shape[0] >= nz:
+        return ws[ws.shape[0] - nz:]
+    return np.zeros(nz)
 
 
 @njit(cache=True)
@@ -412,7 +440,7 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
         for j in range(nz):
             length, nx, ny, nzz, q, d, c, hf = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
                                                            e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
-                                                           hu, lu, h_floor, law)
+                                                           hu, lu, h_floor, law, films[j])
             loads[j], dq[j], cd[j], lengths[j], films[j] = q, d, c, length, hf
             normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
             if q != 0.0:
@@ -525,7 +553,7 @@ def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, l
         hu, lu, h_floor = _law_speed(speed, law)
         for j in range(e0.shape[0]):
             lengths[j], normals[j, 0], normals[j, 1], normals[j, 2], loads[j], dq[j], cd[j], films[j] = _contact(
-                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law)
+                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law, films[j])
 
 
 @njit(cache=True)
@@ -626,8 +654,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
     coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
     compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); ws_i / ws_o: their work arrays (:func:`condense_workspace`:
-    contact deflections and last tangent, updated);
+    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
+    contact deflections and last tangent; every ring: the contacts' films, the film
+    iteration's warm start, :func:`film_workspace`; updated);
     state (int64, 4): [non-converged condensations, 1 if the last call had one,
     sum of the local iterations, local solves]; rec: (Z, N_RECORD) per-ball
     record, or (0, N_RECORD).
@@ -762,8 +791,8 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     cd_o = np.empty(nz)
     len_i = np.empty(nz)
     len_o = np.empty(nz)
-    film_i = np.empty(nz)
-    film_o = np.empty(nz)
+    film_i = _films(ws_i, nz)  # the last call's films (the film iteration's warm start), overwritten
+    film_o = _films(ws_o, nz)
     nci = 3 * nz if (cond_i and jacobian) else 0
     nco = 3 * nz if (cond_o and jacobian) else 0
     wg_i = np.empty((nci, comp_i.shape[2]))  # condensed rings' global compliance factors (Jacobian only)

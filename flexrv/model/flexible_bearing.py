@@ -44,7 +44,7 @@ import numpy as np
 from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output
-from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, law_parameters,
+from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, film_workspace, law_parameters,
                                          ring_modal_amplitudes, row_element, row_force_kernel, row_history,
                                          row_kernel)
 
@@ -228,7 +228,7 @@ _NO_COMPLIANCE = np.zeros((0, 3, 0))
 def _ring_arrays(ring, ball_count: int) -> tuple:
     """(modal table, z sign, compliance factors, work array) of a ring for the kernel."""
     if ring is None:
-        return _NO_TABLE, 1.0, _NO_COMPLIANCE, np.zeros(0)
+        return _NO_TABLE, 1.0, _NO_COMPLIANCE, film_workspace(ball_count)
     zs = -1.0 if getattr(ring, "mirror", False) else 1.0
     table = getattr(ring, "table", None)
     if table is None:
@@ -237,7 +237,7 @@ def _ring_arrays(ring, ball_count: int) -> tuple:
     if _is_condensed(ring):
         factors = np.ascontiguousarray(ring.compliance_factors, dtype=float)
         return _NO_TABLE, zs, factors, condense_workspace(ball_count, factors.shape[2])
-    return table, zs, _NO_COMPLIANCE, np.zeros(0)
+    return table, zs, _NO_COMPLIANCE, film_workspace(ball_count)
 
 
 def kernel_inputs(model: RowModel) -> tuple:
