@@ -39,6 +39,19 @@ instead of a history pass: rv221 5.48, 5.49 -> 5.36, 5.34; rv40e 8.75, 8.65 ->
 TE statistics in this start-up window move at the Newton-tolerance level
 (default 1e-3); converged (tolerance 1e-5) the code before and after agree
 (tests/reference_values.py, balls_rv40e note).
+Then (paired against 3e05f72, two runs each) each contact's film iteration
+started from its film of the previous call (flexrv.model.bearing_kernel._normal_load:
+the same fixed point within 1e-14; row force 21.8 -> 19.7 us on rv221, 1 film
+evaluation per contact instead of 3 when the state moved little) and one curve
+evaluation less per pin: rv40e 8.51, 8.66 -> 7.81, 8.04; rv221 5.31, 5.42 ->
+5.32, 5.42 (its Jacobians 253 -> 309: the modified Newton's update decisions
+moved with the round-off). The start-up window's TE moved with them (rv221 mean
+11.2913 -> 10.4327", p-p 21.8931 -> 23.7735"; rv40e -21.1915 -> -21.3084",
+14.0568 -> 13.2864"); the same runs to 0.4 s agree over the steady window
+(0.30-0.40 s): rv40e TE mean -166.36759" and p-p 0.39236" both, rv221 at
+3000 N m -139.60677 / -139.60676" and 3.1625 / 3.1658" (rv221 at its preset's
+light load lands on one of its two steady responses, tests/test_time_step.py),
+and the converged regression case balls_rv40e is unchanged.
 """
 
 from __future__ import annotations

@@ -100,6 +100,16 @@ give the same answer to 9e-6" (mean) and 1.1e-6" (p-p).
 Then the rows' outputs recorded from the integrator's calls (no history pass of
 the rows; paired against f6e224e, two runs each): rv221 13.0, 12.9 -> 12.5, 12.7;
 rv40e 30.3, 27.3 -> 25.8, 25.3 s/s; TE statistics unchanged to the printed digits.
+
+Then the films' warm starts (the film iteration from each contact's film of the
+previous call, also inside the condensed rings' local solve) and one curve
+evaluation less per pin (paired against 3e05f72 on a busier machine, two runs
+each): rv221 11.7, 11.8 -> 11.4, 11.2; rv40e 26.3, 27.8 -> 26.5, 26.0 s/s (the
+condensed rings' linear algebra, not the films, dominates their rows). Start-up
+window TE moved with the round-off (rv221 9.8983 -> 10.0439", p-p 22.0241 ->
+20.8366"; rv40e -21.1817 -> -21.2698", 15.0181 -> 13.2064"); to 0.4 s the steady
+window (0.30-0.40 s) of rv40e is the same, TE mean -166.36764" and p-p 0.39327"
+both, and the converged regression case flexible_rv221 is unchanged.
 """
 
 from __future__ import annotations

@@ -33,7 +33,8 @@ setting :data:`MODEL_NEWTON`). Cost (benchmarks/bench_rigid.py, CPU, 0.3 s
 simulated, 2026-11-24): 1.3 / 2.0 Newton iterations per step with a fresh Jacobian
 per step (rv40e / rv221), 45-47 / 35-36 us per fused residual call (the condensed
 FE bodies' local Newtons) plus ~1.4 us of Python glue; real-time factor (solve +
-outputs) 1.85-1.90 / 1.82-1.88.
+outputs) 1.83-1.84 / 1.84-1.85 (paired against 1.87 / 1.83 before one curve
+evaluation less per pin).
 """
 
 from __future__ import annotations
