@@ -271,7 +271,7 @@ class Simulation:
 
         start_of_step = exu.ConfigurationType.StartOfStep
 
-        from flexrv.model.base import ForceGroup
+        from flexrv.model.base import ForceGroup, exudyn_vector
 
         # only the groups that override the per-step hooks (the others' are no-ops), in group order
         steppers = [g for g in model.groups if type(g).new_step is not ForceGroup.new_step]
@@ -280,7 +280,7 @@ class Simulation:
         def prestep(mbs_, t_target):
             # Exudyn calls this with the step's END time; the state is the start-of-step state
             t = sd.GetTime(start_of_step)
-            q = np.asarray(sd.GetODE2Coordinates())
+            q = exudyn_vector(sd.GetODE2Coordinates())
             k = state["k"]
             while k > 0 and ts[k - 1] >= t - 1e-12 * dt:  # a step was repeated (adaptive step reduction)
                 k -= 1
@@ -291,7 +291,7 @@ class Simulation:
             if (k == 0 or t >= ts[k - 1] + output_every * dt * (1 - 1e-9)) and k < n_out:
                 ts[k] = t
                 qs[k] = q
-                vs[k] = sd.GetODE2Coordinates_t()
+                vs[k] = exudyn_vector(sd.GetODE2Coordinates_t())
                 if recorder is not None:
                     recorder.store(k, t, q, vs[k])
                 state["k"] = k + 1

@@ -68,6 +68,18 @@ class Output:
     long_name: str
 
 
+def exudyn_vector(values) -> np.ndarray:
+    """An Exudyn user function's coordinate list (Exudyn passes Python lists) as a new
+    float64 array: ``np.fromiter``, the fastest conversion of a list of floats
+    (issue 15, per conversion: 84 floats 1.3 us instead of 1.6 us with np.array, 120
+    floats 1.8 instead of 2.5-3.2 us; two per element call, ~12 row calls per step).
+
+    >>> exudyn_vector([1.0, 2.5])
+    array([1. , 2.5])
+    """
+    return np.fromiter(values, np.float64, len(values))
+
+
 class ForceGroup:
     """Base class of a vectorised force-element group.
 
@@ -123,14 +135,14 @@ class ForceGroup:
 
         def force_fn(mbs_, t, item, q, q_t):
             stats[0] += 1
-            f, _ = self.evaluate(t, np.asarray(q), np.asarray(q_t))
+            f, _ = self.evaluate(t, exudyn_vector(q), exudyn_vector(q_t))
             return f
 
         kwargs = {}
         if self.analytic_jacobian:
             def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
                 stats[1] += 1
-                dq, dv = self.jacobian(t, np.asarray(q), np.asarray(q_t))
+                dq, dv = self.jacobian(t, exudyn_vector(q), exudyn_vector(q_t))
                 return -(f_q * dq + f_v * dv)
 
             kwargs["jacobianUserFunction"] = jac_fn

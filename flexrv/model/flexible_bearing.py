@@ -43,7 +43,7 @@ import numpy as np
 
 from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
-from flexrv.model.base import ForceGroup, Output
+from flexrv.model.base import ForceGroup, Output, exudyn_vector
 from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, film_workspace, law_parameters,
                                          ring_modal_amplitudes, row_element, row_force_kernel, row_history,
                                          row_kernel)
@@ -462,7 +462,7 @@ class RowElement:
     def _call(self, t, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
         self.memo = None  # until the call has filled the records
         parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
-        qn, vn = np.array(q, dtype=np.float64), np.array(q_t, dtype=np.float64)
+        qn, vn = exudyn_vector(q), exudyn_vector(q_t)
         args = (qn, vn, self.absolute, jacobian, f_q, f_v, self.out_f, self.out_j, parts)
         if self._entry is not None:
             self._entry(*args)

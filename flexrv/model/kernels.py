@@ -43,6 +43,7 @@ import os
 import numpy as np
 from numba import njit
 
+from flexrv.model.base import exudyn_vector
 from flexrv.model.cranks_discs import CrankSupports, NeedleBearings, crank_support_kernel, needle_kernel
 from flexrv.model.gear_stage import GearMeshes, gear_stage_kernel
 from flexrv.model.loads import OutputLoads, loads_kernel
@@ -326,12 +327,12 @@ class FusedForces:
         from exudyn.itemInterface import ObjectGenericODE2
 
         def force_fn(mbs_, t, item, q, q_t):
-            return self.residual(t, np.asarray(q), np.asarray(q_t))
+            return self.residual(t, exudyn_vector(q), exudyn_vector(q_t))
 
         out, tmp = np.empty((self.n, self.n)), np.empty((self.n, self.n))
 
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
-            dq, dv = self.jacobian(t, np.asarray(q), np.asarray(q_t))
+            dq, dv = self.jacobian(t, exudyn_vector(q), exudyn_vector(q_t))
             np.multiply(dq, -f_q, out=out)  # -(f_q dq + f_v dv) without temporaries (Exudyn copies it)
             np.multiply(dv, f_v, out=tmp)
             return np.subtract(out, tmp, out=out)
