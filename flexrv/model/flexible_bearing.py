@@ -802,7 +802,8 @@ class BallBearingGroup(ForceGroup):
         run's records ``rec`` (:meth:`recorded_elements`' keys, (T, ...)), which are
         filled in place at the samples not ``valid`` by the history pass
         (:func:`~flexrv.model.bearing_kernel.row_history`) and are the same numbers
-        as :meth:`evaluate` to the condensed rings' local tolerance (the warm starts
+        as :meth:`evaluate` to the condensed rings' local tolerance and, for rigid
+        rings, to round-off (the warm starts of the local solves and of the films
         differ). Only the carrier's force enters :func:`bearing_outputs` (the
         ``forces`` argument is (T, 6) here)."""
         q = np.asarray(q, dtype=float)

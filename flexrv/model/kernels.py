@@ -356,7 +356,7 @@ class HistoryRecorder:
     matched (the others: segment starts and repeated steps).
 
     Same numbers as the history pass to the solvers' own tolerances (the crank supports'
-    inner solve, the closest points' and the condensed rings' warm starts), with one
+    inner solve, the closest points', the condensed rings' and the films' warm starts), with one
     difference: a pin the solver
     proved open (:func:`flexrv.model.pins.pin_kernel`'s bound > 0: no force, no Jacobian)
     keeps that positive lower bound of its gap in ``pin_gap`` instead of the exact gap;
