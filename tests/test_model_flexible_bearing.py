@@ -443,7 +443,9 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
     preset's pocket spring (1e3 N/m) they move by less than 1 % (measured 6.5e-9 /
     5.4e-9 m). Ball forces end below the 1e-8 N tolerance (~1e-10 of the loads) in
     <= 6 steps, also on a displaced, tilted, spinning frame; a warm restart after a
-    0.1 nm frame move takes one Newton step."""
+    0.1 nm frame move takes one or two Newton steps (the second when the balls'
+    velocities, b_t = -K_bb^-1 K_bx x_t, moved their damping forces by more than
+    the tolerance)."""
     from dataclasses import replace
 
     from flexrv.model.bearing_kernel import ball_equilibrium
@@ -451,7 +453,7 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
 
     row = rows_from_design(load(preset), ehl="hamrock_dowson")[0]
     n, nz = row.n_coordinates, row.ball_count
-    f, kbb = np.empty(n), np.empty((3 * nz, 3))
+    f, kbb = np.empty(n), np.empty((3 * nz, 4))
     ref = initial_ball_displacements(row).ravel()
     bare = replace(row, pocket_stiffness=0.0)
     q, qt = np.zeros(n), np.zeros(n)
@@ -466,4 +468,4 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
     ev = evaluate_row(row, q, qt, False)
     assert np.abs(ev.force[6:]).max() <= 1e-8 and ev.inner.load.max() > 40.0
     q[0] += 1e-10
-    assert ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) == 1
+    assert 1 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) <= 2

@@ -80,8 +80,11 @@ N_RECORD = len(RECORD_FIELDS)
 CONDENSE_TOL = 1e-13
 CONDENSE_MAXIT = 50
 
-#: ``jacobian`` mode of :func:`row_eval`: only each ball's own 3x3 block d f_ball / d ball,
-#: into ``jq`` of shape (3Z, 3) (the local solve of quasi-static balls, :func:`ball_equilibrium`)
+#: ``jacobian`` mode of :func:`row_eval` for the local solve of quasi-static balls
+#: (:func:`ball_equilibrium`): into ``jq`` of shape (3Z, 4) each ball's own 3x3 block
+#: K_bb = d f_ball / d ball and, in column 3, K_bx x_t = (d f_ball / d x) x_t, the rate of
+#: the ball's force from the motion of the frame and rings at a fixed ball (-K_c times
+#: each groove centre's velocity, and the cage pocket's turn)
 BALL_BLOCKS = 2
 
 #: relative Newton step below which the film iteration of :func:`_normal_load` stops
@@ -880,15 +883,21 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
         if not jacobian:
             continue
-        if jacobian == BALL_BLOCKS:  # only d f_ball / d ball (3x3 per ball) into jq (3Z, 3): the local ball solve
+        if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
             _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
             _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
             et = (etx, ety, 0.0)
+            # groove centres' velocities (ball velocity minus the contacts' relative velocities)
+            gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
+            go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
             for c1 in range(3):
+                rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
                 for c2 in range(3):
                     ee = et[c1] * et[c2]
                     eye = 1.0 if c1 == c2 else 0.0
                     jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
+                    rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
+                jq[3 * j + c1, 3] = rate
             continue
         # ---- Jacobian blocks
         if not cond_i:  # (condensed rings: the blocks' factors below)
@@ -1041,41 +1050,57 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)
-    vanishes, at the frame and modal coordinates and velocities in q, qt (the balls'
-    velocities qt[b0:] as given). Newton per ball on its own 3x3 block (row_eval's
-    BALL_BLOCKS mode into ``kbb`` (3Z, 3)); stops when the largest ball force is below
-    ``tol`` [N]. ``f`` (n,): the row's forces at the last evaluation. Returns the
-    number of Newton steps (-1: not converged in ``max_iter``)."""
+    vanishes, at the frame and modal coordinates and velocities in q, qt. The balls'
+    velocities qt[b0:] (out) are those of the static equilibrium, b_t = S x_t with
+    S = -K_bb^-1 K_bx (the contacts' damping and the cage's see the ball move with
+    the stiffer side), from the blocks of each evaluation. Newton per ball on its own
+    3x3 block (row_eval's BALL_BLOCKS mode into ``kbb`` (3Z, 4)); stops when the
+    largest ball force is below ``tol`` [N] (~1e-10 of the loads: an absolute 1e-9 N
+    stalls at ~3e-9 N on rv221). ``f`` (n,): the row's forces at the last evaluation
+    (at the returned balls and velocities). Returns the number of Newton steps (-1:
+    not converged in ``max_iter``)."""
     nz = ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
     empty = np.empty((0, N_RECORD))
     jv = np.empty((0, 0))
+    # a change of the balls' velocities below vtol changes their damping forces by less than tol
+    vtol = tol / max(law_i[5], law_o[5], geometry[11], 1e-300)
+    step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     for it in range(max_iter + 1):
         row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
                  state, BALL_BLOCKS, empty, f, kbb, jv)
         err = 0.0
         for e in range(b0, q.shape[0]):
             err = max(err, abs(f[e]))
-        if err <= tol:
-            return it
-        if it == max_iter:
-            break
-        for j in range(nz):  # d = -K^-1 f_j (3x3, Cramer)
+        dv = 0.0
+        for j in range(nz):  # -K^-1 f_j and b_t = -K^-1 (K_bx x_t) (3x3, cofactors)
             k = kbb[3 * j:3 * j + 3]
-            r0, r1, r2 = f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]
             c00 = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
             c01 = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
             c02 = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-            det = k[0, 0] * c00 + k[0, 1] * c01 + k[0, 2] * c02
             c10 = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
             c11 = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
             c12 = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
             c20 = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
             c21 = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
             c22 = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-            q[b0 + 3 * j] -= (c00 * r0 + c10 * r1 + c20 * r2) / det
-            q[b0 + 3 * j + 1] -= (c01 * r0 + c11 * r1 + c21 * r2) / det
-            q[b0 + 3 * j + 2] -= (c02 * r0 + c12 * r1 + c22 * r2) / det
+            det = k[0, 0] * c00 + k[0, 1] * c01 + k[0, 2] * c02
+            for off in (0, 3):  # right-hand sides: the ball's force, then K_bx x_t
+                r0, r1, r2 = (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else \
+                    (k[0, 3], k[1, 3], k[2, 3])
+                step[j, off] = -(c00 * r0 + c10 * r1 + c20 * r2) / det
+                step[j, off + 1] = -(c01 * r0 + c11 * r1 + c21 * r2) / det
+                step[j, off + 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
+            for c in range(3):
+                dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
+        if err <= tol and dv <= vtol:
+            return it
+        if it == max_iter:
+            break
+        for j in range(nz):
+            for c in range(3):
+                q[b0 + 3 * j + c] += step[j, c]
+                qt[b0 + 3 * j + c] = step[j, 3 + c]
     return -1
 
 
