@@ -469,3 +469,46 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
     assert np.abs(ev.force[6:]).max() <= 1e-8 and ev.inner.load.max() > 40.0
     q[0] += 1e-10
     assert 1 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) <= 2
+
+
+@pytest.mark.parametrize("preset", ["rv221", "rv40e"])
+def test_condensed_ball_jacobian_vs_finite_difference(preset):
+    """With quasi-static balls the row's force on the frame F(x, x_t) (the balls solved by
+    ball_equilibrium at every evaluation) has the Jacobians of
+    bearing_kernel.condensed_ball_jacobian: the Schur complement of row_eval's own
+    Jacobian over each ball's 3x3 block, with b_t = S x_t. Central differences
+    (1e-9 m / 1e-8 rad, 1e-5 m/s; the local solve's 1e-8 N tolerance over these steps
+    is ~10 N/m against ~1e8) on a displaced, tilted, spinning, moving frame: within
+    1e-4 (stiffness) and 5e-4 (damping) of the largest entry (measured 1.7e-5 / 1.7e-5
+    and 6.9e-6 / 7.5e-5 on rv221 / rv40e: the left-out d S / d x x_t and round-off)."""
+    from flexrv.model.bearing_kernel import ball_equilibrium, condensed_ball_jacobian
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    row = rows_from_design(load(preset), ehl="hamrock_dowson")[0]
+    n, nz = row.n_coordinates, row.ball_count
+    nx = n - 3 * nz
+    inputs = kernel_inputs(row)
+    f, kbb = np.empty(n), np.empty((3 * nz, 4))
+    q, qt = np.zeros(n), np.zeros(n)
+    q[0], q[2], q[4], qt[0], qt[5] = 2e-6, 1e-6, 1e-5, 1e-4, 1.3
+    assert ball_equilibrium(q, qt, *inputs, 1e-8, 50, f, kbb) >= 0
+    balls = q[nx:].copy()
+
+    def force(x, xt):
+        qq, qqt = np.concatenate([x, balls]), np.concatenate([xt, np.zeros(3 * nz)])
+        assert ball_equilibrium(qq, qqt, *inputs, 1e-8, 50, f, kbb) >= 0
+        return f[:nx].copy(), qq, qqt
+
+    x0, xt0 = q[:nx].copy(), qt[:nx].copy()
+    _, qq, qqt = force(x0, xt0)
+    jq, jv, kx, cx = np.empty((n, n)), np.empty((n, n)), np.empty((nx, nx)), np.empty((nx, nx))
+    condensed_ball_jacobian(qq, qqt, *inputs, jq, jv, kx, cx)
+    k_fd, c_fd = np.zeros((nx, nx)), np.zeros((nx, nx))
+    for c in range(nx):
+        d = np.zeros(nx)
+        d[c] = 1e-9 if c < 3 else 1e-8
+        k_fd[:, c] = (force(x0 + d, xt0)[0] - force(x0 - d, xt0)[0]) / (2 * d[c])
+        d[c] = 1e-5
+        c_fd[:, c] = (force(x0, xt0 + d)[0] - force(x0, xt0 - d)[0]) / (2 * d[c])
+    assert np.abs(kx - k_fd).max() <= 1e-4 * np.abs(k_fd).max() and np.abs(k_fd).max() > 1e8
+    assert np.abs(cx - c_fd).max() <= 5e-4 * np.abs(c_fd).max() and np.abs(c_fd).max() > 10.0

@@ -1105,6 +1105,71 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
+def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
+                            ws_o, state, jq, jv, kx, cx):
+    """The row's Jacobians with quasi-static balls (at the state :func:`ball_equilibrium`
+    returned): :func:`row_eval`'s full jq = d f / d q and jv = d f / d q_t (n, n, filled
+    here) condensed onto the frame and modal coordinates x (the first nx = n - 3Z),
+    ball by ball (the balls couple only through x): with S = -J_bb^-1 J_bx,
+
+        kx = J_xx + J_xb S,
+        cx = V_xx + V_xb S - J_xb J_bb^-1 (V_bx + V_bb S)   (V = jv),
+
+    the balls following x statically (b_x = S) and moving with b_t = S x_t, whose
+    change with x (second order, d S / d x x_t) is left out."""
+    n = q.shape[0]
+    nz = ball_ref.shape[0]
+    nx = n - 3 * nz
+    f = np.empty(n)
+    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+             state, True, np.empty((0, N_RECORD)), f, jq, jv)
+    for r in range(nx):
+        for c in range(nx):
+            kx[r, c] = jq[r, c]
+            cx[r, c] = jv[r, c]
+    inv = np.empty((3, 3))
+    sm = np.empty((3, nx))
+    tm = np.empty((3, nx))
+    for j in range(nz):
+        b = nx + 3 * j
+        k = jq[b:b + 3, b:b + 3]
+        inv[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
+        inv[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
+        inv[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
+        inv[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
+        inv[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
+        inv[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
+        inv[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
+        inv[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
+        inv[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
+        det = k[0, 0] * inv[0, 0] + k[0, 1] * inv[1, 0] + k[0, 2] * inv[2, 0]
+        for r in range(3):
+            for c in range(3):
+                inv[r, c] /= det
+        for r in range(3):  # S = -J_bb^-1 J_bx
+            for c in range(nx):
+                sm[r, c] = -(inv[r, 0] * jq[b, c] + inv[r, 1] * jq[b + 1, c] + inv[r, 2] * jq[b + 2, c])
+        for r in range(3):  # T = J_bb^-1 (V_bx + V_bb S)
+            for c in range(nx):
+                acc = 0.0
+                for a in range(3):
+                    w = jv[b + a, c]
+                    for d in range(3):
+                        w += jv[b + a, b + d] * sm[d, c]
+                    acc += inv[r, a] * w
+                tm[r, c] = acc
+        for r in range(nx):
+            for c in range(nx):
+                acc_k = 0.0
+                acc_c = 0.0
+                for a in range(3):
+                    acc_k += jq[r, b + a] * sm[a, c]
+                    acc_c += jv[r, b + a] * sm[a, c] - jq[r, b + a] * tm[a, c]
+                kx[r, c] += acc_k
+                cx[r, c] += acc_c
+
+
+@njit(cache=True)
 def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
