@@ -95,10 +95,10 @@ def _timed_method(cls, attr, acc, key):
     setattr(cls, attr, timed)
 
 
-def bench(name: str, t_end: float, newton: dict | None) -> dict:
+def bench(name: str, t_end: float, newton: dict | None, options: dict | None = None) -> dict:
     from flexrv.simulation import Simulation
 
-    sim = Simulation(name, model="balls")
+    sim = Simulation(name, model="balls", model_options=options)
     model = sim.build()
     # numba load/compile, not timed (5-step segments: the segment starts take the outputs' history pass)
     sim.run(t_end=0.002, newton_options=newton, segment_steps=5)
@@ -135,13 +135,15 @@ def main() -> None:
     ap.add_argument("--presets", nargs="*", default=["rv221", "rv40e"])
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--newton", default=None, help="newton_options as JSON")
+    ap.add_argument("--options", default=None, help='model options as JSON, e.g. \'{"ball_inertia": true}\'')
     a = ap.parse_args()
     import flexrv
 
     newton = json.loads(a.newton) if a.newton else None
-    print(f"flexrv from {os.path.dirname(flexrv.__file__)}; newton_options {newton}")
+    options = json.loads(a.options) if a.options else None
+    print(f"flexrv from {os.path.dirname(flexrv.__file__)}; newton_options {newton}; model options {options}")
     for name in a.presets:
-        r = bench(name, a.t_end, newton)
+        r = bench(name, a.t_end, newton, options)
         print(f"{r['preset']} balls: n = {r['n']}, {r['steps']} steps for {r['simulated_s']:.3g} s, "
               f"Newton/step {r['newton_per_step']:.2f}, Jacobians {r['jacobians']}")
         print(f"  CPU per simulated s: {r['cpu_per_s']:.2f} (solve {r['solve_cpu_per_s']:.2f}; outputs "

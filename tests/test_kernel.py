@@ -499,17 +499,19 @@ def test_short_rigid_run_same_te():
     assert new["te_pp_arcsec"] == pytest.approx(ref["te_pp_arcsec"], abs=1e-3)
 
 
-def test_fused_element_coexists_with_ball_bearing():
+@pytest.mark.parametrize("ball_inertia", [True, False])
+def test_fused_element_coexists_with_ball_bearing(ball_inertia):
     """Ball-resolved main bearing (its own element): the fused element covers only
-    the kernel groups' members (carrier, cranks, discs; no rigid main bearing) and
+    the kernel groups' members (carrier, cranks, discs; no rigid main bearing: with
+    ball inertia not the balls, with quasi-static balls every coordinate) and
     generalized_forces = fused part scattered into the model vector + the ball
     group, equal to the sum of every group's evaluate/jacobian (1e-9 rel.)."""
     from flexrv.model.assembled import group_index
 
-    m = build_model(_variant("rv40e", "empirical"), "balls", exudyn=False)
+    m = build_model(_variant("rv40e", "empirical"), "balls", exudyn=False, ball_inertia=ball_inertia)
     q, v = _loaded(m)
     f, dq, dv = m.generalized_forces(0.002, q, v)
-    assert not m.fused.is_full and m.fused.n < m.n
+    assert m.fused.is_full != ball_inertia and (m.fused.n < m.n) == ball_inertia
     assert "main_bearing" not in [g.kind for g in m.fused.groups]
     fr, dqr, dvr = np.zeros(m.n), np.zeros((m.n, m.n)), np.zeros((m.n, m.n))
     for g in m.groups:

@@ -433,82 +433,136 @@ def test_two_rows_one_element():
 
 @pytest.mark.parametrize("preset", ["rv221", "rv40e"])
 def test_ball_equilibrium_matches_the_static_ball_solver(preset):
-    """Quasi-static balls (issue 15's next step: the ball coordinates solved inside
-    the row element, bearing_kernel.ball_equilibrium, a Newton per ball on
-    row_eval's own 3x3 ball blocks) at the reference frame and at rest give the ball
-    positions of flexrv.contact.ball_raceway.solve_ball_positions (an independent
-    vectorised Newton on the contact laws, through initial_ball_displacements)
-    within 1e-15 m once the pocket spring, the one force that solver leaves out, is
-    removed (measured 9e-17 / 3e-17 m on displacements of 2.8 / 1.1 um); with the
-    preset's pocket spring (1e3 N/m) they move by less than 1 % (measured 6.5e-9 /
-    5.4e-9 m). Ball forces end below the 1e-8 N tolerance (~1e-10 of the loads) in
+    """Quasi-static balls (issue 15: the ball coordinates solved inside the row
+    element, bearing_kernel.ball_equilibrium, a Newton per ball on row_eval's own
+    3x3 ball blocks) at the reference frame and at rest give the ball positions of
+    flexrv.contact.ball_raceway.solve_ball_positions (an independent vectorised
+    Newton on the contact laws, through initial_ball_displacements) within 1e-15 m
+    once the pocket spring, the one force that solver leaves out, is removed
+    (measured 9e-17 / 3e-17 m on displacements of 2.8 / 1.1 um); with the preset's
+    pocket spring (1e3 N/m) they move by less than 1 % (measured 6.5e-9 / 5.4e-9 m).
+    Ball forces end below the tolerance (1e-10 of the row's largest load here) in
     <= 6 steps, also on a displaced, tilted, spinning frame; a warm restart after a
     0.1 nm frame move takes one or two Newton steps (the second when the balls'
     velocities, b_t = -K_bb^-1 K_bx x_t, moved their damping forces by more than
     the tolerance)."""
     from dataclasses import replace
 
-    from flexrv.model.bearing_kernel import ball_equilibrium
+    from flexrv.model.bearing_kernel import N_RECORD, ball_equilibrium
     from flexrv.model.flexible_bearing import initial_ball_displacements, kernel_inputs
 
     row = rows_from_design(load(preset), ehl="hamrock_dowson")[0]
     n, nz = row.n_coordinates, row.ball_count
-    f, kbb = np.empty(n), np.empty((3 * nz, 4))
+    f, kbb, rec = np.empty(n), np.empty((3 * nz, 4)), np.empty((nz, N_RECORD))
     ref = initial_ball_displacements(row).ravel()
     bare = replace(row, pocket_stiffness=0.0)
     q, qt = np.zeros(n), np.zeros(n)
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(bare), 1e-8, 30, f, kbb) <= 6
+    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(bare), 1e-10, 30, f, kbb, rec) <= 6
     assert np.abs(q[6:] - ref).max() < 1e-15
     q = np.zeros(n)
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) <= 6
-    assert np.abs(f[6:]).max() <= 1e-8
+    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
+    assert np.abs(f[6:]).max() <= 1e-10 * rec[:, :2].max()
     assert 1e-10 < np.abs(q[6:] - ref).max() < 0.01 * np.abs(ref).max()
     q[0], q[2], q[4], qt[5] = 2e-6, 1e-6, 1e-5, 1.3  # frame displaced, tilted, spinning
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) <= 6
+    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
     ev = evaluate_row(row, q, qt, False)
-    assert np.abs(ev.force[6:]).max() <= 1e-8 and ev.inner.load.max() > 40.0
+    assert np.abs(ev.force[6:]).max() <= 1e-10 * ev.inner.load.max() and ev.inner.load.max() > 40.0
+    np.testing.assert_array_equal(rec[:, 0], ev.inner.load)  # the records of the last evaluation
     q[0] += 1e-10
-    assert 1 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-8, 30, f, kbb) <= 2
+    assert 1 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 2
+
+
+def _quasi_static_row(preset, tol=None):
+    """Row 0 of a preset with quasi-static balls (EHL contacts), its local solve's
+    relative tolerance set to ``tol`` (None: the kernel's BALL_FORCE_TOL)."""
+    from flexrv.model.flexible_bearing import kernel_inputs
+
+    row = rows_from_design(load(preset), ehl="hamrock_dowson", ball_inertia=False)[0]
+    if tol is not None:
+        kernel_inputs(row)[1][13] = tol
+    return row
+
+
+_FRAME = (np.array([2e-6, 0.0, 1e-6, 0.0, 1e-5, 0.3]), np.array([1e-4, 0.0, 0.0, 0.0, 0.0, 1.3]))
 
 
 @pytest.mark.parametrize("preset", ["rv221", "rv40e"])
-def test_condensed_ball_jacobian_vs_finite_difference(preset):
-    """With quasi-static balls the row's force on the frame F(x, x_t) (the balls solved by
-    ball_equilibrium at every evaluation) has the Jacobians of
-    bearing_kernel.condensed_ball_jacobian: the Schur complement of row_eval's own
-    Jacobian over each ball's 3x3 block, with b_t = S x_t. Central differences
-    (1e-9 m / 1e-8 rad, 1e-5 m/s; the local solve's 1e-8 N tolerance over these steps
-    is ~10 N/m against ~1e8) on a displaced, tilted, spinning, moving frame: within
-    1e-4 (stiffness) and 5e-4 (damping) of the largest entry (measured 1.7e-5 / 1.7e-5
-    and 6.9e-6 / 7.5e-5 on rv221 / rv40e: the left-out d S / d x x_t and round-off)."""
-    from flexrv.model.bearing_kernel import ball_equilibrium, condensed_ball_jacobian
+def test_quasi_static_row_is_the_dynamic_row_at_ball_equilibrium(preset):
+    """A row with quasi-static balls (RowModel.ball_inertia = False: the element has
+    the frame's 6 coordinates only) returns the force on the frame of the same row
+    with ball coordinates (one row_eval, no solve) evaluated at the balls it solved
+    -- the same kernel at the same state, to round-off (1e-13 of the largest entry:
+    the two rows' film iterations start from different films) -- and
+    there every ball's force vanishes to its tolerance (1e-8 of the largest load,
+    bearing_kernel.BALL_FORCE_TOL). The per-ball records (loads, normals, ball
+    centres) are those of that state too. Checked along a path that turns the frame
+    by 0.3 rad in one call (the prediction turns the balls with their cage) and
+    then moves it by 10 nm steps (the prediction b + S dx)."""
+    from flexrv.model.bearing_kernel import BALL_FORCE_TOL, _split_balls
     from flexrv.model.flexible_bearing import kernel_inputs
 
-    row = rows_from_design(load(preset), ehl="hamrock_dowson")[0]
-    n, nz = row.n_coordinates, row.ball_count
-    nx = n - 3 * nz
-    inputs = kernel_inputs(row)
-    f, kbb = np.empty(n), np.empty((3 * nz, 4))
-    q, qt = np.zeros(n), np.zeros(n)
-    q[0], q[2], q[4], qt[0], qt[5] = 2e-6, 1e-6, 1e-5, 1e-4, 1.3
-    assert ball_equilibrium(q, qt, *inputs, 1e-8, 50, f, kbb) >= 0
-    balls = q[nx:].copy()
+    qs_row = _quasi_static_row(preset)
+    dyn = rows_from_design(load(preset), ehl="hamrock_dowson")[0]
+    nz = dyn.ball_count
+    assert qs_row.n_coordinates == 6 and dyn.n_coordinates == 6 + 3 * nz
+    x, xt = _FRAME[0].copy(), _FRAME[1].copy()
+    ws = kernel_inputs(qs_row)[12]
+    for step in range(4):
+        ev = evaluate_row(qs_row, x, xt, jacobian=True)
+        b, bt = (a.copy() for a in _split_balls(ws, 3 * nz, 6)[:2])
+        ref = evaluate_row(dyn, np.concatenate([x, b]), np.concatenate([xt, bt]), jacobian=False)
+        np.testing.assert_allclose(ev.force, ref.force[:6], rtol=0, atol=1e-13 * np.abs(ref.force).max())
+        assert np.abs(ref.force[6:]).max() <= BALL_FORCE_TOL * ref.inner.load.max()
+        np.testing.assert_allclose(ev.inner.load, ref.inner.load, rtol=1e-13)
+        np.testing.assert_array_equal(ev.ball_pos, ref.ball_pos)
+        assert ev.inner.load.max() > 40.0 and np.abs(ev.force[:3]).max() > 100.0
+        x[0] += 1e-8
+        x[5] += 1e-6
+    assert kernel_inputs(qs_row)[-1][4] == 0  # no failed solve
 
-    def force(x, xt):
-        qq, qqt = np.concatenate([x, balls]), np.concatenate([xt, np.zeros(3 * nz)])
-        assert ball_equilibrium(qq, qqt, *inputs, 1e-8, 50, f, kbb) >= 0
-        return f[:nx].copy(), qq, qqt
 
-    x0, xt0 = q[:nx].copy(), qt[:nx].copy()
-    _, qq, qqt = force(x0, xt0)
-    jq, jv, kx, cx = np.empty((n, n)), np.empty((n, n)), np.empty((nx, nx)), np.empty((nx, nx))
-    condensed_ball_jacobian(qq, qqt, *inputs, jq, jv, kx, cx)
-    k_fd, c_fd = np.zeros((nx, nx)), np.zeros((nx, nx))
-    for c in range(nx):
-        d = np.zeros(nx)
+@pytest.mark.parametrize("preset", ["rv221", "rv40e"])
+def test_quasi_static_row_jacobian_vs_finite_difference(preset):
+    """With quasi-static balls the row's force on the frame F(x, x_t) (the balls solved
+    at every evaluation) has the Jacobians of bearing_kernel.condensed_ball_jacobian
+    (the Schur complement of row_eval's own Jacobian over each ball's 3x3 block,
+    with b_t = S x_t), returned by the row kernel. Central differences (1e-9 m /
+    1e-8 rad, 1e-5 m/s; the local solve's tolerance tightened to 1e-11 of the loads,
+    ~1e-9 N over these steps, ~1 N/m against ~1e8) on a displaced, tilted, spinning,
+    moving frame: within 1e-4 (stiffness) and 5e-4 (damping) of the largest entry
+    (measured 1.7e-5 / 1.7e-5 and 7.0e-6 / 7.6e-5 on rv221 / rv40e: the left-out
+    d S / d x x_t and round-off)."""
+    from flexrv.model.flexible_bearing import row_force, row_jacobian
+
+    row = _quasi_static_row(preset, tol=1e-11)
+    x0, xt0 = _FRAME[0].copy(), _FRAME[1].copy()
+    kx, cx = row_jacobian(row, x0, xt0)
+    k_fd, c_fd = np.zeros((6, 6)), np.zeros((6, 6))
+    for c in range(6):
+        d = np.zeros(6)
         d[c] = 1e-9 if c < 3 else 1e-8
-        k_fd[:, c] = (force(x0 + d, xt0)[0] - force(x0 - d, xt0)[0]) / (2 * d[c])
+        k_fd[:, c] = (row_force(row, x0 + d, xt0) - row_force(row, x0 - d, xt0)) / (2 * d[c])
         d[c] = 1e-5
-        c_fd[:, c] = (force(x0, xt0 + d)[0] - force(x0, xt0 - d)[0]) / (2 * d[c])
+        c_fd[:, c] = (row_force(row, x0, xt0 + d) - row_force(row, x0, xt0 - d)) / (2 * d[c])
     assert np.abs(kx - k_fd).max() <= 1e-4 * np.abs(k_fd).max() and np.abs(k_fd).max() > 1e8
     assert np.abs(cx - c_fd).max() <= 5e-4 * np.abs(c_fd).max() and np.abs(c_fd).max() > 10.0
+
+
+def test_quasi_static_ball_failure_is_reported():
+    """A local ball solve that cannot converge (tolerance 1e-20 of the loads, below
+    round-off) is counted and flagged in the row's state, and the ball group's
+    check() turns it into a failure message (a run then stops with it); the stored
+    solution is not overwritten by the failed one."""
+    from flexrv.model.flexible_bearing import BallBearingGroup, kernel_inputs, row_force
+
+    row = _quasi_static_row("rv221", tol=1e-20)
+    group = BallBearingGroup([row])
+    assert group.members == ("carrier",)
+    ws = kernel_inputs(row)[12].copy()
+    row_force(row, *_FRAME)
+    state = kernel_inputs(row)[-1]
+    assert state[4] == 1 and state[5] == 1
+    np.testing.assert_array_equal(kernel_inputs(row)[12], ws)
+    assert "quasi-static balls" in group.check()
+
+

@@ -9,7 +9,7 @@ from flexrv.simulation import Simulation
 
 @pytest.mark.parametrize("model, options, message", [
     ("rigid", {"bogus": 1}, "model options of 'rigid': unknown option 'bogus'"),
-    ("flexible", {"crankshaft": "flexible"}, "unknown option 'crankshaft'; allowed: crank_options, drive, exudyn, parts"),
+    ("flexible", {"crankshaft": "flexible"}, "unknown option 'crankshaft'; allowed: ball_inertia, crank_options, drive, exudyn, parts"),
     ("flexible", {"ring_options": {"harmonic": 8}}, "ring_options: unknown option 'harmonic'"),
     ("flexible", {"parts": ("crankshaft",), "crank_options": {"damping_ratio": True}},
      "crank_options.damping_ratio = True is not allowed: expected a value of type float"),

@@ -87,6 +87,17 @@ CONDENSE_MAXIT = 50
 #: each groove centre's velocity, and the cage pocket's turn)
 BALL_BLOCKS = 2
 
+#: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
+#: force tolerance (relative to the row's largest contact load, ``geometry[13]``) turns
+#: absolute, and its Newton steps per call before a failure is reported
+BALL_LOAD_SCALE = 1.0
+BALL_MAXIT = 30
+#: relative force tolerance of the quasi-static balls' local solve: 1e-8 of the row's largest
+#: load (~1e-6 N on rv221's 111 N balls; the sum over a row's 26-38 balls stays ~4 orders
+#: below the absolute Newton tolerance of the system, 0.1 N, flexrv.simulation); the round-off
+#: floor is ~3e-11 of the loads (an absolute 1e-9 N stalls on rv221)
+BALL_FORCE_TOL = 1e-8
+
 #: relative Newton step below which the film iteration of :func:`_normal_load` stops
 #: (its next iterate is then exact to 0.75 FILM_STEP_STOP^2 relative, see there)
 FILM_STEP_STOP = 1e-8
@@ -574,17 +585,32 @@ def _rotation_z(a, c, s, out):
 
 
 @njit(cache=True)
-def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
                state, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n) (new arrays; :func:`row_eval`
-    with its outputs allocated here)."""
-    n = 6 + tab_i.shape[2] + tab_o.shape[2] + 3 * ball_ref.shape[0]
+    with its outputs allocated here). Quasi-static balls (``geometry[13]`` > 0):
+    q, q_t, the force and the Jacobians cover the frame and modal coordinates only
+    (:func:`quasi_static_balls`, warm-started from and updating ``balls``)."""
+    nb = 3 * ball_ref.shape[0]
+    n = 6 + tab_i.shape[2] + tab_o.shape[2] + nb
     nj = n if jacobian else 0
     f = np.empty(n)
     jq = np.empty((nj, nj))
     jv = np.empty((nj, nj))
-    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+    if geometry[13] > 0.0:
+        nx = n - nb
+        qf = np.zeros(n)
+        vf = np.zeros(n)
+        qf[:nx] = q
+        vf[:nx] = qt
+        nk = nx if jacobian else 0
+        kx = np.empty((nk, nk))
+        cx = np.empty((nk, nk))
+        quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
+                           ws_o, balls, state, jacobian, rec, f, jq, jv, np.empty((nb, 4)), kx, cx)
+        return f[:nx].copy(), kx, cx
+    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
              state, jacobian, rec, f, jq, jv)
     return f, jq, jv
 
@@ -652,7 +678,7 @@ def _modal_sums(bas, q, qt, off, m):
     return d0, d1, d2, v0, v1, v2
 
 @njit(cache=True)
-def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
              state, jacobian, rec, f, jq, jv):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (all overwritten);
@@ -664,9 +690,14 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
     contact deflections and last tangent; every ring: the contacts' films, the film
     iteration's warm start, :func:`film_workspace`; updated);
-    state (int64, 4): [non-converged condensations, 1 if the last call had one,
-    sum of the local iterations, local solves]; rec: (Z, N_RECORD) per-ball
-    record, or (0, N_RECORD).
+    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
+    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
+    sum of the local iterations, local solves, then the same four of the
+    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
+    (0, N_RECORD). geometry: (14,) [z, inner centre radius and z, outer centre
+    radius and z, inner and outer offsets, ball pitch radius, speed factor, cage
+    ratio, cage stiffness and damping, pocket stiffness, the quasi-static balls'
+    relative force tolerance (0: the balls are element coordinates)].
 
     Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
     d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
@@ -1035,18 +1066,15 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
 
 @njit(cache=True)
 def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                     state):
-    """Generalized force (n,) of a row element (see :func:`row_eval`)."""
-    f = np.empty(q.shape[0])
-    empty = np.empty((0, 0))
-    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-             state, False, np.empty((0, N_RECORD)), f, empty, empty)
-    return f
+                     balls, state):
+    """Generalized force of a row element (see :func:`row_kernel`)."""
+    return row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                      balls, state, False, np.empty((0, N_RECORD)))[0]
 
 
 @njit(cache=True)
-def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                     state, tol, max_iter, f, kbb):
+def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
+                     state, tol, max_iter, f, kbb, rec):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)
@@ -1055,20 +1083,27 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     S = -K_bb^-1 K_bx (the contacts' damping and the cage's see the ball move with
     the stiffer side), from the blocks of each evaluation. Newton per ball on its own
     3x3 block (row_eval's BALL_BLOCKS mode into ``kbb`` (3Z, 4)); stops when the
-    largest ball force is below ``tol`` [N] (~1e-10 of the loads: an absolute 1e-9 N
-    stalls at ~3e-9 N on rv221). ``f`` (n,): the row's forces at the last evaluation
-    (at the returned balls and velocities). Returns the number of Newton steps (-1:
-    not converged in ``max_iter``)."""
+    largest ball force is below ``tol`` times the largest contact load of the row
+    (at least :data:`BALL_LOAD_SCALE`; relative, ~1e-10: an absolute 1e-9 N stalls at
+    ~3e-9 N, the round-off of 111 N loads on rv221). ``f`` (n,): the row's forces
+    and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
+    last evaluation (at the returned balls and velocities). Returns the number of
+    Newton steps (-1: not converged in ``max_iter``)."""
     nz = ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
-    empty = np.empty((0, N_RECORD))
+    recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
     jv = np.empty((0, 0))
-    # a change of the balls' velocities below vtol changes their damping forces by less than tol
-    vtol = tol / max(law_i[5], law_o[5], geometry[11], 1e-300)
+    damping = max(law_i[5], law_o[5], geometry[11], 1e-300)
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     for it in range(max_iter + 1):
-        row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                 state, BALL_BLOCKS, empty, f, kbb, jv)
+        row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
+                 state, BALL_BLOCKS, recs, f, kbb, jv)
+        scale = BALL_LOAD_SCALE
+        for j in range(nz):
+            scale = max(scale, recs[j, 0], recs[j, 1])
+        atol = tol * scale
+        # a change of the balls' velocities below vtol changes their damping forces by less than atol
+        vtol = atol / damping
         err = 0.0
         for e in range(b0, q.shape[0]):
             err = max(err, abs(f[e]))
@@ -1093,7 +1128,7 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
                 step[j, off + 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
             for c in range(3):
                 dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
-        if err <= tol and dv <= vtol:
+        if err <= atol and dv <= vtol:
             return it
         if it == max_iter:
             break
@@ -1106,7 +1141,7 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 @njit(cache=True)
 def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                            ws_o, state, jq, jv, kx, cx):
+                            ws_o, balls, state, jq, jv, kx, cx, s_out):
     """The row's Jacobians with quasi-static balls (at the state :func:`ball_equilibrium`
     returned): :func:`row_eval`'s full jq = d f / d q and jv = d f / d q_t (n, n, filled
     here) condensed onto the frame and modal coordinates x (the first nx = n - 3Z),
@@ -1116,12 +1151,13 @@ def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o,
         cx = V_xx + V_xb S - J_xb J_bb^-1 (V_bx + V_bb S)   (V = jv),
 
     the balls following x statically (b_x = S) and moving with b_t = S x_t, whose
-    change with x (second order, d S / d x x_t) is left out."""
+    change with x (second order, d S / d x x_t) is left out. S (3Z, nx) into
+    ``s_out`` ((0, 0): not kept)."""
     n = q.shape[0]
     nz = ball_ref.shape[0]
     nx = n - 3 * nz
     f = np.empty(n)
-    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
              state, True, np.empty((0, N_RECORD)), f, jq, jv)
     for r in range(nx):
         for c in range(nx):
@@ -1149,6 +1185,10 @@ def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o,
         for r in range(3):  # S = -J_bb^-1 J_bx
             for c in range(nx):
                 sm[r, c] = -(inv[r, 0] * jq[b, c] + inv[r, 1] * jq[b + 1, c] + inv[r, 2] * jq[b + 2, c])
+        if s_out.shape[0] > 0:
+            for r in range(3):
+                for c in range(nx):
+                    s_out[3 * j + r, c] = sm[r, c]
         for r in range(3):  # T = J_bb^-1 (V_bx + V_bb S)
             for c in range(nx):
                 acc = 0.0
@@ -1169,16 +1209,113 @@ def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o,
                 cx[r, c] += acc_c
 
 
+def ball_workspace(ball_count: int, nx: int) -> np.ndarray:
+    """Work array of a row's quasi-static balls (:func:`quasi_static_balls`): the
+    last solution's ball displacements b and velocities b_t (3Z each), the static
+    ball sensitivity S = d b / d x (3Z x nx, of the last Jacobian), the frame and
+    modal coordinates x and velocities x_t of the last solution (nx each) and a
+    flag (1: a solution is stored). Views: :func:`_split_balls`."""
+    return np.zeros(6 * ball_count + 3 * ball_count * nx + 2 * nx + 1)
+
+
+@njit(cache=True)
+def _split_balls(ws, nb, nx):
+    """(b, b_t, S (3Z, nx), x, x_t, flag (1,)) views of :func:`ball_workspace` (nb = 3Z)."""
+    sm = ws[2 * nb:2 * nb + nb * nx].reshape((nb, nx))
+    o = 2 * nb + nb * nx
+    return ws[:nb], ws[nb:2 * nb], sm, ws[o:o + nx], ws[o + nx:o + 2 * nx], ws[o + 2 * nx:o + 2 * nx + 1]
+
+
+@njit(cache=True)
+def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                       balls, state, jacobian, rec, f, jq, jv, kbb, kx, cx):
+    """One evaluation of a row with quasi-static balls: q, q_t (n, the full element
+    vectors, work arrays) hold the frame and modal coordinates x in their first
+    nx = n - 3Z entries (set by the caller); ``balls`` (:func:`ball_workspace`)
+    keeps the last solution (b, b_t at x_last, x_t_last; initially the preload
+    equilibrium at x = 0). The balls start from its prediction: turned about the
+    axis with their cage by cage_ratio (phi_z - phi_z,last) (exact for a rigid turn
+    of any size: a history pass may jump), then b += S (x - x_last) over the other
+    coordinates and b_t = b_t,last + S (x_t - x_t,last) (S: the static sensitivity d b /
+    d x of the last Jacobian call, zero before it), and are solved by
+    :func:`ball_equilibrium` (relative force tolerance ``geometry[13]``,
+    :data:`BALL_MAXIT` steps; if the prediction fails, once more from b_last; a
+    failure is counted in state[4], flagged in state[5] and not stored). Out: f[:nx]
+    the force on x (f (n,) work), the per-ball records ``rec`` and, with
+    ``jacobian``, the condensed Jacobians kx, cx (nx, nx)
+    (:func:`condensed_ball_jacobian`; jq, jv (n, n) work), whose S is stored. A
+    Jacobian call at the state of the last solution (Exudyn's usual order) reuses
+    it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
+    nz = ball_ref.shape[0]
+    nb = 3 * nz
+    nx = q.shape[0] - nb
+    b, bt, sm, xl, xtl, flag = _split_balls(balls, nb, nx)
+    same = flag[0] > 0.0
+    if same:
+        for c in range(nx):
+            if q[c] != xl[c] or qt[c] != xtl[c]:
+                same = False
+                break
+    if same and jacobian:
+        for e in range(nb):
+            q[nx + e] = b[e]
+            qt[nx + e] = bt[e]
+    else:
+        turn = geometry[9] * (q[5] - xl[5])
+        ct, st = math.cos(turn), math.sin(turn)
+        for j in range(nz):
+            px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
+            q[nx + 3 * j] = ct * px - st * py - ball_ref[j, 0]
+            q[nx + 3 * j + 1] = st * px + ct * py - ball_ref[j, 1]
+            q[nx + 3 * j + 2] = b[3 * j + 2]
+        for e in range(nb):
+            acc = 0.0
+            acc_t = bt[e]
+            for c in range(nx):
+                if c != 5:
+                    acc += sm[e, c] * (q[c] - xl[c])
+                acc_t += sm[e, c] * (qt[c] - xtl[c])
+            q[nx + e] += acc
+            qt[nx + e] = acc_t
+        its = ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
+                               ws_o, balls, state, geometry[13], BALL_MAXIT, f, kbb, rec)
+        if its < 0:  # once more from the last solution
+            for e in range(nb):
+                q[nx + e] = b[e]
+                qt[nx + e] = bt[e]
+            its = ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
+                                   ws_i, ws_o, balls, state, geometry[13], BALL_MAXIT, f, kbb, rec)
+        state[5] = 0
+        state[7] += 1
+        if its < 0:
+            state[4] += 1
+            state[5] = 1
+        else:
+            state[6] += its
+            for e in range(nb):
+                b[e] = q[nx + e]
+                bt[e] = qt[nx + e]
+            for c in range(nx):
+                xl[c] = q[c]
+                xtl[c] = qt[c]
+            flag[0] = 1.0
+    if jacobian:
+        condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
+                                ws_i, ws_o, balls, state, jq, jv, kx, cx, sm)
+
+
 @njit(cache=True)
 def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
-    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, then the
-    row's kernel inputs, :func:`flexrv.model.flexible_bearing.kernel_inputs`). Per
-    row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
+    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx,
+    then the row's kernel inputs, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
+    Per row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
     vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
-    reference ``ball_ref`` is subtracted), then :func:`row_eval`; the rows'
-    results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
+    reference ``ball_ref`` is subtracted), then :func:`row_eval` -- or, for
+    quasi-static balls (``geometry[13]`` > 0; idx covers the frame and modal
+    coordinates only, qe / ve are the full work vectors), :func:`quasi_static_balls`;
+    the rows' results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
     f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
     (entries no row touches stay zero: the rows interact only through the
     carrier, so the row-row blocks are exact zeros, which Exudyn's sparse
@@ -1194,25 +1331,31 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             for e in range(n):
                 out_f[idx[e]] = 0.0
     for part in parts:
-        (idx, qe, ve, f, jq, jv, rec, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-         ws_i, ws_o, state) = part
+        (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o,
+         comp_i, comp_o, ws_i, ws_o, balls, state) = part
         n = idx.shape[0]
-        nz = ball_ref.shape[0]
-        b0 = n - 3 * nz
         for e in range(n):
             qe[e] = qn[idx[e]]
             ve[e] = vn[idx[e]]
-        if absolute:
-            for j in range(nz):
-                for c in range(3):
-                    qe[b0 + 3 * j + c] -= ball_ref[j, c]
-        row_eval(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                 state, jacobian, rec, f, jq, jv)
+        if geometry[13] > 0.0:
+            quasi_static_balls(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
+                               ws_i, ws_o, balls, state, jacobian, rec, f, jq, jv, kbb, kx, cx)
+            jq_, jv_ = kx, cx
+        else:
+            if absolute:
+                nz = ball_ref.shape[0]
+                b0 = n - 3 * nz
+                for j in range(nz):
+                    for c in range(3):
+                        qe[b0 + 3 * j + c] -= ball_ref[j, c]
+            row_eval(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                     balls, state, jacobian, rec, f, jq, jv)
+            jq_, jv_ = jq, jv
         if jacobian:
             for r in range(n):
                 ir = idx[r]
                 for c in range(n):
-                    out_j[ir, idx[c]] += -(f_q * jq[r, c] + f_v * jv[r, c])
+                    out_j[ir, idx[c]] += -(f_q * jq_[r, c] + f_v * jv_[r, c])
         else:
             for e in range(n):
                 out_f[idx[e]] += f[e]
@@ -1220,18 +1363,33 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
 
 @njit(cache=True)
 def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                state, recs):
+                balls, state, recs):
     """:func:`row_eval` over a recorded history (the outputs pass, one compiled loop):
     element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
     per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
-    condensed ring's local solve warm-started from the previous sample (as one
-    call per sample would)."""
+    condensed ring's local solve (and quasi-static balls' solve, whose qs, vts and
+    forces cover the frame and modal coordinates only) warm-started from the
+    previous sample (as one call per sample would)."""
     nt = qs.shape[0]
     out = np.zeros(qs.shape)
     empty = np.empty((0, 0))
+    if geometry[13] > 0.0:
+        nx = qs.shape[1]
+        nb = 3 * ball_ref.shape[0]
+        qf = np.zeros(nx + nb)
+        vf = np.zeros(nx + nb)
+        f = np.empty(nx + nb)
+        kbb = np.empty((nb, 4))
+        for i in range(nt):
+            qf[:nx] = qs[i]
+            vf[:nx] = vts[i]
+            quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
+                               ws_i, ws_o, balls, state, False, recs[i], f, empty, empty, kbb, empty, empty)
+            out[i] = f[:nx]
+        return out
     for i in range(nt):
         row_eval(qs[i], vts[i], ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                 ws_o, state, False, recs[i], out[i], empty, empty)
+                 ws_o, balls, state, False, recs[i], out[i], empty, empty)
     return out
 
 

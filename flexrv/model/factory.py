@@ -61,7 +61,8 @@ def empirical_needle_constant(reducer) -> float:
 
 def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
                 crankshaft: str = "rigid", ring_options: dict | None = None, crank_options: dict | None = None,
-                model_name: str = "rigid", exudyn: bool = True, bodies=None) -> AssembledModel:
+                model_name: str = "rigid", exudyn: bool = True, bodies=None,
+                ball_inertia: bool | None = None) -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
     ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
@@ -69,7 +70,11 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     point mass between rigid rings, Hertz/EHL contacts per the design) or
     ``"flexible"`` (the same with reduced flexible rings, ``ring_options``);
     ``crankshaft``: ``"rigid"`` or ``"flexible"`` (:mod:`flexrv.model.flexible_crank`,
-    options ``crank_options``). ``model_name`` labels the results of a non-rigid
+    options ``crank_options``). ``ball_inertia`` (ball-resolved bearings): False
+    makes the balls quasi-static (no ball coordinates, solved inside the row
+    elements), True point masses; None (default) takes quasi-static balls unless a
+    ring is condensed (the flexible model's default rings), where each ball keeps
+    its inertia (:mod:`flexrv.model.flexible_bearing`). ``model_name`` labels the results of a non-rigid
     variant. ``exudyn=False`` returns the members and force groups without an Exudyn
     system (the quasi-static solver evaluates the same groups directly).
 
@@ -128,7 +133,10 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
                                                             signature_options(flexible_rings, skip=1)))
             info["flexible_bodies"] = rings["bodies"]
             info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
-        group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer")))
+        if ball_inertia is None:  # quasi-static balls unless a condensed ring couples them (see the docstring)
+            ball_inertia = any(r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or [])
+        group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer"),
+                                                  ball_inertia=bool(ball_inertia)))
         members.update(group.new_members())
         groups.insert(4, group)
     else:

@@ -11,7 +11,21 @@ Members per row of the back-to-back pair:
   orders below the modal stiffness terms omega_mode^2 > (2 pi 500 Hz)^2 — so no
   FFRF body is needed for the inner rings either;
 * the **outer ring** sits in the housing (fixed frame), modal coordinates ``q_o``;
-* **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`);
+* **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`)
+  or, with ``ball_inertia=False`` (the ball model's default, issue 15),
+  **quasi-static**: massless, in force equilibrium at every instant, solved inside
+  the row kernel (:func:`flexrv.model.bearing_kernel.quasi_static_balls`, a Newton
+  per ball warm-started from a prediction; the element then has the frame's and
+  modal rings' coordinates only, its Jacobian the balls' Schur complement). Why:
+  the balls' inertia does not reach the transmission -- on rv40e the steady TE
+  moved by < 1e-4 arcsec with ball masses x0.1 / x1 / x10 (mean -166.3676",
+  p-p 0.3924 / 0.3924 / 0.3927") and quasi-static balls give -166.36764" /
+  0.39239" against -166.36759" / 0.39236" (0.30-0.40 s, benchmarks/bench_balls.py);
+  the centrifugal load of a 9-12 mm ball orbiting at ~1 rad/s is ~1e-5 N against
+  contact loads of 1-100 N -- while the ball coordinates (6 Z per bearing) and
+  their stiff contact dynamics make up most of the system and its Newton
+  iterations. Condensed rings couple all balls of a row (a dense 3Z block): there
+  the balls keep their inertia (the flexible model's default);
 * a kinematic **cage**: a tangential spring-damper pulls every ball towards its
   pocket at theta_cage + 2 pi j / Z, theta_cage = cage_ratio * theta_frame (pure
   rolling on a fixed outer ring). Without friction nothing else drives the balls
@@ -44,9 +58,9 @@ import numpy as np
 from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output, exudyn_vector
-from flexrv.model.bearing_kernel import (N_RECORD, RECORD_FIELDS, condense_workspace, film_workspace, law_parameters,
-                                         ring_modal_amplitudes, row_element, row_force_kernel, row_history,
-                                         row_kernel)
+from flexrv.model.bearing_kernel import (BALL_FORCE_TOL, N_RECORD, RECORD_FIELDS, ball_workspace, condense_workspace,
+                                         film_workspace, law_parameters, ring_modal_amplitudes, row_element, row_force_kernel,
+                                         row_history, row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -188,12 +202,20 @@ class RowModel:
     #: E' [Pa] (for the Hertz pressure output; None: not reported)
     inner_radii: tuple | None = None
     e_eff: float = 0.0
+    #: True: every ball is a point mass with 3 element coordinates; False: the balls are
+    #: quasi-static (massless, in force equilibrium at every instant, solved inside the
+    #: row kernel, :func:`flexrv.model.bearing_kernel.quasi_static_balls`; rigid or
+    #: uncondensed modal rings only) and the element has the frame and modal coordinates
+    ball_inertia: bool = field(default=True, kw_only=True)
     #: reference ball centres (Z, 3) in global coordinates
     ball_reference: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self._sizes = tuple(0 if (r is None or _is_condensed(r)) else r.stiffness.shape[0]
                             for r in (self.inner, self.outer))
+        if not self.ball_inertia and (_is_condensed(self.inner) or _is_condensed(self.outer)):
+            raise ConfigError("quasi-static balls (ball_inertia = false) need rigid or uncondensed modal rings: "
+                              "a condensed ring couples every ball of the row")
         psi = 2.0 * np.pi * np.arange(self.ball_count) / self.ball_count
         rb = self.row.ball_radius_pitch
         self.ball_reference = np.stack([rb * np.cos(psi), rb * np.sin(psi), np.full(self.ball_count, self.z)], -1)
@@ -207,14 +229,24 @@ class RowModel:
         return self._sizes[1]
 
     @property
+    def n_ball_coordinates(self) -> int:
+        """3 Z with ball inertia, 0 for quasi-static balls (not element coordinates)."""
+        return 3 * self.ball_count if self.ball_inertia else 0
+
+    @property
     def n_coordinates(self) -> int:
+        return 6 + self.m_inner + self.m_outer + self.n_ball_coordinates
+
+    @property
+    def n_kernel(self) -> int:
+        """Length of the row kernel's full coordinate vector (frame, modes, 3Z balls)."""
         return 6 + self.m_inner + self.m_outer + 3 * self.ball_count
 
     def slices(self) -> tuple[slice, slice, slice, slice]:
         """Coordinate slices of frame, inner modes, outer modes, balls in the element."""
         a = 6 + self.m_inner
         b = a + self.m_outer
-        return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + 3 * self.ball_count)
+        return slice(0, 6), slice(6, a), slice(a, b), slice(b, b + self.n_ball_coordinates)
 
     def ring_nodes(self) -> list[str]:
         """Labels of the rings with modal coordinates in the element ("inner", "outer")."""
@@ -262,9 +294,15 @@ def kernel_inputs(model: RowModel) -> tuple:
     geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
                          row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
                          model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
-                         model.pocket_stiffness])
+                         model.pocket_stiffness, 0.0 if model.ball_inertia else BALL_FORCE_TOL])
+    # quasi-static balls: the local solve's work array, its first warm start the preload
+    # equilibrium; with ball inertia the balls are element coordinates
+    balls = np.zeros(0)
+    if not model.ball_inertia:
+        balls = ball_workspace(model.ball_count, model.n_coordinates)
+        balls[:3 * model.ball_count] = initial_ball_displacements(model).ravel()
     inputs = (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, tab_i, zs_i, tab_o, zs_o,
-              laws[0], laws[1], comp_i, comp_o, ws_i, ws_o, np.zeros(4, np.int64))
+              laws[0], laws[1], comp_i, comp_o, ws_i, ws_o, balls, np.zeros(8, np.int64))
     model._kernel_inputs = inputs
     return inputs
 
@@ -442,8 +480,12 @@ class RowElement:
             m = r.n_coordinates
             if i.shape != (m,):
                 raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
-            self._work.append((i, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, m)), np.zeros((m, m)),
-                               np.zeros((r.ball_count if record else 0, N_RECORD))))
+            full = r.n_kernel  # quasi-static balls: the kernel's work vectors also hold the balls
+            qs = 0 if r.ball_inertia else 1
+            self._work.append((i, np.zeros(full), np.zeros(full), np.zeros(full), np.zeros((full, full)),
+                               np.zeros((full, full)), np.zeros((r.ball_count if record else 0, N_RECORD)),
+                               np.zeros((qs * 3 * r.ball_count, 4)), np.zeros((qs * m, qs * m)),
+                               np.zeros((qs * m, qs * m))))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
         #: (t, q, q_t) of the last call (the nodes' coordinates, copies), None during a call
@@ -537,7 +579,7 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandl
             store.append(node)
             node_list.append(node)
         balls = []
-        for ref, init in zip(model.ball_reference, initial_ball_displacements(model)):
+        for ref, init in zip(model.ball_reference, initial_ball_displacements(model) if model.ball_inertia else []):
             nb = mbs.AddNode(NodePoint(referenceCoordinates=list(ref), initialCoordinates=list(init)))
             mbs.AddObject(MassPoint(mass=model.ball_mass, nodeNumber=nb))
             balls.append(nb)
@@ -550,7 +592,7 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandl
 
 
 def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_max: float | None = None,
-                     depth: float | None = None) -> list[RowModel]:
+                     depth: float | None = None, ball_inertia: bool = True) -> list[RowModel]:
     """Row models of a design's main bearing (both rows, back-to-back).
 
     Parameters
@@ -560,6 +602,7 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
         the lubricated laws come from :class:`flexrv.ehl.law.EHLPointLaw`
         and use the entrainment speed of the frame's rotation.
     c_max, depth : contact damping and its ramp depth (default: the design's).
+    ball_inertia : False: quasi-static balls (:attr:`RowModel.ball_inertia`).
     """
     from flexrv.ehl.law import EHLPointLaw
     from flexrv.contact.hertz import effective_modulus
@@ -593,7 +636,8 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
                              pocket_stiffness=mb.pocket_stiffness_N_per_m,
                              ball_mass=geom.ball_mass(ball_mat.density_kg_m3), law_inner=law_i, law_outer=law_o,
                              speed_factor=speed_factor, inner_radii=(float(rx_i), float(ry_i)), e_eff=e_eff,
-                             inner=None if inner is None else inner[k], outer=None if outer is None else outer[k]))
+                             inner=None if inner is None else inner[k], outer=None if outer is None else outer[k],
+                             ball_inertia=ball_inertia))
     return rows
 
 
@@ -688,7 +732,7 @@ class BallBearingGroup(ForceGroup):
         members, sizes, index = ["carrier"], [6], []
         for k, row in enumerate(rows):
             parts = [_PERM]
-            for label, m in (("inner", row.m_inner), ("outer", row.m_outer), ("balls", 3 * row.ball_count)):
+            for label, m in (("inner", row.m_inner), ("outer", row.m_outer), ("balls", row.n_ball_coordinates)):
                 if m == 0:
                     continue
                 start = sum(sizes)
@@ -736,11 +780,14 @@ class BallBearingGroup(ForceGroup):
         return any(r.inner is not None or r.outer is not None for r in self.rows)
 
     def check(self) -> str | None:
-        """Failure message if a condensed ring's local contact solve did not converge
-        in the last evaluation (the accepted state of the step)."""
-        if any(int(kernel_inputs(r)[-1][1]) for r in self.rows if hasattr(r, "_kernel_inputs")
-               and (_is_condensed(r.inner) or _is_condensed(r.outer))):  # (rigid and modal rings: no local solve)
+        """Failure message if a condensed ring's local contact solve or the quasi-static
+        balls' equilibrium did not converge in the last evaluation (the accepted state
+        of the step)."""
+        states = [kernel_inputs(r)[-1] for r in self.rows if hasattr(r, "_kernel_inputs")]
+        if any(int(s[1]) for s in states):  # (rigid and modal rings: no local solve, never set)
             return "main bearing: the condensed rings' contact deflections did not converge"
+        if any(int(s[5]) for s in states):
+            return "main bearing: the quasi-static balls' force equilibrium did not converge"
         return None
 
     def new_members(self) -> dict:
@@ -758,6 +805,8 @@ class BallBearingGroup(ForceGroup):
                     f"main_bearing_{label}{k}", np.asarray(ring.mass, dtype=float), np.zeros(m), np.zeros(m),
                     tuple(f"mode{i}" for i in range(m)), kind="modal", stiffness_matrix=ring.stiffness,
                     damping_matrix=ring.damping)
+            if not row.ball_inertia:  # quasi-static balls: no coordinates
+                continue
             q0 = (row.ball_reference + initial_ball_displacements(row)).ravel()
             out[f"main_bearing_balls{k}"] = Member(
                 f"main_bearing_balls{k}", np.eye(q0.size) * row.ball_mass, q0, np.zeros(q0.size),
@@ -768,7 +817,8 @@ class BallBearingGroup(ForceGroup):
         row = self.rows[k]
         idx = self._index[k]
         qe = q[..., idx].copy()
-        qe[..., -3 * row.ball_count:] -= row.ball_reference.ravel()
+        if row.ball_inertia:
+            qe[..., -3 * row.ball_count:] -= row.ball_reference.ravel()
         return qe, v[..., idx], idx
 
     def _force(self, q, v) -> np.ndarray:
