@@ -63,7 +63,11 @@ DEFAULT_DT = 1e-4
 #: reused across steps, goes stale within a step as lightly loaded balls enter and leave contact: a
 #: new one when the residual contracts worse than 0.25 per iteration (Exudyn's default 0.5) took
 #: rv221 from 5.0 to 2.9 Newton iterations per step (benchmarks/bench_balls.py); it makes the
-#: flexible rings slower (rv221 14.2 -> 15.7 s per simulated s) and is not used there
+#: flexible rings slower (rv221 14.2 -> 15.7 s per simulated s) and is not used there. It applies
+#: to balls with inertia (model option ball_inertia = true) only: the default quasi-static balls
+#: leave a 6-coordinate element on the carrier, whose Jacobian is fresh every step (the small
+#: dense system, as the rigid model), and run faster with Exudyn's 0.5 (rv40e 5.45, 5.50 ->
+#: 5.19, 5.17 s per simulated s, rv221 4.63, 4.54 -> 4.52, 4.56; 2026-11-24, paired)
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
 
@@ -228,9 +232,10 @@ class Simulation:
         import exudyn as exu
 
         newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
-        newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
-
         model = self.model if self.model is not None else self.build()
+        if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
+            newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
+
         from flexrv.model.kernel_cache import announce_compile
 
         kinds = (["fused"] if model.fused is not None else []) + (

@@ -170,12 +170,15 @@ def test_default_step_and_tolerance_against_fine_reference(name, torque):
 
 
 def test_ball_model_newton_setting():
-    """The ball model runs with its own Newton setting (flexrv.simulation.MODEL_NEWTON), the
-    user's newton_options on top; the others with Exudyn's defaults."""
+    """The ball model with ball inertia runs with its own Newton setting
+    (flexrv.simulation.MODEL_NEWTON), the user's newton_options on top; the others, and
+    the ball model's default quasi-static balls, with Exudyn's defaults."""
     assert MODEL_NEWTON == {"balls": {"modifiedNewtonContractivity": 0.25}}
-    sim = Simulation("rv40e", model="balls")
-    res = sim.run(t_end=0.004)
-    assert sim.timing["steps"] == 40 and res.attrs["status"] == "completed"
+    for options, inertia in (({}, False), ({"ball_inertia": True}, True)):
+        sim = Simulation("rv40e", model="balls", model_options=options)
+        res = sim.run(t_end=0.004)
+        assert sim.model.info["ball_inertia"] is inertia
+        assert sim.timing["steps"] == 40 and res.attrs["status"] == "completed"
 
 
 @pytest.mark.slow

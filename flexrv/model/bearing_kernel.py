@@ -86,17 +86,26 @@ CONDENSE_MAXIT = 50
 #: the ball's force from the motion of the frame and rings at a fixed ball (-K_c times
 #: each groove centre's velocity, and the cage pocket's turn)
 BALL_BLOCKS = 2
+#: ``jacobian`` mode of :func:`row_eval` for quasi-static balls (rigid and modal rings): into
+#: ``jq``, ``jv`` of shape (nx, nx) the Jacobians condensed onto the frame and modal
+#: coordinates x, ball by ball (:func:`_condense_ball`), each ball's S = d b / d x into the
+#: balls' work array (:func:`ball_workspace`)
+CONDENSED_BALLS = 3
 
 #: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
 #: force tolerance (relative to the row's largest contact load, ``geometry[13]``) turns
 #: absolute, and its Newton steps per call before a failure is reported
 BALL_LOAD_SCALE = 1.0
 BALL_MAXIT = 30
-#: relative force tolerance of the quasi-static balls' local solve: 1e-8 of the row's largest
-#: load (~1e-6 N on rv221's 111 N balls; the sum over a row's 26-38 balls stays ~4 orders
-#: below the absolute Newton tolerance of the system, 0.1 N, flexrv.simulation); the round-off
-#: floor is ~3e-11 of the loads (an absolute 1e-9 N stalls on rv221)
-BALL_FORCE_TOL = 1e-8
+#: relative force tolerance of the quasi-static balls' local solve: 1e-6 of the row's largest
+#: load (1e-4 N on rv221's 111 N balls, 2e-5 N on rv40e's 18 N): the sum over both rows'
+#: 52-76 balls, at most 5e-3 / 1.5e-3 N, stays 20-70x below the absolute Newton tolerance of
+#: the system (0.1 N per coordinate, flexrv.simulation.DEFAULT_NEWTON_TOLERANCE), and a ball
+#: load error of 1e-6 is far below any output's meaning. Tighter costs Newton steps: 1e-8
+#: took 1.14 steps per solve on rv40e against 0.77 (row force 73 -> 63 us per call of both
+#: rows, replayed). The round-off floor is ~3e-11 of the loads (an absolute 1e-9 N stalls on
+#: rv221)
+BALL_FORCE_TOL = 1e-6
 
 #: relative Newton step below which the film iteration of :func:`_normal_load` stops
 #: (its next iterate is then exact to 0.75 FILM_STEP_STOP^2 relative, see there)
@@ -594,10 +603,7 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
     (:func:`quasi_static_balls`, warm-started from and updating ``balls``)."""
     nb = 3 * ball_ref.shape[0]
     n = 6 + tab_i.shape[2] + tab_o.shape[2] + nb
-    nj = n if jacobian else 0
     f = np.empty(n)
-    jq = np.empty((nj, nj))
-    jv = np.empty((nj, nj))
     if geometry[13] > 0.0:
         nx = n - nb
         qf = np.zeros(n)
@@ -608,8 +614,11 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         kx = np.empty((nk, nk))
         cx = np.empty((nk, nk))
         quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                           ws_o, balls, state, jacobian, rec, f, jq, jv, np.empty((nb, 4)), kx, cx)
+                           ws_o, balls, state, jacobian, rec, f, np.empty((nb, 4)), kx, cx)
         return f[:nx].copy(), kx, cx
+    nj = n if jacobian else 0
+    jq = np.zeros((nj, nj))  # (zero: row_eval clears only the entries it writes)
+    jv = np.zeros((nj, nj))
     row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
              state, jacobian, rec, f, jq, jv)
     return f, jq, jv
@@ -678,10 +687,33 @@ def _modal_sums(bas, q, qt, off, m):
     return d0, d1, d2, v0, v1, v2
 
 @njit(cache=True)
+def _zero_written(jac, nx, nz):
+    """Zero the entries of a row Jacobian (n, n) that :func:`row_eval` writes for rigid
+    and modal rings: the nx rows and columns of the frame and modal coordinates and
+    each ball's own 3x3 block (the ball-ball blocks of different balls are never
+    written and stay zero from the array's allocation: ~(3Z)^2 entries not touched
+    per call, 2 x 14,400 on rv40e)."""
+    n = jac.shape[0]
+    for r in range(nx):
+        for c in range(n):
+            jac[r, c] = 0.0
+    for r in range(nx, n):
+        for c in range(nx):
+            jac[r, c] = 0.0
+    for j in range(nz):
+        b = nx + 3 * j
+        for r in range(3):
+            for c in range(3):
+                jac[b + r, b + c] = 0.0
+
+
+@njit(cache=True)
 def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
              state, jacobian, rec, f, jq, jv):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
-    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (all overwritten);
+    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
+    rigid and modal rings only the entries it writes, :func:`_zero_written`: the
+    other entries must be zero, as in a zero-allocated work array);
     coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
 
     tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
@@ -698,6 +730,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     radius and z, inner and outer offsets, ball pitch radius, speed factor, cage
     ratio, cage stiffness and damping, pocket stiffness, the quasi-static balls'
     relative force tolerance (0: the balls are element coordinates)].
+
+    ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
+    CONDENSED_BALLS (the quasi-static balls' modes, see there).
 
     Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
     d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
@@ -720,9 +755,17 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
     f[:] = 0.0
-    if jacobian:
+    if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
         jq[:, :] = 0.0
-        jv[:, :] = 0.0
+        if jacobian == CONDENSED_BALLS:
+            jv[:, :] = 0.0
+    elif jacobian:
+        if cond_i or cond_o:
+            jq[:, :] = 0.0
+            jv[:, :] = 0.0
+        else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
+            _zero_written(jq, b0, nz)
+            _zero_written(jv, b0, nz)
     ax, ay, az = q[3], q[4], q[5]
     sa, ca, sb, cb, sc, cc = math.sin(ax), math.cos(ax), math.sin(ay), math.cos(ay), math.sin(az), math.cos(az)
     # A = Rx(ax) Ry(ay) Rz(az); omega = G phi_t (Exudyn RotXYZ2RotationMatrix / RotXYZ2G)
@@ -773,7 +816,8 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         ly = dx * a[0, 1] + dy * a[1, 1] + dz * a[2, 1]
         psi = math.atan2(ly, lx)
         psi_i[j] = psi
-        cos_p, sin_p = math.cos(psi), math.sin(psi)
+        rl = math.sqrt(lx * lx + ly * ly)  # cos, sin of psi without evaluating them
+        cos_p, sin_p = lx / rl, ly / rl
         p0, p1, p2 = ci_r * cos_p, ci_r * sin_p, ci_z + z_row
         apv0 = apv1 = apv2 = 0.0  # velocity of the groove centre relative to the frame (modal ring)
         if m_i > 0:
@@ -800,7 +844,8 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         # ---- outer ring (housing)
         psi = math.atan2(by, bx)
         psi_o[j] = psi
-        cos_p, sin_p = math.cos(psi), math.sin(psi)
+        rl = math.sqrt(bx * bx + by * by)
+        cos_p, sin_p = bx / rl, by / rl
         cs_o[j, 0], cs_o[j, 1] = cos_p, sin_p
         ox, oy, oz = co_r * cos_p, co_r * sin_p, co_z + z_row
         ovx = ovy = ovz = 0.0
@@ -849,6 +894,13 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     k_o = np.empty((3, 3))
     d_o = np.empty((3, 3))
     t_i = np.zeros((3, nx_i))
+    nl = b0 + 3 if (jacobian and jacobian != BALL_BLOCKS) else 0
+    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see below)
+    vl = np.empty((nl, nl))
+    inv3 = np.empty((3, 3))  # (work of _condense_ball)
+    tm3 = np.empty((3, b0))
+    s_balls = balls[2 * 3 * nz:2 * 3 * nz + 3 * nz * b0].reshape((3 * nz, b0)) if jacobian == CONDENSED_BALLS \
+        else np.empty((0, b0))
     for r in range(3):
         t_i[r, r] = 1.0
     ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
@@ -930,7 +982,11 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
                     rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
                 jq[3 * j + c1, 3] = rate
             continue
-        # ---- Jacobian blocks
+        # ---- Jacobian blocks of this ball: its (b0 + 3)^2 square [x (0..b0-1), the ball
+        # (b0..b0+2)] into jl, vl (the helpers at ball index b0), then scattered into jq, jv
+        # -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS)
+        jl[:, :] = 0.0
+        vl[:, :] = 0.0
         if not cond_i:  # (condensed rings: the blocks' factors below)
             _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
         if not cond_o:
@@ -940,10 +996,10 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             for c2 in range(3):
                 ee = et[c1] * et[c2]
                 eye = 1.0 if c1 == c2 else 0.0
-                jq[bj + c1, bj + c2] += -cage_k * ee - pocket_k * (eye - ee)
-                jv[bj + c1, bj + c2] += -cage_c * ee
-            jq[bj + c1, 5] += cage_k * radius * cage_ratio * et[c1]
-            jv[bj + c1, 5] += cage_c * radius * cage_ratio * et[c1]
+                jl[b0 + c1, b0 + c2] += -cage_k * ee - pocket_k * (eye - ee)
+                vl[b0 + c1, b0 + c2] += -cage_c * ee
+            jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
+            vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
         # T_i = [I | -[Ap]x G | A basis_i]
         for c in range(3):  # -(skew(Ap) G)[:, c]
             g0, g1, g2 = g[0, c], g[1, c], g[2, c]
@@ -961,22 +1017,31 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
                     ti_all[3 * j + r, c] = t_i[r, c]
             _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
         else:
-            _add_block_jacobian(jq, k_i, t_i, bj, 0, nx_i)
-            _add_block_jacobian(jv, d_i, t_i, bj, 0, nx_i)
+            _add_block_jacobian(jl, k_i, t_i, b0, 0, nx_i)
+            _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
             gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
             if gain != 0.0:
-                _add_speed_column(jv, k_i, t_i, bj, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1],
+                _add_speed_column(vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1],
                                   gain * nrm_i[j, 2])
         if cond_o:
             _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
         else:
             bo = bas_o_all[j] if m_o > 0 else bas_o
-            _add_block_jacobian(jq, k_o, bo, bj, 6 + m_i, m_o)
-            _add_block_jacobian(jv, d_o, bo, bj, 6 + m_i, m_o)
+            _add_block_jacobian(jl, k_o, bo, b0, 6 + m_i, m_o)
+            _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
             gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
             if gain != 0.0:
-                _add_speed_column(jv, k_o, bo, bj, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1],
+                _add_speed_column(vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1],
                                   gain * nrm_o[j, 2])
+        if jacobian == CONDENSED_BALLS:
+            _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j:3 * j + 3], inv3, tm3)
+        else:
+            for r in range(b0 + 3):
+                rr = r if r < b0 else bj + r - b0
+                for c in range(b0 + 3):
+                    cc = c if c < b0 else bj + c - b0
+                    jq[rr, cc] += jl[r, c]
+                    jv[rr, cc] += vl[r, c]
     if jacobian and (cond_i or cond_o):
         ball = slice(b0, b0 + 3 * nz)
         if cond_i:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
@@ -1140,73 +1205,52 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
-def condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                            ws_o, balls, state, jq, jv, kx, cx, s_out):
-    """The row's Jacobians with quasi-static balls (at the state :func:`ball_equilibrium`
-    returned): :func:`row_eval`'s full jq = d f / d q and jv = d f / d q_t (n, n, filled
-    here) condensed onto the frame and modal coordinates x (the first nx = n - 3Z),
-    ball by ball (the balls couple only through x): with S = -J_bb^-1 J_bx,
+def _condense_ball(jl, vl, nx, kx, cx, s_ball, inv, tm):
+    """Add one quasi-static ball's share of the condensed Jacobians to kx, cx (nx, nx):
+    from its blocks jl = d f / d q, vl = d f / d q_t over [x (nx), the ball (3)] (J, V
+    below), with S = -J_bb^-1 J_bx (into ``s_ball`` (3, nx)),
 
-        kx = J_xx + J_xb S,
-        cx = V_xx + V_xb S - J_xb J_bb^-1 (V_bx + V_bb S)   (V = jv),
+        kx += J_xx + J_xb S,
+        cx += V_xx + V_xb S - J_xb J_bb^-1 (V_bx + V_bb S),
 
-    the balls following x statically (b_x = S) and moving with b_t = S x_t, whose
-    change with x (second order, d S / d x x_t) is left out. S (3Z, nx) into
-    ``s_out`` ((0, 0): not kept)."""
-    n = q.shape[0]
-    nz = ball_ref.shape[0]
-    nx = n - 3 * nz
-    f = np.empty(n)
-    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-             state, True, np.empty((0, N_RECORD)), f, jq, jv)
+    the ball following x statically (b_x = S) and moving with b_t = S x_t, whose
+    change with x (second order, d S / d x x_t) is left out. The balls couple only
+    through x, so the Schur complement over all balls is this sum. inv (3, 3), tm
+    (3, nx): work."""
+    k = jl[nx:, nx:]
+    inv[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
+    inv[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
+    inv[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
+    inv[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
+    inv[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
+    inv[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
+    inv[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
+    inv[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
+    inv[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
+    det = k[0, 0] * inv[0, 0] + k[0, 1] * inv[1, 0] + k[0, 2] * inv[2, 0]
+    for r in range(3):
+        for c in range(3):
+            inv[r, c] /= det
+    for r in range(3):  # S = -J_bb^-1 J_bx
+        for c in range(nx):
+            s_ball[r, c] = -(inv[r, 0] * jl[nx, c] + inv[r, 1] * jl[nx + 1, c] + inv[r, 2] * jl[nx + 2, c])
+    for c in range(nx):  # T = J_bb^-1 W, W = V_bx + V_bb S (column by column)
+        w0 = vl[nx, c] + vl[nx, nx] * s_ball[0, c] + vl[nx, nx + 1] * s_ball[1, c] + vl[nx, nx + 2] * s_ball[2, c]
+        w1 = vl[nx + 1, c] + vl[nx + 1, nx] * s_ball[0, c] + vl[nx + 1, nx + 1] * s_ball[1, c] \
+            + vl[nx + 1, nx + 2] * s_ball[2, c]
+        w2 = vl[nx + 2, c] + vl[nx + 2, nx] * s_ball[0, c] + vl[nx + 2, nx + 1] * s_ball[1, c] \
+            + vl[nx + 2, nx + 2] * s_ball[2, c]
+        for r in range(3):
+            tm[r, c] = inv[r, 0] * w0 + inv[r, 1] * w1 + inv[r, 2] * w2
     for r in range(nx):
         for c in range(nx):
-            kx[r, c] = jq[r, c]
-            cx[r, c] = jv[r, c]
-    inv = np.empty((3, 3))
-    sm = np.empty((3, nx))
-    tm = np.empty((3, nx))
-    for j in range(nz):
-        b = nx + 3 * j
-        k = jq[b:b + 3, b:b + 3]
-        inv[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
-        inv[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
-        inv[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
-        inv[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
-        inv[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-        inv[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
-        inv[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-        inv[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
-        inv[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-        det = k[0, 0] * inv[0, 0] + k[0, 1] * inv[1, 0] + k[0, 2] * inv[2, 0]
-        for r in range(3):
-            for c in range(3):
-                inv[r, c] /= det
-        for r in range(3):  # S = -J_bb^-1 J_bx
-            for c in range(nx):
-                sm[r, c] = -(inv[r, 0] * jq[b, c] + inv[r, 1] * jq[b + 1, c] + inv[r, 2] * jq[b + 2, c])
-        if s_out.shape[0] > 0:
-            for r in range(3):
-                for c in range(nx):
-                    s_out[3 * j + r, c] = sm[r, c]
-        for r in range(3):  # T = J_bb^-1 (V_bx + V_bb S)
-            for c in range(nx):
-                acc = 0.0
-                for a in range(3):
-                    w = jv[b + a, c]
-                    for d in range(3):
-                        w += jv[b + a, b + d] * sm[d, c]
-                    acc += inv[r, a] * w
-                tm[r, c] = acc
-        for r in range(nx):
-            for c in range(nx):
-                acc_k = 0.0
-                acc_c = 0.0
-                for a in range(3):
-                    acc_k += jq[r, b + a] * sm[a, c]
-                    acc_c += jv[r, b + a] * sm[a, c] - jq[r, b + a] * tm[a, c]
-                kx[r, c] += acc_k
-                cx[r, c] += acc_c
+            acc_k = jl[r, c]
+            acc_c = vl[r, c]
+            for a in range(3):
+                acc_k += jl[r, nx + a] * s_ball[a, c]
+                acc_c += vl[r, nx + a] * s_ball[a, c] - jl[r, nx + a] * tm[a, c]
+            kx[r, c] += acc_k
+            cx[r, c] += acc_c
 
 
 def ball_workspace(ball_count: int, nx: int) -> np.ndarray:
@@ -1228,7 +1272,7 @@ def _split_balls(ws, nb, nx):
 
 @njit(cache=True)
 def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                       balls, state, jacobian, rec, f, jq, jv, kbb, kx, cx):
+                       balls, state, jacobian, rec, f, kbb, kx, cx):
     """One evaluation of a row with quasi-static balls: q, q_t (n, the full element
     vectors, work arrays) hold the frame and modal coordinates x in their first
     nx = n - 3Z entries (set by the caller); ``balls`` (:func:`ball_workspace`)
@@ -1242,8 +1286,8 @@ def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_
     :data:`BALL_MAXIT` steps; if the prediction fails, once more from b_last; a
     failure is counted in state[4], flagged in state[5] and not stored). Out: f[:nx]
     the force on x (f (n,) work), the per-ball records ``rec`` and, with
-    ``jacobian``, the condensed Jacobians kx, cx (nx, nx)
-    (:func:`condensed_ball_jacobian`; jq, jv (n, n) work), whose S is stored. A
+    ``jacobian``, the condensed Jacobians kx, cx (nx, nx) (:func:`row_eval`'s
+    CONDENSED_BALLS mode), whose S is stored. A
     Jacobian call at the state of the last solution (Exudyn's usual order) reuses
     it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
     nz = ball_ref.shape[0]
@@ -1300,8 +1344,8 @@ def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_
                 xtl[c] = qt[c]
             flag[0] = 1.0
     if jacobian:
-        condensed_ball_jacobian(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                                ws_i, ws_o, balls, state, jq, jv, kx, cx, sm)
+        row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
+                 state, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
 
 
 @njit(cache=True)
@@ -1339,7 +1383,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             ve[e] = vn[idx[e]]
         if geometry[13] > 0.0:
             quasi_static_balls(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                               ws_i, ws_o, balls, state, jacobian, rec, f, jq, jv, kbb, kx, cx)
+                               ws_i, ws_o, balls, state, jacobian, rec, f, kbb, kx, cx)
             jq_, jv_ = kx, cx
         else:
             if absolute:
@@ -1384,7 +1428,7 @@ def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, la
             qf[:nx] = qs[i]
             vf[:nx] = vts[i]
             quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                               ws_i, ws_o, balls, state, False, recs[i], f, empty, empty, kbb, empty, empty)
+                               ws_i, ws_o, balls, state, False, recs[i], f, kbb, empty, empty)
             out[i] = f[:nx]
         return out
     for i in range(nt):

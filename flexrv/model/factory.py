@@ -137,6 +137,7 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
             ball_inertia = any(r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or [])
         group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer"),
                                                   ball_inertia=bool(ball_inertia)))
+        info["ball_inertia"] = bool(ball_inertia)
         members.update(group.new_members())
         groups.insert(4, group)
     else:

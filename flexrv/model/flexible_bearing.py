@@ -443,7 +443,7 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
 
 class RowElement:
     """THE Exudyn glue of the bearing rows (issue 15): one Exudyn element for one or
-    more rows (the reducer model uses one per row, see
+    more rows (the reducer model: one per row, or one for all rows with quasi-static balls, see
     :meth:`BallBearingGroup.add_to`), one compiled call
     (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
     evaluation into arrays preallocated here — per row the gather of its element
@@ -482,12 +482,14 @@ class RowElement:
                 raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
             full = r.n_kernel  # quasi-static balls: the kernel's work vectors also hold the balls
             qs = 0 if r.ball_inertia else 1
-            self._work.append((i, np.zeros(full), np.zeros(full), np.zeros(full), np.zeros((full, full)),
-                               np.zeros((full, full)), np.zeros((r.ball_count if record else 0, N_RECORD)),
+            nj = (1 - qs) * m  # (quasi-static balls: the condensed Jacobians kx, cx instead)
+            self._work.append((i, np.zeros(full), np.zeros(full), np.zeros(full), np.zeros((nj, nj)),
+                               np.zeros((nj, nj)), np.zeros((r.ball_count if record else 0, N_RECORD)),
                                np.zeros((qs * 3 * r.ball_count, 4)), np.zeros((qs * m, qs * m)),
                                np.zeros((qs * m, qs * m))))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
+        self._parts = None
         #: (t, q, q_t) of the last call (the nodes' coordinates, copies), None during a call
         self.memo = None
 
@@ -503,7 +505,9 @@ class RowElement:
 
     def _call(self, t, q, q_t, jacobian: bool, f_q: float, f_v: float) -> None:
         self.memo = None  # until the call has filled the records
-        parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
+        parts = self._parts
+        if parts is None:  # (the rows' kernel inputs are made once and kept on them)
+            parts = self._parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
         qn, vn = exudyn_vector(q), exudyn_vector(q_t)
         args = (qn, vn, self.absolute, jacobian, f_q, f_v, self.out_f, self.out_j, parts)
         if self._entry is not None:
@@ -744,8 +748,9 @@ class BallBearingGroup(ForceGroup):
         self.sizes = sizes
         self._index = index  # per row: element coordinates in the group's local vector
         self._n = int(sum(sizes))
-        #: the rows' Exudyn elements and their nodes' member names (set by add_to)
-        self.elements, self._element_members = [], []
+        #: the rows' Exudyn elements, their nodes' member names and, per row, (element, row in
+        #: it) (set by add_to)
+        self.elements, self._element_members, self._row_slots = [], [], []
 
     def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
         """One Exudyn element per row over [carrier, the row's modal rings, its balls]
@@ -754,9 +759,18 @@ class BallBearingGroup(ForceGroup):
         converts, copies and scans the element's dense Jacobian, which grows as
         (6 + 6Z)^2 instead of 2 (6 + 3Z)^2: on two dense 120-coordinate blocks (the
         condensed rows of rv40e) a synthetic system took 1.86 s instead of 1.31 s
-        for 1000 Jacobians (issue 15). Returns the first row's object number."""
+        for 1000 Jacobians (issue 15). Rows with quasi-static balls between rigid
+        rings act on the carrier's six coordinates only: then ONE element carries
+        all rows (a 6 x 6 Jacobian; one Python call per evaluation instead of one
+        per row). Returns the first row's object number."""
         stats, objects, pos = self.stats, [], 1
-        self.elements, self._element_members = [], []
+        self.elements, self._element_members, self._row_slots = [], [], []
+        if all(not row.ring_nodes() and not row.ball_inertia for row in self.rows):
+            element = RowElement(self.rows, [_PERM.copy() for _ in self.rows], True, stats, record=True)
+            self.elements.append(element)
+            self._element_members.append([self.members[0]])
+            self._row_slots = [(0, k) for k in range(len(self.rows))]
+            return element.add_to(mbs, [nodes[0]])
         for k, row in enumerate(self.rows):
             count = 1 + len(row.ring_nodes())
             row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
@@ -765,6 +779,7 @@ class BallBearingGroup(ForceGroup):
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
             element = RowElement(row, idx, True, stats, record=True)
             self.elements.append(element)
+            self._row_slots.append((k, 0))
             objects.append(element.add_to(mbs, row_nodes))
         return objects[0]
 
@@ -772,8 +787,14 @@ class BallBearingGroup(ForceGroup):
         """(element, its nodes' member names, [(group, key, live record array)]) per row
         element (:class:`flexrv.model.kernels.HistoryRecorder`): row k's per-ball
         records ``balls<k>`` and its force on the frame ``frame<k>`` (element order)."""
-        return [(e, members, [(self, f"balls{k}", e.records[0]), (self, f"frame{k}", e.frame_force(0))])
-                for k, (e, members) in enumerate(zip(self.elements, self._element_members))]
+        out = []
+        for i, (e, members) in enumerate(zip(self.elements, self._element_members)):
+            entries = []
+            for k, (element, j) in enumerate(self._row_slots):
+                if element == i:
+                    entries += [(self, f"balls{k}", e.records[j]), (self, f"frame{k}", e.frame_force(j))]
+            out.append((e, members, entries))
+        return out
 
     @property
     def flexible(self) -> bool:
