@@ -128,12 +128,12 @@ def test_integrator_records_match_the_history_pass(name, model):
     (~1e9 N/m) turns into ~3e-8 N on pin forces of ~200 N, ~2e-10, with the friction
     outputs more sensitive through the sliding speed; 2e-9 keeps a factor 2 over the
     measured; the ball model's rows, recorded from their own elements, agree to
-    their quasi-static balls' local solve (bearing_kernel.quasi_static_balls, 1e-8
+    their quasi-static balls' local solve (bearing_kernel.quasi_static_balls, 1e-6
     of the row's largest load, BALL_FORCE_TOL), reached from the run's prediction
     in the one and from the previous sample in the other: measured 2026-11-24 on
-    rv221, ball loads 1.1e-8 and the bearing's radial force 3.3e-8 of their largest
-    values (with ball inertia, before: 3.5e-16, round-off); bound 1e-7 relative
-    with a 1e-9 floor [N, N m]; with the
+    rv221, ball loads 6.2e-7 and the bearing's radial force 2.1e-6 of their largest
+    values (with ball inertia, before: 3.5e-16, round-off); bound 1e-5
+    relative with a 1e-9 floor [N, N m]; with the
     condensed flexible rings the bearing's outputs agree to the rings' local solve,
     started from other deflections: CONDENSE_TOL = 1e-13 m on the contact deflections
     times a ball's contact stiffness (~1e9 N/m) is ~1e-4 N on ~100 N loads; measured
@@ -178,7 +178,7 @@ def test_integrator_records_match_the_history_pass(name, model):
         if model == "flexible" and key.startswith(("ball_", "main_bearing_", "ring_")):
             rel, floor = 2e-6, (1e-12 if key.startswith("ring_deformation") else 1e-8)  # [m], [N] (zero forces)
         elif model == "balls" and key.startswith(("ball_", "main_bearing_")):
-            rel, floor = 1e-7, 1e-9  # the balls' local solve; [N], [N m]: net forces that are round-off
+            rel, floor = 1e-5, 1e-9  # the balls' local solve; [N], [N m]: net forces that are round-off
         assert np.max(np.abs(a - b), initial=0.0) <= max(rel * max(np.max(np.abs(b), initial=0.0), 1e-300),
                                                          floor), key
     gap, gap_exact, force = fast["pin_gap"].values, exact["pin_gap"].values, exact["pin_force"].values
@@ -220,14 +220,16 @@ def test_group_with_its_own_record_keeps_its_own_outputs_path(history):
 
 def test_recorder_checkpoint_round_trip_with_bearing_rows():
     """The recorder's buffers of every recording element (the fused element and the
-    ball model's two row elements) go into a checkpoint (:meth:`HistoryRecorder.arrays`)
-    and come back bit for bit (:meth:`HistoryRecorder.fill`, as Simulation.resume
-    does); a checkpoint of another layout (a 1-D valid mask, or other buffers) is left
-    to the history pass (nothing filled)."""
+    ball model's two row elements, balls with inertia) go into a checkpoint
+    (:meth:`HistoryRecorder.arrays`) and come back bit for bit
+    (:meth:`HistoryRecorder.fill`, as Simulation.resume does); a checkpoint of another
+    layout (a 1-D valid mask, or other buffers) is left to the history pass (nothing
+    filled). With quasi-static balls (the default) both rows share one element on the
+    carrier, whose records are both rows'."""
     from flexrv.model.kernels import HistoryRecorder
     from flexrv.simulation import Simulation
 
-    sim = Simulation(_fast("rv221"), model="balls")
+    sim = Simulation(_fast("rv221"), model="balls", model_options={"ball_inertia": True})
     sim.run(t_end=0.003, dt=1e-4)
     m = sim.model
     rec = HistoryRecorder(m, 8)
@@ -253,3 +255,8 @@ def test_recorder_checkpoint_round_trip_with_bearing_rows():
     other.fill(5, arrays, valid[0])  # a rigid model's (one element's) mask layout
     other.fill(5, arrays[:-1], valid)
     assert not other.valid.any()
+    sim = Simulation(_fast("rv221"), model="balls")
+    sim.run(t_end=0.002, dt=1e-4)
+    rec = HistoryRecorder(sim.model, 8)
+    assert len(rec.sources) == 2 and [key for _, key, _ in rec.sources[1][2]] == ["balls0", "frame0", "balls1",
+                                                                                  "frame1"]

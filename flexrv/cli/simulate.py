@@ -61,6 +61,10 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
+BALLS_HELP = ("Ball-resolved main bearing (--model balls / flexible): the balls as point masses, or "
+              "quasi-static (massless, solved inside the bearing rows). Default: quasi-static balls between "
+              "rigid rings (--model balls), point masses between condensed flexible rings (--model flexible, "
+              "which needs them).")
 DT_HELP = ("Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s: TE mean and lines within 0.05 arcsec / "
            "2 % of a 2.5e-5 s reference on rv40e, rigid and ball models, tests/test_time_step.py).")
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
@@ -81,6 +85,7 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
              t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
              dt: float = typer.Option(None, "--dt", help=DT_HELP),
              parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
+             ball_inertia: bool = typer.Option(None, "--ball-inertia/--quasi-static-balls", help=BALLS_HELP),
              out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
              overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
              resume: Path = typer.Option(None, "--resume", help="Continue a killed run from the last checkpoint in this output directory."),
@@ -116,6 +121,8 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
         if preset is None:
             raise InputError("flexrv simulate: missing argument PRESET (a preset name or design TOML), or --resume DIR")
         options = model_options(model, parts)
+        if ball_inertia is not None:
+            options["ball_inertia"] = ball_inertia
         out = check_output_dir(out or _default_out(preset, model, "sim"), "--out", overwrite=overwrite)
         sim = Simulation(preset, model=model, model_options=options)
         try:

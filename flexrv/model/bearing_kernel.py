@@ -1149,7 +1149,7 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     the stiffer side), from the blocks of each evaluation. Newton per ball on its own
     3x3 block (row_eval's BALL_BLOCKS mode into ``kbb`` (3Z, 4)); stops when the
     largest ball force is below ``tol`` times the largest contact load of the row
-    (at least :data:`BALL_LOAD_SCALE`; relative, ~1e-10: an absolute 1e-9 N stalls at
+    (at least :data:`BALL_LOAD_SCALE`; relative, BALL_FORCE_TOL; an absolute 1e-9 N stalls at
     ~3e-9 N, the round-off of 111 N loads on rv221). ``f`` (n,): the row's forces
     and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
     last evaluation (at the returned balls and velocities). Returns the number of

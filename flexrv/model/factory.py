@@ -121,6 +121,9 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     members = _members(p)
     info: dict = {}
     if main_bearing == "rigid":
+        if ball_inertia is not None:
+            raise ConfigError(f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
+                              f"applies to the ball-resolved bearing (model 'balls' or 'flexible')")
         groups.insert(4, RigidMainBearing(p))
     elif main_bearing in ("balls", "flexible"):
         from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design

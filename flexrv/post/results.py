@@ -247,6 +247,8 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         "timing": json.dumps(to_jsonable(timing or {})),
     })
     for key, value in model.info.items():  # e.g. flexible_bodies: how to rebuild the reduced bodies
+        if isinstance(value, bool):  # (NetCDF has no boolean attributes: 0 / 1)
+            value = int(value)
         ds.attrs[key] = value if isinstance(value, (str, int, float)) else json.dumps(to_jsonable(value))
     return cls(ds, reducer=red)
 
