@@ -4,6 +4,7 @@ of the bearing rows and of the fused compiled element, Newton iterations per ste
 and the TE statistics (so speed never buys a different answer).
 
     python benchmarks/bench_balls.py [--presets rv221 rv40e] [--t-end 0.1] [--newton '{"...": ...}']
+                                     [--options '{"ball_inertia": true}']
 
 The preset's default ramps are kept; a short warm-up run (0.002 s) loads or
 compiles the numba kernels first (a cold compile inside the timed run cost
@@ -52,6 +53,23 @@ moved with the round-off). The start-up window's TE moved with them (rv221 mean
 3000 N m -139.60677 / -139.60676" and 3.1625 / 3.1658" (rv221 at its preset's
 light load lands on one of its two steady responses, tests/test_time_step.py),
 and the converged regression case balls_rv40e is unchanged.
+Then (branch qs2, paired against 9b988b1, two runs each, 2026-11-24) the balls became
+quasi-static by default (``ball_inertia = false``: massless, solved inside the row
+kernel, flexrv.model.bearing_kernel.quasi_static_balls; both rows in one 6-coordinate
+element on the carrier): rv221 5.32, 5.32 -> **4.40, 4.43**, rv40e 7.94 (the other run
+of the old code recompiled its kernels) -> **4.96, 4.97** CPU s per simulated s: the goal
+is met. The system shrinks from
+174 / 249 to 18 / 21 coordinates and the Newton iterations per step from ~3.1-3.3 to
+1.8 / 2.1 with a fresh (small, dense) Jacobian per step, as the rigid model; per call
+of both rows ~46 / ~61 us (each row's local Newton from the prediction b + S dx:
+0.77 steps per solve on rv40e at the 1e-6 force tolerance) and ~49 / ~64 us for the
+condensed Jacobian. The start-up window's TE moves (the balls' inertia shows in the
+start-up: rv221 mean 10.4327 -> 11.7080", p-p 23.7735 -> 21.4495"; rv40e -21.3084 ->
+-20.7907", 13.2864 -> 17.7748"); the steady window
+of a 0.4 s run does not: rv40e -166.36759 / 0.39236" (inertia) against -166.36764 /
+0.39239" (quasi-static), rv221 at 3000 N m -139.60677 / 3.1625" against -139.60685 /
+3.1598". ``--options '{"ball_inertia": true}'`` measures the balls with inertia.
+
 """
 
 from __future__ import annotations

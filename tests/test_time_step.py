@@ -45,6 +45,10 @@ rv221     20 (preset)  1e-4         0.0039              0.07 % (13.6 Hz)
 rv221     20 (preset)  2e-4         0.0016              0.21 %
 ========  ===========  ===========  ==================  ====================
 
+With the quasi-static balls of the ball model's default (issue 15, 2026-11-24; Exudyn's
+Newton defaults, MODEL_NEWTON being for balls with inertia): rv40e at 1e-4 s mean +0.0000,
+lines 1.11 %; rv221 at 3000 N m +0.0001, 0.03 % -- the same as with ball inertia.
+
 2e-4 s met the criterion in this study (CPU per simulated s -30 to -45 %), but it is not robust:
 after the disc's mesh change (issue 15, branch fecold: a 2.4 % softer disc) the same rv40e run at
 2e-4 s failed in the speed ramp (disc 1 skipped a pin at t = 0.074 s), as the flexible rings at 2e-4

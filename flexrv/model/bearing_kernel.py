@@ -562,6 +562,18 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
 
 
 @njit(cache=True)
+def _count_solve(state, k, its):
+    """A local solve's statistics in state[k:k + 4] (:func:`row_eval`'s ``state``): its
+    failure (its < 0) counted and flagged, or its iterations added; solves counted."""
+    state[k + 3] += 1
+    if its < 0:
+        state[k] += 1
+        state[k + 1] = 1
+    else:
+        state[k + 2] += its
+
+
+@njit(cache=True)
 def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
                    du, wglobal, state):
     """The ball contacts of one ring of a row: the condensed ring's local solve
@@ -570,12 +582,7 @@ def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, l
     if condensed:
         its = _condensed_ring(psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
                               du, wglobal)
-        state[3] += 1
-        if its < 0:
-            state[0] += 1
-            state[1] = 1
-        else:
-            state[2] += its
+        _count_solve(state, 0, its)
     else:
         hu, lu, h_floor = _law_speed(speed, law)
         for j in range(e0.shape[0]):
@@ -1330,12 +1337,8 @@ def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_
             its = ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
                                    ws_i, ws_o, balls, state, geometry[13], BALL_MAXIT, f, kbb, rec)
         state[5] = 0
-        state[7] += 1
-        if its < 0:
-            state[4] += 1
-            state[5] = 1
-        else:
-            state[6] += its
+        _count_solve(state, 4, its)
+        if its >= 0:
             for e in range(nb):
                 b[e] = q[nx + e]
                 bt[e] = qt[nx + e]

@@ -113,7 +113,8 @@ def _input_speed(model, t):
 
 
 def _kinetic_energy(model, t, q, v):
-    """Sum of 1/2 v^T M v over the members plus the input shaft's 1/2 J_in omega_in^2."""
+    """Sum of 1/2 v^T M v over the members plus the input shaft's 1/2 J_in omega_in^2
+    (quasi-static balls, the ball model's default, carry none: they are no members)."""
     ke = np.zeros_like(t)
     for m in model.members.values():
         vm = v[:, model.slice(m.name)]
@@ -155,7 +156,7 @@ DERIVED_OUTPUTS: tuple[DerivedOutput, ...] = (
                   lambda model, t, q, v: np.asarray(model.load_torque(t), dtype=float)),
     DerivedOutput("kinetic_energy", ("time",), "J", "kinetic energy", _kinetic_energy),
     DerivedOutput("angular_momentum", ("time",), "N m s",
-                  "angular momentum of the rigid members and balls about the axis", _angular_momentum),
+                  "angular momentum of the rigid members and massive balls about the axis", _angular_momentum),
 )
 
 #: result order of the member and drive outputs (group outputs follow ``carrier_tilt``)
