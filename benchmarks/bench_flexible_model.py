@@ -110,6 +110,15 @@ window TE moved with the round-off (rv221 9.8983 -> 10.0439", p-p 22.0241 ->
 20.8366"; rv40e -21.1817 -> -21.2698", 15.0181 -> 13.2064"); to 0.4 s the steady
 window (0.30-0.40 s) of rv40e is the same, TE mean -166.36764" and p-p 0.39327"
 both, and the converged regression case flexible_rv221 is unchanged.
+
+Then (branch qs2, issue 15) the row kernel's azimuth cosines and sines from the
+coordinates (no cos/sin of the atan2) and each ball's Jacobian blocks assembled once
+(scattered here, condensed for the ball model's quasi-static balls; the flexible model
+keeps balls with inertia, as a condensed ring couples every ball of its row): paired
+against 9b988b1, rv221 11.1, 11.2 -> 10.9, 11.1 s/s (unchanged); start-up window TE
+moved with the round-off (rv221 10.0439 -> 10.3052", p-p 20.8366 -> 19.6546"); the
+0.4 s run of rv40e gives the same steady window, -166.36764" and 0.39327", and the
+converged regression case flexible_rv221 is unchanged.
 """
 
 from __future__ import annotations
