@@ -1145,8 +1145,8 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
-def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-                     state, tol, max_iter, f, kbb, rec):
+def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
+                     balls, state, tol, max_iter, f, kbb, rec):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)

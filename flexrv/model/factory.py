@@ -137,7 +137,8 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
             info["flexible_bodies"] = rings["bodies"]
             info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
         if ball_inertia is None:  # quasi-static balls unless a condensed ring couples them (see the docstring)
-            ball_inertia = any(r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or [])
+            ball_inertia = any(r is not None and r.condensed
+                               for side in ("inner", "outer") for r in rings.get(side) or [])
         group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer"),
                                                   ball_inertia=bool(ball_inertia)))
         info["ball_inertia"] = bool(ball_inertia)

@@ -18,11 +18,12 @@ Members per row of the back-to-back pair:
   per ball warm-started from a prediction; the element then has the frame's and
   modal rings' coordinates only, its Jacobian the balls' Schur complement). Why:
   the balls' inertia does not reach the transmission -- on rv40e the steady TE
-  moved by < 1e-4 arcsec with ball masses x0.1 / x1 / x10 (mean -166.3676",
-  p-p 0.3924 / 0.3924 / 0.3927") and quasi-static balls give -166.36764" /
-  0.39239" against -166.36759" / 0.39236" (0.30-0.40 s, benchmarks/bench_balls.py);
-  the centrifugal load of a 9-12 mm ball orbiting at ~1 rad/s is ~1e-5 N against
-  contact loads of 1-100 N -- while the ball coordinates (6 Z per bearing) and
+  mean moved by < 1e-5 arcsec and its p-p by < 4e-4 arcsec with ball masses
+  x0.1 / x1 / x10 (mean -166.3676", p-p 0.3924 / 0.3924 / 0.3927"), and
+  quasi-static balls give -166.36764" / 0.39239" against -166.36759" / 0.39236"
+  (0.30-0.40 s, benchmarks/bench_balls.py); the centrifugal load of a few-gram
+  ball orbiting with the cage at < 1 rad/s is < 1e-4 N against contact loads of
+  1-100 N -- while the ball coordinates (6 Z per bearing) and
   their stiff contact dynamics make up most of the system and its Newton
   iterations. Condensed rings couple all balls of a row (a dense 3Z block): there
   the balls keep their inertia (the flexible model's default);
@@ -59,8 +60,8 @@ from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.model.base import ForceGroup, Output, exudyn_vector
 from flexrv.model.bearing_kernel import (BALL_FORCE_TOL, N_RECORD, RECORD_FIELDS, ball_workspace, condense_workspace,
-                                         film_workspace, law_parameters, ring_modal_amplitudes, row_element, row_force_kernel,
-                                         row_history, row_kernel)
+                                         film_workspace, law_parameters, ring_modal_amplitudes, row_element,
+                                         row_force_kernel, row_history, row_kernel)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -443,8 +444,8 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
 
 class RowElement:
     """THE Exudyn glue of the bearing rows (issue 15): one Exudyn element for one or
-    more rows (the reducer model: one per row, or one for all rows with quasi-static balls, see
-    :meth:`BallBearingGroup.add_to`), one compiled call
+    more rows (the reducer model: one per row, or one for all rows with quasi-static
+    balls, see :meth:`BallBearingGroup.add_to`), one compiled call
     (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
     evaluation into arrays preallocated here — per row the gather of its element
     coordinates from the nodes' (``idx``: row element coordinate -> nodes'
