@@ -524,9 +524,9 @@ def test_quasi_static_row_is_the_dynamic_row_at_ball_equilibrium(preset):
 @pytest.mark.parametrize("preset", ["rv221", "rv40e"])
 def test_quasi_static_row_jacobian_vs_finite_difference(preset):
     """With quasi-static balls the row's force on the frame F(x, x_t) (the balls solved
-    at every evaluation) has the Jacobians of bearing_kernel.condensed_ball_jacobian
-    (the Schur complement of row_eval's own Jacobian over each ball's 3x3 block,
-    with b_t = S x_t), returned by the row kernel. Central differences (1e-9 m /
+    at every evaluation) has the Jacobians of row_eval's CONDENSED_BALLS mode (the
+    Schur complement of each ball's 3x3 block, bearing_kernel._condense_ball, with
+    b_t = S x_t), returned by the row kernel. Central differences (1e-9 m /
     1e-8 rad, 1e-5 m/s; the local solve's tolerance tightened to 1e-11 of the loads,
     ~1e-9 N over these steps, ~1 N/m against ~1e8) on a displaced, tilted, spinning,
     moving frame: within 1e-4 (stiffness) and 5e-4 (damping) of the largest entry
