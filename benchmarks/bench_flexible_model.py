@@ -119,6 +119,33 @@ against 9b988b1, rv221 11.1, 11.2 -> 10.9, 11.1 s/s (unchanged); start-up window
 moved with the round-off (rv221 10.0439 -> 10.3052", p-p 20.8366 -> 19.6546"); the
 0.4 s run of rv40e gives the same steady window, -166.36764" and 0.39327", and the
 converged regression case flexible_rv221 is unchanged.
+
+Where the time goes (2026-11-24, 0.1 s from rest, CPU per step; user functions timed
+around their calls; scratch measurement, not printed by this script):
+
+=====  ========  ================================  ===============================  ============  ============
+preset per step  rows' residuals                   rows' Jacobians                  fused groups  the rest
+=====  ========  ================================  ===============================  ============  ============
+rv221  1125 us   618 us (12.0 calls, 51 us each)   31 us (0.11 calls, 277 us each)  162 us        314 us
+rv40e  2600 us   876 us (9.2 calls, 96 us each)    640 us (1.10 calls, 581 us each) 168 us        916 us
+=====  ========  ================================  ===============================  ============  ============
+
+(Newton iterations / Jacobians per step: rv221 5.0 / 0.056, rv40e 3.6 / 0.55; "the rest" is
+Exudyn's own work -- the sparse LU of the 249-coordinate system, ~0.8 ms per Jacobian on
+rv40e, the assembly and back-substitutions -- and the pre-step hook.) rv40e's goal (<= 15 s
+per simulated s, 1.5 ms per step) is not met, and these did not bring it closer (measured
+the same way): Exudyn's Newton contractivity 0.25 / 0.8 instead of 0.5: 25.3 / 25.7 s/s
+against 26.1 (3.3 / 5.3 iterations, the Jacobians traded for iterations); a fresh
+Jacobian every step: 36.3 s/s (2.1 iterations, 1.13 Jacobians per step); Exudyn's dense
+solver for the 249 coordinates: 142 s/s. A low-rank ring compliance is not available:
+the compliance factor tables (rv40e 165 / 181 modes, rv221 99 / 115) have a flat
+singular-value spectrum, the smallest s^2 0.7-0.8 % of the largest, so every mode
+counts at the raceway (the compliance there is local, not a few ring modes). Quasi-static
+balls with the condensed rings (as the ball model's) would shrink the system to 21
+coordinates but need the row's dense 3Z x 3Z ball solve inside every residual call:
+estimated (~2 calls per step x 2 rows x ~3 row evaluations of 96 us, ~1.2 ms, plus a
+Jacobian per step, ~1.2 ms for the two rows and their dense 114 x 114 condensations)
+no faster than today, so not built.
 """
 
 from __future__ import annotations

@@ -9,6 +9,13 @@ timing measures steady operation under the preset's load torque. Printed per pre
 * ``residual`` / ``jacobian``: wall µs per call of the Python force user
   function(s) and Jacobian user function(s) during the run (all groups of one
   residual together);
+* ``compiled kernel``: wall µs per time step inside the compiled entry point of the
+  fused kernel (the physics), and everything else of the solve per step (Exudyn's
+  own work, the Python glue of every call, the pre-step hook): the real-time factor
+  the model would have at zero physics cost. Measured 2026-11-24 (0.3 s): kernel
+  100 / 101 µs per step (3.34 / 3.98 calls), the rest 79 / 81 µs per step (rv40e /
+  rv221), i.e. real-time factor 0.79 / 0.81 without any physics: issue 15's goal
+  (<= 1) would leave the kernel ~20 µs per step, ~6 µs per call;
 * ``generalized_forces``: µs per call of ``AssembledModel.generalized_forces`` with
   the Jacobian at a loaded state (the quasi-static solver's path);
 * real-time factor = solve wall s per simulated s, and post-processing wall s
@@ -48,7 +55,7 @@ def _instrument(model):
     """Accumulate wall time and calls of the Python force/Jacobian user functions:
     the fused element (``model.fused``) if present, else every group's
     evaluate/jacobian (one residual = one call of every group)."""
-    acc = {"res": [0.0, 0], "jac": [0.0, 0]}
+    acc = {"res": [0.0, 0], "jac": [0.0, 0], "kernel": [0.0, 0]}
 
     def wrap(obj, attr, key, count=True, single_state_only=False):
         fn = getattr(obj, attr)
@@ -68,6 +75,8 @@ def _instrument(model):
     if fused is not None:
         wrap(fused, "residual", "res")
         wrap(fused, "jacobian", "jac")
+        if getattr(fused, "_entry", None) is not None:  # the compiled kernel alone (found by the warm-up run)
+            wrap(fused, "_entry", "kernel")
     else:
         python_groups = [g for g in model.groups if type(g).__name__ != "RigidMainBearing"]
         for i, g in enumerate(python_groups):
@@ -128,6 +137,10 @@ def bench(name: str, t_end: float, dt: float) -> dict:
             "residual_us": acc["res"][0] / max(acc["res"][1], 1) * 1e6, "residual_calls": acc["res"][1],
             "jacobian_us": acc["jac"][0] / max(acc["jac"][1], 1) * 1e6, "jacobian_calls": acc["jac"][1],
             "user_function_share": (acc["res"][0] + acc["jac"][0]) / solve, "generalized_forces_us": gf_us,
+            "kernel_us_per_step": acc["kernel"][0] / max(tm["steps"], 1) * 1e6,
+            "kernel_calls_per_step": acc["kernel"][1] / max(tm["steps"], 1),
+            "rest_us_per_step": ((solve - acc["kernel"][0]) / max(tm["steps"], 1) * 1e6 if acc["kernel"][1]
+                                 else float("nan")),
             "te_mean_arcsec": float(np.mean(sel)), "te_pp_arcsec": float(np.ptp(sel)),
             "solve_cpu_s": solve_cpu, "post_cpu_s": total_cpu - solve_cpu, "run_cpu_s": total_cpu,
             "rtf_cpu": total_cpu / tm["simulated_s"],
@@ -149,6 +162,10 @@ def main() -> None:
         print(f"  residual {r['residual_us']:.1f} us/call ({r['residual_calls']} calls), "
               f"jacobian {r['jacobian_us']:.1f} us/call ({r['jacobian_calls']} calls), "
               f"user functions {100 * r['user_function_share']:.0f} % of solve")
+        if r["kernel_calls_per_step"]:
+            print(f"  compiled kernel {r['kernel_us_per_step']:.0f} us/step ({r['kernel_calls_per_step']:.2f} calls); "
+                  f"everything else (Exudyn, Python glue, pre-step hook) {r['rest_us_per_step']:.0f} us/step = "
+                  f"real-time factor {r['rest_us_per_step'] * 1e-6 / r['dt_s']:.2f} at zero physics cost")
         print(f"  generalized_forces with Jacobian {r['generalized_forces_us']:.1f} us/call")
         print(f"  solve wall {r['solve_wall_s']:.2f} s -> real-time factor {r['real_time_factor']:.2f}; "
               f"post-processing {r['post_wall_s']:.2f} s; Newton iterations/step "
