@@ -1145,6 +1145,22 @@ def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
 
 
 @njit(cache=True)
+def _adjugate3(k, adj):
+    """The adjugate of the 3x3 block k[:3, :3] into ``adj`` (k^-1 = adj / det); returns
+    det (cofactor expansion along the first row)."""
+    adj[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
+    adj[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
+    adj[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
+    adj[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
+    adj[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
+    adj[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
+    adj[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
+    adj[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
+    adj[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
+    return k[0, 0] * adj[0, 0] + k[0, 1] * adj[1, 0] + k[0, 2] * adj[2, 0]
+
+
+@njit(cache=True)
 def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
                      balls, state, tol, max_iter, f, kbb, rec):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
@@ -1167,6 +1183,7 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     jv = np.empty((0, 0))
     damping = max(law_i[5], law_o[5], geometry[11], 1e-300)
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
+    adj = np.empty((3, 3))
     for it in range(max_iter + 1):
         row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
                  state, BALL_BLOCKS, recs, f, kbb, jv)
@@ -1182,22 +1199,13 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
         dv = 0.0
         for j in range(nz):  # -K^-1 f_j and b_t = -K^-1 (K_bx x_t) (3x3, cofactors)
             k = kbb[3 * j:3 * j + 3]
-            c00 = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
-            c01 = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
-            c02 = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-            c10 = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
-            c11 = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-            c12 = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
-            c20 = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
-            c21 = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
-            c22 = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-            det = k[0, 0] * c00 + k[0, 1] * c01 + k[0, 2] * c02
+            det = _adjugate3(k, adj)
             for off in (0, 3):  # right-hand sides: the ball's force, then K_bx x_t
                 r0, r1, r2 = (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else \
                     (k[0, 3], k[1, 3], k[2, 3])
-                step[j, off] = -(c00 * r0 + c10 * r1 + c20 * r2) / det
-                step[j, off + 1] = -(c01 * r0 + c11 * r1 + c21 * r2) / det
-                step[j, off + 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
+                step[j, off] = -(adj[0, 0] * r0 + adj[0, 1] * r1 + adj[0, 2] * r2) / det
+                step[j, off + 1] = -(adj[1, 0] * r0 + adj[1, 1] * r1 + adj[1, 2] * r2) / det
+                step[j, off + 2] = -(adj[2, 0] * r0 + adj[2, 1] * r1 + adj[2, 2] * r2) / det
             for c in range(3):
                 dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
         if err <= atol and dv <= vtol:
@@ -1224,17 +1232,7 @@ def _condense_ball(jl, vl, nx, kx, cx, s_ball, inv, tm):
     change with x (second order, d S / d x x_t) is left out. The balls couple only
     through x, so the Schur complement over all balls is this sum. inv (3, 3), tm
     (3, nx): work."""
-    k = jl[nx:, nx:]
-    inv[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
-    inv[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
-    inv[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
-    inv[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
-    inv[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-    inv[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
-    inv[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-    inv[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
-    inv[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-    det = k[0, 0] * inv[0, 0] + k[0, 1] * inv[1, 0] + k[0, 2] * inv[2, 0]
+    det = _adjugate3(jl[nx:, nx:], inv)
     for r in range(3):
         for c in range(3):
             inv[r, c] /= det

@@ -482,12 +482,12 @@ class RowElement:
             if i.shape != (m,):
                 raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
             full = r.n_kernel  # quasi-static balls: the kernel's work vectors also hold the balls
-            qs = 0 if r.ball_inertia else 1
-            nj = (1 - qs) * m  # (quasi-static balls: the condensed Jacobians kx, cx instead)
+            # row Jacobians (m, m) with ball inertia; quasi-static balls: the balls' blocks (3Z, 4)
+            # and the condensed Jacobians kx, cx (m, m) instead
+            nj, nb, nk = (m, 0, 0) if r.ball_inertia else (0, 3 * r.ball_count, m)
             self._work.append((i, np.zeros(full), np.zeros(full), np.zeros(full), np.zeros((nj, nj)),
                                np.zeros((nj, nj)), np.zeros((r.ball_count if record else 0, N_RECORD)),
-                               np.zeros((qs * 3 * r.ball_count, 4)), np.zeros((qs * m, qs * m)),
-                               np.zeros((qs * m, qs * m))))
+                               np.zeros((nb, 4)), np.zeros((nk, nk)), np.zeros((nk, nk))))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
         self._parts = None
