@@ -69,6 +69,16 @@ start-up: rv221 mean 10.4327 -> 11.7080", p-p 23.7735 -> 21.4495"; rv40e -21.308
 of a 0.4 s run does not: rv40e -166.36759 / 0.39236" (inertia) against -166.36764 /
 0.39239" (quasi-static), rv221 at 3000 N m -139.60677 / 3.1625" against -139.60685 /
 3.1598". ``--options '{"ball_inertia": true}'`` measures the balls with inertia.
+Then (paired against 8e32984, two runs each, 2026-11-24) the fused element's Jacobians
+came with the step's first residual call (flexrv.model.kernels.FusedForces.residual):
+rv221 4.44, 4.61 -> 4.39, 4.44; rv40e 5.08, 5.08 -> 4.93, 4.99. Those Jacobians differ
+from a second call's at the same state by ~1e-11 (the inner solves restart from their
+own converged state there), which moves the Newton path and the start-up window's TE
+(rv221 11.7080 -> 11.1585", 21.4495 -> 23.8637"; rv40e -20.7907 -> -20.8299", 17.7748
+-> 17.8421"; the same window moves by 0.2" (mean) and 2.8" (p-p) between Newton
+tolerances 1e-3 and 1e-6 with either code); the steady window of a 0.4 s run: rv40e
+-166.36764 / 0.39239" both, rv221 at 3000 N m -139.60685 / 3.1598" -> -139.60671 /
+3.1443" (p-p is not converged in dt, tests/test_time_step.py).
 
 """
 

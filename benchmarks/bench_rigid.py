@@ -15,7 +15,14 @@ timing measures steady operation under the preset's load torque. Printed per pre
   the model would have at zero physics cost. Measured 2026-11-24 (0.3 s): kernel
   100 / 101 µs per step (3.34 / 3.98 calls), the rest 79 / 81 µs per step (rv40e /
   rv221), i.e. real-time factor 0.79 / 0.81 without any physics: issue 15's goal
-  (<= 1) would leave the kernel ~20 µs per step, ~6 µs per call;
+  (<= 1) would leave the kernel ~20 µs per step, ~6 µs per call. 2026-11-24, with the
+  Jacobians made by the step's first residual call (``FusedForces.jacobian_each_step``):
+  kernel 90 / 94-96 µs per step (2.34 / 3.05 calls), the rest 81-82 / 84-87 µs. Where the
+  rest goes (rv40e, 0.2 s, timed around each layer): the pre-step hook 22 µs (its records
+  copy ~10 of it), the element's Python methods around the kernel 5 µs per residual call,
+  the Exudyn user functions' list conversions and Jacobian combination plus Exudyn itself
+  ~38 µs per step, of which Exudyn with trivial Python user functions (two residual, one
+  Jacobian and one pre-step call per step, 21 coordinates, dense LU) takes 9-10 µs;
 * ``generalized_forces``: µs per call of ``AssembledModel.generalized_forces`` with
   the Jacobian at a loaded state (the quasi-static solver's path);
 * real-time factor = solve wall s per simulated s, and post-processing wall s

@@ -34,7 +34,11 @@ simulated, 2026-11-24): 1.3 / 2.0 Newton iterations per step with a fresh Jacobi
 per step (rv40e / rv221), 45-47 / 35-36 us per fused residual call (the condensed
 FE bodies' local Newtons) plus ~1.4 us of Python glue; real-time factor (solve +
 outputs) 1.83-1.84 / 1.84-1.85 (paired against 1.87 / 1.83 before one curve
-evaluation less per pin).
+evaluation less per pin). Then the step's first residual call made the
+fused element's Jacobians too (FusedForces.jacobian_each_step, set here from the
+Newton settings): kernel 100-103 -> 90 us per step on rv40e, real-time factor 1.88,
+1.94 -> 1.79, 1.81 (paired); rv221 1.88, 1.88 -> 1.90, 1.84, its Newton path changed at
+round-off (kernel calls per step 3.98 -> 3.05 but 1.97 -> 2.05 Newton iterations).
 """
 
 from __future__ import annotations
@@ -285,14 +289,17 @@ class Simulation:
         def prestep(mbs_, t_target):
             # Exudyn calls this with the step's END time; the state is the start-of-step state
             t = sd.GetTime(start_of_step)
-            q = exudyn_vector(sd.GetODE2Coordinates())
+            values = sd.GetODE2Coordinates()
             k = state["k"]
             while k > 0 and ts[k - 1] >= t - 1e-12 * dt:  # a step was repeated (adaptive step reduction)
                 k -= 1
             state["k"] = k
-            if not math.isfinite(q.sum()):  # before recording: a failed run's results hold finite states only
+            # before recording: a failed run's results hold finite states only (the sum of the Python
+            # floats: 0.3 us, numpy's 2.5 us per step)
+            if not math.isfinite(sum(values)):
                 state["fail"] = (t, "the state became NaN/inf")
                 return False
+            q = exudyn_vector(values)
             if (k == 0 or t >= ts[k - 1] + output_every * dt * (1 - 1e-9)) and k < n_out:
                 ts[k] = t
                 qs[k] = q
@@ -328,6 +335,9 @@ class Simulation:
         ti.generalizedAlpha.spectralRadius = spectral_radius
         for key, value in newton_options.items():
             setattr(ti.newton, key, value)
+        if model.fused is not None:  # its Jacobians then come with the step's first residual
+            model.fused.jacobian_each_step = bool(ti.newton.useModifiedNewton
+                                                  and ti.newton.modifiedNewtonJacUpdatePerStep)
         # massless (quasi-static) coordinates make M singular: start from rest with
         # zero accelerations instead (every run starts at rest in equilibrium)
         massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())

@@ -260,3 +260,73 @@ def test_recorder_checkpoint_round_trip_with_bearing_rows():
     rec = HistoryRecorder(sim.model, 8)
     assert len(rec.sources) == 2 and [key for _, key, _ in rec.sources[1][2]] == ["balls0", "frame0", "balls1",
                                                                                   "frame1"]
+
+
+def _pack_arrays(x, out):
+    """Every array of a (nested) pack, for a snapshot of the kernels' warm-start state."""
+    if isinstance(x, np.ndarray):
+        out.append(x)
+    elif isinstance(x, (tuple, list)):
+        for y in x:
+            _pack_arrays(y, out)
+    return out
+
+
+def test_first_residual_of_a_step_supplies_the_jacobian(history):
+    """With jacobian_each_step (the rigid model's Newton updates its Jacobian every
+    step), the first residual call at a new time also fills the Jacobians and the
+    solver's Jacobian call at that state returns them without a kernel call: force
+    and Jacobians bit for bit those of the kernel called from the same warm-start
+    state (what a separate Jacobian call computes differs only by the inner solves
+    restarting from their own converged state: 1e-11 relative, measured 2026-11-24);
+    a later residual at the same time computes no Jacobian, a Jacobian call at
+    another state or after ``full`` calls the kernel."""
+    model, t, q, v = history
+    fused = model.fused
+    runs = []
+    call = fused._call
+
+    def counted(*args):
+        runs.append(args[3])
+        return call(*args)
+
+    arrays = _pack_arrays(fused.packs, [])
+    fused.jacobian_each_step = True
+    fused._call = counted
+    try:
+        fused.residual(float(t[-2]), q[-2].copy(), v[-2].copy())
+        snap = [a.copy() for a in arrays]
+        t1, q1, v1 = float(t[-1]), q[-1].copy(), v[-1].copy()
+        f = fused.residual(t1, q1, v1).copy()
+        jq, jv = (a.copy() for a in fused.jacobian(t1, q1.copy(), v1.copy()))
+        assert runs == [True, True]  # the second residual's kernel call made the Jacobians; none after it
+        for a, s in zip(arrays, snap):
+            a[...] = s
+        call(t1, q1, v1, True)
+        assert np.array_equal(fused.f, f) and np.array_equal(fused.jq, jq) and np.array_equal(fused.jv, jv)
+        assert np.abs(jq).max() > 1e8
+        for a, s in zip(arrays, snap):
+            a[...] = s
+        call(t1, q1, v1, False)
+        assert np.array_equal(fused.f, f)  # the force does not depend on whether the Jacobians are made
+        runs.clear()
+        fused.residual(t1, q1 + 1e-9, v1)  # a Newton iterate: same time, no Jacobian
+        fused.jacobian(t1, q1, v1)  # another state than the last call's: the kernel
+        fused.full(t1, q1, v1, jacobian=False)
+        fused.jacobian(t1, q1, v1)  # full() overwrote the arrays: the kernel again
+        assert runs == [False, True, False, True]
+    finally:
+        fused._call = call
+        fused.jacobian_each_step = False
+
+
+def test_simulation_sets_jacobian_each_step_from_its_newton_settings():
+    """The fused element makes its Jacobians with the step's first residual exactly when
+    the solver updates the Jacobian at every step (the rigid model's default)."""
+    from flexrv.simulation import Simulation
+
+    sim = Simulation(_fast("rv40e"))
+    sim.run(t_end=0.002)
+    assert sim.model.fused.jacobian_each_step is True
+    sim.run(t_end=0.002, newton_options={"modifiedNewtonJacUpdatePerStep": False})
+    assert sim.model.fused.jacobian_each_step is False

@@ -218,3 +218,30 @@ def test_start_with_a_skipped_pin_is_a_failure_not_a_result():
     for j in range(m.params.n_cranks):  # the same model from its nominal start runs
         m.members[f"crank{j}"].q0[2] -= 2 * np.pi
     assert sim.run(t_end=0.005, dt=1e-4).attrs["status"] == "completed"
+
+
+def test_non_finite_state_is_a_failure_not_a_result(monkeypatch):
+    """A state that is not finite at the start of a step (here a restart whose last
+    state holds a NaN) ends the run as a failure naming it (SimulationError); its
+    results keep only the finite states recorded before it."""
+    from flexrv.post import results as post_results
+
+    cap = {}
+    orig = post_results.results_from_states
+
+    def spy(model, t, q, v, **kw):
+        cap.update(t=np.array(t), q=np.array(q), v=np.array(v))
+        return orig(model, t, q, v, **kw)
+
+    monkeypatch.setattr(post_results, "results_from_states", spy)
+    sim = Simulation("rv40e")
+    sim.run(t_end=0.002)
+    t, q, v = cap["t"], cap["q"], cap["v"]
+    q_bad = q[10].copy()
+    q_bad[0] = np.nan
+    restart = {"step": 10, "t": t[:10], "q": q[:10], "v": v[:10], "q_b": q_bad, "v_b": v[10],
+               "a_b": np.zeros_like(q_bad)}
+    with pytest.raises(SimulationError, match="the state became NaN/inf") as exc:
+        sim.run(t_end=0.002, restart=restart)
+    assert exc.value.results.attrs["status"] == "failed"
+    assert len(cap["t"]) == 10 and np.all(np.isfinite(cap["q"]))
