@@ -213,8 +213,8 @@ class FusedForces:
         #: belong to (HistoryRecorder), or None. References, not copies: Exudyn passes every call fresh
         #: arrays it never reuses (checked: 127 calls, none changed afterwards)
         self.memo = None
-        #: (t, q bytes, v bytes) of the last call if it filled the Jacobians (jq, jv hold them), else None
-        self.jac_state = None
+        #: jq, jv hold the Jacobians of the call that ``memo`` describes
+        self._jac_ready = False
         #: time of the last residual call
         self._t_last = None
         #: the solver updates its Jacobian at the start of every step (set by the simulation from its
@@ -298,7 +298,7 @@ class FusedForces:
         """Generalized force on the element's coordinates (a view, overwritten by the next call).
 
         With :attr:`jacobian_each_step` the first call at a new time (the solver's predictor
-        of a new step) also fills the Jacobians (:attr:`jac_state`): a solver that updates its
+        of a new step) also fills the Jacobians: a solver that updates its
         Jacobian every step asks for them next, at that same state (the rigid model's calls per
         step are R J R [R ...]; every Jacobian call of a 0.1 s rv40e / rv221 run, 1266 / 1119,
         came at the previous call's state), and :meth:`jacobian` then returns them without a
@@ -307,30 +307,30 @@ class FusedForces:
         self.memo = None  # until the call has filled the records
         first = self.jacobian_each_step and t != self._t_last
         self._t_last = t
-        self.jac_state = None
+        self._jac_ready = False
         self._call(t, q, v, first)
         self.memo = (t, q, v)
-        if first:
-            self.jac_state = (t, q.tobytes(), v.tobytes())
+        self._jac_ready = first
         return self.f
 
     def jacobian(self, t, q, v):
         """(dF/dq, dF/dv) on the element's coordinates (views, overwritten by the next call):
         those the last residual call computed if it was at exactly (t, q, v), else a kernel call."""
         self.stats[1] += 1
-        js = self.jac_state
-        if js is not None and js[0] == t and js[1] == q.tobytes() and js[2] == v.tobytes():
+        m = self.memo
+        if (self._jac_ready and m is not None and m[0] == t and m[1].tobytes() == q.tobytes()
+                and m[2].tobytes() == v.tobytes()):
             return self.jq, self.jv
         self.memo = None  # until the call has filled the records
         self._call(t, q, v, True)
         self.memo = (t, q, v)
-        self.jac_state = (t, q.tobytes(), v.tobytes())
+        self._jac_ready = True
         return self.jq, self.jv
 
     def full(self, t, q, v, jacobian: bool = True):
         """Force and Jacobians on the MODEL's full vector (copies), for static solvers."""
         n_model = len(q)
-        self.memo = self.jac_state = None  # the caller may change its arrays afterwards
+        self.memo, self._jac_ready = None, False  # the caller may change its arrays afterwards
         if self.is_full:
             self._call(float(t), q, v, bool(jacobian))
             return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
