@@ -147,15 +147,23 @@ def bench(name: str, t_end: float, newton: dict | None, options: dict | None = N
     te = res["te"]
     sel = te.values[te["time"].values >= 0.5 * t_end]
     steps = max(tm["steps"], 1)
-    return {"preset": name, "n": model.n, "simulated_s": tm["simulated_s"], "cpu_per_s": cpu / tm["simulated_s"],
-            "solve_cpu_per_s": tm["solve_cpu_s"] / tm["simulated_s"],
-            "outputs_cpu_s": cpu - tm["solve_cpu_s"], "newton_per_step": tm["newton_iterations"] / steps,
-            "jacobians": tm["jacobians"], "steps": steps,
-            **{f"{k}_us": v[0] / max(v[1], 1) * 1e6 for k, v in acc.items()},
-            **{f"{k}_calls": v[1] for k, v in acc.items()},
-            "te_mean": float(np.mean(sel)), "te_pp": float(np.ptp(sel)),
-            "max_ball_load": float(np.max(res["ball_load_inner"].values[-1])) if "ball_load_inner" in res else np.nan,
-            "status": res.attrs.get("status")}
+    return {
+        "preset": name,
+        "n": model.n,
+        "simulated_s": tm["simulated_s"],
+        "cpu_per_s": cpu / tm["simulated_s"],
+        "solve_cpu_per_s": tm["solve_cpu_s"] / tm["simulated_s"],
+        "outputs_cpu_s": cpu - tm["solve_cpu_s"],
+        "newton_per_step": tm["newton_iterations"] / steps,
+        "jacobians": tm["jacobians"],
+        "steps": steps,
+        **{f"{k}_us": v[0] / max(v[1], 1) * 1e6 for k, v in acc.items()},
+        **{f"{k}_calls": v[1] for k, v in acc.items()},
+        "te_mean": float(np.mean(sel)),
+        "te_pp": float(np.ptp(sel)),
+        "max_ball_load": float(np.max(res["ball_load_inner"].values[-1])) if "ball_load_inner" in res else np.nan,
+        "status": res.attrs.get("status"),
+    }
 
 
 def main() -> None:
@@ -163,7 +171,7 @@ def main() -> None:
     ap.add_argument("--presets", nargs="*", default=["rv221", "rv40e"])
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--newton", default=None, help="newton_options as JSON")
-    ap.add_argument("--options", default=None, help='model options as JSON, e.g. \'{"ball_inertia": true}\'')
+    ap.add_argument("--options", default=None, help="model options as JSON, e.g. '{\"ball_inertia\": true}'")
     a = ap.parse_args()
     import flexrv
 
@@ -172,15 +180,24 @@ def main() -> None:
     print(f"flexrv from {os.path.dirname(flexrv.__file__)}; newton_options {newton}; model options {options}")
     for name in a.presets:
         r = bench(name, a.t_end, newton, options)
-        print(f"{r['preset']} balls: n = {r['n']}, {r['steps']} steps for {r['simulated_s']:.3g} s, "
-              f"Newton/step {r['newton_per_step']:.2f}, Jacobians {r['jacobians']}")
-        print(f"  CPU per simulated s: {r['cpu_per_s']:.2f} (solve {r['solve_cpu_per_s']:.2f}; outputs "
-              f"{r['outputs_cpu_s']:.3f} s)")
-        print(f"  row force {r['row_us']:.1f} us x {r['row_calls']}, row Jacobian {r['row_jac_us']:.1f} us x "
-              f"{r['row_jac_calls']}, fused residual {r['fused_us']:.1f} us x {r['fused_calls']}, fused Jacobian "
-              f"{r['fused_jac_us']:.1f} us x {r['fused_jac_calls']}")
-        print(f"  TE (t >= {0.5 * a.t_end:g} s): mean {r['te_mean']:.4f} arcsec, p-p {r['te_pp']:.4f} arcsec; "
-              f"max inner ball load {r['max_ball_load']:.3f} N; {r['status']}", flush=True)
+        print(
+            f"{r['preset']} balls: n = {r['n']}, {r['steps']} steps for {r['simulated_s']:.3g} s, "
+            f"Newton/step {r['newton_per_step']:.2f}, Jacobians {r['jacobians']}"
+        )
+        print(
+            f"  CPU per simulated s: {r['cpu_per_s']:.2f} (solve {r['solve_cpu_per_s']:.2f}; outputs "
+            f"{r['outputs_cpu_s']:.3f} s)"
+        )
+        print(
+            f"  row force {r['row_us']:.1f} us x {r['row_calls']}, row Jacobian {r['row_jac_us']:.1f} us x "
+            f"{r['row_jac_calls']}, fused residual {r['fused_us']:.1f} us x {r['fused_calls']}, fused Jacobian "
+            f"{r['fused_jac_us']:.1f} us x {r['fused_jac_calls']}"
+        )
+        print(
+            f"  TE (t >= {0.5 * a.t_end:g} s): mean {r['te_mean']:.4f} arcsec, p-p {r['te_pp']:.4f} arcsec; "
+            f"max inner ball load {r['max_ball_load']:.3f} N; {r['status']}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

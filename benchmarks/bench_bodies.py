@@ -69,8 +69,13 @@ def run(preset: str, body: str, size_mm: float | None) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg")
     with tempfile.TemporaryDirectory() as tmp:
         env["FLEXRV_CACHE_DIR"] = tmp
-        out = subprocess.run([sys.executable, "-c", CHILD, preset, body, "none" if size_mm is None else str(size_mm)],
-                             env=env, capture_output=True, text=True, check=True)
+        out = subprocess.run(
+            [sys.executable, "-c", CHILD, preset, body, "none" if size_mm is None else str(size_mm)],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=True,
+        )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -84,8 +89,10 @@ def main() -> None:
     args = ap.parse_args()
     if args.rbe2:
         os.environ["BENCH_RBE2"] = "1"
-    print(f"{'preset':6} {'body':8} {'size mm':>7} {'nodes':>7} {'mesh s':>7} {'asm s':>6} {'solve s':>7} "
-          f"{'CPU s':>6} {'wall s':>6} {'peak MB':>7} {'base MB':>7}  value [rad/(N m)]")
+    print(
+        f"{'preset':6} {'body':8} {'size mm':>7} {'nodes':>7} {'mesh s':>7} {'asm s':>6} {'solve s':>7} "
+        f"{'CPU s':>6} {'wall s':>6} {'peak MB':>7} {'base MB':>7}  value [rad/(N m)]"
+    )
     total = 0.0
     for p in args.presets:
         for b in args.bodies:
@@ -93,9 +100,12 @@ def main() -> None:
             t0 = time.perf_counter()
             d = run(p, b, size)
             total += d["cpu"]
-            print(f"{p:6} {b:8} {d['size_mm']:7.3g} {d['n_nodes']:7d} {d['mesh']:7.1f} {d['assemble']:6.1f} "
-                  f"{d['solve']:7.1f} {d['cpu']:6.1f} {d['wall']:6.1f} {d['peak_MB']:7.0f} {d['base_MB']:7.0f}  "
-                  f"{d['value']:.5e}", flush=True)
+            print(
+                f"{p:6} {b:8} {d['size_mm']:7.3g} {d['n_nodes']:7d} {d['mesh']:7.1f} {d['assemble']:6.1f} "
+                f"{d['solve']:7.1f} {d['cpu']:6.1f} {d['wall']:6.1f} {d['peak_MB']:7.0f} {d['base_MB']:7.0f}  "
+                f"{d['value']:.5e}",
+                flush=True,
+            )
     print(f"total child CPU {total:.1f} s")
 
 

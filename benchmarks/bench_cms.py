@@ -35,7 +35,9 @@ def main() -> None:
 
     rv = load("rv221")
     mat = material_dict(rv, "outer_ring")
-    print(f"{'DOF':>8} {'mesh s':>7} {'assemble s':>10} {'reduce s':>9} {'modes':>6} {'total s':>8} {'peak RSS MB':>11}")
+    print(
+        f"{'DOF':>8} {'mesh s':>7} {'assemble s':>10} {'reduce s':>9} {'modes':>6} {'total s':>8} {'peak RSS MB':>11}"
+    )
     for size_mm in (float(s) for s in args.sizes.split(",")):
         h = size_mm * 1e-3
         t0 = time.perf_counter()
@@ -46,8 +48,10 @@ def main() -> None:
         rw = raceway_spec_for(spec_for(rv, "outer_ring"), None, args.harmonics) if args.harmonics else None
         body = build_reduced_body(mres, mat, n_eig=args.eig, raceway=rw, fe=fe, cache=False)
         t3 = time.perf_counter()
-        print(f"{fe.n_dof:8d} {t1 - t0:7.2f} {t2 - t1:10.2f} {t3 - t2:9.2f} {body.n_modes:6d} {t3 - t0:8.2f} "
-              f"{peak_mb():11.0f}   lowest clamped f = {np.round(body.frequencies_hz[:2], 0)} Hz")
+        print(
+            f"{fe.n_dof:8d} {t1 - t0:7.2f} {t2 - t1:10.2f} {t3 - t2:9.2f} {body.n_modes:6d} {t3 - t0:8.2f} "
+            f"{peak_mb():11.0f}   lowest clamped f = {np.round(body.frequencies_hz[:2], 0)} Hz"
+        )
 
 
 if __name__ == "__main__":

@@ -57,10 +57,14 @@ def main() -> None:
     cpu = time.process_time() - c0
     t = cmp.numbers["timing"]
     print(f"compare {args.preset} --t-end {args.t_end} --parts {args.parts} ({'cold' if args.cold else 'warm'} cache)")
-    print(f"  rigid model (build + run + save):      {t['rigid_s']:8.1f} s wall {t['rigid_cpu_s']:8.1f} s CPU "
-          f"(solve {t['rigid_solve_cpu_s']:.1f} s CPU)")
-    print(f"  flexible model (build + run + save):   {t['flexible_s']:8.1f} s wall {t['flexible_cpu_s']:8.1f} s CPU "
-          f"(build incl. meshing/CMS {t['flexible_build_s']:.1f} s wall, solve {t['flexible_solve_cpu_s']:.1f} s CPU)")
+    print(
+        f"  rigid model (build + run + save):      {t['rigid_s']:8.1f} s wall {t['rigid_cpu_s']:8.1f} s CPU "
+        f"(solve {t['rigid_solve_cpu_s']:.1f} s CPU)"
+    )
+    print(
+        f"  flexible model (build + run + save):   {t['flexible_s']:8.1f} s wall {t['flexible_cpu_s']:8.1f} s CPU "
+        f"(build incl. meshing/CMS {t['flexible_build_s']:.1f} s wall, solve {t['flexible_solve_cpu_s']:.1f} s CPU)"
+    )
     if "main_bearing" in args.parts:
         from flexrv.design import load
         from flexrv.model.flexible_bearing import flexible_rings
@@ -68,15 +72,19 @@ def main() -> None:
         for label, rings in flexible_rings(load(args.preset)).items():  # cache hits: the run's bodies
             if label in ("inner", "outer"):
                 info = rings[0].body.info
-                print(f"    {label} ring: {info['n_dof']} DOF, {rings[0].n_modes} modes; FE assembly "
-                      f"{info['t_assemble_s']:.1f} s, reduction (sparse LU + attachment modes) {info['t_reduce_s']:.1f} s"
-                      " wall (in the build)")
+                print(
+                    f"    {label} ring: {info['n_dof']} DOF, {rings[0].n_modes} modes; FE assembly "
+                    f"{info['t_assemble_s']:.1f} s, reduction (sparse LU + attachment modes) {info['t_reduce_s']:.1f} s"
+                    " wall (in the build)"
+                )
     print(f"  plots + summary: {total - t['rigid_s'] - t['flexible_s']:8.1f} s wall")
     print(f"  total: {total:8.1f} s wall, {cpu:8.1f} s CPU   (goal: 60 s for rv221, t_end 1 s, cold)")
     for name in ("rigid", "flexible"):
         n = cmp.numbers[name]
-        print(f"  {name:8s} TE mean {n['te_mean_arcsec']:10.4f} arcsec, p-p {n['te_pp_arcsec']:8.4f} arcsec, "
-              f"rms fluctuation {n['te_rms_fluctuation_arcsec']:8.4f} arcsec")
+        print(
+            f"  {name:8s} TE mean {n['te_mean_arcsec']:10.4f} arcsec, p-p {n['te_pp_arcsec']:8.4f} arcsec, "
+            f"rms fluctuation {n['te_rms_fluctuation_arcsec']:8.4f} arcsec"
+        )
 
 
 if __name__ == "__main__":

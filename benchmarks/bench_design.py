@@ -43,12 +43,18 @@ def main() -> None:
     ss = r.second_stage
     c, rot = nominal_disc_pose(ss.pin_count, ss.eccentricity, 0.3)
     pins = to_disc_frame(pin_positions(ss.pin_count, ss.pin_circle_radius), c, rot)
-    med, best = _time(lambda: pin_gap(pins, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
-                                      d_pin_radius=5e-6), repeat=200)
+    med, best = _time(
+        lambda: pin_gap(pins, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity, d_pin_radius=5e-6),
+        repeat=200,
+    )
     rows.append(("pin_gap, 40 pins, cold start", med, best))
     _, _, phi = pin_gap(pins, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity)
-    med, best = _time(lambda: pin_gap(pins, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
-                                      d_pin_radius=5e-6, phi0=phi), repeat=200)
+    med, best = _time(
+        lambda: pin_gap(
+            pins, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity, d_pin_radius=5e-6, phi0=phi
+        ),
+        repeat=200,
+    )
     rows.append(("pin_gap, 40 pins, warm start", med, best))
     g = BallBearingGeometry.from_design(load("rv221").main_bearing)
     e = float(effective_modulus(208e9, 0.3, 208e9, 0.3))

@@ -26,8 +26,14 @@ from flexrv.ehl.solver import LubricantProperties, solve_point_contact  # noqa: 
 
 CASES = {
     "circular M=260": (100.0, 1.0, 0.01, 0.01, 2.2e11, LubricantProperties(0.05, 2e-8, 0.67, 1.96e8, 870.0)),
-    "rv221 ball M=720": (97.7, 0.0548, 0.01389, 0.39, 2.2857e11,
-                         LubricantProperties(0.13, 2e-8, 0.68, 1.96e8, 870.0, 0.6e-9, 1.7e-9)),
+    "rv221 ball M=720": (
+        97.7,
+        0.0548,
+        0.01389,
+        0.39,
+        2.2857e11,
+        LubricantProperties(0.13, 2e-8, 0.68, 1.96e8, 870.0, 0.6e-9, 1.7e-9),
+    ),
 }
 
 
@@ -36,10 +42,17 @@ def bench_solver(repeats: int = 2) -> None:
     refinement), the fast first-order path (``wedge_order=1, extrapolate=False``) at 129^2, and the
     default adaptive solve (scheme ``+A``: 129^2 refined until h_c changes < 2 %; the grid
     column shows where it stopped)."""
-    print(f"{'case':18s} {'grid':>6s} {'scheme':>8s} {'wall [s]':>9s} {'cpu [s]':>8s} {'Newton':>7s} "
-          f"{'h_c [nm]':>9s} {'h_c grid':>9s} {'h_min [nm]':>10s}")
-    runs = [(65, {}), (129, dict(grid_tol=None)), (129, dict(wedge_order=1, extrapolate=False)),
-            (257, dict(grid_tol=None)), (129, {})]
+    print(
+        f"{'case':18s} {'grid':>6s} {'scheme':>8s} {'wall [s]':>9s} {'cpu [s]':>8s} {'Newton':>7s} "
+        f"{'h_c [nm]':>9s} {'h_c grid':>9s} {'h_min [nm]':>10s}"
+    )
+    runs = [
+        (65, {}),
+        (129, dict(grid_tol=None)),
+        (129, dict(wedge_order=1, extrapolate=False)),
+        (257, dict(grid_tol=None)),
+        (129, {}),
+    ]
     for name, (q, u, rx, ry, e, lub) in CASES.items():
         for n, kw in runs:
             best_wall = best_cpu = np.inf
@@ -48,11 +61,12 @@ def bench_solver(repeats: int = 2) -> None:
                 res = solve_point_contact(q, u, rx, ry, e, lub, grid=n, **kw)
                 best_wall = min(best_wall, time.perf_counter() - t0)
                 best_cpu = min(best_cpu, time.process_time() - c0)
-            scheme = f"o{res.wedge_order}" + ("+R" if res.extrapolated else "") + ("+A" if not kw
-                                                                                   and n >= 129 else "")
-            print(f"{name:18s} {res.grid:4d}^2 {scheme:>8s} {best_wall:9.3f} {best_cpu:8.3f} "
-                  f"{res.iterations:3d}/{res.total_iterations:<3d} {res.h_central * 1e9:9.2f} "
-                  f"{res.h_central_grid * 1e9:9.2f} {res.h_min * 1e9:10.2f}")
+            scheme = f"o{res.wedge_order}" + ("+R" if res.extrapolated else "") + ("+A" if not kw and n >= 129 else "")
+            print(
+                f"{name:18s} {res.grid:4d}^2 {scheme:>8s} {best_wall:9.3f} {best_cpu:8.3f} "
+                f"{res.iterations:3d}/{res.total_iterations:<3d} {res.h_central * 1e9:9.2f} "
+                f"{res.h_central_grid * 1e9:9.2f} {res.h_min * 1e9:10.2f}"
+            )
 
 
 def bench_law(n_calls: int = 2000) -> None:

@@ -19,10 +19,17 @@ import time
 import numpy as np
 
 
-def build(preset: str, flexible: bool, size: float | None, axial: float, radial: float, ramp_time: float = 0.0,
-          condense: bool = True):
+def build(
+    preset: str,
+    flexible: bool,
+    size: float | None,
+    axial: float,
+    radial: float,
+    ramp_time: float = 0.0,
+    condense: bool = True,
+):
     import exudyn as exu
-    from exudyn.itemInterface import (LoadForceVector, MarkerNodeRigid, NodeRigidBodyRxyz, ObjectRigidBody)
+    from exudyn.itemInterface import LoadForceVector, MarkerNodeRigid, NodeRigidBodyRxyz, ObjectRigidBody
     from exudyn.utilities import RigidBodyInertia
 
     from flexrv.design import load
@@ -39,16 +46,22 @@ def build(preset: str, flexible: bool, size: float | None, axial: float, radial:
         body = reduce_part(reducer, "outer_ring", size=size)
         t_reduce = time.perf_counter() - t0
         zeta = reducer.main_bearing.ring_damping_ratio
-        outer = [ModalRing(body, damping_ratio=zeta, condense=condense),
-                 ModalRing(body, damping_ratio=zeta, mirror=True, condense=condense)]
+        outer = [
+            ModalRing(body, damping_ratio=zeta, condense=condense),
+            ModalRing(body, damping_ratio=zeta, mirror=True, condense=condense),
+        ]
     rows = rows_from_design(reducer, outer=outer)
     omega_c = float(reducer_kinematics(reducer).speeds.carrier)
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     frame = mbs.AddNode(NodeRigidBodyRxyz(referenceCoordinates=[0.0] * 6, initialVelocities=[0, 0, 0, 0, 0, omega_c]))
-    inertia = RigidBodyInertia(mass=reducer.inertia.carrier_mass_kg,
-                               inertiaTensor=np.diag([0.5, 0.5, 1.0]) * reducer.inertia.carrier_inertia_kg_m2)
-    mbs.AddObject(ObjectRigidBody(mass=reducer.inertia.carrier_mass_kg, inertia=inertia.GetInertia6D(), nodeNumber=frame))
+    inertia = RigidBodyInertia(
+        mass=reducer.inertia.carrier_mass_kg,
+        inertiaTensor=np.diag([0.5, 0.5, 1.0]) * reducer.inertia.carrier_inertia_kg_m2,
+    )
+    mbs.AddObject(
+        ObjectRigidBody(mass=reducer.inertia.carrier_mass_kg, inertia=inertia.GetInertia6D(), nodeNumber=frame)
+    )
     handle = add_main_bearing(mbs, rows, frame)
     marker = mbs.AddMarker(MarkerNodeRigid(nodeNumber=frame))
     load_vec = np.array([radial, 0.0, axial])
@@ -75,12 +88,14 @@ def main() -> None:
     parser.add_argument("--size", type=float, default=None, help="ring mesh size [m] (default: the part's)")
     parser.add_argument("--t-end", type=float, default=0.01)
     parser.add_argument("--dt", type=float, default=1e-4)
-    parser.add_argument("--ramp", type=float, default=None,
-                        help="external-load ramp time [s] (default: half of --t-end; 0 = step load)")
+    parser.add_argument(
+        "--ramp", type=float, default=None, help="external-load ramp time [s] (default: half of --t-end; 0 = step load)"
+    )
     args = parser.parse_args()
     ramp_time = 0.5 * args.t_end if args.ramp is None else args.ramp
-    mbs, sc, handle, rows, t_reduce = build(args.preset, args.flexible, args.size, 15e3, 20e3, ramp_time,
-                                            condense=not args.uncondensed)
+    mbs, sc, handle, rows, t_reduce = build(
+        args.preset, args.flexible, args.size, 15e3, 20e3, ramp_time, condense=not args.uncondensed
+    )
     import flexrv.model.flexible_bearing as fb
 
     calls = {"n": 0, "t": 0.0}
@@ -92,6 +107,7 @@ def main() -> None:
             calls["t"] += time.process_time() - t0
             calls["n"] += 1
             return out
+
         return wrapper
 
     fb.row_force = timed(fb.row_force)
@@ -113,13 +129,17 @@ def main() -> None:
     steps = settings.timeIntegration.numberOfSteps
     modes = rows[0].outer.n_modes if args.flexible else 0
     kind = ("condensed" if not args.uncondensed else "uncondensed") + f" flexible outer rings ({modes} modes each)"
-    print(f"{args.preset}: {kind if args.flexible else 'rigid rings'}, "
-          f"{rows[0].ball_count} balls x 2 rows, dt = {args.dt:g} s, {steps} steps, "
-          f"15/20 kN axial/radial ramped over {ramp_time:g} s")
+    print(
+        f"{args.preset}: {kind if args.flexible else 'rigid rings'}, "
+        f"{rows[0].ball_count} balls x 2 rows, dt = {args.dt:g} s, {steps} steps, "
+        f"15/20 kN axial/radial ramped over {ramp_time:g} s"
+    )
     if args.flexible:
         print(f"  reduce outer ring (cached after first run): {t_reduce:.2f} s")
-    print(f"  wall {wall:.2f} s -> {1e3 * wall / steps:.2f} ms/step, {wall / args.t_end:.0f} s per simulated s; "
-          f"CPU {cpu:.2f} s -> {cpu / args.t_end:.0f} s per simulated s")
+    print(
+        f"  wall {wall:.2f} s -> {1e3 * wall / steps:.2f} ms/step, {wall / args.t_end:.0f} s per simulated s; "
+        f"CPU {cpu:.2f} s -> {cpu / args.t_end:.0f} s per simulated s"
+    )
     print(f"  user-function calls {calls['n']} ({calls['n'] / steps:.1f}/step), share of CPU {calls['t'] / cpu:.0%}")
 
 

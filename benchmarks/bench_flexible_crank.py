@@ -26,16 +26,17 @@ def main(t_end: float = T_END) -> dict:
     comp = crank_compliance(red, cache=False)
     cold = time.perf_counter() - t0
     crank_compliance(red)  # warm the cache for the timed runs
-    out = {"condensation_cold_s": cold, "k_t_Nm_per_rad": comp.torsional,
-           "lowest_clamped_hz": comp.lowest_clamped_hz}
+    out = {"condensation_cold_s": cold, "k_t_Nm_per_rad": comp.torsional, "lowest_clamped_hz": comp.lowest_clamped_hz}
     for label, model, opts in (("rigid crank", "rigid", {}), ("flexible crank", "flexible", {"parts": ["crankshaft"]})):
         sim = Simulation(red, model=model, model_options=opts)
         t0 = time.perf_counter()
         res = sim.run(t_end=t_end)
         wall = time.perf_counter() - t0
         out[label] = {"wall_s": wall, "wall_per_simulated_s": wall / t_end, "steps": int(len(res.time))}
-    print(f"rv40e, t_end = {t_end:g} s (seed002 drive); crank FE condensation cold: {cold:.2f} s "
-          f"(k_t = {comp.torsional:.4g} N m/rad, lowest clamped mode {comp.lowest_clamped_hz:.4g} Hz)")
+    print(
+        f"rv40e, t_end = {t_end:g} s (seed002 drive); crank FE condensation cold: {cold:.2f} s "
+        f"(k_t = {comp.torsional:.4g} N m/rad, lowest clamped mode {comp.lowest_clamped_hz:.4g} Hz)"
+    )
     for label in ("rigid crank", "flexible crank"):
         o = out[label]
         print(f"  {label:15s} wall {o['wall_s']:7.2f} s   {o['wall_per_simulated_s']:7.1f} s per simulated s")

@@ -178,11 +178,22 @@ def run(preset: str, model: str, t_end: float, options: dict, window: float | No
     te = res["te"].sel(time=slice(t_end - (0.5 * t_end if window is None else window), None)).values
     ball = float(np.max(res["ball_load_inner"].values[-1])) if "ball_load_inner" in res else float("nan")
     ring = float(np.max(res["ring_deformation_outer"].values[-1])) if "ring_deformation_outer" in res else float("nan")
-    return {"model": model, "coordinates": m.n, "build_s": build, "solve_s": t["solve_s"],
-            "wall_per_sim_s": t["solve_s"] / sim_s, "cpu_per_sim_s": cpu / sim_s,
-            "ms_per_step": 1e3 * t["solve_s"] / steps, "newton_per_step": t["newton_iterations"] / steps,
-            "jacobians": t["jacobians"], "te_mean": float(te.mean()), "te_pp": float(np.ptp(te)),
-            "max_ball_load": ball, "ring_um": 1e6 * ring, "status": res.attrs.get("status")}
+    return {
+        "model": model,
+        "coordinates": m.n,
+        "build_s": build,
+        "solve_s": t["solve_s"],
+        "wall_per_sim_s": t["solve_s"] / sim_s,
+        "cpu_per_sim_s": cpu / sim_s,
+        "ms_per_step": 1e3 * t["solve_s"] / steps,
+        "newton_per_step": t["newton_iterations"] / steps,
+        "jacobians": t["jacobians"],
+        "te_mean": float(te.mean()),
+        "te_pp": float(np.ptp(te)),
+        "max_ball_load": ball,
+        "ring_um": 1e6 * ring,
+        "status": res.attrs.get("status"),
+    }
 
 
 def main() -> None:
@@ -193,17 +204,26 @@ def main() -> None:
     parser.add_argument("--harmonics", type=int, default=None, help="raceway harmonics K of the rings")
     parser.add_argument("--parts", default="main_bearing", help="flexible parts of the flexible model")
     parser.add_argument("--ring-options", default="{}", help="extra ring options (JSON), e.g. '{\"condense\": false}'")
-    parser.add_argument("--window", type=float, default=None, help="TE statistics over the last WINDOW s "
-                        "(default: the last half; past the load ramp 0.1-0.2 s use --t-end 0.3 --window 0.1)")
+    parser.add_argument(
+        "--window",
+        type=float,
+        default=None,
+        help="TE statistics over the last WINDOW s "
+        "(default: the last half; past the load ramp 0.1-0.2 s use --t-end 0.3 --window 0.1)",
+    )
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
     args = parser.parse_args()
     if args.cold:
         os.environ["FLEXRV_CACHE"] = tempfile.mkdtemp(prefix="flexrv-bench-")
     window = 0.5 * args.t_end if args.window is None else args.window
-    print(f"preset {args.preset}, t_end {args.t_end} s, dt 1e-4 s; TE over the last {window:g} s [arcsec]; "
-          f"cpu/sim: CPU of run() (solve + outputs) per simulated s")
-    print(f"{'model':10s} {'n':>5s} {'build s':>8s} {'solve s':>8s} {'wall/sim':>8s} {'cpu/sim':>8s} {'ms/step':>8s} "
-          f"{'Newton/st':>9s} {'Jacobians':>9s} {'TE mean':>10s} {'TE p-p':>8s} {'max Q_i N':>10s} {'ring um':>8s}")
+    print(
+        f"preset {args.preset}, t_end {args.t_end} s, dt 1e-4 s; TE over the last {window:g} s [arcsec]; "
+        f"cpu/sim: CPU of run() (solve + outputs) per simulated s"
+    )
+    print(
+        f"{'model':10s} {'n':>5s} {'build s':>8s} {'solve s':>8s} {'wall/sim':>8s} {'cpu/sim':>8s} {'ms/step':>8s} "
+        f"{'Newton/st':>9s} {'Jacobians':>9s} {'TE mean':>10s} {'TE p-p':>8s} {'max Q_i N':>10s} {'ring um':>8s}"
+    )
     for model in args.models.split(","):
         opts = {}
         if model == "flexible":
@@ -214,10 +234,13 @@ def main() -> None:
             if ring:
                 opts["ring_options"] = ring
         r = run(args.preset, model, args.t_end, opts, args.window)
-        print(f"{r['model']:10s} {r['coordinates']:5d} {r['build_s']:8.2f} {r['solve_s']:8.2f} "
-              f"{r['wall_per_sim_s']:8.1f} {r['cpu_per_sim_s']:8.1f} {r['ms_per_step']:8.2f} "
-              f"{r['newton_per_step']:9.2f} {r['jacobians']:9d} {r['te_mean']:10.4f} {r['te_pp']:8.4f} "
-              f"{r['max_ball_load']:10.2f} {r['ring_um']:8.4f}  {r['status']}", flush=True)
+        print(
+            f"{r['model']:10s} {r['coordinates']:5d} {r['build_s']:8.2f} {r['solve_s']:8.2f} "
+            f"{r['wall_per_sim_s']:8.1f} {r['cpu_per_sim_s']:8.1f} {r['ms_per_step']:8.2f} "
+            f"{r['newton_per_step']:9.2f} {r['jacobians']:9d} {r['te_mean']:10.4f} {r['te_pp']:8.4f} "
+            f"{r['max_ball_load']:10.2f} {r['ring_um']:8.4f}  {r['status']}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -137,21 +137,36 @@ def bench(name: str, t_end: float, dt: float) -> dict:
     solve_cpu = tm.get("solve_cpu_s", float("nan"))  # absent before the segmented runs
     te = res["te"]
     sel = te.values[te["time"].values > 0.02]
-    return {"preset": name, "dt_s": dt, "simulated_s": tm["simulated_s"], "solve_wall_s": solve,
-            "post_wall_s": total - solve, "real_time_factor": solve / tm["simulated_s"],
-            "steps": tm["steps"], "newton_iterations_per_step": tm["newton_iterations"] / max(tm["steps"], 1),
-            "jacobian_updates": tm["jacobians"], "warm_up_s": t_warm,
-            "residual_us": acc["res"][0] / max(acc["res"][1], 1) * 1e6, "residual_calls": acc["res"][1],
-            "jacobian_us": acc["jac"][0] / max(acc["jac"][1], 1) * 1e6, "jacobian_calls": acc["jac"][1],
-            "user_function_share": (acc["res"][0] + acc["jac"][0]) / solve, "generalized_forces_us": gf_us,
-            "kernel_us_per_step": acc["kernel"][0] / max(tm["steps"], 1) * 1e6,
-            "kernel_calls_per_step": acc["kernel"][1] / max(tm["steps"], 1),
-            "rest_us_per_step": ((solve - acc["kernel"][0]) / max(tm["steps"], 1) * 1e6 if acc["kernel"][1]
-                                 else float("nan")),
-            "te_mean_arcsec": float(np.mean(sel)), "te_pp_arcsec": float(np.ptp(sel)),
-            "solve_cpu_s": solve_cpu, "post_cpu_s": total_cpu - solve_cpu, "run_cpu_s": total_cpu,
-            "rtf_cpu": total_cpu / tm["simulated_s"],
-            "status": res.attrs.get("status", "?") if hasattr(res, "attrs") else "?"}
+    return {
+        "preset": name,
+        "dt_s": dt,
+        "simulated_s": tm["simulated_s"],
+        "solve_wall_s": solve,
+        "post_wall_s": total - solve,
+        "real_time_factor": solve / tm["simulated_s"],
+        "steps": tm["steps"],
+        "newton_iterations_per_step": tm["newton_iterations"] / max(tm["steps"], 1),
+        "jacobian_updates": tm["jacobians"],
+        "warm_up_s": t_warm,
+        "residual_us": acc["res"][0] / max(acc["res"][1], 1) * 1e6,
+        "residual_calls": acc["res"][1],
+        "jacobian_us": acc["jac"][0] / max(acc["jac"][1], 1) * 1e6,
+        "jacobian_calls": acc["jac"][1],
+        "user_function_share": (acc["res"][0] + acc["jac"][0]) / solve,
+        "generalized_forces_us": gf_us,
+        "kernel_us_per_step": acc["kernel"][0] / max(tm["steps"], 1) * 1e6,
+        "kernel_calls_per_step": acc["kernel"][1] / max(tm["steps"], 1),
+        "rest_us_per_step": (
+            (solve - acc["kernel"][0]) / max(tm["steps"], 1) * 1e6 if acc["kernel"][1] else float("nan")
+        ),
+        "te_mean_arcsec": float(np.mean(sel)),
+        "te_pp_arcsec": float(np.ptp(sel)),
+        "solve_cpu_s": solve_cpu,
+        "post_cpu_s": total_cpu - solve_cpu,
+        "run_cpu_s": total_cpu,
+        "rtf_cpu": total_cpu / tm["simulated_s"],
+        "status": res.attrs.get("status", "?") if hasattr(res, "attrs") else "?",
+    }
 
 
 def main() -> None:
@@ -166,19 +181,27 @@ def main() -> None:
     for name in a.presets:
         r = bench(name, a.t_end, a.dt)
         print(f"{r['preset']}: dt = {r['dt_s']:g} s, {r['steps']} steps for {r['simulated_s']:.3g} s simulated")
-        print(f"  residual {r['residual_us']:.1f} us/call ({r['residual_calls']} calls), "
-              f"jacobian {r['jacobian_us']:.1f} us/call ({r['jacobian_calls']} calls), "
-              f"user functions {100 * r['user_function_share']:.0f} % of solve")
+        print(
+            f"  residual {r['residual_us']:.1f} us/call ({r['residual_calls']} calls), "
+            f"jacobian {r['jacobian_us']:.1f} us/call ({r['jacobian_calls']} calls), "
+            f"user functions {100 * r['user_function_share']:.0f} % of solve"
+        )
         if r["kernel_calls_per_step"]:
-            print(f"  compiled kernel {r['kernel_us_per_step']:.0f} us/step ({r['kernel_calls_per_step']:.2f} calls); "
-                  f"everything else (Exudyn, Python glue, pre-step hook) {r['rest_us_per_step']:.0f} us/step = "
-                  f"real-time factor {r['rest_us_per_step'] * 1e-6 / r['dt_s']:.2f} at zero physics cost")
+            print(
+                f"  compiled kernel {r['kernel_us_per_step']:.0f} us/step ({r['kernel_calls_per_step']:.2f} calls); "
+                f"everything else (Exudyn, Python glue, pre-step hook) {r['rest_us_per_step']:.0f} us/step = "
+                f"real-time factor {r['rest_us_per_step'] * 1e-6 / r['dt_s']:.2f} at zero physics cost"
+            )
         print(f"  generalized_forces with Jacobian {r['generalized_forces_us']:.1f} us/call")
-        print(f"  solve wall {r['solve_wall_s']:.2f} s -> real-time factor {r['real_time_factor']:.2f}; "
-              f"post-processing {r['post_wall_s']:.2f} s; Newton iterations/step "
-              f"{r['newton_iterations_per_step']:.2f}, Jacobian updates {r['jacobian_updates']}")
-        print(f"  CPU: solve {r['solve_cpu_s']:.3f} s, outputs {r['post_cpu_s']:.3f} s -> real-time factor "
-              f"(solve + outputs, CPU) {r['rtf_cpu']:.2f}")
+        print(
+            f"  solve wall {r['solve_wall_s']:.2f} s -> real-time factor {r['real_time_factor']:.2f}; "
+            f"post-processing {r['post_wall_s']:.2f} s; Newton iterations/step "
+            f"{r['newton_iterations_per_step']:.2f}, Jacobian updates {r['jacobian_updates']}"
+        )
+        print(
+            f"  CPU: solve {r['solve_cpu_s']:.3f} s, outputs {r['post_cpu_s']:.3f} s -> real-time factor "
+            f"(solve + outputs, CPU) {r['rtf_cpu']:.2f}"
+        )
         print(f"  TE (t > 0.02 s): mean {r['te_mean_arcsec']:.4f} arcsec, p-p {r['te_pp_arcsec']:.4f} arcsec")
         print(f"  warm-up (numba load/compile) {r['warm_up_s']:.2f} s")
 

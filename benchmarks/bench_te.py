@@ -42,12 +42,16 @@ def bench(name: str, crank_revolutions: float, output_revolutions: float | None 
     r = loaded_te(red, points_per_mesh=8, **kw)
     total = time.perf_counter() - t0
     s = r.summary()
-    print(f"{name}: {len(angles)} positions; loaded curve {dt / len(angles) * 1e6:.0f} us/position "
-          f"({np.mean(its):.2f} iterations, {calls:.2f} residual+Jacobian calls per position), "
-          f"{dt:.2f} s; whole loaded_te (loaded + no-load + catalog) {total:.2f} s")
-    print(f"   TE p-p {s['te_pp_arcsec']:.4f} arcsec, mean {s['te_mean_arcsec']:.3f} arcsec, no-load p-p "
-          f"{s['no_load_te_pp_arcsec']:.4f} arcsec, lost motion {s['lost_motion_arcmin']:.4f} arcmin, "
-          f"rigidity {s['torsional_rigidity_Nm_per_arcmin']:.2f} N m/arcmin")
+    print(
+        f"{name}: {len(angles)} positions; loaded curve {dt / len(angles) * 1e6:.0f} us/position "
+        f"({np.mean(its):.2f} iterations, {calls:.2f} residual+Jacobian calls per position), "
+        f"{dt:.2f} s; whole loaded_te (loaded + no-load + catalog) {total:.2f} s"
+    )
+    print(
+        f"   TE p-p {s['te_pp_arcsec']:.4f} arcsec, mean {s['te_mean_arcsec']:.3f} arcsec, no-load p-p "
+        f"{s['no_load_te_pp_arcsec']:.4f} arcsec, lost motion {s['lost_motion_arcmin']:.4f} arcmin, "
+        f"rigidity {s['torsional_rigidity_Nm_per_arcmin']:.2f} N m/arcmin"
+    )
 
 
 def main() -> None:

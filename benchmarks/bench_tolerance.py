@@ -33,7 +33,9 @@ from pathlib import Path
 #: this checkout's flexrv, in this process and in the spawned dask workers
 ROOT = str(Path(__file__).resolve().parent.parent)
 sys.path.insert(0, ROOT)
-os.environ["PYTHONPATH"] = os.pathsep.join([ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
+os.environ["PYTHONPATH"] = os.pathsep.join(
+    [ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+)
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -49,8 +51,17 @@ def study(n: int, workers: int, res: dict) -> tuple[float, float, int]:
     from flexrv.studies.tolerance import StudyConfig, run_study
 
     with tempfile.TemporaryDirectory() as tmp:
-        cfg = StudyConfig(design="rv40e", tolerances="rv40e", samples=n, seed=1, sampler="sobol", workers=workers,
-                          what_if_samples=0, out=tmp, resolution=res)
+        cfg = StudyConfig(
+            design="rv40e",
+            tolerances="rv40e",
+            samples=n,
+            seed=1,
+            sampler="sobol",
+            workers=workers,
+            what_if_samples=0,
+            out=tmp,
+            resolution=res,
+        )
         c0, t0 = _cpu(), time.perf_counter()
         r = run_study(cfg, progress=False)
         return time.perf_counter() - t0, _cpu() - c0, r["failed"]
@@ -78,10 +89,16 @@ def main() -> None:
         fixed = t1 - n1 / rate
         cpu_per = (c2 - c1) / (n2 - n1)
         rates[w] = rate
-        print(f"workers {w}: {n1} samples {t1:.1f} s wall ({c1:.1f} s CPU), {n2} samples {t2:.1f} s wall "
-              f"({c2:.1f} s CPU), failed {f1} / {f2}", flush=True)
-        print(f"  fixed start-up {fixed:.1f} s, steady {rate:.2f} samples/s ({cpu_per:.3f} CPU s per sample); "
-              f"projected 1,000 samples: {(fixed + 1000 / rate) / 60:.1f} min", flush=True)
+        print(
+            f"workers {w}: {n1} samples {t1:.1f} s wall ({c1:.1f} s CPU), {n2} samples {t2:.1f} s wall "
+            f"({c2:.1f} s CPU), failed {f1} / {f2}",
+            flush=True,
+        )
+        print(
+            f"  fixed start-up {fixed:.1f} s, steady {rate:.2f} samples/s ({cpu_per:.3f} CPU s per sample); "
+            f"projected 1,000 samples: {(fixed + 1000 / rate) / 60:.1f} min",
+            flush=True,
+        )
     if 1 in rates and 2 in rates:
         print(f"steady-rate scaling 1 -> 2 workers: x{rates[2] / rates[1]:.2f}")
 

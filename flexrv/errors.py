@@ -62,8 +62,10 @@ def check_options(where: str, given: dict | None, allowed: dict[str, object]) ->
         else:
             ok = isinstance(value, type(ref)) or isinstance(ref, (tuple, list)) and isinstance(value, (tuple, list))
         if not ok:
-            raise InputError(f"{where}.{key} = {value!r} is not allowed: expected a value of type "
-                             f"{type(ref).__name__} (like {ref!r})")
+            raise InputError(
+                f"{where}.{key} = {value!r} is not allowed: expected a value of type "
+                f"{type(ref).__name__} (like {ref!r})"
+            )
     return given
 
 
@@ -84,5 +86,8 @@ def signature_options(fn, skip: int = 0, exclude: tuple[str, ...] = ()) -> dict[
         return None
 
     params = list(inspect.signature(fn).parameters.values())[skip:]
-    return {p.name: example(p) for p in params
-            if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in exclude}
+    return {
+        p.name: example(p)
+        for p in params
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in exclude
+    }

@@ -53,8 +53,8 @@ import numpy as np
 
 from flexrv.design import load
 from flexrv.errors import ConvergenceError, InputError, SimulationError, check_options
-from flexrv.viz.plots import PlottedResults as Results  # re-exported: flexrv.Results (saves its PNGs)
 from flexrv.units import ARCMIN_PER_RAD
+from flexrv.viz.plots import PlottedResults as Results  # re-exported: flexrv.Results (saves its PNGs)
 
 #: systems with more coordinates than this use Exudyn's sparse linear solver
 SPARSE_ABOVE = 100
@@ -107,24 +107,29 @@ SEGMENT_STEPS = 1000
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
 
-def check_step_count(t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None,
-                     t_start: float = 0.0) -> int:
+def check_step_count(
+    t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None, t_start: float = 0.0
+) -> int:
     """Number of steps of a run; InputError (naming --dt/--t-end and the estimate)
     if it exceeds :data:`MAX_STEPS` or the recorded states would exceed
     :data:`MAX_RECORD_BYTES` (checked again with the real coordinate count after
     the model is built)."""
     n_steps = int(round((t_end - t_start) / dt))
     if n_steps > MAX_STEPS:
-        raise InputError(f"t_end = {t_end:g} s with dt = {dt:g} s needs {n_steps:.3g} time steps: at most "
-                         f"{MAX_STEPS:.3g} are allowed (~{n_steps * 2.5e-3 / 3600:.3g} h of wall time at ~2.5 ms "
-                         f"per step); increase dt or reduce t_end")
+        raise InputError(
+            f"t_end = {t_end:g} s with dt = {dt:g} s needs {n_steps:.3g} time steps: at most "
+            f"{MAX_STEPS:.3g} are allowed (~{n_steps * 2.5e-3 / 3600:.3g} h of wall time at ~2.5 ms "
+            f"per step); increase dt or reduce t_end"
+        )
     if n_coordinates is not None:
         n_out = n_steps // max(int(output_every), 1) + 2
         nbytes = 8.0 * n_out * (2 * n_coordinates + 1)
         if nbytes > MAX_RECORD_BYTES:
-            raise InputError(f"t_end = {t_end:g} s with dt = {dt:g} s records {n_out:.3g} states of {n_coordinates} "
-                             f"coordinates: ~{nbytes / 1024**3:.3g} GiB, at most {MAX_RECORD_BYTES / 1024**3:g} GiB "
-                             "allowed; increase dt or output_every, or reduce t_end")
+            raise InputError(
+                f"t_end = {t_end:g} s with dt = {dt:g} s records {n_out:.3g} states of {n_coordinates} "
+                f"coordinates: ~{nbytes / 1024**3:.3g} GiB, at most {MAX_RECORD_BYTES / 1024**3:g} GiB "
+                "allowed; increase dt or output_every, or reduce t_end"
+            )
     return n_steps
 
 
@@ -142,8 +147,14 @@ class Simulation:
         (:func:`flexrv.model.factory.build_flexible`).
     """
 
-    def __init__(self, preset_or_config, model: str = "rigid", drive: str = "ramp", torque: Callable | None = None,
-                 model_options: dict | None = None):
+    def __init__(
+        self,
+        preset_or_config,
+        model: str = "rigid",
+        drive: str = "ramp",
+        torque: Callable | None = None,
+        model_options: dict | None = None,
+    ):
         self.reducer = load(preset_or_config)
         self.model_name = model
         self.model_options = dict(model_options or {})
@@ -156,16 +167,27 @@ class Simulation:
         from flexrv.model.factory import build_model
 
         t0 = _time.perf_counter()
-        self.model = build_model(self.reducer, self.model_name, drive=self.drive, torque=self.torque,
-                                 **self.model_options)
+        self.model = build_model(
+            self.reducer, self.model_name, drive=self.drive, torque=self.torque, **self.model_options
+        )
         self.timing["build_s"] = _time.perf_counter() - t0
         return self.model
 
-    def run(self, t_end: float | None = None, dt: float = DEFAULT_DT, progress: bool | Callable = False,
-            output_every: int = 1, save_to: str | Path | None = None, spectral_radius: float = 0.5,
-            newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE, newton_options: dict | None = None,
-            checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, segment_steps: int = SEGMENT_STEPS,
-            restart: dict | None = None, record_outputs: bool = True):
+    def run(
+        self,
+        t_end: float | None = None,
+        dt: float = DEFAULT_DT,
+        progress: bool | Callable = False,
+        output_every: int = 1,
+        save_to: str | Path | None = None,
+        spectral_radius: float = 0.5,
+        newton_tolerance: tuple[float, float] = DEFAULT_NEWTON_TOLERANCE,
+        newton_options: dict | None = None,
+        checkpoint_s: float | None = CHECKPOINT_INTERVAL_S,
+        segment_steps: int = SEGMENT_STEPS,
+        restart: dict | None = None,
+        record_outputs: bool = True,
+    ):
         """Integrate to ``t_end`` [s] with step ``dt`` [s]; return :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
@@ -243,7 +265,8 @@ class Simulation:
         from flexrv.model.kernel_cache import announce_compile
 
         kinds = (["fused"] if model.fused is not None else []) + (
-            ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else [])
+            ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
+        )
         announce_compile(kinds=kinds)  # one line on stderr if the numba kernels compile now (first run)
         mbs = model.mbs
         n_steps = check_step_count(t_end, dt, output_every, model.n, t_start=t_start)
@@ -272,8 +295,11 @@ class Simulation:
         checkpoint = None
         if save_to is not None and checkpoint_s is not None and checkpoint_s > 0:
             checkpoint = _Checkpointer(self, Path(save_to), t_end, dt, output_every, seg, float(checkpoint_s))
-            checkpoint.meta.update(newton_tolerance=list(newton_tolerance), spectral_radius=spectral_radius,
-                                   newton_options=dict(newton_options or {}))
+            checkpoint.meta.update(
+                newton_tolerance=list(newton_tolerance),
+                spectral_radius=spectral_radius,
+                newton_options=dict(newton_options or {}),
+            )
             checkpoint.recorder = recorder
         report = _progress_callback(progress, t_end)
         sd = mbs.systemData
@@ -336,8 +362,9 @@ class Simulation:
         for key, value in newton_options.items():
             setattr(ti.newton, key, value)
         if model.fused is not None:  # its Jacobians then come with the step's first residual
-            model.fused.jacobian_each_step = bool(ti.newton.useModifiedNewton
-                                                  and ti.newton.modifiedNewtonJacUpdatePerStep)
+            model.fused.jacobian_each_step = bool(
+                ti.newton.useModifiedNewton and ti.newton.modifiedNewtonJacUpdatePerStep
+            )
         # massless (quasi-static) coordinates make M singular: start from rest with
         # zero accelerations instead (every run starts at rest in equilibrium)
         massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
@@ -346,8 +373,9 @@ class Simulation:
         ss.solution.file.write = False
         # dense LU for the small rigid models; sparse for the ball/ring models, whose
         # dense path costs 2-4x more in Exudyn (rv40e flexible: 10.2 -> 4.1 s per 10 ms)
-        ss.linearSolver.solverType = (exu.LinearSolverType.EXUdense if model.n <= SPARSE_ABOVE
-                                      else exu.LinearSolverType.EigenSparse)
+        ss.linearSolver.solverType = (
+            exu.LinearSolverType.EXUdense if model.n <= SPARSE_ABOVE else exu.LinearSolverType.EigenSparse
+        )
 
         def on_stop(signum, frame):
             state["stop"] = True
@@ -415,12 +443,18 @@ class Simulation:
             if recorder is not None:
                 recorder.store(k, t_end, q_b, v_b)
             k += 1
-        self.timing.update(solve_s=wall, solve_cpu_s=cpu, steps=state["step"], simulated_s=float(ts[k - 1]) if k else 0.0,
-                           newton_iterations=counts["newton"], jacobians=counts["jacobians"],
-                           segments=counts["segments"],
-                           checkpoint_s=checkpoint.spent if checkpoint is not None else 0.0,
-                           force_calls={g.name: g.stats[0] for g in model.groups},
-                           jacobian_calls={g.name: g.stats[1] for g in model.groups})
+        self.timing.update(
+            solve_s=wall,
+            solve_cpu_s=cpu,
+            steps=state["step"],
+            simulated_s=float(ts[k - 1]) if k else 0.0,
+            newton_iterations=counts["newton"],
+            jacobians=counts["jacobians"],
+            segments=counts["segments"],
+            checkpoint_s=checkpoint.spent if checkpoint is not None else 0.0,
+            force_calls={g.name: g.stats[0] for g in model.groups},
+            jacobian_calls={g.name: g.stats[1] for g in model.groups},
+        )
         status = "completed"
         if state["fail"] is not None or (not ok and not state["stop"]):
             status = "failed"
@@ -428,8 +462,17 @@ class Simulation:
             status = "interrupted"
         from flexrv.post.results import results_from_states
 
-        res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=dt, status=status, timing=self.timing,
-                                  cls=Results, records=recorder.records(k) if recorder is not None else None)
+        res = results_from_states(
+            model,
+            ts[:k],
+            qs[:k],
+            vs[:k],
+            dt=dt,
+            status=status,
+            timing=self.timing,
+            cls=Results,
+            records=recorder.records(k) if recorder is not None else None,
+        )
         if state["signal"] is not None:
             res.attrs["signal"] = state["signal"]
         if checkpoint is not None:  # the last boundary (the complete run: a resume of it is refused as complete)
@@ -437,20 +480,27 @@ class Simulation:
         if status == "failed":
             detail = " ".join(str(error).split())[:200] if error is not None else ""
             t_fin = float(sd.GetTime())
-            t_fail, cause = state["fail"] if state["fail"] is not None else (t_fin, f"Newton iteration failed ({detail})")
+            t_fail, cause = (
+                state["fail"] if state["fail"] is not None else (t_fin, f"Newton iteration failed ({detail})")
+            )
             res.attrs["failure"] = f"t = {t_fail:.6g} s: {cause}"
             path = None
             if save_to is not None and k > 1:
                 path = res.save(save_to)
             if t_fail <= t_start + 2 * dt:  # at the very start: the assembled design, not the step
-                advice = ("the design cannot start from rest: check the profile modifications and clearances "
-                          "(second_stage.modification_*, needle_bearing.radial_clearance_um, first_stage.backlash_um) "
-                          "for interference at assembly")
+                advice = (
+                    "the design cannot start from rest: check the profile modifications and clearances "
+                    "(second_stage.modification_*, needle_bearing.radial_clearance_um, first_stage.backlash_um) "
+                    "for interference at assembly"
+                )
             else:
-                advice = (f"reduce the step (dt = {dt:g} s -> {dt / 2:g} s) or increase contact damping "
-                          "(contact.pin_max_damping_Ns_per_m)")
-            msg = (f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: {advice}"
-                   + (f"; partial results saved to {path}" if path else "; partial results in exc.results"))
+                advice = (
+                    f"reduce the step (dt = {dt:g} s -> {dt / 2:g} s) or increase contact damping "
+                    "(contact.pin_max_damping_Ns_per_m)"
+                )
+            msg = f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: {advice}" + (
+                f"; partial results saved to {path}" if path else "; partial results in exc.results"
+            )
             err = SimulationError(msg)
             err.results = res
             raise err
@@ -459,8 +509,13 @@ class Simulation:
         return res
 
     @classmethod
-    def resume(cls, directory: str | Path, progress: bool | Callable = False,
-               checkpoint_s: float | None = CHECKPOINT_INTERVAL_S, **run_options):
+    def resume(
+        cls,
+        directory: str | Path,
+        progress: bool | Callable = False,
+        checkpoint_s: float | None = CHECKPOINT_INTERVAL_S,
+        **run_options,
+    ):
         """Continue a run that was killed (or interrupted) from the last checkpoint in
         ``directory`` (written by :meth:`run` with ``save_to``): same design, model,
         options, step, segment length and end time; the drive and load are functions
@@ -477,8 +532,10 @@ class Simulation:
         ck = load_checkpoint(directory)
         meta = ck["meta"]
         if "step" not in meta or ck.get("a") is None:
-            raise InputError(f"--resume {directory}: the checkpoint was written by an older flexrv (no segment "
-                             "boundary state); rerun the simulation")
+            raise InputError(
+                f"--resume {directory}: the checkpoint was written by an older flexrv (no segment "
+                "boundary state); rerun the simulation"
+            )
         if int(meta["step"]) >= max(int(round(meta["t_end"] / meta["dt"])), 1):
             raise InputError(f"--resume {directory}: the run is already complete (t_end = {meta['t_end']:g} s)")
         options = dict(meta.get("model_options") or {})
@@ -489,11 +546,27 @@ class Simulation:
         run_options.setdefault("spectral_radius", meta.get("spectral_radius", 0.5))
         run_options.setdefault("newton_options", meta.get("newton_options") or None)
         t, q, v = ck["t"], ck["q"], ck["v"]
-        restart = {"t": t[:-1], "q": q[:-1], "v": v[:-1], "q_b": q[-1], "v_b": v[-1], "a_b": ck["a"],
-                   "step": int(meta["step"]), "records": ck.get("records")}
-        res = sim.run(t_end=meta["t_end"], dt=meta["dt"], progress=progress, output_every=meta["output_every"],
-                      save_to=directory, checkpoint_s=checkpoint_s, segment_steps=int(meta["segment_steps"]),
-                      restart=restart, **run_options)
+        restart = {
+            "t": t[:-1],
+            "q": q[:-1],
+            "v": v[:-1],
+            "q_b": q[-1],
+            "v_b": v[-1],
+            "a_b": ck["a"],
+            "step": int(meta["step"]),
+            "records": ck.get("records"),
+        }
+        res = sim.run(
+            t_end=meta["t_end"],
+            dt=meta["dt"],
+            progress=progress,
+            output_every=meta["output_every"],
+            save_to=directory,
+            checkpoint_s=checkpoint_s,
+            segment_steps=int(meta["segment_steps"]),
+            restart=restart,
+            **run_options,
+        )
         return sim, res
 
 
@@ -506,11 +579,26 @@ class _Checkpointer:
     and at least 5x the time the last checkpoint took
     (so a long run never spends more than ~1/6 of its time saving)."""
 
-    def __init__(self, sim: "Simulation", directory: Path, t_end: float, dt: float, output_every: int,
-                 segment_steps: int, interval: float):
+    def __init__(
+        self,
+        sim: "Simulation",
+        directory: Path,
+        t_end: float,
+        dt: float,
+        output_every: int,
+        segment_steps: int,
+        interval: float,
+    ):
         self.sim, self.directory, self.interval = sim, directory, interval
-        self.meta = {"model": sim.model_name, "model_options": sim.model_options, "drive": sim.drive,
-                     "t_end": t_end, "dt": dt, "output_every": output_every, "segment_steps": segment_steps}
+        self.meta = {
+            "model": sim.model_name,
+            "model_options": sim.model_options,
+            "drive": sim.drive,
+            "t_end": t_end,
+            "dt": dt,
+            "output_every": output_every,
+            "segment_steps": segment_steps,
+        }
         self.custom = sim.drive != "ramp" or sim.torque is not None  # not resumable from files
         self.next_at = _time.perf_counter() + interval
         #: the run's HistoryRecorder (its records before a boundary go into the checkpoint), or None
@@ -528,9 +616,16 @@ class _Checkpointer:
             from flexrv.post.io import save_partial
             from flexrv.post.results import results_from_states
 
-            res = results_from_states(model, ts[:k], qs[:k], vs[:k], dt=self.meta["dt"], status="running",
-                                      timing=self.sim.timing,
-                                      records=self.recorder.records(k) if self.recorder is not None else None)
+            res = results_from_states(
+                model,
+                ts[:k],
+                qs[:k],
+                vs[:k],
+                dt=self.meta["dt"],
+                status="running",
+                timing=self.sim.timing,
+                records=self.recorder.records(k) if self.recorder is not None else None,
+            )
             save_partial(res, self.directory)
         except Exception as exc:  # a full disk (or any save error) must not kill the run; the next one retries
             import warnings
@@ -551,10 +646,19 @@ class _Checkpointer:
             return
         t0 = _time.perf_counter()
         meta = dict(self.meta, resumable=not self.custom, step=int(j))
-        t_b = self.meta["t_end"] if j >= max(int(round(self.meta["t_end"] / self.meta["dt"])), 1) else j * self.meta["dt"]
-        save_checkpoint(self.directory, np.append(ts[:k], t_b), np.vstack([qs[:k], q_b[None]]),
-                        np.vstack([vs[:k], v_b[None]]), meta, self.sim.reducer, a_b,
-                        records=self.recorder.arrays(k) if self.recorder is not None else None)
+        t_b = (
+            self.meta["t_end"] if j >= max(int(round(self.meta["t_end"] / self.meta["dt"])), 1) else j * self.meta["dt"]
+        )
+        save_checkpoint(
+            self.directory,
+            np.append(ts[:k], t_b),
+            np.vstack([qs[:k], q_b[None]]),
+            np.vstack([vs[:k], v_b[None]]),
+            meta,
+            self.sim.reducer,
+            a_b,
+            records=self.recorder.arrays(k) if self.recorder is not None else None,
+        )
         self.spent += _time.perf_counter() - t0
 
 
@@ -584,14 +688,21 @@ def _progress_callback(progress, t_end):
     if not progress:
         return None
     if callable(progress):
+
         def rep(t):
             if t is not None:
                 progress(t, t_end)
+
         return rep
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    bar = Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed:.3f}/{task.total:.3f} s"),
-                   TimeRemainingColumn(), transient=True)
+    bar = Progress(
+        TextColumn("simulating"),
+        BarColumn(),
+        TextColumn("{task.completed:.3f}/{task.total:.3f} s"),
+        TimeRemainingColumn(),
+        transient=True,
+    )
     task = bar.add_task("sim", total=t_end)
     bar.start()
 
@@ -628,13 +739,26 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict
     bend = outs.get("crank_bending_fraction")
     frac = float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0
     comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
-    return {"compliances": comp, "tangent_rigidity": float(k_t), "torque": float(torque), "notes": list(notes),
-            "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS and k not in shares}}
+    return {
+        "compliances": comp,
+        "tangent_rigidity": float(k_t),
+        "torque": float(torque),
+        "notes": list(notes),
+        "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS and k not in shares},
+    }
 
 
-def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float = DEFAULT_QUARTER_TIME, settle: float = 0.005,
-                   dt: float = DEFAULT_DT, torque: float | None = None, progress: bool | Callable = False,
-                   save_to: str | Path | None = None, model_options: dict | None = None):
+def stiffness_test(
+    preset_or_config,
+    model: str = "rigid",
+    quarter_time: float = DEFAULT_QUARTER_TIME,
+    settle: float = 0.005,
+    dt: float = DEFAULT_DT,
+    torque: float | None = None,
+    progress: bool | Callable = False,
+    save_to: str | Path | None = None,
+    model_options: dict | None = None,
+):
     """Virtual torsional-stiffness test bench (:cite:`seed004`): input locked, output
     torque ramped 0 -> +T -> -T -> 0 (T = rated torque unless given), each
     quarter of the loop over ``quarter_time`` [s] (default :data:`DEFAULT_QUARTER_TIME`; quasi-static: far longer than
@@ -650,8 +774,12 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     rigidity fit range, lost motion and hysteresis marked).
     """
     from flexrv.model.loads import piecewise_torque
-    from flexrv.post.stiffness import (evaluate_stiffness_test, stiffness_dataset, stiffness_json,
-                                       stiffness_summary_markdown)
+    from flexrv.post.stiffness import (
+        evaluate_stiffness_test,
+        stiffness_dataset,
+        stiffness_json,
+        stiffness_summary_markdown,
+    )
 
     reducer = load(preset_or_config)
     t_r = reducer.operating.rated_torque_Nm if torque is None else float(torque)
@@ -665,28 +793,40 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
     res = sim.run(t_end=float(times[-1]), dt=dt, progress=progress)
     tq = res["output_torque"].values
     angle = -res["theta_out"].values  # the load torque acts against +theta: positive torque winds the output negative
-    figures = evaluate_stiffness_test(res.time, tq, angle, times[1:], friction_power=(
-        res["friction_power"].values if "friction_power" in res.ds else None))
+    figures = evaluate_stiffness_test(
+        res.time,
+        tq,
+        angle,
+        times[1:],
+        friction_power=(res["friction_power"].values if "friction_power" in res.ds else None),
+    )
     res.ds = stiffness_dataset(figures, res.time, tq, angle * ARCMIN_PER_RAD, base=res.ds)
     import json
 
     try:
         budget = stiffness_test_budget(reducer, t_r)
     except ConvergenceError as exc:  # the figures stand without it
-        budget = {"compliances": {}, "tangent_rigidity": float("nan"), "torque": float(t_r), "unmodelled": {},
-                  "notes": [f"stiffness budget not available: the quasi-static equilibrium at +{t_r:g} N m did "
-                            f"not converge ({exc})"]}
+        budget = {
+            "compliances": {},
+            "tangent_rigidity": float("nan"),
+            "torque": float(t_r),
+            "unmodelled": {},
+            "notes": [
+                f"stiffness budget not available: the quasi-static equilibrium at +{t_r:g} N m did not converge ({exc})"
+            ],
+        }
     if model != "rigid":
-        budget["notes"].append(f"budget of the rigid quasi-static model at the test's pose (the loop ran the "
-                               f"{model} model)")
+        budget["notes"].append(
+            f"budget of the rigid quasi-static model at the test's pose (the loop ran the {model} model)"
+        )
     budget["measured_rigidity"] = figures.rigidity_Nm_per_arcmin * ARCMIN_PER_RAD
     #: the loop's rigidity with the elements the model lacks in series (none: the housing is in the model)
-    budget["measured_with_unmodelled_rigidity"] = 1.0 / (1.0 / budget["measured_rigidity"]
-                                                         + sum(budget["unmodelled"].values()))
+    budget["measured_with_unmodelled_rigidity"] = 1.0 / (
+        1.0 / budget["measured_rigidity"] + sum(budget["unmodelled"].values())
+    )
     budget["model"] = model
     res.ds.attrs["stiffness_budget"] = json.dumps(budget)
     if save_to is not None:
-
         from flexrv.cache import atomic_path, atomic_write_text
         from flexrv.design import to_toml
         from flexrv.viz.plots import plot_hysteresis
@@ -696,11 +836,28 @@ def stiffness_test(preset_or_config, model: str = "rigid", quarter_time: float =
         with atomic_path(d / "results.nc") as tmp:
             res.ds.to_netcdf(tmp, engine="h5netcdf")
         atomic_write_text(d / "config.toml", to_toml(reducer))
-        atomic_write_text(d / "stiffness.json", json.dumps(
-            {"preset": reducer.name, "model": model, "quarter_time_s": quarter_time, "dt_s": dt,
-             "figures": stiffness_json(figures), "stiffness_budget_SI": budget}, indent=2))
-        plot_hysteresis(angle * ARCMIN_PER_RAD, tq, d / "hysteresis.png", figures=figures,
-                        title=f"{reducer.name} stiffness test ({model} model)")
-        atomic_write_text(d / "summary.md", stiffness_summary_markdown(figures, reducer.name, model,
-                                                                       quarter_time, dt, budget=budget))
+        atomic_write_text(
+            d / "stiffness.json",
+            json.dumps(
+                {
+                    "preset": reducer.name,
+                    "model": model,
+                    "quarter_time_s": quarter_time,
+                    "dt_s": dt,
+                    "figures": stiffness_json(figures),
+                    "stiffness_budget_SI": budget,
+                },
+                indent=2,
+            ),
+        )
+        plot_hysteresis(
+            angle * ARCMIN_PER_RAD,
+            tq,
+            d / "hysteresis.png",
+            figures=figures,
+            title=f"{reducer.name} stiffness test ({model} model)",
+        )
+        atomic_write_text(
+            d / "summary.md", stiffness_summary_markdown(figures, reducer.name, model, quarter_time, dt, budget=budget)
+        )
     return figures, res

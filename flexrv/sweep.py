@@ -62,6 +62,7 @@ def simulate_task(reducer, model: str = "rigid", t_end: float = 0.5, dt: float |
     results = Simulation(reducer, model=model).run(t_end=t_end, progress=False, **options)
     return results.summary()
 
+
 _SPEC_KEYS = {"name", "preset", "task", "outputs", "options", "grid", "cases", "description"}
 
 
@@ -120,35 +121,60 @@ def load_spec(path: str | os.PathLike) -> SweepSpec:
         if key in data:
             _require(isinstance(data[key], str), path, key, f"must be a string, got {data[key]!r}")
     name = data["name"]
-    _require(bool(_NAME_RE.match(name)) and ".." not in name, path, "name",
-             f"{name!r} is not allowed: one folder name of letters, digits and ._- (no path separators, no '..'), "
-             "the sweep writes to results/<name>/")
+    _require(
+        bool(_NAME_RE.match(name)) and ".." not in name,
+        path,
+        "name",
+        f"{name!r} is not allowed: one folder name of letters, digits and ._- (no path separators, no '..'), "
+        "the sweep writes to results/<name>/",
+    )
     if not isinstance(data["outputs"], list) or not all(isinstance(o, str) and o for o in data["outputs"]):
         raise ConfigError(f"{path}: outputs: must be a list of dotted result keys (strings), got {data['outputs']!r}")
     _require(len(set(data["outputs"])) == len(data["outputs"]), path, "outputs", "duplicate keys")
     options = data.get("options", {})
-    _require(isinstance(options, dict), path, "options",
-             f"must be a table of keyword arguments of the task ([options]), got {options!r}")
+    _require(
+        isinstance(options, dict),
+        path,
+        "options",
+        f"must be a table of keyword arguments of the task ([options]), got {options!r}",
+    )
     grid = data.get("grid", {})
-    _require(isinstance(grid, dict), path, "grid",
-             f"must be a table of dotted design fields -> lists of values ([grid]), got {grid!r}")
+    _require(
+        isinstance(grid, dict),
+        path,
+        "grid",
+        f"must be a table of dotted design fields -> lists of values ([grid]), got {grid!r}",
+    )
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             raise ConfigError(f"{path}: grid.{key} must be a non-empty list of values, got {values!r}")
         for v in values:
             _require(not isinstance(v, (dict, list)), path, f"grid.{key}", f"values must be scalars, got {v!r}")
     cases = data.get("cases", [])
-    _require(isinstance(cases, list) and all(isinstance(c, dict) for c in cases), path, "cases",
-             f"must be an array of tables ([[cases]]) of dotted design fields -> values, got {cases!r}")
+    _require(
+        isinstance(cases, list) and all(isinstance(c, dict) for c in cases),
+        path,
+        "cases",
+        f"must be an array of tables ([[cases]]) of dotted design fields -> values, got {cases!r}",
+    )
     for i, case in enumerate(cases):
         _require(bool(case), path, f"cases[{i}]", "is empty")
     if not grid and not cases:
         raise ConfigError(f"{path}: a sweep needs a [grid] or [[cases]]")
-    spec = SweepSpec(name=name, preset=data["preset"], task=data["task"],
-                     outputs=list(data["outputs"]), options=dict(options), grid=dict(grid),
-                     cases=list(cases), description=str(data.get("description", "")))
+    spec = SweepSpec(
+        name=name,
+        preset=data["preset"],
+        task=data["task"],
+        outputs=list(data["outputs"]),
+        options=dict(options),
+        grid=dict(grid),
+        cases=list(cases),
+        description=str(data.get("description", "")),
+    )
     if spec.task not in TASKS and ":" not in spec.task:
-        raise ConfigError(f"{path}: task {spec.task!r} is neither a built-in task {sorted(TASKS)} nor 'module:function'")
+        raise ConfigError(
+            f"{path}: task {spec.task!r} is neither a built-in task {sorted(TASKS)} nor 'module:function'"
+        )
     return spec
 
 
@@ -251,8 +277,11 @@ def run_case(design: dict[str, Any], task: str, options: dict[str, Any]) -> dict
     except FlexrvError as exc:
         record = {"status": "failed", "error": f"{type(exc).__name__}: {exc}"}
     except Exception as exc:  # a failing case must not stop the sweep
-        record = {"status": "failed", "error": f"{type(exc).__name__}: {exc}",
-                  "traceback": traceback.format_exc(limit=8)}
+        record = {
+            "status": "failed",
+            "error": f"{type(exc).__name__}: {exc}",
+            "traceback": traceback.format_exc(limit=8),
+        }
     record["wall_time_s"] = time.perf_counter() - start
     return record
 
@@ -268,9 +297,8 @@ class Case:
 
 def build_cases(spec: SweepSpec) -> list[Case]:
     """Expand the spec into cases with stable ids (hash of design, task, options)."""
-    from flexrv.design import load
-
     from flexrv.cache import flexrv_version
+    from flexrv.design import load
 
     base = load(spec.preset).model_dump(mode="python")
     cases = []
@@ -320,9 +348,15 @@ class SweepSummary:
     plots: list[Path]
 
 
-def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, scheduler: str | None = None,
-              n_workers: int | None = None, retry_failed: bool = False, progress: bool = True,
-              plots: bool = True) -> SweepSummary:
+def run_sweep(
+    spec: SweepSpec,
+    out_dir: str | os.PathLike | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    retry_failed: bool = False,
+    progress: bool = True,
+    plots: bool = True,
+) -> SweepSummary:
     """Run the missing cases of a sweep on dask.distributed and write the table.
 
     Parameters
@@ -365,12 +399,15 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
             client = connect_scheduler(scheduler)
         else:
             workers = n_workers or os.cpu_count() or 1
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=40)
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=40
+            )
             client = Client(cluster)
         try:
-            futures = {client.submit(run_case, c.design, spec.task, spec.options, key=f"case-{c.case_id}", pure=False): c
-                       for c in todo}
+            futures = {
+                client.submit(run_case, c.design, spec.task, spec.options, key=f"case-{c.case_id}", pure=False): c
+                for c in todo
+            }
             bar = _progress(progress, len(cases), len(cases) - len(todo))
             with bar:
                 task_id = bar.add_task(f"sweep {spec.name}", total=len(cases), completed=len(cases) - len(todo))
@@ -391,8 +428,16 @@ def run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None = None, schedul
     total_failed = sum(json.loads(case_file(out, c).read_text()).get("status") != "ok" for c in cases)
     if output_keys is None:
         _check_outputs_after(spec, cases, out)
-    return SweepSummary(out_dir=out, total=len(cases), computed=len(todo), skipped=len(cases) - len(todo),
-                        failed=total_failed, table_csv=csv_path, table_nc=nc_path, plots=plot_paths)
+    return SweepSummary(
+        out_dir=out,
+        total=len(cases),
+        computed=len(todo),
+        skipped=len(cases) - len(todo),
+        failed=total_failed,
+        table_csv=csv_path,
+        table_nc=nc_path,
+        plots=plot_paths,
+    )
 
 
 def connect_scheduler(address: str, timeout_s: float = 5.0):
@@ -403,8 +448,10 @@ def connect_scheduler(address: str, timeout_s: float = 5.0):
     try:
         return Client(address, timeout=timeout_s)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
-        raise ConfigError(f"--scheduler {address}: cannot connect within {timeout_s:g} s "
-                          f"({type(exc).__name__}: {' '.join(str(exc).split())[:160]})") from None
+        raise ConfigError(
+            f"--scheduler {address}: cannot connect within {timeout_s:g} s "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:160]})"
+        ) from None
 
 
 def _check_outputs_after(spec: SweepSpec, cases: list[Case], out: Path) -> None:
@@ -426,8 +473,14 @@ def _check_outputs_after(spec: SweepSpec, cases: list[Case], out: Path) -> None:
 def _progress(enabled: bool, total: int, done: int):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                    disable=not enabled, transient=False)
+    return Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        disable=not enabled,
+        transient=False,
+    )
 
 
 def _as_float(value: Any) -> float:
@@ -450,8 +503,12 @@ def write_table(spec: SweepSpec, cases: list[Case], out: Path, plots: bool = Tru
     for case in cases:
         path = case_file(out, case)
         record = json.loads(path.read_text()) if path.exists() else {"status": "missing"}
-        row = {"case_id": case.case_id, "status": record.get("status", "missing"),
-               "error": record.get("error", ""), "wall_time_s": record.get("wall_time_s", math.nan)}
+        row = {
+            "case_id": case.case_id,
+            "status": record.get("status", "missing"),
+            "error": record.get("error", ""),
+            "wall_time_s": record.get("wall_time_s", math.nan),
+        }
         for p in params:
             row[p] = case.overrides.get(p, math.nan)
         result = record.get("result", {})
@@ -471,8 +528,11 @@ def write_table(spec: SweepSpec, cases: list[Case], out: Path, plots: bool = Tru
         data_vars[c.replace("/", "_")] = ("case", np.asarray(values, dtype=float))
     data_vars["status"] = ("case", np.asarray([r["status"] for r in rows], dtype=str))
     data_vars["error"] = ("case", np.asarray([r["error"] for r in rows], dtype=str))
-    ds = xr.Dataset(data_vars, coords={"case": [r["case_id"] for r in rows]},
-                    attrs={"sweep": spec.name, "preset": spec.preset, "task": spec.task})
+    ds = xr.Dataset(
+        data_vars,
+        coords={"case": [r["case_id"] for r in rows]},
+        attrs={"sweep": spec.name, "preset": spec.preset, "task": spec.task},
+    )
     nc_path = out / "table.nc"
     with atomic_path(nc_path) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 #: short ramps so that a short run reaches the loaded state: speed 0 -> rated and load 0 -> rated
 #: over the first 20 ms
 FAST = {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0, "operating.load_ramp_end_s": 0.02}
@@ -25,8 +24,11 @@ def _dynamic(preset: str, model: str, t_end: float) -> dict:
     # and 0.3759 arcsec at the default tolerance before and after the row-kernel rewrite, 0.3616 converged)
     res = Simulation(override(preset, FAST), model=model).run(t_end=t_end, dt=1e-4, newton_tolerance=NEWTON_TOLERANCE)
     sel = res.ds.sel(time=slice(0.5 * t_end, None))
-    out = {"te_mean_arcsec": float(sel["te"].mean()), "te_pp_arcsec": float(np.ptp(sel["te"].values)),
-           "max_pin_force_N": float(sel["pin_force"].max())}
+    out = {
+        "te_mean_arcsec": float(sel["te"].mean()),
+        "te_pp_arcsec": float(np.ptp(sel["te"].values)),
+        "max_pin_force_N": float(sel["pin_force"].max()),
+    }
     if "ball_load_inner" in sel:
         out["max_ball_load_N"] = float(sel["ball_load_inner"].max())
     return out
@@ -53,8 +55,16 @@ def quasi_static_rv40e() -> dict:
     from flexrv.model.quasi_static import loaded_te
 
     s = loaded_te(load("rv40e"), crank_revolutions=0.25, points_per_mesh=8, catalog_positions=2).summary()
-    return {k: s[k] for k in ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motion_arcmin",
-                              "torsional_rigidity_Nm_per_arcmin")}
+    return {
+        k: s[k]
+        for k in (
+            "te_pp_arcsec",
+            "te_mean_arcsec",
+            "no_load_te_pp_arcsec",
+            "lost_motion_arcmin",
+            "torsional_rigidity_Nm_per_arcmin",
+        )
+    }
 
 
 def quasi_static_rv40e_grade5() -> dict:

@@ -55,8 +55,9 @@ def test_stribeck_single_row_zero_clearance(geom):
     Kotzalas 2007 eq. 7.44) within 5 %, and Q(psi)/Q_max = cos(psi)^1.5 within 2 %
     (a small deviation comes from the load-dependent contact angle)."""
     fr = 20e3
-    res = ball_load_distribution(geom, E_EFF, force=(fr, 0.0, 0.0), rows=[0], preload=0.0,
-                                 free=(True, True, False, False, False))
+    res = ball_load_distribution(
+        geom, E_EFF, force=(fr, 0.0, 0.0), rows=[0], preload=0.0, free=(True, True, False, False, False)
+    )
     q_ref = stribeck_max_load(fr, geom.ball_count, geom.contact_angle)
     assert abs(res.max_load / q_ref - 1) < 0.05
     psi = res.azimuth

@@ -5,8 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from flexrv.analysis.life import (ball_dynamic_rating, equivalent_radial_load, geometry_factor_fc, l10, life_hours,
-                                  system_life)
+from flexrv.analysis.life import (
+    ball_dynamic_rating,
+    equivalent_radial_load,
+    geometry_factor_fc,
+    l10,
+    life_hours,
+    system_life,
+)
 from flexrv.errors import InputError
 
 

@@ -23,9 +23,19 @@ def test_report_numbers_rv40e(rv40e_report):
     rep = rv40e_report
     f = rep["kinematics"]["frequencies_Hz"]
     assert rep["kinematics"]["ratio"] == 81.0
-    assert np.allclose([f["input"], f["crank_rotation"], f["carrier"], f["first_stage_mesh"], f["cycloid_mesh"],
-                        f["pins_x_crank_rotation"], f["disc_tooth_pin_passing"]], [20.25, 10, 0.25, 320, 390, 400, 10],
-                       rtol=1e-12)
+    assert np.allclose(
+        [
+            f["input"],
+            f["crank_rotation"],
+            f["carrier"],
+            f["first_stage_mesh"],
+            f["cycloid_mesh"],
+            f["pins_x_crank_rotation"],
+            f["disc_tooth_pin_passing"],
+        ],
+        [20.25, 10, 0.25, 320, 390, 400, 10],
+        rtol=1e-12,
+    )
     assert "pin_passing" not in f  # the misnamed key is gone (issue 17 (4))
     for case in rep["pin_loads"].values():
         assert abs(case["torque_balance_error_Nm"]) < 1e-6 * abs(case["disc_torque_Nm"])

@@ -3,10 +3,20 @@
 import numpy as np
 import pytest
 
-from flexrv.analysis.torsional import (SEED004_CC_NMM, SEED004_CW_NMM, SEED004_KTC_NMM, bearing_torsional_stiffness,
-                                       crank_bearing_forces, crank_hole_angles, identify_meshing_zone,
-                                       mesh_torsional_stiffness, needle_radial_stiffness, required_mesh_stiffness,
-                                       second_stage_stiffness, series_stiffness)
+from flexrv.analysis.torsional import (
+    SEED004_CC_NMM,
+    SEED004_CW_NMM,
+    SEED004_KTC_NMM,
+    bearing_torsional_stiffness,
+    crank_bearing_forces,
+    crank_hole_angles,
+    identify_meshing_zone,
+    mesh_torsional_stiffness,
+    needle_radial_stiffness,
+    required_mesh_stiffness,
+    second_stage_stiffness,
+    series_stiffness,
+)
 from flexrv.design import load
 from flexrv.errors import InputError
 
@@ -95,8 +105,7 @@ def test_stepped_shaft_bending_uniform_closed_form():
         b = span - a
         return b * x * (span**2 - b**2 - x**2) / (6 * ei * span) + b * x / (kga * span)
 
-    np.testing.assert_allclose(res.compliance, [[defl(x1, x1), defl(x1, x2)], [defl(x1, x2), defl(x2, x2)]],
-                               rtol=1e-12)
+    np.testing.assert_allclose(res.compliance, [[defl(x1, x1), defl(x1, x2)], [defl(x1, x2), defl(x2, x2)]], rtol=1e-12)
     assert res.k_symmetric == pytest.approx(4.0 / res.compliance.sum(), rel=1e-15)
 
 

@@ -45,7 +45,7 @@ def _support_state(p, theta=0.3, seed=1, scale=20e-6):
     c, s = np.cos(theta), np.sin(theta)
     for j in range(n):
         b = p.crank_bores[j]
-        q[6 + 3 * j:8 + 3 * j] = q[0:2] + [c * b[0] - s * b[1], s * b[0] + c * b[1]] + rng.normal(0.0, scale, 2)
+        q[6 + 3 * j : 8 + 3 * j] = q[0:2] + [c * b[0] - s * b[1], s * b[0] + c * b[1]] + rng.normal(0.0, scale, 2)
         q[8 + 3 * j] = rng.normal()
     return q
 
@@ -96,7 +96,8 @@ def test_rim_compliance_reproduces_fe_torsion(params):
     assert cd.shape == (2, 3, 3)
     assert cd[0, 2, 2] == pytest.approx(d.mean, rel=1e-12)
     assert cd[1, 2, 2] / params.n_discs == pytest.approx(
-        body_compliances(r)["cycloid_disc"]["compliance_rad_per_Nm"], rel=1e-12)
+        body_compliances(r)["cycloid_disc"]["compliance_rad_per_Nm"], rel=1e-12
+    )
 
 
 # ------------------------------------------------------------------ carrier in the crank supports
@@ -127,9 +128,17 @@ def test_condensed_carrier_equals_explicit_bore_unknowns(params):
     def spring(u):
         out = np.zeros(2 * n)
         for j in range(n):
-            fx, fy, *_ = crank_support_force(d0[j, 0] - u[2 * j], d0[j, 1] - u[2 * j + 1], gam[j],
-                                             p.support_clearances[j], p.support_law, p.support_roller_angles,
-                                             p.support_linear, 0.0, 0.0)
+            fx, fy, *_ = crank_support_force(
+                d0[j, 0] - u[2 * j],
+                d0[j, 1] - u[2 * j + 1],
+                gam[j],
+                p.support_clearances[j],
+                p.support_law,
+                p.support_roller_angles,
+                p.support_linear,
+                0.0,
+                0.0,
+            )
             out[2 * j], out[2 * j + 1] = fx, fy
         return out
 
@@ -236,7 +245,9 @@ def test_condensed_disc_equals_explicit_rim_unknowns(params):
     def resid(x):
         d = x.reshape(-1, 3) * np.array([1.0, 1.0, 1.0 / p.pin_circle_radius])
         Q = g0.evaluate(0.0, q + d.ravel(), v)[0].reshape(-1, 3)
-        return (d - np.einsum("kab,kb->ka", cd, Q)).ravel() * np.array([1.0, 1.0, p.pin_circle_radius] * p.n_discs) * 1e6
+        return (
+            (d - np.einsum("kab,kb->ka", cd, Q)).ravel() * np.array([1.0, 1.0, p.pin_circle_radius] * p.n_discs) * 1e6
+        )
 
     sol = root(resid, np.zeros_like(q), method="hybr", tol=1e-15)
     delta = sol.x.reshape(-1, 3) * np.array([1.0, 1.0, 1.0 / p.pin_circle_radius])
@@ -366,11 +377,13 @@ def test_self_intersecting_disc_and_bad_switch_name_the_field():
     from flexrv.design import override
     from flexrv.errors import ConfigError
 
-    cases = [({"second_stage.center_hole_radius_mm": 30.0}, "second_stage.center_hole_radius_mm"),
-             ({"first_stage.module_mm": 2.2}, "first_stage.module_mm"),
-             ({"first_stage.n_planets": 6}, "first_stage.n_planets"),
-             ({"second_stage.disc_body_model": "flexible"}, "disc_body_model"),
-             ({"carrier.body_model": "modal"}, "body_model")]
+    cases = [
+        ({"second_stage.center_hole_radius_mm": 30.0}, "second_stage.center_hole_radius_mm"),
+        ({"first_stage.module_mm": 2.2}, "first_stage.module_mm"),
+        ({"first_stage.n_planets": 6}, "first_stage.n_planets"),
+        ({"second_stage.disc_body_model": "flexible"}, "disc_body_model"),
+        ({"carrier.body_model": "modal"}, "body_model"),
+    ]
     for ov, field in cases:
         with pytest.raises(ConfigError, match=field):
             override("rv40e", ov)
@@ -394,8 +407,10 @@ def test_parts_semantics_and_cli_errors():
     assert parts_options("rigid", "none") == {"bodies": ()} and parts_options("flexible", "none") == {"parts": ()}
     with pytest.raises(ConfigError, match="main_bearing needs --model flexible"):
         parts_options("rigid", "main_bearing")
-    for args, words in ((["simulate", "rv40e", "--parts", "crankshaft"], "needs --model flexible"),
-                        (["stiffness-test", "rv40e", "--parts", "housing"], "parts = housing is not allowed")):
+    for args, words in (
+        (["simulate", "rv40e", "--parts", "crankshaft"], "needs --model flexible"),
+        (["stiffness-test", "rv40e", "--parts", "housing"], "parts = housing is not allowed"),
+    ):
         res = CliRunner().invoke(app, args)
         assert isinstance(res.exception, ConfigError) and words in str(res.exception), res.output
 

@@ -57,6 +57,7 @@ def _counting_build(path: Path, counter: Path, value: float, delay: float = 0.0)
         time.sleep(delay)
         atomic_write_text(path, json.dumps({"value": value}))
         return value
+
     return build
 
 
@@ -68,9 +69,11 @@ def test_corrupt_entries_are_rebuilt_with_a_notice(cache_root, capsys):
     assert cached_entry([path], "k1", load, build) == (1.5, False)
     assert cached_entry([path], "k1", load, build) == (1.5, True)
     assert capsys.readouterr().err == ""
-    for corrupt in (lambda: path.write_text(path.read_text()[:5]),   # truncated
-                    lambda: path.write_bytes(b""),                     # 0 bytes
-                    lambda: path.write_text(path.read_text().replace("1.5", "2.5"))):  # same size, other content
+    for corrupt in (
+        lambda: path.write_text(path.read_text()[:5]),  # truncated
+        lambda: path.write_bytes(b""),  # 0 bytes
+        lambda: path.write_text(path.read_text().replace("1.5", "2.5")),
+    ):  # same size, other content
         corrupt()
         assert cached_entry([path], "k1", load, build) == (1.5, False)
         err = capsys.readouterr().err
@@ -105,8 +108,9 @@ def _builder_process(root: str, counter: str, barrier) -> None:
     os.environ["FLEXRV_CACHE_DIR"] = root
     path = Path(root) / "shared.json"
     barrier.wait()
-    cached_entry([path], "k", lambda: json.loads(path.read_text())["value"],
-                 _counting_build(path, Path(counter), 3.0, delay=1.0))
+    cached_entry(
+        [path], "k", lambda: json.loads(path.read_text())["value"], _counting_build(path, Path(counter), 3.0, delay=1.0)
+    )
 
 
 def test_concurrent_builders_build_once(cache_root):
@@ -150,7 +154,11 @@ def test_cli_cache_dir_option(tmp_path):
     import sys
 
     d = tmp_path / "cache"
-    cp = subprocess.run([sys.executable, "-m", "flexrv", "--cache-dir", str(d), "mesh", "rv40e", "--part",
-                         "outer_ring", "--json"], capture_output=True, text=True, timeout=300)
+    cp = subprocess.run(
+        [sys.executable, "-m", "flexrv", "--cache-dir", str(d), "mesh", "rv40e", "--part", "outer_ring", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert cp.returncode == 0, cp.stderr
     assert any(p.name.startswith("outer_ring-") and p.suffix == ".msh" for p in d.iterdir())

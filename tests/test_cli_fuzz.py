@@ -81,34 +81,71 @@ def _cases(d: Path) -> list[tuple[str, list[str], list[str]]]:
         ("utf16_sweep", ["sweep", str(d / "sweep_u16.toml")], ["sweep_u16.toml", "UTF-16"]),
         ("markup_path", ["design", str(d / "[/x].toml")], ["[/x].toml"]),
         ("markup_bold_path", ["show", str(d / "[bold]x.toml")], ["[bold]x.toml"]),
-        ("markup_value", ["show", _design(d / "m.toml", first_stage__sun_teeth="[/x]")],
-         ["first_stage.sun_teeth", "[/x]"]),
+        (
+            "markup_value",
+            ["show", _design(d / "m.toml", first_stage__sun_teeth="[/x]")],
+            ["first_stage.sun_teeth", "[/x]"],
+        ),
         # --- strict types
-        ("string_number", ["show", _design(d / "s.toml", second_stage__disc_width_mm="12.0")],
-         ["second_stage.disc_width_mm", "12.0"]),
-        ("bool_number", ["show", _design(d / "b.toml", inertia__input_shaft_inertia_kg_m2=True)],
-         ["inertia.input_shaft_inertia_kg_m2", "True"]),
+        (
+            "string_number",
+            ["show", _design(d / "s.toml", second_stage__disc_width_mm="12.0")],
+            ["second_stage.disc_width_mm", "12.0"],
+        ),
+        (
+            "bool_number",
+            ["show", _design(d / "b.toml", inertia__input_shaft_inertia_kg_m2=True)],
+            ["inertia.input_shaft_inertia_kg_m2", "True"],
+        ),
         ("float_int", ["show", _design(d / "f.toml", second_stage__disc_teeth=39.0)], ["second_stage.disc_teeth"]),
         # --- infeasible designs
-        ("needles_overlap", ["show", _design(d / "n.toml", needle_bearing__roller_count=80)],
-         ["needle_bearing.roller_count", "80"]),
-        ("roller_too_long", ["show", _design(d / "r.toml", needle_bearing__roller_length_mm=100.0)],
-         ["needle_bearing.roller_length_mm"]),
-        ("main_bearing_in_crank_circle",
-         ["show", _design(d / "mb.toml", main_bearing__pitch_diameter_mm=90.0,
-                          main_bearing__inner_ring_bore_diameter_mm=70.0,
-                          main_bearing__outer_ring_outer_diameter_mm=110.0, main_bearing__ball_count=20)],
-         ["main_bearing.pitch_diameter_mm", "crank"]),
-        ("contact_ratio_low", ["show", _design(d / "c1.toml", first_stage__sun_profile_shift=1.5,
-                                               first_stage__planet_profile_shift=1.5)],
-         ["first_stage.sun_profile_shift", "eps_alpha = 0.792"]),
-        ("contact_ratio_high", ["show", _design(d / "c2.toml", first_stage__sun_profile_shift=-1.0,
-                                                first_stage__planet_profile_shift=-1.0)],
-         ["first_stage.sun_profile_shift", "eps_alpha"]),
-        ("contact_angle_design", ["design", _design(d / "ca.toml", main_bearing__contact_angle_deg=10.0)],
-         ["main_bearing.contact_angle_deg", "10"]),
-        ("clearance_design", ["design", _design(d / "pre.toml", "rv221", main_bearing__axial_preload_um=-100.0)],
-         ["main_bearing.axial_preload_um", "-100"]),
+        (
+            "needles_overlap",
+            ["show", _design(d / "n.toml", needle_bearing__roller_count=80)],
+            ["needle_bearing.roller_count", "80"],
+        ),
+        (
+            "roller_too_long",
+            ["show", _design(d / "r.toml", needle_bearing__roller_length_mm=100.0)],
+            ["needle_bearing.roller_length_mm"],
+        ),
+        (
+            "main_bearing_in_crank_circle",
+            [
+                "show",
+                _design(
+                    d / "mb.toml",
+                    main_bearing__pitch_diameter_mm=90.0,
+                    main_bearing__inner_ring_bore_diameter_mm=70.0,
+                    main_bearing__outer_ring_outer_diameter_mm=110.0,
+                    main_bearing__ball_count=20,
+                ),
+            ],
+            ["main_bearing.pitch_diameter_mm", "crank"],
+        ),
+        (
+            "contact_ratio_low",
+            ["show", _design(d / "c1.toml", first_stage__sun_profile_shift=1.5, first_stage__planet_profile_shift=1.5)],
+            ["first_stage.sun_profile_shift", "eps_alpha = 0.792"],
+        ),
+        (
+            "contact_ratio_high",
+            [
+                "show",
+                _design(d / "c2.toml", first_stage__sun_profile_shift=-1.0, first_stage__planet_profile_shift=-1.0),
+            ],
+            ["first_stage.sun_profile_shift", "eps_alpha"],
+        ),
+        (
+            "contact_angle_design",
+            ["design", _design(d / "ca.toml", main_bearing__contact_angle_deg=10.0)],
+            ["main_bearing.contact_angle_deg", "10"],
+        ),
+        (
+            "clearance_design",
+            ["design", _design(d / "pre.toml", "rv221", main_bearing__axial_preload_um=-100.0)],
+            ["main_bearing.axial_preload_um", "-100"],
+        ),
         # --- bounds and output paths, before any work
         ("dt_tiny", ["simulate", "rv40e", "--dt", "1e-12", "--out", out], ["dt", "1e-12", "time steps"]),
         ("t_end_huge", ["simulate", "rv40e", "--t-end", "1e9", "--out", out], ["t_end", "1e+09", "time steps"]),
@@ -118,34 +155,61 @@ def _cases(d: Path) -> list[tuple[str, list[str], list[str]]]:
         ("stiffness_out_not_empty", ["stiffness-test", "rv40e", "--out", str(full)], ["--out", "--overwrite"]),
         ("resume_no_checkpoint", ["simulate", "--resume", str(empty)], ["--resume", "checkpoint"]),
         ("ehl_png_proc", ["ehl", "--png", "/proc/x/a.png"], ["--png"]),
-        ("ehl_negative_load", ["ehl", "--load-n", "-1", "--speed-m-s", "1", "--rx-m", "0.005", "--ry-m", "0.05"],
-         ["--load-n", "-1"]),
+        (
+            "ehl_negative_load",
+            ["ehl", "--load-n", "-1", "--speed-m-s", "1", "--rx-m", "0.005", "--ry-m", "0.05"],
+            ["--load-n", "-1"],
+        ),
         ("view_not_netcdf", ["view", str(bogus_run)], ["results.nc"]),
         # --- sweep specs
         ("sweep_grid_scalar", ["sweep", _spec(d / "g.toml", _HEAD + "grid = 5\n")], ["grid", "5"]),
         ("sweep_cases_scalar", ["sweep", _spec(d / "cs.toml", _HEAD + "cases = 5\n")], ["cases", "5"]),
         ("sweep_options_string", ["sweep", _spec(d / "o.toml", _HEAD + 'options = "x"\n' + _GRID)], ["options", "'x'"]),
-        ("sweep_name_parent", ["sweep", _spec(d / "n1.toml", _HEAD.replace('"fz"', '"../y"') + _GRID)],
-         ["name", "../y"]),
-        ("sweep_name_absolute", ["sweep", _spec(d / "n2.toml", _HEAD.replace('"fz"', '"/tmp/x"') + _GRID)],
-         ["name", "/tmp/x"]),
-        ("sweep_task_missing", ["sweep", _spec(d / "t.toml", _HEAD.replace('"design"', '"no.such.module:fn"') + _GRID)],
-         ["no.such.module"]),
-        ("sweep_output_misspelled",
-         ["sweep", _spec(d / "k.toml", _HEAD.replace("kinematics.ratio", "kinematics.ratioo") + _GRID)],
-         ["outputs", "kinematics.ratioo"]),
-        ("sweep_task_option", ["sweep", _spec(d / "to.toml", _HEAD + "[options]\nbogus = 1\n" + _GRID)],
-         ["options.bogus"]),
-        ("sweep_scheduler_unreachable", ["sweep", _spec(d / "sc.toml", _HEAD + _GRID), "--scheduler",
-                                         "tcp://127.0.0.1:1"], ["--scheduler"]),
+        (
+            "sweep_name_parent",
+            ["sweep", _spec(d / "n1.toml", _HEAD.replace('"fz"', '"../y"') + _GRID)],
+            ["name", "../y"],
+        ),
+        (
+            "sweep_name_absolute",
+            ["sweep", _spec(d / "n2.toml", _HEAD.replace('"fz"', '"/tmp/x"') + _GRID)],
+            ["name", "/tmp/x"],
+        ),
+        (
+            "sweep_task_missing",
+            ["sweep", _spec(d / "t.toml", _HEAD.replace('"design"', '"no.such.module:fn"') + _GRID)],
+            ["no.such.module"],
+        ),
+        (
+            "sweep_output_misspelled",
+            ["sweep", _spec(d / "k.toml", _HEAD.replace("kinematics.ratio", "kinematics.ratioo") + _GRID)],
+            ["outputs", "kinematics.ratioo"],
+        ),
+        (
+            "sweep_task_option",
+            ["sweep", _spec(d / "to.toml", _HEAD + "[options]\nbogus = 1\n" + _GRID)],
+            ["options.bogus"],
+        ),
+        (
+            "sweep_scheduler_unreachable",
+            ["sweep", _spec(d / "sc.toml", _HEAD + _GRID), "--scheduler", "tcp://127.0.0.1:1"],
+            ["--scheduler"],
+        ),
     ]
 
 
 def _run(argv: list[str], cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg", "COLUMNS": "200"}
-    return subprocess.run([sys.executable, "-m", "flexrv", *argv], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=TIMEOUT_S)
+    env = {
+        **os.environ,
+        "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MPLBACKEND": "Agg",
+        "COLUMNS": "200",
+    }
+    return subprocess.run(
+        [sys.executable, "-m", "flexrv", *argv], cwd=cwd, env=env, capture_output=True, text=True, timeout=TIMEOUT_S
+    )
 
 
 @pytest.fixture(scope="module")

@@ -37,8 +37,16 @@ def test_compare_writes_everything_and_numbers_match_netcdf(compared):
     from flexrv.post.spectra import te_spectrum
 
     out = compared.out_dir
-    for name in ("te_overlay.png", "te_spectrum.png", "ball_loads.png", "ring_deformation.png", "summary.md",
-                 "compare.json", "rigid/results.nc", "flexible/results.nc"):
+    for name in (
+        "te_overlay.png",
+        "te_spectrum.png",
+        "ball_loads.png",
+        "ring_deformation.png",
+        "summary.md",
+        "compare.json",
+        "rigid/results.nc",
+        "flexible/results.nc",
+    ):
         assert (out / name).exists(), name
     numbers = json.loads((out / "compare.json").read_text())
     for model in ("rigid", "flexible"):
@@ -51,7 +59,8 @@ def test_compare_writes_everything_and_numbers_match_netcdf(compared):
         assert numbers[model]["characteristic_frequencies_hz"] == pytest.approx(marks)
     assert numbers["flexible"]["max_ball_load_N"] > 0
     assert numbers["difference"]["te_pp_arcsec"] == pytest.approx(
-        numbers["flexible"]["te_pp_arcsec"] - numbers["rigid"]["te_pp_arcsec"])
+        numbers["flexible"]["te_pp_arcsec"] - numbers["rigid"]["te_pp_arcsec"]
+    )
     text = (out / "summary.md").read_text()
     # rv40e is not the seeds' reducer (rv221): no seed TE values, no prose about them
     assert "-25.2" not in text and "seed000/seed001 TE range" not in text and "No seed reference" in text
@@ -68,7 +77,7 @@ def test_view_png_and_pvd_match_the_reduced_bodies(compared, tmp_path):
     import meshio
 
     from flexrv.post.results import load_results
-    from flexrv.viz.rings import ring_bodies, render_rings_png, write_pvd
+    from flexrv.viz.rings import render_rings_png, ring_bodies, write_pvd
 
     res = load_results(compared.out_dir / "flexible")
     png = render_rings_png(res, tmp_path / "rings.png")
@@ -93,8 +102,9 @@ def test_view_png_and_pvd_match_the_reduced_bodies(compared, tmp_path):
     expected = body.displacement(q) * np.array([1.0, 1.0, -1.0])  # row 1: mirrored
     mesh = meshio.read(tmp_path / "vtu" / f"outer_row1_{i:06d}.vtu")
     used = np.unique(body.tris[:, :3])
-    np.testing.assert_allclose(mesh.point_data["displacement"], expected[used], rtol=0,
-                               atol=1e-9 * np.abs(expected).max())
+    np.testing.assert_allclose(
+        mesh.point_data["displacement"], expected[used], rtol=0, atol=1e-9 * np.abs(expected).max()
+    )
     assert np.abs(expected).max() > 1e-10
 
 

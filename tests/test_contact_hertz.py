@@ -6,8 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from flexrv.contact.hertz import (effective_modulus, line_contact, line_contact_stiffness, point_contact,
-                                  point_contact_stiffness, series_stiffness)
+from flexrv.contact.hertz import (
+    effective_modulus,
+    line_contact,
+    line_contact_stiffness,
+    point_contact,
+    point_contact_stiffness,
+    series_stiffness,
+)
 from flexrv.errors import InputError
 
 E_STEEL, NU = 207e9, 0.3

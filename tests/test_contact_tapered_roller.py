@@ -9,8 +9,16 @@ import numpy as np
 import pytest
 from scipy.special import gamma as gamma_fn
 
-from flexrv.contact.tapered_roller import (SC_COS_A, SC_DELTA0, SC_EXPONENT, SC_K_BEND, SC_K_ROLLER, SC_LINEAR,
-                                           crank_support_force, support_deflection)
+from flexrv.contact.tapered_roller import (
+    SC_COS_A,
+    SC_DELTA0,
+    SC_EXPONENT,
+    SC_K_BEND,
+    SC_K_ROLLER,
+    SC_LINEAR,
+    crank_support_force,
+    support_deflection,
+)
 
 N = 10.0 / 9.0
 

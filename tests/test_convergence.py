@@ -50,8 +50,10 @@ class ConvergenceEHLCircular:
 
     def films(self):
         q, u, rx, ry, e, lub = self.case
-        out = [solve_point_contact(q, u, rx, ry, e, lub, grid=g, wedge_order=2, extrapolate=False, grid_tol=None)
-               for g in (33, 65, 129)]
+        out = [
+            solve_point_contact(q, u, rx, ry, e, lub, grid=g, wedge_order=2, extrapolate=False, grid_tol=None)
+            for g in (33, 65, 129)
+        ]
         return [r.h_central for r in out], [r.h_min for r in out]
 
     def test_order(self):
@@ -104,8 +106,9 @@ class TestConvergenceShaftTorsion:
             f, v = eigenmodes(fe.K, fe.M, 12)
             u = v.reshape(-1, 3, v.shape[1])
             x = m.nodes
-            tang = (-x[:, 1, None] * u[:, 0] + x[:, 0, None] * u[:, 1]) / np.maximum(np.hypot(x[:, 0], x[:, 1]),
-                                                                                    1e-12)[:, None]
+            tang = (-x[:, 1, None] * u[:, 0] + x[:, 0, None] * u[:, 1]) / np.maximum(np.hypot(x[:, 0], x[:, 1]), 1e-12)[
+                :, None
+            ]
             share = (tang**2).sum(0) / (u**2).sum((0, 1))
             errors.append(f[(f > 1.0) & (share > 0.9)][0] / exact - 1.0)
         errors = np.array(errors)
@@ -168,10 +171,19 @@ class TestConvergenceCarrierTorsion:
         from flexrv.meshing.mesh import generate_mesh
         from flexrv.meshing.parts import CarrierSpec
 
-        spec = CarrierSpec(plate_radius=0.03, input_thickness=0.006, output_thickness=0.006, gap=0.012,
-                           crank_circle_radius=0.014, crank_bore_radius=0.005, n_cranks=3, center_bore_radius=0.003,
-                           pillar_circle_radius=0.016, pillar_radius=0.003,
-                           pillar_angles=tuple(np.pi / 3 + 2 * np.pi * k / 3 for k in range(3)))
+        spec = CarrierSpec(
+            plate_radius=0.03,
+            input_thickness=0.006,
+            output_thickness=0.006,
+            gap=0.012,
+            crank_circle_radius=0.014,
+            crank_bore_radius=0.005,
+            n_cranks=3,
+            center_bore_radius=0.003,
+            pillar_circle_radius=0.016,
+            pillar_radius=0.003,
+            pillar_angles=tuple(np.pi / 3 + 2 * np.pi * k / 3 for k in range(3)),
+        )
         g = torque_load_vector(3, spec.crank_circle_radius, 0.5)
         c = []
         for h in self.sizes:

@@ -9,10 +9,20 @@ import numpy as np
 import pytest
 
 from flexrv.errors import InputError
-from flexrv.geometry.cycloid import (center_curve_curvature, k34, moment_arm, nominal_disc_pose, pin_gap,
-                                     pin_positions, pin_stiffness_seed000, pin_stiffness_seed004,
-                                     profile_curvature_radius, profile_points, seed004_curvature_radius,
-                                     to_disc_frame)
+from flexrv.geometry.cycloid import (
+    center_curve_curvature,
+    k34,
+    moment_arm,
+    nominal_disc_pose,
+    pin_gap,
+    pin_positions,
+    pin_stiffness_seed000,
+    pin_stiffness_seed004,
+    profile_curvature_radius,
+    profile_points,
+    seed004_curvature_radius,
+    to_disc_frame,
+)
 
 Z, R, RP, A = 40, 0.064, 0.003, 0.0013  # RV-40E second stage (:cite:`seed002` Table 1)
 

@@ -33,8 +33,7 @@ def member_literals(source: str, filename: str = "<string>") -> list[str]:
         line = f"{filename}:{getattr(node, 'lineno', '?')}"
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in _STATE_CALLS:
             found.append(f"{line}: .{node.func.attr}(...) slices the state by member")
-        elif (isinstance(node, ast.Subscript) and isinstance(node.value, ast.Attribute)
-              and node.value.attr == "members"):
+        elif isinstance(node, ast.Subscript) and isinstance(node.value, ast.Attribute) and node.value.attr == "members":
             found.append(f"{line}: .members[...] looks a member up by name")
         elif isinstance(node, ast.Attribute) and node.attr == "offset":
             found.append(f"{line}: .offset is a member's position in the state vector")
@@ -43,8 +42,12 @@ def member_literals(source: str, filename: str = "<string>") -> list[str]:
         elif isinstance(node, ast.JoinedStr):
             parts = node.values
             for a, b in zip(parts, parts[1:]):
-                if (isinstance(a, ast.Constant) and isinstance(a.value, str) and isinstance(b, ast.FormattedValue)
-                        and re.search(r"(^|[^A-Za-z_])(" + "|".join(_MEMBER_PREFIXES) + r")$", a.value)):
+                if (
+                    isinstance(a, ast.Constant)
+                    and isinstance(a.value, str)
+                    and isinstance(b, ast.FormattedValue)
+                    and re.search(r"(^|[^A-Za-z_])(" + "|".join(_MEMBER_PREFIXES) + r")$", a.value)
+                ):
                     found.append(f"{line}: member name f-string {a.value!r}{{...}}")
     return found
 
@@ -58,30 +61,33 @@ def _files_above_model():
 def test_scanner_finds_planted_member_literals():
     """The scanner flags each kind of member-name / state-index use and passes the by-name
     reads post uses (a scanner that cannot fail would be a defect)."""
-    bad = '''
+    bad = """
 cs = model.slice("carrier")
 crank = [q[:, model.slice(f"crank{j}")] for j in range(3)]
 d = model.members["disc0"].mass_matrix
 o = member.offset
 x = state["planet1"]
 qg = model.group_state(g, q)
-'''
+"""
     hits = member_literals(bad)
     assert len(hits) == 8, hits  # slice x2, f"crank{", members[], "disc0", offset, "planet1", group_state
-    good = '''
+    good = """
 th = res["theta_out"].values
 w = res["crank_speed"].values[:, 0]
 label = f"crank {j}"
 names = {"carrier": "output (carrier)", "crank_rotation": "crank"}
-'''
+"""
     assert member_literals(good) == []
 
 
 def test_no_member_name_or_state_index_outside_model():
     """post/, viz/, simulation.py, sweep.py, studies/, workflows/ and cli/ read results by
     name: no member-name literal and no state slicing anywhere in them."""
-    hits = [h for path in _files_above_model()
-            for h in member_literals(path.read_text(encoding="utf-8"), str(path.relative_to(ROOT.parent)))]
+    hits = [
+        h
+        for path in _files_above_model()
+        for h in member_literals(path.read_text(encoding="utf-8"), str(path.relative_to(ROOT.parent)))
+    ]
     assert not hits, "member names / state layout used above the model layer:\n" + "\n".join(hits)
 
 
@@ -91,8 +97,19 @@ def test_declared_outputs_have_units_and_names():
     from flexrv.model.outputs import ROLES, STATE_OUTPUTS, declared_outputs
 
     decl = declared_outputs()
-    assert {"theta_in", "theta_out", "omega_in", "omega_out", "crank_x", "disc_speed", "carrier_tilt",
-            "kinetic_energy", "angular_momentum", "input_torque", "output_torque"} <= set(decl)
+    assert {
+        "theta_in",
+        "theta_out",
+        "omega_in",
+        "omega_out",
+        "crank_x",
+        "disc_speed",
+        "carrier_tilt",
+        "kinetic_energy",
+        "angular_momentum",
+        "input_torque",
+        "output_torque",
+    } <= set(decl)
     for name, (dims, units, long_name) in decl.items():
         assert dims[0] == "time" and units and long_name, name
     assert {s.role for s in STATE_OUTPUTS} == set(ROLES)
@@ -150,8 +167,10 @@ def test_member_outputs_match_the_state_vector():
         assert np.array_equal(out["crank_speed"].values[:, j], v[:, model.members[f"crank{j}"].offset + 2])
     for k in range(p.n_discs):
         assert np.array_equal(out["disc_y"].values[:, k], q[:, model.members[f"disc{k}"].offset + 1])
-    ke = sum(0.5 * np.einsum("ti,ij,tj->t", v[:, m.offset:m.offset + m.n], m.mass_matrix,
-                             v[:, m.offset:m.offset + m.n]) for m in model.members.values())
+    ke = sum(
+        0.5 * np.einsum("ti,ij,tj->t", v[:, m.offset : m.offset + m.n], m.mass_matrix, v[:, m.offset : m.offset + m.n])
+        for m in model.members.values()
+    )
     ke = ke + 0.5 * p.input_inertia * np.asarray(model.input_speed(t)) ** 2
     assert np.allclose(out["kinetic_energy"].values, ke, rtol=1e-13, atol=0)
     assert out["crank_x"].dims == ("time", "crank") and out["disc_y"].values.shape == (len(t), p.n_discs)

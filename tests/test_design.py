@@ -126,8 +126,11 @@ def test_ball_larger_than_ring(name):
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(name=st.sampled_from(PRESETS), data=st.data(),
-       bad=st.sampled_from([-1.0, 0.0, float("nan"), float("inf"), -1e9, 1e12, "text"]))
+@given(
+    name=st.sampled_from(PRESETS),
+    data=st.data(),
+    bad=st.sampled_from([-1.0, 0.0, float("nan"), float("inf"), -1e9, 1e12, "text"]),
+)
 def test_bad_numeric_value_names_field(name, data, bad):
     """Negative, zero, NaN, inf, huge or non-numeric values either are valid for that
     field or raise ConfigError naming exactly that field."""
@@ -152,10 +155,17 @@ def test_missing_field_named(name, data):
 
 
 @settings(max_examples=40, deadline=None)
-@given(name=st.sampled_from(PRESETS), data=st.data(),
-       key=st.text(alphabet="abcdefghijklmnopqrstuvwxyz_", min_size=3, max_size=12))
+@given(
+    name=st.sampled_from(PRESETS),
+    data=st.data(),
+    key=st.text(alphabet="abcdefghijklmnopqrstuvwxyz_", min_size=3, max_size=12),
+)
 def test_unknown_field_named(name, data, key):
-    section = data.draw(st.sampled_from([k for k, v in RAW[name].items() if isinstance(v, dict) and k not in ("provenance", "materials")]))
+    section = data.draw(
+        st.sampled_from(
+            [k for k, v in RAW[name].items() if isinstance(v, dict) and k not in ("provenance", "materials")]
+        )
+    )
     if key in RAW[name][section]:
         return
     mutated = _set(RAW[name], (section, key), 1.0)
@@ -174,10 +184,12 @@ def test_range_in_message():
 def test_cli_bad_file_exit_2_no_traceback(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(to_toml(load("rv40e")).replace("ball_count = 38", "ball_count = -3"))
-    from flexrv.cli import main
-    import subprocess, sys
-    proc = subprocess.run([sys.executable, "-c", "from flexrv.cli import main; main()", "show", str(bad)],
-                          capture_output=True, text=True)
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-c", "from flexrv.cli import main; main()", "show", str(bad)], capture_output=True, text=True
+    )
     assert proc.returncode == 2
     assert "main_bearing.ball_count" in proc.stderr and "Traceback" not in proc.stderr
 
@@ -208,10 +220,12 @@ def test_strict_types(name):
     data = _dump(name)
     data["second_stage"]["disc_width_mm"] = int(data["second_stage"]["disc_width_mm"])
     assert isinstance(from_dict(data).second_stage.disc_width_mm, float)
-    for section, field, bad in (("second_stage", "disc_width_mm", "12.0"),
-                                ("inertia", "input_shaft_inertia_kg_m2", True),
-                                ("second_stage", "disc_teeth", float(data["second_stage"]["disc_teeth"])),
-                                ("first_stage", "sun_teeth", "[/x]")):
+    for section, field, bad in (
+        ("second_stage", "disc_width_mm", "12.0"),
+        ("inertia", "input_shaft_inertia_kg_m2", True),
+        ("second_stage", "disc_teeth", float(data["second_stage"]["disc_teeth"])),
+        ("first_stage", "sun_teeth", "[/x]"),
+    ):
         d = _dump(name)
         d[section][field] = bad
         with pytest.raises(ConfigError, match=rf"{section}\.{field} = {re.escape(repr(bad))}"):
@@ -233,14 +247,26 @@ def test_first_stage_contact_ratio(name):
 
     r = load(name)
     fs = r.first_stage
-    assert fs.contact_ratio == pytest.approx(float(contact_ratio(fs.sun_teeth, fs.planet_teeth, fs.module,
-                                                                 fs.pressure_angle, fs.sun_profile_shift,
-                                                                 fs.planet_profile_shift)), rel=1e-12)
+    assert fs.contact_ratio == pytest.approx(
+        float(
+            contact_ratio(
+                fs.sun_teeth,
+                fs.planet_teeth,
+                fs.module,
+                fs.pressure_angle,
+                fs.sun_profile_shift,
+                fs.planet_profile_shift,
+            )
+        ),
+        rel=1e-12,
+    )
     if name == "rv40e":
         m, al = 1.5, math.radians(20.0)
         ra1, ra2 = m * (16 + 2) / 2, m * (32 + 2) / 2
         rb1, rb2 = m * 16 / 2 * math.cos(al), m * 32 / 2 * math.cos(al)
-        eps = (math.sqrt(ra1**2 - rb1**2) + math.sqrt(ra2**2 - rb2**2) - m * 24 * math.sin(al)) / (math.pi * m * math.cos(al))
+        eps = (math.sqrt(ra1**2 - rb1**2) + math.sqrt(ra2**2 - rb2**2) - m * 24 * math.sin(al)) / (
+            math.pi * m * math.cos(al)
+        )
         assert fs.contact_ratio == pytest.approx(eps, rel=1e-9)
         assert eps == pytest.approx(1.583, abs=1e-3)
     for shifts in ((1.5, 1.5), (-1.0, -1.0)):
@@ -271,8 +297,15 @@ def test_geometric_feasibility(name):
     d = _dump(name)
     mb = d["main_bearing"]
     dm = 2 * r_out - 4.0
-    mb.update(pitch_diameter_mm=dm, inner_ring_bore_diameter_mm=dm - 20.0, outer_ring_outer_diameter_mm=dm + 20.0,
-              ball_diameter_mm=6.0, ball_count=20, ring_width_mm=8.0, row_spacing_mm=max(mb["row_spacing_mm"], 8.0))
+    mb.update(
+        pitch_diameter_mm=dm,
+        inner_ring_bore_diameter_mm=dm - 20.0,
+        outer_ring_outer_diameter_mm=dm + 20.0,
+        ball_diameter_mm=6.0,
+        ball_count=20,
+        ring_width_mm=8.0,
+        row_spacing_mm=max(mb["row_spacing_mm"], 8.0),
+    )
     with pytest.raises(ConfigError, match="main_bearing.pitch_diameter_mm.*crank-hole circle"):
         from_dict(d)
 
@@ -283,8 +316,10 @@ def test_design_report_load_sanity_warnings():
     from flexrv.analysis.report import design_report
     from flexrv.cli.design import load_sanity_warnings
 
-    fake = {"main_bearing": {"external": {"hertz_max_ball": {"inner_p_max_Pa": 4.3e9, "outer_p_max_Pa": 4.1e9}}},
-            "pin_loads": {"rated_torque": {"max_hertz_pressure_Pa": 4.05e9}}}
+    fake = {
+        "main_bearing": {"external": {"hertz_max_ball": {"inner_p_max_Pa": 4.3e9, "outer_p_max_Pa": 4.1e9}}},
+        "pin_loads": {"rated_torque": {"max_hertz_pressure_Pa": 4.05e9}},
+    }
     warnings = load_sanity_warnings(fake)
     assert len(warnings) == 2
     assert warnings[0].startswith("main_bearing.external.hertz_max_ball.inner_p_max_Pa = 4.3 GPa")
@@ -306,12 +341,13 @@ def test_toml_template_comments_round_trip_and_optional_provenance(tmp_path):
     assert "# Sun gear teeth z_s [-]; allowed: 8 <= value <= 200\nsun_teeth = 16" in text
     assert loads(text) == red
     bare = "\n".join(line for line in to_toml(red).splitlines())
-    bare = bare[:bare.index("[provenance]")]
+    bare = bare[: bare.index("[provenance]")]
     path = tmp_path / "own.toml"
     path.write_text(bare)
     assert load(path).provenance == {}
-    cp = subprocess.run([sys.executable, "-m", "flexrv", "show", str(path)], capture_output=True, text=True,
-                        timeout=120)
+    cp = subprocess.run(
+        [sys.executable, "-m", "flexrv", "show", str(path)], capture_output=True, text=True, timeout=120
+    )
     assert cp.returncode == 0 and "no [provenance] table" in cp.stderr
 
 

@@ -47,7 +47,9 @@ def test_docstring_examples(name):
 def test_examples_run_not_only_skipped():
     """At least the units, formatting, design, cache and EHL-law examples really execute
     (a doctest run where everything is skipped would check nothing)."""
-    attempted = {name: _run(name).attempted for name in
-                 ("flexrv.units", "flexrv.post.format", "flexrv.design", "flexrv.cache", "flexrv.ehl.law")}
+    attempted = {
+        name: _run(name).attempted
+        for name in ("flexrv.units", "flexrv.post.format", "flexrv.design", "flexrv.cache", "flexrv.ehl.law")
+    }
     assert all(n >= 1 for n in attempted.values()), attempted
     assert sum(attempted.values()) >= 15, attempted

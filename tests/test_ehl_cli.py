@@ -34,11 +34,13 @@ def test_ehl_preset_json(tmp_path):
     np.testing.assert_allclose(inp["load_N"], q, rtol=1e-9)
     w_c = 1500.0 * 2 * math.pi / 60.0 / 221.0
     gam = geom.ball_diameter * math.cos(geom.contact_angle) / geom.pitch_diameter
-    np.testing.assert_allclose(inp["entrainment_speed_m_s"], 0.25 * geom.pitch_diameter * (1 - gam**2) * w_c,
-                               rtol=2e-3)  # loaded vs nominal contact angle
+    np.testing.assert_allclose(
+        inp["entrainment_speed_m_s"], 0.25 * geom.pitch_diameter * (1 - gam**2) * w_c, rtol=2e-3
+    )  # loaded vs nominal contact angle
     assert inp["grid"] == 33 and inp["viscosity_Pa_s"] == red.lubricant.viscosity_Pa_s
-    np.testing.assert_allclose(inp["roelands_pressure_viscosity_1_Pa"], 0.68 * (math.log(0.13) + 9.67) / 1.96e8,
-                               rtol=1e-12)  # Roelands 1966 slope at p -> 0
+    np.testing.assert_allclose(
+        inp["roelands_pressure_viscosity_1_Pa"], 0.68 * (math.log(0.13) + 9.67) / 1.96e8, rtol=1e-12
+    )  # Roelands 1966 slope at p -> 0
     assert abs(out["h_central_m"] / out["hamrock_dowson_h_central_m"] - 1) < 0.35
     assert 1e-8 < out["h_min_m"] < out["h_central_m"] < 1e-6  # EHL films: 0.01-1 um
     assert abs(out["p_max_Pa"] / out["hertz_pressure_Pa"] - 1) < 0.1
@@ -47,8 +49,9 @@ def test_ehl_preset_json(tmp_path):
 
 
 def test_ehl_explicit_case_table():
-    res = CliRunner().invoke(app, ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.01", "--ry-m", "0.04",
-                                   "--grid", "33"])
+    res = CliRunner().invoke(
+        app, ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.01", "--ry-m", "0.04", "--grid", "33"]
+    )
     assert res.exit_code == 0, res.output
     assert "h_central_m" in res.output and "explicit" in res.output
 

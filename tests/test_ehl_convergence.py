@@ -59,9 +59,17 @@ def solve(case, grid=129, refine=True):
     return solve_point_contact(q, u, rx, ry, e, lub, grid=grid, wedge_order=2, extrapolate=True, **kw)
 
 
-@pytest.mark.parametrize("case", ["circ31", "ell4", "rv221", "circ260",
-                                  pytest.param("ell10", marks=pytest.mark.slow),
-                                  pytest.param("circ640", marks=pytest.mark.slow)])
+@pytest.mark.parametrize(
+    "case",
+    [
+        "circ31",
+        "ell4",
+        "rv221",
+        "circ260",
+        pytest.param("ell10", marks=pytest.mark.slow),
+        pytest.param("circ640", marks=pytest.mark.slow),
+    ],
+)
 def test_default_solve_is_grid_converged(case):
     """The default solve reports h_c that changes by < 2 % from the next-coarser grid: checked
     against an independent solve on that coarser grid (no refinement), which must also give the
@@ -121,8 +129,9 @@ def test_nested_dissection_lu(shape):
             rows.append((ii * nj + jj)[ok])
             cols.append(((ii + di) * nj + jj + dj)[ok])
     rows, cols = np.concatenate(rows), np.concatenate(cols)
-    A = (sp.csc_matrix((rng.standard_normal(rows.size), (rows, cols)), shape=(n, n))
-         + sp.eye(n) * 4.0 * wx * wy).tocsc()
+    A = (
+        sp.csc_matrix((rng.standard_normal(rows.size), (rows, cols)), shape=(n, n)) + sp.eye(n) * 4.0 * wx * wy
+    ).tocsc()
     pos = np.empty_like(perm)
     pos[perm] = np.arange(n)
     coo = A.tocoo()
@@ -169,7 +178,6 @@ def test_incompressible_film_vs_nvm_with_roelands_alpha(case, measured):
     assert abs(incompressible.h_central / nvm - 1.0) < 0.08
     drop = 1.0 - solve(case).h_central / incompressible.h_central
     assert 0.10 < drop < 0.20
-
 
 
 @pytest.mark.slow
@@ -224,8 +232,9 @@ def test_h_min_at_the_accuracy_of_h_c(case):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case,measured", [("circ31", 0.0013), ("ell4", -0.0025), ("rv221", 0.0005),
-                                           ("circ260", -0.0008)])
+@pytest.mark.parametrize(
+    "case,measured", [("circ31", 0.0013), ("ell4", -0.0025), ("rv221", 0.0005), ("circ260", -0.0008)]
+)
 def test_h_min_vs_513(case, measured):
     """The default h_min against the solver's 513^2 extrapolation: within 0.5 % (measured
     +0.13, -0.25, +0.05, -0.08 %); the old raw node minimum read -0.94, -3.71, -2.30, -2.82 %."""

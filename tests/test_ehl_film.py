@@ -9,16 +9,17 @@ piezoviscous-elastic regime tests both coefficient sets.
 import numpy as np
 import pytest
 
-from flexrv.ehl.film import dimensionless_groups, ellipticity_approx, hamrock_dowson, moes_central, pan_hamrock_line
 from flexrv.contact.hertz import point_contact
+from flexrv.ehl.film import dimensionless_groups, ellipticity_approx, hamrock_dowson, moes_central, pan_hamrock_line
 from flexrv.errors import InputError
 
 E = 2.2e11
 ETA, ALPHA = 0.05, 2e-8
 
 
-@pytest.mark.parametrize("load,speed,ry", [(100.0, 1.0, 0.01), (1000.0, 1.0, 0.01), (100.0, 1.0, 0.04),
-                                           (500.0, 1.0, 0.1), (50.0, 0.1, 0.01)])
+@pytest.mark.parametrize(
+    "load,speed,ry", [(100.0, 1.0, 0.01), (1000.0, 1.0, 0.01), (100.0, 1.0, 0.04), (500.0, 1.0, 0.1), (50.0, 0.1, 0.01)]
+)
 def test_hamrock_dowson_vs_moes_piezoviscous_elastic(load, speed, ry):
     """HD and Moes h_c agree within 20 % for M = 100-3000, L = 6-12, lambda = 0.1-1 (measured Moes/HD =
     1.08-1.18: the two fits use different load exponents, W^-0.067 against M^-1/12)."""
@@ -106,8 +107,12 @@ def test_moes_blend_reduces_to_its_asymptotes(lam):
     cases = [(1e-3 / lam, tiny_l, 0), (1e4, tiny_l, 1), (1.0, 1e8, 2), (1e12, 1e4, 3)]
     for m, el, which in cases:
         expected = moes_asymptotes(m, el, lam)[which]
-        np.testing.assert_allclose(moes_dimensionless(m, el, lam), expected, rtol=0.02,
-                                   err_msg=f"M={m}, L={el}, lambda={lam}, asymptote {which}")
+        np.testing.assert_allclose(
+            moes_dimensionless(m, el, lam),
+            expected,
+            rtol=0.02,
+            err_msg=f"M={m}, L={el}, lambda={lam}, asymptote {which}",
+        )
 
 
 def test_moes_circular_coefficients():

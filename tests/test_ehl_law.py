@@ -10,9 +10,9 @@ import time
 import numpy as np
 import pytest
 
-from flexrv.ehl.law import EHLLineLaw, EHLPointLaw
 from flexrv.contact.hertz import line_contact, point_contact
 from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, hamrock_dowson, pan_hamrock_line
+from flexrv.ehl.law import EHLLineLaw, EHLPointLaw
 from flexrv.ehl.maps import build_film_map, film_map
 from flexrv.ehl.solver import LubricantProperties, solve_point_contact
 from flexrv.errors import InputError
@@ -101,8 +101,9 @@ def test_line_law_dry_and_pan_hamrock():
     np.testing.assert_allclose(wet.elastic_approach - delta, hc, rtol=1e-9)
 
 
-@pytest.mark.parametrize("kwargs,match", [(dict(mode="wet"), "mode"), (dict(mode="map"), "film_map"),
-                                          (dict(lubricant=None), "lubricant")])
+@pytest.mark.parametrize(
+    "kwargs,match", [(dict(mode="wet"), "mode"), (dict(mode="map"), "film_map"), (dict(lubricant=None), "lubricant")]
+)
 def test_law_bad_input(kwargs, match):
     args = dict(rx=RX, ry=RY, e_eff=E, lubricant=LUB, mode="hamrock_dowson")
     args.update(kwargs)
@@ -185,9 +186,18 @@ def test_map_interpolation_vs_scipy_bilinear():
     from flexrv.ehl.maps import FilmMap
 
     rng = np.random.default_rng(1)
-    fmap = FilmMap(rx=RX, ry=RY, e_eff=E, lubricant=LUB, log_load=np.linspace(1, 6, 5),
-                   log_speed=np.linspace(-4, -1, 3), log_ratio=rng.normal(0, 0.1, (5, 3)),
-                   h_central=np.ones((5, 3)), valid=np.ones((5, 3), bool), grid=17)
+    fmap = FilmMap(
+        rx=RX,
+        ry=RY,
+        e_eff=E,
+        lubricant=LUB,
+        log_load=np.linspace(1, 6, 5),
+        log_speed=np.linspace(-4, -1, 3),
+        log_ratio=rng.normal(0, 0.1, (5, 3)),
+        h_central=np.ones((5, 3)),
+        valid=np.ones((5, 3), bool),
+        grid=17,
+    )
     q = np.exp(rng.uniform(0, 7, 52))
     u = np.exp(rng.uniform(-5, 0, 52))
     c, dc = fmap.log_correction(q, u)

@@ -26,8 +26,7 @@ from flexrv.ehl.solver import LubricantProperties, influence_kernel, solve_point
 from flexrv.errors import ConvergenceError, InputError
 
 E = 2.2e11
-LUB = LubricantProperties(viscosity=0.05, pressure_viscosity=2e-8, roelands_z=0.67, roelands_p0=1.96e8,
-                          density=870.0)
+LUB = LubricantProperties(viscosity=0.05, pressure_viscosity=2e-8, roelands_z=0.67, roelands_p0=1.96e8, density=870.0)
 CASES = {"circ260": (100.0, 1.0, 0.01, 0.01), "ell4": (100.0, 1.0, 0.01, 0.04), "circ31": (20.0, 2.0, 0.01, 0.01)}
 
 
@@ -101,10 +100,20 @@ def test_light_load_rigid_regime_converges():
     assert res.load_error < 1e-3 and 1e-8 < res.h_central < 1e-6
 
 
-@pytest.mark.parametrize("bad,match", [(dict(load=0.0), "load"), (dict(speed=-1.0), "speed"), (dict(rx=0.0), "rx"),
-                                       (dict(ry=-0.01), "ry"), (dict(grid=100), "grid"),
-                                       (dict(max_grid=17), "max_grid"), (dict(max_grid=100), "max_grid"),
-                                       (dict(grid_tol=0.0), "grid_tol"), (dict(grid_tol=2.0), "grid_tol")])
+@pytest.mark.parametrize(
+    "bad,match",
+    [
+        (dict(load=0.0), "load"),
+        (dict(speed=-1.0), "speed"),
+        (dict(rx=0.0), "rx"),
+        (dict(ry=-0.01), "ry"),
+        (dict(grid=100), "grid"),
+        (dict(max_grid=17), "max_grid"),
+        (dict(max_grid=100), "max_grid"),
+        (dict(grid_tol=0.0), "grid_tol"),
+        (dict(grid_tol=2.0), "grid_tol"),
+    ],
+)
 def test_bad_input(bad, match):
     args = dict(load=100.0, speed=1.0, rx=0.01, ry=0.01, e_eff=E, lubricant=LUB, grid=33)
     args.update(bad)

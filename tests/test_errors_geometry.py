@@ -11,14 +11,23 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from flexrv.analysis.pin_load import disc_effective_modulus, pin_contact_constant, pin_load_distribution, reducer_pin_loads
+from flexrv.analysis.pin_load import (
+    disc_effective_modulus,
+    pin_contact_constant,
+    pin_load_distribution,
+    reducer_pin_loads,
+)
 from flexrv.cli import app
-from flexrv.design import from_dict, load, loads, to_toml
-from flexrv.design import error_set_names, load_error_set, with_errors
+from flexrv.design import error_set_names, from_dict, load, load_error_set, loads, to_toml, with_errors
 from flexrv.design.manufacturing import ASSEMBLY_PENETRATION_LIMIT_UM, ManufacturingErrors
 from flexrv.errors import ConfigError
-from flexrv.geometry.as_built import (as_built, as_built_pin_gap, assembly_disc_poses, assembly_penetration,
-                                      profile_deviation)
+from flexrv.geometry.as_built import (
+    as_built,
+    as_built_pin_gap,
+    assembly_disc_poses,
+    assembly_penetration,
+    profile_deviation,
+)
 from flexrv.geometry.cycloid import nominal_disc_pose, pin_gap, to_disc_frame
 from flexrv.model.parameters import rigid_parameters
 from flexrv.units import M_PER_UM, RAD_PER_ARCMIN, RAD_PER_DEG
@@ -52,8 +61,10 @@ def test_zero_errors_as_built_is_nominal_exactly(name):
     psi = 2.0 * np.pi * np.arange(z) / z
     np.testing.assert_array_equal(ab.pins, ss.pin_circle_radius * np.stack([np.sin(psi), np.cos(psi)], -1))
     np.testing.assert_array_equal(ab.pin_radii, np.full(z, ss.pin_radius))
-    np.testing.assert_array_equal(ab.disc_profile, np.tile([ss.modification_shift, ss.modification_equidistant,
-                                                            ss.modification_rotation], (nd, 1)))
+    np.testing.assert_array_equal(
+        ab.disc_profile,
+        np.tile([ss.modification_shift, ss.modification_equidistant, ss.modification_rotation], (nd, 1)),
+    )
     assert ab.profile_harmonics.shape == (nd, 0, 3)
     beta = 2.0 * np.pi * np.arange(n) / n
     bores = fs.center_distance * np.stack([np.cos(beta), np.sin(beta)], -1)
@@ -61,18 +72,36 @@ def test_zero_errors_as_built_is_nominal_exactly(name):
     for k in range(nd):
         rot = 2.0 * np.pi * k / nd / ss.disc_teeth
         c, s = math.cos(rot), math.sin(rot)
-        np.testing.assert_array_equal(ab.holes[k], np.stack([c * bores[:, 0] + s * bores[:, 1],
-                                                             -s * bores[:, 0] + c * bores[:, 1]], -1))
+        np.testing.assert_array_equal(
+            ab.holes[k], np.stack([c * bores[:, 0] + s * bores[:, 1], -s * bores[:, 0] + c * bores[:, 1]], -1)
+        )
     np.testing.assert_array_equal(ab.eccentricities, np.full((n, nd), ss.eccentricity))
     np.testing.assert_array_equal(ab.needle_clearances, np.full((n, nd), r.needle_bearing.radial_clearance_um * 1e-6))
-    for arr in (ab.eccentric_phase_errors, ab.support_clearances, ab.sun_runout, ab.planet_runout,
-                ab.planet_phase_errors):
+    for arr in (
+        ab.eccentric_phase_errors,
+        ab.support_clearances,
+        ab.sun_runout,
+        ab.planet_runout,
+        ab.planet_phase_errors,
+    ):
         assert not np.any(arr)
     # the rigid model reads the same arrays
     p = rigid_parameters(r)
-    for key in ("pins", "pin_radii", "disc_profile", "profile_harmonics", "holes", "eccentricities", "crank_bores",
-                "needle_clearances", "support_clearances", "sun_runout", "planet_runout", "planet_phase_errors",
-                "eccentric_phase_errors"):
+    for key in (
+        "pins",
+        "pin_radii",
+        "disc_profile",
+        "profile_harmonics",
+        "holes",
+        "eccentricities",
+        "crank_bores",
+        "needle_clearances",
+        "support_clearances",
+        "sun_runout",
+        "planet_runout",
+        "planet_phase_errors",
+        "eccentric_phase_errors",
+    ):
         np.testing.assert_array_equal(getattr(p, key), getattr(ab, key))
     # assembly pose of the ideal design = nominal pose (round-off)
     centres, rots = assembly_disc_poses(r, ab)
@@ -90,11 +119,20 @@ def test_zero_errors_pin_loads_unchanged():
     ss = r.second_stage
     for k in range(ss.n_discs):
         res = reducer_pin_loads(r, 412.0, crank_angle=0.1, disc=k)
-        ref = pin_load_distribution(412.0 / ss.n_discs, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
-                                    ss.eccentricity, ss.disc_width, disc_effective_modulus(r),
-                                    ss.modification_shift, ss.modification_equidistant, ss.modification_rotation,
-                                    0.1 + 2.0 * np.pi * k / ss.n_discs,
-                                    stiffness_constant=pin_contact_constant(r).k)  # the design's pin path (issue 14)
+        ref = pin_load_distribution(
+            412.0 / ss.n_discs,
+            ss.pin_count,
+            ss.pin_circle_radius,
+            ss.pin_radius,
+            ss.eccentricity,
+            ss.disc_width,
+            disc_effective_modulus(r),
+            ss.modification_shift,
+            ss.modification_equidistant,
+            ss.modification_rotation,
+            0.1 + 2.0 * np.pi * k / ss.n_discs,
+            stiffness_constant=pin_contact_constant(r).k,
+        )  # the design's pin path (issue 14)
         np.testing.assert_array_equal(res.forces, ref.forces)
         np.testing.assert_array_equal(res.clearance, ref.clearance)
         assert res.rotation == ref.rotation and res.max_pressure == ref.max_pressure
@@ -109,8 +147,15 @@ def test_uniform_pin_radius_equals_reduced_equidistant():
     both discs, and the assembly clearance shrinks by exactly d (5 -> 2 um, 1e-12 m)."""
     d_um = 3.0
     r_err = _with({"pins": {"pin_radius_um": d_um}})
-    r_eq = from_dict({**load("rv40e").model_dump(), "second_stage": {
-        **load("rv40e").second_stage.model_dump(), "modification_equidistant_mm": 0.005 - d_um * 1e-3}})
+    r_eq = from_dict(
+        {
+            **load("rv40e").model_dump(),
+            "second_stage": {
+                **load("rv40e").second_stage.model_dump(),
+                "modification_equidistant_mm": 0.005 - d_um * 1e-3,
+            },
+        }
+    )
     for k in range(ND):
         a = reducer_pin_loads(r_err, 412.0, crank_angle=0.2, disc=k)
         b = reducer_pin_loads(r_eq, 412.0, crank_angle=0.2, disc=k)
@@ -146,12 +191,25 @@ def test_crank_disc_errors_land_at_crank_disc():
     ecc = [[0.0, 0.0], [0.0, 0.0], [0.0, 3.0]]
     phase = [[0.0, 0.0], [0.0, -2.0], [0.0, 0.0]]
     needle = [[1.0, 0.0], [0.0, 0.0], [0.0, -2.0]]
-    r = _with({"cranks": {"eccentricity_um": ecc, "eccentric_phase_arcmin": phase, "bore_radial_um": [0.0, 2.0, 0.0],
-                          "bore_tangential_um": [1.5, 0.0, 0.0]},
-               "clearances": {"needle_extra_clearance_um": needle, "support_clearance_um": [0.0, 4.0, 0.0]},
-               "first_stage": {"sun_runout_um": 2.0, "sun_runout_phase_deg": 30.0, "planet_runout_um": [0.0, 1.0, 0.0],
-                               "planet_runout_phase_deg": 45.0, "planet_phase_arcmin": [0.0, 0.0, 0.5]},
-               "discs": [{"hole_radial_um": [0.0, 0.0, 1.0]}, {}]})
+    r = _with(
+        {
+            "cranks": {
+                "eccentricity_um": ecc,
+                "eccentric_phase_arcmin": phase,
+                "bore_radial_um": [0.0, 2.0, 0.0],
+                "bore_tangential_um": [1.5, 0.0, 0.0],
+            },
+            "clearances": {"needle_extra_clearance_um": needle, "support_clearance_um": [0.0, 4.0, 0.0]},
+            "first_stage": {
+                "sun_runout_um": 2.0,
+                "sun_runout_phase_deg": 30.0,
+                "planet_runout_um": [0.0, 1.0, 0.0],
+                "planet_runout_phase_deg": 45.0,
+                "planet_phase_arcmin": [0.0, 0.0, 0.5],
+            },
+            "discs": [{"hole_radial_um": [0.0, 0.0, 1.0]}, {}],
+        }
+    )
     ab, nom = as_built(r), as_built(load("rv40e"))
     a, c0 = r.second_stage.eccentricity, r.needle_bearing.radial_clearance_um * 1e-6
     expected = np.full((N, ND), a)
@@ -163,10 +221,14 @@ def test_crank_disc_errors_land_at_crank_disc():
     np.testing.assert_allclose(ab.needle_clearances, c0 + np.array(needle) * 1e-6, atol=1e-21)
     np.testing.assert_array_equal(ab.support_clearances, [0.0, 4e-6, 0.0])
     np.testing.assert_allclose(ab.sun_runout, [2e-6, 30.0 * RAD_PER_DEG])
-    np.testing.assert_allclose(ab.planet_runout, [[0.0, 45 * RAD_PER_DEG], [1e-6, 45 * RAD_PER_DEG], [0.0, 45 * RAD_PER_DEG]])
+    np.testing.assert_allclose(
+        ab.planet_runout, [[0.0, 45 * RAD_PER_DEG], [1e-6, 45 * RAD_PER_DEG], [0.0, 45 * RAD_PER_DEG]]
+    )
     np.testing.assert_allclose(ab.planet_phase_errors, [0.0, 0.0, 0.5 * RAD_PER_ARCMIN])
     b = 2.0 * np.pi / 3  # crank 1
-    np.testing.assert_allclose(ab.crank_bores[1] - nom.crank_bores[1], 2e-6 * np.array([np.cos(b), np.sin(b)]), atol=1e-18)
+    np.testing.assert_allclose(
+        ab.crank_bores[1] - nom.crank_bores[1], 2e-6 * np.array([np.cos(b), np.sin(b)]), atol=1e-18
+    )
     np.testing.assert_allclose(ab.crank_bores[0] - nom.crank_bores[0], [0.0, 1.5e-6], atol=1e-18)
     u = nom.holes[0, 2] / np.linalg.norm(nom.holes[0, 2])
     np.testing.assert_allclose(ab.holes[0, 2] - nom.holes[0, 2], 1e-6 * u, atol=1e-18)
@@ -177,8 +239,19 @@ def test_profile_harmonic_reduces_the_gap_by_its_value_at_the_foot_point():
     """A disc harmonic (order n, amplitude A, phase p) adds A cos(n phi* + p) of
     material at the pin's foot point phi*: as_built_pin_gap = pin_gap - delta(phi*)
     exactly (foot points from pin_gap), and the as-built table carries (n, A [m], p [rad])."""
-    r = _with({"discs": [{"harmonics": [{"order": 39, "amplitude_um": 2.0, "phase_deg": 40.0},
-                                        {"order": 1, "amplitude_um": 1.0}]}, {}]})
+    r = _with(
+        {
+            "discs": [
+                {
+                    "harmonics": [
+                        {"order": 39, "amplitude_um": 2.0, "phase_deg": 40.0},
+                        {"order": 1, "amplitude_um": 1.0},
+                    ]
+                },
+                {},
+            ]
+        }
+    )
     ab = as_built(r)
     ss = r.second_stage
     np.testing.assert_allclose(ab.profile_harmonics[0], [[39, 2e-6, 40 * RAD_PER_DEG], [1, 1e-6, 0.0]])
@@ -186,16 +259,25 @@ def test_profile_harmonic_reduces_the_gap_by_its_value_at_the_foot_point():
     center, rot = nominal_disc_pose(Z, ss.eccentricity, 0.3)
     p = to_disc_frame(ab.pins, center, rot)
     g0, _, phi = pin_gap(p, Z, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity, *ab.disc_profile[0])
-    g, _, phi1 = as_built_pin_gap(p, ab.pin_radii, Z, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
-                                  ab.disc_profile[0], ab.profile_harmonics[0])
+    g, _, phi1 = as_built_pin_gap(
+        p,
+        ab.pin_radii,
+        Z,
+        ss.pin_circle_radius,
+        ss.pin_radius,
+        ss.eccentricity,
+        ab.disc_profile[0],
+        ab.profile_harmonics[0],
+    )
     np.testing.assert_array_equal(phi1, phi)
     closed = 2e-6 * np.cos(39 * phi + 40 * RAD_PER_DEG) + 1e-6 * np.cos(phi)
     np.testing.assert_allclose(g, g0 - closed, rtol=0, atol=1e-18)
     np.testing.assert_allclose(profile_deviation(phi, ab.profile_harmonics[0]), closed, atol=1e-20)
     # the analytic pin loads read the harmonics: disc 0 changes, disc 1 does not
     assert reducer_pin_loads(r, 412.0, disc=0).max_force != reducer_pin_loads(load("rv40e"), 412.0, disc=0).max_force
-    np.testing.assert_array_equal(reducer_pin_loads(r, 412.0, disc=1).forces,
-                                  reducer_pin_loads(load("rv40e"), 412.0, disc=1).forces)
+    np.testing.assert_array_equal(
+        reducer_pin_loads(r, 412.0, disc=1).forces, reducer_pin_loads(load("rv40e"), 412.0, disc=1).forces
+    )
 
 
 def test_disc_rotation_error_is_a_rigid_turn_of_that_disc():
@@ -225,36 +307,62 @@ def test_assembly_pose_follows_eccentricity_errors():
 BAD = [
     ({"pins": {"pin_radius_um": [1.0] * 39}}, "errors.pins.pin_radius_um", "exactly 40 values"),
     ({"pins": {"pin_radius_um": float("nan")}}, "errors.pins.pin_radius_um", "NaN"),
-    ({"pins": {"pin_tangential_position_um": [0.0] * 5 + [float("inf")] + [0.0] * 34}},
-     "errors.pins.pin_tangential_position_um[5]", "-500..500 um"),
+    (
+        {"pins": {"pin_tangential_position_um": [0.0] * 5 + [float("inf")] + [0.0] * 34}},
+        "errors.pins.pin_tangential_position_um[5]",
+        "-500..500 um",
+    ),
     ({"pins": {"pin_radial_position_um": 600.0}}, "errors.pins.pin_radial_position_um", "-500..500 um"),
     ({"pins": {"pin_radius_um": "2"}}, "errors.pins.pin_radius_um", "number"),
     ({"pins": {"pin_radius_um": True}}, "errors.pins.pin_radius_um", "number"),
-    ({"cranks": {"eccentricity_um": [[0.0, 0.0], [0.0, 0.0], [0.0, float("nan")]]}},
-     "errors.cranks.eccentricity_um[2][1]", "NaN"),
+    (
+        {"cranks": {"eccentricity_um": [[0.0, 0.0], [0.0, 0.0], [0.0, float("nan")]]}},
+        "errors.cranks.eccentricity_um[2][1]",
+        "NaN",
+    ),
     ({"cranks": {"eccentricity_um": [[0.0, 0.0], [0.0, 0.0]]}}, "errors.cranks.eccentricity_um", "N = 3"),
-    ({"cranks": {"eccentricity_um": [[0.0, 0.0], [0.0], [0.0, 0.0]]}}, "errors.cranks.eccentricity_um[1]",
-     "n_discs = 2"),
+    (
+        {"cranks": {"eccentricity_um": [[0.0, 0.0], [0.0], [0.0, 0.0]]}},
+        "errors.cranks.eccentricity_um[1]",
+        "n_discs = 2",
+    ),
     ({"cranks": {"eccentricity_um": [0.0, 0.0, 0.0]}}, "errors.cranks.eccentricity_um[0]", "one value per disc"),
-    ({"cranks": {"eccentric_phase_arcmin": [[0.0, 0.0], [61.0, 0.0], [0.0, 0.0]]}},
-     "errors.cranks.eccentric_phase_arcmin[1][0]", "-60..60 arcmin"),
+    (
+        {"cranks": {"eccentric_phase_arcmin": [[0.0, 0.0], [61.0, 0.0], [0.0, 0.0]]}},
+        "errors.cranks.eccentric_phase_arcmin[1][0]",
+        "-60..60 arcmin",
+    ),
     ({"cranks": {"bore_radial_um": [1.0, 2.0]}}, "errors.cranks.bore_radial_um", "exactly 3 values"),
     ({"discs": [{}]}, "errors.discs", "n_discs = 2"),
     ({"discs": [{}, {"rotation_arcmin": -75.0}]}, "errors.discs[1].rotation_arcmin", "-60..60 arcmin"),
-    ({"discs": [{"harmonics": [{"order": 0, "amplitude_um": 1.0}]}, {}]}, "errors.discs[0].harmonics[0].order",
-     ">= 1"),
-    ({"discs": [{}, {"harmonics": [{"order": 161, "amplitude_um": 1.0}]}]}, "errors.discs[1].harmonics[0].order",
-     "1..4 z_rp = 160"),
-    ({"discs": [{"harmonics": [{"order": 2, "amplitude_um": -1.0}]}, {}]},
-     "errors.discs[0].harmonics[0].amplitude_um", "0..500 um"),
-    ({"discs": [{"harmonics": [{"order": 2, "amplitude_um": 1.0, "phase_deg": float("inf")}]}, {}]},
-     "errors.discs[0].harmonics[0].phase_deg", "finite"),
+    ({"discs": [{"harmonics": [{"order": 0, "amplitude_um": 1.0}]}, {}]}, "errors.discs[0].harmonics[0].order", ">= 1"),
+    (
+        {"discs": [{}, {"harmonics": [{"order": 161, "amplitude_um": 1.0}]}]},
+        "errors.discs[1].harmonics[0].order",
+        "1..4 z_rp = 160",
+    ),
+    (
+        {"discs": [{"harmonics": [{"order": 2, "amplitude_um": -1.0}]}, {}]},
+        "errors.discs[0].harmonics[0].amplitude_um",
+        "0..500 um",
+    ),
+    (
+        {"discs": [{"harmonics": [{"order": 2, "amplitude_um": 1.0, "phase_deg": float("inf")}]}, {}]},
+        "errors.discs[0].harmonics[0].phase_deg",
+        "finite",
+    ),
     ({"discs": [{"hole_tangential_um": [1.0] * 4}, {}]}, "errors.discs[0].hole_tangential_um", "exactly 3 values"),
     ({"first_stage": {"sun_runout_um": -1.0}}, "errors.first_stage.sun_runout_um", "0..500 um"),
-    ({"first_stage": {"planet_phase_arcmin": [0.0, 90.0, 0.0]}}, "errors.first_stage.planet_phase_arcmin[1]",
-     "-60..60"),
-    ({"clearances": {"needle_extra_clearance_um": [[0.0, 0.0], [-3.5, 0.0], [0.0, 0.0]]}},
-     "errors.clearances.needle_extra_clearance_um[1][0]", "total needle clearance"),
+    (
+        {"first_stage": {"planet_phase_arcmin": [0.0, 90.0, 0.0]}},
+        "errors.first_stage.planet_phase_arcmin[1]",
+        "-60..60",
+    ),
+    (
+        {"clearances": {"needle_extra_clearance_um": [[0.0, 0.0], [-3.5, 0.0], [0.0, 0.0]]}},
+        "errors.clearances.needle_extra_clearance_um[1][0]",
+        "total needle clearance",
+    ),
     ({"clearances": {"support_clearance_um": -1.0}}, "errors.clearances.support_clearance_um", "0..500 um"),
     ({"pins": {"pin_size_um": 1.0}}, "errors.pins.pin_size_um", "unknown field"),
     ({"pins": {"pin_radius_um": 30.0}}, "errors.pins:", "penetrates disc"),
@@ -280,7 +388,11 @@ def test_interference_message_names_the_group():
     with pytest.raises(ConfigError) as info:
         _with({"pins": {"pin_radius_um": 30.0}})
     msg = str(info.value)
-    assert "errors.pins: the as-built parts interfere" in msg and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg and "errors.pins alone: 25 um interference" in msg
+    assert (
+        "errors.pins: the as-built parts interfere" in msg
+        and f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um" in msg
+        and "errors.pins alone: 25 um interference" in msg
+    )
     assert assembly_penetration(_with({"pins": {"pin_radius_um": 24.0}}))[0] == pytest.approx(19e-6, abs=1e-12)
 
 
@@ -290,7 +402,9 @@ def test_cli_bad_errors_exit_2(tmp_path):
     import sys
 
     path = tmp_path / "bad.toml"
-    path.write_text(to_toml(load("rv40e")) + "\n[errors.cranks]\neccentricity_um = [[0.0, 0.0], [0.0, 0.0], [0.0, 900.0]]\n")
+    path.write_text(
+        to_toml(load("rv40e")) + "\n[errors.cranks]\neccentricity_um = [[0.0, 0.0], [0.0, 0.0], [0.0, 900.0]]\n"
+    )
     proc = subprocess.run([sys.executable, "-m", "flexrv", "show", str(path)], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "errors.cranks.eccentricity_um[2][1]" in proc.stderr and "Traceback" not in proc.stderr
@@ -298,11 +412,17 @@ def test_cli_bad_errors_exit_2(tmp_path):
 
 # --------------------------------------------------------------------------- TOML round trip, show
 def _example():
-    return _with({"pins": {"pin_radius_um": 2.0, "pin_tangential_position_um": [1.0] + _zeros(38) + [-1.5]},
-                  "cranks": {"eccentricity_um": [[0.0, 1.0], [2.0, 0.0], [0.0, 3.0]]},
-                  "discs": [{"rotation_arcmin": 0.5, "harmonics": [{"order": 1, "amplitude_um": 2.0, "phase_deg": 30.0}]},
-                            {"hole_radial_um": [1.0, -1.0, 0.5]}],
-                  "first_stage": {"sun_runout_um": 3.0}})
+    return _with(
+        {
+            "pins": {"pin_radius_um": 2.0, "pin_tangential_position_um": [1.0] + _zeros(38) + [-1.5]},
+            "cranks": {"eccentricity_um": [[0.0, 1.0], [2.0, 0.0], [0.0, 3.0]]},
+            "discs": [
+                {"rotation_arcmin": 0.5, "harmonics": [{"order": 1, "amplitude_um": 2.0, "phase_deg": 30.0}]},
+                {"hole_radial_um": [1.0, -1.0, 0.5]},
+            ],
+            "first_stage": {"sun_runout_um": 3.0},
+        }
+    )
 
 
 def test_toml_round_trip_with_errors(tmp_path):
@@ -325,9 +445,15 @@ def test_show_prints_nonzero_errors(tmp_path):
     path = tmp_path / "d.toml"
     path.write_text(to_toml(_example()))
     out = CliRunner().invoke(app, ["show", str(path)], terminal_width=200).stdout
-    for field in ("errors.pins.pin_radius_um", "errors.pins.pin_tangential_position_um", "errors.cranks.eccentricity_um",
-                  "errors.discs[0].rotation_arcmin", "errors.discs[0].harmonics[0]", "errors.discs[1].hole_radial_um",
-                  "errors.first_stage.sun_runout_um"):
+    for field in (
+        "errors.pins.pin_radius_um",
+        "errors.pins.pin_tangential_position_um",
+        "errors.cranks.eccentricity_um",
+        "errors.discs[0].rotation_arcmin",
+        "errors.discs[0].harmonics[0]",
+        "errors.discs[1].hole_radial_um",
+        "errors.first_stage.sun_runout_um",
+    ):
         assert field in out, field
     assert "planet_runout" not in out and "support_clearance" not in out
     assert "errors: none" in CliRunner().invoke(app, ["show", "rv40e"]).stdout
@@ -339,9 +465,8 @@ def test_example_error_sets_load(name):
     the file sets is non-zero, the assembly penetration stays within the limit, the
     file is exactly what `python -m flexrv.workflows._error_sets` writes, and the pin loads
     of both discs read it."""
-    from flexrv.workflows._error_sets import iso_grade5_toml
-
     from flexrv.design import error_set_path
+    from flexrv.workflows._error_sets import iso_grade5_toml
 
     assert f"iso_grade5_{name}" in error_set_names()
     assert error_set_path(f"iso_grade5_{name}").read_text() == iso_grade5_toml(name)

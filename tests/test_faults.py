@@ -28,14 +28,37 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _env() -> dict:
-    return {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
-            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
+    return {
+        **os.environ,
+        "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MPLBACKEND": "Agg",
+    }
 
 
 def _start(out: Path, t_end: float, checkpoint_s: float = 0.5) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "flexrv", "simulate", "rv40e", "--t-end", str(t_end),
-                             "--out", str(out), "--checkpoint-s", str(checkpoint_s), "--json"],
-                            cwd=out.parent, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "flexrv",
+            "simulate",
+            "rv40e",
+            "--t-end",
+            str(t_end),
+            "--out",
+            str(out),
+            "--checkpoint-s",
+            str(checkpoint_s),
+            "--json",
+        ],
+        cwd=out.parent,
+        env=_env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def _wait_for_checkpoint(proc: subprocess.Popen, out: Path, timeout: float = 400.0) -> None:
@@ -85,13 +108,35 @@ def test_sigkill_checkpoint_and_resume(tmp_path):
     t_part = part["time"].values
     assert 0.0 < t_part[-1] < t_end and np.all(np.isfinite(part["te"].values))
 
-    resumed = subprocess.run([sys.executable, "-m", "flexrv", "simulate", "--resume", str(killed), "--json"],
-                             cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=600)
+    resumed = subprocess.run(
+        [sys.executable, "-m", "flexrv", "simulate", "--resume", str(killed), "--json"],
+        cwd=tmp_path,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert resumed.returncode == 0, resumed.stderr[-2000:]
     assert not list(killed.glob(".*.tmp*"))  # stale temp files removed by the resumed saves
-    full = subprocess.run([sys.executable, "-m", "flexrv", "simulate", "rv40e", "--t-end", str(t_end), "--out",
-                           str(tmp_path / "full"), "--json"], cwd=tmp_path, env=_env(), capture_output=True,
-                          text=True, timeout=600)
+    full = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "flexrv",
+            "simulate",
+            "rv40e",
+            "--t-end",
+            str(t_end),
+            "--out",
+            str(tmp_path / "full"),
+            "--json",
+        ],
+        cwd=tmp_path,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert full.returncode == 0, full.stderr[-2000:]
     a, b = load_results(killed), load_results(tmp_path / "full")
     assert a.attrs["status"] == b.attrs["status"] == "completed"

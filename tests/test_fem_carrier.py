@@ -12,9 +12,16 @@ import scipy.sparse.linalg as spla
 from flexrv.design import load, override
 from flexrv.errors import ConfigError, InputError
 from flexrv.fem.assembly import assemble
-from flexrv.fem.carrier import (bore_groups, carrier_compliance, clamped_flexibility,
-                                pillar_frame_stiffness, rbe2_bore_compliance, rbe3_loads, rigid_plate_frame_stiffness,
-                                torque_load_vector)
+from flexrv.fem.carrier import (
+    bore_groups,
+    carrier_compliance,
+    clamped_flexibility,
+    pillar_frame_stiffness,
+    rbe2_bore_compliance,
+    rbe3_loads,
+    rigid_plate_frame_stiffness,
+    torque_load_vector,
+)
 from flexrv.fem.static import solve_static
 from flexrv.meshing import build_mesh
 from flexrv.meshing.mesh import generate_mesh
@@ -31,10 +38,19 @@ def _cache(tmp_path, monkeypatch):
 
 
 #: a small carrier (3 cranks, 3 pillars) for the exactness tests
-MINI = CarrierSpec(plate_radius=0.03, input_thickness=0.006, output_thickness=0.006, gap=0.012,
-                   crank_circle_radius=0.014, crank_bore_radius=0.005, n_cranks=3, center_bore_radius=0.003,
-                   pillar_circle_radius=0.016, pillar_radius=0.003,
-                   pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)))
+MINI = CarrierSpec(
+    plate_radius=0.03,
+    input_thickness=0.006,
+    output_thickness=0.006,
+    gap=0.012,
+    crank_circle_radius=0.014,
+    crank_bore_radius=0.005,
+    n_cranks=3,
+    center_bore_radius=0.003,
+    pillar_circle_radius=0.016,
+    pillar_radius=0.003,
+    pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
+)
 
 
 @pytest.fixture(scope="module")
@@ -76,8 +92,15 @@ def test_carrier_mesh_groups_lie_on_the_geometry():
             assert z.min() >= spec.input_thickness + spec.gap - 1e-9
     assert np.max(np.abs(mesh.nodes[mesh.node_set("flange"), 2] - spec.length)) < 1e-9
     xp = mesh.nodes[mesh.node_set("pillar")]
-    d = np.min([np.hypot(xp[:, 0] - spec.pillar_circle_radius * math.cos(a),
-                         xp[:, 1] - spec.pillar_circle_radius * math.sin(a)) for a in spec.pillar_angles], axis=0)
+    d = np.min(
+        [
+            np.hypot(
+                xp[:, 0] - spec.pillar_circle_radius * math.cos(a), xp[:, 1] - spec.pillar_circle_radius * math.sin(a)
+            )
+            for a in spec.pillar_angles
+        ],
+        axis=0,
+    )
     assert np.max(np.abs(d - spec.pillar_radius)) < 1e-6
 
 
@@ -148,9 +171,9 @@ def test_rigid_bore_bound_matches_lagrange_solve(mini):
     g = torque_load_vector(n, spec.crank_circle_radius, 0.3)
     rhs = np.zeros(A.shape[0])
     for b in range(len(bores)):
-        rhs[nf + 6 * b:nf + 6 * b + 2] = g[2 * b:2 * b + 2]
+        rhs[nf + 6 * b : nf + 6 * b + 2] = g[2 * b : 2 * b + 2]
     x = spla.spsolve(A, rhs)
-    qxy = np.array([x[nf + 6 * b:nf + 6 * b + 2] for b in range(len(bores))]).ravel()
+    qxy = np.array([x[nf + 6 * b : nf + 6 * b + 2] for b in range(len(bores))]).ravel()
     np.testing.assert_allclose(C2 @ g, qxy, rtol=1e-8, atol=1e-8 * np.abs(qxy).max())
     W = rbe3_loads(mesh.nodes, [mesh.faces(gname) for gname in names])
     C3, _ = clamped_flexibility(fe.K, mesh.node_set("flange"), W)
@@ -165,10 +188,19 @@ def test_pillars_between_rigid_plates_match_the_built_in_frame():
     sway + pillar torsion, :func:`pillar_frame_stiffness`) within 1.5 % (observed
     0.3-0.5 % on three meshes; the residual is the 3-D clamp effect at the
     pillar roots and the mesh)."""
-    spec = CarrierSpec(plate_radius=0.04, input_thickness=0.008, output_thickness=0.008, gap=0.04,
-                       crank_circle_radius=0.015, crank_bore_radius=0.005, n_cranks=3, center_bore_radius=0.0,
-                       pillar_circle_radius=0.025, pillar_radius=0.003,
-                       pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)))
+    spec = CarrierSpec(
+        plate_radius=0.04,
+        input_thickness=0.008,
+        output_thickness=0.008,
+        gap=0.04,
+        crank_circle_radius=0.015,
+        crank_bore_radius=0.005,
+        n_cranks=3,
+        center_bore_radius=0.0,
+        pillar_circle_radius=0.025,
+        pillar_radius=0.003,
+        pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
+    )
     mesh = generate_mesh(spec, "carrier", 0.008, local_size=0.0015, cache=False).data
     E, nu = 2.1e11, 0.3
     fe = assemble(mesh.nodes, mesh.tets, E, nu, 7800.0)
@@ -216,10 +248,19 @@ def test_mesh_convergence_fast():
     from above (stiffness decreases monotonically: 5288, 5255, 5229 N m/rad
     observed), the observed rate p > 0.3 (0.62 observed: non-nested meshes and
     the re-entrant pillar roots), the finest within 1 % of the closed form."""
-    spec = CarrierSpec(plate_radius=0.04, input_thickness=0.008, output_thickness=0.008, gap=0.04,
-                       crank_circle_radius=0.015, crank_bore_radius=0.005, n_cranks=3, center_bore_radius=0.0,
-                       pillar_circle_radius=0.025, pillar_radius=0.003,
-                       pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)))
+    spec = CarrierSpec(
+        plate_radius=0.04,
+        input_thickness=0.008,
+        output_thickness=0.008,
+        gap=0.04,
+        crank_circle_radius=0.015,
+        crank_bore_radius=0.005,
+        n_cranks=3,
+        center_bore_radius=0.0,
+        pillar_circle_radius=0.025,
+        pillar_radius=0.003,
+        pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
+    )
     E, nu = 2.1e11, 0.3
     k_cf = pillar_frame_stiffness(3, spec.pillar_circle_radius, spec.pillar_radius, spec.gap, E, nu)
     h = [0.003, 0.003 / math.sqrt(2), 0.0015]
@@ -257,13 +298,15 @@ def test_carrier_design_errors_name_the_field(tmp_path):
     """Bores that overlap, pillars that hit a bore or cut the disc teeth, a plate
     larger than the main bearing's bore, discs that do not fit between the plates:
     ConfigError naming the carrier field; a design without [carrier] refuses the part."""
-    cases = [({"carrier.crank_bore_diameter_mm": 63.0}, "carrier.crank_bore_diameter_mm"),
-             ({"carrier.pillar_circle_radius_mm": 50.0}, "carrier.pillar_circle_radius_mm"),
-             ({"carrier.pillar_diameter_mm": 40.0}, "pillar_diameter_mm"),
-             ({"carrier.plate_outer_diameter_mm": 150.0}, "carrier.plate_outer_diameter_mm"),
-             ({"carrier.plate_gap_mm": 20.0}, "carrier.plate_gap_mm"),
-             ({"carrier.center_bore_diameter_mm": 45.0}, "carrier.center_bore_diameter_mm"),
-             ({"carrier.crank_bore_diameter_mm": 12.0}, "support_journal_diameter_mm")]
+    cases = [
+        ({"carrier.crank_bore_diameter_mm": 63.0}, "carrier.crank_bore_diameter_mm"),
+        ({"carrier.pillar_circle_radius_mm": 50.0}, "carrier.pillar_circle_radius_mm"),
+        ({"carrier.pillar_diameter_mm": 40.0}, "pillar_diameter_mm"),
+        ({"carrier.plate_outer_diameter_mm": 150.0}, "carrier.plate_outer_diameter_mm"),
+        ({"carrier.plate_gap_mm": 20.0}, "carrier.plate_gap_mm"),
+        ({"carrier.center_bore_diameter_mm": 45.0}, "carrier.center_bore_diameter_mm"),
+        ({"carrier.crank_bore_diameter_mm": 12.0}, "support_journal_diameter_mm"),
+    ]
     for ov, field in cases:
         with pytest.raises(ConfigError, match=field):
             override("rv40e", ov)
@@ -286,6 +329,7 @@ def test_pillar_root_refinement_grades_the_mesh():
     of the tetrahedra whose centroid lies within 1 mm of a root circle is below twice the edge size
     and under 0.6 times the default's (no edge size: above the 2 mm pillar size there; measured
     1.32 against 2.83 mm); its key differs from the default's."""
+
     def root_edge_length(mesh):
         p = mesh.nodes[mesh.tets[:, :4]]
         c = p.mean(axis=1)

@@ -32,8 +32,9 @@ def test_modes_json_ordering_and_bad_part(tmp_path):
     and free-free beams share beta_1 L = 4.730, Blevins table 8-1, but the clamped
     span between the journals is shorter than the whole shaft). Bad part -> exit 2
     with a message naming it."""
-    r = CliRunner().invoke(app, ["modes", "rv40e", "--part", "crankshaft", "--size", "5", "--n", "3", "--json",
-                                 "--vtu", str(tmp_path)])
+    r = CliRunner().invoke(
+        app, ["modes", "rv40e", "--part", "crankshaft", "--size", "5", "--n", "3", "--json", "--vtu", str(tmp_path)]
+    )
     assert r.exit_code == 0, r.output
     data = json.loads(r.output)
     f, fc = np.array(data["free_hz"]), np.array(data["constrained_hz"])

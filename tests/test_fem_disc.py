@@ -12,8 +12,15 @@ from flexrv.design import load
 from flexrv.errors import InputError
 from flexrv.fem.assembly import assemble
 from flexrv.fem.body import material_dict
-from flexrv.fem.disc import (disc_compliance, disc_compliance_sweep, disc_torsion_sweep, held_flexibility, hole_masters,
-                             pin_contact_case, pin_patch_loads)
+from flexrv.fem.disc import (
+    disc_compliance,
+    disc_compliance_sweep,
+    disc_torsion_sweep,
+    held_flexibility,
+    hole_masters,
+    pin_contact_case,
+    pin_patch_loads,
+)
 from flexrv.meshing import build_mesh
 from flexrv.units import RAD_PER_ARCMIN
 

@@ -106,10 +106,18 @@ def test_free_free_modes_reproducible_and_rigid_modes_deflated(monkeypatch):
     f3, _ = eigenmodes(fe.K, fe.M, 14)
     np.testing.assert_allclose(f3[6:], f1[6:], rtol=1e-9)
     # independent reference: plain shift-invert away from the rigid-body cluster
-    sigma = -(2 * np.pi * f1[6]) ** 2
+    sigma = -((2 * np.pi * f1[6]) ** 2)
     solve = modal.factorize(fe.K - sigma * fe.M)
-    w2 = sla.eigsh(fe.K, k=14, M=fe.M, sigma=sigma, which="LM", tol=1e-12, return_eigenvectors=False,
-                   OPinv=sla.LinearOperator(fe.K.shape, matvec=solve, dtype=float))
+    w2 = sla.eigsh(
+        fe.K,
+        k=14,
+        M=fe.M,
+        sigma=sigma,
+        which="LM",
+        tol=1e-12,
+        return_eigenvectors=False,
+        OPinv=sla.LinearOperator(fe.K.shape, matvec=solve, dtype=float),
+    )
     ref = np.sort(np.sqrt(np.clip(w2, 0, None))) / (2 * np.pi)
     np.testing.assert_allclose(f1[6:], ref[6:], rtol=1e-9)
     assert np.all(f1[:6] < 1e-5 * f1[6]) and f1[6] > 100.0

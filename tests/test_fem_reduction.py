@@ -21,6 +21,7 @@ FORCE = 5000.0  # N per ball
 @pytest.fixture(scope="module")
 def ring(tmp_path_factory):
     import os
+
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     rv = load("rv221")
     mres = build_mesh(rv, "outer_ring", size=SIZE, local_size=LOCAL)
@@ -121,8 +122,9 @@ def test_exudyn_static_matches_fe(ring):
 def test_load_vector_is_transpose_of_displacement(ring):
     """Virtual work: F . u(q, theta) == Q(theta, F) . q for random q, F, theta."""
     rv, mres, mat, fe = ring
-    body = build_reduced_body(mres, mat, n_eig=0, raceway=raceway_spec_for(spec_for(rv, "outer_ring"), None, 4),
-                              fe=fe, cache=False)
+    body = build_reduced_body(
+        mres, mat, n_eig=0, raceway=raceway_spec_for(spec_for(rv, "outer_ring"), None, 4), fe=fe, cache=False
+    )
     rng = np.random.default_rng(1)
     th = rng.uniform(0, 2 * np.pi, 5)
     F = rng.normal(size=(5, 3))

@@ -23,8 +23,13 @@ def cantilever(tmp_path_factory):
 
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     r, span, r_end, a = 0.008, 0.12, 0.010, 0.010
-    segs = (("gear_seat", r_end, a, 0.0), ("support_a", r, span, 0.0), ("eccentric_1", r_end, a, 0.0),
-            ("eccentric_2", 0.009, 2e-3, 0.0), ("support_b", 0.007, 2e-3, 0.0))
+    segs = (
+        ("gear_seat", r_end, a, 0.0),
+        ("support_a", r, span, 0.0),
+        ("eccentric_1", r_end, a, 0.0),
+        ("eccentric_2", 0.009, 2e-3, 0.0),
+        ("support_b", 0.007, 2e-3, 0.0),
+    )
     m = generate_mesh(CrankshaftSpec(segments=segs), "crankshaft", 0.0025).data
     fe = assemble(m.nodes, m.tets, E, NU, RHO)
     tip = m.node_set("gear_seat")
@@ -37,8 +42,9 @@ def cantilever(tmp_path_factory):
 def test_sector_loads_keep_the_resultant(cantilever):
     m, u, f, g = cantilever
     np.testing.assert_allclose(f.sum(axis=0), [1000.0, 0.0, 0.0], atol=1e-9)
-    f2 = sector_loads(m.nodes, m.node_set("gear_seat"), (0.0, 0.0), [0.3, 2.0], [[10.0, 20.0, 0.0], [0.0, 0.0, 5.0]],
-                      np.pi / 15)
+    f2 = sector_loads(
+        m.nodes, m.node_set("gear_seat"), (0.0, 0.0), [0.3, 2.0], [[10.0, 20.0, 0.0], [0.0, 0.0, 5.0]], np.pi / 15
+    )
     np.testing.assert_allclose(f2.sum(axis=0), [10.0, 20.0, 5.0], atol=1e-12)
 
 
@@ -50,8 +56,12 @@ def test_tip_deflection_matches_timoshenko_cantilever(cantilever):
     r, span, e = g["r"], g["span"], g["a"] / 2
     inertia, area = np.pi * r**4 / 4, np.pi * r**2
     kappa = 6 * (1 + NU) / (7 + 6 * NU)
-    ref = 1000.0 * (span**3 / (3 * E * inertia) + e * span**2 / (2 * E * inertia)
-                    + e * (span**2 / (2 * E * inertia) + e * span / (E * inertia)) + span / (kappa * G * area))
+    ref = 1000.0 * (
+        span**3 / (3 * E * inertia)
+        + e * span**2 / (2 * E * inertia)
+        + e * (span**2 / (2 * E * inertia) + e * span / (E * inertia))
+        + span / (kappa * G * area)
+    )
     tip = u[m.node_set("gear_seat"), 0].mean()
     assert 0.0 <= tip / ref - 1 < 0.08, tip / ref
 
@@ -81,7 +91,7 @@ def test_iso281_line_contact_fc_and_rating():
     assert line_contact_fc(0.10) == pytest.approx(84.2, abs=0.1)
     assert line_contact_fc(0.18) == pytest.approx(88.8, abs=0.1)
     c = roller_dynamic_rating(3.5e-3, 10e-3, 15, 18.5e-3)
-    assert roller_dynamic_rating(3.5e-3, 10e-3, 30, 18.5e-3) / c == pytest.approx(2 ** 0.75, rel=1e-12)
+    assert roller_dynamic_rating(3.5e-3, 10e-3, 30, 18.5e-3) / c == pytest.approx(2**0.75, rel=1e-12)
     assert roller_dynamic_rating(3.5e-3, 20e-3, 15, 18.5e-3) / c == pytest.approx(2 ** (7 / 9), rel=1e-12)
 
 

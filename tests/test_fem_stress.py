@@ -13,6 +13,7 @@ E, NU = 2.1e11, 0.3
 @pytest.fixture(scope="module")
 def mesh(tmp_path_factory):
     import os
+
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     m = generate_mesh(PlainRingSpec(0.09, 0.1, 0.02), "plain_ring", 0.012).data
     del os.environ["FLEXRV_CACHE"]

@@ -86,8 +86,9 @@ def test_pin_friction_jacobian_vs_central_differences(v_scale):
     and far beyond it (~1e-3). Measured 2026-11-24: 6-8e-9 (q), 4e-9 / 4e-8 (v: the
     differences' round-off). The friction must be active: dF/dv is dominated by
     mu F / v_reg (> 1e5 N s/m at 1e-5) and the friction power < 0."""
-    m = build_model(override(load("rv40e"), {"second_stage.disc_body_model": "rigid", "housing.body_model": "rigid"}),
-                    exudyn=False)
+    m = build_model(
+        override(load("rv40e"), {"second_stage.disc_body_model": "rigid", "housing.body_model": "rigid"}), exudyn=False
+    )
     g = next(g for g in m.groups if g.name == "pins")
     assert g.mu == 0.05 and g.v_reg == pytest.approx(1e-5) and not g.elastic_discs
     q, v = _loaded_state(m, v_scale)
@@ -174,9 +175,17 @@ def test_friction_switch_and_zero_coefficients_are_exact():
     frictionless model with the stored reference forces (tests/data/force_reference.npz)."""
     base = load("rv40e")
     off = build_model(override(base, {"contact.friction": False}), exudyn=False)
-    zero = build_model(override(base, {"contact.pin_friction_coefficient": 0.0,
-                                       "contact.pin_seat_friction_coefficient": 0.0,
-                                       "contact.needle_friction_coefficient": 0.0}), exudyn=False)
+    zero = build_model(
+        override(
+            base,
+            {
+                "contact.pin_friction_coefficient": 0.0,
+                "contact.pin_seat_friction_coefficient": 0.0,
+                "contact.needle_friction_coefficient": 0.0,
+            },
+        ),
+        exudyn=False,
+    )
     on = build_model(base, exudyn=False)
     q, v = _loaded_state(off, 1e-3)
     fo, dqo, dvo = off.generalized_forces(0.002, q, v)
@@ -192,9 +201,15 @@ def test_friction_switch_and_zero_coefficients_are_exact():
     assert np.abs(fn - fo).max() > 1.0  # friction on acts at speed
 
 
-@pytest.mark.parametrize("field,value", [("pin_friction_coefficient", 0.7), ("needle_friction_coefficient", -0.01),
-                                         ("pin_seat_friction_coefficient", 0.51),
-                                         ("friction_velocity_mm_per_s", 0.0)])
+@pytest.mark.parametrize(
+    "field,value",
+    [
+        ("pin_friction_coefficient", 0.7),
+        ("needle_friction_coefficient", -0.01),
+        ("pin_seat_friction_coefficient", 0.51),
+        ("friction_velocity_mm_per_s", 0.0),
+    ],
+)
 def test_friction_field_out_of_range(tmp_path, capsys, field, value):
     """A friction field out of range: one message naming field, value and allowed range, exit 2."""
     from flexrv.cli import main
@@ -294,8 +309,10 @@ def driven():
     0.06 s at dt 1e-4; the window t >= 0.03 s (loaded, at speed)."""
     from flexrv.simulation import Simulation
 
-    red = override("rv40e", {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0,
-                             "operating.load_ramp_end_s": 0.02})
+    red = override(
+        "rv40e",
+        {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0, "operating.load_ramp_end_s": 0.02},
+    )
     res = Simulation(red).run(t_end=0.06, dt=1e-4)
     return red, res, res.ds.sel(time=slice(0.03, None))
 
@@ -340,14 +357,12 @@ def test_friction_loss_vs_kinematic_sliding_speeds(driven):
     p = rigid_parameters(red)
     fs, ss = red.first_stage, red.second_stage
     t = ds.time.values
-    sp = member_speeds(mean_speed(ds["theta_in"].values, t), fs.sun_teeth, fs.planet_teeth, ss.disc_teeth,
-                       ss.pin_count)
+    sp = member_speeds(mean_speed(ds["theta_in"].values, t), fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
     ix, iy = p.z_rp * ds["disc_x"].values, p.z_rp * ds["disc_y"].values  # pitch points (T, disc)
     arm = np.hypot(p.pins[:, 0] - ix[..., None], p.pins[:, 1] - iy[..., None]) - p.pin_radii
     est_pins = p.pin_friction * abs(sp.disc_rotation) * (ds["pin_force"].values * arm).sum(axis=(1, 2)).mean()
     rel = abs(sp.crank_absolute - sp.disc_rotation)
-    est_needles = p.needle_friction * p.needle_friction_radius * rel * ds["needle_force"].values.sum(
-        axis=(1, 2)).mean()
+    est_needles = p.needle_friction * p.needle_friction_radius * rel * ds["needle_force"].values.sum(axis=(1, 2)).mean()
     sim_pins = float(ds["pin_friction_power"].sum("disc").mean())
     sim_needles = float(ds["needle_friction_power"].sum(("crank", "disc")).mean())
     assert est_pins == pytest.approx(sim_pins, rel=0.01)
@@ -364,8 +379,11 @@ QUARTER = 0.02
 #: 0.84566/1.25218 with pin seats and the FE carrier and disc bodies; 196.78552/0.850773/1.252842 with the
 #: housing in the model; now with the disc body's flank mesh r_rp and consistent pin-patch loads, branch fecold:
 #: disc compliance -2.4 %)
-TODAY_RV40E = {"rigidity_Nm_per_arcmin": 196.69429712862188, "lost_motion_arcmin": 0.8523796077514558,
-               "hysteresis_arcmin": 1.2523201375992152}
+TODAY_RV40E = {
+    "rigidity_Nm_per_arcmin": 196.69429712862188,
+    "lost_motion_arcmin": 0.8523796077514558,
+    "hysteresis_arcmin": 1.2523201375992152,
+}
 #: relative tolerance of TODAY_RV40E: the loop's figures at the default Newton tolerance move by ~1e-3 with
 #: equivalent residuals (rigidity 196.79, 196.84, 196.69 N m/arcmin for the same model with the row-kernel and
 #: condensation speed-ups of issue 15, 2026-11-24; a cold FE rebuild alone: 1e-5)
@@ -395,8 +413,9 @@ def test_stiffness_loop_closes_as_mu_goes_to_zero():
     assert fig.friction_energy_J == 0.0
     energy = {}
     for s in (0.25, 0.5, 1.0):
-        red = override("rv40e", {"contact.pin_friction_coefficient": 0.05 * s,
-                                 "contact.needle_friction_coefficient": 0.0025 * s})
+        red = override(
+            "rv40e", {"contact.pin_friction_coefficient": 0.05 * s, "contact.needle_friction_coefficient": 0.0025 * s}
+        )
         f, _ = stiffness_test(red, quarter_time=QUARTER)
         energy[s] = f.friction_energy_J
         assert abs(f.hysteresis_arcmin - TODAY_RV40E["hysteresis_arcmin"]) < 0.01

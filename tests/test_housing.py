@@ -194,8 +194,13 @@ def test_budgets_count_the_housing_once():
     """The analytic budget lists the housing as c_h (the models' constant) and the
     model budgets take it from the model's own share: budget_from_group_shares adds
     nothing unmodelled; body_model = "rigid" drops it from every budget (noted)."""
-    from flexrv.analysis.torsional import (UNMODELLED_ELEMENTS, budget_from_group_shares, housing_model_compliance,
-                                           stiffness_budget, unmodelled_elements)
+    from flexrv.analysis.torsional import (
+        UNMODELLED_ELEMENTS,
+        budget_from_group_shares,
+        housing_model_compliance,
+        stiffness_budget,
+        unmodelled_elements,
+    )
 
     r = load("rv40e")
     b = stiffness_budget(r)

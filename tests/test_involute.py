@@ -5,11 +5,24 @@ import math
 import numpy as np
 import pytest
 
-from flexrv.analysis.mesh_stiffness import (basic_rack_factor, involute_stage, mesh_damping, mesh_stiffness_per_width,
-                                            min_flexibility, single_tooth_stiffness, time_varying_mesh_stiffness)
+from flexrv.analysis.mesh_stiffness import (
+    basic_rack_factor,
+    involute_stage,
+    mesh_damping,
+    mesh_stiffness_per_width,
+    min_flexibility,
+    single_tooth_stiffness,
+    time_varying_mesh_stiffness,
+)
 from flexrv.design import load
 from flexrv.errors import InputError
-from flexrv.geometry.involute import contact_ratio, line_of_action, tip_radius, tooth_pair_count, working_center_distance
+from flexrv.geometry.involute import (
+    contact_ratio,
+    line_of_action,
+    tip_radius,
+    tooth_pair_count,
+    working_center_distance,
+)
 
 A20 = math.radians(20.0)
 

@@ -92,8 +92,9 @@ def test_fused_generalized_forces_match_reference(ref, name, needle):
         f, dq, dv = m.generalized_forces(float(t[i]), q[i], v[i])
         fr, dqr, dvr = np.zeros(m.n), np.zeros((m.n, m.n)), np.zeros((m.n, m.n))
         for g in m.groups:
-            ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members],
-                                            [m.members[n].n for n in g.members])]
+            ix = np.arange(m.n)[
+                group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])
+            ]
             fr[ix] += ref[f"{key}/{g.name}/force"][i]
             if g.name in COMPLETED_JACOBIANS:  # the group's own (checked against differences below)
                 g.reset()
@@ -203,8 +204,9 @@ def test_completed_jacobians_vs_central_differences(errors):
             for g in m.groups:
                 if g.name not in COMPLETED_JACOBIANS or (v_scale > 1e-2 and g.name != "needle_bearings"):
                     continue
-                ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members],
-                                                [m.members[n].n for n in g.members])]
+                ix = np.arange(m.n)[
+                    group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])
+                ]
                 g.new_step()
                 jq, _ = g.jacobian(th, q[ix], v[ix])
                 nq = np.zeros_like(jq)
@@ -350,8 +352,11 @@ def test_needle_eccentricity_phase_and_clearance():
     errs, ecc = zero.copy(), np.full_like(zero, p.eccentricity)
     errs[0, 1] = err
     ecc[2, 0] += de
-    g = NeedleBearings(dataclasses.replace(p, needle_clearances=zero, eccentric_phase_errors=errs,
-                                           eccentricities=ecc), "empirical", k_emp)
+    g = NeedleBearings(
+        dataclasses.replace(p, needle_clearances=zero, eccentric_phase_errors=errs, eccentricities=ecc),
+        "empirical",
+        k_emp,
+    )
     q = _state(_members(p), g.members)
     _, out = g.evaluate(0.0, q, np.zeros_like(q), want_outputs=True)
     force = out["needle_force"].values
@@ -378,8 +383,9 @@ def test_pin_radius_position_profile_harmonics():
     from flexrv.model.pins import PinContacts
 
     r = _variant("rv40e", "empirical")
-    ss = r.second_stage.model_copy(update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0,
-                                           "modification_rotation_deg": 0.0})
+    ss = r.second_stage.model_copy(
+        update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0, "modification_rotation_deg": 0.0}
+    )
     from flexrv.model.parameters import rigid_parameters
 
     p = rigid_parameters(r.model_copy(update={"second_stage": ss}))
@@ -427,8 +433,12 @@ def test_gear_runout_and_phase_errors():
     runout = np.array([[5e-6, 0.4], [0.0, 0.0], [7e-6, -1.0]])
     err = np.array([0.0, 1e-4, 0.0])
     g0 = GearMeshes(p, stage, th, om)
-    g = GearMeshes(dataclasses.replace(p, sun_runout=np.array([4e-6, 1.1]), planet_runout=runout,
-                                       planet_phase_errors=err), stage, th, om)
+    g = GearMeshes(
+        dataclasses.replace(p, sun_runout=np.array([4e-6, 1.1]), planet_runout=runout, planet_phase_errors=err),
+        stage,
+        th,
+        om,
+    )
     q = _state(_members(p), g0.members)
     q[8::3] += 3e-5
     t = 0.003
@@ -436,10 +446,12 @@ def test_gear_runout_and_phase_errors():
     _, o1 = g.evaluate(t, q, np.zeros_like(q), want_outputs=True)
     beta = np.arctan2(q[7::3], q[6::3])
     ts = float(th(t))
-    expect = (4e-6 * np.sin(ts - beta + 1.1) + runout[:, 0] * np.sin(q[8::3] - beta + runout[:, 1])
-              + p.base_radius_planet * err)
-    np.testing.assert_allclose(o1["mesh_deflection"].values - o0["mesh_deflection"].values, expect, rtol=0,
-                               atol=1e-15)
+    expect = (
+        4e-6 * np.sin(ts - beta + 1.1)
+        + runout[:, 0] * np.sin(q[8::3] - beta + runout[:, 1])
+        + p.base_radius_planet * err
+    )
+    np.testing.assert_allclose(o1["mesh_deflection"].values - o0["mesh_deflection"].values, expect, rtol=0, atol=1e-15)
 
 
 # ----------------------------------------------------------------------------- skipped pin
@@ -534,7 +546,7 @@ def test_curve_reach_and_certified_warm_start():
     finds a ~mm gap) gets the cold-start gap: the same gaps as a fresh group to
     1e-12 m and forces to 1e-9 (without the reach check the gaps are wrong)."""
     from flexrv.geometry.cycloid import center_curve
-    from flexrv.model.pins import PinContacts, _curve_reach
+    from flexrv.model.pins import _curve_reach
 
     p = _params()
     radius = p.pin_circle_radius + p.disc_profile[0][0]

@@ -7,9 +7,14 @@ import pytest
 
 from flexrv.design import load
 from flexrv.errors import InputError
+from flexrv.geometry.kinematics import (
+    characteristic_frequencies,
+    harmonics,
+    member_speeds,
+    reducer_kinematics,
+    total_ratio,
+)
 from flexrv.units import RAD_S_PER_RPM
-from flexrv.geometry.kinematics import characteristic_frequencies, harmonics, member_speeds, reducer_kinematics, total_ratio
-
 
 
 def test_ratios_exact():
@@ -28,8 +33,15 @@ def test_seed002_table4_frequencies():
     (600 r/min relative to the carrier minus the 15 r/min carrier speed)."""
     kin = reducer_kinematics(load("rv40e"), 1215 * RAD_S_PER_RPM)
     f = kin.frequencies
-    got = [f.input, f.crank_rotation, f.carrier, f.first_stage_mesh, f.cycloid_mesh, f.pins_x_crank_rotation,
-           f.disc_tooth_pin_passing]
+    got = [
+        f.input,
+        f.crank_rotation,
+        f.carrier,
+        f.first_stage_mesh,
+        f.cycloid_mesh,
+        f.pins_x_crank_rotation,
+        f.disc_tooth_pin_passing,
+    ]
     assert np.allclose(got, [20.25, 10.0, 0.25, 320.0, 390.0, 400.0, 10.0], rtol=1e-12)
     # the cycloid mesh seen from both members: z_c |w_rel| = z_rp |w_e| (Willis)
     assert np.isclose(f.cycloid_mesh, 40 * f.crank_absolute, rtol=1e-12)

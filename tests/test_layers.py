@@ -162,7 +162,8 @@ def test_no_new_upward_import():
     """Every import goes to the importer's own layer or below, except the allowlisted ones."""
     new = sorted(upward_imports() - set(ALLOWED_UPWARD))
     assert not new, "upward imports (a lower layer importing a higher one):\n" + "\n".join(
-        f"  {a} -> {b}" for a, b in new)
+        f"  {a} -> {b}" for a, b in new
+    )
 
 
 def test_allowlisted_upward_imports_still_exist():

@@ -36,6 +36,7 @@ def test_outer_ring_groups_geometry_and_cache():
     assert again.cached and np.array_equal(again.data.tets, d.tets)
     assert res.msh_path.exists() and res.vtu_path.exists()
     import meshio
+
     assert meshio.read(res.vtu_path).points.shape[0] == d.n_nodes
     assert not list(res.npz_path.parent.glob(".*tmp*"))  # no leftover temp files
 
@@ -108,7 +109,12 @@ def test_carrier_part_groups_and_cli(tmp_path, monkeypatch):
     data = json.loads(r.output)
     n = rv.first_stage.n_planets
     expected = {f"bore_{p}_{k}" for p in ("in", "out") for k in range(1, n + 1)} | {
-        "flange", "seat_in", "seat_out", "pillar", "center_bore"}
+        "flange",
+        "seat_in",
+        "seat_out",
+        "pillar",
+        "center_bore",
+    }
     assert expected <= set(data["groups"]) and all(data["groups"][g] > 0 for g in expected)
     d = MeshData.load_npz(data["msh"].replace(".msh", ".npz"))
     spec = spec_for(rv, "carrier")

@@ -20,8 +20,16 @@ def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None, coordinate
     about z held) under a force and moment on the frame. Returns rows, row
     evaluations, frame coordinates and, with ``coordinates``, each row element's q."""
     import exudyn as exu
-    from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, LoadTorqueVector, MarkerNodeCoordinate,
-                                      MarkerNodeRigid, NodePointGround, NodeRigidBodyRxyz, ObjectRigidBody)
+    from exudyn.itemInterface import (
+        CoordinateConstraint,
+        LoadForceVector,
+        LoadTorqueVector,
+        MarkerNodeCoordinate,
+        MarkerNodeRigid,
+        NodePointGround,
+        NodeRigidBodyRxyz,
+        ObjectRigidBody,
+    )
     from exudyn.utilities import RigidBodyInertia
 
     rows = rows or rows_from_design(reducer, ehl="dry")
@@ -32,8 +40,14 @@ def _static_rig(reducer, load_vec, moment=(0.0, 0.0, 0.0), rows=None, coordinate
     mbs.AddObject(ObjectRigidBody(mass=10.0, inertia=inertia.GetInertia6D(), nodeNumber=frame))
     handle = add_main_bearing(mbs, rows, frame)
     ground = mbs.AddNode(NodePointGround())
-    mbs.AddObject(CoordinateConstraint(markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0)),
-                                                      mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=frame, coordinate=5))]))
+    mbs.AddObject(
+        CoordinateConstraint(
+            markerNumbers=[
+                mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0)),
+                mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=frame, coordinate=5)),
+            ]
+        )
+    )
     marker = mbs.AddMarker(MarkerNodeRigid(nodeNumber=frame))
     mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=list(load_vec)))
     mbs.AddLoad(LoadTorqueVector(markerNumber=marker, loadVector=list(moment)))
@@ -81,7 +95,9 @@ def test_axial_load_closed_form(name, fa):
     q_expected = ks * (ap - a) ** 1.5
     assert q.mean() == pytest.approx(q_expected, rel=1e-3)
     assert abs(frame_q[2]) == pytest.approx(e - geom.axial_preload, rel=1e-2)
-    assert np.sum(-loaded.inner.force_ball[:, 2]) == pytest.approx(math.copysign(fa, np.sum(-loaded.inner.force_ball[:, 2])), rel=1e-6)
+    assert np.sum(-loaded.inner.force_ball[:, 2]) == pytest.approx(
+        math.copysign(fa, np.sum(-loaded.inner.force_ball[:, 2])), rel=1e-6
+    )
 
 
 def test_radial_load_balance_and_zone():
@@ -115,7 +131,9 @@ def _fd_jacobian(model, q, qt, h=1e-10):
     for k in range(n):
         dq = np.zeros(n)
         dq[k] = h
-        jac[:, k] = (evaluate_row(model, q + dq, qt, False).force - evaluate_row(model, q - dq, qt, False).force) / (2 * h)
+        jac[:, k] = (evaluate_row(model, q + dq, qt, False).force - evaluate_row(model, q - dq, qt, False).force) / (
+            2 * h
+        )
     return jac
 
 
@@ -130,11 +148,14 @@ def test_jacobian_vs_finite_difference():
     assert np.abs(jac - ev.jac_q).max() < 0.02 * np.abs(jac).max()
 
 
-@pytest.mark.parametrize("name,force,moment", [
-    ("rv221", (20000.0, 0.0, 15000.0), (0.0, 0.0)),
-    ("rv221", (5000.0, 0.0, 2000.0), (0.0, 1500.0)),
-    ("rv40e", (3000.0, 0.0, 2000.0), (0.0, 0.0)),
-])
+@pytest.mark.parametrize(
+    "name,force,moment",
+    [
+        ("rv221", (20000.0, 0.0, 15000.0), (0.0, 0.0)),
+        ("rv221", (5000.0, 0.0, 2000.0), (0.0, 1500.0)),
+        ("rv40e", (3000.0, 0.0, 2000.0), (0.0, 0.0)),
+    ],
+)
 def test_rigid_ring_limit_matches_analytic_distribution(name, force, moment):
     """Stiff-ring limit: the ball-resolved Exudyn bearing (free balls, cage, rigid
     rings) and the foundation's 5-DOF quasi-static distribution
@@ -154,7 +175,9 @@ def test_rigid_ring_limit_matches_analytic_distribution(name, force, moment):
     exudyn_loads = np.array([ev.inner.load for ev in evals])
     scale = analytic.loads.max()
     assert np.abs(exudyn_loads - analytic.loads).max() < 0.01 * scale
-    np.testing.assert_allclose(frame_q[:3], analytic.displacement[:3], atol=0.01 * np.abs(analytic.displacement[:3]).max())
+    np.testing.assert_allclose(
+        frame_q[:3], analytic.displacement[:3], atol=0.01 * np.abs(analytic.displacement[:3]).max()
+    )
 
 
 class _FourierRing:
@@ -182,8 +205,9 @@ def test_jacobian_with_modal_rings_vs_finite_difference():
     """Modal (flexible) inner and outer rings: analytic Jacobian within 2 % of
     central differences, including the modal rows and columns."""
     reducer = load("rv221")
-    rows = rows_from_design(reducer, inner=[_FourierRing(), _FourierRing()], outer=[_FourierRing(), _FourierRing()],
-                            ehl="dry")
+    rows = rows_from_design(
+        reducer, inner=[_FourierRing(), _FourierRing()], outer=[_FourierRing(), _FourierRing()], ehl="dry"
+    )
     m = rows[0]
     q, qt = _random_state(m, seed=2)
     ev = evaluate_row(m, q, qt)
@@ -240,8 +264,13 @@ def map_rows():
     with pytest.warns(RuntimeWarning, match="EHL map"):
         for side in ("law_inner", "law_outer"):
             law = getattr(rows[0], side)
-            maps[side] = replace(law, mode="map", film_map=build_film_map(
-                law.rx, law.ry, law.e_eff, law.lubricant, (20.0, 500.0), (0.02, 0.2), n_load=3, n_speed=3, grid=33))
+            maps[side] = replace(
+                law,
+                mode="map",
+                film_map=build_film_map(
+                    law.rx, law.ry, law.e_eff, law.lubricant, (20.0, 500.0), (0.02, 0.2), n_load=3, n_speed=3, grid=33
+                ),
+            )
     return [replace(row, law_inner=maps["law_inner"], law_outer=maps["law_outer"]) for row in rows]
 
 
@@ -279,16 +308,30 @@ def test_kernel_map_law_equals_ehl_law(map_rows, omega):
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
     local = (ball - q[:3]) @ rot
     psi_i = np.arctan2(local[:, 1], local[:, 0])
-    centre_i = np.c_[row.inner_center_radius * np.cos(psi_i), row.inner_center_radius * np.sin(psi_i),
-                     np.full(psi_i.size, row.inner_center_z + m.z)] @ rot.T
+    centre_i = (
+        np.c_[
+            row.inner_center_radius * np.cos(psi_i),
+            row.inner_center_radius * np.sin(psi_i),
+            np.full(psi_i.size, row.inner_center_z + m.z),
+        ]
+        @ rot.T
+    )
     e_i = ball - q[:3] - centre_i
     w_i = vel - qt[:3] - np.cross([0.0, 0.0, omega], centre_i)
     psi_o = np.arctan2(ball[:, 1], ball[:, 0])
-    e_o = ball - np.c_[row.outer_center_radius * np.cos(psi_o), row.outer_center_radius * np.sin(psi_o),
-                       np.full(psi_o.size, row.outer_center_z + m.z)]
+    e_o = (
+        ball
+        - np.c_[
+            row.outer_center_radius * np.cos(psi_o),
+            row.outer_center_radius * np.sin(psi_o),
+            np.full(psi_o.size, row.outer_center_z + m.z),
+        ]
+    )
     speed = m.speed_factor * omega
-    for label, e, w, offset, law in (("inner", e_i, w_i, row.inner_offset, m.law_inner),
-                                     ("outer", e_o, vel, row.outer_offset, m.law_outer)):
+    for label, e, w, offset, law in (
+        ("inner", e_i, w_i, row.inner_offset, m.law_inner),
+        ("outer", e_o, vel, row.outer_offset, m.law_outer),
+    ):
         length = np.linalg.norm(e, axis=1)
         rate = np.sum(e * w, axis=1) / length
         ref = law(length - offset, rate, speed)
@@ -379,7 +422,7 @@ def test_film_speed_jacobian_vs_finite_difference():
     model = rows_from_design(load("rv40e"), ehl="hamrock_dowson")[0]
     q, qt = _random_state(model, seed=4)
     q[6:] = 0.0
-    q[6 + 2::3] = -2e-7  # axial preload side: every ball loaded
+    q[6 + 2 :: 3] = -2e-7  # axial preload side: every ball loaded
     qt[:] = 0.0
     qt[5] = 1.1
     ev = evaluate_row(model, q, qt, jacobian=True)
@@ -428,7 +471,7 @@ def test_two_rows_one_element():
     jac = element.jacobian(list(qn), list(vn), f_q, f_v)
     np.testing.assert_allclose(force, ref_f, rtol=0, atol=1e-14 * np.abs(ref_f).max())
     np.testing.assert_allclose(jac, ref_j, rtol=0, atol=1e-14 * np.abs(ref_j).max())
-    assert not jac[6:6 + nb[0], 6 + nb[0]:].any() and not jac[6 + nb[0]:, 6:6 + nb[0]].any()
+    assert not jac[6 : 6 + nb[0], 6 + nb[0] :].any() and not jac[6 + nb[0] :, 6 : 6 + nb[0]].any()
 
 
 @pytest.mark.parametrize("preset", ["rv221", "rv40e"])
@@ -564,8 +607,6 @@ def test_quasi_static_ball_failure_is_reported():
     assert state[4] == 1 and state[5] == 1
     np.testing.assert_array_equal(kernel_inputs(row)[12], ws)
     assert "quasi-static balls" in group.check()
-
-
 
 
 def test_ball_inertia_option_routes():

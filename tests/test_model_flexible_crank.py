@@ -20,8 +20,13 @@ def _shaft_compliance(span, r=0.008, r_end=0.010, a=0.010, h=0.003):
     shaft: free span B (radius r, length ``span``) between A and C (radius r_end,
     length a; their lateral surfaces are the RBE2 interfaces), plus two short free
     tails beyond C (the mesher needs distinct radii for distinct surfaces)."""
-    segs = (("gear_seat", r_end, a, 0.0), ("support_a", r, span, 0.0), ("eccentric_1", r_end, a, 0.0),
-            ("eccentric_2", 0.009, 2e-3, 0.0), ("support_b", 0.007, 2e-3, 0.0))
+    segs = (
+        ("gear_seat", r_end, a, 0.0),
+        ("support_a", r, span, 0.0),
+        ("eccentric_1", r_end, a, 0.0),
+        ("eccentric_2", 0.009, 2e-3, 0.0),
+        ("support_b", 0.007, 2e-3, 0.0),
+    )
     m = generate_mesh(CrankshaftSpec(segments=segs), "crankshaft", h).data
     fe = assemble(m.nodes, m.tets, E, NU, RHO)
     seat, held = _disjoint(m.node_set("gear_seat"), m.node_set("eccentric_1"))
@@ -66,8 +71,12 @@ def test_condensed_bending_matches_timoshenko_cantilever(shafts):
     inertia, area = np.pi * r**4 / 4, np.pi * r**2
     e = a / 2
     kappa = 6 * (1 + NU) / (7 + 6 * NU)
-    u = (span**3 / (3 * E * inertia) + e * span**2 / (2 * E * inertia)
-         + e * (span**2 / (2 * E * inertia) + e * span / (E * inertia)) + span / (kappa * G * area))
+    u = (
+        span**3 / (3 * E * inertia)
+        + e * span**2 / (2 * E * inertia)
+        + e * (span**2 / (2 * E * inertia) + e * span / (E * inertia))
+        + span / (kappa * G * area)
+    )
     for c in (comp[0, 0], comp[1, 1]):
         assert 0.0 <= c / u - 1 < 0.08, c / u
 
@@ -184,8 +193,11 @@ def locked_runs():
     runs = {}
     for key, opts in (("rigid", None), ("flexible", {}), ("stiff", {"stiffness_scale": 1000.0})):
         # --parts names every elastic part: the flexible runs have rigid carrier and discs, so has the reference
-        model, mo = (("rigid", {"bodies": []}) if opts is None
-                     else ("flexible", {"parts": ["crankshaft"], "crank_options": opts}))
+        model, mo = (
+            ("rigid", {"bodies": []})
+            if opts is None
+            else ("flexible", {"parts": ["crankshaft"], "crank_options": opts})
+        )
         runs[key] = Simulation(red, model=model, drive="locked", torque=tq, model_options=mo).run(t_end=0.06)
     return red, runs
 
@@ -241,9 +253,10 @@ def test_stiff_crank_limit_reproduces_rigid_te_in_motion():
     red = load("rv40e")
     tq = step_torque(412.0, 0.0, 0.02)
     te = {}
-    for key, model, mo in (("rigid", "rigid", {"bodies": []}),  # no elastic body, as --parts crankshaft
-                           ("stiff", "flexible", {"parts": ["crankshaft"],
-                                                  "crank_options": {"stiffness_scale": 1000.0}})):
+    for key, model, mo in (
+        ("rigid", "rigid", {"bodies": []}),  # no elastic body, as --parts crankshaft
+        ("stiff", "flexible", {"parts": ["crankshaft"], "crank_options": {"stiffness_scale": 1000.0}}),
+    ):
         res = Simulation(red, model=model, torque=tq, model_options=mo).run(t_end=0.1)
         te[key] = res["te"].values[res.time > 0.05]
     assert te["stiff"].mean() == pytest.approx(te["rigid"].mean(), rel=1e-4)

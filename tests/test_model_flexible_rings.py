@@ -14,8 +14,15 @@ import pytest
 from flexrv.design import load
 from flexrv.fem.body import _assemble, build_reduced_body, material_dict, raceway_spec_for
 from flexrv.meshing import build_mesh, spec_for
-from flexrv.model.flexible_bearing import (RING_EIGENMODES_QUASI_STATIC, RING_HARMONICS, ModalRing, evaluate_row,
-                                           ring_modal_coordinates, rows_from_design, rxyz_matrices)
+from flexrv.model.flexible_bearing import (
+    RING_EIGENMODES_QUASI_STATIC,
+    RING_HARMONICS,
+    ModalRing,
+    evaluate_row,
+    ring_modal_coordinates,
+    rows_from_design,
+    rxyz_matrices,
+)
 from tests.test_fem_reduction import fe_patch_deflection
 from tests.test_model_flexible_bearing import _static_rig
 
@@ -30,6 +37,7 @@ def rings(tmp_path_factory):
     default basis for quasi-static rings (RING_HARMONICS, no eigenmodes); full FE
     kept for reference."""
     import os
+
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     rv = load("rv221")
     out = {}
@@ -49,8 +57,10 @@ def _flexible_rows(rv, out, scale=1.0, rings=("inner", "outer"), condense=True, 
     for label in rings:
         body = out[f"{label}_ring"][2]
         zeta = rv.main_bearing.ring_damping_ratio
-        kw[label] = [ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, condense=condense),
-                     ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, mirror=True, condense=condense)]
+        kw[label] = [
+            ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, condense=condense),
+            ModalRing(body, damping_ratio=zeta, stiffness_scale=scale, mirror=True, condense=condense),
+        ]
     return rows_from_design(rv, ehl=ehl, **kw)
 
 
@@ -66,8 +76,9 @@ def test_ring_deflection_under_ball_loads_matches_full_fe(rings, condense):
     mirror image z -> -z of the meshed ring, so its loads are mirrored for the
     FE reference)."""
     rv, out = rings
-    rows, evals, frame_q, qs = _static_rig(rv, SEED001_FORCE, rows=_flexible_rows(rv, out, condense=condense),
-                                           coordinates=True)
+    rows, evals, frame_q, qs = _static_rig(
+        rv, SEED001_FORCE, rows=_flexible_rows(rv, out, condense=condense), coordinates=True
+    )
     checked = 0
     for k, (row, ev) in enumerate(zip(rows, evals)):
         for label, st in (("outer", ev.outer), ("inner", ev.inner)):
@@ -160,9 +171,9 @@ def test_flexible_reducer_run_outputs(rings):
     q_modal = res["ring_modal_outer"].values[-1, 0]
     balls = model.members["main_bearing_balls0"]
     q_end = np.asarray(model.mbs.systemData.GetODE2Coordinates())
-    pos = q_end[balls.offset:balls.offset + balls.n].reshape(-1, 3)
+    pos = q_end[balls.offset : balls.offset + balls.n].reshape(-1, 3)
     j_max = int(np.argmax(res["ball_load_outer"].values[-1, 0]))
-    u = group.rows[0].outer.groove_basis(np.arctan2(pos[j_max:j_max + 1, 1], pos[j_max:j_max + 1, 0]))[0] @ q_modal
+    u = group.rows[0].outer.groove_basis(np.arctan2(pos[j_max : j_max + 1, 1], pos[j_max : j_max + 1, 0]))[0] @ q_modal
     assert np.linalg.norm(u) > 1e-9
     assert abs(res["ring_deformation_outer"].values[-1, 0]) <= np.linalg.norm(u) * (1 + 1e-9)
     assert res["ring_deformation_outer"].values[-1, 0] > 0.5 * np.linalg.norm(u)
@@ -176,9 +187,8 @@ def test_stiffened_flexible_reducer_matches_rigid_ring_reducer():
     0.07 arcsec of 86 at the end of the load ramp), ball loads within 1 % of the maximum; the kinematic ratio
     stays exact in the mean (0.2 %). Then the real rings: the TE level moves by
     less than 1 arcsec (ring deflection ~0.1 um at these loads)."""
-    from flexrv.simulation import Simulation
-
     from flexrv.design import override
+    from flexrv.simulation import Simulation
 
     rv = override("rv40e", {"contact.ehl": "dry"})
     t_end = 0.3  # past the load ramp (0.1-0.2 s): the steady window gives the mean ratio
@@ -209,8 +219,9 @@ def test_condensed_rings_match_the_uncondensed_formulation(rings):
     B^T g holds for the uncondensed solution)."""
     rv, out = rings
     rows_c, ev_c, frame_c, q_c = _static_rig(rv, SEED001_FORCE, rows=_flexible_rows(rv, out), coordinates=True)
-    rows_f, ev_f, frame_f, q_f = _static_rig(rv, SEED001_FORCE, rows=_flexible_rows(rv, out, condense=False),
-                                             coordinates=True)
+    rows_f, ev_f, frame_f, q_f = _static_rig(
+        rv, SEED001_FORCE, rows=_flexible_rows(rv, out, condense=False), coordinates=True
+    )
     assert rows_c[0].n_coordinates == 6 + 3 * rows_c[0].ball_count  # no ring coordinates left
     assert rows_f[0].n_coordinates > rows_c[0].n_coordinates + 200
     np.testing.assert_allclose(frame_c[:3], frame_f[:3], rtol=0, atol=1e-6 * np.abs(frame_f[:3]).max())
@@ -222,14 +233,12 @@ def test_condensed_rings_match_the_uncondensed_formulation(rings):
             a, b = getattr(ev_c[k], label), getattr(ev_f[k], label)
             assert b.load.max() > 1000.0 and np.abs(b.displacement).max() > 5e-7
             np.testing.assert_allclose(a.load, b.load, rtol=0, atol=1e-6 * b.load.max())
-            np.testing.assert_allclose(a.displacement, b.displacement, rtol=0,
-                                       atol=1e-6 * np.abs(b.displacement).max())
+            np.testing.assert_allclose(a.displacement, b.displacement, rtol=0, atol=1e-6 * np.abs(b.displacement).max())
             qm_c = ring_modal_coordinates(rows_c[k], label, q_c[k], ev_c[k])
             qm_f = ring_modal_coordinates(rows_f[k], label, q_f[k], ev_f[k])
             np.testing.assert_allclose(qm_c, qm_f, rtol=0, atol=1e-6 * np.abs(qm_f).max())
             s = getattr(ev_same, label)
-            np.testing.assert_allclose(s.displacement, b.displacement, rtol=0,
-                                       atol=1e-6 * np.abs(b.displacement).max())
+            np.testing.assert_allclose(s.displacement, b.displacement, rtol=0, atol=1e-6 * np.abs(b.displacement).max())
             np.testing.assert_allclose(s.load, b.load, rtol=0, atol=1e-6 * b.load.max())
 
 
@@ -242,8 +251,9 @@ def _fd(row, q, qt, which, h):
         d[k] = h
         args_p = (q + d, qt) if which == 0 else (q, qt + d)
         args_m = (q - d, qt) if which == 0 else (q, qt - d)
-        jac[:, k] = (evaluate_row(row, *args_p, jacobian=False).force
-                     - evaluate_row(row, *args_m, jacobian=False).force) / (2 * h)
+        jac[:, k] = (
+            evaluate_row(row, *args_p, jacobian=False).force - evaluate_row(row, *args_m, jacobian=False).force
+        ) / (2 * h)
     return jac
 
 
@@ -332,10 +342,19 @@ def test_output_pass_equals_per_sample_kernel_calls(rings):
             s = label[0]
             psi = recs[:, :, col[f"psi_{label}"]]
             g = np.ascontiguousarray(recs[:, :, [col[f"g{s}x"], col[f"g{s}y"], col[f"g{s}z"]]])
-            got = ring_modal_amplitudes(np.ascontiguousarray(psi), g, ring.table, -1.0 if ring.mirror else 1.0,
-                                        np.ascontiguousarray(ring.compliance_diag))
-            ref = np.stack([ring.compliance_diag * np.einsum("jcm,jc->m", ring.groove_basis(psi[i]), g[i])
-                            for i in range(psi.shape[0])])
+            got = ring_modal_amplitudes(
+                np.ascontiguousarray(psi),
+                g,
+                ring.table,
+                -1.0 if ring.mirror else 1.0,
+                np.ascontiguousarray(ring.compliance_diag),
+            )
+            ref = np.stack(
+                [
+                    ring.compliance_diag * np.einsum("jcm,jc->m", ring.groove_basis(psi[i]), g[i])
+                    for i in range(psi.shape[0])
+                ]
+            )
             np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
 
 
@@ -363,8 +382,8 @@ def test_condensed_tangent_equals_direct_solve():
     k = np.zeros((3 * nz, 3 * nz))
     nn = np.zeros((3 * nz, nz))
     for j in range(nz):
-        k[3 * j:3 * j + 3, 3 * j:3 * j + 3] = -factors[j].T @ factors[j]
-        nn[3 * j:3 * j + 3, j] = n[j]
+        k[3 * j : 3 * j + 3, 3 * j : 3 * j + 3] = -factors[j].T @ factors[j]
+        nn[3 * j : 3 * j + 3, j] = n[j]
     a = np.eye(3 * nz) - k @ cmat
     ref_q = np.linalg.solve(a, k)
     ref_v = -np.linalg.solve(a, nn) @ np.diag(cd) @ nn.T
@@ -451,7 +470,11 @@ def test_film_warm_start_same_fixed_point(ehl):
     delta = np.geomspace(1e-9, 5e-6, 25)
     cold = np.array([_normal_load(d, 1e-4, *terms, p) for d in delta])
     assert np.all(cold[:, 0] > 0) and np.all(cold[:, 3] > 1e-8)
-    for start in (np.array([_normal_load(d * (1 + 1e-4), 1e-4, *terms, p)[3] for d in delta]), cold[:, 3],
-                  10.0 * cold[:, 3], 0.1 * cold[:, 3]):
+    for start in (
+        np.array([_normal_load(d * (1 + 1e-4), 1e-4, *terms, p)[3] for d in delta]),
+        cold[:, 3],
+        10.0 * cold[:, 3],
+        0.1 * cold[:, 3],
+    ):
         warm = np.array([_normal_load(d, 1e-4, *terms, p, h) for d, h in zip(delta, start)])
         np.testing.assert_allclose(warm, cold, rtol=1e-14, atol=0)

@@ -253,13 +253,20 @@ def test_linear_support_option_is_the_legacy_spring():
     assert "crank_bending_fraction" not in out
 
 
-@pytest.mark.parametrize("field,value,words", [
-    ("support_bearing_roller_count", 30, ["support_bearing_roller_count", "must be <= 15", "overlap"]),
-    ("support_bearing_pitch_diameter_mm", 16.0, ["support_bearing_pitch_diameter_mm", "does not fit on the journal"]),
-    ("support_bearing_roller_length_mm", 12.0, ["support_bearing_roller_length_mm", "support_journal_length_mm"]),
-    ("support_bearing_contact_angle_deg", 50.0, ["support_bearing_contact_angle_deg", "35"]),
-    ("support_bearing_model", "linear", ["support_bearing_radial_stiffness_N_per_m", "required"]),
-])
+@pytest.mark.parametrize(
+    "field,value,words",
+    [
+        ("support_bearing_roller_count", 30, ["support_bearing_roller_count", "must be <= 15", "overlap"]),
+        (
+            "support_bearing_pitch_diameter_mm",
+            16.0,
+            ["support_bearing_pitch_diameter_mm", "does not fit on the journal"],
+        ),
+        ("support_bearing_roller_length_mm", 12.0, ["support_bearing_roller_length_mm", "support_journal_length_mm"]),
+        ("support_bearing_contact_angle_deg", 50.0, ["support_bearing_contact_angle_deg", "35"]),
+        ("support_bearing_model", "linear", ["support_bearing_radial_stiffness_N_per_m", "required"]),
+    ],
+)
 def test_support_bearing_bad_input(field, value, words):
     """A support bearing that cannot fit (rollers vs pitch circle, cone vs journal,
     rollers longer than the journal), out-of-range geometry or a missing field of

@@ -12,6 +12,7 @@ from flexrv.meshing.parts import PlainRingSpec
 @pytest.fixture(scope="module")
 def ring_mode(tmp_path_factory):
     import os
+
     os.environ["FLEXRV_CACHE"] = str(tmp_path_factory.mktemp("cache"))
     m = generate_mesh(PlainRingSpec(0.09, 0.1, 0.02), "plain_ring", 0.01).data
     fe = assemble(m.nodes, m.tets, 2.1e11, 0.3, 7850.0)

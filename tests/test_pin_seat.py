@@ -154,8 +154,14 @@ def test_housing_compliance_energy_and_budget():
         fv = f[:, None] * u / np.linalg.norm(u, axis=1)[:, None]
         fr = fv[:, 0] * np.cos(th) + fv[:, 1] * np.sin(th)
         ft = -fv[:, 0] * np.sin(th) + fv[:, 1] * np.cos(th)
-        w, v = ring_displacements(th, fr, ft, 0.5 * (r_i + r_o), mat.youngs_modulus * width * thick**3 / 12,
-                                  mat.youngs_modulus * width * thick)
+        w, v = ring_displacements(
+            th,
+            fr,
+            ft,
+            0.5 * (r_i + r_o),
+            mat.youngs_modulus * width * thick**3 / 12,
+            mat.youngs_modulus * width * thick,
+        )
         energy += float(fr @ w + ft @ v)
     assert hc.ring == pytest.approx(energy / t**2, rel=1e-10)
     b = stiffness_budget(r)
@@ -163,11 +169,14 @@ def test_housing_compliance_energy_and_budget():
     assert 0.01 < b.shares["housing"] < 0.2
 
 
-@pytest.mark.parametrize("field,value,match", [
-    ("housing.ring_outer_diameter_mm", 130.0, "housing.ring_outer_diameter_mm"),
-    ("housing.pin_seat_length_mm", 80.0, "housing.pin_seat_length_mm"),
-    ("housing.pin_seat_clearance_um", 0.0, "pin_seat_clearance_um"),
-])
+@pytest.mark.parametrize(
+    "field,value,match",
+    [
+        ("housing.ring_outer_diameter_mm", 130.0, "housing.ring_outer_diameter_mm"),
+        ("housing.pin_seat_length_mm", 80.0, "housing.pin_seat_length_mm"),
+        ("housing.pin_seat_clearance_um", 0.0, "pin_seat_clearance_um"),
+    ],
+)
 def test_bad_housing_fields_name_the_field(field, value, match):
     with pytest.raises(ConfigError, match=match):
         override("rv40e", {field: value})
@@ -209,7 +218,11 @@ def test_housing_ring_against_a_solid_fe_slice(tmp_path, monkeypatch):
     th = np.arctan2(pins[:, 1], pins[:, 0])
     center, _ = nominal_disc_pose(ss.pin_count, ss.eccentricity, float(ab.chi0[0]))
     u = pins - ss.pin_count * center
-    f = reducer_pin_loads(r, r.operating.rated_torque_Nm, disc=0).forces[:, None] * u / np.linalg.norm(u, axis=1)[:, None]
+    f = (
+        reducer_pin_loads(r, r.operating.rated_torque_Nm, disc=0).forces[:, None]
+        * u
+        / np.linalg.norm(u, axis=1)[:, None]
+    )
     loads = sector_loads(m.nodes, bore, (0, 0), th, np.c_[f, np.zeros(len(f))], np.pi / ss.pin_count)
     fx, fy = f.sum(axis=0)
     tz = float(np.sum(pins[:, 0] * f[:, 1] - pins[:, 1] * f[:, 0]))
@@ -220,13 +233,16 @@ def test_housing_ring_against_a_solid_fe_slice(tmp_path, monkeypatch):
     loads += sector_loads(m.nodes, outer, (0, 0), ang, react, np.pi / k)
     assert np.abs(loads.sum(axis=0)).max() < 1e-6 * np.abs(f).max()
     an = np.arctan2(m.nodes[outer, 1], m.nodes[outer, 0])
-    held = [outer[np.argmin(np.abs(np.angle(np.exp(1j * (an - t)))) + np.abs(m.nodes[outer, 2]))]
-            for t in (0.0, 2 * np.pi / 3, 4 * np.pi / 3)]
+    held = [
+        outer[np.argmin(np.abs(np.angle(np.exp(1j * (an - t)))) + np.abs(m.nodes[outer, 2]))]
+        for t in (0.0, 2 * np.pi / 3, 4 * np.pi / 3)
+    ]
     energy_fe = float(np.sum(loads * solve_static(fe.K, np.array(held), loads)))
     thick = r_o - r_i
     fr = f[:, 0] * np.cos(th) + f[:, 1] * np.sin(th)
     ft = -f[:, 0] * np.sin(th) + f[:, 1] * np.cos(th)
-    w, v = ring_displacements(th, fr, ft, 0.5 * (r_i + r_o), mat.youngs_modulus * width * thick**3 / 12,
-                              mat.youngs_modulus * width * thick)
+    w, v = ring_displacements(
+        th, fr, ft, 0.5 * (r_i + r_o), mat.youngs_modulus * width * thick**3 / 12, mat.youngs_modulus * width * thick
+    )
     ratio = energy_fe / float(fr @ w + ft @ v)
     assert 1.0 < ratio < 1.5

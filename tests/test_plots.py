@@ -97,10 +97,12 @@ def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captur
     red = load("rv40e")
     w_in = red.operating.input_speed
     t = np.arange(0, 0.6, 1e-4)
-    ds = xr.Dataset({"te": ("time", 2.0 * np.sin(2 * np.pi * 390.0 * t)), "theta_in": ("time", w_in * t)},
-                    coords={"time": t})
-    ds.attrs.update({"steady_start_s": 0.3, "steady_end_s": float(t[-1]), "preset": "rv40e", "model": "rigid",
-                     "steady": 1})
+    ds = xr.Dataset(
+        {"te": ("time", 2.0 * np.sin(2 * np.pi * 390.0 * t)), "theta_in": ("time", w_in * t)}, coords={"time": t}
+    )
+    ds.attrs.update(
+        {"steady_start_s": 0.3, "steady_end_s": float(t[-1]), "preset": "rv40e", "model": "rigid", "steady": 1}
+    )
     _not_blank(plot_te_spectrum(Results(ds, red), tmp_path / "spec.png"))
     ax = captured[-1].axes[0]
     y = ax.lines[0].get_ydata()
@@ -144,10 +146,15 @@ def _synthetic_flexible(red, n_ball=20, rows=2):
     t = np.arange(0, 0.3, 1e-4)
     ball = np.zeros((len(t), rows, n_ball))
     ball[:, :, 5] = 150.0  # ball 6 (pocket angle 90 deg) carries 150 N
-    ds = xr.Dataset({"ball_load_inner": (("time", "bearing_row", "ball"), ball),
-                     "ring_deformation_outer": (("time", "bearing_row"), np.full((len(t), rows), 0.8e-6)),
-                     "te": ("time", 0.5 * np.sin(2 * np.pi * 100 * t)),
-                     "theta_in": ("time", red.operating.input_speed * t)}, coords={"time": t})
+    ds = xr.Dataset(
+        {
+            "ball_load_inner": (("time", "bearing_row", "ball"), ball),
+            "ring_deformation_outer": (("time", "bearing_row"), np.full((len(t), rows), 0.8e-6)),
+            "te": ("time", 0.5 * np.sin(2 * np.pi * 100 * t)),
+            "theta_in": ("time", red.operating.input_speed * t),
+        },
+        coords={"time": t},
+    )
     ds.attrs.update({"steady_start_s": 0.1, "steady_end_s": float(t[-1]), "preset": red.name, "model": "flexible"})
     return Results(ds, red)
 
@@ -186,8 +193,9 @@ def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
     r2 = (X / 1e-4) ** 2 + (Y / 8e-4) ** 2
     p = 1.5e9 * np.sqrt(np.clip(1 - r2, 0, None))
     h = 0.2e-6 + 1e-6 * np.clip(r2 - 1, 0, None)
-    result = SimpleNamespace(x=x, y=y, pressure=p, film=h, h_central=0.2e-6, h_min=0.18e-6, p_max=1.5e9,
-                             hertz_pressure=1.5e9)
+    result = SimpleNamespace(
+        x=x, y=y, pressure=p, film=h, h_central=0.2e-6, h_min=0.18e-6, p_max=1.5e9, hertz_pressure=1.5e9
+    )
     fig = ehl_figure(result)
     maps = [ax for ax in fig.axes if ax.get_title().startswith(("pressure", "film thickness"))]
     assert len(maps) == 2 and all(ax.get_aspect() == 1.0 for ax in maps)
@@ -202,8 +210,21 @@ def test_mode_png_offscreen(tmp_path):
     pytest.importorskip("pyvista")
     from flexrv.viz.modes import render_mode_png
 
-    nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1],
-                      [.5, 0, 0], [.5, .5, 0], [0, .5, 0], [0, 0, .5], [.5, 0, .5], [0, .5, .5]], float)
+    nodes = np.array(
+        [
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [0.5, 0, 0],
+            [0.5, 0.5, 0],
+            [0, 0.5, 0],
+            [0, 0, 0.5],
+            [0.5, 0, 0.5],
+            [0, 0.5, 0.5],
+        ],
+        float,
+    )
     tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
     disp = np.zeros_like(nodes)
     disp[3] = [0.1, 0.1, 0.2]

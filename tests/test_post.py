@@ -82,7 +82,9 @@ def test_cli_simulate_json(tmp_path):
     from flexrv.cli import app
 
     out = tmp_path / "cli_run"
-    r = CliRunner().invoke(app, ["simulate", "rv40e", "--model", "rigid", "--t-end", "0.004", "--out", str(out), "--json"])
+    r = CliRunner().invoke(
+        app, ["simulate", "rv40e", "--model", "rigid", "--t-end", "0.004", "--out", str(out), "--json"]
+    )
     assert r.exit_code == 0, r.output
     data = json.loads(r.stdout)
     assert data["ratio_theoretical"] == pytest.approx(81.0)

@@ -22,10 +22,16 @@ from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD
 def ideal(name: str):
     """The preset with ideal geometry: no profile modification, no needle
     clearance, no first-stage backlash."""
-    return override(name, {"second_stage.modification_equidistant_mm": 0.0,
-                           "second_stage.modification_shift_mm": 0.0,
-                           "second_stage.modification_rotation_deg": 0.0,
-                           "needle_bearing.radial_clearance_um": 0.0, "first_stage.backlash_um": 0.0})
+    return override(
+        name,
+        {
+            "second_stage.modification_equidistant_mm": 0.0,
+            "second_stage.modification_shift_mm": 0.0,
+            "second_stage.modification_rotation_deg": 0.0,
+            "needle_bearing.radial_clearance_um": 0.0,
+            "first_stage.backlash_um": 0.0,
+        },
+    )
 
 
 @pytest.fixture(scope="module")
@@ -73,10 +79,21 @@ def test_pin_loads_vs_analytic_distribution():
     f = r.outputs["pin_force"].values[0, 0]
     t_disc = r.outputs["disc_pin_torque"].values[0, 0]
     ss = red.second_stage
-    ref = pin_load_distribution(t_disc, ss.pin_count, ss.pin_circle_radius, ss.pin_radius, ss.eccentricity,
-                                ss.disc_width, disc_effective_modulus(red), ss.modification_shift,
-                                ss.modification_equidistant, ss.modification_rotation, 0.0, "palmgren",
-                                stiffness_constant=pin_contact_constant(red).k)  # pin path with the seats (issue 14)
+    ref = pin_load_distribution(
+        t_disc,
+        ss.pin_count,
+        ss.pin_circle_radius,
+        ss.pin_radius,
+        ss.eccentricity,
+        ss.disc_width,
+        disc_effective_modulus(red),
+        ss.modification_shift,
+        ss.modification_equidistant,
+        ss.modification_rotation,
+        0.0,
+        "palmgren",
+        stiffness_constant=pin_contact_constant(red).k,
+    )  # pin path with the seats (issue 14)
     assert abs(int((f > 0).sum()) - ref.n_contact) <= 1
     assert f.max() == pytest.approx(ref.max_force, rel=0.05)
     # static torque balance about the axis (exact at equilibrium): the pins' reaction on the
@@ -146,13 +163,14 @@ def test_convergence_in_points_per_mesh_and_newton_tolerance():
         r = loaded_te(red, crank_revolutions=crank, points_per_mesh=k, catalog_positions=1)
         assert len(r.te) == 4 * k
         pp[k] = r.summary()["te_pp_arcsec"]
-    assert pp[8] <= pp[16] + 1e-5 and pp[16] <= pp[32] + 1e-5 and pp[32] <= pp[64] + 1e-5  # nested, up to solver tolerance
+    assert (
+        pp[8] <= pp[16] + 1e-5 and pp[16] <= pp[32] + 1e-5 and pp[32] <= pp[64] + 1e-5
+    )  # nested, up to solver tolerance
     err = {k: (pp[64] - pp[k]) / pp[64] for k in (8, 16, 32)}
     assert err[8] >= err[16] >= err[32] - 1e-9
     assert err[8] < 0.10 and err[32] < 0.005
     a = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1)
-    b = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1,
-                  options={"force_tol": 1e-8})
+    b = loaded_te(red, crank_revolutions=0.05, points_per_mesh=8, catalog_positions=1, options={"force_tol": 1e-8})
     assert np.max(np.abs(a.te - b.te)) * ARCSEC_PER_RAD < 1e-4
 
 
@@ -165,11 +183,18 @@ def test_catalog_numbers_are_consistent(rv40e_quarter):
     assert s["catalog_rigidity_Nm_per_arcmin"] == pytest.approx(s["torsional_rigidity_Nm_per_arcmin"], rel=0.05)
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    ({"torque": -1.0}, "torque"), ({"torque": 1e9}, "torque"), ({"points_per_mesh": 1}, "points_per_mesh"),
-    ({"output_revolutions": 0.0}, "output_revolutions"), ({"crank_revolutions": float("nan")}, "crank_revolutions"),
-    ({"output_revolutions": 1.0, "crank_revolutions": 1.0}, "crank_revolutions"),
-    ({"options": {"bogus": 1}}, "bogus")])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"torque": -1.0}, "torque"),
+        ({"torque": 1e9}, "torque"),
+        ({"points_per_mesh": 1}, "points_per_mesh"),
+        ({"output_revolutions": 0.0}, "output_revolutions"),
+        ({"crank_revolutions": float("nan")}, "crank_revolutions"),
+        ({"output_revolutions": 1.0, "crank_revolutions": 1.0}, "crank_revolutions"),
+        ({"options": {"bogus": 1}}, "bogus"),
+    ],
+)
 def test_bad_inputs_name_the_field(kwargs, field):
     with pytest.raises(InputError, match=field):
         loaded_te(load("rv40e"), **kwargs)
@@ -181,13 +206,38 @@ def test_cli_te_json_matches_saved_results(tmp_path):
     import xarray as xr
 
     out = tmp_path / "te"
-    cp = subprocess.run([sys.executable, "-m", "flexrv", "te", "rv40e", "--crank-revolutions", "0.1",
-                         "--points-per-mesh", "8", "--json", "--out", str(out)], capture_output=True, text=True,
-                        timeout=600)
+    cp = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "flexrv",
+            "te",
+            "rv40e",
+            "--crank-revolutions",
+            "0.1",
+            "--points-per-mesh",
+            "8",
+            "--json",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert cp.returncode == 0, cp.stderr
     d = json.loads(cp.stdout)
-    for key in ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motion_arcmin", "backlash_arcmin",
-                "torsional_rigidity_Nm_per_arcmin", "positions", "solve_time_s", "spectrum_lines"):
+    for key in (
+        "te_pp_arcsec",
+        "te_mean_arcsec",
+        "no_load_te_pp_arcsec",
+        "lost_motion_arcmin",
+        "backlash_arcmin",
+        "torsional_rigidity_Nm_per_arcmin",
+        "positions",
+        "solve_time_s",
+        "spectrum_lines",
+    ):
         assert key in d
     ds = xr.load_dataset(out / "results.nc")
     te = ds["te"].values
@@ -207,12 +257,19 @@ def test_dynamic_model_follows_the_quasi_static_curve_at_low_speed():
     curves must coincide: measured mean difference 2e-5 arcsec and largest
     deviation 0.0036 arcsec (1.4 % of the 0.25 arcsec p-p); required 0.005 and
     0.015 arcsec (6 % of p-p)."""
-    from flexrv.simulation import Simulation
     from flexrv.model.quasi_static import equilibrium_path
+    from flexrv.simulation import Simulation
 
-    red = override("rv40e", {"operating.input_speed_rpm": 121.5, "operating.speed_ramp_time_s": 0.05,
-                             "operating.load_ramp_start_s": 0.0, "operating.load_ramp_end_s": 0.05,
-                             "contact.friction": False})  # the static solver has no friction (zero speed)
+    red = override(
+        "rv40e",
+        {
+            "operating.input_speed_rpm": 121.5,
+            "operating.speed_ramp_time_s": 0.05,
+            "operating.load_ramp_start_s": 0.0,
+            "operating.load_ramp_end_s": 0.05,
+            "contact.friction": False,
+        },
+    )  # the static solver has no friction (zero speed)
     res = Simulation(red).run(t_end=0.2, dt=1e-4)
     sel = res.time > 0.12
     th = res["theta_in"].values[sel][::4]
@@ -233,6 +290,7 @@ def test_compliance_budget_predicts_a_stiffer_support():
     lowers the torsional compliance by share/2 of it (exact for an element in
     series; measured 0.12 % of C off, the load sharing between cranks shifting
     slightly); required within 1 % of C."""
+
     def compliance(red):
         sm = StaticModel(red)
         sm.torque = 0.0
@@ -309,8 +367,14 @@ def test_uniform_pin_circle_radius_error_is_a_shift_modification():
     design without errors (flexrv.design.manufacturing.nominal_design), so the error
     keeps the base design's constants while the modification gets its own; the
     equivalence is one of the contact geometry."""
-    base = override("rv40e", {"needle_bearing.radial_clearance_um": 0.0, "second_stage.disc_body_model": "rigid",
-                              "housing.body_model": "rigid"})
+    base = override(
+        "rv40e",
+        {
+            "needle_bearing.radial_clearance_um": 0.0,
+            "second_stage.disc_body_model": "rigid",
+            "housing.body_model": "rigid",
+        },
+    )
     kw = dict(crank_revolutions=0.25, points_per_mesh=8, catalog_positions=1)
     r0 = loaded_te(base, **kw)
     r1 = loaded_te(_pins(base, "pin_radial_position_um", 2.0), **kw)

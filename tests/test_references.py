@@ -12,9 +12,13 @@ import pytest
 from flexrv.references import CITE_PATTERN, REFERENCES, SECTIONS, cite, cited_keys, markdown
 
 ROOT = Path(__file__).resolve().parents[1]
-SOURCES = sorted(p for d in ("flexrv", "workflows", "benchmarks", "tests") if (ROOT / d).exists()
-                 for p in (ROOT / d).rglob("*.py")
-                 if p.name not in ("references.py", "test_references.py"))
+SOURCES = sorted(
+    p
+    for d in ("flexrv", "workflows", "benchmarks", "tests")
+    if (ROOT / d).exists()
+    for p in (ROOT / d).rglob("*.py")
+    if p.name not in ("references.py", "test_references.py")
+)
 
 
 def _citations():
@@ -38,7 +42,10 @@ def test_every_cited_key_exists():
 
 def test_cited_keys_parser():
     assert cited_keys("a :cite:`hamrock1994`, eq. 1 and :cite:`seed000,seed001`.") == [
-        "hamrock1994", "seed000", "seed001"]
+        "hamrock1994",
+        "seed000",
+        "seed001",
+    ]
     assert cited_keys("units [m] and [seed000] are not citations") == []
     assert CITE_PATTERN.pattern == r":cite:`([^`]+)`"
 
@@ -74,8 +81,12 @@ def test_no_citation_inside_runtime_strings_of_converted_modules():
                 if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
                     docstrings.add(id(first.value))
         for node in ast.walk(tree):
-            if (isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings
-                    and CITE_PATTERN.search(node.value)):
+            if (
+                isinstance(node, ast.Constant)
+                and isinstance(node.value, str)
+                and id(node) not in docstrings
+                and CITE_PATTERN.search(node.value)
+            ):
                 bad.append(f"{path.relative_to(ROOT)}:{node.lineno}")
     assert not bad, bad
 
@@ -93,8 +104,11 @@ def test_no_bare_seed_citation_in_the_package():
         assert BARE_SEED.search(old), old
     for new in (":cite:`seed004`", "seed000/seed001", "random seed 42", "Seed study 003"):
         assert not BARE_SEED.search(new), new
-    bare = [f"{p.relative_to(ROOT)}:{p.read_text(encoding='utf-8')[:m.start()].count(chr(10)) + 1}: {m.group(0)!r}"
-            for p in PACKAGE_TEXTS for m in BARE_SEED.finditer(p.read_text(encoding="utf-8"))]
+    bare = [
+        f"{p.relative_to(ROOT)}:{p.read_text(encoding='utf-8')[: m.start()].count(chr(10)) + 1}: {m.group(0)!r}"
+        for p in PACKAGE_TEXTS
+        for m in BARE_SEED.finditer(p.read_text(encoding="utf-8"))
+    ]
     assert not bare, "bare seed citations (use :cite:`seed00X` or the key seed00X):\n" + "\n".join(bare)
 
 

@@ -13,8 +13,9 @@ from flexrv.design import load
 def _fast(name, t_ramp=0.005):
     """Rated speed and load reached at ``t_ramp`` (as benchmarks/bench_rigid.py)."""
     r = load(name)
-    op = r.operating.model_copy(update={"speed_ramp_time_s": t_ramp, "load_ramp_start_s": 0.0,
-                                        "load_ramp_end_s": t_ramp})
+    op = r.operating.model_copy(
+        update={"speed_ramp_time_s": t_ramp, "load_ramp_start_s": 0.0, "load_ramp_end_s": t_ramp}
+    )
     return r.model_copy(update={"operating": op})
 
 
@@ -95,8 +96,9 @@ def test_support_inner_solve_against_independent_root(name):
         gam = rng.uniform(0, 2 * np.pi)
         clear = 0.0 if i % 3 else 2e-6
         b0 = rng.uniform(-20e-6, 20e-6, 2) if i % 2 else np.zeros(2)
-        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qs = crank_support_force(dx, dy, gam, clear, sc, angles, False,
-                                                                        b0[0], b0[1])
+        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qs = crank_support_force(
+            dx, dy, gam, clear, sc, angles, False, b0[0], b0[1]
+        )
         ux, uy = _roller_directions(gam, angles)
 
         def resid(b):
@@ -110,8 +112,9 @@ def test_support_inner_solve_against_independent_root(name):
         assert np.hypot(bx - sol.x[0], by - sol.x[1]) <= 1e-12 * load_scale / kb, i
 
 
-@pytest.mark.parametrize("name, model", [("rv40e", "rigid"), ("rv221", "rigid"), ("rv221", "balls"),
-                                         ("rv221", "flexible")])
+@pytest.mark.parametrize(
+    "name, model", [("rv40e", "rigid"), ("rv221", "rigid"), ("rv221", "balls"), ("rv221", "flexible")]
+)
 def test_integrator_records_match_the_history_pass(name, model):
     """The compiled groups' outputs recorded from the integrator's own calls
     (HistoryRecorder, Simulation.run's default) against evaluating them again from
@@ -179,8 +182,7 @@ def test_integrator_records_match_the_history_pass(name, model):
             rel, floor = 2e-6, (1e-12 if key.startswith("ring_deformation") else 1e-8)  # [m], [N] (zero forces)
         elif model == "balls" and key.startswith(("ball_", "main_bearing_")):
             rel, floor = 1e-5, 1e-9  # the balls' local solve; [N], [N m]: net forces that are round-off
-        assert np.max(np.abs(a - b), initial=0.0) <= max(rel * max(np.max(np.abs(b), initial=0.0), 1e-300),
-                                                         floor), key
+        assert np.max(np.abs(a - b), initial=0.0) <= max(rel * max(np.max(np.abs(b), initial=0.0), 1e-300), floor), key
     gap, gap_exact, force = fast["pin_gap"].values, exact["pin_gap"].values, exact["pin_force"].values
     bound = np.abs(gap - gap_exact) > 1e-12
     assert np.all(force[bound] == 0.0) and np.all(gap[bound] > 0.0) and np.all(gap[bound] <= gap_exact[bound])
@@ -198,7 +200,9 @@ def test_group_with_its_own_record_keeps_its_own_outputs_path(history):
     model, t, q, v = history
     pins = next(g for g in model.groups if g.kind == "pins")
     cls = type(pins)
-    legacy = type("LegacyPins", (cls,), {"record": lambda self: {k: a.copy() for k, a in cls.record_sources(self).items()}})
+    legacy = type(
+        "LegacyPins", (cls,), {"record": lambda self: {k: a.copy() for k, a in cls.record_sources(self).items()}}
+    )
     fused = model.fused
     try:
         pins.__class__ = legacy
@@ -258,8 +262,12 @@ def test_recorder_checkpoint_round_trip_with_bearing_rows():
     sim = Simulation(_fast("rv221"), model="balls")
     sim.run(t_end=0.002, dt=1e-4)
     rec = HistoryRecorder(sim.model, 8)
-    assert len(rec.sources) == 2 and [key for _, key, _ in rec.sources[1][2]] == ["balls0", "frame0", "balls1",
-                                                                                  "frame1"]
+    assert len(rec.sources) == 2 and [key for _, key, _ in rec.sources[1][2]] == [
+        "balls0",
+        "frame0",
+        "balls1",
+        "frame1",
+    ]
 
 
 def _pack_arrays(x, out):

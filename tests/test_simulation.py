@@ -20,18 +20,27 @@ from flexrv.simulation import Simulation, stiffness_test
 
 def fast(name, speed_ramp=0.01, t1=0.01, t2=0.03, **operating):
     r = load(name)
-    op = r.operating.model_copy(update={"speed_ramp_time_s": speed_ramp, "load_ramp_start_s": t1,
-                                        "load_ramp_end_s": t2, **operating})
+    op = r.operating.model_copy(
+        update={"speed_ramp_time_s": speed_ramp, "load_ramp_start_s": t1, "load_ramp_end_s": t2, **operating}
+    )
     return r.model_copy(update={"operating": op})
 
 
 def ideal(r):
     """Unmodified profile, zero needle clearance, zero backlash."""
-    return r.model_copy(update={
-        "second_stage": r.second_stage.model_copy(update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0,
-                                                          "modification_rotation_deg": 0.0}),
-        "needle_bearing": r.needle_bearing.model_copy(update={"radial_clearance_um": 0.0}),
-        "first_stage": r.first_stage.model_copy(update={"backlash_um": 0.0})})
+    return r.model_copy(
+        update={
+            "second_stage": r.second_stage.model_copy(
+                update={
+                    "modification_equidistant_mm": 0.0,
+                    "modification_shift_mm": 0.0,
+                    "modification_rotation_deg": 0.0,
+                }
+            ),
+            "needle_bearing": r.needle_bearing.model_copy(update={"radial_clearance_um": 0.0}),
+            "first_stage": r.first_stage.model_copy(update={"backlash_um": 0.0}),
+        }
+    )
 
 
 @pytest.fixture(scope="module", params=["rv40e", "rv221"])
@@ -79,7 +88,9 @@ def test_power_and_torque_balance(steady_run):
     ext = -sel["output_torque"].values + sel["sun_torque"].values - sel["housing_pin_torque"].values.sum(axis=-1)
     t = sel["time"].values
     impulse = float(np.sum(0.5 * (ext[1:] + ext[:-1]) * np.diff(t)))
-    load_impulse = float(np.sum(0.5 * (sel["output_torque"].values[1:] + sel["output_torque"].values[:-1]) * np.diff(t)))
+    load_impulse = float(
+        np.sum(0.5 * (sel["output_torque"].values[1:] + sel["output_torque"].values[:-1]) * np.diff(t))
+    )
     assert abs((lz[-1] - lz[0]) - impulse) < 0.01 * load_impulse
 
 
@@ -115,7 +126,8 @@ def test_static_pin_load_distribution_and_torque_balance():
     # the load acts against +rotation, i.e. the discs are loaded like a negative output torque
     ref = reducer_pin_loads(r, -t_r, crank_angle=0.0)
     assert set(np.flatnonzero(f > 0.05 * f.max())) <= set(np.flatnonzero(ref.forces > 0)) | set(
-        np.flatnonzero(np.roll(ref.forces, 1) > 0)) | set(np.flatnonzero(np.roll(ref.forces, -1) > 0))
+        np.flatnonzero(np.roll(ref.forces, 1) > 0)
+    ) | set(np.flatnonzero(np.roll(ref.forces, -1) > 0))
     assert abs(int((f > 0).sum()) - ref.n_contact) <= 2
     assert f.max() == pytest.approx(ref.max_force, rel=0.20)
     t = res.time
@@ -174,7 +186,8 @@ def test_roller_resolved_needle_bearing_option():
         r = load("rv40e")
         r = r.model_copy(update={"needle_bearing": r.needle_bearing.model_copy(update={"model": model})})
         res = Simulation(r, drive="locked", torque=piecewise_torque([0, 0.01, 1], [0, 412.0, 412.0])).run(
-            t_end=0.013, dt=1e-4)
+            t_end=0.013, dt=1e-4
+        )
         te[model] = float(res["te"].values[-1])
         if model == "rollers":
             rf = res["roller_force"]
@@ -239,8 +252,15 @@ def test_non_finite_state_is_a_failure_not_a_result(monkeypatch):
     t, q, v = cap["t"], cap["q"], cap["v"]
     q_bad = q[10].copy()
     q_bad[0] = np.nan
-    restart = {"step": 10, "t": t[:10], "q": q[:10], "v": v[:10], "q_b": q_bad, "v_b": v[10],
-               "a_b": np.zeros_like(q_bad)}
+    restart = {
+        "step": 10,
+        "t": t[:10],
+        "q": q[:10],
+        "v": v[:10],
+        "q_b": q_bad,
+        "v_b": v[10],
+        "a_b": np.zeros_like(q_bad),
+    }
     with pytest.raises(SimulationError, match="the state became NaN/inf") as exc:
         sim.run(t_end=0.002, restart=restart)
     assert exc.value.results.attrs["status"] == "failed"

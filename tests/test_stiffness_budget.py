@@ -60,7 +60,8 @@ def test_stiffness_test_budget_matches_design_budget():
     assert set(ana.compliances) <= set(comp)
     assert sum(comp.values()) == pytest.approx(ana.total, rel=0.10)
     assert comp["pins"] + comp["pin_seats"] == pytest.approx(
-        ana.compliances["pins"] + ana.compliances["pin_seats"], rel=0.10)
+        ana.compliances["pins"] + ana.compliances["pin_seats"], rel=0.10
+    )
     assert comp["housing"] == pytest.approx(ana.compliances["housing"], rel=0.10)
     assert dyn["unmodelled"] == {}
     assert sum(comp.values()) == pytest.approx(1.0 / dyn["tangent_rigidity"], rel=1e-6)
@@ -90,8 +91,11 @@ def test_design_te_and_stiffness_test_totals_agree(tmp_path):
     te = quasi_static_budget(summary, res.outputs, r)["rigidity_Nm_per_arcmin"]
     # te's low-torque secant (3-50 % rated) lies below the catalog one (the Palmgren laws stiffen with load
     # and the contacts close in the low range): measured 2026-11-24
-    assert 0.5 * summary["catalog_rigidity_Nm_per_arcmin"] < summary["low_torque_rigidity_Nm_per_arcmin"] \
+    assert (
+        0.5 * summary["catalog_rigidity_Nm_per_arcmin"]
+        < summary["low_torque_rigidity_Nm_per_arcmin"]
         < summary["catalog_rigidity_Nm_per_arcmin"]
+    )
     fig, run = stiffness_test("rv40e", save_to=tmp_path)
     import json
 
@@ -120,8 +124,16 @@ def test_design_cli_prints_the_budget():
     assert res.exit_code == 0, res.output
     b = json.loads(res.output)["stiffness_budget"]
     el = b["elements"]
-    assert set(el) == {"pins", "needle_bearings", "support_bearings", "crank_bending", "pin_seats", "housing",
-                       "carrier", "cycloid_disc"}
+    assert set(el) == {
+        "pins",
+        "needle_bearings",
+        "support_bearings",
+        "crank_bending",
+        "pin_seats",
+        "housing",
+        "carrier",
+        "cycloid_disc",
+    }
     assert sum(e["share_percent"] for e in el.values()) == pytest.approx(100.0, rel=1e-12)
     total = sum(e["compliance_arcsec_per_Nm"] for e in el.values())
     assert b["total_compliance_arcsec_per_Nm"] == pytest.approx(total, rel=1e-12)
@@ -131,8 +143,17 @@ def test_design_cli_prints_the_budget():
     ref = stiffness_budget(load("rv40e"), bodies=elastic_body_compliances(load("rv40e")))
     assert b["rigidity_Nm_per_arcmin"] == pytest.approx(ref.rigidity * RAD_PER_ARCMIN, rel=1e-12)
     table = CliRunner().invoke(app, ["design", "rv40e"]).output
-    for name in ("crank bending", "support bearings", "needle bearings", "pins", "pin seats", "housing", "carrier",
-                 "cycloid disc", "total"):
+    for name in (
+        "crank bending",
+        "support bearings",
+        "needle bearings",
+        "pins",
+        "pin seats",
+        "housing",
+        "carrier",
+        "cycloid disc",
+        "total",
+    ):
         assert name in table
 
 
@@ -146,8 +167,11 @@ def test_quasi_static_budget_splits_the_crank_supports():
     from flexrv.model.base import Output
     from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
-    summary = {"torsional_rigidity_Nm_per_arcmin": 250.0, "torque_Nm": 412.0,
-               "compliance_budget_percent": {"crank_supports": 60.0, "needle_bearings": 30.0, "pins": 10.0}}
+    summary = {
+        "torsional_rigidity_Nm_per_arcmin": 250.0,
+        "torque_Nm": 412.0,
+        "compliance_budget_percent": {"crank_supports": 60.0, "needle_bearings": 30.0, "pins": 10.0},
+    }
     frac = Output(np.array([[0.5, 0.6, 0.7], [0.5, 0.6, 0.7]]), ("position", "crank"), "1", "")
     b = quasi_static_budget(summary, {"crank_bending_fraction": frac})
     total = RAD_PER_ARCMIN / 250.0 * ARCSEC_PER_RAD

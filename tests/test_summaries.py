@@ -82,10 +82,19 @@ def test_power_balance_words_follow_the_numbers():
 
 # ----------------------------------------------------------------------------- compare reference
 def _numbers(seed):
-    n = {"te_min_arcsec": -2.0, "te_max_arcsec": 1.0, "te_pp_arcsec": 3.0, "te_mean_arcsec": -0.5,
-         "dominant_period_s": 0.1, "steady_window_s": [0.3, 0.6], "steady_state": True, "steady_note": "",
-         "characteristic_frequencies_hz": {"crank_rotation": 10.0, "cycloid_mesh": 390.0},
-         "spectrum_window_s": 0.3, "spectrum_resolution_hz": 3.33}
+    n = {
+        "te_min_arcsec": -2.0,
+        "te_max_arcsec": 1.0,
+        "te_pp_arcsec": 3.0,
+        "te_mean_arcsec": -0.5,
+        "dominant_period_s": 0.1,
+        "steady_window_s": [0.3, 0.6],
+        "steady_state": True,
+        "steady_note": "",
+        "characteristic_frequencies_hz": {"crank_rotation": 10.0, "cycloid_mesh": 390.0},
+        "spectrum_window_s": 0.3,
+        "spectrum_resolution_hz": 3.33,
+    }
     f = dict(n, te_mean_arcsec=-0.25, te_pp_arcsec=3.5, max_ball_load_N=100.0, max_ring_deformation_m=0.02e-6)
     return {"rigid": n, "flexible": f, "seed": seed}
 
@@ -137,12 +146,19 @@ def test_stiffness_test_saves_its_numbers(tmp_path):
 
 
 # ----------------------------------------------------------------------------- tables: units
-@pytest.mark.parametrize("key, label, unit", [
-    ("C_W_seed004_Nm_per_rad", "C_W_seed004", "N m/rad"), ("entrainment_speed", "entrainment_speed", ""),
-    ("entrainment_speed_m_s", "entrainment_speed", "m/s"), ("max_force_N", "max_force", "N"),
-    ("c12_N_s_per_m", "c12", "N s/m"), ("density_kg_m3", "density", "kg/m³"),
-    ("planet_inertia_estimate_kg_m2", "planet_inertia_estimate", "kg m²"), ("pins_in_contact_max",
-                                                                             "pins_in_contact_max", "")])
+@pytest.mark.parametrize(
+    "key, label, unit",
+    [
+        ("C_W_seed004_Nm_per_rad", "C_W_seed004", "N m/rad"),
+        ("entrainment_speed", "entrainment_speed", ""),
+        ("entrainment_speed_m_s", "entrainment_speed", "m/s"),
+        ("max_force_N", "max_force", "N"),
+        ("c12_N_s_per_m", "c12", "N s/m"),
+        ("density_kg_m3", "density", "kg/m³"),
+        ("planet_inertia_estimate_kg_m2", "planet_inertia_estimate", "kg m²"),
+        ("pins_in_contact_max", "pins_in_contact_max", ""),
+    ],
+)
 def test_design_report_unit_column(key, label, unit):
     """The issue's cases: 'C_W_seed004_Nm_per_rad' was read as 'W seed004 Nm/rad' and
     'entrainment_speed_m_s' as 'm s'."""
@@ -178,8 +194,10 @@ def test_first_compile_notice(tmp_path):
 
     helper_index, helper = dispatcher("cycloid._pin_gap_kernel")
     entry_index, entry = dispatcher("kernels.fused_kernel")
-    modules = {"flexrv.geometry.cycloid": SimpleNamespace(_PIN_GAP=helper),
-               "flexrv.model.kernels": SimpleNamespace(fused_kernel=entry)}
+    modules = {
+        "flexrv.geometry.cycloid": SimpleNamespace(_PIN_GAP=helper),
+        "flexrv.model.kernels": SimpleNamespace(fused_kernel=entry),
+    }
     assert uncached_kernels(modules) == ["cycloid._PIN_GAP", "kernels.fused_kernel"]
     out = io.StringIO()
     assert announce_compile(out, modules) and "compiling numba kernels (once, ~" in out.getvalue()

@@ -57,9 +57,14 @@ def test_sweep_killed_and_resumed(tmp_path):
     spec_path = _spec(tmp_path, delay=1.5)
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
-    proc = subprocess.Popen([sys.executable, "-m", "flexrv", "sweep", str(spec_path), "--out", str(out),
-                             "--workers", "2", "--json"], env=env, cwd=tmp_path, start_new_session=True,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "flexrv", "sweep", str(spec_path), "--out", str(out), "--workers", "2", "--json"],
+        env=env,
+        cwd=tmp_path,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     cases_dir = out / "cases"
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -108,8 +113,10 @@ def test_table_follows_a_changed_spec(tmp_path, monkeypatch):
 
     sys.path.insert(0, str(ROOT))
     spec_path = tmp_path / "s.toml"
-    body = ('name = "grow"\npreset = "rv40e"\ntask = "tests.sweep_tasks:slow_ratio"\noutputs = ["kinematics.ratio"]\n'
-            '[grid]\n"second_stage.eccentricity_mm" = {values}\n')
+    body = (
+        'name = "grow"\npreset = "rv40e"\ntask = "tests.sweep_tasks:slow_ratio"\noutputs = ["kinematics.ratio"]\n'
+        '[grid]\n"second_stage.eccentricity_mm" = {values}\n'
+    )
     spec_path.write_text(body.format(values="[1.0]"))
     out = tmp_path / "out"
     summary = run_sweep(load_spec(spec_path), out_dir=out, n_workers=1, progress=False)
@@ -133,10 +140,13 @@ def test_spec_validated_before_running(tmp_path):
     head = 'name = "v"\npreset = "rv40e"\ntask = "design"\noutputs = ["kinematics.ratio"]\n'
     grid = '[grid]\n"second_stage.eccentricity_mm" = [1.0]\n'
     bad = tmp_path / "bad.toml"
-    for body, key in ((head + "grid = 5\n", "grid"), (head + "cases = 5\n", "cases"),
-                      (head + 'options = "x"\n' + grid, "options"),
-                      (head.replace('"v"', '"../v"') + grid, "name"),
-                      (head.replace('"v"', '"a/b"') + grid, "name")):
+    for body, key in (
+        (head + "grid = 5\n", "grid"),
+        (head + "cases = 5\n", "cases"),
+        (head + 'options = "x"\n' + grid, "options"),
+        (head.replace('"v"', '"../v"') + grid, "name"),
+        (head.replace('"v"', '"a/b"') + grid, "name"),
+    ):
         bad.write_text(body)
         with pytest.raises(ConfigError, match=key):
             load_spec(bad)
@@ -145,8 +155,7 @@ def test_spec_validated_before_running(tmp_path):
         run_sweep(load_spec(bad), out_dir=tmp_path / "o", progress=False)
     assert not (tmp_path / "o").exists()
     with pytest.raises(ConfigError, match="--workers"):
-        run_sweep(load_spec(spec_path_ok(tmp_path, head + grid)), out_dir=tmp_path / "o", n_workers=0,
-                  progress=False)
+        run_sweep(load_spec(spec_path_ok(tmp_path, head + grid)), out_dir=tmp_path / "o", n_workers=0, progress=False)
 
 
 def spec_path_ok(tmp_path, body):

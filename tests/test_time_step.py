@@ -96,8 +96,7 @@ GRID = 2e-4  #: common sampling of the compared TE signals [s]
 def fast(name):
     """Shortened ramps: rated speed at 0.01 s, load 0.01-0.03 s."""
     r = load(name)
-    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.01, "load_ramp_start_s": 0.01,
-                                        "load_ramp_end_s": 0.03})
+    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.01, "load_ramp_start_s": 0.01, "load_ramp_end_s": 0.03})
     return r.model_copy(update={"operating": op})
 
 
@@ -114,9 +113,13 @@ def te_signal(reducer, t_end, dt, tol, model="rigid"):
 
 def lines(reducer, f, a):
     """Indices of the spectral lines of ``a`` up to the cycloid mesh frequency."""
-    cf = characteristic_frequencies(reducer.operating.input_speed_rpm * RAD_S_PER_RPM,
-                                    reducer.first_stage.sun_teeth, reducer.first_stage.planet_teeth,
-                                    reducer.second_stage.disc_teeth, reducer.second_stage.pin_count)
+    cf = characteristic_frequencies(
+        reducer.operating.input_speed_rpm * RAD_S_PER_RPM,
+        reducer.first_stage.sun_teeth,
+        reducer.first_stage.planet_teeth,
+        reducer.second_stage.disc_teeth,
+        reducer.second_stage.pin_count,
+    )
     sel = np.where((f > 0) & (f <= 1.01 * float(cf.cycloid_mesh)))[0]
     top = a[sel].max()
     return [i for i in sel if a[i] >= a[i - 1] and a[i] >= a[min(i + 1, len(a) - 1)] and a[i] > 0.05 * top]

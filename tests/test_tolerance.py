@@ -27,8 +27,7 @@ import pytest
 from flexrv.design import load
 from flexrv.design.tolerances import load_tolerances, parse_tolerances
 from flexrv.errors import ConfigError, InputError
-from flexrv.studies.tolerance import (OUTPUTS, TolerancePlan, parse_spec, sobol_indices, te_task,
-                                      yield_estimate)
+from flexrv.studies.tolerance import OUTPUTS, TolerancePlan, parse_spec, sobol_indices, te_task, yield_estimate
 
 ROOT = Path(__file__).resolve().parents[1]
 #: smoke resolution of the CLI studies: 0.1 crank revolution at 2 points per pin mesh
@@ -46,8 +45,15 @@ def _env():
 
 
 def _cli(*args, timeout=600, **kw):
-    return subprocess.run([sys.executable, "-m", "flexrv", "tolerance", *args], cwd=ROOT, env=_env(),
-                          capture_output=True, text=True, timeout=timeout, **kw)
+    return subprocess.run(
+        [sys.executable, "-m", "flexrv", "tolerance", *args],
+        cwd=ROOT,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        **kw,
+    )
 
 
 def _free_port() -> int:
@@ -57,20 +63,29 @@ def _free_port() -> int:
 
 
 # --------------------------------------------------------------------------- validation
-@pytest.mark.parametrize("table, words", [
-    ({"pins.pin_size_um": {"distribution": "normal", "sigma_um": 1.0}}, ["pins.pin_size_um", "no such"]),
-    ({"pins.pin_radius_um": {"distribution": "normal", "sigma_um": -1.0}}, ["sigma_um", "-1.0"]),
-    ({"pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0, "scope": "lot"}}, ["scope", "lot"]),
-    ({"pins.pin_radius_um": {"distribution": "normal", "sigma_arcmin": 1.0}}, ["sigma_arcmin", "sigma_um"]),
-    ({"pins.pin_radius_um": {"distribution": "band"}}, ["band_um"]),
-    ({"pins.pin_radius_um": {"distribution": "triangular", "band_um": 1.0}}, ["distribution", "triangular"]),
-    ({"clearances.support_clearance_um": {"distribution": "uniform", "band_um": 2.0, "mean_um": 1.0}},
-     ["support_clearance_um", "lower bound"]),
-    ({"first_stage.sun_runout_phase_deg": {"distribution": "normal", "sigma_deg": 1.0}}, ["sun_runout_phase_deg"]),
-    ({"pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0},
-      "correlations": [{"fields": ["pins.pin_radius_um", "cranks.bore_radial_um"], "coefficient": 0.5}]},
-     ["correlations[0]", "cranks.bore_radial_um"]),
-])
+@pytest.mark.parametrize(
+    "table, words",
+    [
+        ({"pins.pin_size_um": {"distribution": "normal", "sigma_um": 1.0}}, ["pins.pin_size_um", "no such"]),
+        ({"pins.pin_radius_um": {"distribution": "normal", "sigma_um": -1.0}}, ["sigma_um", "-1.0"]),
+        ({"pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0, "scope": "lot"}}, ["scope", "lot"]),
+        ({"pins.pin_radius_um": {"distribution": "normal", "sigma_arcmin": 1.0}}, ["sigma_arcmin", "sigma_um"]),
+        ({"pins.pin_radius_um": {"distribution": "band"}}, ["band_um"]),
+        ({"pins.pin_radius_um": {"distribution": "triangular", "band_um": 1.0}}, ["distribution", "triangular"]),
+        (
+            {"clearances.support_clearance_um": {"distribution": "uniform", "band_um": 2.0, "mean_um": 1.0}},
+            ["support_clearance_um", "lower bound"],
+        ),
+        ({"first_stage.sun_runout_phase_deg": {"distribution": "normal", "sigma_deg": 1.0}}, ["sun_runout_phase_deg"]),
+        (
+            {
+                "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0},
+                "correlations": [{"fields": ["pins.pin_radius_um", "cranks.bore_radial_um"], "coefficient": 0.5}],
+            },
+            ["correlations[0]", "cranks.bore_radial_um"],
+        ),
+    ],
+)
 def test_bad_tolerance_tables(rv40e, table, words):
     """Each bad entry raises one ConfigError naming the entry/key and value."""
     with pytest.raises(ConfigError) as info:
@@ -79,8 +94,10 @@ def test_bad_tolerance_tables(rv40e, table, words):
         assert w in str(info.value)
 
 
-@pytest.mark.parametrize("text, word", [("te_pp<=60", "unknown output"), ("te_pp_arcsec=60", "bad syntax"),
-                                        ("lost_motion_arcmin<=inf", "finite")])
+@pytest.mark.parametrize(
+    "text, word",
+    [("te_pp<=60", "unknown output"), ("te_pp_arcsec=60", "bad syntax"), ("lost_motion_arcmin<=inf", "finite")],
+)
 def test_bad_specs(text, word):
     with pytest.raises(InputError, match=word):
         parse_spec(text)
@@ -95,11 +112,14 @@ def test_cli_bad_inputs_exit_2_quickly(tmp_path):
     unknown = tmp_path / "unknown.toml"
     unknown.write_text('[tolerances."pins.pin_colour_um"]\ndistribution = "normal"\nsigma_um = 2.0\n')
     port = _free_port()
-    cases = [(["--samples", "0"], "--samples"), (["--samples", "4", "--spec", "te_pp<=60"], "te_pp"),
-             (["--samples", "4", "--spec", "te_pp_arcsec=60"], "bad syntax"),
-             (["--samples", "4", "--tolerances", str(bad_tol)], "sigma_um"),
-             (["--samples", "4", "--tolerances", str(unknown)], "pins.pin_colour_um"),
-             (["--samples", "4", "--scheduler", f"tcp://127.0.0.1:{port}"], "scheduler")]
+    cases = [
+        (["--samples", "0"], "--samples"),
+        (["--samples", "4", "--spec", "te_pp<=60"], "te_pp"),
+        (["--samples", "4", "--spec", "te_pp_arcsec=60"], "bad syntax"),
+        (["--samples", "4", "--tolerances", str(bad_tol)], "sigma_um"),
+        (["--samples", "4", "--tolerances", str(unknown)], "pins.pin_colour_um"),
+        (["--samples", "4", "--scheduler", f"tcp://127.0.0.1:{port}"], "scheduler"),
+    ]
     for args, word in cases:
         args = [a if a != "--tolerances" else a for a in args]
         if "--tolerances" not in args:
@@ -153,12 +173,14 @@ def test_same_seed_identical_samples(rv40e, sampler):
 def test_marginals_and_correlation(rv40e):
     """Random sampler, 20,000 draws: normal sigma, band-3-sigma truncated sigma, uniform half width,
     and a correlation group's coefficient, within 4 standard errors."""
-    table = {"cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 2.0, "mean_um": 1.0},
-             "cranks.bore_tangential_um": {"distribution": "band", "band_um": 3.0},
-             "pins.pin_radius_um": {"distribution": "uniform", "band_um": 1.5, "scope": "per_reducer"},
-             "discs.hole_radial_um": {"distribution": "normal", "sigma_um": 1.0},
-             "discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 1.0},
-             "correlations": [{"fields": ["discs.hole_radial_um", "discs.hole_tangential_um"], "coefficient": 0.6}]}
+    table = {
+        "cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 2.0, "mean_um": 1.0},
+        "cranks.bore_tangential_um": {"distribution": "band", "band_um": 3.0},
+        "pins.pin_radius_um": {"distribution": "uniform", "band_um": 1.5, "scope": "per_reducer"},
+        "discs.hole_radial_um": {"distribution": "normal", "sigma_um": 1.0},
+        "discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 1.0},
+        "correlations": [{"fields": ["discs.hole_radial_um", "discs.hole_tangential_um"], "coefficient": 0.6}],
+    }
     tol = parse_tolerances(table, rv40e)
     plan = TolerancePlan.build(rv40e, tol, 3)
     n = 20000
@@ -172,8 +194,9 @@ def test_marginals_and_correlation(rv40e):
     assert abs(tol.sigma_of("cranks.bore_tangential_um") - 0.98658) < 1e-4
     pr = x[:, plan.slices["pins.pin_radius_um"]]
     assert pr.shape[1] == 1 and abs(pr.std() / (1.5 / math.sqrt(3)) - 1) < 4 * se * 1.2
-    r = np.corrcoef(x[:, plan.slices["discs.hole_radial_um"]].ravel(),
-                    x[:, plan.slices["discs.hole_tangential_um"]].ravel())[0, 1]
+    r = np.corrcoef(
+        x[:, plan.slices["discs.hole_radial_um"]].ravel(), x[:, plan.slices["discs.hole_tangential_um"]].ravel()
+    )[0, 1]
     assert abs(r - 0.6) < 4 * (1 - 0.36) / math.sqrt(n)
     errs = plan.errors_for(x[0])
     assert len(errs["pins"]["pin_radius_um"]) == 40 and len(set(errs["pins"]["pin_radius_um"])) == 1
@@ -185,8 +208,10 @@ def test_yield_clopper_pearson():
     independently of scipy's binomtest root finding; 1e-7."""
     from scipy.stats import beta
 
-    y = {"te_pp_arcsec": np.r_[np.full(45, 10.0), np.full(5, 100.0), np.nan],
-         "lost_motion_arcmin": np.r_[1.5, np.full(50, 0.5)]}
+    y = {
+        "te_pp_arcsec": np.r_[np.full(45, 10.0), np.full(5, 100.0), np.nan],
+        "lost_motion_arcmin": np.r_[1.5, np.full(50, 0.5)],
+    }
     res = yield_estimate(y, [parse_spec("te_pp_arcsec<=60")])
     assert res["passed"] == 45 and res["n"] == 50 and res["yield"] == 0.9  # the NaN sample is not counted
     assert res["ci_low"] == pytest.approx(beta.ppf(0.025, 45, 6), abs=1e-7)
@@ -200,9 +225,11 @@ def test_sobol_indices_additive(rv40e):
     uniform on [0, 1] is additive, so S1_g = ST_g = a_g^2 n_g / sum_h a_h^2 n_h (n_g variables in
     group g): 3 bores (a=1), 2 sun-runout components (a=2), 1 per-reducer pin radius (a=3) ->
     3/20, 8/20, 9/20. Tolerance 0.03 (N = 2048 base samples; SALib's bootstrap half widths ~0.01)."""
-    table = {"cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 1.0},
-             "first_stage.sun_runout_um": {"distribution": "normal", "sigma_um": 1.0},
-             "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0, "scope": "per_reducer"}}
+    table = {
+        "cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 1.0},
+        "first_stage.sun_runout_um": {"distribution": "normal", "sigma_um": 1.0},
+        "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 1.0, "scope": "per_reducer"},
+    }
     plan = TolerancePlan.build(rv40e, parse_tolerances(table, rv40e), 11)
     u = plan.saltelli(2048)
     assert u.shape == (2048 * (3 + 2), 6)
@@ -230,8 +257,10 @@ def test_first_order_propagation_mean_te(rv40e):
 
     from flexrv.design import with_errors
 
-    table = {"discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 0.3},
-             "pins.pin_tangential_position_um": {"distribution": "normal", "sigma_um": 0.5, "scope": "per_reducer"}}
+    table = {
+        "discs.hole_tangential_um": {"distribution": "normal", "sigma_um": 0.3},
+        "pins.pin_tangential_position_um": {"distribution": "normal", "sigma_um": 0.5, "scope": "per_reducer"},
+    }
     tol = parse_tolerances(table, rv40e)
     plan = TolerancePlan.build(rv40e, tol, 5)
     res = {"crank_revolutions": 0.1, "points_per_mesh": 2}
@@ -247,7 +276,7 @@ def test_first_order_propagation_mean_te(rv40e):
         e = np.zeros(d)
         e[i] = sig[i]
         jac[i] = (mean_te(e) - mean_te(-e)) / (2 * sig[i])
-    var_pred = float(np.sum(jac ** 2 * sig ** 2))
+    var_pred = float(np.sum(jac**2 * sig**2))
     n = 20
     x = plan.values(plan.unit_samples(n, "random"))
     y = np.array([mean_te(row) for row in x])
@@ -279,8 +308,23 @@ def _assert_same(a: dict, b: dict) -> None:
 def local_run(tmp_path_factory):
     """A tiny study on a LocalCluster (1 worker): 4 samples, no what-if."""
     out = tmp_path_factory.mktemp("tol") / "local"
-    res = _cli("rv40e", "--tolerances", "rv40e", "--samples", "4", "--seed", "3", "--workers", "1",
-               "--what-if-samples", "0", *SMOKE, "--out", str(out), "--json")
+    res = _cli(
+        "rv40e",
+        "--tolerances",
+        "rv40e",
+        "--samples",
+        "4",
+        "--seed",
+        "3",
+        "--workers",
+        "1",
+        "--what-if-samples",
+        "0",
+        *SMOKE,
+        "--out",
+        str(out),
+        "--json",
+    )
     assert res.returncode == 0, res.stderr
     return out, json.loads(res.stdout)
 
@@ -297,12 +341,42 @@ def test_study_outputs_and_rerun_identical(local_run, tmp_path):
     ok = t["status"] == "ok"
     assert ok.sum() >= 3
     assert np.all(t["torsional_rigidity_Nm_per_arcmin"][ok] > 100.0)
-    again = _cli("rv40e", "--tolerances", "rv40e", "--samples", "4", "--seed", "3", "--workers", "1",
-                 "--what-if-samples", "0", *SMOKE, "--out", str(out), "--json")
+    again = _cli(
+        "rv40e",
+        "--tolerances",
+        "rv40e",
+        "--samples",
+        "4",
+        "--seed",
+        "3",
+        "--workers",
+        "1",
+        "--what-if-samples",
+        "0",
+        *SMOKE,
+        "--out",
+        str(out),
+        "--json",
+    )
     assert again.returncode == 0 and json.loads(again.stdout)["computed_now"] == 0
     fresh = tmp_path / "fresh"
-    res = _cli("rv40e", "--tolerances", "rv40e", "--samples", "4", "--seed", "3", "--workers", "1",
-               "--what-if-samples", "0", *SMOKE, "--out", str(fresh), "--json")
+    res = _cli(
+        "rv40e",
+        "--tolerances",
+        "rv40e",
+        "--samples",
+        "4",
+        "--seed",
+        "3",
+        "--workers",
+        "1",
+        "--what-if-samples",
+        "0",
+        *SMOKE,
+        "--out",
+        str(fresh),
+        "--json",
+    )
     assert res.returncode == 0, res.stderr
     _assert_same(t, _table(fresh))
 
@@ -312,10 +386,30 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     same command computes only the missing samples (finished ones are skipped, their files
     untouched) and the table equals the uninterrupted run's."""
     out = tmp_path / "killed"
-    args = [sys.executable, "-m", "flexrv", "tolerance", "rv40e", "--tolerances", "rv40e", "--samples", "4",
-            "--seed", "3", "--workers", "1", "--what-if-samples", "0", *SMOKE, "--out", str(out), "--json"]
-    proc = subprocess.Popen(args, cwd=ROOT, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            start_new_session=True)
+    args = [
+        sys.executable,
+        "-m",
+        "flexrv",
+        "tolerance",
+        "rv40e",
+        "--tolerances",
+        "rv40e",
+        "--samples",
+        "4",
+        "--seed",
+        "3",
+        "--workers",
+        "1",
+        "--what-if-samples",
+        "0",
+        *SMOKE,
+        "--out",
+        str(out),
+        "--json",
+    ]
+    proc = subprocess.Popen(
+        args, cwd=ROOT, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
     cases = out / "runs" / "cases"
     t0 = time.time()
     try:
@@ -345,9 +439,16 @@ def test_real_dask_scheduler_and_workers(local_run, tmp_path):
     addr = f"tcp://127.0.0.1:{port}"
     dask_bin = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
     worker_bin = [sys.executable, "-m", "distributed.cli.dask_worker"]
-    procs = [subprocess.Popen([*dask_bin, "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0",
-                               "--no-show"], cwd=ROOT, env=_env(), stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, start_new_session=True)]
+    procs = [
+        subprocess.Popen(
+            [*dask_bin, "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0", "--no-show"],
+            cwd=ROOT,
+            env=_env(),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+    ]
     try:
         t0 = time.time()
         while True:
@@ -358,17 +459,39 @@ def test_real_dask_scheduler_and_workers(local_run, tmp_path):
                 assert time.time() - t0 < 60, "scheduler did not start"
                 time.sleep(0.3)
         for _ in range(2):
-            procs.append(subprocess.Popen([*worker_bin, addr, "--nthreads", "1", "--nworkers", "1",
-                                           "--no-dashboard", "--host", "127.0.0.1"], cwd=ROOT, env=_env(),
-                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                          start_new_session=True))
+            procs.append(
+                subprocess.Popen(
+                    [*worker_bin, addr, "--nthreads", "1", "--nworkers", "1", "--no-dashboard", "--host", "127.0.0.1"],
+                    cwd=ROOT,
+                    env=_env(),
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                    start_new_session=True,
+                )
+            )
         from dask.distributed import Client
 
         with Client(addr, timeout=30) as client:
             client.wait_for_workers(2, timeout=120)
         out = tmp_path / "remote"
-        res = _cli("rv40e", "--tolerances", "rv40e", "--samples", "4", "--seed", "3", "--scheduler", addr,
-                   "--what-if-samples", "0", *SMOKE, "--out", str(out), "--json", timeout=600)
+        res = _cli(
+            "rv40e",
+            "--tolerances",
+            "rv40e",
+            "--samples",
+            "4",
+            "--seed",
+            "3",
+            "--scheduler",
+            addr,
+            "--what-if-samples",
+            "0",
+            *SMOKE,
+            "--out",
+            str(out),
+            "--json",
+            timeout=600,
+        )
         assert res.returncode == 0, res.stderr
         _assert_same(_table(local_run[0]), _table(out))
     finally:
@@ -386,9 +509,11 @@ def test_src_linear_function(rv40e):
     runout 2 x (a=2, sigma 0.5), pin radius per reducer (a=0.5, sigma 2) -> 3/6, 2/6, 1/6; 0.02."""
     from flexrv.studies.tolerance import src_indices
 
-    table = {"cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 1.0},
-             "first_stage.sun_runout_um": {"distribution": "normal", "sigma_um": 0.5},
-             "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 2.0, "scope": "per_reducer"}}
+    table = {
+        "cranks.bore_radial_um": {"distribution": "normal", "sigma_um": 1.0},
+        "first_stage.sun_runout_um": {"distribution": "normal", "sigma_um": 0.5},
+        "pins.pin_radius_um": {"distribution": "normal", "sigma_um": 2.0, "scope": "per_reducer"},
+    }
     plan = TolerancePlan.build(rv40e, parse_tolerances(table, rv40e), 2)
     x = plan.values(plan.unit_samples(4000, "random"))
     a = np.r_[1.0, 1.0, 1.0, 2.0, 2.0, 0.5]
@@ -407,11 +532,29 @@ def test_study_sobol_and_what_if(tmp_path):
     run once, Sobol' indices and the what-if rows are reported; the halved tolerance's stored
     error values are exactly half the plain sample's."""
     tol = tmp_path / "tol.toml"
-    tol.write_text('[tolerances."cranks.bore_tangential_um"]\ndistribution = "band"\nband_um = 3.0\n'
-                   '[tolerances."pins.pin_radius_um"]\ndistribution = "normal"\nsigma_um = 0.4\n')
+    tol.write_text(
+        '[tolerances."cranks.bore_tangential_um"]\ndistribution = "band"\nband_um = 3.0\n'
+        '[tolerances."pins.pin_radius_um"]\ndistribution = "normal"\nsigma_um = 0.4\n'
+    )
     out = tmp_path / "s"
-    res = _cli("rv40e", "--tolerances", str(tol), "--samples", "2", "--sobol", "--what-if-samples", "1",
-               "--workers", "1", "--spec", "lost_motion_arcmin<=1.5", *SMOKE, "--out", str(out), "--json")
+    res = _cli(
+        "rv40e",
+        "--tolerances",
+        str(tol),
+        "--samples",
+        "2",
+        "--sobol",
+        "--what-if-samples",
+        "1",
+        "--workers",
+        "1",
+        "--spec",
+        "lost_motion_arcmin<=1.5",
+        *SMOKE,
+        "--out",
+        str(out),
+        "--json",
+    )
     assert res.returncode == 0, res.stderr
     data = json.loads(res.stdout)
     assert data["samples"] == 4 and data["evaluations"] == 8 + 4

@@ -60,8 +60,9 @@ def test_fe_load_resultant_equals_the_bearing_resultant(run_smoke):
     fy = res["needle_force_y"].values[i, 0].sum()
     assert st["resultant_N"] == pytest.approx(np.hypot(fx, fy), rel=1e-9, abs=1e-9)
     assert np.isfinite(st["von_mises_max_Pa"]) and st["von_mises_max_Pa"] > 0
-    assert st["location"] in {"eccentric_1", "eccentric_2", "support_a", "support_b", "gear_seat"} \
-        or st["location"].startswith("shoulder")
+    assert st["location"] in {"eccentric_1", "eccentric_2", "support_a", "support_b", "gear_seat"} or st[
+        "location"
+    ].startswith("shoulder")
 
 
 def test_hertz_and_life_against_closed_forms(run_smoke):
@@ -75,7 +76,7 @@ def test_hertz_and_life_against_closed_forms(run_smoke):
     nb, cs = red.needle_bearing, red.crankshaft
     d, L, D = nb.roller_diameter_mm * 1e-3, nb.roller_length_mm * 1e-3, cs.eccentric_journal_diameter_mm * 1e-3
     mat = red.material("crankshaft")
-    e_star = mat.youngs_modulus / (2.0 * (1.0 - mat.poisson_ratio ** 2))
+    e_star = mat.youngs_modulus / (2.0 * (1.0 - mat.poisson_ratio**2))
     r_eff = 1.0 / (2.0 / d + 2.0 / D)
     b = np.sqrt(4.0 * F * r_eff / (np.pi * L * e_star))
     assert hl["hertz_half_width_m"] == pytest.approx(b, rel=1e-9)

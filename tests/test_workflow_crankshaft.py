@@ -35,7 +35,12 @@ def test_table4_frequencies_follow_from_the_kinematics():
     f_in = 1215.0 / 60.0
     f_out = f_in / 81.0
     f_crank = (f_in - f_out) * 16 / 32
-    ours = {"input shaft": f_in, "crank rotation": f_crank, "carrier (crank revolution)": f_out,
-            "first-stage mesh": 16 * (f_in - f_out), "cycloid mesh": 39 * f_crank}
+    ours = {
+        "input shaft": f_in,
+        "crank rotation": f_crank,
+        "carrier (crank revolution)": f_out,
+        "first-stage mesh": 16 * (f_in - f_out),
+        "cycloid mesh": 39 * f_crank,
+    }
     for name, value in ours.items():
         assert SEED_TABLE4[name] == pytest.approx(value, rel=0.01), name

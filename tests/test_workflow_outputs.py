@@ -48,8 +48,19 @@ def test_summary_has_references_and_formatted_numbers():
     assert "| 1235 | 3 |" in text
 
 
-@pytest.mark.parametrize("value, cell", [(6214726455202.804, "6.215e+12"), (0.0, "0"), (1e-5, "1.000e-05"),
-                                         (12.3456, "12.35"), (17138.2, "17138"), (None, "–"), (7, "7"), ("1 .. 2", "1 .. 2")])
+@pytest.mark.parametrize(
+    "value, cell",
+    [
+        (6214726455202.804, "6.215e+12"),
+        (0.0, "0"),
+        (1e-5, "1.000e-05"),
+        (12.3456, "12.35"),
+        (17138.2, "17138"),
+        (None, "–"),
+        (7, "7"),
+        ("1 .. 2", "1 .. 2"),
+    ],
+)
 def test_fmt(value, cell):
     assert wc._fmt(value) == cell
 

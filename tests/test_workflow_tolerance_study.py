@@ -29,8 +29,9 @@ def test_what_if_entries_restrict_the_cases():
     _, full = plan_cases(StudyConfig(design="rv40e", tolerances="rv40e", samples=5, what_if_samples=3), red, tol)
     assert [c[4] for c in full["cases"][:5]] == [c[4] for c in cases[:5]]
     with pytest.raises(InputError, match="pins.no_such_um"):
-        plan_cases(StudyConfig(design="rv40e", tolerances="rv40e", samples=5, what_if_entries=["pins.no_such_um"]),
-                   red, tol)
+        plan_cases(
+            StudyConfig(design="rv40e", tolerances="rv40e", samples=5, what_if_entries=["pins.no_such_um"]), red, tol
+        )
 
 
 @pytest.mark.slow

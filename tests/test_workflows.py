@@ -52,8 +52,14 @@ def test_kinematic_validation(kinematic):
     n = kinematic.numbers
     assert n["rv40e"]["ratio_theory"] == pytest.approx(81.0, rel=1e-12)
     assert abs(n["rv40e"]["ratio_simulated"] / n["rv40e"]["ratio_theory"] - 1) < 5e-4
-    seed = {"input": 20.25, "crank_rotation": 10.0, "carrier": 0.25, "first_stage_mesh": 320.0,
-            "cycloid_mesh": 390.0, "pins_x_crank_rotation": 400.0}
+    seed = {
+        "input": 20.25,
+        "crank_rotation": 10.0,
+        "carrier": 0.25,
+        "first_stage_mesh": 320.0,
+        "cycloid_mesh": 390.0,
+        "pins_x_crank_rotation": 400.0,
+    }
     for key, val in seed.items():
         assert n["rv40e_frequencies_hz"][key] == pytest.approx(val, rel=1e-9), key
     planet = n["rv221_planet_deg_s"]
@@ -173,7 +179,7 @@ def test_crankshaft_flexibility_smoke(tmp_path):
     r = run(tmp_path / "crankshaft_flexibility", smoke=True)
     for c in r.comparisons:
         if c.quantity.endswith("frequency"):
-            assert c.flexrv == pytest.approx(SEED_TABLE4[c.quantity[:-len(" frequency")]], rel=1e-3)
+            assert c.flexrv == pytest.approx(SEED_TABLE4[c.quantity[: -len(" frequency")]], rel=1e-3)
     labels = [row["line"] for row in r.numbers["lines"]]
     assert "3 x crank rotation" in labels and "cycloid mesh" in labels
     assert (tmp_path / "crankshaft_flexibility" / "te_spectra_table4.png").exists()
@@ -211,9 +217,9 @@ def test_crank_bearing_forces_smoke(tmp_path):
 def test_crank_bearing_sweep_reports_invalid_eccentricities():
     """The seed's 2.0 mm on the RV-40E (R_p = 64 mm, 40 pins) makes K1 = 1.25 > 1:
     the workflow's design step rejects it with the physics reason."""
+    from flexrv.design import load
     from flexrv.errors import ConfigError
     from flexrv.workflows.crank_bearing_forces import _design
-    from flexrv.design import load
 
     with pytest.raises(ConfigError, match="K1"):
         _design(load("rv40e"), 2.0)

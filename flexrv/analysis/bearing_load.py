@@ -72,9 +72,18 @@ def _row_setup(geom, rows):
     return z_rows, sides
 
 
-def ball_load_distribution(geom, e_eff: float, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0), rows=None,
-                           preload: float | None = None, free=(True, True, True, True, True), u0=None,
-                           tol: float = 1e-9, max_iter: int = 200) -> BallLoadResult:
+def ball_load_distribution(
+    geom,
+    e_eff: float,
+    force=(0.0, 0.0, 0.0),
+    moment=(0.0, 0.0),
+    rows=None,
+    preload: float | None = None,
+    free=(True, True, True, True, True),
+    u0=None,
+    tol: float = 1e-9,
+    max_iter: int = 200,
+) -> BallLoadResult:
     """Quasi-static ball loads of the rigid-ring bearing under external loads on
     the inner ring (see module docstring).
 
@@ -97,7 +106,9 @@ def ball_load_distribution(geom, e_eff: float, force=(0.0, 0.0, 0.0), moment=(0.
     force = np.asarray(force, dtype=float)
     moment = np.asarray(moment, dtype=float)
     if force.shape != (3,) or moment.shape != (2,) or not (np.all(np.isfinite(force)) and np.all(np.isfinite(moment))):
-        raise InputError(f"force must be 3 finite values [N] and moment 2 finite values [N m], got {force!r}, {moment!r}")
+        raise InputError(
+            f"force must be 3 finite values [N] and moment 2 finite values [N m], got {force!r}, {moment!r}"
+        )
     z_rows, sides = _row_setup(geom, rows)
     pre = geom.axial_preload if preload is None else float(preload)
     d, a0 = geom.ball_diameter, geom.contact_angle
@@ -133,8 +144,9 @@ def ball_load_distribution(geom, e_eff: float, force=(0.0, 0.0, 0.0), moment=(0.
         fx, fy, fz = -g * vx, -g * vy, -g * vz
         mx = py * fz - pz * fy
         my = pz * fx - px * fz
-        res = np.array([force[0] + fx.sum(), force[1] + fy.sum(), force[2] + fz.sum(),
-                        moment[0] + mx.sum(), moment[1] + my.sum()])
+        res = np.array(
+            [force[0] + fx.sum(), force[1] + fy.sum(), force[2] + fz.sum(), moment[0] + mx.sum(), moment[1] + my.sum()]
+        )
         # Jacobian
         h = (dq - g) / ad**2
         dg1, dg2 = h * a1, h * a2
@@ -195,14 +207,26 @@ def ball_load_distribution(geom, e_eff: float, force=(0.0, 0.0, 0.0), moment=(0.
         res, jac, *_ = state(u, kn)
         norm = np.linalg.norm((res * scale_r)[free])
     if not norm < tol * load_scale:
-        raise ConvergenceError(f"ball_load_distribution: equilibrium residual {norm:.3g} N after {it} Newton "
-                               f"iterations (load scale {load_scale:.3g} N); the load may not be supportable "
-                               "by the selected rows/free directions")
+        raise ConvergenceError(
+            f"ball_load_distribution: equilibrium residual {norm:.3g} N after {it} Newton "
+            f"iterations (load scale {load_scale:.3g} N); the load may not be supportable "
+            "by the selected rows/free directions"
+        )
     res, jac, q, alpha, delta, row_f = state(u, kn)
     idx = np.unravel_index(int(np.argmax(q)), q.shape)
-    return BallLoadResult(displacement=u, loads=q, contact_angle=alpha, approach=delta, azimuth=psi,
-                          stiffness_constant=kn, max_load=float(q[idx]), max_index=(int(idx[0]), int(idx[1])),
-                          row_forces=row_f, residual=float(np.max(np.abs(res[free]))), iterations=it)
+    return BallLoadResult(
+        displacement=u,
+        loads=q,
+        contact_angle=alpha,
+        approach=delta,
+        azimuth=psi,
+        stiffness_constant=kn,
+        max_load=float(q[idx]),
+        max_index=(int(idx[0]), int(idx[1])),
+        row_forces=row_f,
+        residual=float(np.max(np.abs(res[free]))),
+        iterations=it,
+    )
 
 
 def stribeck_max_load(radial_force, ball_count, contact_angle):

@@ -26,7 +26,9 @@ def l10(dynamic_rating, equivalent_load, kind: str = "ball"):
     c = np.asarray(dynamic_rating, dtype=float)
     load = np.asarray(equivalent_load, dtype=float)
     if np.any(c <= 0) or np.any(load < 0) or not (np.all(np.isfinite(c)) and np.all(np.isfinite(load))):
-        raise InputError(f"dynamic rating must be > 0 and load >= 0, got C = {dynamic_rating!r}, P = {equivalent_load!r}")
+        raise InputError(
+            f"dynamic rating must be > 0 and load >= 0, got C = {dynamic_rating!r}, P = {equivalent_load!r}"
+        )
     with np.errstate(divide="ignore"):
         return np.where(load > 0, (c / np.where(load > 0, load, 1.0)) ** p, np.inf)
 
@@ -56,12 +58,27 @@ def geometry_factor_fc(gamma, inner_conformity: float, outer_conformity: float, 
     if not 0 < g < 1 or fi <= 0.5 or fo <= 0.5:
         raise InputError(f"gamma = {gamma} must lie in (0, 1) and conformities must be > 0.5")
     bracket = 1.0 + (1.04 * ((1 - g) / (1 + g)) ** 1.72 * (fi * (2 * fo - 1) / (fo * (2 * fi - 1))) ** 0.41) ** (10 / 3)
-    return (39.9 * reduction * bracket ** -0.3 * g**0.3 * (1 - g) ** 1.39 / (1 + g) ** (1 / 3)
-            * (2 * fi / (2 * fi - 1)) ** 0.41)
+    return (
+        39.9
+        * reduction
+        * bracket**-0.3
+        * g**0.3
+        * (1 - g) ** 1.39
+        / (1 + g) ** (1 / 3)
+        * (2 * fi / (2 * fi - 1)) ** 0.41
+    )
 
 
-def ball_dynamic_rating(ball_diameter: float, pitch_diameter: float, ball_count: int, contact_angle: float,
-                        inner_conformity: float, outer_conformity: float, rows: int = 1, b_m: float = B_M_BALL):
+def ball_dynamic_rating(
+    ball_diameter: float,
+    pitch_diameter: float,
+    ball_count: int,
+    contact_angle: float,
+    inner_conformity: float,
+    outer_conformity: float,
+    rows: int = 1,
+    b_m: float = B_M_BALL,
+):
     """Basic dynamic radial load rating C_r [N] of a radial/angular contact ball
     bearing (ISO 281:2007 eqs. 2-3, N and mm inside):
 
@@ -78,8 +95,16 @@ def ball_dynamic_rating(ball_diameter: float, pitch_diameter: float, ball_count:
 
 
 #: ISO 281:2007 Table 3, single-row angular contact ball bearings: (alpha_deg, e, X, Y).
-_ISO281_XY = np.array([[20, 0.57, 0.43, 1.00], [25, 0.68, 0.41, 0.87], [30, 0.80, 0.39, 0.76],
-                       [35, 0.95, 0.37, 0.66], [40, 1.14, 0.35, 0.57], [45, 1.34, 0.33, 0.50]])
+_ISO281_XY = np.array(
+    [
+        [20, 0.57, 0.43, 1.00],
+        [25, 0.68, 0.41, 0.87],
+        [30, 0.80, 0.39, 0.76],
+        [35, 0.95, 0.37, 0.66],
+        [40, 1.14, 0.35, 0.57],
+        [45, 1.34, 0.33, 0.50],
+    ]
+)
 
 
 def equivalent_radial_load(radial, axial, contact_angle):
@@ -115,18 +140,34 @@ def line_contact_fc(gamma, lambda_nu: float = 0.83):
     if np.any((g <= 0) | (g >= 1)):
         raise InputError(f"gamma = {gamma!r} must lie in (0, 1)")
     ratio = (1.0 - g) / (1.0 + g)
-    return (207.9 * lambda_nu * g ** (2.0 / 9.0) * (1.0 - g) ** (29.0 / 27.0) * (1.0 + g) ** -0.25
-            * (1.0 + (1.04 * ratio ** (143.0 / 108.0)) ** 4.5) ** (-2.0 / 9.0))
+    return (
+        207.9
+        * lambda_nu
+        * g ** (2.0 / 9.0)
+        * (1.0 - g) ** (29.0 / 27.0)
+        * (1.0 + g) ** -0.25
+        * (1.0 + (1.04 * ratio ** (143.0 / 108.0)) ** 4.5) ** (-2.0 / 9.0)
+    )
 
 
-def roller_dynamic_rating(roller_diameter: float, roller_length: float, roller_count: int, pitch_diameter: float,
-                          rows: int = 1, contact_angle: float = 0.0, b_m: float = 1.1) -> float:
+def roller_dynamic_rating(
+    roller_diameter: float,
+    roller_length: float,
+    roller_count: int,
+    pitch_diameter: float,
+    rows: int = 1,
+    contact_angle: float = 0.0,
+    b_m: float = 1.1,
+) -> float:
     """Basic dynamic radial load rating C_r [N] of a roller (needle) bearing,
     ISO 281:2007: C_r = b_m f_c (i L_we cos a)^(7/9) Z^(3/4) D_we^(29/27) with lengths
     in mm; b_m = 1.1 (needle roller bearings with machined raceways; the crank's
     eccentric and the disc's bore are the raceways). Inputs in SI [m]."""
-    for name, v in (("roller_diameter", roller_diameter), ("roller_length", roller_length),
-                    ("pitch_diameter", pitch_diameter)):
+    for name, v in (
+        ("roller_diameter", roller_diameter),
+        ("roller_length", roller_length),
+        ("pitch_diameter", pitch_diameter),
+    ):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} m must be > 0")
     if roller_count < 1 or rows < 1:
@@ -134,4 +175,4 @@ def roller_dynamic_rating(roller_diameter: float, roller_length: float, roller_c
     d_mm, l_mm = 1e3 * roller_diameter, 1e3 * roller_length
     c = math.cos(contact_angle)
     fc = float(line_contact_fc(roller_diameter * c / pitch_diameter))
-    return b_m * fc * (rows * l_mm * c) ** (7.0 / 9.0) * roller_count ** 0.75 * d_mm ** (29.0 / 27.0)
+    return b_m * fc * (rows * l_mm * c) ** (7.0 / 9.0) * roller_count**0.75 * d_mm ** (29.0 / 27.0)

@@ -46,8 +46,17 @@ def basic_rack_factor(alpha, dedendum_coefficient: float = 1.25):
     return (1.0 + 0.5 * (1.2 - dedendum_coefficient)) * (1.0 - 0.02 * (20.0 - alpha_deg))
 
 
-def single_tooth_stiffness(z1, z2, x1, x2, alpha, helix_angle: float = 0.0, c_m: float = C_M, c_r: float = 1.0,
-                           dedendum_coefficient: float = 1.25):
+def single_tooth_stiffness(
+    z1,
+    z2,
+    x1,
+    x2,
+    alpha,
+    helix_angle: float = 0.0,
+    c_m: float = C_M,
+    c_r: float = 1.0,
+    dedendum_coefficient: float = 1.25,
+):
     """Single tooth-pair stiffness c' [N/m^2, per unit face width] (ISO 6336-1 method B):
 
     c'_th = 1/q',  c' = c'_th C_M C_R C_B cos(beta),
@@ -182,8 +191,15 @@ def involute_stage(reducer) -> InvoluteStage:
     a solid steel disc of pitch radius and face width, rho pi b r^4 / 2 (estimate;
     the crankshaft's inertia is not included)."""
     fs = reducer.first_stage
-    z1, z2, m, al, x1, x2, b = (fs.sun_teeth, fs.planet_teeth, fs.module, fs.pressure_angle,
-                                fs.sun_profile_shift, fs.planet_profile_shift, fs.face_width)
+    z1, z2, m, al, x1, x2, b = (
+        fs.sun_teeth,
+        fs.planet_teeth,
+        fs.module,
+        fs.pressure_angle,
+        fs.sun_profile_shift,
+        fs.planet_profile_shift,
+        fs.face_width,
+    )
     eps = float(contact_ratio(z1, z2, m, al, x1, x2))
     q = float(min_flexibility(z1, z2, x1, x2))
     c_s = float(single_tooth_stiffness(z1, z2, x1, x2, al))
@@ -193,6 +209,17 @@ def involute_stage(reducer) -> InvoluteStage:
     j2 = rho * math.pi * b * (0.5 * m * z2) ** 4 / 2.0
     k12 = c_g * b
     c12 = float(mesh_damping(k12, rb1, rb2, reducer.inertia.input_shaft_inertia_kg_m2, j2, fs.mesh_damping_ratio))
-    return InvoluteStage(eps_alpha=eps, q_min=q, c_th=ISO_UNIT / q, c_single=c_s, c_gamma=c_g, k_single=c_s * b,
-                         k12=k12, c12=c12, rb_sun=rb1, rb_planet=rb2,
-                         center_distance=float(working_center_distance(z1, z2, m, al, x1, x2)), planet_inertia=j2)
+    return InvoluteStage(
+        eps_alpha=eps,
+        q_min=q,
+        c_th=ISO_UNIT / q,
+        c_single=c_s,
+        c_gamma=c_g,
+        k_single=c_s * b,
+        k12=k12,
+        c12=c12,
+        rb_sun=rb1,
+        rb_planet=rb2,
+        center_distance=float(working_center_distance(z1, z2, m, al, x1, x2)),
+        planet_inertia=j2,
+    )

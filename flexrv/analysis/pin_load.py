@@ -48,10 +48,15 @@ from scipy.optimize import brentq
 
 from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact, line_contact_stiffness
 from flexrv.errors import ConvergenceError, InputError
-from flexrv.units import M_PER_MM
 from flexrv.geometry.as_built import as_built, as_built_pin_gap
-from flexrv.geometry.cycloid import (nominal_disc_pose, pin_positions, pin_stiffness_seed000, profile_curvature_radius,
-                                     to_disc_frame)
+from flexrv.geometry.cycloid import (
+    nominal_disc_pose,
+    pin_positions,
+    pin_stiffness_seed000,
+    profile_curvature_radius,
+    to_disc_frame,
+)
+from flexrv.units import M_PER_MM
 
 
 @dataclass(frozen=True)
@@ -98,10 +103,25 @@ def _law(law: str, width: float, e_eff: float):
     raise InputError(f"law = {law!r} must be 'palmgren' or 'linear'")
 
 
-def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
-                          width: float, e_eff: float, d_radius: float = 0.0, d_pin_radius: float = 0.0,
-                          d_rotation: float = 0.0, crank_angle: float = 0.0, law: str = "palmgren", *,
-                          pins=None, pin_radii=None, harmonics=None, stiffness_constant: float | None = None) -> PinLoadResult:
+def pin_load_distribution(
+    torque,
+    z_rp: int,
+    pin_circle_radius: float,
+    pin_radius: float,
+    eccentricity: float,
+    width: float,
+    e_eff: float,
+    d_radius: float = 0.0,
+    d_pin_radius: float = 0.0,
+    d_rotation: float = 0.0,
+    crank_angle: float = 0.0,
+    law: str = "palmgren",
+    *,
+    pins=None,
+    pin_radii=None,
+    harmonics=None,
+    stiffness_constant: float | None = None,
+) -> PinLoadResult:
     """Pin forces of one disc under the disc torque ``torque`` [N m] (see module
     docstring for the method and the laws).
 
@@ -144,7 +164,9 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
     pins_h = pin_positions(z_rp, pin_circle_radius) if pins is None else np.asarray(pins, dtype=float)
     radii = np.full(z_rp, float(pin_radius)) if pin_radii is None else np.asarray(pin_radii, dtype=float)
     if pins_h.shape != (z_rp, 2) or radii.shape != (z_rp,):
-        raise InputError(f"pins must have shape ({z_rp}, 2) and pin_radii ({z_rp},), got {pins_h.shape} and {radii.shape}")
+        raise InputError(
+            f"pins must have shape ({z_rp}, 2) and pin_radii ({z_rp},), got {pins_h.shape} and {radii.shape}"
+        )
     if not (np.all(np.isfinite(pins_h)) and np.all(np.isfinite(radii)) and np.all(radii > 0)):
         raise InputError("pins and pin_radii must be finite, pin_radii > 0")
     if harmonics is not None:
@@ -157,8 +179,9 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
         """Exact gaps, normals, foot points and arms with the disc turned on by
         sign * beta from the nominal pose."""
         p = to_disc_frame(pins_h, center, rot + sign * beta)
-        gap, normal, phi = as_built_pin_gap(p, radii, z_rp, pin_circle_radius, pin_radius, eccentricity, profile,
-                                            harmonics, phi0=phi0)
+        gap, normal, phi = as_built_pin_gap(
+            p, radii, z_rp, pin_circle_radius, pin_radius, eccentricity, profile, harmonics, phi0=phi0
+        )
         return gap, normal, phi, p[:, 0] * normal[:, 1] - p[:, 1] * normal[:, 0]
 
     # no-load pose: first contact, Newton steps on the exact gaps
@@ -214,14 +237,31 @@ def pin_load_distribution(torque, z_rp: int, pin_circle_radius: float, pin_radiu
     p_max = 0.0
     if forces[imax] > 0:
         # curvature of the modified profile (the error harmonics' own curvature is neglected)
-        rho = float(profile_curvature_radius(phi[imax], z_rp, pin_circle_radius, pin_radius, eccentricity,
-                                             d_radius, d_pin_radius))
+        rho = float(
+            profile_curvature_radius(
+                phi[imax], z_rp, pin_circle_radius, pin_radius, eccentricity, d_radius, d_pin_radius
+            )
+        )
         r_eff = 1.0 / (1.0 / radii[imax] + 1.0 / rho)
         p_max = float(line_contact(forces[imax], width, r_eff, e_eff).p_max)
-    return PinLoadResult(torque=torque, rotation=sign * beta, forces=forces, clearance=gap, arms=arms, approach=w,
-                         in_contact=contact, n_contact=int(contact.sum()), max_force=float(forces[imax]),
-                         max_pressure=p_max, torsional_stiffness=stiffness, backlash_rotation=sign * max(beta0, 0.0),
-                         resultant=resultant, law=law, exponent=e, stiffness_constant=k)
+    return PinLoadResult(
+        torque=torque,
+        rotation=sign * beta,
+        forces=forces,
+        clearance=gap,
+        arms=arms,
+        approach=w,
+        in_contact=contact,
+        n_contact=int(contact.sum()),
+        max_force=float(forces[imax]),
+        max_pressure=p_max,
+        torsional_stiffness=stiffness,
+        backlash_rotation=sign * max(beta0, 0.0),
+        resultant=resultant,
+        law=law,
+        exponent=e,
+        stiffness_constant=k,
+    )
 
 
 def disc_effective_modulus(reducer) -> float:
@@ -230,9 +270,15 @@ def disc_effective_modulus(reducer) -> float:
     return float(effective_modulus(d.youngs_modulus, d.poisson_ratio, p.youngs_modulus, p.poisson_ratio))
 
 
-def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, law: str = "palmgren",
-                      d_pin_radius: float | None = None, disc: int = 0,
-                      stiffness_constant: float | None = None) -> PinLoadResult:
+def reducer_pin_loads(
+    reducer,
+    output_torque: float,
+    crank_angle: float = 0.0,
+    law: str = "palmgren",
+    d_pin_radius: float | None = None,
+    disc: int = 0,
+    stiffness_constant: float | None = None,
+) -> PinLoadResult:
     """Pin load distribution of disc ``disc`` of a design under the OUTPUT torque
     [N m], shared equally by the n_discs discs (rigid cranks): T_disc = T / n_discs.
 
@@ -253,11 +299,24 @@ def reducer_pin_loads(reducer, output_torque: float, crank_angle: float = 0.0, l
     d_radius, dr, d_rot = (float(v) for v in ab.disc_profile[disc])
     if d_pin_radius is not None:
         dr = d_pin_radius + (dr - ss.modification_equidistant)
-    return pin_load_distribution(output_torque / ss.n_discs, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
-                                 ss.eccentricity, ss.disc_width, disc_effective_modulus(reducer),
-                                 d_radius, dr, d_rot, crank_angle + float(ab.chi0[disc]), law,
-                                 pins=ab.pins, pin_radii=ab.pin_radii, harmonics=ab.profile_harmonics[disc],
-                                 stiffness_constant=stiffness_constant)
+    return pin_load_distribution(
+        output_torque / ss.n_discs,
+        ss.pin_count,
+        ss.pin_circle_radius,
+        ss.pin_radius,
+        ss.eccentricity,
+        ss.disc_width,
+        disc_effective_modulus(reducer),
+        d_radius,
+        dr,
+        d_rot,
+        crank_angle + float(ab.chi0[disc]),
+        law,
+        pins=ab.pins,
+        pin_radii=ab.pin_radii,
+        harmonics=ab.profile_harmonics[disc],
+        stiffness_constant=stiffness_constant,
+    )
 
 
 def shear_coefficient(nu: float) -> float:
@@ -277,13 +336,16 @@ def pin_bending_stiffness(span: float, radius: float, youngs_modulus: float, poi
 
     ``span`` = 0 (a fully supported pin) gives inf."""
     if not (np.isfinite(span) and span >= 0 and radius > 0 and youngs_modulus > 0 and 0 <= poisson_ratio < 0.5):
-        raise InputError(f"span = {span!r} m must be >= 0, radius = {radius!r} m and youngs_modulus > 0, "
-                         f"0 <= poisson_ratio < 0.5")
+        raise InputError(
+            f"span = {span!r} m must be >= 0, radius = {radius!r} m and youngs_modulus > 0, 0 <= poisson_ratio < 0.5"
+        )
     if span == 0:
         return float("inf")
     g_mod = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
     area, inertia = np.pi * radius**2, 0.25 * np.pi * radius**4
-    return 1.0 / (span**3 / (48.0 * youngs_modulus * inertia) + span / (4.0 * shear_coefficient(poisson_ratio) * g_mod * area))
+    return 1.0 / (
+        span**3 / (48.0 * youngs_modulus * inertia) + span / (4.0 * shear_coefficient(poisson_ratio) * g_mod * area)
+    )
 
 
 @dataclass(frozen=True)
@@ -337,9 +399,16 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     n = LINE_EXPONENT
     k_disc = float(line_contact_stiffness(ss.disc_width, disc_effective_modulus(reducer)))
     if h is None:
-        return PinContactConstant(k=k_disc, exponent=n, k_disc=k_disc, k_seat=float("inf"), k_bending=float("inf"),
-                                  reference_load=float("nan"), seat_semi_angle=float("nan"),
-                                  shares={"pins": 1.0, "pin_seats": 0.0, "pin_bending": 0.0})
+        return PinContactConstant(
+            k=k_disc,
+            exponent=n,
+            k_disc=k_disc,
+            k_seat=float("inf"),
+            k_bending=float("inf"),
+            reference_load=float("nan"),
+            seat_semi_angle=float("nan"),
+            shares={"pins": 1.0, "pin_seats": 0.0, "pin_bending": 0.0},
+        )
     mp, mh = reducer.material("pins"), reducer.material("housing")
     e_seat = float(effective_modulus(mp.youngs_modulus, mp.poisson_ratio, mh.youngs_modulus, mh.poisson_ratio))
     length = M_PER_MM * h.pin_seat_length_mm / ss.n_discs
@@ -348,16 +417,25 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     from flexrv.design.manufacturing import nominal_design
 
     # Q_ref of the design without its errors (a design-level constant, shared by every error set)
-    q_ref = reducer_pin_loads(nominal_design(reducer), reducer.operating.rated_torque_Nm,
-                              stiffness_constant=k_contacts).max_force
+    q_ref = reducer_pin_loads(
+        nominal_design(reducer), reducer.operating.rated_torque_Nm, stiffness_constant=k_contacts
+    ).max_force
     _, semi = conformal_line_contact(q_ref, length, ss.pin_radius, ss.pin_radius + h.pin_seat_clearance, e_seat)
-    k_bend = pin_bending_stiffness(M_PER_MM * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus,
-                                   mp.poisson_ratio)
+    k_bend = pin_bending_stiffness(
+        M_PER_MM * h.pin_unsupported_length_mm, ss.pin_radius, mp.youngs_modulus, mp.poisson_ratio
+    )
     # tangent compliances at Q_ref: power law delta / (n Q), linear spring 1 / k
     d_disc, d_seat = (q_ref / k_disc) ** (1.0 / n), (q_ref / k_seat) ** (1.0 / n)
     c = {"pins": d_disc / (n * q_ref), "pin_seats": d_seat / (n * q_ref), "pin_bending": 1.0 / k_bend}
     k = k_contacts if np.isinf(k_bend) else q_ref / (d_disc + d_seat + q_ref / k_bend) ** n
     total = sum(c.values())
-    return PinContactConstant(k=float(k), exponent=n, k_disc=k_disc, k_seat=k_seat, k_bending=float(k_bend),
-                              reference_load=float(q_ref), seat_semi_angle=float(semi),
-                              shares={key: v / total for key, v in c.items()})
+    return PinContactConstant(
+        k=float(k),
+        exponent=n,
+        k_disc=k_disc,
+        k_seat=k_seat,
+        k_bending=float(k_bend),
+        reference_load=float(q_ref),
+        seat_semi_angle=float(semi),
+        shares={key: v / total for key, v in c.items()},
+    )

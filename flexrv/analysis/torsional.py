@@ -56,8 +56,9 @@ def needle_radial_stiffness(radial_force, roller_count, roller_length, contact_a
     if np.any(np.asarray(roller_length) <= 0) or np.any(np.asarray(roller_count) <= 0):
         raise InputError("roller_count and roller_length must be > 0")
     l_mm = np.asarray(roller_length, dtype=float) * 1e3
-    k_n_per_mm = NEEDLE_COEFF * f**0.1 * np.asarray(roller_count, dtype=float) ** 0.9 * l_mm**0.8 \
-        * np.cos(contact_angle) ** 1.9
+    k_n_per_mm = (
+        NEEDLE_COEFF * f**0.1 * np.asarray(roller_count, dtype=float) ** 0.9 * l_mm**0.8 * np.cos(contact_angle) ** 1.9
+    )
     return k_n_per_mm * 1e3
 
 
@@ -124,8 +125,10 @@ def required_mesh_stiffness(measured, bearing):
     Raises InputError if C_W >= C_Hc (no positive mesh stiffness explains the
     measurement)."""
     if measured <= 0 or bearing <= measured:
-        raise InputError(f"measured stiffness {measured:.4g} N m/rad must be > 0 and below the bearing "
-                         f"stiffness C_Hc = {bearing:.4g} N m/rad")
+        raise InputError(
+            f"measured stiffness {measured:.4g} N m/rad must be > 0 and below the bearing "
+            f"stiffness C_Hc = {bearing:.4g} N m/rad"
+        )
     return 1.0 / (1.0 / measured - 1.0 / bearing)
 
 
@@ -174,16 +177,50 @@ def identify_meshing_zone(contributions, target, phase_angles=None, n_pins: int 
     cand = np.flatnonzero(sizes == n_pins) if n_pins else np.arange(len(totals))
     b = cand[np.argmin(np.abs(totals[cand] - target))]
     first, last = int(i[b]) + 1, int(j[b])
-    ang = (float("nan"), float("nan")) if phase_angles is None else (float(phase_angles[first - 1]),
-                                                                       float(phase_angles[last - 1]))
-    return MeshingZone(target=float(target), first=first, last=last, n_pins=last - first + 1, total=float(totals[b]),
-                       rel_error=float((totals[b] - target) / target), angles=ang, best_by_count=best_by)
+    ang = (
+        (float("nan"), float("nan"))
+        if phase_angles is None
+        else (float(phase_angles[first - 1]), float(phase_angles[last - 1]))
+    )
+    return MeshingZone(
+        target=float(target),
+        first=first,
+        last=last,
+        n_pins=last - first + 1,
+        total=float(totals[b]),
+        rel_error=float((totals[b] - target) / target),
+        angles=ang,
+        best_by_count=best_by,
+    )
 
 
 #: :cite:`seed004` table: single-point equivalent torsional stiffness KTC_j [N mm/rad]
 #: of pins 1..21 at meshing phase 0, 9, ..., 180 deg (RV-40E, two discs).
-SEED004_KTC_NMM = np.array([0.0, 2.20e6, 1.97e7, 1.33e8, 1.84e8, 1.76e8, 1.66e8, 1.52e8, 1.38e8, 1.22e8, 1.06e8,
-                            8.93e7, 7.33e7, 5.79e7, 4.38e7, 3.12e7, 2.03e7, 1.16e7, 5.25e6, 1.33e6, 0.0])
+SEED004_KTC_NMM = np.array(
+    [
+        0.0,
+        2.20e6,
+        1.97e7,
+        1.33e8,
+        1.84e8,
+        1.76e8,
+        1.66e8,
+        1.52e8,
+        1.38e8,
+        1.22e8,
+        1.06e8,
+        8.93e7,
+        7.33e7,
+        5.79e7,
+        4.38e7,
+        3.12e7,
+        2.03e7,
+        1.16e7,
+        5.25e6,
+        1.33e6,
+        0.0,
+    ]
+)
 #: :cite:`seed004`: measured C_W = 3.06e8 N mm/rad and derived C_c = 6.24e8 N mm/rad.
 SEED004_CW_NMM = 3.06e8
 SEED004_CC_NMM = 6.24e8
@@ -238,8 +275,9 @@ def seed004_pin_contributions(reducer, n_pins: int | None = None):
     return th, np.nan_to_num(ss.n_discs * k * arms**2)
 
 
-def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0.0,
-                           first_hole_angle: float = 0.0) -> SecondStageStiffness:
+def second_stage_stiffness(
+    reducer, output_torque: float, crank_angle: float = 0.0, first_hole_angle: float = 0.0
+) -> SecondStageStiffness:
     """:cite:`seed004` series model evaluated for a design under ``output_torque`` [N m]:
     pin loads (initial-clearance method, :mod:`flexrv.analysis.pin_load`) give the
     pin resultant and the loaded pins; the crank-bearing forces
@@ -265,10 +303,18 @@ def second_stage_stiffness(reducer, output_torque: float, crank_angle: float = 0
         k_c = np.nan_to_num(pin_stiffness_seed004(rho, ss.pin_radius, ss.disc_width, disc_effective_modulus(reducer)))
     c_c_seed = float(mesh_torsional_stiffness(k_c, res.arms, ss.n_discs, res.in_contact))
     c_c_tan = ss.n_discs * res.torsional_stiffness
-    return SecondStageStiffness(bearing_forces=forces, bearing_loads=loads, bearing_stiffness=k_hc, lever_arm=a_w,
-                                c_bearings=c_hc, c_mesh_seed=c_c_seed, c_mesh_tangent=c_c_tan,
-                                c_w_seed=float(series_stiffness(c_hc, c_c_seed)),
-                                c_w_tangent=float(series_stiffness(c_hc, c_c_tan)), n_contact=res.n_contact)
+    return SecondStageStiffness(
+        bearing_forces=forces,
+        bearing_loads=loads,
+        bearing_stiffness=k_hc,
+        lever_arm=a_w,
+        c_bearings=c_hc,
+        c_mesh_seed=c_c_seed,
+        c_mesh_tangent=c_c_tan,
+        c_w_seed=float(series_stiffness(c_hc, c_c_seed)),
+        c_w_tangent=float(series_stiffness(c_hc, c_c_tan)),
+        n_contact=res.n_contact,
+    )
 
 
 # --------------------------------------------------------------------------- crank bending and supports
@@ -332,9 +378,12 @@ def stepped_shaft_bending(segments, youngs_modulus: float, poisson_ratio: float)
         m = np.array([np.where(z <= a, (1.0 - a / span) * z, a * (1.0 - z / span)) for a in loads])
         v = np.array([np.where(z <= a, 1.0 - a / span, -a / span) for a in loads])
         c += (m * w) @ m.T / (e_mod * inertia) + (v * w) @ v.T / (kappa * g_mod * area)
-    return CrankBending(compliance=c, k_symmetric=float(4.0 / c.sum()),
-                        k_antisymmetric=float(4.0 / (c[0, 0] + c[1, 1] - 2.0 * c[0, 1])),
-                        positions=(float(z_a), float(z1), float(z2), float(z_b)))
+    return CrankBending(
+        compliance=c,
+        k_symmetric=float(4.0 / c.sum()),
+        k_antisymmetric=float(4.0 / (c[0, 0] + c[1, 1] - 2.0 * c[0, 1])),
+        positions=(float(z_a), float(z1), float(z2), float(z_b)),
+    )
 
 
 def crank_bending(reducer) -> CrankBending:
@@ -349,11 +398,15 @@ def crank_bending(reducer) -> CrankBending:
     tests/test_fem_crank_bending.py."""
     cs = reducer.crankshaft
     mat = reducer.material("crankshaft")
-    segs = [(M_PER_MM * d, M_PER_MM * length) for d, length in (
-        (cs.support_journal_diameter_mm, cs.support_journal_length_mm),
-        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
-        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
-        (cs.support_journal_diameter_mm, cs.support_journal_length_mm))]
+    segs = [
+        (M_PER_MM * d, M_PER_MM * length)
+        for d, length in (
+            (cs.support_journal_diameter_mm, cs.support_journal_length_mm),
+            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+            (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm),
+            (cs.support_journal_diameter_mm, cs.support_journal_length_mm),
+        )
+    ]
     return stepped_shaft_bending(segs, mat.youngs_modulus, mat.poisson_ratio)
 
 
@@ -388,11 +441,16 @@ def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
     return sc, 2.0 * np.pi * np.arange(z) / z, False
 
 
-
-
 # --------------------------------------------------------------------------- housing ring
-def ring_displacements(angles, radial, tangential, mean_radius: float, bending_stiffness: float,
-                       axial_stiffness: float, harmonics: int = 400):
+def ring_displacements(
+    angles,
+    radial,
+    tangential,
+    mean_radius: float,
+    bending_stiffness: float,
+    axial_stiffness: float,
+    harmonics: int = 400,
+):
     """Displacements of a thin circular ring under point loads (curved-beam theory,
     Fourier series; Timoshenko & Goodier / Roark's *Formulas for Stress and Strain*,
     ch. 9 thin rings): loads f_r (outward) and f_t (in +theta) at ``angles`` [rad];
@@ -535,8 +593,17 @@ class StiffnessBudget:
 
 
 #: budget element names, shared with the quasi-static model's force groups where they coincide
-BUDGET_ELEMENTS = ("pins", "needle_bearings", "support_bearings", "crank_bending", "pin_seats", "pin_bending",
-                   "housing", "carrier", "cycloid_disc")
+BUDGET_ELEMENTS = (
+    "pins",
+    "needle_bearings",
+    "support_bearings",
+    "crank_bending",
+    "pin_seats",
+    "pin_bending",
+    "housing",
+    "carrier",
+    "cycloid_disc",
+)
 #: budget elements that the dynamic and quasi-static models may lack (:func:`unmodelled_elements`): none since
 #: the housing entered the models (``housing.body_model``); kept for the budgets' "unmodelled" entry
 UNMODELLED_ELEMENTS = ()
@@ -561,8 +628,9 @@ def split_pin_path(compliances: dict, reducer) -> dict:
     return out
 
 
-def budget_from_group_shares(shares: dict, total: float, bending_fraction: float, reducer=None,
-                             torque: float | None = None) -> tuple[dict, tuple]:
+def budget_from_group_shares(
+    shares: dict, total: float, bending_fraction: float, reducer=None, torque: float | None = None
+) -> tuple[dict, tuple]:
     """Budget elements [rad/(N m)] of a model's strain-energy shares
     (:meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`, group -> fraction)
     times its tangent compliance ``total``: the crank-support group (bearings and crank
@@ -603,21 +671,30 @@ def unmodelled_elements(reducer, model_total: float, torque: float | None = None
     if reducer.housing is None:
         return {}, ("housing: no [housing] table, pins rigidly seated, rigid housing",)
     pc = pin_contact_constant(reducer)
-    seat = (f"pin seats: Palmgren line contact in series with the pin-disc contact; the groove's Hertz half-width "
-            f"is {pc.seat_semi_angle:.2g} pin radii at the largest pin load ({pc.reference_load:.4g} N): a conformal "
-            "seat spreads wider and is expected stiffer, so the element is a conservative (compliant) estimate")
+    seat = (
+        f"pin seats: Palmgren line contact in series with the pin-disc contact; the groove's Hertz half-width "
+        f"is {pc.seat_semi_angle:.2g} pin radii at the largest pin load ({pc.reference_load:.4g} N): a conformal "
+        "seat spreads wider and is expected stiffer, so the element is a conservative (compliant) estimate"
+    )
     if reducer.housing.body_model == "ring_estimate":
-        return {}, ("housing: elastic rotation of the pin ring about the axis in every model (thin-ring + tube "
-                    "estimate, energy-equivalent torsional compliance: the ring's ovalisation enters only through "
-                    "its strain energy)", seat)
+        return {}, (
+            "housing: elastic rotation of the pin ring about the axis in every model (thin-ring + tube "
+            "estimate, energy-equivalent torsional compliance: the ring's ovalisation enters only through "
+            "its strain energy)",
+            seat,
+        )
     hc = housing_compliance(reducer, torque)
     share = hc.total / (model_total + hc.total)
-    return {}, (f"housing: rigid (housing.body_model = 'rigid'); its thin-ring estimate would be {100 * share:.3g} % "
-                "of the total", seat)
+    return {}, (
+        f"housing: rigid (housing.body_model = 'rigid'); its thin-ring estimate would be {100 * share:.3g} % "
+        "of the total",
+        seat,
+    )
 
 
-def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
-                     bodies: dict | None = None) -> StiffnessBudget:
+def stiffness_budget(
+    reducer, output_torque: float | None = None, crank_angle: float = 0.0, bodies: dict | None = None
+) -> StiffnessBudget:
     """Torsional compliance of each element of the torque path, in series
     (output carrier held against the housing through the path carrier -> crank
     supports -> crank shaft -> eccentrics -> needle bearings -> discs -> pins):
@@ -695,9 +772,12 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
             k_along = c_emp * fm**0.1
             k_across = fm / (fm**0.9 / (0.9 * c_emp) + clear)
             k_needle += a_w**2 * (k_along * cos2 + k_across * (1.0 - cos2))
-    comp = {"pins": float(1.0 / st.c_mesh_tangent), "needle_bearings": float(1.0 / k_needle),
-            "support_bearings": float(1.0 / (a_w**2 * k_bear)),
-            "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0}
+    comp = {
+        "pins": float(1.0 / st.c_mesh_tangent),
+        "needle_bearings": float(1.0 / k_needle),
+        "support_bearings": float(1.0 / (a_w**2 * k_bear)),
+        "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0,
+    }
     for name in ("carrier", "cycloid_disc"):
         value = (bodies or {}).get(name)
         if value is not None:
@@ -711,6 +791,12 @@ def stiffness_budget(reducer, output_torque: float | None = None, crank_angle: f
     extra, notes = unmodelled_elements(reducer, float(sum(comp.values())), torque)
     comp.update(extra)
     total = float(sum(comp.values()))
-    return StiffnessBudget(compliances=comp, total=total, rigidity=1.0 / total,
-                           shares={k: v / total for k, v in comp.items()}, torque=torque,
-                           support_forces=np.full(n, f_sup), notes=notes)
+    return StiffnessBudget(
+        compliances=comp,
+        total=total,
+        rigidity=1.0 / total,
+        shares={k: v / total for k, v in comp.items()},
+        torque=torque,
+        support_forces=np.full(n, f_sup),
+        notes=notes,
+    )

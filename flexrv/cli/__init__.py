@@ -31,11 +31,17 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
+
 @app.callback()
-def _options(cache_dir: Path = typer.Option(None, "--cache-dir",
-                                            help="Folder of the cached meshes, reduced bodies and EHL maps "
-                                                 "(default: $FLEXRV_CACHE_DIR, else the user cache directory, "
-                                                 "~/.cache/flexrv on Linux).")) -> None:
+def _options(
+    cache_dir: Path = typer.Option(
+        None,
+        "--cache-dir",
+        help="Folder of the cached meshes, reduced bodies and EHL maps "
+        "(default: $FLEXRV_CACHE_DIR, else the user cache directory, "
+        "~/.cache/flexrv on Linux).",
+    ),
+) -> None:
     """Transmission error, stiffness and contact loads of RV reducers (gmsh -> FE -> CMS -> Exudyn)."""
     if cache_dir is not None:
         from flexrv.cache import CACHE_ENV
@@ -95,7 +101,7 @@ def _argv_value(opts, argv: list[str]) -> str | None:
             if arg == opt and i + 1 < len(argv):
                 return argv[i + 1]
             if arg.startswith(opt + "="):
-                return arg[len(opt) + 1:]
+                return arg[len(opt) + 1 :]
     return None
 
 
@@ -109,7 +115,7 @@ def usage_message(exc, argv: list[str]) -> str:
     the value given and what is allowed."""
     ctx = getattr(exc, "ctx", None)
     command = ctx.command_path if ctx is not None else "flexrv"
-    command = "flexrv" + command[command.find(" "):] if " " in command else "flexrv"
+    command = "flexrv" + command[command.find(" ") :] if " " in command else "flexrv"
     kind = type(exc).__name__
     param = getattr(exc, "param", None)
     msg = exc.format_message() if hasattr(exc, "format_message") else str(exc)
@@ -167,8 +173,14 @@ def main(argv: list[str] | None = None) -> None:
         print(exc.format_message(), file=sys.stderr)
         sys.exit(USAGE_EXIT)
     except click_exc as exc:
-        if type(exc).__name__ in ("BadParameter", "MissingParameter", "NoSuchOption", "UsageError",
-                                  "BadOptionUsage", "BadArgumentUsage"):
+        if type(exc).__name__ in (
+            "BadParameter",
+            "MissingParameter",
+            "NoSuchOption",
+            "UsageError",
+            "BadOptionUsage",
+            "BadArgumentUsage",
+        ):
             try:
                 text = usage_message(exc, args)
             except Exception:  # never a traceback for a usage error

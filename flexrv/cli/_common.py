@@ -66,8 +66,32 @@ def render_nested(title: str, data: dict[str, Any]) -> None:
 
 
 #: unit tokens of flexrv's unit-suffixed keys (``max_force_N``, ``C_W_seed004_Nm_per_rad``)
-_UNIT_TOKENS = {"N", "Nm", "Pa", "kPa", "MPa", "GPa", "Hz", "W", "J", "m", "mm", "um", "nm", "s", "ms", "rad",
-                "rpm", "deg", "arcsec", "arcmin", "kg", "m2", "m3", "percent"}
+_UNIT_TOKENS = {
+    "N",
+    "Nm",
+    "Pa",
+    "kPa",
+    "MPa",
+    "GPa",
+    "Hz",
+    "W",
+    "J",
+    "m",
+    "mm",
+    "um",
+    "nm",
+    "s",
+    "ms",
+    "rad",
+    "rpm",
+    "deg",
+    "arcsec",
+    "arcmin",
+    "kg",
+    "m2",
+    "m3",
+    "percent",
+}
 #: suffixes whose plain reading (tokens joined by spaces) is wrong
 _UNIT_SPECIAL = {("m", "s"): "m/s", ("rad", "s"): "rad/s", ("kg", "m3"): "kg/m³", ("mm", "s"): "mm/s"}
 _UNIT_PRETTY = {"Nm": "N m", "um": "µm", "m2": "m²", "m3": "m³", "percent": "%"}
@@ -175,8 +199,9 @@ def check_output_dir(path: Path, option: str = "--out", overwrite: bool = False,
         raise InputError(f"{option} {path}: exists and is not a directory")
     if path.is_dir() and any(path.iterdir()) and not allow_existing:
         if not overwrite:
-            raise InputError(f"{option} {path}: directory exists and is not empty; choose another directory or "
-                             "pass --overwrite")
+            raise InputError(
+                f"{option} {path}: directory exists and is not empty; choose another directory or pass --overwrite"
+            )
         for name in RUN_FILES:
             (path / name).unlink(missing_ok=True)
         for png in path.glob("*.png"):
@@ -192,8 +217,10 @@ def check_output_file(path: Path, option: str, suffixes: tuple[str, ...] = ()) -
 
     path = Path(path)
     if path.is_dir():
-        raise InputError(f"{option} {path}: is a directory; give a file name" +
-                         (f" ending in {'/'.join(suffixes)}" if suffixes else ""))
+        raise InputError(
+            f"{option} {path}: is a directory; give a file name"
+            + (f" ending in {'/'.join(suffixes)}" if suffixes else "")
+        )
     if suffixes and path.suffix.lower() not in suffixes:
         raise InputError(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
     _probe_writable(path.parent if str(path.parent) else Path("."), option)

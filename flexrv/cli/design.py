@@ -19,10 +19,17 @@ def presets(json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     rows = []
     for name in list_presets():
         r = load(name)
-        rows.append({"name": name, "description": r.description,
-                     "ratio": 1 + r.first_stage.planet_teeth * r.second_stage.pin_count
-                     / (r.first_stage.sun_teeth * (r.second_stage.pin_count - r.second_stage.disc_teeth)),
-                     "estimated_fields": len(r.provenance)})
+        rows.append(
+            {
+                "name": name,
+                "description": r.description,
+                "ratio": 1
+                + r.first_stage.planet_teeth
+                * r.second_stage.pin_count
+                / (r.first_stage.sun_teeth * (r.second_stage.pin_count - r.second_stage.disc_teeth)),
+                "estimated_fields": len(r.provenance),
+            }
+        )
 
     def render(data: list[dict[str, Any]]) -> None:
         table = Table(title="flexrv presets", title_justify="left")
@@ -35,9 +42,13 @@ def presets(json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
     emit(rows, json, render)
 
 
-def show(preset: str = typer.Argument(..., help=PRESET_HELP),
-         toml: bool = typer.Option(False, "--toml", help="Print as TOML that loads back unchanged (a template for your own design)."),
-         json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def show(
+    preset: str = typer.Argument(..., help=PRESET_HELP),
+    toml: bool = typer.Option(
+        False, "--toml", help="Print as TOML that loads back unchanged (a template for your own design)."
+    ),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Print a design (all fields, with provenance notes of estimated values)."""
     reducer = load(preset)
     if not reducer.provenance:  # optional for an own design, but then nothing says where estimates come from
@@ -45,7 +56,8 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
 
         Console(stderr=True, markup=False, highlight=False).print(
             f"warning: {reducer.name} has no [provenance] table: no field says where its value comes from "
-            "(add 'field.path = \"note\"' lines for every estimated value)")
+            "(add 'field.path = \"note\"' lines for every estimated value)"
+        )
     if toml:
         print(to_toml(reducer, comments=True), end="")
         return
@@ -73,14 +85,17 @@ def show(preset: str = typer.Argument(..., help=PRESET_HELP),
         table.add_column("field", no_wrap=True, min_width=max(len(key) for key, _ in errors))
         table.add_column("value", justify="right", overflow="fold")
         for key, value in errors:
-            table.add_row(escape(key), escape(", ".join(fmt(v) for v in value) if isinstance(value, list) else fmt(value)))
+            table.add_row(
+                escape(key), escape(", ".join(fmt(v) for v in value) if isinstance(value, list) else fmt(value))
+            )
         console.print(table)
 
     emit(reducer, json, render)
 
 
-def design(preset: str = typer.Argument(..., help=PRESET_HELP),
-           json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def design(
+    preset: str = typer.Argument(..., help=PRESET_HELP), json: bool = typer.Option(False, "--json", help=JSON_HELP)
+) -> None:
     """Analytic design report at the preset's operating point (kinematics, ISO 6336
     mesh stiffness, cycloid stage and pin loads, torsional stiffness, main-bearing
     loads, Hertz, film thickness, life) and the stiffness budget of the torque path
@@ -98,7 +113,8 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
             raise ConvergenceError(
                 f"main_bearing.axial_preload_um = {mb.axial_preload_um:g} um (axial clearance) is not supported by "
                 f"flexrv design: the quasi-static ball loads are indeterminate in the clearance at this load "
-                f"({exc}); use a preload >= 0 for the design report (simulate models the clearance)") from None
+                f"({exc}); use a preload >= 0 for the design report (simulate models the clearance)"
+            ) from None
         raise
     warnings = load_sanity_warnings(report)
     if warnings:
@@ -106,10 +122,16 @@ def design(preset: str = typer.Argument(..., help=PRESET_HELP),
     report["stiffness_budget"] = analytic_budget(reducer)
 
     def render(rep):
-        render_nested(f"Design report: {reducer.name}",
-                      {k: v for k, v in rep.items() if k not in ("warnings", "stiffness_budget")})
-        console.print(budget_table(f"stiffness budget (analytic series model) at {rep['stiffness_budget']['torque_Nm']:.6g} N m",
-                                   rep["stiffness_budget"]))
+        render_nested(
+            f"Design report: {reducer.name}",
+            {k: v for k, v in rep.items() if k not in ("warnings", "stiffness_budget")},
+        )
+        console.print(
+            budget_table(
+                f"stiffness budget (analytic series model) at {rep['stiffness_budget']['torque_Nm']:.6g} N m",
+                rep["stiffness_budget"],
+            )
+        )
         for message in rep.get("warnings", []):
             console.print(f"warning: {message}", style="yellow")
 
@@ -123,10 +145,15 @@ def budget_dict(compliances: dict[str, float], torque: float) -> dict:
     from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
     total = sum(compliances.values())
-    return {"elements": {k: {"compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD, "share_percent": 100.0 * v / total}
-                         for k, v in compliances.items()},
-            "total_compliance_arcsec_per_Nm": total * ARCSEC_PER_RAD,
-            "rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / total, "torque_Nm": torque}
+    return {
+        "elements": {
+            k: {"compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD, "share_percent": 100.0 * v / total}
+            for k, v in compliances.items()
+        },
+        "total_compliance_arcsec_per_Nm": total * ARCSEC_PER_RAD,
+        "rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / total,
+        "torque_Nm": torque,
+    }
 
 
 def analytic_budget(reducer, torque: float | None = None) -> dict:
@@ -171,9 +198,11 @@ def budget_table(title: str, budget: dict) -> Table:
     table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100")
     table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "")
     if "analytic_rigidity_Nm_per_arcmin" in budget:
-        table.add_row("analytic series model (flexrv design) [N m/arcmin]",
-                      fmt(budget["analytic_rigidity_Nm_per_arcmin"]),
-                      f"{budget['analytic_difference_percent']:+.3g} % total")
+        table.add_row(
+            "analytic series model (flexrv design) [N m/arcmin]",
+            fmt(budget["analytic_rigidity_Nm_per_arcmin"]),
+            f"{budget['analytic_difference_percent']:+.3g} % total",
+        )
     if budget.get("notes"):
         table.caption = "; ".join(budget["notes"])
     return table
@@ -196,12 +225,19 @@ def load_sanity_warnings(report: dict, prefix: str = "") -> list[str]:
         if isinstance(value, dict):
             out += load_sanity_warnings(value, f"{path}.")
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            limit = ISO76_BALL_PA if key.endswith("_p_max_Pa") else ISO76_LINE_PA if key.endswith(
-                "max_hertz_pressure_Pa") else None
+            limit = (
+                ISO76_BALL_PA
+                if key.endswith("_p_max_Pa")
+                else ISO76_LINE_PA
+                if key.endswith("max_hertz_pressure_Pa")
+                else None
+            )
             if limit is not None and value > limit:
-                out.append(f"{path} = {value / 1e9:.3g} GPa exceeds the ISO 76 static limit {limit / 1e9:g} GPa: "
-                           "the contact yields, the elastic (Hertz) results do not hold; check the loads "
-                           "(operating.*) and the contact geometry")
+                out.append(
+                    f"{path} = {value / 1e9:.3g} GPa exceeds the ISO 76 static limit {limit / 1e9:g} GPa: "
+                    "the contact yields, the elastic (Hertz) results do not hold; check the loads "
+                    "(operating.*) and the contact geometry"
+                )
     return out
 
 
@@ -214,8 +250,10 @@ def check_design_report_range(reducer) -> None:
     lo, hi = float(_ISO281_XY[0, 0]), float(_ISO281_XY[-1, 0])
     angle = reducer.main_bearing.contact_angle_deg
     if not lo <= angle <= hi:
-        raise InputError(f"main_bearing.contact_angle_deg = {angle:g} is not allowed for flexrv design: must lie in "
-                         f"{lo:g} <= value <= {hi:g} deg (the ISO 281 X/Y table of the bearing life rating)")
+        raise InputError(
+            f"main_bearing.contact_angle_deg = {angle:g} is not allowed for flexrv design: must lie in "
+            f"{lo:g} <= value <= {hi:g} deg (the ISO 281 X/Y table of the bearing life rating)"
+        )
 
 
 def register(app: typer.Typer) -> None:

@@ -31,14 +31,20 @@ def _size_m(size_mm: Optional[float]) -> Optional[float]:
     return None if size_mm is None else size_mm * 1e-3
 
 
-COMPLIANCE_HELP = ("carrier / cycloid_disc: also condense the part (FE) and print its torsional compliance at the "
-                   "output (carrier: flange held, crank bores loaded by the torque path; disc: crank holes held, pin "
-                   "loads at the rated torque, mean over 6 crank angles of one crank-hole period).")
+COMPLIANCE_HELP = (
+    "carrier / cycloid_disc: also condense the part (FE) and print its torsional compliance at the "
+    "output (carrier: flange held, crank bores loaded by the torque path; disc: crank holes held, pin "
+    "loads at the rated torque, mean over 6 crank angles of one crank-hole period)."
+)
 
 
-def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
-         size: Optional[float] = SIZE_OPT, json: bool = typer.Option(False, "--json", help=JSON_HELP),
-         compliance: bool = typer.Option(False, "--compliance", help=COMPLIANCE_HELP)) -> None:
+def mesh(
+    preset: str = typer.Argument(..., help=PRESET_HELP),
+    part: Part = PART_OPT,
+    size: Optional[float] = SIZE_OPT,
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    compliance: bool = typer.Option(False, "--compliance", help=COMPLIANCE_HELP),
+) -> None:
     """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
     from flexrv.errors import InputError
@@ -49,10 +55,18 @@ def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_
     reducer = load(preset)
     res = build_mesh(reducer, part.value, _size_m(size))
     d = res.data
-    data = {"part": part.value, "msh": str(res.msh_path), "vtu": str(res.vtu_path), "cached": res.cached,
-            "nodes": d.n_nodes, "elements": d.n_elements, "element_type": "tetra10",
-            "size_mm": d.size * 1e3, "local_size_mm": d.info.get("local_size", d.size) * 1e3,
-            "groups": {g: int(len(d.node_set(g))) for g in d.group_names}}
+    data = {
+        "part": part.value,
+        "msh": str(res.msh_path),
+        "vtu": str(res.vtu_path),
+        "cached": res.cached,
+        "nodes": d.n_nodes,
+        "elements": d.n_elements,
+        "element_type": "tetra10",
+        "size_mm": d.size * 1e3,
+        "local_size_mm": d.info.get("local_size", d.size) * 1e3,
+        "groups": {g: int(len(d.node_set(g))) for g in d.group_names},
+    }
     if "profile_deviation_m" in d.info:
         data["profile_deviation_um"] = d.info["profile_deviation_m"] * 1e6
     if compliance:
@@ -82,13 +96,16 @@ def mesh(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_
     emit(data, json, render)
 
 
-def modes(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART_OPT,
-          n: int = typer.Option(10, "--n", help="Number of elastic modes."), size: Optional[float] = SIZE_OPT,
-          json: bool = typer.Option(False, "--json", help=JSON_HELP),
-          png: Optional[Path] = typer.Option(None, "--png", help="Render each free mode to PNGs in this folder."),
-          show: bool = typer.Option(False, "--show", help="Open an interactive window (needs a display)."),
-          vtu: Optional[Path] = typer.Option(None, "--vtu", help="Write the modes as VTU for ParaView to this folder.")
-          ) -> None:
+def modes(
+    preset: str = typer.Argument(..., help=PRESET_HELP),
+    part: Part = PART_OPT,
+    n: int = typer.Option(10, "--n", help="Number of elastic modes."),
+    size: Optional[float] = SIZE_OPT,
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    png: Optional[Path] = typer.Option(None, "--png", help="Render each free mode to PNGs in this folder."),
+    show: bool = typer.Option(False, "--show", help="Open an interactive window (needs a display)."),
+    vtu: Optional[Path] = typer.Option(None, "--vtu", help="Write the modes as VTU for ParaView to this folder."),
+) -> None:
     """Free-free and constrained (interfaces clamped) eigenfrequencies [Hz] of a part."""
     from flexrv.cli._common import check_output_dir
     from flexrv.design import load
@@ -108,29 +125,55 @@ def modes(preset: str = typer.Argument(..., help=PRESET_HELP), part: Part = PART
 
         png.mkdir(parents=True, exist_ok=True)
         for k, f in enumerate(pm.free_hz):
-            p = render_mode_png(png / f"{part.value}_free_mode{k + 1:02d}.png", m.nodes, m.tris,
-                                pm.free_modes[:, k].reshape(-1, 3), title=f"{part.value} free mode {k + 1}: {f:.1f} Hz")
+            p = render_mode_png(
+                png / f"{part.value}_free_mode{k + 1:02d}.png",
+                m.nodes,
+                m.tris,
+                pm.free_modes[:, k].reshape(-1, 3),
+                title=f"{part.value} free mode {k + 1}: {f:.1f} Hz",
+            )
             files.append(str(p))
     if vtu is not None:
         from flexrv.viz.modes import export_modes_vtu
 
         vtu.mkdir(parents=True, exist_ok=True)
-        files.append(str(export_modes_vtu(vtu / f"{part.value}_free_modes.vtu", m.nodes, m.tets, pm.free_modes,
-                                          pm.free_hz)))
+        files.append(
+            str(export_modes_vtu(vtu / f"{part.value}_free_modes.vtu", m.nodes, m.tets, pm.free_modes, pm.free_hz))
+        )
         if pm.constrained_hz.size:
-            files.append(str(export_modes_vtu(vtu / f"{part.value}_constrained_modes.vtu", m.nodes, m.tets,
-                                              pm.constrained_modes, pm.constrained_hz, prefix="cmode")))
+            files.append(
+                str(
+                    export_modes_vtu(
+                        vtu / f"{part.value}_constrained_modes.vtu",
+                        m.nodes,
+                        m.tets,
+                        pm.constrained_modes,
+                        pm.constrained_hz,
+                        prefix="cmode",
+                    )
+                )
+            )
     shown = False
     if show:
         from flexrv.viz.modes import show_mode
 
         shown = show_mode(m.nodes, m.tris, pm.free_modes[:, 0].reshape(-1, 3), f"{pm.free_hz[0]:.1f} Hz")
-    data = {"part": part.value, "nodes": m.n_nodes, "dof": 3 * m.n_nodes, "constrained_at": pm.interfaces,
-            "free_hz": pm.free_hz, "constrained_hz": pm.constrained_hz, "files": files}
+    data = {
+        "part": part.value,
+        "nodes": m.n_nodes,
+        "dof": 3 * m.n_nodes,
+        "constrained_at": pm.interfaces,
+        "free_hz": pm.free_hz,
+        "constrained_hz": pm.constrained_hz,
+        "files": files,
+    }
 
     def render(x):
-        table = Table(title=f"modes {preset} {part.value} ({x['dof']} DOF; constrained: "
-                            f"{', '.join(x['constrained_at'])} clamped)", title_justify="left")
+        table = Table(
+            title=f"modes {preset} {part.value} ({x['dof']} DOF; constrained: "
+            f"{', '.join(x['constrained_at'])} clamped)",
+            title_justify="left",
+        )
         for col in ("mode", "free-free [Hz]", "constrained [Hz]"):
             table.add_column(col, justify="right")
         for k in range(max(len(x["free_hz"]), len(x["constrained_hz"]))):

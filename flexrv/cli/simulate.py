@@ -7,8 +7,7 @@ from pathlib import Path
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, check_output_dir, console, emit, kv_table
-from flexrv.cli._common import OVERWRITE_HELP
+from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -20,8 +19,15 @@ def _bar(enabled: bool):
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    bar = Progress(TextColumn("[bold]simulating[/]"), BarColumn(), TextColumn("{task.completed:.4f}/{task.total:.4f} s"),
-                   TimeElapsedColumn(), TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+    bar = Progress(
+        TextColumn("[bold]simulating[/]"),
+        BarColumn(),
+        TextColumn("{task.completed:.4f}/{task.total:.4f} s"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
     state = {"task": None}
 
     def report(t, t_end):
@@ -40,12 +46,16 @@ def _bar(enabled: bool):
     return report
 
 
-MODEL_HELP = ("Model name: rigid (5-DOF main-bearing element), balls (ball-resolved main bearing, rigid rings) "
-              "or flexible (reduced flexible parts, see --parts).")
-PARTS_HELP = ("Elastic parts of the run, comma-separated (the others rigid): carrier, cycloid_disc (FE bodies, "
-              "any --model) and, with --model flexible, main_bearing (flexible rings of both rows), crankshaft. "
-              "Default: the design's carrier.body_model / second_stage.disc_body_model (and main_bearing for "
-              "--model flexible); none: every part rigid.")
+MODEL_HELP = (
+    "Model name: rigid (5-DOF main-bearing element), balls (ball-resolved main bearing, rigid rings) "
+    "or flexible (reduced flexible parts, see --parts)."
+)
+PARTS_HELP = (
+    "Elastic parts of the run, comma-separated (the others rigid): carrier, cycloid_disc (FE bodies, "
+    "any --model) and, with --model flexible, main_bearing (flexible rings of both rows), crankshaft. "
+    "Default: the design's carrier.body_model / second_stage.disc_body_model (and main_bearing for "
+    "--model flexible); none: every part rigid."
+)
 
 
 def model_options(model: str, parts: str | None) -> dict:
@@ -61,12 +71,16 @@ def _default_out(preset: str, model: str, kind: str) -> Path:
     return Path("results") / f"{stem}_{model}_{kind}_{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-BALLS_HELP = ("Ball-resolved main bearing (--model balls / flexible): the balls as point masses, or "
-              "quasi-static (massless, solved inside the bearing rows). Default: quasi-static balls between "
-              "rigid rings (--model balls), point masses between condensed flexible rings (--model flexible, "
-              "which needs them).")
-DT_HELP = ("Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s: TE mean and lines within 0.05 arcsec / "
-           "2 % of a 2.5e-5 s reference on rv40e, rigid and ball models, tests/test_time_step.py).")
+BALLS_HELP = (
+    "Ball-resolved main bearing (--model balls / flexible): the balls as point masses, or "
+    "quasi-static (massless, solved inside the bearing rows). Default: quasi-static balls between "
+    "rigid rings (--model balls), point masses between condensed flexible rings (--model flexible, "
+    "which needs them)."
+)
+DT_HELP = (
+    "Time step [s] (default flexrv.simulation.DEFAULT_DT = 1e-4 s: TE mean and lines within 0.05 arcsec / "
+    "2 % of a 2.5e-5 s reference on rv40e, rigid and ball models, tests/test_time_step.py)."
+)
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
 
 
@@ -80,17 +94,21 @@ def _exit_code(res) -> int:
     return 128 + int(getattr(signal, name, signal.SIGINT))
 
 
-def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --resume."),
-             model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
-             t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
-             dt: float = typer.Option(None, "--dt", help=DT_HELP),
-             parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
-             ball_inertia: bool = typer.Option(None, "--ball-inertia/--quasi-static-balls", help=BALLS_HELP),
-             out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
-             overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-             resume: Path = typer.Option(None, "--resume", help="Continue a killed run from the last checkpoint in this output directory."),
-             checkpoint: float = typer.Option(10.0, "--checkpoint-s", help=CHECKPOINT_HELP),
-             json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def simulate(
+    preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --resume."),
+    model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
+    t_end: float = typer.Option(None, "--t-end", help="End time [s] (default: ramps + 0.2 s)."),
+    dt: float = typer.Option(None, "--dt", help=DT_HELP),
+    parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
+    ball_inertia: bool = typer.Option(None, "--ball-inertia/--quasi-static-balls", help=BALLS_HELP),
+    out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    resume: Path = typer.Option(
+        None, "--resume", help="Continue a killed run from the last checkpoint in this output directory."
+    ),
+    checkpoint: float = typer.Option(10.0, "--checkpoint-s", help=CHECKPOINT_HELP),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Run the multibody model; write NetCDF, config, summary.md and PNGs.
     Checkpoints into --out while running; Ctrl-C or SIGTERM keeps the partial results
     (exit 130 / 143); --resume DIR continues a killed run."""
@@ -105,8 +123,9 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
     bar = _bar(not json)
     if resume is not None:
         if preset is not None or out is not None:
-            raise InputError("--resume DIR continues the run in DIR with its own design and options: "
-                             "give no PRESET and no --out")
+            raise InputError(
+                "--resume DIR continues the run in DIR with its own design and options: give no PRESET and no --out"
+            )
         if not resume.is_dir():
             raise InputError(f"--resume {resume}: not a directory")
         check_output_dir(resume, "--resume", allow_existing=True)
@@ -135,15 +154,28 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
         if res.attrs.get("status") == "completed":  # saved in full: the resume data is no longer needed
             (Path(out) / "checkpoint.npz").unlink(missing_ok=True)
     s = res.summary()
-    data = {"output_dir": str(out), "status": s["status"],
-            "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
-            "ratio_theoretical": s["ratio_theoretical"], "ratio_simulated": s["ratio_simulated"],
-            "te_min_arcsec": s["te_min_arcsec"], "te_max_arcsec": s["te_max_arcsec"], "te_pp_arcsec": s["te_pp_arcsec"],
-            "steady_window_s": s["steady_window_s"], "max_pin_force_N": s["max_pin_force_N"],
-            "pins_in_contact_mean": s["pins_in_contact_mean"], "pins_in_contact_max": s["pins_in_contact_max"],
-            "wall_time_s": sim.timing.get("solve_s")}
-    for key in ("max_ball_load_N", "max_ring_deformation_m", "min_film_thickness_m", "efficiency",
-                "mean_friction_power_W"):
+    data = {
+        "output_dir": str(out),
+        "status": s["status"],
+        "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
+        "ratio_theoretical": s["ratio_theoretical"],
+        "ratio_simulated": s["ratio_simulated"],
+        "te_min_arcsec": s["te_min_arcsec"],
+        "te_max_arcsec": s["te_max_arcsec"],
+        "te_pp_arcsec": s["te_pp_arcsec"],
+        "steady_window_s": s["steady_window_s"],
+        "max_pin_force_N": s["max_pin_force_N"],
+        "pins_in_contact_mean": s["pins_in_contact_mean"],
+        "pins_in_contact_max": s["pins_in_contact_max"],
+        "wall_time_s": sim.timing.get("solve_s"),
+    }
+    for key in (
+        "max_ball_load_N",
+        "max_ring_deformation_m",
+        "min_film_thickness_m",
+        "efficiency",
+        "mean_friction_power_W",
+    ):
         if key in s:
             data[key] = s[key]
 
@@ -157,16 +189,22 @@ def simulate(preset: str = typer.Argument(None, help=PRESET_HELP + " Not with --
         raise typer.Exit(code)
 
 
-def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
-                       model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
-                       quarter_time: float = typer.Option(None, "--quarter-time", help="Duration of each quarter of the torque loop [s] "
-                                                          "(default flexrv.simulation.DEFAULT_QUARTER_TIME = 0.08 s: "
-                                                          "the branches are quasi-static on both presets)."),
-                       dt: float = typer.Option(None, "--dt", help=DT_HELP),
-                       parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
-                       out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
-                       overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-                       json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def stiffness_test_cmd(
+    preset: str = typer.Argument(..., help=PRESET_HELP),
+    model: str = typer.Option("rigid", "--model", help=MODEL_HELP),
+    quarter_time: float = typer.Option(
+        None,
+        "--quarter-time",
+        help="Duration of each quarter of the torque loop [s] "
+        "(default flexrv.simulation.DEFAULT_QUARTER_TIME = 0.08 s: "
+        "the branches are quasi-static on both presets).",
+    ),
+    dt: float = typer.Option(None, "--dt", help=DT_HELP),
+    parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
+    out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
     torsional rigidity, lost motion, hysteresis loop PNG."""
     from dataclasses import asdict
@@ -179,8 +217,9 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
     out = check_output_dir(out or _default_out(preset, model, "stiffness"), "--out", overwrite=overwrite)
     bar = _bar(not json)
     try:
-        fig, res = stiffness_test(preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out,
-                                  model_options=options)
+        fig, res = stiffness_test(
+            preset, model=model, quarter_time=quarter_time, dt=dt, progress=bar, save_to=out, model_options=options
+        )
     finally:
         if bar:
             bar.stop()
@@ -196,11 +235,16 @@ def stiffness_test_cmd(preset: str = typer.Argument(..., help=PRESET_HELP),
             for note in b.get("notes", []):
                 console.print(f"note: {note}", style="yellow")
             return
-        console.print(budget_table(f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
-                                   f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
-                                   f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
-                                   f"({b['measured_with_unmodelled_Nm_per_arcmin']:.4g} with the unmodelled "
-                                   "elements in series)", b))
+        console.print(
+            budget_table(
+                f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
+                f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
+                f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
+                f"({b['measured_with_unmodelled_Nm_per_arcmin']:.4g} with the unmodelled "
+                "elements in series)",
+                b,
+            )
+        )
 
     emit(data, json, render)
 
@@ -216,8 +260,12 @@ def _budget(res) -> dict:
 
     b = json.loads(res.attrs["stiffness_budget"])
     if not b["compliances"]:
-        return {"elements": {}, "torque_Nm": b["torque"], "notes": b.get("notes", []),
-                "measured_rigidity_Nm_per_arcmin": b["measured_rigidity"] * RAD_PER_ARCMIN}
+        return {
+            "elements": {},
+            "torque_Nm": b["torque"],
+            "notes": b.get("notes", []),
+            "measured_rigidity_Nm_per_arcmin": b["measured_rigidity"] * RAD_PER_ARCMIN,
+        }
     out = budget_dict(b["compliances"], b["torque"])
     out["measured_rigidity_Nm_per_arcmin"] = b["measured_rigidity"] * RAD_PER_ARCMIN
     out["tangent_rigidity_Nm_per_arcmin"] = b["tangent_rigidity"] * RAD_PER_ARCMIN

@@ -14,17 +14,22 @@ from flexrv.cli.design import analytic_budget, budget_table
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
 
-def te(preset: str = typer.Argument(..., help=PRESET_HELP),
-       torque_nm: float = typer.Option(None, "--torque-nm", help="Output torque in N m (default: the rated torque)."),
-       output_revolutions: float = typer.Option(None, "--output-revolutions",
-                                                help="Range in output revolutions (default 1)."),
-       crank_revolutions: float = typer.Option(None, "--crank-revolutions",
-                                               help="Range in crank revolutions relative to the carrier."),
-       points_per_mesh: int = typer.Option(8, "--points-per-mesh",
-                                           help="Positions per cycloid-mesh (pin-mesh) period, 2-1000."),
-       out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
-       overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-       json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def te(
+    preset: str = typer.Argument(..., help=PRESET_HELP),
+    torque_nm: float = typer.Option(None, "--torque-nm", help="Output torque in N m (default: the rated torque)."),
+    output_revolutions: float = typer.Option(
+        None, "--output-revolutions", help="Range in output revolutions (default 1)."
+    ),
+    crank_revolutions: float = typer.Option(
+        None, "--crank-revolutions", help="Range in crank revolutions relative to the carrier."
+    ),
+    points_per_mesh: int = typer.Option(
+        8, "--points-per-mesh", help="Positions per cycloid-mesh (pin-mesh) period, 2-1000."
+    ),
+    out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
     output torque: loaded and no-load TE, lost motion, backlash, torsional rigidity, contact forces,
     TE spectrum; NetCDF, summary.md and PNGs."""
@@ -37,10 +42,18 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     if output_revolutions is not None and crank_revolutions is not None:
         raise InputError("--output-revolutions and --crank-revolutions exclude each other: give one")
     reducer = load(preset)
-    out = check_output_dir(out or Path("results") / f"{Path(preset).stem}_te_{time.strftime('%Y%m%d-%H%M%S')}",
-                           "--out", overwrite=overwrite)
-    result = loaded_te(reducer, torque=torque_nm, output_revolutions=output_revolutions,
-                       crank_revolutions=crank_revolutions, points_per_mesh=points_per_mesh)
+    out = check_output_dir(
+        out or Path("results") / f"{Path(preset).stem}_te_{time.strftime('%Y%m%d-%H%M%S')}",
+        "--out",
+        overwrite=overwrite,
+    )
+    result = loaded_te(
+        reducer,
+        torque=torque_nm,
+        output_revolutions=output_revolutions,
+        crank_revolutions=crank_revolutions,
+        points_per_mesh=points_per_mesh,
+    )
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)
     save_te(ds, summary, reducer, out)
@@ -50,21 +63,30 @@ def te(preset: str = typer.Argument(..., help=PRESET_HELP),
     analytic = analytic_budget(reducer, summary["torque_Nm"])
     data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
     data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
-        analytic["total_compliance_arcsec_per_Nm"] / data["stiffness_budget"]["total_compliance_arcsec_per_Nm"] - 1.0)
+        analytic["total_compliance_arcsec_per_Nm"] / data["stiffness_budget"]["total_compliance_arcsec_per_Nm"] - 1.0
+    )
 
     def render(d):
-        rows = [("loaded TE p-p", d["te_pp_arcsec"], "arcsec"), ("loaded TE mean", d["te_mean_arcsec"], "arcsec"),
-                ("no-load TE p-p", d["no_load_te_pp_arcsec"], "arcsec"),
-                ("lost motion (±3 % rated)", d["lost_motion_arcmin"], "arcmin"),
-                (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
-                ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-                ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-                ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
-                ("max pin force", d.get("max_pin_force_N"), "N"), ("positions", d["positions"], "-"),
-                ("solve time", d["solve_time_s"], "s"), ("output", d["output_dir"], "")]
+        rows = [
+            ("loaded TE p-p", d["te_pp_arcsec"], "arcsec"),
+            ("loaded TE mean", d["te_mean_arcsec"], "arcsec"),
+            ("no-load TE p-p", d["no_load_te_pp_arcsec"], "arcsec"),
+            ("lost motion (±3 % rated)", d["lost_motion_arcmin"], "arcmin"),
+            (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
+            ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+            ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+            ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
+            ("max pin force", d.get("max_pin_force_N"), "N"),
+            ("positions", d["positions"], "-"),
+            ("solve time", d["solve_time_s"], "s"),
+            ("output", d["output_dir"], ""),
+        ]
         console.print(kv_table(f"quasi-static TE {reducer.name} at {d['torque_Nm']:.6g} N m", rows))
-        console.print(budget_table(f"stiffness budget (quasi-static, strain energy) at {d['torque_Nm']:.6g} N m",
-                                   d["stiffness_budget"]))
+        console.print(
+            budget_table(
+                f"stiffness budget (quasi-static, strain energy) at {d['torque_Nm']:.6g} N m", d["stiffness_budget"]
+            )
+        )
         lines = [(f"{x['label']}", x["amplitude_arcsec"], f"order {x['order']:.4g}") for x in d["spectrum_lines"]]
         console.print(kv_table("largest TE lines [arcsec]", lines))
 

@@ -30,14 +30,18 @@ class Workflow(str, enum.Enum):
     tolerance_study = "tolerance_study"
 
 
-def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_sensitive=True),
-             smoke: bool = typer.Option(False, "--smoke",
-                                        help="Short runs / coarse meshes (a quick check, not results); "
-                                             "written to results/NAME-smoke/."),
-             out: Optional[Path] = typer.Option(None, "--out",
-                                                help="Output folder (default: ./results/NAME, or "
-                                                     "./results/NAME-smoke with --smoke)."),
-             json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def workflow(
+    name: Workflow = typer.Argument(..., help="Workflow to run.", case_sensitive=True),
+    smoke: bool = typer.Option(
+        False,
+        "--smoke",
+        help="Short runs / coarse meshes (a quick check, not results); written to results/NAME-smoke/.",
+    ),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Output folder (default: ./results/NAME, or ./results/NAME-smoke with --smoke)."
+    ),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Run a seed-study workflow: seed-vs-flexrv table, NetCDF, PNGs and summary.md."""
     if out is not None:  # a workflow regenerates its folder: existing content is expected
         from flexrv.cli._common import check_output_dir
@@ -47,13 +51,21 @@ def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_
 
     mod = importlib.import_module(f"flexrv.workflows.{name.value}")
     res = mod.run(out_dir=out, smoke=smoke)
-    data = {"workflow": name.value, "smoke": smoke, "out_dir": str(res.out_dir), "numbers": res.numbers,
-            "comparisons": [{"quantity": c.quantity, "unit": c.unit, "seed": c.seed, "flexrv": c.flexrv,
-                             "note": c.note} for c in res.comparisons]}
+    data = {
+        "workflow": name.value,
+        "smoke": smoke,
+        "out_dir": str(res.out_dir),
+        "numbers": res.numbers,
+        "comparisons": [
+            {"quantity": c.quantity, "unit": c.unit, "seed": c.seed, "flexrv": c.flexrv, "note": c.note}
+            for c in res.comparisons
+        ],
+    }
 
     def render(d):
-        table = Table(title=f"workflow {name.value}" + (" (SMOKE RUN: not results)" if smoke else ""),
-                      title_justify="left")
+        table = Table(
+            title=f"workflow {name.value}" + (" (SMOKE RUN: not results)" if smoke else ""), title_justify="left"
+        )
         for col, just in (("quantity", "left"), ("seed", "right"), ("flexrv", "right"), ("unit", "left")):
             table.add_column(col, justify=just, overflow="fold")
         for c in d["comparisons"]:
@@ -64,20 +76,28 @@ def workflow(name: Workflow = typer.Argument(..., help="Workflow to run.", case_
     emit(data, json, render)
 
 
-def report(results: Optional[Path] = typer.Option(None, "--results",
-                                                  help="Results folder (default: ./results)."),
-           smoke: bool = typer.Option(False, "--smoke",
-                                      help="Collect the smoke runs (results/NAME-smoke) into REPORT-smoke.md."),
-           json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:
+def report(
+    results: Optional[Path] = typer.Option(None, "--results", help="Results folder (default: ./results)."),
+    smoke: bool = typer.Option(
+        False, "--smoke", help="Collect the smoke runs (results/NAME-smoke) into REPORT-smoke.md."
+    ),
+    json: bool = typer.Option(False, "--json", help=JSON_HELP),
+) -> None:
     """Collect the workflow summaries into the generated results/REPORT.md (full runs only;
     --smoke: results/REPORT-smoke.md from the smoke runs)."""
     from flexrv.workflows._common import SMOKE_SUFFIX, collect_report, is_workflow_summary, results_root
 
     root = Path(results) if results else results_root()
     path = collect_report(root, smoke=smoke)
-    data = {"path": str(path), "smoke": smoke,
-            "sections": sorted(p.parent.name for p in root.glob("*/summary.md")
-                               if p.parent.name.endswith(SMOKE_SUFFIX) == smoke and is_workflow_summary(p))}
+    data = {
+        "path": str(path),
+        "smoke": smoke,
+        "sections": sorted(
+            p.parent.name
+            for p in root.glob("*/summary.md")
+            if p.parent.name.endswith(SMOKE_SUFFIX) == smoke and is_workflow_summary(p)
+        ),
+    }
 
     def render(d):
         console.print(f"wrote {d['path']} ({', '.join(d['sections']) or 'no workflow results yet'})")

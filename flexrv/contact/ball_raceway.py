@@ -96,12 +96,18 @@ class RowContactGeometry:
         so = geom.ring_section("outer", side)
         rx_i, ry_i, rx_o, ry_o = geom.contact_radii()
         d = geom.ball_diameter
-        return cls(inner_center_radius=si.groove_center_r, inner_center_z=si.groove_center_z + side * preload,
-                   outer_center_radius=so.groove_center_r, outer_center_z=so.groove_center_z,
-                   inner_offset=(geom.inner_conformity - 0.5) * d, outer_offset=(geom.outer_conformity - 0.5) * d,
-                   k_inner=float(point_contact_stiffness(rx_i, ry_i, e_eff)),
-                   k_outer=float(point_contact_stiffness(rx_o, ry_o, e_eff)),
-                   ball_radius_pitch=0.5 * geom.pitch_diameter, side=side)
+        return cls(
+            inner_center_radius=si.groove_center_r,
+            inner_center_z=si.groove_center_z + side * preload,
+            outer_center_radius=so.groove_center_r,
+            outer_center_z=so.groove_center_z,
+            inner_offset=(geom.inner_conformity - 0.5) * d,
+            outer_offset=(geom.outer_conformity - 0.5) * d,
+            k_inner=float(point_contact_stiffness(rx_i, ry_i, e_eff)),
+            k_outer=float(point_contact_stiffness(rx_o, ry_o, e_eff)),
+            ball_radius_pitch=0.5 * geom.pitch_diameter,
+            side=side,
+        )
 
     def groove_centers(self, azimuth, ring: str) -> np.ndarray:
         """Undeformed groove-centre positions (N,3) at the given azimuths (ring frame)."""
@@ -153,13 +159,22 @@ def raceway_contacts(ball_pos, ball_vel, center_pos, center_vel, offset: float, 
     damping = -dq_dr[:, None, None] * nn
     radial = np.hypot(n[:, 0], n[:, 1])
     angle = np.arctan2(np.abs(n[:, 2]), radial)
-    return ContactState(force_ball=force, load=q, approach=delta, normal=n, contact_angle=angle,
-                        stiffness=stiffness, damping=damping)
+    return ContactState(
+        force_ball=force, load=q, approach=delta, normal=n, contact_angle=angle, stiffness=stiffness, damping=damping
+    )
 
 
-def solve_ball_positions(row: RowContactGeometry, inner_centers, outer_centers, law_inner: NormalLaw,
-                         law_outer: NormalLaw, ball_pos0=None, external=None, tol: float = 1e-12,
-                         max_iter: int = 60) -> tuple[np.ndarray, ContactState, ContactState]:
+def solve_ball_positions(
+    row: RowContactGeometry,
+    inner_centers,
+    outer_centers,
+    law_inner: NormalLaw,
+    law_outer: NormalLaw,
+    ball_pos0=None,
+    external=None,
+    tol: float = 1e-12,
+    max_iter: int = 60,
+) -> tuple[np.ndarray, ContactState, ContactState]:
     """Quasi-static positions of the balls between given groove centres.
 
     Each ball's meridian-plane position is found by a vectorised damped Newton

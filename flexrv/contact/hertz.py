@@ -147,8 +147,16 @@ def point_contact(load, rx, ry, e_eff) -> PointContact:
         p_max = np.where(load > 0, 3.0 * load / (2.0 * np.pi * major * minor), 0.0)
     a = np.where(swapped, minor, major)
     b = np.where(swapped, major, minor)
-    return PointContact(a=a, b=b, p_max=p_max, approach=delta, ellipticity=np.where(swapped, 1.0 / k, k),
-                        first_kind=big_f, second_kind=big_e, reduced_radius=reduced)
+    return PointContact(
+        a=a,
+        b=b,
+        p_max=p_max,
+        approach=delta,
+        ellipticity=np.where(swapped, 1.0 / k, k),
+        first_kind=big_f,
+        second_kind=big_e,
+        reduced_radius=reduced,
+    )
 
 
 def point_contact_stiffness(rx, ry, e_eff):
@@ -260,7 +268,8 @@ def conformal_line_contact(load, length, pin_radius, groove_radius, e_eff):
     r = _positive("pin_radius", pin_radius)
     rg = _positive("groove_radius", groove_radius)
     if np.any(rg <= r):
-        raise InputError(f"groove_radius = {groove_radius!r} m must be > pin_radius = {pin_radius!r} m "
-                         "(a seat with clearance)")
+        raise InputError(
+            f"groove_radius = {groove_radius!r} m must be > pin_radius = {pin_radius!r} m (a seat with clearance)"
+        )
     contact = line_contact(load, length, r * rg / (rg - r), e_eff)
     return contact, contact.half_width / r

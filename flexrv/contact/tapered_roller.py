@@ -179,8 +179,9 @@ def support_deflection(force, sc, angles, is_linear, clear: float = 0.0, gamma: 
     d = np.zeros(2) if fn == 0.0 else f / fn * (clear + 1e-9)
     b = d.copy()
     for _ in range(200):
-        fx, fy, kxx, kxy, kyy, _, _, bx, by, _ = crank_support_force(d[0], d[1], gamma, clear, sc, angles,
-                                                                   is_linear, b[0], b[1])
+        fx, fy, kxx, kxy, kyy, _, _, bx, by, _ = crank_support_force(
+            d[0], d[1], gamma, clear, sc, angles, is_linear, b[0], b[1]
+        )
         b = np.array([bx, by])
         r = np.array([fx, fy]) + f
         if np.hypot(*r) <= 1e-10 * max(fn, 1.0):

@@ -21,8 +21,18 @@ from pydantic import BaseModel, ValidationError
 from flexrv.design.model import Reducer
 from flexrv.errors import ConfigError
 
-__all__ = ["Reducer", "load", "loads", "from_dict", "list_presets", "to_toml", "preset_path", "override",
-           "apply_overrides", "read_text_file"]
+__all__ = [
+    "Reducer",
+    "load",
+    "loads",
+    "from_dict",
+    "list_presets",
+    "to_toml",
+    "preset_path",
+    "override",
+    "apply_overrides",
+    "read_text_file",
+]
 
 _PRESET_PACKAGE = "flexrv.design.presets"
 
@@ -54,7 +64,9 @@ def load(preset_or_path: str | Path | Reducer) -> Reducer:
     if text_name in list_presets():
         path = preset_path(text_name)
     elif not (path.suffix == ".toml" or path.exists()):
-        raise ConfigError(f"unknown preset {text_name!r}: choose one of {list_presets()} or give a path to a .toml file")
+        raise ConfigError(
+            f"unknown preset {text_name!r}: choose one of {list_presets()} or give a path to a .toml file"
+        )
     if not path.is_file():
         what = "is not a regular file" if path.exists() else "does not exist"
         raise ConfigError(f"design file {str(path)!r} {what}")
@@ -281,8 +293,11 @@ def read_named_table(name_or_path: str, folder: str, table: str, what: str) -> d
     if not path.is_file() and builtin.is_file():
         path = builtin
     if not path.is_file():
-        known = sorted(p.name[:-5] for p in (resources.files("flexrv.design.presets") / folder).iterdir()
-                       if p.name.endswith(".toml"))
+        known = sorted(
+            p.name[:-5]
+            for p in (resources.files("flexrv.design.presets") / folder).iterdir()
+            if p.name.endswith(".toml")
+        )
         raise ConfigError(f"unknown {what} {text_name!r}: choose one of {known} or give a TOML file")
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))

@@ -70,9 +70,12 @@ class PinErrors(_Strict):
     2 pi j / z_rp clockwise from +y)."""
 
     pin_radius_um: float | list[float] = _meta("pin", "disp", "Pin radius error (+ larger pin) [um]")
-    pin_radial_position_um: float | list[float] = _meta("pin", "disp", "Pin centre radial position error (+ outward) [um]")
-    pin_tangential_position_um: float | list[float] = _meta("pin", "disp",
-                                                           "Pin centre tangential position error (+ counter-clockwise) [um]")
+    pin_radial_position_um: float | list[float] = _meta(
+        "pin", "disp", "Pin centre radial position error (+ outward) [um]"
+    )
+    pin_tangential_position_um: float | list[float] = _meta(
+        "pin", "disp", "Pin centre tangential position error (+ counter-clockwise) [um]"
+    )
 
 
 class Harmonic(_Strict):
@@ -91,20 +94,27 @@ class DiscErrors(_Strict):
     shift_um: float = _meta("one", "disp", "Extra shift modification dR_p [um]")
     rotation_arcmin: float = _meta("one", "angle", "Extra rotation modification [arcmin]")
     harmonics: list[Harmonic] = Field(default_factory=list, description="Profile/pitch error harmonics")
-    hole_radial_um: float | list[float] = _meta("crank", "disp", "Crank-hole centre radial error in the disc (+ outward) [um]")
-    hole_tangential_um: float | list[float] = _meta("crank", "disp",
-                                                    "Crank-hole centre tangential error in the disc (+ counter-clockwise) [um]")
+    hole_radial_um: float | list[float] = _meta(
+        "crank", "disp", "Crank-hole centre radial error in the disc (+ outward) [um]"
+    )
+    hole_tangential_um: float | list[float] = _meta(
+        "crank", "disp", "Crank-hole centre tangential error in the disc (+ counter-clockwise) [um]"
+    )
 
 
 class CrankErrors(_Strict):
     """Crankshaft errors: eccentrics [crank][disc], crank bores in the carrier per crank."""
 
-    eccentricity_um: float | list[list[float]] = _meta("crank_disc", "disp", "Eccentricity error of each eccentric [um]")
-    eccentric_phase_arcmin: float | list[list[float]] = _meta("crank_disc", "angle",
-                                                               "Eccentric phase error (added to the clockwise angle chi) [arcmin]")
+    eccentricity_um: float | list[list[float]] = _meta(
+        "crank_disc", "disp", "Eccentricity error of each eccentric [um]"
+    )
+    eccentric_phase_arcmin: float | list[list[float]] = _meta(
+        "crank_disc", "angle", "Eccentric phase error (added to the clockwise angle chi) [arcmin]"
+    )
     bore_radial_um: float | list[float] = _meta("crank", "disp", "Crank bore radial position error in the carrier [um]")
-    bore_tangential_um: float | list[float] = _meta("crank", "disp",
-                                                    "Crank bore tangential position error in the carrier [um]")
+    bore_tangential_um: float | list[float] = _meta(
+        "crank", "disp", "Crank bore tangential position error in the carrier [um]"
+    )
 
 
 class FirstStageErrors(_Strict):
@@ -114,16 +124,20 @@ class FirstStageErrors(_Strict):
     sun_runout_phase_deg: float = _meta("one", "phase", "Sun runout phase [deg]")
     planet_runout_um: float | list[float] = _meta("crank", "amp", "Planet runout amplitude [um]")
     planet_runout_phase_deg: float | list[float] = _meta("crank", "phase", "Planet runout phase [deg]")
-    planet_phase_arcmin: float | list[float] = _meta("crank", "angle", "Planet assembly phase error on its crank [arcmin]")
+    planet_phase_arcmin: float | list[float] = _meta(
+        "crank", "angle", "Planet assembly phase error on its crank [arcmin]"
+    )
 
 
 class ClearanceErrors(_Strict):
     """Bearing clearances: needle bearings [crank][disc], crank supports per crank."""
 
     needle_extra_clearance_um: float | list[list[float]] = _meta(
-        "crank_disc", "disp", "Added to the design's needle radial clearance (total >= 0) [um]")
-    support_clearance_um: float | list[float] = _meta("crank", "clear",
-                                                      "Radial clearance of each crank's support bearings [um]")
+        "crank_disc", "disp", "Added to the design's needle radial clearance (total >= 0) [um]"
+    )
+    support_clearance_um: float | list[float] = _meta(
+        "crank", "clear", "Radial clearance of each crank's support bearings [um]"
+    )
 
 
 _GROUPS = {"pins": PinErrors, "cranks": CrankErrors, "first_stage": FirstStageErrors, "clearances": ClearanceErrors}
@@ -181,8 +195,9 @@ def _check_harmonics(path: str, data: Any) -> None:
         if not isinstance(item, dict):
             continue
         p = f"{path}[{h}]"
-        if "order" in item and (not isinstance(item["order"], int) or isinstance(item["order"], bool)
-                                or item["order"] < 1):
+        if "order" in item and (
+            not isinstance(item["order"], int) or isinstance(item["order"], bool) or item["order"] < 1
+        ):
             raise _bad(f"{p}.order", item["order"], "must be an integer >= 1 (at most 4 z_rp)")
         if "amplitude_um" in item:
             _check_value(f"{p}.amplitude_um", item["amplitude_um"], "amp")
@@ -192,8 +207,11 @@ def _check_harmonics(path: str, data: Any) -> None:
 
 def _length(path: str, value: Any, n: int, what: str) -> None:
     if isinstance(value, list) and len(value) != n:
-        raise _bad(path, value if len(value) <= 8 else f"<list of {len(value)} values>",
-                   f"must be one number or a list of exactly {n} values ({what})")
+        raise _bad(
+            path,
+            value if len(value) <= 8 else f"<list of {len(value)} values>",
+            f"must be one number or a list of exactly {n} values ({what})",
+        )
 
 
 def _nonzero(path: str, value: Any, out: list[tuple[str, Any]]) -> None:
@@ -248,8 +266,12 @@ class ManufacturingErrors(_Strict):
                 if name == "harmonics":
                     for h, harm in enumerate(value):
                         if harm.amplitude_um:
-                            out.append((f"errors.discs[{k}].harmonics[{h}]",
-                                        f"order {harm.order}, {harm.amplitude_um:g} um, {harm.phase_deg:g} deg"))
+                            out.append(
+                                (
+                                    f"errors.discs[{k}].harmonics[{h}]",
+                                    f"order {harm.order}, {harm.amplitude_um:g} um, {harm.phase_deg:g} deg",
+                                )
+                            )
                 else:
                     _nonzero(f"errors.discs[{k}].{name}", value, out)
         return out
@@ -277,17 +299,24 @@ class ManufacturingErrors(_Strict):
         for name, value in self.pins:
             _length(f"errors.pins.{name}", value, z, f"z_rp = {z} pins")
         if self.discs and len(self.discs) != nd:
-            raise _bad("errors.discs", f"<{len(self.discs)} tables>",
-                       f"must be absent or exactly n_discs = {nd} [[errors.discs]] tables")
+            raise _bad(
+                "errors.discs",
+                f"<{len(self.discs)} tables>",
+                f"must be absent or exactly n_discs = {nd} [[errors.discs]] tables",
+            )
         for k, disc in enumerate(self.discs):
             for name in ("hole_radial_um", "hole_tangential_um"):
                 _length(f"errors.discs[{k}].{name}", getattr(disc, name), n, f"N = {n} cranks")
             for h, harm in enumerate(disc.harmonics):
                 if harm.order > 4 * z:
-                    raise _bad(f"errors.discs[{k}].harmonics[{h}].order", harm.order,
-                               f"must be within 1..4 z_rp = {4 * z}")
-        groups = ((self.cranks, "errors.cranks"), (self.first_stage, "errors.first_stage"),
-                  (self.clearances, "errors.clearances"))
+                    raise _bad(
+                        f"errors.discs[{k}].harmonics[{h}].order", harm.order, f"must be within 1..4 z_rp = {4 * z}"
+                    )
+        groups = (
+            (self.cranks, "errors.cranks"),
+            (self.first_stage, "errors.first_stage"),
+            (self.clearances, "errors.clearances"),
+        )
         for obj, path in groups:
             for name, info in type(obj).model_fields.items():
                 shape = (info.json_schema_extra or {}).get("shape")
@@ -305,8 +334,12 @@ class ManufacturingErrors(_Strict):
             for k, v in enumerate(row):
                 if c0 + v < 0.0:
                     where = f"[{j}][{k}]" if isinstance(extra, list) else ""
-                    raise _bad(f"errors.clearances.needle_extra_clearance_um{where}", v,
-                               f"must be >= {-c0:g} um", f"the total needle clearance {c0:g} + ({v:g}) um would be negative")
+                    raise _bad(
+                        f"errors.clearances.needle_extra_clearance_um{where}",
+                        v,
+                        f"must be >= {-c0:g} um",
+                        f"the total needle clearance {c0:g} + ({v:g}) um would be negative",
+                    )
         if not self.is_zero():
             self._check_assembly(reducer)
 
@@ -328,15 +361,20 @@ class ManufacturingErrors(_Strict):
             if not sub.is_zero():
                 alone.append((assembly_penetration(reducer, sub)[0] * UM_PER_M, f"errors.{group}"))
         alone.sort(reverse=True)
-        detail = ", ".join(f"{name} alone: " + (f"{p:.3g} um interference" if p > 0 else f"{-p:.3g} um clearance")
-                           for p, name in alone)
-        culprit = alone[0][1] if alone and alone[0][0] > max(nominal * UM_PER_M, 0.0) + 1e-3 else "the combination of errors"
-        nominal_text = (f"{nominal * UM_PER_M:.3g} um" if nominal > 0 else "none")
-        raise ValueError(f"{culprit}: the as-built parts interfere at assembly: pin {pin} penetrates disc {disc} by "
-                         f"{pen * UM_PER_M:.3g} um at the best common disc rotation, more than the "
-                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um the pin contact law can carry (allowed: <= "
-                         f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um; nominal design's interference: {nominal_text}; {detail}); "
-                         f"reduce {culprit}")
+        detail = ", ".join(
+            f"{name} alone: " + (f"{p:.3g} um interference" if p > 0 else f"{-p:.3g} um clearance") for p, name in alone
+        )
+        culprit = (
+            alone[0][1] if alone and alone[0][0] > max(nominal * UM_PER_M, 0.0) + 1e-3 else "the combination of errors"
+        )
+        nominal_text = f"{nominal * UM_PER_M:.3g} um" if nominal > 0 else "none"
+        raise ValueError(
+            f"{culprit}: the as-built parts interfere at assembly: pin {pin} penetrates disc {disc} by "
+            f"{pen * UM_PER_M:.3g} um at the best common disc rotation, more than the "
+            f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um the pin contact law can carry (allowed: <= "
+            f"{ASSEMBLY_PENETRATION_LIMIT_UM:g} um; nominal design's interference: {nominal_text}; {detail}); "
+            f"reduce {culprit}"
+        )
 
 
 def nominal_design(reducer):

@@ -18,10 +18,7 @@ from typing import Literal
 from pydantic import Field, model_serializer, model_validator
 
 from flexrv.design._base import _bad, _Strict
-
 from flexrv.units import M_PER_UM, RAD_PER_DEG
-
-
 
 #: allowed transverse contact ratio of the first stage: below 1 the mesh loses
 #: contact between pairs; above 2.5 a spur pair needs unusually long addenda
@@ -75,9 +72,16 @@ class FirstStage(_Strict):
         """
         from flexrv.geometry.involute import working_center_distance
 
-        return float(working_center_distance(self.sun_teeth, self.planet_teeth, self.module,
-                                             self.pressure_angle, self.sun_profile_shift,
-                                             self.planet_profile_shift))
+        return float(
+            working_center_distance(
+                self.sun_teeth,
+                self.planet_teeth,
+                self.module,
+                self.pressure_angle,
+                self.sun_profile_shift,
+                self.planet_profile_shift,
+            )
+        )
 
     @property
     def contact_ratio(self) -> float:
@@ -88,8 +92,16 @@ class FirstStage(_Strict):
         from flexrv.geometry.involute import contact_ratio
 
         with np.errstate(invalid="ignore"):  # tips that miss the line of action: NaN, refused by the validator
-            return float(contact_ratio(self.sun_teeth, self.planet_teeth, self.module, self.pressure_angle,
-                                       self.sun_profile_shift, self.planet_profile_shift))
+            return float(
+                contact_ratio(
+                    self.sun_teeth,
+                    self.planet_teeth,
+                    self.module,
+                    self.pressure_angle,
+                    self.sun_profile_shift,
+                    self.planet_profile_shift,
+                )
+            )
 
     @model_validator(mode="after")
     def _mesh(self) -> "FirstStage":
@@ -97,22 +109,31 @@ class FirstStage(_Strict):
         eps = self.contact_ratio
         if not (math.isfinite(eps) and lo < eps < hi):
             shown = f"{eps:.3g}" if math.isfinite(eps) else "undefined (tips do not reach the line of action)"
-            raise _bad("first_stage.sun_profile_shift", self.sun_profile_shift,
-                       f"the transverse contact ratio eps_alpha = {shown} of sun_teeth = {self.sun_teeth}, "
-                       f"planet_teeth = {self.planet_teeth}, planet_profile_shift = {self.planet_profile_shift:g} "
-                       f"must lie in {lo:g} < eps_alpha < {hi:g}", "change the profile shifts or tooth numbers")
+            raise _bad(
+                "first_stage.sun_profile_shift",
+                self.sun_profile_shift,
+                f"the transverse contact ratio eps_alpha = {shown} of sun_teeth = {self.sun_teeth}, "
+                f"planet_teeth = {self.planet_teeth}, planet_profile_shift = {self.planet_profile_shift:g} "
+                f"must lie in {lo:g} < eps_alpha < {hi:g}",
+                "change the profile shifts or tooth numbers",
+            )
         # involute undercut (practical limit, DIN 3960 / Niemann & Winter: slight undercut allowed
         # down to z' = 5/6 of the theoretical 2 h_a / sin^2(alpha), i.e. 14 teeth at 20 deg):
         # x >= 5/6 h_a - z sin^2(alpha) / 2 with the addendum h_a = 1 module
         s2 = math.sin(self.pressure_angle) ** 2
-        for name, z, x in (("sun", self.sun_teeth, self.sun_profile_shift),
-                           ("planet", self.planet_teeth, self.planet_profile_shift)):
+        for name, z, x in (
+            ("sun", self.sun_teeth, self.sun_profile_shift),
+            ("planet", self.planet_teeth, self.planet_profile_shift),
+        ):
             x_min = 5.0 / 6.0 - 0.5 * z * s2
             if x < x_min - 1e-12:
-                raise _bad(f"first_stage.{name}_profile_shift", x,
-                           f"must be >= {x_min:.3f} for {z} teeth at {self.pressure_angle_deg:g} deg "
-                           "(involute undercut; practical limit 5/6 h_a - z sin^2(alpha)/2)",
-                           "the tooth root would be cut away by the generating tool")
+                raise _bad(
+                    f"first_stage.{name}_profile_shift",
+                    x,
+                    f"must be >= {x_min:.3f} for {z} teeth at {self.pressure_angle_deg:g} deg "
+                    "(involute undercut; practical limit 5/6 h_a - z sin^2(alpha)/2)",
+                    "the tooth root would be cut away by the generating tool",
+                )
         return self
 
 
@@ -134,8 +155,10 @@ class SecondStage(_Strict):
     center_hole_radius_mm: float = Field(ge=0.0, le=500.0, description="Radius of the disc's centre hole [mm]")
     mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Pin-disc contact damping ratio xi_34 [-]")
     disc_body_model: Literal["condensed_fe", "rigid"] = Field(
-        default="condensed_fe", description="Cycloid-disc body between the crank holes and the tooth region: "
-        "'condensed_fe' (FE condensation, flexrv.fem.disc, in series in every model) or 'rigid'")
+        default="condensed_fe",
+        description="Cycloid-disc body between the crank holes and the tooth region: "
+        "'condensed_fe' (FE condensation, flexrv.fem.disc, in series in every model) or 'rigid'",
+    )
 
     @property
     def pin_circle_radius(self) -> float:
@@ -177,30 +200,43 @@ class SecondStage(_Strict):
     @model_validator(mode="after")
     def _consistent(self) -> "SecondStage":
         if self.pin_count - self.disc_teeth != 1:
-            raise _bad("second_stage.pin_count", self.pin_count,
-                       f"must equal disc_teeth + 1 = {self.disc_teeth + 1}",
-                       "an RV cycloid stage has one pin more than disc teeth")
+            raise _bad(
+                "second_stage.pin_count",
+                self.pin_count,
+                f"must equal disc_teeth + 1 = {self.disc_teeth + 1}",
+                "an RV cycloid stage has one pin more than disc teeth",
+            )
         spacing = 2.0 * self.pin_circle_radius_mm * math.sin(math.pi / self.pin_count)
         if 2.0 * self.pin_radius_mm >= spacing:
-            raise _bad("second_stage.pin_radius_mm", self.pin_radius_mm,
-                       f"must be < {spacing / 2:.4g} mm (half the pin spacing on R_p = "
-                       f"{self.pin_circle_radius_mm:g} mm)", "neighbouring pins would overlap")
+            raise _bad(
+                "second_stage.pin_radius_mm",
+                self.pin_radius_mm,
+                f"must be < {spacing / 2:.4g} mm (half the pin spacing on R_p = {self.pin_circle_radius_mm:g} mm)",
+                "neighbouring pins would overlap",
+            )
         k1 = self.shortening_coefficient
         if k1 >= 1.0:
-            raise _bad("second_stage.eccentricity_mm", self.eccentricity_mm,
-                       f"must be < R_p/z_rp = {self.pin_circle_radius_mm / self.pin_count:.4g} mm "
-                       f"(shortening coefficient K1 = a z_rp / R_p = {k1:.3f} must be < 1)",
-                       "the pin-centre curve loops and the disc profile undercuts")
+            raise _bad(
+                "second_stage.eccentricity_mm",
+                self.eccentricity_mm,
+                f"must be < R_p/z_rp = {self.pin_circle_radius_mm / self.pin_count:.4g} mm "
+                f"(shortening coefficient K1 = a z_rp / R_p = {k1:.3f} must be < 1)",
+                "the pin-centre curve loops and the disc profile undercuts",
+            )
         from flexrv.geometry.cycloid import min_convex_curvature_radius
 
-        rho_min = min_convex_curvature_radius(self.pin_count, self.pin_circle_radius + self.modification_shift,
-                                              self.eccentricity)
+        rho_min = min_convex_curvature_radius(
+            self.pin_count, self.pin_circle_radius + self.modification_shift, self.eccentricity
+        )
         offset = self.pin_radius + self.modification_equidistant
         if offset >= rho_min:
-            raise _bad("second_stage.pin_radius_mm", self.pin_radius_mm,
-                       f"pin radius + equidistant modification must be < {rho_min * 1e3:.4g} mm, the minimum "
-                       "convex curvature radius of the pin-centre epitrochoid",
-                       "the disc profile would undercut; reduce the eccentricity or the pin radius")
+            raise _bad(
+                "second_stage.pin_radius_mm",
+                self.pin_radius_mm,
+                f"pin radius + equidistant modification must be < {rho_min * 1e3:.4g} mm, the minimum "
+                "convex curvature radius of the pin-centre epitrochoid",
+                "the disc profile would undercut; reduce the eccentricity or the pin radius",
+            )
         return self
 
 
@@ -213,23 +249,47 @@ class Crankshaft(_Strict):
     gear_seat_length_mm: float = Field(gt=1.0, le=200.0)
     support_journal_diameter_mm: float = Field(gt=1.0, le=200.0)
     support_journal_length_mm: float = Field(gt=1.0, le=200.0)
-    eccentric_journal_diameter_mm: float = Field(gt=1.0, le=200.0, description="Needle-bearing inner raceway diameter [mm]")
+    eccentric_journal_diameter_mm: float = Field(
+        gt=1.0, le=200.0, description="Needle-bearing inner raceway diameter [mm]"
+    )
     eccentric_journal_length_mm: float = Field(gt=1.0, le=200.0)
     support_bearing_model: Literal["tapered_rollers", "linear"] = Field(
-        default="tapered_rollers", description="Crank support law: roller-resolved preloaded tapered-roller pair "
-        "(flexrv.contact.tapered_roller) or the linear spring of support_bearing_radial_stiffness_N_per_m")
-    support_bearing_roller_count: int | None = Field(default=None, ge=6, le=60, description="Rollers per support bearing Z [-]")
-    support_bearing_roller_diameter_mm: float | None = Field(default=None, gt=0.5, le=50.0, description="Mean roller diameter D [mm]")
-    support_bearing_roller_length_mm: float | None = Field(default=None, gt=0.5, le=100.0, description="Effective roller contact length l [mm]")
-    support_bearing_pitch_diameter_mm: float | None = Field(default=None, gt=2.0, le=500.0, description="Roller-set pitch diameter d_m [mm]")
-    support_bearing_contact_angle_deg: float | None = Field(default=None, ge=5.0, le=35.0, description="Cup (outer raceway) half-angle alpha [deg]")
-    support_bearing_axial_preload_um: float | None = Field(default=None, ge=-50.0, le=50.0, description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end play (-) [um]")
-    support_bearing_radial_stiffness_N_per_m: float | None = Field(default=None, gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing (linear model only)")
+        default="tapered_rollers",
+        description="Crank support law: roller-resolved preloaded tapered-roller pair "
+        "(flexrv.contact.tapered_roller) or the linear spring of support_bearing_radial_stiffness_N_per_m",
+    )
+    support_bearing_roller_count: int | None = Field(
+        default=None, ge=6, le=60, description="Rollers per support bearing Z [-]"
+    )
+    support_bearing_roller_diameter_mm: float | None = Field(
+        default=None, gt=0.5, le=50.0, description="Mean roller diameter D [mm]"
+    )
+    support_bearing_roller_length_mm: float | None = Field(
+        default=None, gt=0.5, le=100.0, description="Effective roller contact length l [mm]"
+    )
+    support_bearing_pitch_diameter_mm: float | None = Field(
+        default=None, gt=2.0, le=500.0, description="Roller-set pitch diameter d_m [mm]"
+    )
+    support_bearing_contact_angle_deg: float | None = Field(
+        default=None, ge=5.0, le=35.0, description="Cup (outer raceway) half-angle alpha [deg]"
+    )
+    support_bearing_axial_preload_um: float | None = Field(
+        default=None,
+        ge=-50.0,
+        le=50.0,
+        description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end play (-) [um]",
+    )
+    support_bearing_radial_stiffness_N_per_m: float | None = Field(
+        default=None, gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing (linear model only)"
+    )
     support_bearing_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
     structural_damping_ratio: float = Field(
-        ge=0.0, le=1.0, description="Damping ratio of the flexible crankshafts' elastic coordinates")
+        ge=0.0, le=1.0, description="Damping ratio of the flexible crankshafts' elastic coordinates"
+    )
     bending_model: Literal["timoshenko", "rigid"] = Field(
-        default="timoshenko", description="Crank bending between the support journals and the eccentrics in series with the supports")
+        default="timoshenko",
+        description="Crank bending between the support journals and the eccentrics in series with the supports",
+    )
 
     @model_serializer(mode="wrap")
     def _drop_unused(self, handler):
@@ -239,40 +299,67 @@ class Crankshaft(_Strict):
 
     @model_validator(mode="after")
     def _support_bearing(self) -> "Crankshaft":
-        tapered = ("support_bearing_roller_count", "support_bearing_roller_diameter_mm", "support_bearing_roller_length_mm",
-                   "support_bearing_pitch_diameter_mm", "support_bearing_contact_angle_deg", "support_bearing_axial_preload_um")
+        tapered = (
+            "support_bearing_roller_count",
+            "support_bearing_roller_diameter_mm",
+            "support_bearing_roller_length_mm",
+            "support_bearing_pitch_diameter_mm",
+            "support_bearing_contact_angle_deg",
+            "support_bearing_axial_preload_um",
+        )
         if self.support_bearing_model == "linear":
             if self.support_bearing_radial_stiffness_N_per_m is None:
-                raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", None,
-                           "missing required field of support_bearing_model = 'linear' (1e6 < value <= 1e12 N/m)")
+                raise _bad(
+                    "crankshaft.support_bearing_radial_stiffness_N_per_m",
+                    None,
+                    "missing required field of support_bearing_model = 'linear' (1e6 < value <= 1e12 N/m)",
+                )
             given = [f for f in tapered if getattr(self, f) is not None]
             if given:
-                raise _bad(f"crankshaft.{given[0]}", getattr(self, given[0]),
-                           "only used with support_bearing_model = 'tapered_rollers'; remove it")
+                raise _bad(
+                    f"crankshaft.{given[0]}",
+                    getattr(self, given[0]),
+                    "only used with support_bearing_model = 'tapered_rollers'; remove it",
+                )
             return self
         for f in tapered:
             if getattr(self, f) is None:
-                raise _bad(f"crankshaft.{f}", None, "missing required field of support_bearing_model = 'tapered_rollers'")
+                raise _bad(
+                    f"crankshaft.{f}", None, "missing required field of support_bearing_model = 'tapered_rollers'"
+                )
         if self.support_bearing_radial_stiffness_N_per_m is not None:
-            raise _bad("crankshaft.support_bearing_radial_stiffness_N_per_m", self.support_bearing_radial_stiffness_N_per_m,
-                       "only used with support_bearing_model = 'linear'; remove it (the tapered-roller law computes it)")
+            raise _bad(
+                "crankshaft.support_bearing_radial_stiffness_N_per_m",
+                self.support_bearing_radial_stiffness_N_per_m,
+                "only used with support_bearing_model = 'linear'; remove it (the tapered-roller law computes it)",
+            )
         d_j, dm = self.support_journal_diameter_mm, self.support_bearing_pitch_diameter_mm
         dw, z = self.support_bearing_roller_diameter_mm, self.support_bearing_roller_count
         wall = 0.15 * dw  # cone (inner ring) section under the roller
         if dm - dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG) < d_j + 2.0 * wall:
-            raise _bad("crankshaft.support_bearing_pitch_diameter_mm", dm,
-                       f"must be >= {d_j + 2.0 * wall + dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG):.4g} mm: "
-                       f"the cone raceway (d_m - D cos alpha) must clear the {d_j:g} mm support journal by a "
-                       f"ring wall of 0.15 D = {wall:.3g} mm", "the bearing does not fit on the journal")
+            raise _bad(
+                "crankshaft.support_bearing_pitch_diameter_mm",
+                dm,
+                f"must be >= {d_j + 2.0 * wall + dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG):.4g} mm: "
+                f"the cone raceway (d_m - D cos alpha) must clear the {d_j:g} mm support journal by a "
+                f"ring wall of 0.15 D = {wall:.3g} mm",
+                "the bearing does not fit on the journal",
+            )
         z_max = int(math.pi * dm / (1.05 * dw))
         if z > z_max:
-            raise _bad("crankshaft.support_bearing_roller_count", z,
-                       f"must be <= {z_max}: {z} rollers of {dw:g} mm on the {dm:g} mm pitch circle need a 5 % cage "
-                       "bar gap", "the rollers would overlap")
+            raise _bad(
+                "crankshaft.support_bearing_roller_count",
+                z,
+                f"must be <= {z_max}: {z} rollers of {dw:g} mm on the {dm:g} mm pitch circle need a 5 % cage bar gap",
+                "the rollers would overlap",
+            )
         if self.support_bearing_roller_length_mm > self.support_journal_length_mm:
-            raise _bad("crankshaft.support_bearing_roller_length_mm", self.support_bearing_roller_length_mm,
-                       f"must be <= support_journal_length_mm = {self.support_journal_length_mm:g} mm",
-                       "the bearing sits on the support journal")
+            raise _bad(
+                "crankshaft.support_bearing_roller_length_mm",
+                self.support_bearing_roller_length_mm,
+                f"must be <= support_journal_length_mm = {self.support_journal_length_mm:g} mm",
+                "the bearing sits on the support journal",
+            )
         return self
 
 
@@ -304,19 +391,28 @@ class MainBearing(_Strict):
     outer_ring_outer_diameter_mm: float = Field(gt=1.0, le=3000.0)
     ring_width_mm: float = Field(gt=1.0, le=300.0, description="Axial width of one ring (one row)")
     row_spacing_mm: float = Field(gt=1.0, le=1000.0, description="Axial distance between the two rows' ball centres")
-    axial_preload_um: float = Field(ge=-100.0, le=100.0, description="Axial interference per row (+ preload, - clearance)")
+    axial_preload_um: float = Field(
+        ge=-100.0, le=100.0, description="Axial interference per row (+ preload, - clearance)"
+    )
     ball_damping_Ns_per_m: float = Field(ge=0.0, le=1e7, description="Max contact damping c_max of the impact law")
     rigid_radial_stiffness_N_per_m: float = Field(
-        gt=1e6, le=1e12, description="Radial stiffness of the pair in the rigid main-bearing model (the ball model resolves it)")
+        gt=1e6,
+        le=1e12,
+        description="Radial stiffness of the pair in the rigid main-bearing model (the ball model resolves it)",
+    )
     rigid_axial_stiffness_N_per_m: float = Field(
-        gt=1e6, le=1e12, description="Axial stiffness of the pair in the rigid main-bearing model")
+        gt=1e6, le=1e12, description="Axial stiffness of the pair in the rigid main-bearing model"
+    )
     rigid_damping_ratio: float = Field(
-        ge=0.0, le=1.0, description="Damping ratio of the rigid main bearing's carrier modes (c = 2 zeta sqrt(k m))")
+        ge=0.0, le=1.0, description="Damping ratio of the rigid main bearing's carrier modes (c = 2 zeta sqrt(k m))"
+    )
     cage_stiffness_N_per_m: float = Field(
-        gt=0.0, le=1e9, description="Tangential spring of each ball to its cage pocket (ball-resolved models)")
+        gt=0.0, le=1e9, description="Tangential spring of each ball to its cage pocket (ball-resolved models)"
+    )
     cage_damping_Ns_per_m: float = Field(ge=0.0, le=1e6, description="Tangential damper of each ball to its pocket")
     pocket_stiffness_N_per_m: float = Field(
-        ge=0.0, le=1e9, description="Weak radial/axial spring of each ball to its pocket (ball-resolved models)")
+        ge=0.0, le=1e9, description="Weak radial/axial spring of each ball to its pocket (ball-resolved models)"
+    )
     ring_damping_ratio: float = Field(ge=0.0, le=1.0, description="Modal damping ratio of dynamic flexible rings")
 
     @model_validator(mode="after")
@@ -325,7 +421,11 @@ class MainBearing(_Strict):
         bore, od = self.inner_ring_bore_diameter_mm, self.outer_ring_outer_diameter_mm
         min_wall = 0.1 * d
         if not bore < dm < od:
-            raise _bad("main_bearing.pitch_diameter_mm", dm, f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm")
+            raise _bad(
+                "main_bearing.pitch_diameter_mm",
+                dm,
+                f"must lie between the inner bore {bore:g} mm and outer diameter {od:g} mm",
+            )
         from flexrv.geometry.bearing import BallBearingGeometry
         from flexrv.units import M_PER_MM
 
@@ -334,22 +434,39 @@ class MainBearing(_Strict):
         bottom_i = geo.groove_bottom_radius("inner") / M_PER_MM
         bottom_o = geo.groove_bottom_radius("outer") / M_PER_MM
         if bottom_i - bore / 2 < min_wall:
-            raise _bad("main_bearing.ball_diameter_mm", d,
-                       f"too large for the inner ring section: the wall under the groove is {bottom_i - bore / 2:.4g} mm, "
-                       f"must be >= 0.1 D = {min_wall:.4g} mm", "ball larger than the ring section")
+            raise _bad(
+                "main_bearing.ball_diameter_mm",
+                d,
+                f"too large for the inner ring section: the wall under the groove is {bottom_i - bore / 2:.4g} mm, "
+                f"must be >= 0.1 D = {min_wall:.4g} mm",
+                "ball larger than the ring section",
+            )
         if od / 2 - bottom_o < min_wall:
-            raise _bad("main_bearing.ball_diameter_mm", d,
-                       f"too large for the outer ring section: the wall under the groove is {od / 2 - bottom_o:.4g} mm, "
-                       f"must be >= 0.1 D = {min_wall:.4g} mm", "ball larger than the ring section")
+            raise _bad(
+                "main_bearing.ball_diameter_mm",
+                d,
+                f"too large for the outer ring section: the wall under the groove is {od / 2 - bottom_o:.4g} mm, "
+                f"must be >= 0.1 D = {min_wall:.4g} mm",
+                "ball larger than the ring section",
+            )
         half_contact = 0.5 * d * math.sin(self.contact_angle_deg * RAD_PER_DEG)
         if self.ring_width_mm < 2.2 * half_contact:
-            raise _bad("main_bearing.ring_width_mm", self.ring_width_mm,
-                       f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} mm) lies on the raceway")
+            raise _bad(
+                "main_bearing.ring_width_mm",
+                self.ring_width_mm,
+                f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} mm) lies on the raceway",
+            )
         if math.pi * dm / self.ball_count <= d * 1.05:
-            raise _bad("main_bearing.ball_count", self.ball_count,
-                       f"must be <= {int(math.pi * dm / (1.05 * d))} for D = {d:g} mm on d_m = {dm:g} mm", "balls would touch")
+            raise _bad(
+                "main_bearing.ball_count",
+                self.ball_count,
+                f"must be <= {int(math.pi * dm / (1.05 * d))} for D = {d:g} mm on d_m = {dm:g} mm",
+                "balls would touch",
+            )
         if self.row_spacing_mm < self.ring_width_mm:
-            raise _bad("main_bearing.row_spacing_mm", self.row_spacing_mm, f"must be >= ring_width_mm = {self.ring_width_mm:g}")
+            raise _bad(
+                "main_bearing.row_spacing_mm", self.row_spacing_mm, f"must be >= ring_width_mm = {self.ring_width_mm:g}"
+            )
         return self
 
     @property
@@ -380,19 +497,33 @@ class Carrier(_Strict):
     cranks at 2 pi k/N (the disc's crank holes). The plates' rims seat the main
     bearing; the output plate's outer face is the output flange."""
 
-    plate_outer_diameter_mm: float = Field(gt=10.0, le=3000.0, description="End-plate outer diameter = main-bearing inner-ring seat [mm]")
-    input_plate_thickness_mm: float = Field(gt=1.0, le=300.0, description="Axial thickness of the input-side end plate [mm]")
-    output_plate_thickness_mm: float = Field(gt=1.0, le=300.0, description="Axial thickness of the output-flange plate [mm]")
-    plate_gap_mm: float = Field(gt=1.0, le=1000.0, description="Axial gap between the plates (disc stack + clearances) [mm]")
-    crank_bore_diameter_mm: float = Field(gt=1.0, le=600.0, description="Bore of a crank support-bearing seat in a plate [mm]")
-    center_bore_diameter_mm: float = Field(ge=0.0, le=2000.0, description="Central through-bore (input shaft) [mm]; 0 = none")
+    plate_outer_diameter_mm: float = Field(
+        gt=10.0, le=3000.0, description="End-plate outer diameter = main-bearing inner-ring seat [mm]"
+    )
+    input_plate_thickness_mm: float = Field(
+        gt=1.0, le=300.0, description="Axial thickness of the input-side end plate [mm]"
+    )
+    output_plate_thickness_mm: float = Field(
+        gt=1.0, le=300.0, description="Axial thickness of the output-flange plate [mm]"
+    )
+    plate_gap_mm: float = Field(
+        gt=1.0, le=1000.0, description="Axial gap between the plates (disc stack + clearances) [mm]"
+    )
+    crank_bore_diameter_mm: float = Field(
+        gt=1.0, le=600.0, description="Bore of a crank support-bearing seat in a plate [mm]"
+    )
+    center_bore_diameter_mm: float = Field(
+        ge=0.0, le=2000.0, description="Central through-bore (input shaft) [mm]; 0 = none"
+    )
     pillar_count: int = Field(ge=2, le=12, description="Number of pillars N_p [-]")
     pillar_circle_radius_mm: float = Field(gt=1.0, le=1500.0, description="Radius of the pillar-centre circle [mm]")
     pillar_diameter_mm: float = Field(gt=1.0, le=600.0, description="Diameter of a (round) pillar [mm]")
     body_model: Literal["condensed_fe", "rigid"] = Field(
-        default="condensed_fe", description="Carrier body between the crank bores and the output flange: "
+        default="condensed_fe",
+        description="Carrier body between the crank bores and the output flange: "
         "'condensed_fe' (FE condensation, flexrv.fem.carrier, in series with the crank supports in every model) "
-        "or 'rigid'")
+        "or 'rigid'",
+    )
 
     def pillar_angles(self) -> list[float]:
         """Angles [rad] of the pillar centres."""
@@ -405,19 +536,29 @@ class Carrier(_Strict):
         r_o, r_c = 0.5 * self.plate_outer_diameter_mm, 0.5 * self.center_bore_diameter_mm
         rp, rc_p = 0.5 * self.pillar_diameter_mm, self.pillar_circle_radius_mm
         if rc_p + rp + lig > r_o:
-            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
-                       f"must be <= {r_o - rp - lig:.4g} mm (plate_outer_diameter_mm / 2 = {r_o:g} mm - pillar radius {rp:g} mm "
-                       f"- ligament {lig:g} mm)", "the pillars would stick out of the plates")
+            raise _bad(
+                "carrier.pillar_circle_radius_mm",
+                rc_p,
+                f"must be <= {r_o - rp - lig:.4g} mm (plate_outer_diameter_mm / 2 = {r_o:g} mm - pillar radius {rp:g} mm "
+                f"- ligament {lig:g} mm)",
+                "the pillars would stick out of the plates",
+            )
         if r_c > 0 and rc_p - rp - lig < r_c:
-            raise _bad("carrier.center_bore_diameter_mm", self.center_bore_diameter_mm,
-                       f"must be <= {2 * (rc_p - rp - lig):.4g} mm (pillar_circle_radius_mm = {rc_p:g}, pillar_diameter_mm = "
-                       f"{self.pillar_diameter_mm:g})",
-                       "the centre bore would cut the pillars")
+            raise _bad(
+                "carrier.center_bore_diameter_mm",
+                self.center_bore_diameter_mm,
+                f"must be <= {2 * (rc_p - rp - lig):.4g} mm (pillar_circle_radius_mm = {rc_p:g}, pillar_diameter_mm = "
+                f"{self.pillar_diameter_mm:g})",
+                "the centre bore would cut the pillars",
+            )
         spacing = 2.0 * rc_p * math.sin(math.pi / self.pillar_count)
         if spacing < 2.0 * rp + lig:
-            raise _bad("carrier.pillar_diameter_mm", self.pillar_diameter_mm,
-                       f"must be <= {spacing - lig:.4g} mm for pillar_count = {self.pillar_count} on pillar_circle_radius_mm = {rc_p:g}",
-                       "neighbouring pillars would overlap")
+            raise _bad(
+                "carrier.pillar_diameter_mm",
+                self.pillar_diameter_mm,
+                f"must be <= {spacing - lig:.4g} mm for pillar_count = {self.pillar_count} on pillar_circle_radius_mm = {rc_p:g}",
+                "neighbouring pillars would overlap",
+            )
         return self
 
     def validate_for(self, reducer) -> None:
@@ -433,20 +574,35 @@ class Carrier(_Strict):
         n = fs.n_planets
         r_o, r_b = 0.5 * self.plate_outer_diameter_mm, 0.5 * self.crank_bore_diameter_mm
         if self.crank_bore_diameter_mm <= cs.support_journal_diameter_mm:
-            raise _bad("carrier.crank_bore_diameter_mm", self.crank_bore_diameter_mm,
-                       f"must be > crankshaft.support_journal_diameter_mm = {cs.support_journal_diameter_mm:g} mm",
-                       "the support bearing sits between journal and bore")
+            raise _bad(
+                "carrier.crank_bore_diameter_mm",
+                self.crank_bore_diameter_mm,
+                f"must be > crankshaft.support_journal_diameter_mm = {cs.support_journal_diameter_mm:g} mm",
+                "the support bearing sits between journal and bore",
+            )
         if n > 1 and 2.0 * a_w * math.sin(math.pi / n) < 2.0 * r_b + lig:
-            raise _bad("carrier.crank_bore_diameter_mm", self.crank_bore_diameter_mm,
-                       f"must be <= {2.0 * a_w * math.sin(math.pi / n) - lig:.4g} mm for {n} bores on the crank "
-                       f"circle a_w = {a_w:.4g} mm", "neighbouring crank bores would overlap")
+            raise _bad(
+                "carrier.crank_bore_diameter_mm",
+                self.crank_bore_diameter_mm,
+                f"must be <= {2.0 * a_w * math.sin(math.pi / n) - lig:.4g} mm for {n} bores on the crank "
+                f"circle a_w = {a_w:.4g} mm",
+                "neighbouring crank bores would overlap",
+            )
         if a_w + r_b + lig > r_o:
-            raise _bad("carrier.plate_outer_diameter_mm", self.plate_outer_diameter_mm,
-                       f"must be >= {2 * (a_w + r_b + lig):.4g} mm (crank circle {a_w:.4g} mm + crank_bore_diameter_mm / 2 = "
-                       f"{r_b:g} mm + ligament {lig:g} mm)", "the crank bores would cut the plate rim")
+            raise _bad(
+                "carrier.plate_outer_diameter_mm",
+                self.plate_outer_diameter_mm,
+                f"must be >= {2 * (a_w + r_b + lig):.4g} mm (crank circle {a_w:.4g} mm + crank_bore_diameter_mm / 2 = "
+                f"{r_b:g} mm + ligament {lig:g} mm)",
+                "the crank bores would cut the plate rim",
+            )
         if self.center_bore_diameter_mm > 0 and 0.5 * self.center_bore_diameter_mm + lig > a_w - r_b:
-            raise _bad("carrier.center_bore_diameter_mm", self.center_bore_diameter_mm,
-                       f"must be <= {2 * (a_w - r_b - lig):.4g} mm", "the centre bore would cut the crank bores")
+            raise _bad(
+                "carrier.center_bore_diameter_mm",
+                self.center_bore_diameter_mm,
+                f"must be <= {2 * (a_w - r_b - lig):.4g} mm",
+                "the centre bore would cut the crank bores",
+            )
         rp, rc_p = 0.5 * self.pillar_diameter_mm, self.pillar_circle_radius_mm
         e = ss.eccentricity_mm
         r_hole = reducer.crank_hole_radius * 1e3
@@ -455,34 +611,55 @@ class Carrier(_Strict):
                 psi = 2.0 * math.pi * k / n
                 dist = math.sqrt(max(rc_p**2 + a_w**2 - 2.0 * rc_p * a_w * math.cos(ang - psi), 0.0))
                 if dist < rp + r_b + lig:
-                    raise _bad("carrier.pillar_circle_radius_mm", rc_p,
-                               f"a pillar (pillar_diameter_mm = {self.pillar_diameter_mm:g}) at {math.degrees(ang):.4g} deg is {dist:.4g} mm from the "
-                               f"crank bore at {math.degrees(psi):.4g} deg; need >= {rp + r_b + lig:.4g} mm",
-                               "pillar and crank bore would intersect")
+                    raise _bad(
+                        "carrier.pillar_circle_radius_mm",
+                        rc_p,
+                        f"a pillar (pillar_diameter_mm = {self.pillar_diameter_mm:g}) at {math.degrees(ang):.4g} deg is {dist:.4g} mm from the "
+                        f"crank bore at {math.degrees(psi):.4g} deg; need >= {rp + r_b + lig:.4g} mm",
+                        "pillar and crank bore would intersect",
+                    )
                 if dist < rp + e + r_hole + lig:
-                    raise _bad("carrier.pillar_diameter_mm", self.pillar_diameter_mm,
-                               f"the pillar's hole in the disc (pillar radius + eccentricity {rp + e:.4g} mm) comes "
-                               f"within {dist - rp - e - r_hole:.3g} mm of the disc's crank hole; need >= {lig:g} mm",
-                               "pillar hole and crank hole of the disc would intersect")
+                    raise _bad(
+                        "carrier.pillar_diameter_mm",
+                        self.pillar_diameter_mm,
+                        f"the pillar's hole in the disc (pillar radius + eccentricity {rp + e:.4g} mm) comes "
+                        f"within {dist - rp - e - r_hole:.3g} mm of the disc's crank hole; need >= {lig:g} mm",
+                        "pillar hole and crank hole of the disc would intersect",
+                    )
         r_root = ss.pin_circle_radius_mm - ss.pin_radius_mm - e
         if rc_p + rp + e + lig > r_root:
-            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
-                       f"must be <= {r_root - rp - e - lig:.4g} mm: the pillar's hole in the disc (pillar_diameter_mm / 2 + "
-                       f"eccentricity = {rp + e:.4g} mm) "
-                       f"must stay inside the disc root radius {r_root:.4g} mm", "the pillars would cut the disc teeth")
+            raise _bad(
+                "carrier.pillar_circle_radius_mm",
+                rc_p,
+                f"must be <= {r_root - rp - e - lig:.4g} mm: the pillar's hole in the disc (pillar_diameter_mm / 2 + "
+                f"eccentricity = {rp + e:.4g} mm) "
+                f"must stay inside the disc root radius {r_root:.4g} mm",
+                "the pillars would cut the disc teeth",
+            )
         if ss.center_hole_radius_mm > 0 and rc_p - rp - e - lig < ss.center_hole_radius_mm:
-            raise _bad("carrier.pillar_circle_radius_mm", rc_p,
-                       f"must be >= {ss.center_hole_radius_mm + rp + e + lig:.4g} mm (disc centre hole "
-                       f"{ss.center_hole_radius_mm:g} mm, pillar_diameter_mm = {self.pillar_diameter_mm:g})", "the pillar holes would cut the disc's centre hole")
+            raise _bad(
+                "carrier.pillar_circle_radius_mm",
+                rc_p,
+                f"must be >= {ss.center_hole_radius_mm + rp + e + lig:.4g} mm (disc centre hole "
+                f"{ss.center_hole_radius_mm:g} mm, pillar_diameter_mm = {self.pillar_diameter_mm:g})",
+                "the pillar holes would cut the disc's centre hole",
+            )
         stack = ss.n_discs * ss.disc_width_mm
         if self.plate_gap_mm < stack:
-            raise _bad("carrier.plate_gap_mm", self.plate_gap_mm,
-                       f"must be >= n_discs x disc_width = {stack:g} mm", "the discs run between the plates")
+            raise _bad(
+                "carrier.plate_gap_mm",
+                self.plate_gap_mm,
+                f"must be >= n_discs x disc_width = {stack:g} mm",
+                "the discs run between the plates",
+            )
         bore = reducer.main_bearing.inner_ring_bore_diameter_mm
         if self.plate_outer_diameter_mm > bore:
-            raise _bad("carrier.plate_outer_diameter_mm", self.plate_outer_diameter_mm,
-                       f"must be <= main_bearing.inner_ring_bore_diameter_mm = {bore:g} mm",
-                       "the main bearing's inner ring sits on the plate rim")
+            raise _bad(
+                "carrier.plate_outer_diameter_mm",
+                self.plate_outer_diameter_mm,
+                f"must be <= main_bearing.inner_ring_bore_diameter_mm = {bore:g} mm",
+                "the main bearing's inner ring sits on the plate rim",
+            )
 
 
 class Housing(_Strict):
@@ -493,15 +670,27 @@ class Housing(_Strict):
     disc. The ring section around the pins (outer diameter, axial length) carries
     the pin loads to the housing's fixture."""
 
-    pin_seat_clearance_um: float = Field(gt=0.0, le=500.0, description="Radial clearance of a pin in its groove, groove radius - pin radius [um]")
-    pin_seat_length_mm: float = Field(gt=0.0, le=2000.0, description="Length of a pin's groove seat that carries the disc loads (all discs) [mm]")
-    pin_unsupported_length_mm: float = Field(ge=0.0, le=2000.0, description="Span of a pin between groove lands at each disc [mm]; 0 = fully supported")
-    ring_outer_diameter_mm: float = Field(gt=1.0, le=5000.0, description="Outer diameter of the housing ring around the pins [mm]")
-    ring_length_mm: float = Field(gt=0.0, le=2000.0, description="Axial length of the housing ring section that carries the pin loads [mm]")
+    pin_seat_clearance_um: float = Field(
+        gt=0.0, le=500.0, description="Radial clearance of a pin in its groove, groove radius - pin radius [um]"
+    )
+    pin_seat_length_mm: float = Field(
+        gt=0.0, le=2000.0, description="Length of a pin's groove seat that carries the disc loads (all discs) [mm]"
+    )
+    pin_unsupported_length_mm: float = Field(
+        ge=0.0, le=2000.0, description="Span of a pin between groove lands at each disc [mm]; 0 = fully supported"
+    )
+    ring_outer_diameter_mm: float = Field(
+        gt=1.0, le=5000.0, description="Outer diameter of the housing ring around the pins [mm]"
+    )
+    ring_length_mm: float = Field(
+        gt=0.0, le=2000.0, description="Axial length of the housing ring section that carries the pin loads [mm]"
+    )
     body_model: Literal["ring_estimate", "rigid"] = Field(
-        default="ring_estimate", description="Pin housing in the models: 'ring_estimate' (elastic rotation of the pin "
+        default="ring_estimate",
+        description="Pin housing in the models: 'ring_estimate' (elastic rotation of the pin "
         "ring about the axis with the thin-ring + tube compliance, flexrv.analysis.torsional.housing_compliance, in "
-        "every model and budget) or 'rigid' (left out of every model and budget)")
+        "every model and budget) or 'rigid' (left out of every model and budget)",
+    )
 
     @property
     def pin_seat_clearance(self) -> float:
@@ -513,16 +702,27 @@ class Housing(_Strict):
         ss = reducer.second_stage
         r_groove = ss.pin_circle_radius_mm + ss.pin_radius_mm
         if 0.5 * self.ring_outer_diameter_mm < r_groove + MIN_LIGAMENT_MM:
-            raise _bad("housing.ring_outer_diameter_mm", self.ring_outer_diameter_mm,
-                       f"must be >= {2 * (r_groove + MIN_LIGAMENT_MM):.4g} mm (pin circle {ss.pin_circle_radius_mm:g} mm + "
-                       f"pin radius {ss.pin_radius_mm:g} mm + ligament {MIN_LIGAMENT_MM:g} mm)",
-                       "the pin grooves would cut through the ring")
+            raise _bad(
+                "housing.ring_outer_diameter_mm",
+                self.ring_outer_diameter_mm,
+                f"must be >= {2 * (r_groove + MIN_LIGAMENT_MM):.4g} mm (pin circle {ss.pin_circle_radius_mm:g} mm + "
+                f"pin radius {ss.pin_radius_mm:g} mm + ligament {MIN_LIGAMENT_MM:g} mm)",
+                "the pin grooves would cut through the ring",
+            )
         if self.pin_seat_length_mm > self.ring_length_mm:
-            raise _bad("housing.pin_seat_length_mm", self.pin_seat_length_mm,
-                       f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm", "the grooves lie in the ring")
+            raise _bad(
+                "housing.pin_seat_length_mm",
+                self.pin_seat_length_mm,
+                f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm",
+                "the grooves lie in the ring",
+            )
         if self.pin_unsupported_length_mm > self.ring_length_mm:
-            raise _bad("housing.pin_unsupported_length_mm", self.pin_unsupported_length_mm,
-                       f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm", "the span lies in the ring")
+            raise _bad(
+                "housing.pin_unsupported_length_mm",
+                self.pin_unsupported_length_mm,
+                f"must be <= housing.ring_length_mm = {self.ring_length_mm:g} mm",
+                "the span lies in the ring",
+            )
 
 
 class Material(_Strict):
@@ -560,7 +760,9 @@ class Lubricant(_Strict):
 
     name: str
     viscosity_Pa_s: float = Field(gt=1e-4, le=10.0, description="Dynamic viscosity eta0 at the operating temperature")
-    pressure_viscosity_1_per_GPa: float = Field(gt=1.0, le=60.0, description="Barus coefficient alpha (for Hamrock-Dowson)")
+    pressure_viscosity_1_per_GPa: float = Field(
+        gt=1.0, le=60.0, description="Barus coefficient alpha (for Hamrock-Dowson)"
+    )
     roelands_z: float = Field(gt=0.2, le=1.5)
     roelands_p0_Pa: float = Field(gt=1e7, le=1e9)
     density_kg_m3: float = Field(gt=500.0, le=2000.0)
@@ -590,26 +792,41 @@ class ContactSettings(_Strict):
 
     pin_law: Literal["hertz_line", "impact"] = Field(description="Pin-disc force law")
     impact_exponent: float = Field(ge=1.0, le=3.0, description="Exponent e of the impact law")
-    impact_damping_depth_mm: float = Field(gt=0.0, le=1.0, description="Penetration d over which damping ramps to c_max")
+    impact_damping_depth_mm: float = Field(
+        gt=0.0, le=1.0, description="Penetration d over which damping ramps to c_max"
+    )
     pin_max_damping_Ns_per_m: float = Field(ge=0.0, le=1e7)
     ehl: Literal["dry", "hamrock_dowson", "map"] = Field(description="EHL correction of lubricated contacts")
     pin_penetration_limit_um: float = Field(
-        gt=0.0, le=1000.0, description="Pin-disc penetration beyond which a run is stopped as failed [um]")
+        gt=0.0, le=1000.0, description="Pin-disc penetration beyond which a run is stopped as failed [um]"
+    )
     needle_penetration_limit_um: float = Field(
-        gt=0.0, le=1000.0, description="Needle-bearing penetration beyond which a run is stopped as failed [um] "
-                                       "(at least 20 x the impact law's damping depth)")
+        gt=0.0,
+        le=1000.0,
+        description="Needle-bearing penetration beyond which a run is stopped as failed [um] "
+        "(at least 20 x the impact law's damping depth)",
+    )
     # friction (issue 14): regularised Coulomb friction, flexrv.contact.laws.friction_force
-    friction: bool = Field(description="Friction at the pin-disc/pin-seat and needle contacts on (true) or off "
-                                       "(false: exactly the frictionless model)")
+    friction: bool = Field(
+        description="Friction at the pin-disc/pin-seat and needle contacts on (true) or off "
+        "(false: exactly the frictionless model)"
+    )
     pin_friction_coefficient: float = Field(ge=0.0, le=0.5, description="Coulomb coefficient pin-disc flank [-]")
     pin_seat_friction_coefficient: float = Field(
-        ge=0.0, le=0.5, description="Coulomb coefficient pin-housing groove [-] (the pin slides where friction is "
-                                    "lower: flexrv.contact.laws.effective_pin_friction)")
+        ge=0.0,
+        le=0.5,
+        description="Coulomb coefficient pin-housing groove [-] (the pin slides where friction is "
+        "lower: flexrv.contact.laws.effective_pin_friction)",
+    )
     needle_friction_coefficient: float = Field(
-        ge=0.0, le=0.05, description="Constant friction coefficient of the needle bearings (rolling-bearing "
-                                     "model M = mu F d/2, d the journal diameter) [-]")
+        ge=0.0,
+        le=0.05,
+        description="Constant friction coefficient of the needle bearings (rolling-bearing "
+        "model M = mu F d/2, d the journal diameter) [-]",
+    )
     friction_velocity_mm_per_s: float = Field(
-        gt=0.0, le=100.0, description="Regularisation speed v_reg of the Coulomb law [mm/s]: s = v/sqrt(v^2+v_reg^2)")
+        gt=0.0, le=100.0, description="Regularisation speed v_reg of the Coulomb law [mm/s]: s = v/sqrt(v^2+v_reg^2)"
+    )
 
 
 class OperatingPoint(_Strict):
@@ -630,8 +847,11 @@ class OperatingPoint(_Strict):
     @model_validator(mode="after")
     def _ramp(self) -> "OperatingPoint":
         if self.load_ramp_end_s < self.load_ramp_start_s:
-            raise _bad("operating.load_ramp_end_s", self.load_ramp_end_s,
-                       f"must be >= load_ramp_start_s = {self.load_ramp_start_s:g} s")
+            raise _bad(
+                "operating.load_ramp_end_s",
+                self.load_ramp_end_s,
+                f"must be >= load_ramp_start_s = {self.load_ramp_start_s:g} s",
+            )
         return self
 
     @property
@@ -650,9 +870,10 @@ class Reducer(_Strict):
     name: str = Field(min_length=1, max_length=64)
     description: str
     sources: list[str] = Field(description="Where the values come from (seeds, handbooks)")
-    provenance: dict[str, str] = Field(default_factory=dict,
-                                       description="field path -> note, for every estimated value (optional; "
-                                                   "`flexrv show` warns where it is missing)")
+    provenance: dict[str, str] = Field(
+        default_factory=dict,
+        description="field path -> note, for every estimated value (optional; `flexrv show` warns where it is missing)",
+    )
     first_stage: FirstStage
     second_stage: SecondStage
     crankshaft: Crankshaft
@@ -664,13 +885,19 @@ class Reducer(_Strict):
     inertia: Inertia
     contact: ContactSettings
     operating: OperatingPoint
-    errors: ManufacturingErrors = Field(default_factory=ManufacturingErrors,
-                                        description="Manufacturing and assembly errors (all zero: ideal reducer)")
-    carrier: Carrier | None = Field(default=None, description="Carrier geometry (end plates, pillars, crank bores); "
-                                                              "optional: the carrier FE needs it")
-    housing: Housing | None = Field(default=None, description="Pin housing: pin seats (grooves), pin supports and the "
-                                                              "ring around the pins; optional: without it the pins "
-                                                              "are rigidly seated and the housing rigid")
+    errors: ManufacturingErrors = Field(
+        default_factory=ManufacturingErrors, description="Manufacturing and assembly errors (all zero: ideal reducer)"
+    )
+    carrier: Carrier | None = Field(
+        default=None,
+        description="Carrier geometry (end plates, pillars, crank bores); optional: the carrier FE needs it",
+    )
+    housing: Housing | None = Field(
+        default=None,
+        description="Pin housing: pin seats (grooves), pin supports and the "
+        "ring around the pins; optional: without it the pins "
+        "are rigidly seated and the housing rigid",
+    )
 
     @model_serializer(mode="wrap")
     def _omit_absent_carrier(self, handler):
@@ -702,42 +929,66 @@ class Reducer(_Strict):
         r_root = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
         r_hole = self.crank_hole_radius
         if a_w + r_hole >= r_root:
-            raise _bad("first_stage.module_mm", fs.module_mm,
-                       f"crank circle radius a_w = {a_w * 1e3:.4g} mm plus crank hole radius {r_hole * 1e3:.4g} mm "
-                       f"must stay inside the disc root radius R_p - r_rp - a = {r_root * 1e3:.4g} mm",
-                       "the crank-bearing holes would cut through the cycloid teeth")
+            raise _bad(
+                "first_stage.module_mm",
+                fs.module_mm,
+                f"crank circle radius a_w = {a_w * 1e3:.4g} mm plus crank hole radius {r_hole * 1e3:.4g} mm "
+                f"must stay inside the disc root radius R_p - r_rp - a = {r_root * 1e3:.4g} mm",
+                "the crank-bearing holes would cut through the cycloid teeth",
+            )
         if ss.center_hole_radius >= a_w - r_hole:
-            raise _bad("second_stage.center_hole_radius_mm", ss.center_hole_radius_mm,
-                       f"must be < {(a_w - r_hole) * 1e3:.4g} mm (crank circle radius minus crank hole radius)",
-                       "centre hole would cut into the crank-bearing holes")
+            raise _bad(
+                "second_stage.center_hole_radius_mm",
+                ss.center_hole_radius_mm,
+                f"must be < {(a_w - r_hole) * 1e3:.4g} mm (crank circle radius minus crank hole radius)",
+                "centre hole would cut into the crank-bearing holes",
+            )
         n = fs.n_planets
         if 2.0 * a_w * math.sin(math.pi / n) <= 2.0 * r_hole:
             raise _bad("first_stage.n_planets", n, "crank-bearing holes would overlap; use fewer planets")
         tip_planet = 0.5 * fs.module * (fs.planet_teeth + 2.0 + 2.0 * fs.planet_profile_shift)
         if 2.0 * a_w * math.sin(math.pi / n) <= 2.0 * tip_planet:
-            raise _bad("first_stage.n_planets", n, f"planet tip circles (r_a = {tip_planet * 1e3:.4g} mm) would overlap on a_w = {a_w * 1e3:.4g} mm")
+            raise _bad(
+                "first_stage.n_planets",
+                n,
+                f"planet tip circles (r_a = {tip_planet * 1e3:.4g} mm) would overlap on a_w = {a_w * 1e3:.4g} mm",
+            )
         if self.crankshaft.eccentric_journal_diameter_mm / 2.0 <= ss.eccentricity_mm:
-            raise _bad("crankshaft.eccentric_journal_diameter_mm", self.crankshaft.eccentric_journal_diameter_mm,
-                       f"must be > 2 a = {2 * ss.eccentricity_mm:g} mm")
+            raise _bad(
+                "crankshaft.eccentric_journal_diameter_mm",
+                self.crankshaft.eccentric_journal_diameter_mm,
+                f"must be > 2 a = {2 * ss.eccentricity_mm:g} mm",
+            )
         nb, cs, mb = self.needle_bearing, self.crankshaft, self.main_bearing
         # needles side by side on their pitch circle (journal diameter + one roller diameter)
         d_j, d_r = cs.eccentric_journal_diameter_mm, nb.roller_diameter_mm
         n_max = int(math.pi * (d_j + d_r) / d_r)
         if nb.roller_count > n_max:
-            raise _bad("needle_bearing.roller_count", nb.roller_count,
-                       f"must be <= {n_max}: {nb.roller_count} rollers of {d_r:g} mm need "
-                       f"{nb.roller_count * d_r:.4g} mm > pi (d_journal + d_roller) = {math.pi * (d_j + d_r):.4g} mm "
-                       f"on the {d_j:g} mm journal", "the needles would overlap")
+            raise _bad(
+                "needle_bearing.roller_count",
+                nb.roller_count,
+                f"must be <= {n_max}: {nb.roller_count} rollers of {d_r:g} mm need "
+                f"{nb.roller_count * d_r:.4g} mm > pi (d_journal + d_roller) = {math.pi * (d_j + d_r):.4g} mm "
+                f"on the {d_j:g} mm journal",
+                "the needles would overlap",
+            )
         if nb.roller_length_mm > ss.disc_width_mm:
-            raise _bad("needle_bearing.roller_length_mm", nb.roller_length_mm,
-                       f"must be <= second_stage.disc_width_mm = {ss.disc_width_mm:g} mm",
-                       "the needles run in the disc's crank hole")
+            raise _bad(
+                "needle_bearing.roller_length_mm",
+                nb.roller_length_mm,
+                f"must be <= second_stage.disc_width_mm = {ss.disc_width_mm:g} mm",
+                "the needles run in the disc's crank hole",
+            )
         r_crank_out = (a_w + r_hole) * 1e3
         if mb.pitch_diameter_mm / 2.0 <= r_crank_out:
-            raise _bad("main_bearing.pitch_diameter_mm", mb.pitch_diameter_mm,
-                       f"must be > {2 * r_crank_out:.4g} mm: the main-bearing pitch circle must lie outside the "
-                       f"crank-hole circle (crank circle radius {a_w * 1e3:.4g} mm + crank hole radius "
-                       f"{r_hole * 1e3:.4g} mm)", "the main bearing would sit inside the crank circle")
+            raise _bad(
+                "main_bearing.pitch_diameter_mm",
+                mb.pitch_diameter_mm,
+                f"must be > {2 * r_crank_out:.4g} mm: the main-bearing pitch circle must lie outside the "
+                f"crank-hole circle (crank circle radius {a_w * 1e3:.4g} mm + crank hole radius "
+                f"{r_hole * 1e3:.4g} mm)",
+                "the main bearing would sit inside the crank circle",
+            )
         if self.carrier is not None:
             self.carrier.validate_for(self)
         if self.housing is not None:

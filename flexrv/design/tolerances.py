@@ -160,13 +160,26 @@ def error_fields(reducer) -> dict[str, FieldInfo]:
     z = reducer.second_stage.pin_count
     zc = reducer.second_stage.disc_teeth
     out = {}
-    names = ["pins.pin_radius_um", "pins.pin_radial_position_um", "pins.pin_tangential_position_um",
-             "cranks.eccentricity_um", "cranks.eccentric_phase_arcmin", "cranks.bore_radial_um",
-             "cranks.bore_tangential_um", "discs.equidistant_um", "discs.shift_um", "discs.rotation_arcmin",
-             "discs.hole_radial_um", "discs.hole_tangential_um", "first_stage.sun_runout_um",
-             "first_stage.planet_runout_um", "first_stage.planet_phase_arcmin",
-             "clearances.needle_extra_clearance_um", "clearances.support_clearance_um",
-             *(f"discs.harmonic_order_{n}_um" for n in sorted({1, 2, zc, z}))]
+    names = [
+        "pins.pin_radius_um",
+        "pins.pin_radial_position_um",
+        "pins.pin_tangential_position_um",
+        "cranks.eccentricity_um",
+        "cranks.eccentric_phase_arcmin",
+        "cranks.bore_radial_um",
+        "cranks.bore_tangential_um",
+        "discs.equidistant_um",
+        "discs.shift_um",
+        "discs.rotation_arcmin",
+        "discs.hole_radial_um",
+        "discs.hole_tangential_um",
+        "first_stage.sun_runout_um",
+        "first_stage.planet_runout_um",
+        "first_stage.planet_phase_arcmin",
+        "clearances.needle_extra_clearance_um",
+        "clearances.support_clearance_um",
+        *(f"discs.harmonic_order_{n}_um" for n in sorted({1, 2, zc, z})),
+    ]
     for key in names:
         out[key] = field_info(reducer, key)
     return out
@@ -196,10 +209,15 @@ def field_info(reducer, key: str) -> FieldInfo:
     model = DiscErrors if group == "discs" else _GROUPS.get(group)
     finfo = model.model_fields.get(name) if model is not None and name != "harmonics" else None
     if finfo is None or name.endswith("_deg"):
-        hint = ("phases follow from the quadrature components of their runout" if name.endswith("_deg") and finfo
-                else "see flexrv.design.tolerances.error_fields")
-        raise ConfigError(f'tolerances."{key}": no such tolerance-able error field ({hint}); allowed: '
-                          f"{', '.join(_allowed_names())}, discs.harmonic_order_<n>_um")
+        hint = (
+            "phases follow from the quadrature components of their runout"
+            if name.endswith("_deg") and finfo
+            else "see flexrv.design.tolerances.error_fields"
+        )
+        raise ConfigError(
+            f'tolerances."{key}": no such tolerance-able error field ({hint}); allowed: '
+            f"{', '.join(_allowed_names())}, discs.harmonic_order_<n>_um"
+        )
     extra = finfo.json_schema_extra or {}
     shape_kind, bound = extra["shape"], extra["bound"]
     unit = name.rsplit("_", 1)[-1]
@@ -222,18 +240,33 @@ def field_info(reducer, key: str) -> FieldInfo:
 
 
 def _allowed_names() -> list[str]:
-    return ["pins.pin_radius_um", "pins.pin_radial_position_um", "pins.pin_tangential_position_um",
-            "cranks.eccentricity_um", "cranks.eccentric_phase_arcmin", "cranks.bore_radial_um",
-            "cranks.bore_tangential_um", "discs.equidistant_um", "discs.shift_um", "discs.rotation_arcmin",
-            "discs.hole_radial_um", "discs.hole_tangential_um", "first_stage.sun_runout_um",
-            "first_stage.planet_runout_um", "first_stage.planet_phase_arcmin",
-            "clearances.needle_extra_clearance_um", "clearances.support_clearance_um"]
+    return [
+        "pins.pin_radius_um",
+        "pins.pin_radial_position_um",
+        "pins.pin_tangential_position_um",
+        "cranks.eccentricity_um",
+        "cranks.eccentric_phase_arcmin",
+        "cranks.bore_radial_um",
+        "cranks.bore_tangential_um",
+        "discs.equidistant_um",
+        "discs.shift_um",
+        "discs.rotation_arcmin",
+        "discs.hole_radial_um",
+        "discs.hole_tangential_um",
+        "first_stage.sun_runout_um",
+        "first_stage.planet_runout_um",
+        "first_stage.planet_phase_arcmin",
+        "clearances.needle_extra_clearance_um",
+        "clearances.support_clearance_um",
+    ]
 
 
 def _entry(key: str, raw: Any, info: FieldInfo) -> Tolerance:
     where = f'tolerances."{key}"'
     if not isinstance(raw, dict):
-        raise ConfigError(f"{where} = {raw!r}: must be a table (distribution, scope, sigma_{info.unit} / band_{info.unit})")
+        raise ConfigError(
+            f"{where} = {raw!r}: must be a table (distribution, scope, sigma_{info.unit} / band_{info.unit})"
+        )
     data = dict(raw)
     u = info.unit
     for k in list(data):
@@ -253,14 +286,21 @@ def _entry(key: str, raw: Any, info: FieldInfo) -> Tolerance:
         err = exc.errors(include_url=False)[0]
         loc = ".".join(str(p) for p in err["loc"])
         name = f"{loc}_{u}" if loc in ("sigma", "band", "mean") else loc
-        allowed = {"distribution": "'normal', 'band' or 'uniform'",
-                   "scope": "'per_element', 'per_reducer' or 'batch'",
-                   "sigma": ">= 0 (finite)", "band": ">= 0 (finite)", "sigma_fraction": "within (0, 1]"}.get(loc, "")
+        allowed = {
+            "distribution": "'normal', 'band' or 'uniform'",
+            "scope": "'per_element', 'per_reducer' or 'batch'",
+            "sigma": ">= 0 (finite)",
+            "band": ">= 0 (finite)",
+            "sigma_fraction": "within (0, 1]",
+        }.get(loc, "")
         if err["type"] == "extra_forbidden":
-            raise ConfigError(f"{where}.{name}: unknown key; allowed: distribution, scope, sigma_{u}, band_{u}, "
-                              f"mean_{u}, sigma_fraction, source") from None
-        raise ConfigError(f"{where}.{name} = {err.get('input')!r}: {err['msg']}"
-                          + (f" (allowed: {allowed})" if allowed else "")) from None
+            raise ConfigError(
+                f"{where}.{name}: unknown key; allowed: distribution, scope, sigma_{u}, band_{u}, "
+                f"mean_{u}, sigma_fraction, source"
+            ) from None
+        raise ConfigError(
+            f"{where}.{name} = {err.get('input')!r}: {err['msg']}" + (f" (allowed: {allowed})" if allowed else "")
+        ) from None
     need = "sigma" if t.distribution == "normal" else "band"
     if getattr(t, need) is None:
         raise ConfigError(f"{where}: distribution {t.distribution!r} needs {need}_{u}")
@@ -269,15 +309,20 @@ def _entry(key: str, raw: Any, info: FieldInfo) -> Tolerance:
         raise ConfigError(f"{where}: {other}_{u} does not apply to distribution {t.distribution!r} (give {need}_{u})")
     if math.isfinite(info.lower):
         if t.distribution == "normal" and t.sigma > 0:
-            raise ConfigError(f"{where}: distribution 'normal' is unbounded but the field must stay >= "
-                              f"{info.lower:g} {u}: use 'band' or 'uniform'")
+            raise ConfigError(
+                f"{where}: distribution 'normal' is unbounded but the field must stay >= "
+                f"{info.lower:g} {u}: use 'band' or 'uniform'"
+            )
         low = t.mean - (t.band or 0.0)
         if low < info.lower:
-            raise ConfigError(f"{where}: mean_{u} - band_{u} = {low:g} {u} is below the field's lower bound "
-                              f"{info.lower:g} {u}")
+            raise ConfigError(
+                f"{where}: mean_{u} - band_{u} = {low:g} {u} is below the field's lower bound {info.lower:g} {u}"
+            )
     if info.vector and t.mean != 0.0:
-        raise ConfigError(f"{where}.mean_{u} = {t.mean!r}: a runout/harmonic is drawn as two zero-mean quadrature "
-                          "components; mean must be 0")
+        raise ConfigError(
+            f"{where}.mean_{u} = {t.mean!r}: a runout/harmonic is drawn as two zero-mean quadrature "
+            "components; mean must be 0"
+        )
     return t
 
 
@@ -304,8 +349,10 @@ def parse_tolerances(table: Any, reducer, source: str = "[tolerances]") -> Toler
         except ValidationError as exc:
             err = exc.errors(include_url=False)[0]
             loc = ".".join(str(p) for p in err["loc"])
-            raise ConfigError(f"{where}.{loc} = {err.get('input')!r}: {err['msg']} "
-                              "(fields: >= 2 tolerance keys; coefficient within -1..1)") from None
+            raise ConfigError(
+                f"{where}.{loc} = {err.get('input')!r}: {err['msg']} "
+                "(fields: >= 2 tolerance keys; coefficient within -1..1)"
+            ) from None
         for f in corr.fields:
             if f not in entries:
                 raise ConfigError(f"{where}.fields: {f!r} has no [tolerances] entry")
@@ -315,11 +362,15 @@ def parse_tolerances(table: Any, reducer, source: str = "[tolerances]") -> Toler
         first = corr.fields[0]
         for f in corr.fields[1:]:
             if fields[f].shape != fields[first].shape or entries[f].scope != entries[first].scope:
-                raise ConfigError(f"{where}.fields: {f!r} and {first!r} must have the same scope and element shape "
-                                  f"({entries[f].scope} {fields[f].shape} vs {entries[first].scope} {fields[first].shape})")
+                raise ConfigError(
+                    f"{where}.fields: {f!r} and {first!r} must have the same scope and element shape "
+                    f"({entries[f].scope} {fields[f].shape} vs {entries[first].scope} {fields[first].shape})"
+                )
         if corr.coefficient < -1.0 / (len(corr.fields) - 1):
-            raise ConfigError(f"{where}.coefficient = {corr.coefficient!r}: an equicorrelation of "
-                              f"{len(corr.fields)} fields must be >= {-1.0 / (len(corr.fields) - 1):g}")
+            raise ConfigError(
+                f"{where}.coefficient = {corr.coefficient!r}: an equicorrelation of "
+                f"{len(corr.fields)} fields must be >= {-1.0 / (len(corr.fields) - 1):g}"
+            )
         correlations.append(corr)
     return ToleranceSet(entries, fields, correlations)
 

@@ -102,8 +102,14 @@ def dimensionless_groups(load, speed, rx, ry, e_eff, viscosity, pressure_viscosi
     u = viscosity * speed / (e_eff * rx)
     g = alpha * e_eff
     w = load / (e_eff * rx**2)
-    return DimensionlessGroups(speed_u=u, material_g=g, load_w=w, moes_m=w * (2.0 * u) ** -0.75,
-                               moes_l=g * (2.0 * u) ** 0.25, ellipticity=ellipticity(rx, ry))
+    return DimensionlessGroups(
+        speed_u=u,
+        material_g=g,
+        load_w=w,
+        moes_m=w * (2.0 * u) ** -0.75,
+        moes_l=g * (2.0 * u) ** 0.25,
+        ellipticity=ellipticity(rx, ry),
+    )
 
 
 def hamrock_dowson(load, speed, rx, ry, e_eff, viscosity, pressure_viscosity, ellipticity=None):
@@ -251,8 +257,7 @@ def pan_hamrock_line(load, length, speed, r_eff, e_eff, viscosity, pressure_visc
     w = load / (e_eff * r_eff * length)
     u = viscosity * speed / (e_eff * r_eff)
     g = alpha * e_eff
-    return (2.922 * w**-0.166 * u**0.692 * g**0.470 * r_eff,
-            1.714 * w**-0.128 * u**0.694 * g**0.568 * r_eff)
+    return (2.922 * w**-0.166 * u**0.692 * g**0.470 * r_eff, 1.714 * w**-0.128 * u**0.694 * g**0.568 * r_eff)
 
 
 #: d ln h_c / d ln w of :func:`pan_hamrock_line`.

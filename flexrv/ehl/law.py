@@ -54,8 +54,7 @@ import numpy as np
 
 from flexrv.contact.hertz import line_contact_stiffness, point_contact_stiffness
 from flexrv.contact.laws import adams_step, adams_step_derivative
-from flexrv.ehl.film import (HAMROCK_DOWSON_LOAD_EXPONENT, PAN_HAMROCK_LOAD_EXPONENT, hamrock_dowson,
-                             pan_hamrock_line)
+from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, PAN_HAMROCK_LOAD_EXPONENT, hamrock_dowson, pan_hamrock_line
 from flexrv.errors import InputError
 
 MODES = ("dry", "hamrock_dowson", "map")
@@ -122,10 +121,13 @@ def _solve(delta, delta_rate, k, n, film: Optional[FilmFunction], load_floor, c_
         c = np.zeros(s.shape)
         force, dforce = spring, dspring
     active = contact & (force > 0)
-    return EHLForce(force=np.where(active, force, 0.0),
-                    dforce_ddelta=np.where(active, dforce, 0.0),
-                    dforce_ddelta_rate=np.where(active, c, 0.0),
-                    film=np.where(contact, h, 0.0), elastic_approach=s)
+    return EHLForce(
+        force=np.where(active, force, 0.0),
+        dforce_ddelta=np.where(active, dforce, 0.0),
+        dforce_ddelta_rate=np.where(active, c, 0.0),
+        film=np.where(contact, h, 0.0),
+        elastic_approach=s,
+    )
 
 
 def _check_mode(mode, lubricant, film_map):
@@ -185,8 +187,10 @@ class EHLPointLaw:
     def __post_init__(self):
         _check_mode(self.mode, self.lubricant, self.film_map)
         if not (self.load_floor > 0 and self.damping_depth > 0 and self.c_max >= 0):
-            raise InputError(f"load_floor ({self.load_floor}) and damping_depth ({self.damping_depth}) must be > 0, "
-                             f"c_max ({self.c_max}) >= 0")
+            raise InputError(
+                f"load_floor ({self.load_floor}) and damping_depth ({self.damping_depth}) must be > 0, "
+                f"c_max ({self.c_max}) >= 0"
+            )
         object.__setattr__(self, "_k", point_contact_stiffness(self.rx, self.ry, self.e_eff))
         if self.mode != "dry":
             lub = self.lubricant
@@ -194,8 +198,17 @@ class EHLPointLaw:
             object.__setattr__(self, "_h_unit", np.asarray(h1))  # h_HD at Q = 1 N, u = 1 m/s
 
     @classmethod
-    def from_design(cls, reducer, rx, ry, *, mode: Optional[str] = None, load_range=(5.0, 2000.0),
-                    speed_range=(0.005, 0.5), map_grid: int = 129) -> "EHLPointLaw":
+    def from_design(
+        cls,
+        reducer,
+        rx,
+        ry,
+        *,
+        mode: Optional[str] = None,
+        load_range=(5.0, 2000.0),
+        speed_range=(0.005, 0.5),
+        map_grid: int = 129,
+    ) -> "EHLPointLaw":
         """Law for the main-bearing ball contacts of a :class:`flexrv.design.model.Reducer`.
 
         E' from the ``rolling_elements`` and ``bearing_rings`` materials, lubricant from
@@ -208,20 +221,31 @@ class EHLPointLaw:
         from flexrv.ehl.solver import LubricantProperties
 
         ball, ring = reducer.material("rolling_elements"), reducer.material("bearing_rings")
-        e_eff = float(effective_modulus(ball.youngs_modulus, ball.poisson_ratio, ring.youngs_modulus,
-                                        ring.poisson_ratio))
+        e_eff = float(
+            effective_modulus(ball.youngs_modulus, ball.poisson_ratio, ring.youngs_modulus, ring.poisson_ratio)
+        )
         lub = LubricantProperties.from_design(reducer.lubricant)
         mode = reducer.contact.ehl if mode is None else mode
         fmap = None
         if mode == "map":
             if np.size(rx) != 1 or np.size(ry) != 1:
-                raise InputError("EHL mode 'map' needs one contact geometry (scalar rx, ry); "
-                                 f"got shapes {np.shape(rx)}, {np.shape(ry)}")
+                raise InputError(
+                    "EHL mode 'map' needs one contact geometry (scalar rx, ry); "
+                    f"got shapes {np.shape(rx)}, {np.shape(ry)}"
+                )
             from flexrv.ehl.maps import film_map
 
             fmap = film_map(float(rx), float(ry), e_eff, lub, load_range, speed_range, grid=map_grid)
-        return cls(rx, ry, e_eff, lub, mode=mode, film_map=fmap, c_max=reducer.main_bearing.ball_damping_Ns_per_m,
-                   damping_depth=reducer.contact.impact_damping_depth_mm * 1e-3)
+        return cls(
+            rx,
+            ry,
+            e_eff,
+            lub,
+            mode=mode,
+            film_map=fmap,
+            c_max=reducer.main_bearing.ball_damping_Ns_per_m,
+            damping_depth=reducer.contact.impact_damping_depth_mm * 1e-3,
+        )
 
     @property
     def stiffness(self):
@@ -260,8 +284,10 @@ class EHLPointLaw:
             def film(q, hu=hu):
                 c, dc = self.film_map.log_correction(q, speed_c)
                 return hu * q**HAMROCK_DOWSON_LOAD_EXPONENT * np.exp(c), HAMROCK_DOWSON_LOAD_EXPONENT + dc
-        return _solve(delta, delta_rate, self._k, 1.5, film, self.load_floor, self.c_max,
-                      self.damping_depth, self.iterations)
+
+        return _solve(
+            delta, delta_rate, self._k, 1.5, film, self.load_floor, self.c_max, self.damping_depth, self.iterations
+        )
 
     def normal_law(self, speed):
         """Adapter to the ``NormalLaw`` signature of :mod:`flexrv.contact.ball_raceway`:
@@ -304,13 +330,16 @@ class EHLLineLaw:
             raise InputError("EHL mode 'map' is available for point contacts only; use 'hamrock_dowson' for lines")
         _check_mode(self.mode, self.lubricant, None)
         if not (self.load_floor > 0 and self.damping_depth > 0 and self.c_max >= 0):
-            raise InputError(f"load_floor ({self.load_floor}) and damping_depth ({self.damping_depth}) must be > 0, "
-                             f"c_max ({self.c_max}) >= 0")
+            raise InputError(
+                f"load_floor ({self.load_floor}) and damping_depth ({self.damping_depth}) must be > 0, "
+                f"c_max ({self.c_max}) >= 0"
+            )
         object.__setattr__(self, "_k", line_contact_stiffness(self.length, self.e_eff))
         if self.mode != "dry":
             lub = self.lubricant
-            h1, _ = pan_hamrock_line(1.0, self.length, 1.0, self.r_eff, self.e_eff, lub.viscosity,
-                                     lub.pressure_viscosity)
+            h1, _ = pan_hamrock_line(
+                1.0, self.length, 1.0, self.r_eff, self.e_eff, lub.viscosity, lub.pressure_viscosity
+            )
             object.__setattr__(self, "_h_unit", np.asarray(h1))
 
     @property
@@ -332,5 +361,15 @@ class EHLLineLaw:
 
             def film(q, hu=hu):
                 return hu * q**PAN_HAMROCK_LOAD_EXPONENT, PAN_HAMROCK_LOAD_EXPONENT
-        return _solve(delta, delta_rate, self._k, 10.0 / 9.0, film, self.load_floor, self.c_max,
-                      self.damping_depth, self.iterations)
+
+        return _solve(
+            delta,
+            delta_rate,
+            self._k,
+            10.0 / 9.0,
+            film,
+            self.load_floor,
+            self.c_max,
+            self.damping_depth,
+            self.iterations,
+        )

@@ -83,15 +83,23 @@ class FilmMap:
         lq = np.log(np.maximum(np.asarray(load, dtype=float), 1e-300))
         lu = np.log(np.maximum(np.asarray(speed, dtype=float), 1e-300))
         lq, lu = np.broadcast_arrays(lq, lu)
-        c, dc = _log_correction_many(self._packed, np.ascontiguousarray(lq).reshape(-1),
-                                     np.ascontiguousarray(lu).reshape(-1))
+        c, dc = _log_correction_many(
+            self._packed, np.ascontiguousarray(lq).reshape(-1), np.ascontiguousarray(lu).reshape(-1)
+        )
         return c.reshape(lq.shape), dc.reshape(lq.shape)
 
 
 #: header of :meth:`FilmMap.packed`: node counts, first ln Q, ln Q step, last ln Q,
 #: first ln u, ln u step; the table log_ratio (n_load x n_speed, row-major) follows
-PACKED_HEADER = ("n_load", "n_speed", "log_load_first", "log_load_step", "log_load_last", "log_speed_first",
-                 "log_speed_step")
+PACKED_HEADER = (
+    "n_load",
+    "n_speed",
+    "log_load_first",
+    "log_load_step",
+    "log_load_last",
+    "log_speed_first",
+    "log_speed_step",
+)
 _NH = len(PACKED_HEADER)
 
 
@@ -156,8 +164,19 @@ def _check_range(name, lo, hi, n):
         raise InputError(f"{name} points must be >= 1 (1 when min == max), got {n}")
 
 
-def build_film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, speed_range, *,
-                   n_load: int = 6, n_speed: int = 4, grid: int = 129, **solver_kw) -> FilmMap:
+def build_film_map(
+    rx,
+    ry,
+    e_eff,
+    lubricant: LubricantProperties,
+    load_range,
+    speed_range,
+    *,
+    n_load: int = 6,
+    n_speed: int = 4,
+    grid: int = 129,
+    **solver_kw,
+) -> FilmMap:
     """Run the solver over a log-spaced load x speed grid (no caching; see
     :func:`film_map` for the cached version).
 
@@ -200,10 +219,14 @@ def build_film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, sp
             except ConvergenceError as exc:
                 errors.append(str(exc))
     if coarse_nodes:
-        warnings.warn(f"EHL map: at {len(coarse_nodes)} of {h.size} nodes h_c changed by more than the grid "
-                      f"tolerance from the next-coarser grid, or the grid has no coarser level to tell "
-                      f"(max {100 * np.nanmax(np.r_[coarse_nodes, 0.0]):.1f} %); "
-                      f"use a finer map grid", RuntimeWarning, stacklevel=2)
+        warnings.warn(
+            f"EHL map: at {len(coarse_nodes)} of {h.size} nodes h_c changed by more than the grid "
+            f"tolerance from the next-coarser grid, or the grid has no coarser level to tell "
+            f"(max {100 * np.nanmax(np.r_[coarse_nodes, 0.0]):.1f} %); "
+            f"use a finer map grid",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     valid = np.isfinite(h)
     if not valid.any():
         raise ConvergenceError("EHL map: the solver converged at no node; first failure: " + errors[0])
@@ -216,34 +239,82 @@ def build_film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, sp
         d = (bi[:, None] - vi[None, :]) ** 2 + (bj[:, None] - vj[None, :]) ** 2
         k = np.argmin(d, axis=1)
         ratio[bi, bj] = ratio[vi[k], vj[k]]
-    return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant, log_load=lq, log_speed=lu,
-                   log_ratio=ratio, h_central=h, valid=valid, grid=grid)
+    return FilmMap(
+        rx=float(rx),
+        ry=float(ry),
+        e_eff=float(e_eff),
+        lubricant=lubricant,
+        log_load=lq,
+        log_speed=lu,
+        log_ratio=ratio,
+        h_central=h,
+        valid=valid,
+        grid=grid,
+    )
 
 
-def film_map(rx, ry, e_eff, lubricant: LubricantProperties, load_range, speed_range, *, n_load: int = 6,
-             n_speed: int = 4, grid: int = 129, **solver_kw) -> FilmMap:
+def film_map(
+    rx,
+    ry,
+    e_eff,
+    lubricant: LubricantProperties,
+    load_range,
+    speed_range,
+    *,
+    n_load: int = 6,
+    n_speed: int = 4,
+    grid: int = 129,
+    **solver_kw,
+) -> FilmMap:
     """Cached :func:`build_film_map`: loaded from ``cache_dir()/ehl_maps/<hash>.npz`` if present."""
     solver_kw.setdefault("max_grid", grid)
-    key_inputs = dict(schema=MAP_SCHEMA, rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=asdict(lubricant),
-                      load_range=[float(v) for v in load_range], speed_range=[float(v) for v in speed_range],
-                      n_load=int(n_load), n_speed=int(n_speed), grid=int(grid), solver_kw=solver_kw,
-                      versions=library_versions("numpy", "scipy", "flexrv"))
+    key_inputs = dict(
+        schema=MAP_SCHEMA,
+        rx=float(rx),
+        ry=float(ry),
+        e_eff=float(e_eff),
+        lubricant=asdict(lubricant),
+        load_range=[float(v) for v in load_range],
+        speed_range=[float(v) for v in speed_range],
+        n_load=int(n_load),
+        n_speed=int(n_speed),
+        grid=int(grid),
+        solver_kw=solver_kw,
+        versions=library_versions("numpy", "scipy", "flexrv"),
+    )
     key = content_hash(key_inputs)
     path = cache_dir() / "ehl_maps" / f"film_map_{key}.npz"
+
     def _load() -> FilmMap:
         with np.load(path) as data:
-            return FilmMap(rx=float(rx), ry=float(ry), e_eff=float(e_eff), lubricant=lubricant,
-                           log_load=data["log_load"], log_speed=data["log_speed"], log_ratio=data["log_ratio"],
-                           h_central=data["h_central"], valid=data["valid"], grid=int(grid))
+            return FilmMap(
+                rx=float(rx),
+                ry=float(ry),
+                e_eff=float(e_eff),
+                lubricant=lubricant,
+                log_load=data["log_load"],
+                log_speed=data["log_speed"],
+                log_ratio=data["log_ratio"],
+                h_central=data["h_central"],
+                valid=data["valid"],
+                grid=int(grid),
+            )
 
     def _build() -> FilmMap:
-        fmap = build_film_map(rx, ry, e_eff, lubricant, load_range, speed_range, n_load=n_load, n_speed=n_speed,
-                              grid=grid, **solver_kw)
+        fmap = build_film_map(
+            rx, ry, e_eff, lubricant, load_range, speed_range, n_load=n_load, n_speed=n_speed, grid=grid, **solver_kw
+        )
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:
-                np.savez(fh, log_load=fmap.log_load, log_speed=fmap.log_speed, log_ratio=fmap.log_ratio,
-                         h_central=fmap.h_central, valid=fmap.valid,
-                         inputs=np.array(json.dumps(key_inputs, default=str)))
+                np.savez(
+                    fh,
+                    log_load=fmap.log_load,
+                    log_speed=fmap.log_speed,
+                    log_ratio=fmap.log_ratio,
+                    h_central=fmap.h_central,
+                    valid=fmap.valid,
+                    inputs=np.array(json.dumps(key_inputs, default=str)),
+                )
         return fmap
 
     fmap, _ = cached_entry([path], key, _load, _build)

@@ -151,17 +151,25 @@ class LubricantProperties:
     @classmethod
     def from_design(cls, lub) -> "LubricantProperties":
         """From a :class:`flexrv.design.model.Lubricant`."""
-        return cls(viscosity=lub.viscosity_Pa_s, pressure_viscosity=lub.pressure_viscosity_1_per_GPa * 1e-9,
-                   roelands_z=lub.roelands_z, roelands_p0=lub.roelands_p0_Pa, density=lub.density_kg_m3,
-                   dh_a=lub.dowson_higginson_a_1_per_GPa * 1e-9, dh_b=lub.dowson_higginson_b_1_per_GPa * 1e-9)
+        return cls(
+            viscosity=lub.viscosity_Pa_s,
+            pressure_viscosity=lub.pressure_viscosity_1_per_GPa * 1e-9,
+            roelands_z=lub.roelands_z,
+            roelands_p0=lub.roelands_p0_Pa,
+            density=lub.density_kg_m3,
+            dh_a=lub.dowson_higginson_a_1_per_GPa * 1e-9,
+            dh_b=lub.dowson_higginson_b_1_per_GPa * 1e-9,
+        )
 
     def check(self) -> None:
         """Raise InputError for missing/invalid data."""
         for name in ("viscosity", "pressure_viscosity", "roelands_z", "roelands_p0", "density"):
             value = getattr(self, name)
             if value is None or not np.isfinite(value) or value <= 0:
-                raise InputError(f"lubricant.{name} must be finite and > 0 (pressure-viscosity data is required "
-                                 f"for EHL), got {value!r}")
+                raise InputError(
+                    f"lubricant.{name} must be finite and > 0 (pressure-viscosity data is required "
+                    f"for EHL), got {value!r}"
+                )
         for name in ("dh_a", "dh_b"):
             value = getattr(self, name)
             if value is None or not np.isfinite(value) or value < 0:
@@ -182,8 +190,7 @@ class LubricantProperties:
         Overflows to inf at extreme pressures, which the solver reads as eps = 0 (no
         pressure flow), the correct limit."""
         with np.errstate(over="ignore"):
-            return np.exp((math.log(self.viscosity) + 9.67)
-                          * ((1.0 + p / self.roelands_p0) ** self.roelands_z - 1.0))
+            return np.exp((math.log(self.viscosity) + 9.67) * ((1.0 + p / self.roelands_p0) ** self.roelands_z - 1.0))
 
     def density_ratio(self, p):
         """rho/rho0 = 1 + a p/(1 + b p) (:cite:`dowson1966`)."""
@@ -280,8 +287,12 @@ def influence_kernel(nx: int, ny: int, dx: float, dy: float):
     k = np.arange(-(nx - 1), nx)[:, None] * dx
     l = np.arange(-(ny - 1), ny)[None, :] * dy
     hx, hy = 0.5 * dx, 0.5 * dy
-    val = (_rect_integral(k + hx, l + hy) - _rect_integral(k + hx, l - hy)
-           - _rect_integral(k - hx, l + hy) + _rect_integral(k - hx, l - hy))
+    val = (
+        _rect_integral(k + hx, l + hy)
+        - _rect_integral(k + hx, l - hy)
+        - _rect_integral(k - hx, l + hy)
+        + _rect_integral(k - hx, l - hy)
+    )
     return 2.0 / np.pi * val
 
 
@@ -308,8 +319,22 @@ class _Elastic:
 class _GridProblem:
     """Dimensionless discrete problem on one grid (see module docstring)."""
 
-    def __init__(self, n, x_in, x_out, y_half, aspect, ky, lam, kernel_scale, pscale, lub: LubricantProperties,
-                 stencil: int, wedge_order: int = 2, symmetric: bool = True):
+    def __init__(
+        self,
+        n,
+        x_in,
+        x_out,
+        y_half,
+        aspect,
+        ky,
+        lam,
+        kernel_scale,
+        pscale,
+        lub: LubricantProperties,
+        stencil: int,
+        wedge_order: int = 2,
+        symmetric: bool = True,
+    ):
         self.wedge_order = wedge_order
         self.n = n
         self.X = np.linspace(x_in, x_out, n)
@@ -388,16 +413,20 @@ class _GridProblem:
             wedge[1:] = 1.5 * rh[2:-1, 1:-1] - 2.0 * rh[1:-2, 1:-1] + 0.5 * rh[:-3, 1:-1]
         else:
             wedge[1:] = rh[2:-1, 1:-1] - rh[1:-2, 1:-1]
-        r = (fx[1:, 1:-1] - fx[:-1, 1:-1]) \
-            + self.ry2 * (self.dX / self.dY) ** 2 * (fy[1:-1, 1:] - fy[1:-1, :-1]) \
+        r = (
+            (fx[1:, 1:-1] - fx[:-1, 1:-1])
+            + self.ry2 * (self.dX / self.dY) ** 2 * (fy[1:-1, 1:] - fy[1:-1, :-1])
             - self.dX * wedge
+        )
         R[1:-1, 1:-1] = r
         # |dR_i/dP_i| (Poiseuille + wedge) for the scaling of the active-set test
         diag = np.ones_like(P)
-        diag[1:-1, 1:-1] = (ex[1:, 1:-1] + ex[:-1, 1:-1]
-                            + self.ry2 * (self.dX / self.dY) ** 2 * (ey[1:-1, 1:] + ey[1:-1, :-1])
-                            + self.dX * rho[1:-1, 1:-1] * self.kernel[self.n - 1, self.n - 1]
-                            * (1.5 if self.wedge_order == 2 else 1.0))
+        diag[1:-1, 1:-1] = (
+            ex[1:, 1:-1]
+            + ex[:-1, 1:-1]
+            + self.ry2 * (self.dX / self.dY) ** 2 * (ey[1:-1, 1:] + ey[1:-1, :-1])
+            + self.dX * rho[1:-1, 1:-1] * self.kernel[self.n - 1, self.n - 1] * (1.5 if self.wedge_order == 2 else 1.0)
+        )
         self._diag = diag
         return R, H, rho, eps
 
@@ -414,7 +443,7 @@ class _GridProblem:
 
     def restrict(self, F):
         """Unknowns' part (n x m) of a full-grid field."""
-        return F[:, self.j0:]
+        return F[:, self.j0 :]
 
     def equations(self, z, free, R=None):
         """Semismooth system on the unknowns z = (P[:, j0:], H0): Reynolds rows on free
@@ -478,7 +507,7 @@ class _GridProblem:
         cols_list += [idx[fi, fj], idx[fi + 1, fj], idx[fi - 1, fj], idx[fi, fj + 1], idx[fi, fj - 1]]
         vals_list += [-(ex_p + ex_m + ey_p + ey_m), ex_p, ex_m, ey_p, ey_m]
         # identity rows for cavitated / boundary nodes
-        ci, cj = np.nonzero(~free[:, self.j0:])
+        ci, cj = np.nonzero(~free[:, self.j0 :])
         cj = cj + self.j0
         rows_list.append(idx[ci, cj])
         cols_list.append(idx[ci, cj])
@@ -495,8 +524,12 @@ class _GridProblem:
         dex_m = 0.5 * (deps[fi, fj] + deps[fi - 1, fj])
         dey_p = cy * 0.5 * (deps[fi, fj] + deps[fi, fj + 1])
         dey_m = cy * 0.5 * (deps[fi, fj] + deps[fi, fj - 1])
-        col[fi, fj] += (dex_p * (P[fi + 1, fj] - P[fi, fj]) - dex_m * (P[fi, fj] - P[fi - 1, fj])
-                        + dey_p * (P[fi, fj + 1] - P[fi, fj]) - dey_m * (P[fi, fj] - P[fi, fj - 1]))
+        col[fi, fj] += (
+            dex_p * (P[fi + 1, fj] - P[fi, fj])
+            - dex_m * (P[fi, fj] - P[fi - 1, fj])
+            + dey_p * (P[fi, fj + 1] - P[fi, fj])
+            - dey_m * (P[fi, fj] - P[fi, fj - 1])
+        )
         return A, self.restrict(col).ravel()
 
     # -- Newton -----------------------------------------------------------
@@ -524,8 +557,9 @@ class _GridProblem:
                 try:
                     lu = _PermutedLU(A.astype(self.lu_dtype), self.perm)
                 except RuntimeError as exc:  # singular preconditioner
-                    raise ConvergenceError(f"EHL Newton step {steps}: singular preconditioner ({exc}); "
-                                           f"residual reached {res:.3e}") from exc
+                    raise ConvergenceError(
+                        f"EHL Newton step {steps}: singular preconditioner ({exc}); residual reached {res:.3e}"
+                    ) from exc
                 y = lu.solve(col)
                 ry = float(weight @ y)
 
@@ -558,8 +592,10 @@ class _GridProblem:
                     break
                 t *= 0.5
             if self.trace:
-                print(f"  n={n} step {steps}: krylov {last_krylov} t {t:.3g} res {rt:.3e} "
-                      f"free {int(free_t.sum())} H0 {zt[-1]:.5f}")
+                print(
+                    f"  n={n} step {steps}: krylov {last_krylov} t {t:.3g} res {rt:.3e} "
+                    f"free {int(free_t.sum())} H0 {zt[-1]:.5f}"
+                )
             z, F, free, res = zt, Ft, free_t, rt
             steps += 1
             history.append(res)
@@ -696,13 +732,31 @@ def _interpolate(P, X0, Y0, X1, Y1):
 
 _TRACE = False
 
+
 # ----------------------------------------------------------------- public API
-def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperties, *, grid: int = 129,
-                        x_inlet: float = -4.5, x_outlet: float = 1.5, y_half: float = 3.0,
-                        tol: float = 1e-6, max_iter: int = 40, stencil: int = 1,
-                        coarsest: int = 17, coarse_tol: float = 1e-4, wedge_order: int | None = None,
-                        extrapolate: bool | None = None, grid_tol: float | None = 0.02, max_grid: int | None = None,
-                        symmetric: bool = True) -> EHLResult:
+def solve_point_contact(
+    load,
+    speed,
+    rx,
+    ry,
+    e_eff,
+    lubricant: LubricantProperties,
+    *,
+    grid: int = 129,
+    x_inlet: float = -4.5,
+    x_outlet: float = 1.5,
+    y_half: float = 3.0,
+    tol: float = 1e-6,
+    max_iter: int = 40,
+    stencil: int = 1,
+    coarsest: int = 17,
+    coarse_tol: float = 1e-4,
+    wedge_order: int | None = None,
+    extrapolate: bool | None = None,
+    grid_tol: float | None = 0.02,
+    max_grid: int | None = None,
+    symmetric: bool = True,
+) -> EHLResult:
     """Solve the steady isothermal EHL point-contact problem.
 
     Parameters
@@ -776,8 +830,9 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
     if stencil not in (0, 1, 2, 3):
         raise InputError(f"stencil must be 0..3, got {stencil!r}")
     if not (x_inlet < 0 < x_outlet) or y_half <= 0:
-        raise InputError(f"domain must contain the contact centre: x_inlet={x_inlet} < 0 < x_outlet={x_outlet}, "
-                         f"y_half={y_half} > 0")
+        raise InputError(
+            f"domain must contain the contact centre: x_inlet={x_inlet} < 0 < x_outlet={x_outlet}, y_half={y_half} > 0"
+        )
     load, speed, rx, ry, e_eff = map(float, (load, speed, rx, ry, e_eff))
     hz = point_contact(load, rx, ry, e_eff)
     a, b, p_h = float(hz.a), float(hz.b), float(hz.p_max)
@@ -798,8 +853,9 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
         n = (n - 1) // 2 + 1
     levels = levels[::-1] or [grid]
     if extrapolate and len(levels) < 2:
-        raise InputError(f"extrapolate=True needs a coarser level: grid={grid} must be >= 2 * coarsest - 1 "
-                         f"= {2 * coarsest - 1}")
+        raise InputError(
+            f"extrapolate=True needs a coarser level: grid={grid} must be >= 2 * coarsest - 1 = {2 * coarsest - 1}"
+        )
     # levels whose central film enters the reported value or the grid-change estimate are solved to
     # ``tol``; the others only to ``coarse_tol``
     exact_from = grid
@@ -830,8 +886,9 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
     change = float("nan")
     while True:
         n = levels[k]
-        prob = _GridProblem(n, x_inlet, x_outlet, y_half, b / a, ky, lam, kernel_scale, p_h, lubricant, stencil,
-                            wedge_order, symmetric)
+        prob = _GridProblem(
+            n, x_inlet, x_outlet, y_half, b / a, ky, lam, kernel_scale, p_h, lubricant, stencil, wedge_order, symmetric
+        )
         if P is None:
             r2 = prob.X[:, None] ** 2 + prob.Y[None, :] ** 2
             P = np.sqrt(np.clip(1.0 - r2, 0.0, None))
@@ -849,9 +906,11 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
         P, H0, steps, res = prob.newton(P, H0, level_tol, max_iter if final else 2 * max_iter, history)
         total += steps
         if (not np.isfinite(res) or res >= level_tol) and n >= exact_from:
-            raise ConvergenceError(f"EHL solver did not converge on the {n}x{n} grid: residual reached {res:.3e} "
-                                   f"(target {level_tol:.1e}) after {steps} Newton steps "
-                                   f"(load {load:g} N, speed {speed:g} m/s)")
+            raise ConvergenceError(
+                f"EHL solver did not converge on the {n}x{n} grid: residual reached {res:.3e} "
+                f"(target {level_tol:.1e}) after {steps} Newton steps "
+                f"(load {load:g} N, speed {speed:g} m/s)"
+            )
         if not (np.all(np.isfinite(P)) and np.isfinite(H0)):  # only possible below exact_from
             P = H0 = None  # unusable coarse start: the next level starts again from the Hertz pressure
             h_levels.append(float("nan"))
@@ -878,30 +937,59 @@ def solve_point_contact(load, speed, rx, ry, e_eff, lubricant: LubricantProperti
         raise ConvergenceError(
             f"EHL solution on the {n}x{n} grid has a closed film (min h = {H[1:-1, 1:-1].min() * hscale:.3e} m < 0) "
             f"after {steps} Newton steps, residual {res:.3e}: the grid does not resolve the film at this load "
-            f"(Moes M = {moes_m:.3g}); use a finer grid (max_grid) or the Hamrock-Dowson formula")
+            f"(Moes M = {moes_m:.3g}); use a finer grid (max_grid) or the Hamrock-Dowson formula"
+        )
     h_grid = h_levels[k]
     h_coarse = h_levels[k - 1] if k >= 1 else float("nan")
     h_central = reported(k)
     if not np.isfinite(h_central) or h_central <= 0:
-        raise ConvergenceError(f"Richardson extrapolation of h_c failed: h_c({n}) = {h_grid:.4e} m, "
-                               f"h_c({(n - 1) // 2 + 1}) = {h_coarse:.4e} m")
+        raise ConvergenceError(
+            f"Richardson extrapolation of h_c failed: h_c({n}) = {h_grid:.4e} m, "
+            f"h_c({(n - 1) // 2 + 1}) = {h_coarse:.4e} m"
+        )
     h_min = reported(k, hmin_levels)
     if not np.isfinite(h_min) or h_min <= 0:
-        raise ConvergenceError(f"Richardson extrapolation of h_min failed: h_min({n}) = {hmin_levels[k]:.4e} m, "
-                               f"h_min({(n - 1) // 2 + 1}) = "
-                               f"{hmin_levels[k - 1] if k >= 1 else float('nan'):.4e} m")
+        raise ConvergenceError(
+            f"Richardson extrapolation of h_min failed: h_min({n}) = {hmin_levels[k]:.4e} m, "
+            f"h_min({(n - 1) // 2 + 1}) = "
+            f"{hmin_levels[k - 1] if k >= 1 else float('nan'):.4e} m"
+        )
     grid_converged = bool(grid_tol is None or (np.isfinite(change) and change <= grid_tol))
     if not grid_converged and refine_asked:  # refinement was asked for and did not reach grid_tol
-        warnings.warn(f"EHL film not grid-converged at the {n}x{n} grid (max_grid): h_c changed by "
-                      f"{100 * change_c:.2f} % and h_min by {100 * change_min:.2f} % from the next-coarser grid "
-                      f"(grid_tol {100 * grid_tol:.1f} %); "
-                      f"load {load:g} N, speed {speed:g} m/s, Moes M = {moes_m:.3g}", RuntimeWarning, stacklevel=2)
-    return EHLResult(x=prob.X * b, y=prob.Y * a, pressure=P * p_h, film=H * hscale,
-                     h_central=h_central, h_min=h_min, h_min_grid=float(H[1:-1, 1:-1].min() * hscale),
-                     p_max=float(P.max() * p_h), hertz_pressure=p_h, hertz_a=a, hertz_b=b,
-                     rigid_approach=float(H0 * hscale), iterations=steps, total_iterations=total,
-                     residual=float(res), residual_history=history, load_error=float(prob.load_error(P)), grid=n,
-                     h_central_grid=h_grid, h_central_coarse=h_coarse, extrapolated=bool(extrapolate),
-                     wedge_order=int(wedge_order), grid_requested=int(grid), grid_change=float(change),
-                     grid_change_central=float(change_c), grid_change_min=float(change_min),
-                     grid_converged=grid_converged)
+        warnings.warn(
+            f"EHL film not grid-converged at the {n}x{n} grid (max_grid): h_c changed by "
+            f"{100 * change_c:.2f} % and h_min by {100 * change_min:.2f} % from the next-coarser grid "
+            f"(grid_tol {100 * grid_tol:.1f} %); "
+            f"load {load:g} N, speed {speed:g} m/s, Moes M = {moes_m:.3g}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return EHLResult(
+        x=prob.X * b,
+        y=prob.Y * a,
+        pressure=P * p_h,
+        film=H * hscale,
+        h_central=h_central,
+        h_min=h_min,
+        h_min_grid=float(H[1:-1, 1:-1].min() * hscale),
+        p_max=float(P.max() * p_h),
+        hertz_pressure=p_h,
+        hertz_a=a,
+        hertz_b=b,
+        rigid_approach=float(H0 * hscale),
+        iterations=steps,
+        total_iterations=total,
+        residual=float(res),
+        residual_history=history,
+        load_error=float(prob.load_error(P)),
+        grid=n,
+        h_central_grid=h_grid,
+        h_central_coarse=h_coarse,
+        extrapolated=bool(extrapolate),
+        wedge_order=int(wedge_order),
+        grid_requested=int(grid),
+        grid_change=float(change),
+        grid_change_central=float(change_c),
+        grid_change_min=float(change_min),
+        grid_converged=grid_converged,
+    )

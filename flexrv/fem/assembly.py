@@ -62,6 +62,7 @@ class FEModel:
     def n_dof(self) -> int:
         return int(self.K.shape[0])
 
+
 def skfem_basis(nodes: np.ndarray, tets: np.ndarray, intorder: int = 2):
     """scikit-fem isoparametric P2 vector basis of a Tet10 mesh (VTK order).
 
@@ -95,8 +96,9 @@ def dof_permutation(basis, nodes: np.ndarray) -> np.ndarray:
     return dofs[:, idx].T.reshape(-1)
 
 
-def assemble(nodes: np.ndarray, tets: np.ndarray, youngs_modulus: float, poisson_ratio: float,
-             density: float, mass: bool = True) -> FEModel:
+def assemble(
+    nodes: np.ndarray, tets: np.ndarray, youngs_modulus: float, poisson_ratio: float, density: float, mass: bool = True
+) -> FEModel:
     """Assemble K and M (consistent mass) of a Tet10 mesh, Exudyn DOF order.
 
     Parameters

@@ -29,16 +29,31 @@ import numpy as np
 
 from flexrv.cache import atomic_path, cache_dir, cached_entry, content_hash, library_versions
 from flexrv.errors import InputError
-from flexrv.fem.reduction import (RacewaySpec, default_harmonics, fourier_loads, hcb_basis, nodal_areas,
-                                  periodic_cubic, raceway_weights)
+from flexrv.fem.reduction import (
+    RacewaySpec,
+    default_harmonics,
+    fourier_loads,
+    hcb_basis,
+    nodal_areas,
+    periodic_cubic,
+    raceway_weights,
+)
 
 BODY_FORMAT_VERSION = 1
 
 #: interface surface groups per part; the first defines the floating frame
-INTERFACES = {"outer_ring": ["fit"], "inner_ring": ["fit"], "crankshaft": ["support_a", "support_b"],
-              "cycloid_disc": None}  # disc: its crank holes, filled in from the mesh
-MATERIAL_OF = {"outer_ring": "bearing_rings", "inner_ring": "bearing_rings", "crankshaft": "crankshaft",
-               "cycloid_disc": "cycloid_disc"}
+INTERFACES = {
+    "outer_ring": ["fit"],
+    "inner_ring": ["fit"],
+    "crankshaft": ["support_a", "support_b"],
+    "cycloid_disc": None,
+}  # disc: its crank holes, filled in from the mesh
+MATERIAL_OF = {
+    "outer_ring": "bearing_rings",
+    "inner_ring": "bearing_rings",
+    "crankshaft": "crankshaft",
+    "cycloid_disc": "cycloid_disc",
+}
 
 
 def interface_groups(part: str, group_names) -> list[str]:
@@ -105,8 +120,9 @@ class ReducedBody:
         """Unit contact directions (..., 3) into the ring at the given azimuths."""
         self._require_raceway()
         a = np.asarray(azimuth, dtype=float)
-        return np.stack([self.raceway.n_r * np.cos(a), self.raceway.n_r * np.sin(a),
-                         np.full_like(a, self.raceway.n_z)], axis=-1)
+        return np.stack(
+            [self.raceway.n_r * np.cos(a), self.raceway.n_r * np.sin(a), np.full_like(a, self.raceway.n_z)], axis=-1
+        )
 
     def raceway_matrix(self, azimuth) -> np.ndarray:
         """(..., 3, m) Cartesian raceway displacement per modal coordinate at ``azimuth``
@@ -115,8 +131,9 @@ class ReducedBody:
         a = np.asarray(azimuth, dtype=float)
         A = periodic_cubic(self.table, a)  # (..., 3, m) cylindrical
         c, s = np.cos(a)[..., None], np.sin(a)[..., None]
-        return np.stack([c * A[..., 0, :] - s * A[..., 1, :], s * A[..., 0, :] + c * A[..., 1, :], A[..., 2, :]],
-                        axis=-2)
+        return np.stack(
+            [c * A[..., 0, :] - s * A[..., 1, :], s * A[..., 0, :] + c * A[..., 1, :], A[..., 2, :]], axis=-2
+        )
 
     def raceway_compliance_factors(self, stiffness_scale: float = 1.0) -> np.ndarray:
         """(n_grid, 3, m) raceway table scaled by K^-1/2 (K = ``stiffness_scale``
@@ -172,13 +189,26 @@ class ReducedBody:
         import exudyn.itemInterface as eii
 
         m = self.n_modes
-        node = mbs.AddNode(eii.NodeGenericODE2(referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
-                                               initialCoordinates_t=[0.0] * m, numberOfODE2Coordinates=m,
-                                               name=name and f"{name}_modal"))
+        node = mbs.AddNode(
+            eii.NodeGenericODE2(
+                referenceCoordinates=[0.0] * m,
+                initialCoordinates=[0.0] * m,
+                initialCoordinates_t=[0.0] * m,
+                numberOfODE2Coordinates=m,
+                name=name and f"{name}_modal",
+            )
+        )
         damp = np.diag(2.0 * damping_ratio * np.sqrt(self.omega2))
-        obj = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=[node], massMatrix=self.mass_matrix,
-                                                  stiffnessMatrix=self.stiffness_matrix, dampingMatrix=damp,
-                                                  visualization=eii.VObjectGenericODE2(show=False), name=name))
+        obj = mbs.AddObject(
+            eii.ObjectGenericODE2(
+                nodeNumbers=[node],
+                massMatrix=self.mass_matrix,
+                stiffnessMatrix=self.stiffness_matrix,
+                dampingMatrix=damp,
+                visualization=eii.VObjectGenericODE2(show=False),
+                name=name,
+            )
+        )
         return node, obj
 
     # ------------------------------------------------------------ file
@@ -186,23 +216,46 @@ class ReducedBody:
         rw = None if self.raceway is None else json.dumps(self.raceway.__dict__)
         sets = {f"set_{k}": v for k, v in self.node_sets.items()}
         extra = {} if self.stress_modes is None else {"stress_modes": self.stress_modes.astype(np.float32)}
-        np.savez(path, version=BODY_FORMAT_VERSION, part=self.part, modes=self.modes, omega2=self.omega2,
-                 nodes=self.nodes, tris=self.tris, raceway=json.dumps(rw), table=np.zeros(0) if self.table is None
-                 else self.table, info=json.dumps(self.info), **sets, **extra)
+        np.savez(
+            path,
+            version=BODY_FORMAT_VERSION,
+            part=self.part,
+            modes=self.modes,
+            omega2=self.omega2,
+            nodes=self.nodes,
+            tris=self.tris,
+            raceway=json.dumps(rw),
+            table=np.zeros(0) if self.table is None else self.table,
+            info=json.dumps(self.info),
+            **sets,
+            **extra,
+        )
 
     @classmethod
     def load(cls, path: str | Path) -> "ReducedBody":
         with np.load(path, allow_pickle=False) as z:
             if int(z["version"]) != BODY_FORMAT_VERSION:
-                raise InputError(f"reduced body file {path} has format {int(z['version'])}, expected "
-                                 f"{BODY_FORMAT_VERSION}; delete it to rebuild")
+                raise InputError(
+                    f"reduced body file {path} has format {int(z['version'])}, expected "
+                    f"{BODY_FORMAT_VERSION}; delete it to rebuild"
+                )
             rw = json.loads(str(z["raceway"]))
             raceway = None if rw is None else RacewaySpec(**json.loads(rw))
             sets = {k[4:]: z[k] for k in z.files if k.startswith("set_")}
             stress = z["stress_modes"].astype(float) if "stress_modes" in z.files else None
-            return cls(part=str(z["part"]), modes=z["modes"], omega2=z["omega2"], nodes=z["nodes"], tris=z["tris"],
-                       node_sets=sets, raceway=raceway, table=None if raceway is None else z["table"],
-                       info=json.loads(str(z["info"])), path=Path(path), stress_modes=stress)
+            return cls(
+                part=str(z["part"]),
+                modes=z["modes"],
+                omega2=z["omega2"],
+                nodes=z["nodes"],
+                tris=z["tris"],
+                node_sets=sets,
+                raceway=raceway,
+                table=None if raceway is None else z["table"],
+                info=json.loads(str(z["info"])),
+                path=Path(path),
+                stress_modes=stress,
+            )
 
 
 def _assemble(mesh, material: dict, mass: bool = True):
@@ -229,8 +282,15 @@ def raceway_spec_for(ring_spec, load_width: float | None, n_harmonics: int | Non
     return RacewaySpec(r=ring_spec.contact_r, z=ring_spec.contact_z, n_r=nr, n_z=nz, b=b, n_harmonics=k)
 
 
-def build_reduced_body(mesh_result, material: dict, n_eig: int = 20, raceway: RacewaySpec | None = None,
-                       stress: bool = False, cache: bool = True, fe=None) -> ReducedBody:
+def build_reduced_body(
+    mesh_result,
+    material: dict,
+    n_eig: int = 20,
+    raceway: RacewaySpec | None = None,
+    stress: bool = False,
+    cache: bool = True,
+    fe=None,
+) -> ReducedBody:
     """Reduce a meshed part (see module doc); cached by mesh key + settings.
 
     Parameters
@@ -245,15 +305,25 @@ def build_reduced_body(mesh_result, material: dict, n_eig: int = 20, raceway: Ra
     mesh = mesh_result.data
     part = mesh.part
     ifaces = interface_groups(part, mesh.group_names)
-    settings = {"n_eig": int(n_eig), "raceway": None if raceway is None else raceway.__dict__,
-                "interfaces": ifaces, "stress": bool(stress)}
-    key = content_hash(mesh_result.key, material, settings, BODY_FORMAT_VERSION,
-                       library_versions("exudyn", "scikit-fem", "scipy", "numpy"))
+    settings = {
+        "n_eig": int(n_eig),
+        "raceway": None if raceway is None else raceway.__dict__,
+        "interfaces": ifaces,
+        "stress": bool(stress),
+    }
+    key = content_hash(
+        mesh_result.key,
+        material,
+        settings,
+        BODY_FORMAT_VERSION,
+        library_versions("exudyn", "scikit-fem", "scipy", "numpy"),
+    )
     path = cache_dir() / f"{part}-{key}.cms.npz"
 
     def _build() -> "ReducedBody":
-        return _reduce_uncached(mesh_result, mesh, part, material, settings, ifaces, n_eig, raceway, stress, fe,
-                                path, cache)
+        return _reduce_uncached(
+            mesh_result, mesh, part, material, settings, ifaces, n_eig, raceway, stress, fe, path, cache
+        )
 
     body, _ = cached_entry([path], key, lambda: ReducedBody.load(path), _build, enabled=cache)
     return body
@@ -281,10 +351,12 @@ def load_cached_body(identity: dict) -> ReducedBody:
     path = cache_dir() / name
     problem = entry_problem([path], key)
     if problem is not None:
-        raise InputError(f"the reduced body {name} this run used is not usable in the cache {cache_dir()} ({problem}); "
-                         "rebuild it by re-running the simulation with the saved config.toml "
-                         "(`flexrv simulate DIR/config.toml --model flexible ...`), or let `flexrv view --rebuild` "
-                         "mesh and reduce it again")
+        raise InputError(
+            f"the reduced body {name} this run used is not usable in the cache {cache_dir()} ({problem}); "
+            "rebuild it by re-running the simulation with the saved config.toml "
+            "(`flexrv simulate DIR/config.toml --model flexible ...`), or let `flexrv view --rebuild` "
+            "mesh and reduce it again"
+        )
     return ReducedBody.load(path)
 
 
@@ -316,23 +388,43 @@ def _reduce_uncached(mesh_result, mesh, part, material, settings, ifaces, n_eig,
     stress_modes = None
     if stress:
         from flexrv.fem.stress import nodal_stress
+
         stress_modes = nodal_stress(mesh.nodes, mesh.tets, res.modes, material["E"], material["nu"])
     t3 = time.perf_counter()
-    info = {"mesh_path": str(mesh_result.npz_path), "mesh_key": mesh_result.key, "material": material,
-            "settings": settings, "n_nodes": mesh.n_nodes, "n_dof": 3 * mesh.n_nodes,
-            "n_interface_modes": res.n_interface, "n_eig": res.n_eig, "n_raceway_modes": res.n_raceway,
-            "fixed_interface_hz": res.fixed_interface_hz.tolist(),
-            "t_assemble_s": t1 - t0, "t_reduce_s": t2 - t1, "t_table_stress_s": t3 - t2}
-    body = ReducedBody(part, res.modes, res.omega2, mesh.nodes, mesh.tris, node_sets, raceway, table, info, path,
-                       stress_modes)
+    info = {
+        "mesh_path": str(mesh_result.npz_path),
+        "mesh_key": mesh_result.key,
+        "material": material,
+        "settings": settings,
+        "n_nodes": mesh.n_nodes,
+        "n_dof": 3 * mesh.n_nodes,
+        "n_interface_modes": res.n_interface,
+        "n_eig": res.n_eig,
+        "n_raceway_modes": res.n_raceway,
+        "fixed_interface_hz": res.fixed_interface_hz.tolist(),
+        "t_assemble_s": t1 - t0,
+        "t_reduce_s": t2 - t1,
+        "t_table_stress_s": t3 - t2,
+    }
+    body = ReducedBody(
+        part, res.modes, res.omega2, mesh.nodes, mesh.tris, node_sets, raceway, table, info, path, stress_modes
+    )
     if cache:
         with atomic_path(path) as tmp:
             body.save(tmp)
     return body
 
 
-def reduce_part(reducer, part: str, size: float | None = None, n_eig: int = 20, n_harmonics: int | None = None,
-                load_width: float | None = None, stress: bool = False, cache: bool = True) -> ReducedBody:
+def reduce_part(
+    reducer,
+    part: str,
+    size: float | None = None,
+    n_eig: int = 20,
+    n_harmonics: int | None = None,
+    load_width: float | None = None,
+    stress: bool = False,
+    cache: bool = True,
+) -> ReducedBody:
     """Mesh (cached) and reduce (cached) a part of a reducer.
 
     Rings get raceway-load modes (``n_harmonics`` K, patch width ``load_width`` b
@@ -345,8 +437,7 @@ def reduce_part(reducer, part: str, size: float | None = None, n_eig: int = 20, 
     rw = None
     if part in ("outer_ring", "inner_ring"):
         rw = raceway_spec_for(spec_for(reducer, part), load_width, n_harmonics)
-    return build_reduced_body(mres, material_dict(reducer, part), n_eig=n_eig, raceway=rw, stress=stress,
-                              cache=cache)
+    return build_reduced_body(mres, material_dict(reducer, part), n_eig=n_eig, raceway=rw, stress=stress, cache=cache)
 
 
 @dataclass

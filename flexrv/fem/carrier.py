@@ -208,9 +208,15 @@ def carrier_material(reducer) -> dict:
     return {"E": mat.youngs_modulus, "nu": mat.poisson_ratio, "rho": mat.density_kg_m3}
 
 
-def carrier_compliance(reducer, size: float | None = None, split_input: float = 0.5,
-                       local_size: float | None = None, rigid_bound: bool = True,
-                       cache: bool = True, edge_size: float | None = None) -> CarrierCompliance:
+def carrier_compliance(
+    reducer,
+    size: float | None = None,
+    split_input: float = 0.5,
+    local_size: float | None = None,
+    rigid_bound: bool = True,
+    cache: bool = True,
+    edge_size: float | None = None,
+) -> CarrierCompliance:
     """Condensed bore compliance and torsional compliance of a design's carrier
     (module doc). ``size``: global mesh size [m] (part default if None), ``local_size``
     the pillar mesh size [m] (part default if None); ``rigid_bound`` also
@@ -223,8 +229,14 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
     mat = carrier_material(reducer)
 
     def keyed(bound: bool):
-        k = content_hash(mres.key, mat, float(split_input), bool(bound), FORMAT_VERSION,
-                         library_versions("scikit-fem", "scipy", "numpy"))
+        k = content_hash(
+            mres.key,
+            mat,
+            float(split_input),
+            bool(bound),
+            FORMAT_VERSION,
+            library_versions("scikit-fem", "scipy", "numpy"),
+        )
         return k, cache_dir() / f"carrier-{k}.compliance.json"
 
     key, path = keyed(rigid_bound)
@@ -246,9 +258,18 @@ def carrier_compliance(reducer, size: float | None = None, split_input: float = 
         c_t = float(g @ C @ g)
         c_rbe2 = float(g @ rbe2_bore_compliance(fe.K, d, names) @ g) if rigid_bound else None
         labels = [f"{b} {c}" for b in names for c in ("x", "y")]
-        out = CarrierCompliance(matrix=C.tolist(), labels=labels, torsional=c_t, torsional_rbe2=c_rbe2,
-                                split_input=float(split_input), crank_circle_radius=float(a_w), n_cranks=int(n),
-                                n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key)
+        out = CarrierCompliance(
+            matrix=C.tolist(),
+            labels=labels,
+            torsional=c_t,
+            torsional_rbe2=c_rbe2,
+            split_input=float(split_input),
+            crank_circle_radius=float(a_w),
+            n_cranks=int(n),
+            n_nodes=int(d.n_nodes),
+            size=float(d.size),
+            mesh_key=mres.key,
+        )
         return out
 
     return cached_dataclass(path, key, CarrierCompliance, _build, enabled=cache)
@@ -269,8 +290,14 @@ def rbe2_bore_compliance(K, mesh, names: list[str]) -> np.ndarray:
     return c6[np.ix_(keep, keep)]
 
 
-def pillar_frame_stiffness(n_pillars: int, pillar_circle_radius: float, pillar_radius: float, length: float,
-                           youngs_modulus: float, poisson_ratio: float) -> float:
+def pillar_frame_stiffness(
+    n_pillars: int,
+    pillar_circle_radius: float,
+    pillar_radius: float,
+    length: float,
+    youngs_modulus: float,
+    poisson_ratio: float,
+) -> float:
     """Torsional stiffness [N m/rad] of round pillars built in between two rigid
     plates (closed form): each pillar sways as a fixed-fixed (guided) Timoshenko
     beam, delta = F L^3 / (12 E I) + F L / (kappa G A) (Timoshenko & Gere,
@@ -304,7 +331,6 @@ def rigid_plate_frame_stiffness(K, mesh, spec) -> float:
     rhs[starts[0] + 5] = 1.0  # unit moment about z on the rigid input plate
     x = factorize(0.5 * (Kr + Kr.T))(rhs)
     return float(1.0 / x[starts[0] + 5])
-
 
 
 def crank_support_compliance(reducer, size: float | None = None, cache: bool = True) -> np.ndarray:

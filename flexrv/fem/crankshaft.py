@@ -92,16 +92,23 @@ def crank_compliance(reducer, size: float | None = None, cache: bool = True) -> 
     def _build() -> CrankCompliance:
         d = mres.data
         fe = _assemble(d, mat)
-        seat, ecc1, ecc2, sup_a, sup_b = (d.node_set(g) for g in ("gear_seat", "eccentric_1", "eccentric_2",
-                                                                  "support_a", "support_b"))
+        seat, ecc1, ecc2, sup_a, sup_b = (
+            d.node_set(g) for g in ("gear_seat", "eccentric_1", "eccentric_2", "support_a", "support_b")
+        )
         seat_t, ecc = _disjoint(seat, np.union1d(ecc1, ecc2))
         k_t = 1.0 / seat_compliance(fe.K, d.nodes, seat_t, [ecc])[5, 5]
         seat_l, a, b = _disjoint(seat, sup_a, sup_b)
         c_l = seat_compliance(fe.K, d.nodes, seat_l, [a, b])
         fixed = np.unique(np.concatenate([seat, ecc1, ecc2, sup_a, sup_b]))
         f_hz, _ = eigenmodes(fe.K, fe.M, 1, fixed_nodes=fixed)
-        out = CrankCompliance(torsional=float(k_t), lateral_x=float(1.0 / c_l[0, 0]), lateral_y=float(1.0 / c_l[1, 1]),
-                              lowest_clamped_hz=float(f_hz[0]), n_nodes=int(d.n_nodes), mesh_key=mres.key)
+        out = CrankCompliance(
+            torsional=float(k_t),
+            lateral_x=float(1.0 / c_l[0, 0]),
+            lateral_y=float(1.0 / c_l[1, 1]),
+            lowest_clamped_hz=float(f_hz[0]),
+            n_nodes=int(d.n_nodes),
+            mesh_key=mres.key,
+        )
         return out
 
     return cached_dataclass(path, key, CrankCompliance, _build, enabled=cache)
@@ -184,8 +191,13 @@ def bending_compliance_of_mesh(mesh, youngs_modulus: float, poisson_ratio: float
                 c[i, j] = float(wi @ u[3 * ni + comp])
         out.append(0.5 * (c + c.T))
     cm = 0.5 * (out[0] + out[1])
-    return CrankBendingFE(compliance=cm, compliance_x=out[0], compliance_y=out[1], k_symmetric=float(4.0 / cm.sum()),
-                          n_nodes=int(mesh.n_nodes))
+    return CrankBendingFE(
+        compliance=cm,
+        compliance_x=out[0],
+        compliance_y=out[1],
+        k_symmetric=float(4.0 / cm.sum()),
+        n_nodes=int(mesh.n_nodes),
+    )
 
 
 def crank_bending_compliance(reducer, size: float | None = None, cache: bool = True) -> CrankBendingFE:

@@ -112,12 +112,20 @@ def pin_contact_case(reducer, output_torque: float, crank_angle: float = 0.0, di
     # at the no-load contact pose, where the solver takes the moment arms (the
     # elastic rotation beyond it, ~1e-4 rad, moves the points by < R_p * 1e-4)
     p = to_disc_frame(ab.pins, center, rot + res.backlash_rotation)
-    gap, normal, _ = as_built_pin_gap(p, ab.pin_radii, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
-                                      ss.eccentricity, tuple(float(v) for v in ab.disc_profile[disc]),
-                                      ab.profile_harmonics[disc])
+    gap, normal, _ = as_built_pin_gap(
+        p,
+        ab.pin_radii,
+        ss.pin_count,
+        ss.pin_circle_radius,
+        ss.pin_radius,
+        ss.eccentricity,
+        tuple(float(v) for v in ab.disc_profile[disc]),
+        ab.profile_harmonics[disc],
+    )
     points = p - (np.asarray(ab.pin_radii) + gap)[:, None] * normal
-    return PinContactCase(points=points, directions=-normal, forces=np.asarray(res.forces, dtype=float),
-                          disc_torque=float(res.torque))
+    return PinContactCase(
+        points=points, directions=-normal, forces=np.asarray(res.forces, dtype=float), disc_torque=float(res.torque)
+    )
 
 
 #: sub-triangles per edge of a profile face for the patch-load quadrature (n^2 equal
@@ -142,8 +150,9 @@ def _tri6_shape(bary: np.ndarray) -> np.ndarray:
     """Tri6 shape functions (q, 6) at barycentric points (q, 3), node order corners
     0, 1, 2 then mid-nodes 01, 12, 20."""
     l0, l1, l2 = bary.T
-    return np.column_stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), 4 * l0 * l1, 4 * l1 * l2,
-                            4 * l2 * l0])
+    return np.column_stack(
+        [l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), 4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0]
+    )
 
 
 def pin_patch_loads(mesh, case: PinContactCase, patch: float) -> sp.csc_matrix:
@@ -172,8 +181,10 @@ def pin_patch_loads(mesh, case: PinContactCase, patch: float) -> sp.csc_matrix:
         w = (inside[:, :, None] * shape[None]).sum(axis=1) * (area[near] / len(bary))[:, None]  # (f, 6)
         total = float(np.sum(inside.sum(axis=1) * area[near]) / len(bary))
         if total <= 0.0:
-            raise InputError(f"pin patch of half-width {patch * 1e3:.3g} mm at pin {i} finds no profile face; "
-                             "refine the disc mesh or widen the patch")
+            raise InputError(
+                f"pin patch of half-width {patch * 1e3:.3g} mm at pin {i} finds no profile face; "
+                "refine the disc mesh or widen the patch"
+            )
         nodes = prof[near].ravel()
         wv = w.ravel() / total
         keep = wv != 0.0
@@ -182,8 +193,9 @@ def pin_patch_loads(mesh, case: PinContactCase, patch: float) -> sp.csc_matrix:
             cols.append(np.full(int(keep.sum()), i))
             vals.append(wv[keep] * d[comp])
     n = 3 * mesh.n_nodes
-    return sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, len(case.points)))
+    return sp.csc_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, len(case.points))
+    )
 
 
 def hole_masters(mesh) -> list:
@@ -234,9 +246,15 @@ class DiscCompliance(_DiscBodyResult):
     n_loaded: int
 
 
-def disc_compliance(reducer, output_torque: float | None = None, crank_angle: float = 0.0,
-                    size: float | None = None, patch: float | None = None, local_size: float | None = None,
-                    cache: bool = True) -> DiscCompliance:
+def disc_compliance(
+    reducer,
+    output_torque: float | None = None,
+    crank_angle: float = 0.0,
+    size: float | None = None,
+    patch: float | None = None,
+    local_size: float | None = None,
+    cache: bool = True,
+) -> DiscCompliance:
     """Disc body compliance (module doc). ``output_torque`` defaults to the rated
     torque; ``patch`` [m] the pin patch half-width (default r_rp / 2); ``size`` /
     ``local_size`` the global / tooth-flank mesh sizes [m] (part defaults if None)."""
@@ -253,8 +271,16 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
     mres = build_mesh(reducer, "cycloid_disc", size, local_size=local_size, cache=cache)
     mat = material_dict(reducer, "cycloid_disc")
     case = pin_contact_case(reducer, torque, crank_angle)
-    key = content_hash(mres.key, mat, case.points, case.directions, case.forces, patch, FORMAT_VERSION,
-                       library_versions("scikit-fem", "scipy", "numpy"))
+    key = content_hash(
+        mres.key,
+        mat,
+        case.points,
+        case.directions,
+        case.forces,
+        patch,
+        FORMAT_VERSION,
+        library_versions("scikit-fem", "scipy", "numpy"),
+    )
     path = cache_dir() / f"cycloid_disc-{key}.compliance.json"
 
     def _build() -> DiscCompliance:
@@ -264,14 +290,23 @@ def disc_compliance(reducer, output_torque: float | None = None, crank_angle: fl
         C, _ = held_flexibility(fe.K, d, W)
         f = case.forces / abs(case.disc_torque)
         c_d = float(f @ C @ f)
-        out = DiscCompliance(matrix=C.tolist(), forces_per_torque=f.tolist(), torsional=c_d,
-                             output_share=c_d / ss.n_discs, n_discs=int(ss.n_discs), torque=torque,
-                             crank_angle=float(crank_angle), patch=patch, n_loaded=int(np.count_nonzero(f)),
-                             n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key)
+        out = DiscCompliance(
+            matrix=C.tolist(),
+            forces_per_torque=f.tolist(),
+            torsional=c_d,
+            output_share=c_d / ss.n_discs,
+            n_discs=int(ss.n_discs),
+            torque=torque,
+            crank_angle=float(crank_angle),
+            patch=patch,
+            n_loaded=int(np.count_nonzero(f)),
+            n_nodes=int(d.n_nodes),
+            size=float(d.size),
+            mesh_key=mres.key,
+        )
         return out
 
     return cached_dataclass(path, key, DiscCompliance, _build, enabled=cache)
-
 
 
 @dataclass(frozen=True)
@@ -297,8 +332,15 @@ def _sweep_angles(reducer, n_angles, patch) -> tuple[float, list]:
     return patch, [2.0 * np.pi * k / (n * n_angles) for k in range(n_angles)]
 
 
-def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | None = None, size: float | None = None,
-                          patch: float | None = None, local_size: float | None = None, cache: bool = True) -> DiscSweep:
+def disc_compliance_sweep(
+    reducer,
+    n_angles: int = 6,
+    output_torque: float | None = None,
+    size: float | None = None,
+    patch: float | None = None,
+    local_size: float | None = None,
+    cache: bool = True,
+) -> DiscSweep:
     """c_d at ``n_angles`` crank angles 2 pi k / (N n_angles), k = 0..n-1, over one
     period of the crank-hole pattern (the loaded flank turns against the N holes
     as the crank turns; c_d varies by +-20 % on the rv40e), and their mean (the
@@ -314,29 +356,51 @@ def disc_compliance_sweep(reducer, n_angles: int = 6, output_torque: float | Non
     mres = build_mesh(reducer, "cycloid_disc", size, local_size=local_size, cache=cache)
     mat = material_dict(reducer, "cycloid_disc")
     cases = [pin_contact_case(reducer, torque, a) for a in angles]
-    key = content_hash(mres.key, mat, [(c.points, c.directions, c.forces) for c in cases], patch, FORMAT_VERSION,
-                       library_versions("scikit-fem", "scipy", "numpy"))
+    key = content_hash(
+        mres.key,
+        mat,
+        [(c.points, c.directions, c.forces) for c in cases],
+        patch,
+        FORMAT_VERSION,
+        library_versions("scikit-fem", "scipy", "numpy"),
+    )
     path = cache_dir() / f"cycloid_disc-{key}.sweep.json"
 
     def _build() -> DiscSweep:
         d = mres.data
         fe = _assemble(d, mat, mass=False)
-        F = sp.hstack([pin_patch_loads(d, c, patch) @ sp.csc_matrix((c.forces / abs(c.disc_torque))[:, None])
-                       for c in cases]).tocsc()
+        F = sp.hstack(
+            [pin_patch_loads(d, c, patch) @ sp.csc_matrix((c.forces / abs(c.disc_torque))[:, None]) for c in cases]
+        ).tocsc()
         C, _ = held_flexibility(fe.K, d, F)
         cd = np.diag(C).tolist()
         mean = float(np.mean(cd))
-        out = DiscSweep(angles=angles, torsional=cd, mean=mean, output_share=mean / ss.n_discs,
-                        n_discs=int(ss.n_discs), torque=torque, patch=patch, n_nodes=int(d.n_nodes),
-                        size=float(d.size), mesh_key=mres.key)
+        out = DiscSweep(
+            angles=angles,
+            torsional=cd,
+            mean=mean,
+            output_share=mean / ss.n_discs,
+            n_discs=int(ss.n_discs),
+            torque=torque,
+            patch=patch,
+            n_nodes=int(d.n_nodes),
+            size=float(d.size),
+            mesh_key=mres.key,
+        )
         return out
 
     return cached_dataclass(path, key, DiscSweep, _build, enabled=cache)
 
 
-def body_compliances(reducer, carrier_size: float | None = None, disc_size: float | None = None,
-                     output_torque: float | None = None, disc_angles: int = 6, cache: bool = True,
-                     rigid_bound: bool = False) -> dict:
+def body_compliances(
+    reducer,
+    carrier_size: float | None = None,
+    disc_size: float | None = None,
+    output_torque: float | None = None,
+    disc_angles: int = 6,
+    cache: bool = True,
+    rigid_bound: bool = False,
+) -> dict:
     """Torsional compliances [rad/(N m)] at the output of the carrier and the
     cycloid disc bodies, from the FE condensations (for the stiffness budget).
 
@@ -356,27 +420,40 @@ def body_compliances(reducer, carrier_size: float | None = None, disc_size: floa
 
     out: dict = {}
     if reducer.carrier is None:
-        out["carrier"] = {"compliance_rad_per_Nm": None, "stiffness_Nm_per_arcmin": None,
-                          "source": "no [carrier] table in the design: carrier compliance not computed"}
+        out["carrier"] = {
+            "compliance_rad_per_Nm": None,
+            "stiffness_Nm_per_arcmin": None,
+            "source": "no [carrier] table in the design: carrier compliance not computed",
+        }
     else:
         c = carrier_compliance(reducer, size=carrier_size, rigid_bound=rigid_bound, cache=cache)
-        out["carrier"] = {"compliance_rad_per_Nm": c.torsional,
-                          "stiffness_Nm_per_arcmin": c.torsional_stiffness_Nm_per_arcmin,
-                          "compliance_rbe2_rad_per_Nm": c.torsional_rbe2,
-                          "source": (f"FE condensation (flexrv.fem.carrier): Tet10 carrier, {c.n_nodes} nodes, size "
-                                     f"{c.size * 1e3:.3g} mm; flange held, crank bores RBE3, tangential crank forces "
-                                     f"T/(N a_w) split {c.split_input:g}/{1 - c.split_input:g} input/output plate"),
-                          "n_nodes": c.n_nodes, "mesh_size_m": c.size}
+        out["carrier"] = {
+            "compliance_rad_per_Nm": c.torsional,
+            "stiffness_Nm_per_arcmin": c.torsional_stiffness_Nm_per_arcmin,
+            "compliance_rbe2_rad_per_Nm": c.torsional_rbe2,
+            "source": (
+                f"FE condensation (flexrv.fem.carrier): Tet10 carrier, {c.n_nodes} nodes, size "
+                f"{c.size * 1e3:.3g} mm; flange held, crank bores RBE3, tangential crank forces "
+                f"T/(N a_w) split {c.split_input:g}/{1 - c.split_input:g} input/output plate"
+            ),
+            "n_nodes": c.n_nodes,
+            "mesh_size_m": c.size,
+        }
     d = disc_torsion_sweep(reducer, n_angles=disc_angles, output_torque=output_torque, size=disc_size, cache=cache)
-    out["cycloid_disc"] = {"compliance_rad_per_Nm": d.output_share,
-                           "stiffness_Nm_per_arcmin": d.output_stiffness_Nm_per_arcmin,
-                           "compliance_one_disc_rad_per_Nm": d.mean,
-                           "compliance_one_disc_range_rad_per_Nm": [min(d.torsional), max(d.torsional)],
-                           "source": (f"FE condensation (flexrv.fem.disc): Tet10 disc, {d.n_nodes} nodes; crank holes "
-                                      f"held (RBE2, rz free), pin loads at T = {d.torque:g} N m as RBE3 patches of "
-                                      f"half-width {d.patch * 1e3:.3g} mm, mean over {len(d.angles)} crank angles of "
-                                      f"one hole period; {d.n_discs} discs in parallel"),
-                           "n_nodes": d.n_nodes, "mesh_size_m": d.size}
+    out["cycloid_disc"] = {
+        "compliance_rad_per_Nm": d.output_share,
+        "stiffness_Nm_per_arcmin": d.output_stiffness_Nm_per_arcmin,
+        "compliance_one_disc_rad_per_Nm": d.mean,
+        "compliance_one_disc_range_rad_per_Nm": [min(d.torsional), max(d.torsional)],
+        "source": (
+            f"FE condensation (flexrv.fem.disc): Tet10 disc, {d.n_nodes} nodes; crank holes "
+            f"held (RBE2, rz free), pin loads at T = {d.torque:g} N m as RBE3 patches of "
+            f"half-width {d.patch * 1e3:.3g} mm, mean over {len(d.angles)} crank angles of "
+            f"one hole period; {d.n_discs} discs in parallel"
+        ),
+        "n_nodes": d.n_nodes,
+        "mesh_size_m": d.size,
+    }
     return out
 
 
@@ -420,8 +497,9 @@ def body_design(reducer):
     any measurable way, but they would key a new mesh and FE solve per design
     variant (sweeps, tolerance samples, tests); the load pattern, which the
     modifications do change, is applied afterwards (:func:`disc_torsion_sweep`)."""
-    ss = reducer.second_stage.model_copy(update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0,
-                                                 "modification_rotation_deg": 0.0})
+    ss = reducer.second_stage.model_copy(
+        update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0, "modification_rotation_deg": 0.0}
+    )
     return nominal_design(reducer).model_copy(update={"second_stage": ss})
 
 
@@ -437,9 +515,16 @@ def contact_geometry(reducer, crank_angle: float, disc: int = 0) -> tuple[np.nda
     ab = as_built(reducer)
     center, rot = nominal_disc_pose(ss.pin_count, ss.eccentricity, crank_angle + float(ab.chi0[disc]))
     p = to_disc_frame(ab.pins, center, rot)
-    gap, normal, _ = as_built_pin_gap(p, ab.pin_radii, ss.pin_count, ss.pin_circle_radius, ss.pin_radius,
-                                      ss.eccentricity, tuple(float(v) for v in ab.disc_profile[disc]),
-                                      ab.profile_harmonics[disc])
+    gap, normal, _ = as_built_pin_gap(
+        p,
+        ab.pin_radii,
+        ss.pin_count,
+        ss.pin_circle_radius,
+        ss.pin_radius,
+        ss.eccentricity,
+        tuple(float(v) for v in ab.disc_profile[disc]),
+        ab.profile_harmonics[disc],
+    )
     points = p - (np.asarray(ab.pin_radii) + gap)[:, None] * normal
     return points, -normal
 
@@ -459,8 +544,14 @@ class DiscPatchSweep:
     mesh_key: str
 
 
-def disc_patch_sweep(reducer, n_angles: int = 6, size: float | None = None, patch: float | None = None,
-                     local_size: float | None = None, cache: bool = True) -> DiscPatchSweep:
+def disc_patch_sweep(
+    reducer,
+    n_angles: int = 6,
+    size: float | None = None,
+    patch: float | None = None,
+    local_size: float | None = None,
+    cache: bool = True,
+) -> DiscPatchSweep:
     """The (z_rp x z_rp) pin-patch compliance of the disc body at ``n_angles`` crank
     angles 2 pi k / (N n_angles) (one factorisation, the angles solved one after the
     other), keyed on the body's geometry only (:func:`body_design`): the same model
@@ -475,8 +566,9 @@ def disc_patch_sweep(reducer, n_angles: int = 6, size: float | None = None, patc
     mres = build_mesh(body, "cycloid_disc", size, local_size=local_size, cache=cache)
     mat = material_dict(body, "cycloid_disc")
     geo = [contact_geometry(body, a) for a in angles]
-    key = content_hash(mres.key, mat, [(p, d) for p, d in geo], patch, FORMAT_VERSION,
-                       library_versions("scikit-fem", "scipy", "numpy"))
+    key = content_hash(
+        mres.key, mat, [(p, d) for p, d in geo], patch, FORMAT_VERSION, library_versions("scikit-fem", "scipy", "numpy")
+    )
     path = cache_dir() / f"cycloid_disc-{key}.patches.json"
 
     def _build() -> DiscPatchSweep:
@@ -487,20 +579,28 @@ def disc_patch_sweep(reducer, n_angles: int = 6, size: float | None = None, patc
         solve = factorize(0.5 * (Kr + Kr.T))
         mats = []
         for p, dirs in geo:
-            W = pin_patch_loads(d, PinContactCase(points=p, directions=dirs, forces=np.zeros(len(p)),
-                                                  disc_torque=1.0), patch)
+            W = pin_patch_loads(
+                d, PinContactCase(points=p, directions=dirs, forces=np.zeros(len(p)), disc_torque=1.0), patch
+            )
             Wr = np.asarray((Z.T @ W).todense())
             C = Wr.T @ solve(Wr)
             mats.append((0.5 * (C + C.T)).tolist())
-        return DiscPatchSweep(angles=angles, matrices=mats, patch=patch, n_nodes=int(d.n_nodes), size=float(d.size),
-                              mesh_key=mres.key)
+        return DiscPatchSweep(
+            angles=angles, matrices=mats, patch=patch, n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key
+        )
 
     return cached_dataclass(path, key, DiscPatchSweep, _build, enabled=cache)
 
 
-def disc_torsion_sweep(reducer, n_angles: int = 6, output_torque: float | None = None, size: float | None = None,
-                       patch: float | None = None, local_size: float | None = None,
-                       cache: bool = True) -> DiscSweep:
+def disc_torsion_sweep(
+    reducer,
+    n_angles: int = 6,
+    output_torque: float | None = None,
+    size: float | None = None,
+    patch: float | None = None,
+    local_size: float | None = None,
+    cache: bool = True,
+) -> DiscSweep:
     """Disc body torsional compliance c_d = f^T C f over crank angles, as
     :func:`disc_compliance_sweep`, with C the cached patch compliances of the disc
     body (:func:`disc_patch_sweep`, geometry only) and f the design's own as-built
@@ -521,6 +621,15 @@ def disc_torsion_sweep(reducer, n_angles: int = 6, output_torque: float | None =
         f = case.forces / abs(case.disc_torque)
         cd.append(float(f @ np.asarray(C) @ f))
     mean = float(np.mean(cd))
-    return DiscSweep(angles=list(ps.angles), torsional=cd, mean=mean, output_share=mean / ss.n_discs,
-                     n_discs=int(ss.n_discs), torque=torque, patch=ps.patch, n_nodes=ps.n_nodes, size=ps.size,
-                     mesh_key=ps.mesh_key)
+    return DiscSweep(
+        angles=list(ps.angles),
+        torsional=cd,
+        mean=mean,
+        output_share=mean / ss.n_discs,
+        n_discs=int(ss.n_discs),
+        torque=torque,
+        patch=ps.patch,
+        n_nodes=ps.n_nodes,
+        size=ps.size,
+        mesh_key=ps.mesh_key,
+    )

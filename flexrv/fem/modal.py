@@ -35,8 +35,7 @@ from flexrv.errors import ConvergenceError, InputError
 def factorize(A: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray]:
     """Sparse LU of a symmetric (positive definite) matrix; returns ``solve(b)``
     accepting (n,) or (n, k) right-hand sides."""
-    lu = sla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                  options={"SymmetricMode": True})
+    lu = sla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
 
     def solve(b: np.ndarray) -> np.ndarray:
         return lu.solve(np.asarray(b, dtype=float))
@@ -53,8 +52,9 @@ def _start_vector(size: int, seed: int = 0) -> np.ndarray:
     return np.random.default_rng(seed).standard_normal(size)
 
 
-def rigid_body_subspace(K, M, solve, n_rigid: int = RIGID_BODY_MODES, seed: int = 0,
-                        steps: int = 3) -> tuple[np.ndarray, np.ndarray]:
+def rigid_body_subspace(
+    K, M, solve, n_rigid: int = RIGID_BODY_MODES, seed: int = 0, steps: int = 3
+) -> tuple[np.ndarray, np.ndarray]:
     """Rigid-body modes of a free body: (eigenvalues [rad^2/s^2] ~0, M-orthonormal (N, n_rigid)).
 
     Subspace iteration X <- (K - sigma M)^-1 M X with ``solve`` = (K - sigma M)^-1 (sigma < 0
@@ -82,9 +82,15 @@ def free_dofs(n_dof: int, fixed_nodes: np.ndarray | None) -> np.ndarray:
     return np.flatnonzero(mask)
 
 
-def eigenmodes(K: sp.spmatrix, M: sp.spmatrix, n: int, fixed_nodes: np.ndarray | None = None,
-               shift_hz: float | None = None, tol: float = 1e-8,
-               solve0: Callable[[np.ndarray], np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def eigenmodes(
+    K: sp.spmatrix,
+    M: sp.spmatrix,
+    n: int,
+    fixed_nodes: np.ndarray | None = None,
+    shift_hz: float | None = None,
+    tol: float = 1e-8,
+    solve0: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Lowest ``n`` eigenpairs of K x = w^2 M x.
 
     Parameters
@@ -119,11 +125,12 @@ def eigenmodes(K: sp.spmatrix, M: sp.spmatrix, n: int, fixed_nodes: np.ndarray |
         if constrained and shift_hz is None:
             solve = solve0 or factorize(Kf)
             op0 = sla.LinearOperator(Kf.shape, matvec=solve, dtype=float)
-            lam1 = sla.eigsh(Kf, k=1, M=Mf, sigma=0.0, which="LM", OPinv=op0, tol=1e-3, v0=v0,
-                             return_eigenvectors=False)[0]
+            lam1 = sla.eigsh(
+                Kf, k=1, M=Mf, sigma=0.0, which="LM", OPinv=op0, tol=1e-3, v0=v0, return_eigenvectors=False
+            )[0]
             sigma = 0.8 * float(lam1)
         else:
-            sigma = -(2.0 * np.pi * (1.0 if shift_hz is None else shift_hz)) ** 2
+            sigma = -((2.0 * np.pi * (1.0 if shift_hz is None else shift_hz)) ** 2)
         solve = factorize(Kf - sigma * Mf)
         if constrained:
             op = sla.LinearOperator(Kf.shape, matvec=solve, dtype=float)
@@ -139,8 +146,9 @@ def eigenmodes(K: sp.spmatrix, M: sp.spmatrix, n: int, fixed_nodes: np.ndarray |
             n_el = n - RIGID_BODY_MODES
             if n_el > 0:
                 op = sla.LinearOperator(Kf.shape, matvec=deflated, dtype=float)
-                w2_e, vec_e = sla.eigsh(Kf, k=n_el, M=Mf, sigma=sigma, which="LM", OPinv=op, tol=tol,
-                                        v0=v0 - R @ (MR.T @ v0))
+                w2_e, vec_e = sla.eigsh(
+                    Kf, k=n_el, M=Mf, sigma=sigma, which="LM", OPinv=op, tol=tol, v0=v0 - R @ (MR.T @ v0)
+                )
                 w2 = np.concatenate([w2_r, w2_e])
                 vec = np.hstack([R, vec_e])
             else:

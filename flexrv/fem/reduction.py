@@ -106,31 +106,39 @@ def rbe2_block(nodes: np.ndarray, interfaces: list[np.ndarray]) -> np.ndarray:
     start = 0
     for k, s in enumerate(interfaces):
         t = rbe2_mapping(nodes, np.asarray(s))
-        T[start:start + t.shape[0], 6 * k:6 * k + 6] = t
+        T[start : start + t.shape[0], 6 * k : 6 * k + 6] = t
         start += t.shape[0]
     return T
 
 
-def raceway_weights(nodes: np.ndarray, race_nodes: np.ndarray, areas: np.ndarray, spec: RacewaySpec,
-                    azimuths: np.ndarray, cutoff: float = 4.0) -> sp.csr_matrix:
+def raceway_weights(
+    nodes: np.ndarray,
+    race_nodes: np.ndarray,
+    areas: np.ndarray,
+    spec: RacewaySpec,
+    azimuths: np.ndarray,
+    cutoff: float = 4.0,
+) -> sp.csr_matrix:
     """Sparse (n_az, n_race) patch weights w_j(theta) (rows sum to 1); see module doc."""
     x = nodes[race_nodes]
     rj = np.hypot(x[:, 0], x[:, 1])
     tj = np.arctan2(x[:, 1], x[:, 0])
     g = areas[race_nodes] * np.exp(-(((rj - spec.r) ** 2 + (x[:, 2] - spec.z) ** 2) / spec.b**2))
-    keep = g > g.max() * math.exp(-cutoff**2)
+    keep = g > g.max() * math.exp(-(cutoff**2))
     idx = np.flatnonzero(keep)
     az = np.asarray(azimuths, dtype=float).ravel()
     d = np.remainder(tj[idx][None, :] - az[:, None] + np.pi, 2.0 * np.pi) - np.pi
     s = spec.r * d / spec.b
     mask = np.abs(s) < cutoff
     rows, cols = np.nonzero(mask)
-    vals = g[idx][cols] * np.exp(-s[rows, cols] ** 2)
+    vals = g[idx][cols] * np.exp(-(s[rows, cols] ** 2))
     W = sp.csr_matrix((vals, (rows, idx[cols])), shape=(az.size, race_nodes.size))
     sums = np.asarray(W.sum(axis=1)).ravel()
     if np.any(sums <= 0):
-        raise InputError(f"raceway patch width b = {spec.b * 1e3:.3g} mm finds no raceway nodes at some azimuths; "
-                         "refine the mesh or widen the patch")
+        raise InputError(
+            f"raceway patch width b = {spec.b * 1e3:.3g} mm finds no raceway nodes at some azimuths; "
+            "refine the mesh or widen the patch"
+        )
     return sp.diags(1.0 / sums) @ W
 
 
@@ -168,8 +176,14 @@ class HCBResult:
     fixed_interface_hz: np.ndarray
 
 
-def hcb_basis(K: sp.csr_matrix, M: sp.csr_matrix, nodes: np.ndarray, interfaces: list[np.ndarray], n_eig: int,
-              raceway_loads: np.ndarray | None = None) -> HCBResult:
+def hcb_basis(
+    K: sp.csr_matrix,
+    M: sp.csr_matrix,
+    nodes: np.ndarray,
+    interfaces: list[np.ndarray],
+    n_eig: int,
+    raceway_loads: np.ndarray | None = None,
+) -> HCBResult:
     """Hurty–Craig–Bampton basis (RBE2 interfaces) + raceway static modes, as Ritz vectors.
 
     Parameters

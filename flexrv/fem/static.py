@@ -45,8 +45,9 @@ def solve_static(K, fixed_nodes: np.ndarray, forces: np.ndarray) -> np.ndarray:
     return u.reshape(-1, 3)
 
 
-def sector_loads(nodes: np.ndarray, surface_nodes: np.ndarray, center_xy, angles, forces,
-                 half_width: float) -> np.ndarray:
+def sector_loads(
+    nodes: np.ndarray, surface_nodes: np.ndarray, center_xy, angles, forces, half_width: float
+) -> np.ndarray:
     """Nodal forces (N, 3) [N] that spread each load ``forces[i]`` (3,) [N] equally
     over the ``surface_nodes`` whose polar angle about the axis through
     ``center_xy`` lies within +/- ``half_width`` [rad] of ``angles[i]`` — a roller's
@@ -71,11 +72,11 @@ def sector_loads(nodes: np.ndarray, surface_nodes: np.ndarray, center_xy, angles
     return out
 
 
-def von_mises_field(nodes: np.ndarray, tets: np.ndarray, displacement: np.ndarray, youngs_modulus: float,
-                    poisson_ratio: float) -> np.ndarray:
+def von_mises_field(
+    nodes: np.ndarray, tets: np.ndarray, displacement: np.ndarray, youngs_modulus: float, poisson_ratio: float
+) -> np.ndarray:
     """Nodal (averaged) von Mises stress [Pa] of a displacement field (N, 3)."""
     from flexrv.fem.stress import nodal_stress, von_mises
 
-    s = nodal_stress(nodes, tets, np.asarray(displacement, dtype=float).reshape(-1, 1), youngs_modulus,
-                     poisson_ratio)
+    s = nodal_stress(nodes, tets, np.asarray(displacement, dtype=float).reshape(-1, 1), youngs_modulus, poisson_ratio)
     return von_mises(s)

@@ -16,8 +16,21 @@ import numpy as np
 from flexrv.fem.assembly import lame
 
 # reference coordinates of the 10 nodes (VTK tetra10 order)
-_REF = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [.5, 0, 0], [.5, .5, 0], [0, .5, 0],
-                 [0, 0, .5], [.5, 0, .5], [0, .5, .5]], dtype=float)
+_REF = np.array(
+    [
+        [0, 0, 0],
+        [1, 0, 0],
+        [0, 1, 0],
+        [0, 0, 1],
+        [0.5, 0, 0],
+        [0.5, 0.5, 0],
+        [0, 0.5, 0],
+        [0, 0, 0.5],
+        [0.5, 0, 0.5],
+        [0, 0.5, 0.5],
+    ],
+    dtype=float,
+)
 _EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
 
 
@@ -33,8 +46,9 @@ def shape_gradients(xi: np.ndarray) -> np.ndarray:
     return g
 
 
-def nodal_stress(nodes: np.ndarray, tets: np.ndarray, modes: np.ndarray, youngs_modulus: float,
-                 poisson_ratio: float, chunk: int = 8) -> np.ndarray:
+def nodal_stress(
+    nodes: np.ndarray, tets: np.ndarray, modes: np.ndarray, youngs_modulus: float, poisson_ratio: float, chunk: int = 8
+) -> np.ndarray:
     """Nodal-averaged stress modes (N, 6 m) [Pa per unit modal coordinate]."""
     lam, mu = lame(youngs_modulus, poisson_ratio)
     dN = shape_gradients(_REF)  # (10 pts, 10 fns, 3)
@@ -47,13 +61,18 @@ def nodal_stress(nodes: np.ndarray, tets: np.ndarray, modes: np.ndarray, youngs_
     U = modes.reshape(n_nodes, 3, m)
     flat = tets.ravel()
     for s in range(0, m, chunk):
-        ue = U[tets, :, s:s + chunk]  # (E, 10, 3, c)
+        ue = U[tets, :, s : s + chunk]  # (E, 10, 3, c)
         grad = np.einsum("epaj,eaic->epijc", G, ue)  # du_i/dx_j
         eps = 0.5 * (grad + grad.transpose(0, 1, 3, 2, 4))
         tr = eps[:, :, 0, 0] + eps[:, :, 1, 1] + eps[:, :, 2, 2]
-        comps = [lam * tr + 2 * mu * eps[:, :, 0, 0], lam * tr + 2 * mu * eps[:, :, 1, 1],
-                 lam * tr + 2 * mu * eps[:, :, 2, 2], 2 * mu * eps[:, :, 1, 2], 2 * mu * eps[:, :, 0, 2],
-                 2 * mu * eps[:, :, 0, 1]]
+        comps = [
+            lam * tr + 2 * mu * eps[:, :, 0, 0],
+            lam * tr + 2 * mu * eps[:, :, 1, 1],
+            lam * tr + 2 * mu * eps[:, :, 2, 2],
+            2 * mu * eps[:, :, 1, 2],
+            2 * mu * eps[:, :, 0, 2],
+            2 * mu * eps[:, :, 0, 1],
+        ]
         for c, val in enumerate(comps):  # val (E, 10, chunk)
             v = val.reshape(-1, val.shape[-1])
             for j in range(v.shape[1]):

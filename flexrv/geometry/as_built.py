@@ -85,8 +85,11 @@ def as_built(reducer, errors=None) -> AsBuilt:
     pins0 = pin_positions(z, ss.pin_circle_radius)
     psi = 2.0 * np.pi * np.arange(z) / z
     u_pin = np.stack([np.sin(psi), np.cos(psi)], axis=-1)
-    pins = pins0 + _radial_tangential(u_pin, _per(err.pins.pin_radial_position_um, z) * M_PER_UM,
-                                      _per(err.pins.pin_tangential_position_um, z) * M_PER_UM)
+    pins = pins0 + _radial_tangential(
+        u_pin,
+        _per(err.pins.pin_radial_position_um, z) * M_PER_UM,
+        _per(err.pins.pin_tangential_position_um, z) * M_PER_UM,
+    )
     pin_radii = ss.pin_radius + _per(err.pins.pin_radius_um, z) * M_PER_UM
     # discs: profile and harmonics
     nominal = np.array([ss.modification_shift, ss.modification_equidistant, ss.modification_rotation])
@@ -107,8 +110,9 @@ def as_built(reducer, errors=None) -> AsBuilt:
     beta = 2.0 * np.pi * np.arange(n) / n
     u_crank = np.stack([np.cos(beta), np.sin(beta)], axis=-1)
     crank_pos = a_w * u_crank
-    bores = crank_pos + _radial_tangential(u_crank, _per(err.cranks.bore_radial_um, n) * M_PER_UM,
-                                           _per(err.cranks.bore_tangential_um, n) * M_PER_UM)
+    bores = crank_pos + _radial_tangential(
+        u_crank, _per(err.cranks.bore_radial_um, n) * M_PER_UM, _per(err.cranks.bore_tangential_um, n) * M_PER_UM
+    )
     chi0 = 2.0 * np.pi * np.arange(nd) / nd
     rot0 = chi0 / ss.disc_teeth
     holes = np.empty((nd, n, 2))
@@ -126,10 +130,23 @@ def as_built(reducer, errors=None) -> AsBuilt:
     sun = np.array([e1.sun_runout_um * M_PER_UM, e1.sun_runout_phase_deg * RAD_PER_DEG])
     planet = np.stack([_per(e1.planet_runout_um, n) * M_PER_UM, _per(e1.planet_runout_phase_deg, n) * RAD_PER_DEG], -1)
     planet_phase = _per(e1.planet_phase_arcmin, n) * RAD_PER_ARCMIN
-    return AsBuilt(pins=pins, pin_radii=pin_radii, disc_profile=profile, profile_harmonics=harmonics, chi0=chi0,
-                   disc_rot0=rot0, holes=holes, eccentricities=ecc, eccentric_phase_errors=phase, crank_bores=bores,
-                   needle_clearances=needle, support_clearances=support, sun_runout=sun, planet_runout=planet,
-                   planet_phase_errors=planet_phase)
+    return AsBuilt(
+        pins=pins,
+        pin_radii=pin_radii,
+        disc_profile=profile,
+        profile_harmonics=harmonics,
+        chi0=chi0,
+        disc_rot0=rot0,
+        holes=holes,
+        eccentricities=ecc,
+        eccentric_phase_errors=phase,
+        crank_bores=bores,
+        needle_clearances=needle,
+        support_clearances=support,
+        sun_runout=sun,
+        planet_runout=planet,
+        planet_phase_errors=planet_phase,
+    )
 
 
 def profile_deviation(phi, harmonics) -> np.ndarray:
@@ -142,8 +159,17 @@ def profile_deviation(phi, harmonics) -> np.ndarray:
     return np.sum(h[:, 1] * np.cos(h[:, 0] * phi[..., None] + h[:, 2]), axis=-1)
 
 
-def as_built_pin_gap(points, pin_radii, z_rp: int, pin_circle_radius: float, pin_radius: float,
-                     eccentricity: float, profile, harmonics=None, phi0=None):
+def as_built_pin_gap(
+    points,
+    pin_radii,
+    z_rp: int,
+    pin_circle_radius: float,
+    pin_radius: float,
+    eccentricity: float,
+    profile,
+    harmonics=None,
+    phi0=None,
+):
     """Signed gap [m] of actual pins (centres ``points`` (..., 2) in the disc frame,
     radii ``pin_radii``) to one as-built disc profile.
 
@@ -159,8 +185,9 @@ def as_built_pin_gap(points, pin_radii, z_rp: int, pin_circle_radius: float, pin
     as :func:`flexrv.geometry.cycloid.pin_gap`.
     """
     d_radius, d_pin_radius, d_rotation = (float(v) for v in profile)
-    gap, normal, phi = pin_gap(points, z_rp, pin_circle_radius, pin_radius, eccentricity, d_radius, d_pin_radius,
-                               d_rotation, phi0=phi0)
+    gap, normal, phi = pin_gap(
+        points, z_rp, pin_circle_radius, pin_radius, eccentricity, d_radius, d_pin_radius, d_rotation, phi0=phi0
+    )
     gap = gap - (np.asarray(pin_radii, dtype=float) - pin_radius)
     if harmonics is not None and np.size(harmonics):
         gap = gap - profile_deviation(phi, harmonics)
@@ -184,7 +211,9 @@ def assembly_disc_poses(reducer, ab: AsBuilt):
         target = ab.crank_bores + ab.eccentricities[:, k, None] * np.stack([np.sin(chi), np.cos(chi)], -1)
         h = ab.holes[k]
         hc, tc = h - h.mean(0), target - target.mean(0)
-        rot = np.arctan2(np.sum(hc[:, 0] * tc[:, 1] - hc[:, 1] * tc[:, 0]), np.sum(hc[:, 0] * tc[:, 0] + hc[:, 1] * tc[:, 1]))
+        rot = np.arctan2(
+            np.sum(hc[:, 0] * tc[:, 1] - hc[:, 1] * tc[:, 0]), np.sum(hc[:, 0] * tc[:, 0] + hc[:, 1] * tc[:, 1])
+        )
         c, s = np.cos(rot), np.sin(rot)
         hm = h.mean(0)
         centres[k] = target.mean(0) - np.array([c * hm[0] - s * hm[1], s * hm[0] + c * hm[1]])
@@ -231,9 +260,17 @@ def assembly_penetration(reducer, errors=None) -> tuple[float, int, int]:
         g, arm, phi = np.empty((nd, z)), np.empty((nd, z)), np.empty((nd, z))
         for k in range(nd):
             p = to_disc_frame(ab.pins, centres[k], rots[k] + beta)
-            g[k], n, phi[k] = as_built_pin_gap(p, ab.pin_radii, z, ss.pin_circle_radius, ss.pin_radius,
-                                               ss.eccentricity, ab.disc_profile[k], ab.profile_harmonics[k],
-                                               phi0=None if phi0 is None else phi0[k])
+            g[k], n, phi[k] = as_built_pin_gap(
+                p,
+                ab.pin_radii,
+                z,
+                ss.pin_circle_radius,
+                ss.pin_radius,
+                ss.eccentricity,
+                ab.disc_profile[k],
+                ab.profile_harmonics[k],
+                phi0=None if phi0 is None else phi0[k],
+            )
             arm[k] = p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]
         return g, arm, phi
 

@@ -171,15 +171,31 @@ class BallBearingGeometry:
         if ring == "inner":
             f = self.inner_conformity
             cr, cz = rm + (f - 0.5) * d * ca, (f - 0.5) * d * sa
-            return RingSection(r_inner=0.5 * self.bore_diameter, r_outer=rm - LAND_OFFSET * d, width=self.ring_width,
-                               groove_center_r=cr, groove_center_z=cz, groove_radius=f * d,
-                               contact_r=rm - 0.5 * d * ca, contact_z=-0.5 * d * sa, fit="bore")
+            return RingSection(
+                r_inner=0.5 * self.bore_diameter,
+                r_outer=rm - LAND_OFFSET * d,
+                width=self.ring_width,
+                groove_center_r=cr,
+                groove_center_z=cz,
+                groove_radius=f * d,
+                contact_r=rm - 0.5 * d * ca,
+                contact_z=-0.5 * d * sa,
+                fit="bore",
+            )
         if ring == "outer":
             f = self.outer_conformity
             cr, cz = rm - (f - 0.5) * d * ca, -(f - 0.5) * d * sa
-            return RingSection(r_inner=rm + LAND_OFFSET * d, r_outer=0.5 * self.outer_diameter, width=self.ring_width,
-                               groove_center_r=cr, groove_center_z=cz, groove_radius=f * d,
-                               contact_r=rm + 0.5 * d * ca, contact_z=0.5 * d * sa, fit="outer")
+            return RingSection(
+                r_inner=rm + LAND_OFFSET * d,
+                r_outer=0.5 * self.outer_diameter,
+                width=self.ring_width,
+                groove_center_r=cr,
+                groove_center_z=cz,
+                groove_radius=f * d,
+                contact_r=rm + 0.5 * d * ca,
+                contact_z=0.5 * d * sa,
+                fit="outer",
+            )
         raise ValueError(f"ring must be 'inner' or 'outer', got {ring!r}")
 
     def groove_bottom_radius(self, ring: str) -> float:

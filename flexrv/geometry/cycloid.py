@@ -50,8 +50,7 @@ def _center_curve_point(phi, z_rp, radius, eccentricity):
     sz, cz = np.sin(zphi), np.cos(zphi)
     rs, rc = radius * s, radius * c
     ez, ez2 = eccentricity * z_rp, eccentricity * z_rp * z_rp
-    return (rs - eccentricity * sz, rc - eccentricity * cz, rc - ez * cz, -rs + ez * sz,
-            -rs + ez2 * sz, -rc + ez2 * cz)
+    return (rs - eccentricity * sz, rc - eccentricity * cz, rc - ez * cz, -rs + ez * sz, -rs + ez2 * sz, -rc + ez2 * cz)
 
 
 _POINT = _jit(_center_curve_point)
@@ -62,7 +61,8 @@ def _center_curve_kernel(phi, z_rp, radius, eccentricity):
     out = np.empty((3, phi.shape[0], 2))
     for i in range(phi.shape[0]):
         out[0, i, 0], out[0, i, 1], out[1, i, 0], out[1, i, 1], out[2, i, 0], out[2, i, 1] = _POINT(
-            phi[i], z_rp, radius, eccentricity)
+            phi[i], z_rp, radius, eccentricity
+        )
     return out
 
 
@@ -90,8 +90,16 @@ def min_convex_curvature_radius(z_rp: int, radius: float, eccentricity: float, s
     return float(1.0 / kappa[convex].max())
 
 
-def profile_points(phi, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
-                   d_radius: float = 0.0, d_pin_radius: float = 0.0, d_rotation: float = 0.0):
+def profile_points(
+    phi,
+    z_rp: int,
+    pin_circle_radius: float,
+    pin_radius: float,
+    eccentricity: float,
+    d_radius: float = 0.0,
+    d_pin_radius: float = 0.0,
+    d_rotation: float = 0.0,
+):
     """Points [m] of the modified disc profile, shape (..., 2).
 
     The profile is the inward offset of the pin-centre curve (pin circle
@@ -220,8 +228,9 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     15: the arctangent was 1.5 % of a rigid run)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
     if np.isfinite(phi0):
-        phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(px, py, phi0, z_rp, radius,
-                                                                            eccentricity, max_step, tol, max_iter)
+        phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(
+            px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter
+        )
         if conv or res <= 1e-12:
             along = px * (z_rp * cx + d1y) + py * (z_rp * cy - d1x)  # R (z - 1) |P| cos(phi - theta)
             if along >= np.cos(0.5 * lobe) * radius * (z_rp - 1) * np.sqrt(px * px + py * py):
@@ -231,7 +240,8 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     best_d2 = np.inf
     for k in range(_COLD_STARTS.shape[0]):
         phi, conv, res, sd, nx, ny, d2, _, _, d1x, d1y, d2x, d2y = _NEWTON(
-            px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius, eccentricity, max_step, tol, max_iter)
+            px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius, eccentricity, max_step, tol, max_iter
+        )
         if (conv or res <= 1e-12) and d2 < best_d2:
             best, best_d2 = (phi, True, sd, nx, ny, d1x, d1y, d2x, d2y), d2
     return best
@@ -245,8 +255,9 @@ def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max
     arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
     failed = 0
     for i in range(px.shape[0]):
-        phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _ = _FOOT(px[i], py[i], phi0[i], z_rp, radius,
-                                                                     eccentricity, max_step, tol, max_iter)
+        phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _ = _FOOT(
+            px[i], py[i], phi0[i], z_rp, radius, eccentricity, max_step, tol, max_iter
+        )
         failed += not ok
         out[3, i] = phi
     return failed
@@ -255,9 +266,19 @@ def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max
 _PIN_GAP = _jit(_pin_gap_kernel)
 
 
-def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
-            d_radius: float = 0.0, d_pin_radius: float = 0.0, d_rotation: float = 0.0, phi0=None,
-            tol: float = 1e-14, max_iter: int = 40):
+def pin_gap(
+    points,
+    z_rp: int,
+    pin_circle_radius: float,
+    pin_radius: float,
+    eccentricity: float,
+    d_radius: float = 0.0,
+    d_pin_radius: float = 0.0,
+    d_rotation: float = 0.0,
+    phi0=None,
+    tol: float = 1e-14,
+    max_iter: int = 40,
+):
     """Exact signed gap between pins and the modified cycloid-disc profile.
 
     The disc profile is the inward offset, by r_rp + dr_rp, of the pin-centre
@@ -316,14 +337,26 @@ def pin_gap(points, z_rp: int, pin_circle_radius: float, pin_radius: float, ecce
         p = _rotate(p, -d_rotation)
     shape = p.shape[:-1]
     flat = np.ascontiguousarray(p.reshape(-1, 2))
-    phi0 = np.full(flat.shape[0], np.nan) if phi0 is None else np.ascontiguousarray(
-        np.broadcast_to(np.asarray(phi0, dtype=float), shape)).ravel()
+    phi0 = (
+        np.full(flat.shape[0], np.nan)
+        if phi0 is None
+        else np.ascontiguousarray(np.broadcast_to(np.asarray(phi0, dtype=float), shape)).ravel()
+    )
     out = np.empty((4, flat.shape[0]))
-    failed = _PIN_GAP(flat[:, 0].copy(), flat[:, 1].copy(), phi0, int(z_rp), float(pin_circle_radius + d_radius),
-                      float(eccentricity), *closest_point_settings(z_rp, pin_circle_radius, tol, max_iter), out)
+    failed = _PIN_GAP(
+        flat[:, 0].copy(),
+        flat[:, 1].copy(),
+        phi0,
+        int(z_rp),
+        float(pin_circle_radius + d_radius),
+        float(eccentricity),
+        *closest_point_settings(z_rp, pin_circle_radius, tol, max_iter),
+        out,
+    )
     if failed:
-        raise ConvergenceError(f"pin_gap: closest-point iteration did not converge in {max_iter} "
-                               f"iterations for {failed} point(s)")
+        raise ConvergenceError(
+            f"pin_gap: closest-point iteration did not converge in {max_iter} iterations for {failed} point(s)"
+        )
     gap = out[0].reshape(shape) + d_pin_radius
     n_out = np.stack([out[1], out[2]], axis=-1).reshape(shape + (2,))
     if d_rotation:
@@ -340,8 +373,15 @@ def closest_point_settings(z_rp: int, pin_circle_radius: float, tol: float = 1e-
 
 
 # =========================================================================== curvature, arms, stiffness
-def profile_curvature_radius(phi, z_rp: int, pin_circle_radius: float, pin_radius: float, eccentricity: float,
-                             d_radius: float = 0.0, d_pin_radius: float = 0.0):
+def profile_curvature_radius(
+    phi,
+    z_rp: int,
+    pin_circle_radius: float,
+    pin_radius: float,
+    eccentricity: float,
+    d_radius: float = 0.0,
+    d_pin_radius: float = 0.0,
+):
     """Signed radius of curvature [m] of the actual (modified) disc profile at
     curve parameter phi: > 0 convex (tooth flank/tip bending towards the disc
     centre), < 0 concave (tooth space).
@@ -416,8 +456,14 @@ def pin_stiffness_seed004(rho, pin_radius: float, width, e_eff):
     where the pin-centre curve has an inflection (rho = r_rp).
     """
     rho = np.asarray(rho, dtype=float)
-    return (np.pi * np.asarray(width) * np.asarray(e_eff) * np.abs(rho) * (rho - pin_radius)
-            / (4.0 * rho * (pin_radius + np.abs(rho))))
+    return (
+        np.pi
+        * np.asarray(width)
+        * np.asarray(e_eff)
+        * np.abs(rho)
+        * (rho - pin_radius)
+        / (4.0 * rho * (pin_radius + np.abs(rho)))
+    )
 
 
 def k34(pin_stiffness, arms, engaged=None):

@@ -29,7 +29,6 @@ from flexrv.errors import InputError
 from flexrv.units import TWO_PI
 
 
-
 def total_ratio(z_s, z_p, z_c, z_rp):
     """Total ratio i = w_in / w_out = 1 + z_p z_rp / (z_s (z_rp - z_c)) (:cite:`seed000,seed001`).
 
@@ -83,8 +82,17 @@ def member_speeds(input_speed, z_s: int, z_p: int, z_c: int, z_rp: int) -> Membe
     w_h = w_in / i
     w_rel = -(z_s / z_p) * (w_in - w_h)
     w_crank = w_h + w_rel
-    return MemberSpeeds(ratio=i, input=w_in, sun_relative=w_in - w_h, carrier=w_h, crank_absolute=w_crank,
-                        crank_relative=w_rel, disc_rotation=w_h, disc_orbit=w_crank, disc_orbit_relative=w_rel)
+    return MemberSpeeds(
+        ratio=i,
+        input=w_in,
+        sun_relative=w_in - w_h,
+        carrier=w_h,
+        crank_absolute=w_crank,
+        crank_relative=w_rel,
+        disc_rotation=w_h,
+        disc_orbit=w_crank,
+        disc_orbit_relative=w_rel,
+    )
 
 
 @dataclass(frozen=True)
@@ -128,8 +136,16 @@ class CharacteristicFrequencies:
 
 
 #: field names of :class:`CharacteristicFrequencies`, in order
-FREQUENCY_NAMES = ("input", "crank_rotation", "carrier", "crank_absolute", "first_stage_mesh", "cycloid_mesh",
-                   "disc_tooth_pin_passing", "pins_x_crank_rotation")
+FREQUENCY_NAMES = (
+    "input",
+    "crank_rotation",
+    "carrier",
+    "crank_absolute",
+    "first_stage_mesh",
+    "cycloid_mesh",
+    "disc_tooth_pin_passing",
+    "pins_x_crank_rotation",
+)
 
 
 def characteristic_frequencies(input_speed, z_s: int, z_p: int, z_c: int, z_rp: int) -> CharacteristicFrequencies:
@@ -140,11 +156,16 @@ def characteristic_frequencies(input_speed, z_s: int, z_p: int, z_c: int, z_rp: 
     s = member_speeds(input_speed, z_s, z_p, z_c, z_rp)
     f = 1.0 / TWO_PI
     rel = np.abs(s.crank_relative) * f
-    return CharacteristicFrequencies(input=np.abs(s.input) * f, crank_rotation=rel, carrier=np.abs(s.carrier) * f,
-                                     crank_absolute=np.abs(s.crank_absolute) * f,
-                                     first_stage_mesh=z_s * np.abs(s.sun_relative) * f,
-                                     cycloid_mesh=z_c * rel, disc_tooth_pin_passing=z_rp * np.abs(s.carrier) * f,
-                                     pins_x_crank_rotation=z_rp * rel)
+    return CharacteristicFrequencies(
+        input=np.abs(s.input) * f,
+        crank_rotation=rel,
+        carrier=np.abs(s.carrier) * f,
+        crank_absolute=np.abs(s.crank_absolute) * f,
+        first_stage_mesh=z_s * np.abs(s.sun_relative) * f,
+        cycloid_mesh=z_c * rel,
+        disc_tooth_pin_passing=z_rp * np.abs(s.carrier) * f,
+        pins_x_crank_rotation=z_rp * rel,
+    )
 
 
 def harmonics(frequency, count: int = 4):
@@ -169,5 +190,6 @@ def reducer_kinematics(reducer, input_speed: float | None = None) -> ReducerKine
     fs, ss = reducer.first_stage, reducer.second_stage
     w = reducer.operating.input_speed if input_speed is None else float(input_speed)
     args = (fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
-    return ReducerKinematics(input_speed=w, speeds=member_speeds(w, *args),
-                             frequencies=characteristic_frequencies(w, *args))
+    return ReducerKinematics(
+        input_speed=w, speeds=member_speeds(w, *args), frequencies=characteristic_frequencies(w, *args)
+    )

@@ -14,5 +14,15 @@ Only this package imports gmsh.
 from flexrv.meshing.mesh import MeshData, MeshResult, build_mesh, generate_mesh, mesh_key
 from flexrv.meshing.parts import PARTS, CrankshaftSpec, CycloidDiscSpec, RingSpec, spec_for
 
-__all__ = ["MeshData", "MeshResult", "build_mesh", "generate_mesh", "mesh_key", "PARTS", "RingSpec",
-           "CrankshaftSpec", "CycloidDiscSpec", "spec_for"]
+__all__ = [
+    "MeshData",
+    "MeshResult",
+    "build_mesh",
+    "generate_mesh",
+    "mesh_key",
+    "PARTS",
+    "RingSpec",
+    "CrankshaftSpec",
+    "CycloidDiscSpec",
+    "spec_for",
+]

@@ -81,18 +81,36 @@ class MeshData:
     def save_npz(self, path: Path) -> None:
         import json
 
-        np.savez(path, nodes=self.nodes, tets=self.tets, tris=self.tris, tri_group=self.tri_group,
-                 group_names=np.array(self.group_names), part=self.part, size=self.size,
-                 spec=json.dumps(self.spec), info=json.dumps(self.info), version=MESH_FORMAT_VERSION)
+        np.savez(
+            path,
+            nodes=self.nodes,
+            tets=self.tets,
+            tris=self.tris,
+            tri_group=self.tri_group,
+            group_names=np.array(self.group_names),
+            part=self.part,
+            size=self.size,
+            spec=json.dumps(self.spec),
+            info=json.dumps(self.info),
+            version=MESH_FORMAT_VERSION,
+        )
 
     @classmethod
     def load_npz(cls, path: str | os.PathLike) -> "MeshData":
         import json
 
         with np.load(path, allow_pickle=False) as z:
-            return cls(nodes=z["nodes"], tets=z["tets"], tris=z["tris"], tri_group=z["tri_group"],
-                       group_names=tuple(str(s) for s in z["group_names"]), part=str(z["part"]),
-                       size=float(z["size"]), spec=json.loads(str(z["spec"])), info=json.loads(str(z["info"])))
+            return cls(
+                nodes=z["nodes"],
+                tets=z["tets"],
+                tris=z["tris"],
+                tri_group=z["tri_group"],
+                group_names=tuple(str(s) for s in z["group_names"]),
+                part=str(z["part"]),
+                size=float(z["size"]),
+                spec=json.loads(str(z["spec"])),
+                info=json.loads(str(z["info"])),
+            )
 
     def to_meshio(self, point_data: dict | None = None):
         """meshio.Mesh with the tetra10 cells (and optional point data)."""
@@ -209,13 +227,20 @@ def mesh_key(spec, size: float, local: float, edge: float | None = None) -> str:
     """Cache key of a mesh: geometry spec, sizes, format version, library versions
     (the edge size only where a part has one, so the other parts keep their keys)."""
     extra = () if edge is None else (("edge", edge),)
-    return content_hash(P.spec_dict(spec), size, local, *extra, MESH_FORMAT_VERSION,
-                        library_versions("gmsh", "meshio"))
+    return content_hash(P.spec_dict(spec), size, local, *extra, MESH_FORMAT_VERSION, library_versions("gmsh", "meshio"))
 
 
-def generate_mesh(spec, part: str, size: float | None = None, *, local_size: float | None = None,
-                  edge_size: float | None = None, max_nodes: int | None = None, cache: bool = True,
-                  threads: int = 1) -> MeshResult:
+def generate_mesh(
+    spec,
+    part: str,
+    size: float | None = None,
+    *,
+    local_size: float | None = None,
+    edge_size: float | None = None,
+    max_nodes: int | None = None,
+    cache: bool = True,
+    threads: int = 1,
+) -> MeshResult:
     """Mesh a part spec with Tet10 elements and cache the result.
 
     Parameters
@@ -271,8 +296,13 @@ def generate_mesh(spec, part: str, size: float | None = None, *, local_size: flo
             except Exception as exc:  # gmsh raises a bare Exception
                 raise InputError(f"meshing {part} with size {size * 1e3:.4g} mm failed: {exc}") from None
             t2 = time.perf_counter()
-            info = {"local_size": chk["local_size"], "edge_size": edge, "estimated_nodes": chk["estimated_nodes"],
-                    "t_geometry_s": t1 - t0, "t_mesh_s": t2 - t1}
+            info = {
+                "local_size": chk["local_size"],
+                "edge_size": edge,
+                "estimated_nodes": chk["estimated_nodes"],
+                "t_geometry_s": t1 - t0,
+                "t_mesh_s": t2 - t1,
+            }
             if isinstance(spec, P.CycloidDiscSpec):
                 info["profile_deviation_m"] = P.profile_deviation(gmsh, spec)
             nodes, tets, tris, tri_group, names = _extract(gmsh, groups)

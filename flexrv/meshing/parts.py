@@ -191,8 +191,11 @@ class CarrierSpec:
         return tuple(2.0 * math.pi * k / self.n_cranks for k in range(self.n_cranks))
 
     def volume(self) -> float:
-        plates = (math.pi * (self.plate_radius**2 - self.center_bore_radius**2 - self.n_cranks * self.crank_bore_radius**2)
-                  * (self.input_thickness + self.output_thickness))
+        plates = (
+            math.pi
+            * (self.plate_radius**2 - self.center_bore_radius**2 - self.n_cranks * self.crank_bore_radius**2)
+            * (self.input_thickness + self.output_thickness)
+        )
         return plates + len(self.pillar_angles) * math.pi * self.pillar_radius**2 * self.gap
 
     def default_size(self) -> float:
@@ -214,8 +217,10 @@ class CarrierSpec:
 
     def min_feature(self) -> float:
         """Smallest wall [m]: plate thickness, ligaments around the crank bores."""
-        lig = min(self.plate_radius - self.crank_circle_radius - self.crank_bore_radius,
-                  self.crank_circle_radius - self.crank_bore_radius - self.center_bore_radius)
+        lig = min(
+            self.plate_radius - self.crank_circle_radius - self.crank_bore_radius,
+            self.crank_circle_radius - self.crank_bore_radius - self.center_bore_radius,
+        )
         return min(self.input_thickness, self.output_thickness, lig)
 
 
@@ -233,40 +238,68 @@ def spec_for(reducer, part: str):
         geo = BallBearingGeometry.from_design(reducer.main_bearing)
         ring = part.split("_")[0]
         sec = geo.ring_section(ring)
-        return RingSpec(ring=ring, r_inner=sec.r_inner, r_outer=sec.r_outer, width=sec.width,
-                        groove_center_r=sec.groove_center_r, groove_center_z=sec.groove_center_z,
-                        groove_radius=sec.groove_radius, contact_r=sec.contact_r, contact_z=sec.contact_z,
-                        contact_angle=geo.contact_angle, ball_diameter=geo.ball_diameter,
-                        n_balls=geo.ball_count, fit=sec.fit)
+        return RingSpec(
+            ring=ring,
+            r_inner=sec.r_inner,
+            r_outer=sec.r_outer,
+            width=sec.width,
+            groove_center_r=sec.groove_center_r,
+            groove_center_z=sec.groove_center_z,
+            groove_radius=sec.groove_radius,
+            contact_r=sec.contact_r,
+            contact_z=sec.contact_z,
+            contact_angle=geo.contact_angle,
+            ball_diameter=geo.ball_diameter,
+            n_balls=geo.ball_count,
+            fit=sec.fit,
+        )
     if part == "crankshaft":
         cs = reducer.crankshaft
         e = reducer.second_stage.eccentricity
-        segs = (("gear_seat", 0.5e-3 * cs.gear_seat_diameter_mm, 1e-3 * cs.gear_seat_length_mm, 0.0),
-                ("support_a", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0),
-                ("eccentric_1", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, e),
-                ("eccentric_2", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, -e),
-                ("support_b", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0))
+        segs = (
+            ("gear_seat", 0.5e-3 * cs.gear_seat_diameter_mm, 1e-3 * cs.gear_seat_length_mm, 0.0),
+            ("support_a", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0),
+            ("eccentric_1", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, e),
+            ("eccentric_2", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, -e),
+            ("support_b", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0),
+        )
         return CrankshaftSpec(segments=segs)
     if part == "cycloid_disc":
         ss = reducer.second_stage
-        return CycloidDiscSpec(z_rp=ss.pin_count, pin_circle_radius=ss.pin_circle_radius, pin_radius=ss.pin_radius,
-                               eccentricity=ss.eccentricity, d_radius=ss.modification_shift,
-                               d_pin_radius=ss.modification_equidistant, d_rotation=ss.modification_rotation,
-                               width=ss.disc_width, crank_circle_radius=reducer.first_stage.center_distance,
-                               crank_hole_radius=reducer.crank_hole_radius, n_crank_holes=reducer.first_stage.n_planets,
-                               center_hole_radius=ss.center_hole_radius)
+        return CycloidDiscSpec(
+            z_rp=ss.pin_count,
+            pin_circle_radius=ss.pin_circle_radius,
+            pin_radius=ss.pin_radius,
+            eccentricity=ss.eccentricity,
+            d_radius=ss.modification_shift,
+            d_pin_radius=ss.modification_equidistant,
+            d_rotation=ss.modification_rotation,
+            width=ss.disc_width,
+            crank_circle_radius=reducer.first_stage.center_distance,
+            crank_hole_radius=reducer.crank_hole_radius,
+            n_crank_holes=reducer.first_stage.n_planets,
+            center_hole_radius=ss.center_hole_radius,
+        )
     if part == "carrier":
         c = reducer.carrier
         if c is None:
-            raise InputError(f"design {reducer.name!r} has no [carrier] table: the carrier part needs its geometry "
-                             "(plate diameter and thicknesses, gap, crank bores, pillars; see the rv40e preset)")
-        return CarrierSpec(plate_radius=0.5e-3 * c.plate_outer_diameter_mm, input_thickness=1e-3 * c.input_plate_thickness_mm,
-                           output_thickness=1e-3 * c.output_plate_thickness_mm, gap=1e-3 * c.plate_gap_mm,
-                           crank_circle_radius=reducer.first_stage.center_distance,
-                           crank_bore_radius=0.5e-3 * c.crank_bore_diameter_mm, n_cranks=reducer.first_stage.n_planets,
-                           center_bore_radius=0.5e-3 * c.center_bore_diameter_mm,
-                           pillar_circle_radius=1e-3 * c.pillar_circle_radius_mm, pillar_radius=0.5e-3 * c.pillar_diameter_mm,
-                           pillar_angles=tuple(c.pillar_angles()))
+            raise InputError(
+                f"design {reducer.name!r} has no [carrier] table: the carrier part needs its geometry "
+                "(plate diameter and thicknesses, gap, crank bores, pillars; see the rv40e preset)"
+            )
+        return CarrierSpec(
+            plate_radius=0.5e-3 * c.plate_outer_diameter_mm,
+            input_thickness=1e-3 * c.input_plate_thickness_mm,
+            output_thickness=1e-3 * c.output_plate_thickness_mm,
+            gap=1e-3 * c.plate_gap_mm,
+            crank_circle_radius=reducer.first_stage.center_distance,
+            crank_bore_radius=0.5e-3 * c.crank_bore_diameter_mm,
+            n_cranks=reducer.first_stage.n_planets,
+            center_bore_radius=0.5e-3 * c.center_bore_diameter_mm,
+            pillar_circle_radius=1e-3 * c.pillar_circle_radius_mm,
+            pillar_radius=0.5e-3 * c.pillar_diameter_mm,
+            pillar_angles=tuple(c.pillar_angles()),
+        )
     raise InputError(f"part = {part!r} is not a known part: choose one of {', '.join(PARTS)}")
 
 
@@ -294,14 +327,18 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
     est_local = 0.0
     if isinstance(spec, RingSpec):
         if spec.wall <= 0.0:
-            raise InputError(f"{spec.ring} ring: the groove cuts through the ring (wall under the groove "
-                             f"{spec.wall * 1e3:.3g} mm); the geometry self-intersects")
+            raise InputError(
+                f"{spec.ring} ring: the groove cuts through the ring (wall under the groove "
+                f"{spec.wall * 1e3:.3g} mm); the geometry self-intersects"
+            )
         limit = min(spec.groove_radius, 2.0 * spec.wall)
         if size > limit:
-            raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse to resolve the {spec.ring} ring: "
-                             f"must be <= {limit * 1e3:.4g} mm (min of the groove radius f D = "
-                             f"{spec.groove_radius * 1e3:.4g} mm and twice the wall under the groove "
-                             f"{spec.wall * 1e3:.4g} mm)")
+            raise InputError(
+                f"mesh size = {size * 1e3:.4g} mm is too coarse to resolve the {spec.ring} ring: "
+                f"must be <= {limit * 1e3:.4g} mm (min of the groove radius f D = "
+                f"{spec.groove_radius * 1e3:.4g} mm and twice the wall under the groove "
+                f"{spec.wall * 1e3:.4g} mm)"
+            )
         local = spec.raceway_size(size)
         race_area = 2.0 * math.pi * spec.groove_center_r * spec.groove_radius * math.pi / 2.0
         est_local = NODE_DENSITY * race_area * local / local**3
@@ -312,24 +349,32 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
     elif isinstance(spec, CrankshaftSpec):
         rmin = min(r for _, r, _, _ in spec.segments)
         if size > rmin:
-            raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the crankshaft: must be <= "
-                             f"the smallest journal radius {rmin * 1e3:.4g} mm")
+            raise InputError(
+                f"mesh size = {size * 1e3:.4g} mm is too coarse for the crankshaft: must be <= "
+                f"the smallest journal radius {rmin * 1e3:.4g} mm"
+            )
         local = size
     elif isinstance(spec, CycloidDiscSpec):
         limit = min(spec.width, spec.crank_hole_radius)
         if size > limit:
-            raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the cycloid disc: must be <= "
-                             f"{limit * 1e3:.4g} mm (min of disc width and crank hole radius)")
+            raise InputError(
+                f"mesh size = {size * 1e3:.4g} mm is too coarse for the cycloid disc: must be <= "
+                f"{limit * 1e3:.4g} mm (min of disc width and crank hole radius)"
+            )
         local = spec.profile_size(size)
         band = 2.0 * math.pi * spec.pin_circle_radius * spec.width * 4.0 * spec.eccentricity
         est_local = NODE_DENSITY * band / local**3
     elif isinstance(spec, CarrierSpec):
         limit = spec.min_feature()
         if limit <= 0:
-            raise InputError("carrier: a crank bore cuts the plate rim or the centre bore; the geometry self-intersects")
+            raise InputError(
+                "carrier: a crank bore cuts the plate rim or the centre bore; the geometry self-intersects"
+            )
         if size > limit:
-            raise InputError(f"mesh size = {size * 1e3:.4g} mm is too coarse for the carrier: must be <= "
-                             f"{limit * 1e3:.4g} mm (thinnest plate or ligament around a crank bore)")
+            raise InputError(
+                f"mesh size = {size * 1e3:.4g} mm is too coarse for the carrier: must be <= "
+                f"{limit * 1e3:.4g} mm (thinnest plate or ligament around a crank bore)"
+            )
         local = spec.pillar_size(size)
         edge = spec.root_size(size)
         est_local = NODE_DENSITY * len(spec.pillar_angles) * math.pi * spec.pillar_radius**2 * spec.gap / local**3
@@ -340,8 +385,10 @@ def check_size(spec, size: float, max_nodes: int) -> dict:
     if isinstance(spec, CarrierSpec) and edge is not None:
         out["edge_size"] = edge
     if est > max_nodes:
-        raise InputError(f"mesh size = {size * 1e3:.4g} mm is too fine: about {est:,} nodes estimated, more than "
-                         f"the memory limit of {max_nodes:,} nodes; use a larger size")
+        raise InputError(
+            f"mesh size = {size * 1e3:.4g} mm is too fine: about {est:,} nodes estimated, more than "
+            f"the memory limit of {max_nodes:,} nodes; use a larger size"
+        )
     return out
 
 
@@ -362,8 +409,9 @@ def _faces_of(gmsh, vol_tag: int) -> list[int]:
 def _single_volume(gmsh, what: str) -> int:
     vols = gmsh.model.getEntities(3)
     if len(vols) != 1:
-        raise InputError(f"{what}: the geometry gives {len(vols)} volumes instead of one; it self-intersects "
-                         "or falls apart")
+        raise InputError(
+            f"{what}: the geometry gives {len(vols)} volumes instead of one; it self-intersects or falls apart"
+        )
     return vols[0][1]
 
 
@@ -393,8 +441,10 @@ def build_ring(gmsh, spec: RingSpec, size: float) -> dict[str, list[int]]:
         else:
             groups["land"].append(tag)
     if not groups["raceway"] or not groups["fit"]:
-        raise InputError(f"{spec.ring} ring: raceway or fit surface not found; the groove does not cut the ring "
-                         "(check contact angle, conformity and ring section)")
+        raise InputError(
+            f"{spec.ring} ring: raceway or fit surface not found; the groove does not cut the ring "
+            "(check contact angle, conformity and ring section)"
+        )
     return groups
 
 
@@ -440,8 +490,13 @@ def build_crankshaft(gmsh, spec: CrankshaftSpec, size: float) -> dict[str, list[
             continue
         x, y, zc = occ.getCenterOfMass(2, tag)
         xmin, _, _, xmax, _, _ = gmsh.model.getBoundingBox(2, tag)
-        best = min(spans, key=lambda s: (not (s[1] - 1e-9 <= zc <= s[2] + 1e-9), abs(0.5 * (xmax + xmin) - s[4])
-                                         + abs(0.5 * (xmax - xmin) - s[3])))
+        best = min(
+            spans,
+            key=lambda s: (
+                not (s[1] - 1e-9 <= zc <= s[2] + 1e-9),
+                abs(0.5 * (xmax + xmin) - s[4]) + abs(0.5 * (xmax - xmin) - s[3]),
+            ),
+        )
         groups[best[0]].append(tag)
     missing = [k for k, v in groups.items() if not v]
     if missing:
@@ -458,8 +513,15 @@ def cycloid_profile(spec: CycloidDiscSpec, points_per_lobe: int | None = None) -
 
     n = points_per_lobe or spec.points_per_lobe
     z_c = spec.z_rp - 1
-    args = (spec.z_rp, spec.pin_circle_radius, spec.pin_radius, spec.eccentricity, spec.d_radius,
-            spec.d_pin_radius, spec.d_rotation)
+    args = (
+        spec.z_rp,
+        spec.pin_circle_radius,
+        spec.pin_radius,
+        spec.eccentricity,
+        spec.d_radius,
+        spec.d_pin_radius,
+        spec.d_rotation,
+    )
     fine = np.linspace(0.0, 2.0 * np.pi / z_c, 20 * n + 1)
     seg = np.linalg.norm(np.diff(profile_points(fine, *args), axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
@@ -475,11 +537,14 @@ def build_cycloid_disc(gmsh, spec: CycloidDiscSpec, size: float) -> dict[str, li
     occ = gmsh.model.occ
     pts = cycloid_profile(spec)
     if not profile_is_simple(pts[:, :-1].reshape(-1, 2)):
-        raise InputError("cycloid disc: the modified profile self-intersects (loops); reduce the eccentricity, "
-                         "the pin radius or the modifications")
+        raise InputError(
+            "cycloid disc: the modified profile self-intersects (loops); reduce the eccentricity, "
+            "the pin radius or the modifications"
+        )
     rmin = float(np.min(np.hypot(pts[..., 0], pts[..., 1])))
     if spec.crank_circle_radius + spec.crank_hole_radius >= rmin or (
-            spec.center_hole_radius and spec.center_hole_radius >= spec.crank_circle_radius - spec.crank_hole_radius):
+        spec.center_hole_radius and spec.center_hole_radius >= spec.crank_circle_radius - spec.crank_hole_radius
+    ):
         raise InputError("cycloid disc: crank holes cut the profile or the centre hole; the geometry self-intersects")
     z0 = -0.5 * spec.width
     z_c, n1, _ = pts.shape
@@ -493,8 +558,12 @@ def build_cycloid_disc(gmsh, spec: CycloidDiscSpec, size: float) -> dict[str, li
     holes = []
     for k in range(spec.n_crank_holes):
         ang = 2.0 * math.pi * k / spec.n_crank_holes
-        c = occ.addCircle(spec.crank_circle_radius * math.cos(ang), spec.crank_circle_radius * math.sin(ang), z0,
-                          spec.crank_hole_radius)
+        c = occ.addCircle(
+            spec.crank_circle_radius * math.cos(ang),
+            spec.crank_circle_radius * math.sin(ang),
+            z0,
+            spec.crank_hole_radius,
+        )
         holes.append(("crank_hole_%d" % (k + 1), ang))
         loops.append(occ.addCurveLoop([c]))
     if spec.center_hole_radius > 0:
@@ -539,8 +608,10 @@ def profile_deviation(gmsh, spec: CycloidDiscSpec, samples_per_curve: int = 200)
     for dim, tag in gmsh.model.getEntities(1):
         lo, hi = gmsh.model.getParametrizationBounds(1, tag)
         xyz = np.asarray(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], samples_per_curve))).reshape(-1, 3)
-        if not np.allclose(xyz[:, 2], z0) or np.hypot(xyz[:, 0], xyz[:, 1]).min() < spec.crank_circle_radius + \
-                spec.crank_hole_radius * 1.01:
+        if (
+            not np.allclose(xyz[:, 2], z0)
+            or np.hypot(xyz[:, 0], xyz[:, 1]).min() < spec.crank_circle_radius + spec.crank_hole_radius * 1.01
+        ):
             continue
         d, idx = tree.query(xyz[:, :2])
         # distance to the polyline through the nearest exact point's neighbours
@@ -568,18 +639,46 @@ def build_carrier(gmsh, spec: CarrierSpec, size: float) -> dict[str, list[int]]:
     total = spec.length
     plate_in = occ.addCylinder(0, 0, 0, 0, 0, t_in, spec.plate_radius)
     plate_out = occ.addCylinder(0, 0, t_in + gap, 0, 0, t_out, spec.plate_radius)
-    pillars = [(3, occ.addCylinder(spec.pillar_circle_radius * math.cos(a), spec.pillar_circle_radius * math.sin(a),
-                                   t_in, 0, 0, gap, spec.pillar_radius)) for a in spec.pillar_angles]
+    pillars = [
+        (
+            3,
+            occ.addCylinder(
+                spec.pillar_circle_radius * math.cos(a),
+                spec.pillar_circle_radius * math.sin(a),
+                t_in,
+                0,
+                0,
+                gap,
+                spec.pillar_radius,
+            ),
+        )
+        for a in spec.pillar_angles
+    ]
     occ.fuse([(3, plate_in)], [(3, plate_out)] + pillars)
-    tools = [(3, occ.addCylinder(spec.crank_circle_radius * math.cos(a), spec.crank_circle_radius * math.sin(a), -total,
-                                 0, 0, 3 * total, spec.crank_bore_radius)) for a in spec.crank_angles()]
+    tools = [
+        (
+            3,
+            occ.addCylinder(
+                spec.crank_circle_radius * math.cos(a),
+                spec.crank_circle_radius * math.sin(a),
+                -total,
+                0,
+                0,
+                3 * total,
+                spec.crank_bore_radius,
+            ),
+        )
+        for a in spec.crank_angles()
+    ]
     if spec.center_bore_radius > 0:
         tools.append((3, occ.addCylinder(0, 0, -total, 0, 0, 3 * total, spec.center_bore_radius)))
     occ.cut(occ.getEntities(3)[:1], tools)
     occ.synchronize()
     vol = _single_volume(gmsh, "carrier")
-    cranks = [(k + 1, spec.crank_circle_radius * math.cos(a), spec.crank_circle_radius * math.sin(a))
-              for k, a in enumerate(spec.crank_angles())]
+    cranks = [
+        (k + 1, spec.crank_circle_radius * math.cos(a), spec.crank_circle_radius * math.sin(a))
+        for k, a in enumerate(spec.crank_angles())
+    ]
     groups: dict[str, list[int]] = {f"bore_{p}_{k}": [] for p in ("in", "out") for k, _, _ in cranks}
     groups.update({"flange": [], "seat_in": [], "seat_out": [], "pillar": [], "side": []})
     if spec.center_bore_radius > 0:
@@ -609,5 +708,12 @@ def build_carrier(gmsh, spec: CarrierSpec, size: float) -> dict[str, list[int]]:
     return groups
 
 
-BUILDERS = {"outer_ring": build_ring, "inner_ring": build_ring, "crankshaft": build_crankshaft,
-            "cycloid_disc": build_cycloid_disc, "carrier": build_carrier, "plain_ring": build_plain_ring, "shaft": build_crankshaft}
+BUILDERS = {
+    "outer_ring": build_ring,
+    "inner_ring": build_ring,
+    "crankshaft": build_crankshaft,
+    "cycloid_disc": build_cycloid_disc,
+    "carrier": build_carrier,
+    "plain_ring": build_plain_ring,
+    "shaft": build_crankshaft,
+}

@@ -71,8 +71,9 @@ class AssembledModel:
 
             with single_thread_blas():
                 for g in others:
-                    idx = group_index([self.members[m].offset for m in g.members],
-                                      [self.members[m].n for m in g.members])
+                    idx = group_index(
+                        [self.members[m].offset for m in g.members], [self.members[m].n for m in g.members]
+                    )
                     g.new_step()
                     qg, vg = q[idx], v[idx]
                     fg, _ = g.evaluate(t, qg, vg)

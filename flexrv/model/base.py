@@ -140,14 +140,14 @@ class ForceGroup:
 
         kwargs = {}
         if self.analytic_jacobian:
+
             def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
                 stats[1] += 1
                 dq, dv = self.jacobian(t, exudyn_vector(q), exudyn_vector(q_t))
                 return -(f_q * dq + f_v * dv)
 
             kwargs["jacobianUserFunction"] = jac_fn
-        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes,
-                                               forceUserFunction=force_fn, **kwargs))
+        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, **kwargs))
 
     @property
     def stats(self) -> list[int]:
@@ -227,8 +227,10 @@ class KernelGroup(ForceGroup):
             out = None
             if want_outputs:
                 rec = {k: a[None] for k, a in self.record().items()}
-                out = {k: Output(o.values[0], o.dims, o.units, o.long_name)
-                       for k, o in self.outputs(np.asarray(t, dtype=float)[None], rec).items()}
+                out = {
+                    k: Output(o.values[0], o.dims, o.units, o.long_name)
+                    for k, o in self.outputs(np.asarray(t, dtype=float)[None], rec).items()
+                }
             return f, out
         lead = q.shape[:-1]
         qf, vf = q.reshape(-1, n), np.broadcast_to(v, q.shape).reshape(-1, n)
@@ -238,8 +240,17 @@ class KernelGroup(ForceGroup):
         recs = []
         inputs = self.time_inputs_many(ts)
         for i in range(qf.shape[0]):
-            self.run(float(ts[i]), qf[i], vf[i], f[i], _NO_JACOBIAN, _NO_JACOBIAN, False, pack,
-                     None if inputs is None else inputs[i])
+            self.run(
+                float(ts[i]),
+                qf[i],
+                vf[i],
+                f[i],
+                _NO_JACOBIAN,
+                _NO_JACOBIAN,
+                False,
+                pack,
+                None if inputs is None else inputs[i],
+            )
             if want_outputs:
                 recs.append(self.record())
         out = None

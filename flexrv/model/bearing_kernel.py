@@ -70,9 +70,35 @@ N_LAW = len(LAW_FIELDS)
 #: own Cartesian frame [N], raceway displacement of each ring at the contact
 #: (global) [m], ball centre (global) [m], central EHL film of each contact [m] (0 dry or
 #: out of contact)
-RECORD_FIELDS = ("load_inner", "load_outer", "nix", "niy", "niz", "nox", "noy", "noz", "psi_inner", "psi_outer",
-                 "gix", "giy", "giz", "gox", "goy", "goz", "uix", "uiy", "uiz", "uox", "uoy", "uoz", "bx", "by", "bz",
-                 "film_inner", "film_outer")
+RECORD_FIELDS = (
+    "load_inner",
+    "load_outer",
+    "nix",
+    "niy",
+    "niz",
+    "nox",
+    "noy",
+    "noz",
+    "psi_inner",
+    "psi_outer",
+    "gix",
+    "giy",
+    "giz",
+    "gox",
+    "goy",
+    "goz",
+    "uix",
+    "uiy",
+    "uiz",
+    "uox",
+    "uoy",
+    "uoz",
+    "bx",
+    "by",
+    "bz",
+    "film_inner",
+    "film_outer",
+)
 N_RECORD = len(RECORD_FIELDS)
 
 #: local condensation: absolute tolerance on the contact deflections [m] and the
@@ -122,15 +148,25 @@ def law_parameters(law) -> np.ndarray | None:
     mode ``"map"`` the map's packed table, :meth:`flexrv.ehl.maps.FilmMap.packed`,
     follows them), or None if the kernel does not cover it."""
     from flexrv.contact.ball_raceway import HertzLaw
-    from flexrv.ehl.law import EHLPointLaw
     from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT
+    from flexrv.ehl.law import EHLPointLaw
 
     if isinstance(law, HertzLaw) and np.ndim(law.k) == 0:
         return np.array([law.k, 0.0, 0.0, 0.0, 1.0, law.c_max, law.depth, 0.0])
     if isinstance(law, EHLPointLaw) and law.mode in ("dry", "hamrock_dowson", "map") and np.ndim(law.stiffness) == 0:
         h_unit = 0.0 if law.mode == "dry" else float(law._h_unit)
-        p = np.array([float(law.stiffness), h_unit, HAMROCK_DOWSON_LOAD_EXPONENT, 0.67, law.load_floor,
-                      law.c_max, law.damping_depth, float(law.iterations)])
+        p = np.array(
+            [
+                float(law.stiffness),
+                h_unit,
+                HAMROCK_DOWSON_LOAD_EXPONENT,
+                0.67,
+                law.load_floor,
+                law.c_max,
+                law.damping_depth,
+                float(law.iterations),
+            ]
+        )
         if law.mode == "map":
             p = np.concatenate([p, law.film_map.packed])
         return p
@@ -157,7 +193,7 @@ def _law_speed(speed, law):
     floor [m])."""
     if not (law[1] > 0.0 and speed > 0.0):
         return 0.0, 0.0, 0.0
-    hu = law[1] * speed**law[3]
+    hu = law[1] * speed ** law[3]
     lu = math.log(speed)
     h_floor, _ = _film(law[4], hu, law[2], lu, law)
     return hu, lu, h_floor
@@ -270,12 +306,24 @@ def _basis(table, zsign, psi, out):
     _taps(psi, table.shape[0], idx, w)
     c, s = math.cos(psi), math.sin(psi)
     for j in range(m):
-        ar = w[0] * table[idx[0], 0, j] + w[1] * table[idx[1], 0, j] + w[2] * table[idx[2], 0, j] \
+        ar = (
+            w[0] * table[idx[0], 0, j]
+            + w[1] * table[idx[1], 0, j]
+            + w[2] * table[idx[2], 0, j]
             + w[3] * table[idx[3], 0, j]
-        at = w[0] * table[idx[0], 1, j] + w[1] * table[idx[1], 1, j] + w[2] * table[idx[2], 1, j] \
+        )
+        at = (
+            w[0] * table[idx[0], 1, j]
+            + w[1] * table[idx[1], 1, j]
+            + w[2] * table[idx[2], 1, j]
             + w[3] * table[idx[3], 1, j]
-        az = w[0] * table[idx[0], 2, j] + w[1] * table[idx[1], 2, j] + w[2] * table[idx[2], 2, j] \
+        )
+        az = (
+            w[0] * table[idx[0], 2, j]
+            + w[1] * table[idx[1], 2, j]
+            + w[2] * table[idx[2], 2, j]
             + w[3] * table[idx[3], 2, j]
+        )
         out[0, j] = c * ar - s * at
         out[1, j] = s * ar + c * at
         out[2, j] = zsign * az
@@ -393,7 +441,7 @@ def _films(ws, nz):
     array (:func:`condense_workspace`, :func:`film_workspace`), or fresh zeros (a
     cold start every call) for a work array without them."""
     if ws.shape[0] >= nz:
-        return ws[ws.shape[0] - nz:]
+        return ws[ws.shape[0] - nz :]
     return np.zeros(nz)
 
 
@@ -402,17 +450,17 @@ def _split_workspace(ws, nz, m):
     """Views of a condensed ring's work array: deflections u (Z,3), tangent-valid
     flag (1,), L^1/2 (Z,), normals (Z,3), P = W^T n (Z,m), Cholesky factor (Z,Z)."""
     o = 0
-    u = ws[o:o + 3 * nz].reshape((nz, 3))
+    u = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    valid = ws[o:o + 1]
+    valid = ws[o : o + 1]
     o += 1
-    sq = ws[o:o + nz]
+    sq = ws[o : o + nz]
     o += nz
-    nf = ws[o:o + 3 * nz].reshape((nz, 3))
+    nf = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    p = ws[o:o + nz * m].reshape((nz, m))
+    p = ws[o : o + nz * m].reshape((nz, m))
     o += nz * m
-    smat = ws[o:o + nz * nz].reshape((nz, nz))
+    smat = ws[o : o + nz * nz].reshape((nz, nz))
     return u, valid, sq, nf, p, smat
 
 
@@ -422,19 +470,19 @@ def _split_scratch(ws, nz, m):
     local factors W (Z,3,m), local approach and velocity (Z,3), local normals (Z,3),
     residual (Z,3), W^T g (m,), Z right-hand side (Z,)."""
     o = 3 * nz + 1 + nz + 3 * nz + nz * m + nz * nz
-    wl = ws[o:o + 3 * nz * m].reshape((nz, 3, m))
+    wl = ws[o : o + 3 * nz * m].reshape((nz, 3, m))
     o += 3 * nz * m
-    el = ws[o:o + 3 * nz].reshape((nz, 3))
+    el = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    wv = ws[o:o + 3 * nz].reshape((nz, 3))
+    wv = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    nl = ws[o:o + 3 * nz].reshape((nz, 3))
+    nl = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    r = ws[o:o + 3 * nz].reshape((nz, 3))
+    r = ws[o : o + 3 * nz].reshape((nz, 3))
     o += 3 * nz
-    y = ws[o:o + m]
+    y = ws[o : o + m]
     o += m
-    rhs = ws[o:o + nz]
+    rhs = ws[o : o + nz]
     return wl, el, wv, nl, r, y, rhs
 
 
@@ -465,9 +513,20 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
         for k in range(m):
             y[k] = 0.0
         for j in range(nz):
-            length, nx, ny, nzz, q, d, c, hf = _contact(e0[j, 0] - u[j, 0], e0[j, 1] - u[j, 1],
-                                                           e0[j, 2] - u[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], offset,
-                                                           hu, lu, h_floor, law, films[j])
+            length, nx, ny, nzz, q, d, c, hf = _contact(
+                e0[j, 0] - u[j, 0],
+                e0[j, 1] - u[j, 1],
+                e0[j, 2] - u[j, 2],
+                w0[j, 0],
+                w0[j, 1],
+                w0[j, 2],
+                offset,
+                hu,
+                lu,
+                h_floor,
+                law,
+                films[j],
+            )
             loads[j], dq[j], cd[j], lengths[j], films[j] = q, d, c, length, hf
             normals[j, 0], normals[j, 1], normals[j, 2] = nx, ny, nzz
             if q != 0.0:
@@ -528,8 +587,9 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
 
 
 @njit(cache=True)
-def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                    du, wglobal):
+def _condensed_ring(
+    psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads, normals, dq, cd, lengths, films, du, wglobal
+):
     """One condensed ring of a row: the contact geometry e0, w0 (Z,3, global) in
     each contact's ring-cylindrical frame (rot (Z,3,3): cylindrical -> global),
     the compliance factors, the contact solve (:func:`_condense`, deflections u
@@ -547,7 +607,7 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
             el[j, a] = rot[j, 0, a] * e0[j, 0] + rot[j, 1, a] * e0[j, 1] + rot[j, 2, a] * e0[j, 2]
             wv[j, a] = rot[j, 0, a] * w0[j, 0] + rot[j, 1, a] * w0[j, 1] + rot[j, 2, a] * w0[j, 2]
     its = _condense(el, wv, wl, offset, speed, law, ws, loads, nl, dq, cd, lengths, films)
-    u = ws[0:3 * nz].reshape((nz, 3))
+    u = ws[0 : 3 * nz].reshape((nz, 3))
     for j in range(nz):
         for a in range(3):
             normals[j, a] = rot[j, a, 0] * nl[j, 0] + rot[j, a, 1] * nl[j, 1] + rot[j, a, 2] * nl[j, 2]
@@ -556,8 +616,9 @@ def _condensed_ring(psi, rot, wtab, zsign, e0, w0, offset, speed, law, ws, loads
         for j in range(nz):
             for a in range(3):
                 for k in range(m):
-                    wglobal[3 * j + a, k] = rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] \
-                        + rot[j, a, 2] * wl[j, 2, k]
+                    wglobal[3 * j + a, k] = (
+                        rot[j, a, 0] * wl[j, 0, k] + rot[j, a, 1] * wl[j, 1, k] + rot[j, a, 2] * wl[j, 2, k]
+                    )
     return its
 
 
@@ -574,20 +635,42 @@ def _count_solve(state, k, its):
 
 
 @njit(cache=True)
-def _ring_contacts(condensed, psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                   du, wglobal, state):
+def _ring_contacts(
+    condensed,
+    psi,
+    rot,
+    comp,
+    zs,
+    e0,
+    w0,
+    off,
+    speed,
+    law,
+    ws,
+    loads,
+    normals,
+    dq,
+    cd,
+    lengths,
+    films,
+    du,
+    wglobal,
+    state,
+):
     """The ball contacts of one ring of a row: the condensed ring's local solve
     (:func:`_condensed_ring`, its iteration count and failures in ``state``) or, for a
     rigid / modal ring, each contact from its approach (:func:`_contact`)."""
     if condensed:
-        its = _condensed_ring(psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films,
-                              du, wglobal)
+        its = _condensed_ring(
+            psi, rot, comp, zs, e0, w0, off, speed, law, ws, loads, normals, dq, cd, lengths, films, du, wglobal
+        )
         _count_solve(state, 0, its)
     else:
         hu, lu, h_floor = _law_speed(speed, law)
         for j in range(e0.shape[0]):
             lengths[j], normals[j, 0], normals[j, 1], normals[j, 2], loads[j], dq[j], cd[j], films[j] = _contact(
-                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law, films[j])
+                e0[j, 0], e0[j, 1], e0[j, 2], w0[j, 0], w0[j, 1], w0[j, 2], off, hu, lu, h_floor, law, films[j]
+            )
 
 
 @njit(cache=True)
@@ -601,8 +684,26 @@ def _rotation_z(a, c, s, out):
 
 
 @njit(cache=True)
-def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-               state, jacobian, rec):
+def row_kernel(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    jacobian,
+    rec,
+):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n) (new arrays; :func:`row_eval`
     with its outputs allocated here). Quasi-static balls (``geometry[13]`` > 0):
@@ -620,14 +721,57 @@ def row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o
         nk = nx if jacobian else 0
         kx = np.empty((nk, nk))
         cx = np.empty((nk, nk))
-        quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                           ws_o, balls, state, jacobian, rec, f, np.empty((nb, 4)), kx, cx)
+        quasi_static_balls(
+            qf,
+            vf,
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+            jacobian,
+            rec,
+            f,
+            np.empty((nb, 4)),
+            kx,
+            cx,
+        )
         return f[:nx].copy(), kx, cx
     nj = n if jacobian else 0
     jq = np.zeros((nj, nj))  # (zero: row_eval clears only the entries it writes)
     jv = np.zeros((nj, nj))
-    row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-             state, jacobian, rec, f, jq, jv)
+    row_eval(
+        q,
+        qt,
+        ball_ref,
+        geometry,
+        tab_i,
+        zs_i,
+        tab_o,
+        zs_o,
+        law_i,
+        law_o,
+        comp_i,
+        comp_o,
+        ws_i,
+        ws_o,
+        balls,
+        state,
+        jacobian,
+        rec,
+        f,
+        jq,
+        jv,
+    )
     return f, jq, jv
 
 
@@ -676,7 +820,6 @@ def _film_speed_gain(law, speed, film):
     return law[3] * film / speed
 
 
-
 @njit(cache=True)
 def _modal_sums(bas, q, qt, off, m):
     """The ring's displacement and velocity at a ball (3 + 3 values): sum_k bas[:, k] q[off + k]
@@ -692,6 +835,7 @@ def _modal_sums(bas, q, qt, off, m):
         v1 += bas[1, k] * vk
         v2 += bas[2, k] * vk
     return d0, d1, d2, v0, v1, v2
+
 
 @njit(cache=True)
 def _zero_written(jac, nx, nz):
@@ -715,8 +859,29 @@ def _zero_written(jac, nx, nz):
 
 
 @njit(cache=True)
-def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-             state, jacobian, rec, f, jq, jv):
+def row_eval(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    jacobian,
+    rec,
+    f,
+    jq,
+    jv,
+):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
     rigid and modal rings only the entries it writes, :func:`_zero_written`: the
@@ -749,10 +914,23 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     terms of the frame rotation are dropped; the modified Newton iteration
     converges on the residual, which is exact). The azimuths' cosines and sines
     are the normalised in-plane coordinates (no sin/cos of the atan2)."""
-    z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (geometry[0], geometry[1], geometry[2], geometry[3],
-                                                       geometry[4], geometry[5], geometry[6], geometry[7])
-    speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (geometry[8], geometry[9], geometry[10], geometry[11],
-                                                         geometry[12])
+    z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (
+        geometry[0],
+        geometry[1],
+        geometry[2],
+        geometry[3],
+        geometry[4],
+        geometry[5],
+        geometry[6],
+        geometry[7],
+    )
+    speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (
+        geometry[8],
+        geometry[9],
+        geometry[10],
+        geometry[11],
+        geometry[12],
+    )
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
     cond_i = comp_i.shape[0] > 0
@@ -887,14 +1065,54 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     nco = 3 * nz if (cond_o and jacobian) else 0
     wg_i = np.empty((nci, comp_i.shape[2]))  # condensed rings' global compliance factors (Jacobian only)
     wg_o = np.empty((nco, comp_o.shape[2]))
-    _ring_contacts(cond_i, psi_i, rot_i, comp_i, zs_i, e0_i, w0_i, off_i, speed, law_i, ws_i, load_i, nrm_i, dq_i,
-                   cd_i, len_i, film_i, du_i, wg_i, state)
+    _ring_contacts(
+        cond_i,
+        psi_i,
+        rot_i,
+        comp_i,
+        zs_i,
+        e0_i,
+        w0_i,
+        off_i,
+        speed,
+        law_i,
+        ws_i,
+        load_i,
+        nrm_i,
+        dq_i,
+        cd_i,
+        len_i,
+        film_i,
+        du_i,
+        wg_i,
+        state,
+    )
     if cond_i:
         for j in range(nz):
             for c in range(3):
                 arm[j, c] += du_i[j, c]
-    _ring_contacts(cond_o, psi_o, rot_o, comp_o, zs_o, e0_o, w0_o, off_o, speed, law_o, ws_o, load_o, nrm_o, dq_o,
-                   cd_o, len_o, film_o, du_o, wg_o, state)
+    _ring_contacts(
+        cond_o,
+        psi_o,
+        rot_o,
+        comp_o,
+        zs_o,
+        e0_o,
+        w0_o,
+        off_o,
+        speed,
+        law_o,
+        ws_o,
+        load_o,
+        nrm_o,
+        dq_o,
+        cd_o,
+        len_o,
+        film_o,
+        du_o,
+        wg_o,
+        state,
+    )
     # ---------------- pass 2: generalized forces (and Jacobian blocks)
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
@@ -906,8 +1124,11 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
     vl = np.empty((nl, nl))
     inv3 = np.empty((3, 3))  # (work of _condense_ball)
     tm3 = np.empty((3, b0))
-    s_balls = balls[2 * 3 * nz:2 * 3 * nz + 3 * nz * b0].reshape((3 * nz, b0)) if jacobian == CONDENSED_BALLS \
+    s_balls = (
+        balls[2 * 3 * nz : 2 * 3 * nz + 3 * nz * b0].reshape((3 * nz, b0))
+        if jacobian == CONDENSED_BALLS
         else np.empty((0, b0))
+    )
     for r in range(3):
         t_i[r, r] = 1.0
     ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
@@ -1016,8 +1237,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
         if m_i > 0:
             for r in range(3):
                 for k in range(m_i):
-                    t_i[r, 6 + k] = a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] \
-                        + a[r, 2] * bas_i_all[j, 2, k]
+                    t_i[r, 6 + k] = (
+                        a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] + a[r, 2] * bas_i_all[j, 2, k]
+                    )
         if cond_i:
             for r in range(3):
                 for c in range(nx_i):
@@ -1028,8 +1250,9 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
             gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
             if gain != 0.0:
-                _add_speed_column(vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1],
-                                  gain * nrm_i[j, 2])
+                _add_speed_column(
+                    vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1], gain * nrm_i[j, 2]
+                )
         if cond_o:
             _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
         else:
@@ -1038,10 +1261,11 @@ def row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, 
             _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
             gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
             if gain != 0.0:
-                _add_speed_column(vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1],
-                                  gain * nrm_o[j, 2])
+                _add_speed_column(
+                    vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1], gain * nrm_o[j, 2]
+                )
         if jacobian == CONDENSED_BALLS:
-            _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j:3 * j + 3], inv3, tm3)
+            _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j : 3 * j + 3], inv3, tm3)
         else:
             for r in range(b0 + 3):
                 rr = r if r < b0 else bj + r - b0
@@ -1137,11 +1361,30 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
 
 
 @njit(cache=True)
-def row_force_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                     balls, state):
+def row_force_kernel(
+    q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state
+):
     """Generalized force of a row element (see :func:`row_kernel`)."""
-    return row_kernel(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                      balls, state, False, np.empty((0, N_RECORD)))[0]
+    return row_kernel(
+        q,
+        qt,
+        ball_ref,
+        geometry,
+        tab_i,
+        zs_i,
+        tab_o,
+        zs_o,
+        law_i,
+        law_o,
+        comp_i,
+        comp_o,
+        ws_i,
+        ws_o,
+        balls,
+        state,
+        False,
+        np.empty((0, N_RECORD)),
+    )[0]
 
 
 @njit(cache=True)
@@ -1161,8 +1404,29 @@ def _adjugate3(k, adj):
 
 
 @njit(cache=True)
-def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                     balls, state, tol, max_iter, f, kbb, rec):
+def ball_equilibrium(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    tol,
+    max_iter,
+    f,
+    kbb,
+    rec,
+):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)
@@ -1185,8 +1449,29 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-                 state, BALL_BLOCKS, recs, f, kbb, jv)
+        row_eval(
+            q,
+            qt,
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+            BALL_BLOCKS,
+            recs,
+            f,
+            kbb,
+            jv,
+        )
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1198,11 +1483,12 @@ def ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i,
             err = max(err, abs(f[e]))
         dv = 0.0
         for j in range(nz):  # -K^-1 f_j and b_t = -K^-1 (K_bx x_t) (3x3, cofactors)
-            k = kbb[3 * j:3 * j + 3]
+            k = kbb[3 * j : 3 * j + 3]
             det = _adjugate3(k, adj)
             for off in (0, 3):  # right-hand sides: the ball's force, then K_bx x_t
-                r0, r1, r2 = (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else \
-                    (k[0, 3], k[1, 3], k[2, 3])
+                r0, r1, r2 = (
+                    (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else (k[0, 3], k[1, 3], k[2, 3])
+                )
                 step[j, off] = -(adj[0, 0] * r0 + adj[0, 1] * r1 + adj[0, 2] * r2) / det
                 step[j, off + 1] = -(adj[1, 0] * r0 + adj[1, 1] * r1 + adj[1, 2] * r2) / det
                 step[j, off + 2] = -(adj[2, 0] * r0 + adj[2, 1] * r1 + adj[2, 2] * r2) / det
@@ -1241,10 +1527,18 @@ def _condense_ball(jl, vl, nx, kx, cx, s_ball, inv, tm):
             s_ball[r, c] = -(inv[r, 0] * jl[nx, c] + inv[r, 1] * jl[nx + 1, c] + inv[r, 2] * jl[nx + 2, c])
     for c in range(nx):  # T = J_bb^-1 W, W = V_bx + V_bb S (column by column)
         w0 = vl[nx, c] + vl[nx, nx] * s_ball[0, c] + vl[nx, nx + 1] * s_ball[1, c] + vl[nx, nx + 2] * s_ball[2, c]
-        w1 = vl[nx + 1, c] + vl[nx + 1, nx] * s_ball[0, c] + vl[nx + 1, nx + 1] * s_ball[1, c] \
+        w1 = (
+            vl[nx + 1, c]
+            + vl[nx + 1, nx] * s_ball[0, c]
+            + vl[nx + 1, nx + 1] * s_ball[1, c]
             + vl[nx + 1, nx + 2] * s_ball[2, c]
-        w2 = vl[nx + 2, c] + vl[nx + 2, nx] * s_ball[0, c] + vl[nx + 2, nx + 1] * s_ball[1, c] \
+        )
+        w2 = (
+            vl[nx + 2, c]
+            + vl[nx + 2, nx] * s_ball[0, c]
+            + vl[nx + 2, nx + 1] * s_ball[1, c]
             + vl[nx + 2, nx + 2] * s_ball[2, c]
+        )
         for r in range(3):
             tm[r, c] = inv[r, 0] * w0 + inv[r, 1] * w1 + inv[r, 2] * w2
     for r in range(nx):
@@ -1270,14 +1564,36 @@ def ball_workspace(ball_count: int, nx: int) -> np.ndarray:
 @njit(cache=True)
 def _split_balls(ws, nb, nx):
     """(b, b_t, S (3Z, nx), x, x_t, flag (1,)) views of :func:`ball_workspace` (nb = 3Z)."""
-    sm = ws[2 * nb:2 * nb + nb * nx].reshape((nb, nx))
+    sm = ws[2 * nb : 2 * nb + nb * nx].reshape((nb, nx))
     o = 2 * nb + nb * nx
-    return ws[:nb], ws[nb:2 * nb], sm, ws[o:o + nx], ws[o + nx:o + 2 * nx], ws[o + 2 * nx:o + 2 * nx + 1]
+    return ws[:nb], ws[nb : 2 * nb], sm, ws[o : o + nx], ws[o + nx : o + 2 * nx], ws[o + 2 * nx : o + 2 * nx + 1]
 
 
 @njit(cache=True)
-def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                       balls, state, jacobian, rec, f, kbb, kx, cx):
+def quasi_static_balls(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    jacobian,
+    rec,
+    f,
+    kbb,
+    kx,
+    cx,
+):
     """One evaluation of a row with quasi-static balls: q, q_t (n, the full element
     vectors, work arrays) hold the frame and modal coordinates x in their first
     nx = n - 3Z entries (set by the caller); ``balls`` (:func:`ball_workspace`)
@@ -1326,14 +1642,56 @@ def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_
                 acc_t += sm[e, c] * (qt[c] - xtl[c])
             q[nx + e] += acc
             qt[nx + e] = acc_t
-        its = ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                               ws_o, balls, state, geometry[13], BALL_MAXIT, f, kbb, rec)
+        its = ball_equilibrium(
+            q,
+            qt,
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+            geometry[13],
+            BALL_MAXIT,
+            f,
+            kbb,
+            rec,
+        )
         if its < 0:  # once more from the last solution
             for e in range(nb):
                 q[nx + e] = b[e]
                 qt[nx + e] = bt[e]
-            its = ball_equilibrium(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                                   ws_i, ws_o, balls, state, geometry[13], BALL_MAXIT, f, kbb, rec)
+            its = ball_equilibrium(
+                q,
+                qt,
+                ball_ref,
+                geometry,
+                tab_i,
+                zs_i,
+                tab_o,
+                zs_o,
+                law_i,
+                law_o,
+                comp_i,
+                comp_o,
+                ws_i,
+                ws_o,
+                balls,
+                state,
+                geometry[13],
+                BALL_MAXIT,
+                f,
+                kbb,
+                rec,
+            )
         state[5] = 0
         _count_solve(state, 4, its)
         if its >= 0:
@@ -1345,8 +1703,29 @@ def quasi_static_balls(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_
                 xtl[c] = qt[c]
             flag[0] = 1.0
     if jacobian:
-        row_eval(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls,
-                 state, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
+        row_eval(
+            q,
+            qt,
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+            CONDENSED_BALLS,
+            np.empty((0, N_RECORD)),
+            f,
+            kx,
+            cx,
+        )
 
 
 @njit(cache=True)
@@ -1376,15 +1755,61 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             for e in range(n):
                 out_f[idx[e]] = 0.0
     for part in parts:
-        (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o,
-         comp_i, comp_o, ws_i, ws_o, balls, state) = part
+        (
+            idx,
+            qe,
+            ve,
+            f,
+            jq,
+            jv,
+            rec,
+            kbb,
+            kx,
+            cx,
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+        ) = part
         n = idx.shape[0]
         for e in range(n):
             qe[e] = qn[idx[e]]
             ve[e] = vn[idx[e]]
         if geometry[13] > 0.0:
-            quasi_static_balls(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                               ws_i, ws_o, balls, state, jacobian, rec, f, kbb, kx, cx)
+            quasi_static_balls(
+                qe,
+                ve,
+                ball_ref,
+                geometry,
+                tab_i,
+                zs_i,
+                tab_o,
+                zs_o,
+                law_i,
+                law_o,
+                comp_i,
+                comp_o,
+                ws_i,
+                ws_o,
+                balls,
+                state,
+                jacobian,
+                rec,
+                f,
+                kbb,
+                kx,
+                cx,
+            )
             jq_, jv_ = kx, cx
         else:
             if absolute:
@@ -1393,8 +1818,29 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
                 for j in range(nz):
                     for c in range(3):
                         qe[b0 + 3 * j + c] -= ball_ref[j, c]
-            row_eval(qe, ve, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                     balls, state, jacobian, rec, f, jq, jv)
+            row_eval(
+                qe,
+                ve,
+                ball_ref,
+                geometry,
+                tab_i,
+                zs_i,
+                tab_o,
+                zs_o,
+                law_i,
+                law_o,
+                comp_i,
+                comp_o,
+                ws_i,
+                ws_o,
+                balls,
+                state,
+                jacobian,
+                rec,
+                f,
+                jq,
+                jv,
+            )
             jq_, jv_ = jq, jv
         if jacobian:
             for r in range(n):
@@ -1407,8 +1853,9 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
 
 
 @njit(cache=True)
-def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o,
-                balls, state, recs):
+def row_history(
+    qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state, recs
+):
     """:func:`row_eval` over a recorded history (the outputs pass, one compiled loop):
     element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
     per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
@@ -1428,13 +1875,56 @@ def row_history(qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, la
         for i in range(nt):
             qf[:nx] = qs[i]
             vf[:nx] = vts[i]
-            quasi_static_balls(qf, vf, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o,
-                               ws_i, ws_o, balls, state, False, recs[i], f, kbb, empty, empty)
+            quasi_static_balls(
+                qf,
+                vf,
+                ball_ref,
+                geometry,
+                tab_i,
+                zs_i,
+                tab_o,
+                zs_o,
+                law_i,
+                law_o,
+                comp_i,
+                comp_o,
+                ws_i,
+                ws_o,
+                balls,
+                state,
+                False,
+                recs[i],
+                f,
+                kbb,
+                empty,
+                empty,
+            )
             out[i] = f[:nx]
         return out
     for i in range(nt):
-        row_eval(qs[i], vts[i], ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i,
-                 ws_o, balls, state, False, recs[i], out[i], empty, empty)
+        row_eval(
+            qs[i],
+            vts[i],
+            ball_ref,
+            geometry,
+            tab_i,
+            zs_i,
+            tab_o,
+            zs_o,
+            law_i,
+            law_o,
+            comp_i,
+            comp_o,
+            ws_i,
+            ws_o,
+            balls,
+            state,
+            False,
+            recs[i],
+            out[i],
+            empty,
+            empty,
+        )
     return out
 
 

@@ -125,9 +125,9 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk,
     on the cranks, the block-diagonal tangent kk = -dfs/dd (2N, 2N), hh (2N, N)
     = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts."""
     for j in range(d0x.shape[0]):
-        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1],
-                                                                       gam[j], clear[j], sc, angles, linear,
-                                                                       bstate[j, 0], bstate[j, 1])
+        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(
+            d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1], gam[j], clear[j], sc, angles, linear, bstate[j, 0], bstate[j, 1]
+        )
         bstate[j, 0], bstate[j, 1] = bx, by
         fs[2 * j], fs[2 * j + 1] = fx, fy
         kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j], kk[2 * j + 1, 2 * j + 1] = kxx, kxy, kxy, kyy
@@ -192,33 +192,37 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     elastic = n > 0 and cc.shape[0] == n2
     st = wk[0:4]
     o = 4
-    qp = wk[o:o + m]
+    qp = wk[o : o + m]
     o += m
-    su = wk[o:o + n2 * m].reshape((n2, m))
+    su = wk[o : o + n2 * m].reshape((n2, m))
     o += n2 * m
-    ulast = wk[o:o + n2]
+    ulast = wk[o : o + n2]
     o += n2
-    rx, ry, d0x, d0y = wk[o:o + n], wk[o + n:o + 2 * n], wk[o + 2 * n:o + 3 * n], wk[o + 3 * n:o + 4 * n]
-    dvx, dvy, gam = wk[o + 4 * n:o + 5 * n], wk[o + 5 * n:o + 6 * n], wk[o + 6 * n:o + 7 * n]
-    qs, damp = wk[o + 7 * n:o + 8 * n], wk[o + 8 * n:o + 9 * n]
+    rx, ry, d0x, d0y = wk[o : o + n], wk[o + n : o + 2 * n], wk[o + 2 * n : o + 3 * n], wk[o + 3 * n : o + 4 * n]
+    dvx, dvy, gam = wk[o + 4 * n : o + 5 * n], wk[o + 5 * n : o + 6 * n], wk[o + 6 * n : o + 7 * n]
+    qs, damp = wk[o + 7 * n : o + 8 * n], wk[o + 8 * n : o + 9 * n]
     o += 9 * n
-    fs, u, res, step = wk[o:o + n2], wk[o + n2:o + 2 * n2], wk[o + 2 * n2:o + 3 * n2], wk[o + 3 * n2:o + 4 * n2]
-    zf, wc, av, u0 = wk[o + 4 * n2:o + 5 * n2], wk[o + 5 * n2:o + 6 * n2], wk[o + 6 * n2:o + 7 * n2], \
-        wk[o + 7 * n2:o + 8 * n2]
+    fs, u, res, step = wk[o : o + n2], wk[o + n2 : o + 2 * n2], wk[o + 2 * n2 : o + 3 * n2], wk[o + 3 * n2 : o + 4 * n2]
+    zf, wc, av, u0 = (
+        wk[o + 4 * n2 : o + 5 * n2],
+        wk[o + 5 * n2 : o + 6 * n2],
+        wk[o + 6 * n2 : o + 7 * n2],
+        wk[o + 7 * n2 : o + 8 * n2],
+    )
     o += 8 * n2
     nn = n2 * n2
-    kk = wk[o:o + nn].reshape((n2, n2))
-    ch = wk[o + nn:o + 2 * nn].reshape((n2, n2))
-    mm = wk[o + 2 * nn:o + 3 * nn].reshape((n2, n2))
-    tmp = wk[o + 3 * nn:o + 4 * nn].reshape((n2, n2))
+    kk = wk[o : o + nn].reshape((n2, n2))
+    ch = wk[o + nn : o + 2 * nn].reshape((n2, n2))
+    mm = wk[o + 2 * nn : o + 3 * nn].reshape((n2, n2))
+    tmp = wk[o + 3 * nn : o + 4 * nn].reshape((n2, n2))
     o += 4 * nn
-    hh = wk[o:o + n2 * n].reshape((n2, n))
+    hh = wk[o : o + n2 * n].reshape((n2, n))
     o += n2 * n
-    d0 = wk[o:o + n2 * m].reshape((n2, m))
-    df = wk[o + n2 * m:o + 2 * n2 * m].reshape((n2, m))
-    t2 = wk[o + 2 * n2 * m:o + 3 * n2 * m].reshape((n2, m))
+    d0 = wk[o : o + n2 * m].reshape((n2, m))
+    df = wk[o + n2 * m : o + 2 * n2 * m].reshape((n2, m))
+    t2 = wk[o + 2 * n2 * m : o + 3 * n2 * m].reshape((n2, m))
     o += 3 * n2 * m
-    gg = wk[o:o + n * m].reshape((n, m))
+    gg = wk[o : o + n * m].reshape((n, m))
     for j in range(n):
         lx, ly = bores[j, 0], bores[j, 1]
         rx[j], ry[j] = c * lx - s * ly, s * lx + c * ly
@@ -447,14 +451,40 @@ class CrankSupports(KernelGroup):
         return self.carrier_c.size > 0
 
     def pack(self, idx, history=False):
-        return (idx, self.sc, self.dc, self.bores, self.clear, self.angles, self.fx, self.fy, self.bstate, self.bend,
-                self.carrier_c, self.ustate, np.zeros_like(self.work) if history else self.work)
+        return (
+            idx,
+            self.sc,
+            self.dc,
+            self.bores,
+            self.clear,
+            self.angles,
+            self.fx,
+            self.fy,
+            self.bstate,
+            self.bend,
+            self.carrier_c,
+            self.ustate,
+            np.zeros_like(self.work) if history else self.work,
+        )
 
     @staticmethod
     def empty_pack():
         z = np.zeros(0)
-        return (np.zeros(6, np.int64), np.zeros(7), np.zeros(2), np.zeros((0, 2)), z, z, z, z, np.zeros((0, 2)), z,
-                np.zeros((0, 0)), np.zeros((0, 4)), np.zeros(support_work_size(0)))
+        return (
+            np.zeros(6, np.int64),
+            np.zeros(7),
+            np.zeros(2),
+            np.zeros((0, 2)),
+            z,
+            z,
+            z,
+            z,
+            np.zeros((0, 2)),
+            z,
+            np.zeros((0, 0)),
+            np.zeros((0, 4)),
+            np.zeros(support_work_size(0)),
+        )
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         crank_support_kernel(q, v, f, jq, jv, jac, pack)
@@ -471,21 +501,38 @@ class CrankSupports(KernelGroup):
         return {"fx": self.fx, "fy": self.fy, "bend": self.bend, "u": self.ustate}
 
     def outputs(self, t, rec):
-        out = {"crank_support_force": Output(np.hypot(rec["fx"], rec["fy"]), ("time", "crank"), "N",
-                                             "radial force of the carrier on each crank (both support bearings)")}
+        out = {
+            "crank_support_force": Output(
+                np.hypot(rec["fx"], rec["fy"]),
+                ("time", "crank"),
+                "N",
+                "radial force of the carrier on each crank (both support bearings)",
+            )
+        }
         if self.sc[SC_K_BEND] > 0.0:  # elastic crank
-            out["crank_bending_fraction"] = Output(rec["bend"], ("time", "crank"), "1",
-                                                   "share of crank bending in the crank support's tangential compliance")
+            out["crank_bending_fraction"] = Output(
+                rec["bend"],
+                ("time", "crank"),
+                "1",
+                "share of crank bending in the crank support's tangential compliance",
+            )
         if self.elastic_carrier:
             u = rec["u"][..., 2:]  # (T, N, 2) carrier frame (ustate columns 2, 3)
-            out["carrier_bore_deflection"] = Output(np.hypot(u[..., 0], u[..., 1]), ("time", "crank"), "m",
-                                                    "deflection of each crank's support point (split-weighted bores) "
-                                                    "in the elastic carrier relative to the output flange")
+            out["carrier_bore_deflection"] = Output(
+                np.hypot(u[..., 0], u[..., 1]),
+                ("time", "crank"),
+                "m",
+                "deflection of each crank's support point (split-weighted bores) "
+                "in the elastic carrier relative to the output flange",
+            )
             t = np.asarray(self.bores, dtype=float)
             t = np.stack([-t[:, 1], t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
-            out["carrier_bore_deflection_tangential"] = Output((u * t).sum(axis=-1), ("time", "crank"), "m",
-                                                               "tangential (torque-direction) component of "
-                                                               "carrier_bore_deflection")
+            out["carrier_bore_deflection_tangential"] = Output(
+                (u * t).sum(axis=-1),
+                ("time", "crank"),
+                "m",
+                "tangential (torque-direction) component of carrier_bore_deflection",
+            )
         return out
 
 
@@ -673,8 +720,20 @@ class NeedleBearings(KernelGroup):
             z = p.needle_roller_count
             self.roller_angles = 2.0 * np.pi * np.arange(z) / z
         g = p.needle_pitch_ratio
-        self.sc = np.array([self.k, LINE_EXPONENT, p.needle_c_max, p.contact_depth, float(model == "rollers"), g,
-                            float(p.z_c), p.needle_friction, p.needle_friction_radius, p.friction_velocity])
+        self.sc = np.array(
+            [
+                self.k,
+                LINE_EXPONENT,
+                p.needle_c_max,
+                p.contact_depth,
+                float(model == "rollers"),
+                g,
+                float(p.z_c),
+                p.needle_friction,
+                p.needle_friction_radius,
+                p.friction_velocity,
+            ]
+        )
         self.mu = p.needle_friction if p.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
         self.fx, self.fy = np.zeros((self.nc, self.nd)), np.zeros((self.nc, self.nd))
@@ -684,8 +743,23 @@ class NeedleBearings(KernelGroup):
         self.reset()
 
     def pack(self, idx, history=False):
-        return (idx, self.sc, self.chi0, self.ecc, self.err, self.hx, self.hy, self.clear, self.roller_angles,
-                self.fx, self.fy, self.roll, self.angle, self.pw, self.state)
+        return (
+            idx,
+            self.sc,
+            self.chi0,
+            self.ecc,
+            self.err,
+            self.hx,
+            self.hy,
+            self.clear,
+            self.roller_angles,
+            self.fx,
+            self.fy,
+            self.roll,
+            self.angle,
+            self.pw,
+            self.state,
+        )
 
     @staticmethod
     def empty_pack():
@@ -709,16 +783,23 @@ class NeedleBearings(KernelGroup):
     def outputs(self, t, rec):
         fx, fy = rec["fx"], rec["fy"]
         dims = ("time", "crank", "disc")
-        out = {"needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
-               "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
-               "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y")}
+        out = {
+            "needle_force": Output(np.hypot(fx, fy), dims, "N", "needle-bearing force (journal on disc hole)"),
+            "needle_force_x": Output(fx, dims, "N", "needle-bearing force on the disc, x"),
+            "needle_force_y": Output(fy, dims, "N", "needle-bearing force on the disc, y"),
+        }
         if self.mu > 0.0:
-            out["needle_friction_power"] = Output(-rec["pw"], dims, "W",
-                                                  "power dissipated by the needle-bearing friction moment (>= 0)")
+            out["needle_friction_power"] = Output(
+                -rec["pw"], dims, "W", "power dissipated by the needle-bearing friction moment (>= 0)"
+            )
         if self.model == "rollers":
             out["roller_force"] = Output(rec["roll"], dims + ("roller",), "N", "needle roller contact force")
-            out["roller_angle"] = Output(rec["angle"], dims + ("roller",), "rad",
-                                         "direction of each roller's contact force on the disc (housing frame)")
+            out["roller_angle"] = Output(
+                rec["angle"],
+                dims + ("roller",),
+                "rad",
+                "direction of each roller's contact force on the disc (housing frame)",
+            )
         return out
 
     def reset(self) -> None:
@@ -733,9 +814,13 @@ class NeedleBearings(KernelGroup):
         if any(abs(d) > limit for d in state[1:]):  # (NaN: not evaluated yet, never a skip)
             dep = self.state[1:]
             k = int(np.nanargmax(np.abs(dep)))
-            return (f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
-                    f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)")
+            return (
+                f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
+                f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)"
+            )
         if state[0] < -max(20.0 * self.depth, self.limit):
-            return (f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
-                    f"{max(20.0 * self.depth, self.limit) * 1e6:.3g} um")
+            return (
+                f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
+                f"{max(20.0 * self.depth, self.limit) * 1e6:.3g} um"
+            )
         return None

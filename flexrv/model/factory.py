@@ -32,18 +32,28 @@ from flexrv.model.base import Member
 
 def _members(p) -> dict[str, Member]:
     mem: dict[str, Member] = {}
-    mc = np.diag([p.carrier_mass, p.carrier_mass, p.carrier_inertia, p.carrier_mass,
-                  0.5 * p.carrier_inertia, 0.5 * p.carrier_inertia])
+    mc = np.diag(
+        [
+            p.carrier_mass,
+            p.carrier_mass,
+            p.carrier_inertia,
+            p.carrier_mass,
+            0.5 * p.carrier_inertia,
+            0.5 * p.carrier_inertia,
+        ]
+    )
     mem["carrier"] = Member("carrier", mc, np.zeros(6), np.zeros(6), ("x", "y", "theta", "z", "rx", "ry"))
     for j in range(p.n_cranks):
         b = p.crank_angles[j]
         q0 = np.array([p.center_distance * np.cos(b), p.center_distance * np.sin(b), 0.0])
-        mem[f"crank{j}"] = Member(f"crank{j}", np.diag([p.crank_mass, p.crank_mass, p.crank_inertia]), q0,
-                                  np.zeros(3), ("x", "y", "phi"))
+        mem[f"crank{j}"] = Member(
+            f"crank{j}", np.diag([p.crank_mass, p.crank_mass, p.crank_inertia]), q0, np.zeros(3), ("x", "y", "phi")
+        )
     for k in range(p.n_discs):
         q0 = np.array([p.eccentricity * np.sin(p.chi0[k]), p.eccentricity * np.cos(p.chi0[k]), p.disc_rot0[k]])
-        mem[f"disc{k}"] = Member(f"disc{k}", np.diag([p.disc_mass, p.disc_mass, p.disc_inertia]), q0,
-                                 np.zeros(3), ("x", "y", "psi"))
+        mem[f"disc{k}"] = Member(
+            f"disc{k}", np.diag([p.disc_mass, p.disc_mass, p.disc_inertia]), q0, np.zeros(3), ("x", "y", "psi")
+        )
     return mem
 
 
@@ -59,10 +69,19 @@ def empirical_needle_constant(reducer) -> float:
     return (0.9 * c) ** (10.0 / 9.0)
 
 
-def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, main_bearing: str = "rigid",
-                crankshaft: str = "rigid", ring_options: dict | None = None, crank_options: dict | None = None,
-                model_name: str = "rigid", exudyn: bool = True, bodies=None,
-                ball_inertia: bool | None = None) -> AssembledModel:
+def build_rigid(
+    reducer,
+    drive: str = "ramp",
+    torque: Callable | None = None,
+    main_bearing: str = "rigid",
+    crankshaft: str = "rigid",
+    ring_options: dict | None = None,
+    crank_options: dict | None = None,
+    model_name: str = "rigid",
+    exudyn: bool = True,
+    bodies=None,
+    ball_inertia: bool | None = None,
+) -> AssembledModel:
     """Rigid-body model with compliant contacts (see module docstring).
 
     ``main_bearing``: ``"rigid"`` (linear 5-DOF element), ``"balls"`` (the
@@ -115,15 +134,22 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         CrankSupports(p),
         NeedleBearings(p, nb_model, k_emp),
         PinContacts(p),
-        OutputLoads(torque, p.external_radial_force, p.external_axial_force, p.tilting_moment,
-                    ramp=None if drive == "position" else p.load_ramp),
+        OutputLoads(
+            torque,
+            p.external_radial_force,
+            p.external_axial_force,
+            p.tilting_moment,
+            ramp=None if drive == "position" else p.load_ramp,
+        ),
     ]
     members = _members(p)
     info: dict = {}
     if main_bearing == "rigid":
         if ball_inertia is not None:
-            raise ConfigError(f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
-                              f"applies to the ball-resolved bearing (model 'balls' or 'flexible')")
+            raise ConfigError(
+                f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
+                f"applies to the ball-resolved bearing (model 'balls' or 'flexible')"
+            )
         groups.insert(4, RigidMainBearing(p))
     elif main_bearing in ("balls", "flexible"):
         from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
@@ -132,15 +158,20 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
         if main_bearing == "flexible":
             from flexrv.model.flexible_bearing import flexible_rings
 
-            rings = flexible_rings(reducer, **check_options("ring_options", ring_options,
-                                                            signature_options(flexible_rings, skip=1)))
+            rings = flexible_rings(
+                reducer, **check_options("ring_options", ring_options, signature_options(flexible_rings, skip=1))
+            )
             info["flexible_bodies"] = rings["bodies"]
             info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
         if ball_inertia is None:  # quasi-static balls unless a condensed ring couples them (see the docstring)
-            ball_inertia = any(r is not None and r.condensed
-                               for side in ("inner", "outer") for r in rings.get(side) or [])
-        group = BallBearingGroup(rows_from_design(reducer, inner=rings.get("inner"), outer=rings.get("outer"),
-                                                  ball_inertia=bool(ball_inertia)))
+            ball_inertia = any(
+                r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or []
+            )
+        group = BallBearingGroup(
+            rows_from_design(
+                reducer, inner=rings.get("inner"), outer=rings.get("outer"), ball_inertia=bool(ball_inertia)
+            )
+        )
         info["ball_inertia"] = bool(ball_inertia)
         members.update(group.new_members())
         groups.insert(4, group)
@@ -149,16 +180,38 @@ def build_rigid(reducer, drive: str = "ramp", torque: Callable | None = None, ma
     if crankshaft == "flexible":
         from flexrv.model.flexible_crank import add_flexible_cranks
 
-        info.update(add_flexible_cranks(reducer, p, members, groups, **check_options(
-            "crank_options", crank_options, signature_options(add_flexible_cranks, skip=4))))
+        info.update(
+            add_flexible_cranks(
+                reducer,
+                p,
+                members,
+                groups,
+                **check_options("crank_options", crank_options, signature_options(add_flexible_cranks, skip=4)),
+            )
+        )
     elif crankshaft != "rigid":
         raise ConfigError(f"crankshaft = {crankshaft!r} is not allowed: choose 'rigid' or 'flexible'")
-    info.update(main_bearing=main_bearing, crankshaft=crankshaft,
-                elastic_bodies=[b for b, on in (("carrier", p.carrier_compliance.size > 0),
-                                                ("cycloid_disc", p.disc_compliance.size > 0)) if on])
+    info.update(
+        main_bearing=main_bearing,
+        crankshaft=crankshaft,
+        elastic_bodies=[
+            b
+            for b, on in (("carrier", p.carrier_compliance.size > 0), ("cycloid_disc", p.disc_compliance.size > 0))
+            if on
+        ],
+    )
     name = "rigid" if (main_bearing, crankshaft) == ("rigid", "rigid") else model_name
-    model = AssembledModel(name=name, reducer=reducer, params=p, members=members, groups=groups, input_angle=theta,
-                           input_speed=omega, load_torque=torque, info=info)
+    model = AssembledModel(
+        name=name,
+        reducer=reducer,
+        params=p,
+        members=members,
+        groups=groups,
+        input_angle=theta,
+        input_speed=omega,
+        load_torque=torque,
+        info=info,
+    )
     if not exudyn:
         offset = 0
         for m in members.values():
@@ -203,15 +256,24 @@ def assemble(model: AssembledModel) -> AssembledModel:
     mbs = sc.AddSystem()
     offset = 0
     for m in model.members.values():
-        m.node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * m.n, initialCoordinates=list(m.q0),
-                                             initialCoordinates_t=list(m.v0), numberOfODE2Coordinates=m.n))
+        m.node = mbs.AddNode(
+            NodeGenericODE2(
+                referenceCoordinates=[0.0] * m.n,
+                initialCoordinates=list(m.q0),
+                initialCoordinates_t=list(m.v0),
+                numberOfODE2Coordinates=m.n,
+            )
+        )
         extra = {}
         if m.stiffness_matrix is not None:
             extra["stiffnessMatrix"] = m.stiffness_matrix
         if m.damping_matrix is not None:
             extra["dampingMatrix"] = m.damping_matrix
-        mbs.AddObject(ObjectGenericODE2(nodeNumbers=[m.node], massMatrix=m.mass_matrix,
-                                        jacobianUserFunction=_member_jacobian(m, exu), **extra))
+        mbs.AddObject(
+            ObjectGenericODE2(
+                nodeNumbers=[m.node], massMatrix=m.mass_matrix, jacobianUserFunction=_member_jacobian(m, exu), **extra
+            )
+        )
         m.offset = offset
         offset += m.n
     from flexrv.model.base import KernelGroup
@@ -225,8 +287,9 @@ def assemble(model: AssembledModel) -> AssembledModel:
         model.fused.add_to(mbs, [model.members[name].node for name in model.fused.member_names])
     for g in model.groups:
         if not isinstance(g, KernelGroup):
-            g.add_to(mbs, [model.members[name].node for name in g.members],
-                     [model.members[name].n for name in g.members])
+            g.add_to(
+                mbs, [model.members[name].node for name in g.members], [model.members[name].n for name in g.members]
+            )
     mbs.Assemble()
     model.mbs, model.sc, model.n = mbs, sc, offset
     q = np.asarray(mbs.systemData.GetODE2Coordinates())
@@ -262,8 +325,10 @@ def parts_options(model: str, parts) -> dict:
         return {"parts": parts}
     own = [x for x in parts if x not in BODY_PARTS]
     if own:
-        raise ConfigError(f"parts = {','.join(own)} needs --model flexible (got --model {model}); with --model "
-                          f"{model} --parts names elastic bodies only: {', '.join(BODY_PARTS)}")
+        raise ConfigError(
+            f"parts = {','.join(own)} needs --model flexible (got --model {model}); with --model "
+            f"{model} --parts names elastic bodies only: {', '.join(BODY_PARTS)}"
+        )
     return {"bodies": parts}
 
 
@@ -277,13 +342,15 @@ def parse_parts(parts) -> tuple[str, ...]:
         return ()
     bad = [p for p in parts if p not in FLEXIBLE_PARTS]
     if bad or not parts:
-        raise ConfigError(f"parts = {','.join(parts) or '(empty)'} is not allowed: choose one or more of "
-                          f"{', '.join(FLEXIBLE_PARTS)}")
+        raise ConfigError(
+            f"parts = {','.join(parts) or '(empty)'} is not allowed: choose one or more of {', '.join(FLEXIBLE_PARTS)}"
+        )
     return parts
 
 
-def build_flexible(reducer, parts=None, ring_options: dict | None = None,
-                   crank_options: dict | None = None, **kwargs) -> AssembledModel:
+def build_flexible(
+    reducer, parts=None, ring_options: dict | None = None, crank_options: dict | None = None, **kwargs
+) -> AssembledModel:
     """Rigid model with the named parts flexible (:data:`FLEXIBLE_PARTS`; None: the
     main bearing, with the design's elastic bodies; a list: exactly the named parts,
     ``carrier`` / ``cycloid_disc`` included or rigid):
@@ -304,14 +371,24 @@ def build_flexible(reducer, parts=None, ring_options: dict | None = None,
     else:
         parts = parse_parts(parts)
         bodies = tuple(x for x in parts if x in BODY_PARTS)
-    return build_rigid(reducer, main_bearing="flexible" if "main_bearing" in parts else "rigid",
-                       crankshaft="flexible" if "crankshaft" in parts else "rigid", ring_options=ring_options,
-                       crank_options=crank_options, model_name="flexible", bodies=bodies, **kwargs)
+    return build_rigid(
+        reducer,
+        main_bearing="flexible" if "main_bearing" in parts else "rigid",
+        crankshaft="flexible" if "crankshaft" in parts else "rigid",
+        ring_options=ring_options,
+        crank_options=crank_options,
+        model_name="flexible",
+        bodies=bodies,
+        **kwargs,
+    )
 
 
 #: model name -> builder(reducer, drive=..., torque=..., **options) -> AssembledModel
-MODELS: dict[str, Callable[..., AssembledModel]] = {"rigid": build_rigid, "balls": build_balls,
-                                                    "flexible": build_flexible}
+MODELS: dict[str, Callable[..., AssembledModel]] = {
+    "rigid": build_rigid,
+    "balls": build_balls,
+    "flexible": build_flexible,
+}
 
 
 def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
@@ -324,6 +401,7 @@ def build_model(reducer, model: str = "rigid", **kwargs) -> AssembledModel:
         set_here = ("main_bearing", "crankshaft", "bodies") if builder is build_flexible else ("main_bearing",)
         allowed = {**signature_options(build_rigid, skip=1, exclude=("model_name",) + set_here), **allowed}
         allowed.pop("kwargs", None)
-    opts = check_options(f"model options of {model!r}", {k: v for k, v in kwargs.items() if k not in ("drive", "torque")},
-                         allowed)
+    opts = check_options(
+        f"model options of {model!r}", {k: v for k, v in kwargs.items() if k not in ("drive", "torque")}, allowed
+    )
     return builder(reducer, **{**kwargs, **opts})

@@ -56,12 +56,23 @@ from typing import Protocol
 
 import numpy as np
 
-from flexrv.errors import ConfigError
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
+from flexrv.errors import ConfigError
 from flexrv.model.base import ForceGroup, Output, exudyn_vector
-from flexrv.model.bearing_kernel import (BALL_FORCE_TOL, N_RECORD, RECORD_FIELDS, ball_workspace, condense_workspace,
-                                         film_workspace, law_parameters, ring_modal_amplitudes, row_element,
-                                         row_force_kernel, row_history, row_kernel)
+from flexrv.model.bearing_kernel import (
+    BALL_FORCE_TOL,
+    N_RECORD,
+    RECORD_FIELDS,
+    ball_workspace,
+    condense_workspace,
+    film_workspace,
+    law_parameters,
+    ring_modal_amplitudes,
+    row_element,
+    row_force_kernel,
+    row_history,
+    row_kernel,
+)
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -106,7 +117,9 @@ class ModalRing:
     """
 
     body: object
-    damping_ratio: float = field(kw_only=True)  #: modal damping of a dynamic ring (design main_bearing.ring_damping_ratio)
+    damping_ratio: float = field(
+        kw_only=True
+    )  #: modal damping of a dynamic ring (design main_bearing.ring_damping_ratio)
     mirror: bool = False
     stiffness_scale: float = 1.0
     quasi_static: bool = True
@@ -212,11 +225,14 @@ class RowModel:
     ball_reference: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
-        self._sizes = tuple(0 if (r is None or _is_condensed(r)) else r.stiffness.shape[0]
-                            for r in (self.inner, self.outer))
+        self._sizes = tuple(
+            0 if (r is None or _is_condensed(r)) else r.stiffness.shape[0] for r in (self.inner, self.outer)
+        )
         if not self.ball_inertia and (_is_condensed(self.inner) or _is_condensed(self.outer)):
-            raise ConfigError("quasi-static balls (ball_inertia = false) need rigid or uncondensed modal rings: "
-                              "a condensed ring couples every ball of the row")
+            raise ConfigError(
+                "quasi-static balls (ball_inertia = false) need rigid or uncondensed modal rings: "
+                "a condensed ring couples every ball of the row"
+            )
         psi = 2.0 * np.pi * np.arange(self.ball_count) / self.ball_count
         rb = self.row.ball_radius_pitch
         self.ball_reference = np.stack([rb * np.cos(psi), rb * np.sin(psi), np.full(self.ball_count, self.z)], -1)
@@ -285,33 +301,64 @@ def kernel_inputs(model: RowModel) -> tuple:
         p = law_parameters(law)
         if p is None:
             mode = getattr(law, "mode", type(law).__name__)
-            raise ConfigError(f"contact law {mode!r} is not supported by the ball-resolved main bearing "
-                              f"({side} contact): use contact.ehl = 'dry', 'hamrock_dowson' or 'map' "
-                              f"(one contact geometry per ring: scalar radii)")
+            raise ConfigError(
+                f"contact law {mode!r} is not supported by the ball-resolved main bearing "
+                f"({side} contact): use contact.ehl = 'dry', 'hamrock_dowson' or 'map' "
+                f"(one contact geometry per ring: scalar radii)"
+            )
         laws.append(p)
     tab_i, zs_i, comp_i, ws_i = _ring_arrays(model.inner, model.ball_count)
     tab_o, zs_o, comp_o, ws_o = _ring_arrays(model.outer, model.ball_count)
     row = model.row
-    geometry = np.array([model.z, row.inner_center_radius, row.inner_center_z, row.outer_center_radius,
-                         row.outer_center_z, row.inner_offset, row.outer_offset, row.ball_radius_pitch,
-                         model.speed_factor, model.cage_ratio, model.cage_stiffness, model.cage_damping,
-                         model.pocket_stiffness, 0.0 if model.ball_inertia else BALL_FORCE_TOL])
+    geometry = np.array(
+        [
+            model.z,
+            row.inner_center_radius,
+            row.inner_center_z,
+            row.outer_center_radius,
+            row.outer_center_z,
+            row.inner_offset,
+            row.outer_offset,
+            row.ball_radius_pitch,
+            model.speed_factor,
+            model.cage_ratio,
+            model.cage_stiffness,
+            model.cage_damping,
+            model.pocket_stiffness,
+            0.0 if model.ball_inertia else BALL_FORCE_TOL,
+        ]
+    )
     # quasi-static balls: the local solve's work array, its first warm start the preload
     # equilibrium; with ball inertia the balls are element coordinates
     balls = np.zeros(0)
     if not model.ball_inertia:
         balls = ball_workspace(model.ball_count, model.n_coordinates)
-        balls[:3 * model.ball_count] = initial_ball_displacements(model).ravel()
-    inputs = (np.ascontiguousarray(model.ball_reference, dtype=float), geometry, tab_i, zs_i, tab_o, zs_o,
-              laws[0], laws[1], comp_i, comp_o, ws_i, ws_o, balls, np.zeros(8, np.int64))
+        balls[: 3 * model.ball_count] = initial_ball_displacements(model).ravel()
+    inputs = (
+        np.ascontiguousarray(model.ball_reference, dtype=float),
+        geometry,
+        tab_i,
+        zs_i,
+        tab_o,
+        zs_o,
+        laws[0],
+        laws[1],
+        comp_i,
+        comp_o,
+        ws_i,
+        ws_o,
+        balls,
+        np.zeros(8, np.int64),
+    )
     model._kernel_inputs = inputs
     return inputs
 
 
 def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
     """Generalized force of a row element (compiled row kernel)."""
-    return row_force_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
-                            *kernel_inputs(model))
+    return row_force_kernel(
+        np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *kernel_inputs(model)
+    )
 
 
 _NO_RECORD = np.zeros((0, N_RECORD))
@@ -319,8 +366,13 @@ _NO_RECORD = np.zeros((0, N_RECORD))
 
 def row_jacobian(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(d force/d q, d force/d q_t) of a row element (compiled row kernel)."""
-    _, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
-                           *kernel_inputs(model), True, _NO_RECORD)
+    _, jq, jv = row_kernel(
+        np.ascontiguousarray(q, dtype=float),
+        np.ascontiguousarray(q_t, dtype=float),
+        *kernel_inputs(model),
+        True,
+        _NO_RECORD,
+    )
     return jq, jv
 
 
@@ -360,11 +412,13 @@ class RowEvaluation:
 
 def _contacts(rec: np.ndarray, label: str) -> RaceContacts:
     s = label[0]
-    return RaceContacts(load=rec[:, _REC[f"load_{label}"]].copy(),
-                        normal=rec[:, [_REC[f"n{s}x"], _REC[f"n{s}y"], _REC[f"n{s}z"]]],
-                        displacement=rec[:, [_REC[f"u{s}x"], _REC[f"u{s}y"], _REC[f"u{s}z"]]],
-                        azimuth=rec[:, _REC[f"psi_{label}"]].copy(),
-                        ring_load=rec[:, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]])
+    return RaceContacts(
+        load=rec[:, _REC[f"load_{label}"]].copy(),
+        normal=rec[:, [_REC[f"n{s}x"], _REC[f"n{s}y"], _REC[f"n{s}z"]]],
+        displacement=rec[:, [_REC[f"u{s}x"], _REC[f"u{s}y"], _REC[f"u{s}z"]]],
+        azimuth=rec[:, _REC[f"psi_{label}"]].copy(),
+        ring_load=rec[:, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]],
+    )
 
 
 def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool = True) -> RowEvaluation:
@@ -377,11 +431,22 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
         configuration), ordered [frame(6), inner modes, outer modes, balls(3Z)].
     """
     rec = np.zeros((model.ball_count, N_RECORD))
-    f, jq, jv = row_kernel(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float),
-                           *kernel_inputs(model), bool(jacobian), rec)
-    return RowEvaluation(inner=_contacts(rec, "inner"), outer=_contacts(rec, "outer"), force=f,
-                         jac_q=jq if jacobian else None, jac_v=jv if jacobian else None,
-                         ball_pos=rec[:, [_REC["bx"], _REC["by"], _REC["bz"]]], azimuth=rec[:, _REC["psi_outer"]].copy())
+    f, jq, jv = row_kernel(
+        np.ascontiguousarray(q, dtype=float),
+        np.ascontiguousarray(q_t, dtype=float),
+        *kernel_inputs(model),
+        bool(jacobian),
+        rec,
+    )
+    return RowEvaluation(
+        inner=_contacts(rec, "inner"),
+        outer=_contacts(rec, "outer"),
+        force=f,
+        jac_q=jq if jacobian else None,
+        jac_v=jv if jacobian else None,
+        ball_pos=rec[:, [_REC["bx"], _REC["by"], _REC["bz"]]],
+        azimuth=rec[:, _REC["psi_outer"]].copy(),
+    )
 
 
 def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEvaluation) -> np.ndarray:
@@ -393,8 +458,13 @@ def ring_modal_coordinates(model: RowModel, label: str, q: np.ndarray, ev: RowEv
         return np.asarray(q)[si if label == "inner" else so].copy()
     st = getattr(ev, label)
     zs = -1.0 if ring.mirror else 1.0
-    return ring_modal_amplitudes(np.ascontiguousarray(st.azimuth)[None], np.ascontiguousarray(st.ring_load)[None],
-                                 ring.table, zs, np.ascontiguousarray(ring.compliance_diag))[0]
+    return ring_modal_amplitudes(
+        np.ascontiguousarray(st.azimuth)[None],
+        np.ascontiguousarray(st.ring_load)[None],
+        ring.table,
+        zs,
+        np.ascontiguousarray(ring.compliance_diag),
+    )[0]
 
 
 # ---------------------------------------------------------------------------- Exudyn
@@ -421,7 +491,9 @@ class BearingHandle:
             nodes.append(self.outer_nodes[row_index])
         nodes += self.ball_nodes[row_index]
         q = np.concatenate([np.asarray(mbs.GetNodeOutput(n, exu.OutputVariableType.Coordinates, cfg)) for n in nodes])
-        q_t = np.concatenate([np.asarray(mbs.GetNodeOutput(n, exu.OutputVariableType.Coordinates_t, cfg)) for n in nodes])
+        q_t = np.concatenate(
+            [np.asarray(mbs.GetNodeOutput(n, exu.OutputVariableType.Coordinates_t, cfg)) for n in nodes]
+        )
         return q, q_t
 
 
@@ -467,12 +539,16 @@ class RowElement:
 
     def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None, record: bool = False):
         rows = [rows] if isinstance(rows, RowModel) else list(rows)
-        idxs = [idx] if (idx is None or np.ndim(idx) == 1 and len(rows) == 1 and not isinstance(idx, list)) else list(idx)
+        idxs = (
+            [idx] if (idx is None or np.ndim(idx) == 1 and len(rows) == 1 and not isinstance(idx, list)) else list(idx)
+        )
         if len(idxs) != len(rows):
             raise ValueError("one coordinate map per row")
         self.rows = rows
-        self.idx = [np.ascontiguousarray(np.arange(r.n_coordinates) if i is None else i, dtype=np.int64)
-                    for r, i in zip(rows, idxs)]
+        self.idx = [
+            np.ascontiguousarray(np.arange(r.n_coordinates) if i is None else i, dtype=np.int64)
+            for r, i in zip(rows, idxs)
+        ]
         n = 1 + max(int(i.max()) for i in self.idx)
         self.absolute = bool(absolute)
         self.stats = [0, 0] if stats is None else stats
@@ -485,9 +561,20 @@ class RowElement:
             # row Jacobians (m, m) with ball inertia; quasi-static balls: the balls' blocks (3Z, 4)
             # and the condensed Jacobians kx, cx (m, m) instead
             nj, nb, nk = (m, 0, 0) if r.ball_inertia else (0, 3 * r.ball_count, m)
-            self._work.append((i, np.zeros(full), np.zeros(full), np.zeros(full), np.zeros((nj, nj)),
-                               np.zeros((nj, nj)), np.zeros((r.ball_count if record else 0, N_RECORD)),
-                               np.zeros((nb, 4)), np.zeros((nk, nk)), np.zeros((nk, nk))))
+            self._work.append(
+                (
+                    i,
+                    np.zeros(full),
+                    np.zeros(full),
+                    np.zeros(full),
+                    np.zeros((nj, nj)),
+                    np.zeros((nj, nj)),
+                    np.zeros((r.ball_count if record else 0, N_RECORD)),
+                    np.zeros((nb, 4)),
+                    np.zeros((nk, nk)),
+                    np.zeros((nk, nk)),
+                )
+            )
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
         self._parts = None
@@ -544,8 +631,9 @@ class RowElement:
         def jac_fn(mbs_, t, item, q, q_t, f_q, f_v):
             return self.jacobian(q, q_t, f_q, f_v, t)
 
-        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
-                                               jacobianUserFunction=jac_fn))
+        return mbs.AddObject(
+            ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn)
+        )
 
 
 def add_row_element(mbs, rows, nodes: list[int], idx=None, absolute: bool = False, stats: list | None = None) -> int:
@@ -577,10 +665,19 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandl
                 store.append(None)
                 continue
             m = ring.stiffness.shape[0]
-            node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
-                                               initialCoordinates_t=[0.0] * m, numberOfODE2Coordinates=m))
-            mbs.AddObject(ObjectGenericODE2(nodeNumbers=[node], massMatrix=ring.mass, stiffnessMatrix=ring.stiffness,
-                                            dampingMatrix=ring.damping))
+            node = mbs.AddNode(
+                NodeGenericODE2(
+                    referenceCoordinates=[0.0] * m,
+                    initialCoordinates=[0.0] * m,
+                    initialCoordinates_t=[0.0] * m,
+                    numberOfODE2Coordinates=m,
+                )
+            )
+            mbs.AddObject(
+                ObjectGenericODE2(
+                    nodeNumbers=[node], massMatrix=ring.mass, stiffnessMatrix=ring.stiffness, dampingMatrix=ring.damping
+                )
+            )
             store.append(node)
             node_list.append(node)
         balls = []
@@ -592,12 +689,25 @@ def add_main_bearing(mbs, rows: list[RowModel], frame_node: int) -> BearingHandl
         node_list += balls
 
         objects.append(add_row_element(mbs, model, node_list))
-    return BearingHandle(rows=rows, frame_node=frame_node, inner_nodes=inner_nodes, outer_nodes=outer_nodes,
-                         ball_nodes=ball_nodes, contact_objects=objects)
+    return BearingHandle(
+        rows=rows,
+        frame_node=frame_node,
+        inner_nodes=inner_nodes,
+        outer_nodes=outer_nodes,
+        ball_nodes=ball_nodes,
+        contact_objects=objects,
+    )
 
 
-def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_max: float | None = None,
-                     depth: float | None = None, ball_inertia: bool = True) -> list[RowModel]:
+def rows_from_design(
+    reducer,
+    inner=None,
+    outer=None,
+    ehl: str | None = None,
+    c_max: float | None = None,
+    depth: float | None = None,
+    ball_inertia: bool = True,
+) -> list[RowModel]:
     """Row models of a design's main bearing (both rows, back-to-back).
 
     Parameters
@@ -609,15 +719,18 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
     c_max, depth : contact damping and its ramp depth (default: the design's).
     ball_inertia : False: quasi-static balls (:attr:`RowModel.ball_inertia`).
     """
-    from flexrv.ehl.law import EHLPointLaw
     from flexrv.contact.hertz import effective_modulus
+    from flexrv.ehl.law import EHLPointLaw
     from flexrv.geometry.bearing import BallBearingGeometry
 
     geom = BallBearingGeometry.from_design(reducer.main_bearing)
     mb = reducer.main_bearing
     ring_mat, ball_mat = reducer.material("bearing_rings"), reducer.material("rolling_elements")
-    e_eff = float(effective_modulus(ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus,
-                                    ball_mat.poisson_ratio))
+    e_eff = float(
+        effective_modulus(
+            ring_mat.youngs_modulus, ring_mat.poisson_ratio, ball_mat.youngs_modulus, ball_mat.poisson_ratio
+        )
+    )
     c_max = reducer.main_bearing.ball_damping_Ns_per_m if c_max is None else c_max
     depth = reducer.contact.impact_damping_depth_mm * 1e-3 if depth is None else depth
     ehl = reducer.contact.ehl if ehl is None else ehl
@@ -625,8 +738,10 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
     if ehl == "dry":
         laws = None
     else:
-        laws = [replace(EHLPointLaw.from_design(reducer, float(rx), float(ry), mode=ehl),
-                                    c_max=c_max, damping_depth=depth) for rx, ry in ((rx_i, ry_i), (rx_o, ry_o))]
+        laws = [
+            replace(EHLPointLaw.from_design(reducer, float(rx), float(ry), mode=ehl), c_max=c_max, damping_depth=depth)
+            for rx, ry in ((rx_i, ry_i), (rx_o, ry_o))
+        ]
     speed_factor = 0.25 * geom.pitch_diameter * (1.0 - geom.gamma**2)
     rows = []
     for k, (z, side) in enumerate(zip(geom.row_positions(), geom.row_sides())):
@@ -635,14 +750,26 @@ def rows_from_design(reducer, inner=None, outer=None, ehl: str | None = None, c_
             law_i, law_o = hertz_law(row.k_inner, c_max, depth), hertz_law(row.k_outer, c_max, depth)
         else:
             law_i, law_o = laws
-        rows.append(RowModel(row=row, z=float(z), ball_count=geom.ball_count,
-                             cage_ratio=float(geom.cage_speed(1.0, 0.0)),  # cage turns per frame (inner ring) turn
-                             cage_stiffness=mb.cage_stiffness_N_per_m, cage_damping=mb.cage_damping_Ns_per_m,
-                             pocket_stiffness=mb.pocket_stiffness_N_per_m,
-                             ball_mass=geom.ball_mass(ball_mat.density_kg_m3), law_inner=law_i, law_outer=law_o,
-                             speed_factor=speed_factor, inner_radii=(float(rx_i), float(ry_i)), e_eff=e_eff,
-                             inner=None if inner is None else inner[k], outer=None if outer is None else outer[k],
-                             ball_inertia=ball_inertia))
+        rows.append(
+            RowModel(
+                row=row,
+                z=float(z),
+                ball_count=geom.ball_count,
+                cage_ratio=float(geom.cage_speed(1.0, 0.0)),  # cage turns per frame (inner ring) turn
+                cage_stiffness=mb.cage_stiffness_N_per_m,
+                cage_damping=mb.cage_damping_Ns_per_m,
+                pocket_stiffness=mb.pocket_stiffness_N_per_m,
+                ball_mass=geom.ball_mass(ball_mat.density_kg_m3),
+                law_inner=law_i,
+                law_outer=law_o,
+                speed_factor=speed_factor,
+                inner_radii=(float(rx_i), float(ry_i)),
+                e_eff=e_eff,
+                inner=None if inner is None else inner[k],
+                outer=None if outer is None else outer[k],
+                ball_inertia=ball_inertia,
+            )
+        )
     return rows
 
 
@@ -656,9 +783,17 @@ RING_EIGENMODES = 12
 RING_EIGENMODES_QUASI_STATIC = 0
 
 
-def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int | None = None, size: float | None = None,
-                   damping_ratio: float | None = None, stiffness_scale: float = 1.0, quasi_static: bool = True,
-                   rings: tuple[str, ...] = ("inner", "outer"), condense: bool = True) -> dict:
+def flexible_rings(
+    reducer,
+    harmonics: int | None = RING_HARMONICS,
+    n_eig: int | None = None,
+    size: float | None = None,
+    damping_ratio: float | None = None,
+    stiffness_scale: float = 1.0,
+    quasi_static: bool = True,
+    rings: tuple[str, ...] = ("inner", "outer"),
+    condense: bool = True,
+) -> dict:
     """Reduced flexible rings of a design's main bearing for both rows.
 
     Returns ``{"inner": [row0, row1], "outer": [row0, row1], "bodies": {...}}`` with
@@ -700,8 +835,9 @@ def flexible_rings(reducer, harmonics: int | None = RING_HARMONICS, n_eig: int |
         settings = {"size": size, "n_eig": int(n_eig), "n_harmonics": None if harmonics is None else int(harmonics)}
         body = reduce_part(reducer, part, **settings)
         zeta = reducer.main_bearing.ring_damping_ratio if damping_ratio is None else float(damping_ratio)
-        opts = dict(damping_ratio=zeta, stiffness_scale=stiffness_scale, quasi_static=quasi_static,
-                    condense=bool(condense))
+        opts = dict(
+            damping_ratio=zeta, stiffness_scale=stiffness_scale, quasi_static=quasi_static, condense=bool(condense)
+        )
         out[label] = [ModalRing(body, **opts), ModalRing(body, mirror=True, **opts)]
         out["bodies"][part] = {**settings, "identity": body_identity(body)}  # view loads this body, never re-meshes
         out.setdefault("lowest_mode_hz", {})[part] = float(np.sqrt(stiffness_scale) * body.frequencies_hz.min())
@@ -774,8 +910,8 @@ class BallBearingGroup(ForceGroup):
             return element.add_to(mbs, [nodes[0]])
         for k, row in enumerate(self.rows):
             count = 1 + len(row.ring_nodes())
-            row_nodes = [nodes[0]] + list(nodes[pos:pos + count])
-            self._element_members.append([self.members[0]] + list(self.members[pos:pos + count]))
+            row_nodes = [nodes[0]] + list(nodes[pos : pos + count])
+            self._element_members.append([self.members[0]] + list(self.members[pos : pos + count]))
             pos += count
             idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
             element = RowElement(row, idx, True, stats, record=True)
@@ -824,15 +960,26 @@ class BallBearingGroup(ForceGroup):
                 ring = getattr(row, label)
                 m = ring.stiffness.shape[0]
                 out[f"main_bearing_{label}{k}"] = Member(
-                    f"main_bearing_{label}{k}", np.asarray(ring.mass, dtype=float), np.zeros(m), np.zeros(m),
-                    tuple(f"mode{i}" for i in range(m)), kind="modal", stiffness_matrix=ring.stiffness,
-                    damping_matrix=ring.damping)
+                    f"main_bearing_{label}{k}",
+                    np.asarray(ring.mass, dtype=float),
+                    np.zeros(m),
+                    np.zeros(m),
+                    tuple(f"mode{i}" for i in range(m)),
+                    kind="modal",
+                    stiffness_matrix=ring.stiffness,
+                    damping_matrix=ring.damping,
+                )
             if not row.ball_inertia:  # quasi-static balls: no coordinates
                 continue
             q0 = (row.ball_reference + initial_ball_displacements(row)).ravel()
             out[f"main_bearing_balls{k}"] = Member(
-                f"main_bearing_balls{k}", np.eye(q0.size) * row.ball_mass, q0, np.zeros(q0.size),
-                tuple(f"{c}{j}" for j in range(row.ball_count) for c in "xyz"), kind="points")
+                f"main_bearing_balls{k}",
+                np.eye(q0.size) * row.ball_mass,
+                q0,
+                np.zeros(q0.size),
+                tuple(f"{c}{j}" for j in range(row.ball_count) for c in "xyz"),
+                kind="points",
+            )
         return out
 
     def _element_state(self, q, v, k):
@@ -840,7 +987,7 @@ class BallBearingGroup(ForceGroup):
         idx = self._index[k]
         qe = q[..., idx].copy()
         if row.ball_inertia:
-            qe[..., -3 * row.ball_count:] -= row.ball_reference.ravel()
+            qe[..., -3 * row.ball_count :] -= row.ball_reference.ravel()
         return qe, v[..., idx], idx
 
     def _force(self, q, v) -> np.ndarray:
@@ -863,8 +1010,7 @@ class BallBearingGroup(ForceGroup):
         for k, row in enumerate(self.rows):
             qe, ve, idx = self._element_state(q, v, k)
             recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
-            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), *kernel_inputs(row),
-                                          recs)
+            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), *kernel_inputs(row), recs)
             history.append((recs, qe))
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
@@ -888,8 +1034,9 @@ class BallBearingGroup(ForceGroup):
             qe, ve, _ = self._element_state(q, v, k)
             if len(todo):
                 part = np.zeros((len(todo), row.ball_count, N_RECORD))
-                frame[todo] = row_history(np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]),
-                                          *kernel_inputs(row), part)[:, :6]
+                frame[todo] = row_history(
+                    np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]), *kernel_inputs(row), part
+                )[:, :6]
                 recs[todo] = part
             fc[:, _PERM] += frame
             history.append((recs, qe))
@@ -940,13 +1087,19 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     load_i, load_o, angle = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     film, p_max = np.zeros(shape), np.zeros(shape)
     defl = {"inner": np.zeros((n_t, n_r)), "outer": np.zeros((n_t, n_r))}
-    modal = {label: [np.zeros((n_t, getattr(row, label).stiffness.shape[0])) if getattr(row, label) is not None
-                     else None for row in rows] for label in ("inner", "outer")}
+    modal = {
+        label: [
+            np.zeros((n_t, getattr(row, label).stiffness.shape[0])) if getattr(row, label) is not None else None
+            for row in rows
+        ]
+        for label in ("inner", "outer")
+    }
     rt = np.arange(n_t)
     for k, (row, (recs, qe)) in enumerate(zip(rows, history)):
         load_i[:, k], load_o[:, k] = recs[:, :, _REC["load_inner"]], recs[:, :, _REC["load_outer"]]
-        angle[:, k] = np.arctan2(np.abs(recs[:, :, _REC["niz"]]), np.hypot(recs[:, :, _REC["nix"]],
-                                                                        recs[:, :, _REC["niy"]]))
+        angle[:, k] = np.arctan2(
+            np.abs(recs[:, :, _REC["niz"]]), np.hypot(recs[:, :, _REC["nix"]], recs[:, :, _REC["niy"]])
+        )
         for label in ("inner", "outer"):
             ring = getattr(row, label)
             if ring is None:
@@ -959,9 +1112,13 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
             if _is_condensed(ring):
                 zs = -1.0 if ring.mirror else 1.0
                 g_local = np.ascontiguousarray(recs[:, :, [_REC[f"g{s}x"], _REC[f"g{s}y"], _REC[f"g{s}z"]]])
-                modal[label][k][:] = ring_modal_amplitudes(np.ascontiguousarray(recs[:, :, _REC[f"psi_{label}"]]),
-                                                        g_local, ring.table, zs,
-                                                        np.ascontiguousarray(ring.compliance_diag))
+                modal[label][k][:] = ring_modal_amplitudes(
+                    np.ascontiguousarray(recs[:, :, _REC[f"psi_{label}"]]),
+                    g_local,
+                    ring.table,
+                    zs,
+                    np.ascontiguousarray(ring.compliance_diag),
+                )
             else:
                 _, si, so, _ = row.slices()
                 modal[label][k][:] = qe[:, si if label == "inner" else so]
@@ -975,21 +1132,30 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
             p_max[ok, k] = point_contact(load_i[ok, k], *row.inner_radii, row.e_eff).p_max
     fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
     dims = ("time", "bearing_row", "ball")
-    out = {"main_bearing_radial_force": Output(np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N",
-                                               "radial reaction of the main bearing on the carrier"),
-           "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
-           "main_bearing_tilting_moment": Output(np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m",
-                                                 "tilting reaction moment on the carrier"),
-           "ball_load_inner": Output(load_i, dims, "N", "ball-inner raceway normal load"),
-           "ball_load_outer": Output(load_o, dims, "N", "ball-outer raceway normal load"),
-           "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
-           "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
-           "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact")}
+    out = {
+        "main_bearing_radial_force": Output(
+            np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N", "radial reaction of the main bearing on the carrier"
+        ),
+        "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
+        "main_bearing_tilting_moment": Output(
+            np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m", "tilting reaction moment on the carrier"
+        ),
+        "ball_load_inner": Output(load_i, dims, "N", "ball-inner raceway normal load"),
+        "ball_load_outer": Output(load_o, dims, "N", "ball-outer raceway normal load"),
+        "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
+        "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
+        "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact"),
+    }
     for label in ("inner", "outer"):
         if any(m is None for m in modal[label]):
             continue
-        out[f"ring_deformation_{label}"] = Output(defl[label], ("time", "bearing_row"), "m",
-                                                  f"{label} raceway deflection at the most-loaded contact")
-        out[f"ring_modal_{label}"] = Output(np.stack(modal[label], 1), ("time", "bearing_row", f"mode_{label}"), "1",
-                                            f"modal coordinates of the {label} rings")
+        out[f"ring_deformation_{label}"] = Output(
+            defl[label], ("time", "bearing_row"), "m", f"{label} raceway deflection at the most-loaded contact"
+        )
+        out[f"ring_modal_{label}"] = Output(
+            np.stack(modal[label], 1),
+            ("time", "bearing_row", f"mode_{label}"),
+            "1",
+            f"modal coordinates of the {label} rings",
+        )
     return out

@@ -77,18 +77,29 @@ class CrankElasticity(ForceGroup):
         if want_outputs:
             qq = q.reshape(q.shape[:-1] + (self.n, 2, 3))
             twist = qq[..., 1, 2] - qq[..., 0, 2]
-            out = {"crank_twist": Output(twist, ("time", "crank"), "rad",
-                                         "twist of the gear seat against the eccentrics (planet - crank)"),
-                   "crank_torque": Output(self.k[2] * twist, ("time", "crank"), "N m",
-                                          "elastic torque transmitted by each crankshaft")}
+            out = {
+                "crank_twist": Output(
+                    twist, ("time", "crank"), "rad", "twist of the gear seat against the eccentrics (planet - crank)"
+                ),
+                "crank_torque": Output(
+                    self.k[2] * twist, ("time", "crank"), "N m", "elastic torque transmitted by each crankshaft"
+                ),
+            }
         return f, out
 
     def jacobian(self, t, q, v):
         return self._jq, self._jv
 
 
-def add_flexible_cranks(reducer, params, members: dict, groups: list, size: float | None = None,
-                        stiffness_scale: float = 1.0, damping_ratio: float | None = None) -> dict:
+def add_flexible_cranks(
+    reducer,
+    params,
+    members: dict,
+    groups: list,
+    size: float | None = None,
+    stiffness_scale: float = 1.0,
+    damping_ratio: float | None = None,
+) -> dict:
     """Turn the rigid cranks of a model under construction into flexible ones (see
     module doc): split the members, re-target the gear meshes, add the coupling.
 
@@ -111,12 +122,16 @@ def add_flexible_cranks(reducer, params, members: dict, groups: list, size: floa
     for j in range(p.n_cranks):
         crank = members[f"crank{j}"]
         crank.mass_matrix = np.diag([m_c, m_c, j_c])
-        members[f"planet{j}"] = Member(f"planet{j}", np.diag([m_p, m_p, j_p]), crank.q0.copy(), crank.v0.copy(),
-                                       ("x", "y", "phi"))
+        members[f"planet{j}"] = Member(
+            f"planet{j}", np.diag([m_p, m_p, j_p]), crank.q0.copy(), crank.v0.copy(), ("x", "y", "phi")
+        )
     gear = next(g for g in groups if g.name == "gear_stage")
     gear.members = ("carrier",) + tuple(f"planet{j}" for j in range(p.n_cranks))
     groups.append(CrankElasticity(p.n_cranks, k_t, k_l, c_t, c_l))
-    return {"crank_torsional_stiffness_Nm_per_rad": k_t, "crank_lateral_stiffness_N_per_m": k_l,
-            "crank_lateral_anisotropy": abs(comp.lateral_x - comp.lateral_y) / comp.lateral,
-            "crank_lowest_clamped_mode_hz": comp.lowest_clamped_hz,
-            "planet_torsional_mode_hz": float(np.sqrt(k_t / j_red) / (2 * np.pi))}
+    return {
+        "crank_torsional_stiffness_Nm_per_rad": k_t,
+        "crank_lateral_stiffness_N_per_m": k_l,
+        "crank_lateral_anisotropy": abs(comp.lateral_x - comp.lateral_y) / comp.lateral,
+        "crank_lowest_clamped_mode_hz": comp.lowest_clamped_hz,
+        "planet_torsional_mode_hz": float(np.sqrt(k_t / j_red) / (2 * np.pi)),
+    }

@@ -69,8 +69,20 @@ def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
     adds Q into f[idx] and, if ``jac``, dQ/dq, dQ/dv into jq, jv. Per-mesh force,
     deflection and stiffness go to the pack's output arrays."""
     idx, sc, beta0, planet, out_f, out_d, out_k = pack
-    rbs, rbp, sw, aw, zs, bn, ks, eps, ramp, c, a_s, ph_s = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6],
-                                                              sc[7], sc[8], sc[9], sc[10], sc[11])
+    rbs, rbp, sw, aw, zs, bn, ks, eps, ramp, c, a_s, ph_s = (
+        sc[0],
+        sc[1],
+        sc[2],
+        sc[3],
+        sc[4],
+        sc[5],
+        sc[6],
+        sc[7],
+        sc[8],
+        sc[9],
+        sc[10],
+        sc[11],
+    )
     r = rbs + rbp
     th_c = q[idx[2]]
     for j in range(beta0.shape[0]):
@@ -84,8 +96,15 @@ def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
         a_p, ph_p, err = planet[j, 0], planet[j, 1], planet[j, 2]
         cos_s = a_s * np.cos(ts - beta + ph_s)
         cos_p = a_p * np.cos(phi - beta + ph_p)
-        delta = (rbs * ts + rbp * phi - r * (beta - beta0[j]) - sw * (a - aw)
-                 + a_s * np.sin(ts - beta + ph_s) + a_p * np.sin(phi - beta + ph_p) + rbp * err)
+        delta = (
+            rbs * ts
+            + rbp * phi
+            - r * (beta - beta0[j])
+            - sw * (a - aw)
+            + a_s * np.sin(ts - beta + ph_s)
+            + a_p * np.sin(phi - beta + ph_p)
+            + rbp * err
+        )
         rb = r + cos_s + cos_p  # -d delta / d beta
         gx = rb * y / a2 - sw * x / a
         gy = -rb * x / a2 - sw * y / a
@@ -121,8 +140,11 @@ def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
             # one stiffness law, exact for its piecewise-linear ramps beyond 1e-6 of their corners)
             bx, by = -y / a2, x / a2
             xi = (zs / TWO_PI) * (ts - beta - beta0[j])
-            dk = (mesh_stiffness_ramped(xi + 1e-6, ks, eps, ramp)
-                  - mesh_stiffness_ramped(xi - 1e-6, ks, eps, ramp)) / 2e-6 * (-zs / TWO_PI)
+            dk = (
+                (mesh_stiffness_ramped(xi + 1e-6, ks, eps, ramp) - mesh_stiffness_ramped(xi - 1e-6, ks, eps, ramp))
+                / 2e-6
+                * (-zs / TWO_PI)
+            )
             d_eff = delta if delta > 0.0 else delta + bn
             vv = (v[ix], v[iy], v[ip])
             for n in range(3):
@@ -152,12 +174,31 @@ class GearMeshes(KernelGroup):
         w1 = stage.eps_alpha - 1.0
         ramp = ramp_fraction * min(w1, 1.0 - w1)
         sun = np.asarray(p.sun_runout, dtype=float)
-        self.sc = np.array([p.base_radius_sun, p.base_radius_planet, np.sin(p.working_pressure_angle),
-                            p.center_distance, float(p.z_s), p.normal_backlash, stage.k_single, stage.eps_alpha,
-                            ramp, stage.c12, sun[0], sun[1]])
+        self.sc = np.array(
+            [
+                p.base_radius_sun,
+                p.base_radius_planet,
+                np.sin(p.working_pressure_angle),
+                p.center_distance,
+                float(p.z_s),
+                p.normal_backlash,
+                stage.k_single,
+                stage.eps_alpha,
+                ramp,
+                stage.c12,
+                sun[0],
+                sun[1],
+            ]
+        )
         #: (N, 3): planet runout amplitude [m], phase [rad], assembly phase error [rad]
-        self.planet = np.ascontiguousarray(np.column_stack([np.asarray(p.planet_runout, dtype=float).reshape(-1, 2),
-                                                            np.asarray(p.planet_phase_errors, dtype=float)]))
+        self.planet = np.ascontiguousarray(
+            np.column_stack(
+                [
+                    np.asarray(p.planet_runout, dtype=float).reshape(-1, 2),
+                    np.asarray(p.planet_phase_errors, dtype=float),
+                ]
+            )
+        )
         self.theta_s, self.omega_s = input_angle, input_speed
         self._drive_cache = None
         self.force, self.deflection, self.stiffness = np.zeros(self.n), np.zeros(self.n), np.zeros(self.n)
@@ -179,8 +220,13 @@ class GearMeshes(KernelGroup):
         return c[1], c[2]
 
     def time_inputs_many(self, ts):
-        return np.stack([np.broadcast_to(np.asarray(self.theta_s(ts), dtype=float), ts.shape),
-                         np.broadcast_to(np.asarray(self.omega_s(ts), dtype=float), ts.shape)], axis=-1)
+        return np.stack(
+            [
+                np.broadcast_to(np.asarray(self.theta_s(ts), dtype=float), ts.shape),
+                np.broadcast_to(np.asarray(self.omega_s(ts), dtype=float), ts.shape),
+            ],
+            axis=-1,
+        )
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ts, ws = self.time_inputs(t) if inputs is None else inputs
@@ -193,8 +239,9 @@ class GearMeshes(KernelGroup):
         force = rec["force"]
         return {
             "mesh_force": Output(force, ("time", "planet"), "N", "sun-planet mesh force along the line of action"),
-            "mesh_deflection": Output(rec["deflection"], ("time", "planet"), "m",
-                                      "mesh deflection along the line of action"),
+            "mesh_deflection": Output(
+                rec["deflection"], ("time", "planet"), "m", "mesh deflection along the line of action"
+            ),
             "mesh_stiffness": Output(rec["stiffness"], ("time", "planet"), "N/m", "time-varying mesh stiffness"),
             "sun_torque": Output(self.rbs * force.sum(axis=-1), ("time",), "N m", "torque of the meshes on the sun"),
         }

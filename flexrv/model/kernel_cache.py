@@ -21,15 +21,26 @@ import sys
 from pathlib import Path
 
 #: modules whose cached numba dispatchers a run may compile (every dispatcher found in them counts)
-KERNEL_MODULES = ("flexrv.geometry.cycloid", "flexrv.contact.laws", "flexrv.analysis.mesh_stiffness",
-                  "flexrv.model.pins", "flexrv.model.gear_stage", "flexrv.model.cranks_discs", "flexrv.model.loads",
-                  "flexrv.model.main_bearing_rigid", "flexrv.model.kernels", "flexrv.model.bearing_kernel")
+KERNEL_MODULES = (
+    "flexrv.geometry.cycloid",
+    "flexrv.contact.laws",
+    "flexrv.analysis.mesh_stiffness",
+    "flexrv.model.pins",
+    "flexrv.model.gear_stage",
+    "flexrv.model.cranks_discs",
+    "flexrv.model.loads",
+    "flexrv.model.main_bearing_rigid",
+    "flexrv.model.kernels",
+    "flexrv.model.bearing_kernel",
+)
 #: the compiled functions a run calls directly, per kind of force element (they compile their callees
 #: into themselves): the fused element of the kernel groups and the ball-bearing rows. A helper a run
 #: never calls (e.g. row_kernel, which the tests and the quasi-static path use) stays uncached and must
 #: not trigger the notice on every run
-RUN_ENTRY_POINTS = {"fused": ("kernels.fused_kernel", "kernels.fused_history", "kernels.copy_records_if_same"),
-                    "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history")}
+RUN_ENTRY_POINTS = {
+    "fused": ("kernels.fused_kernel", "kernels.fused_history", "kernels.copy_records_if_same"),
+    "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history"),
+}
 #: measured first-compile time [s] of the rigid model's kernels (see module docstring), for the message
 COMPILE_ESTIMATE_S = 15
 
@@ -68,6 +79,10 @@ def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bo
         # only helpers the run does not call are uncached: nothing compiles now
         return False
     stream = sys.stderr if stream is None else stream
-    print(f"flexrv: compiling numba kernels (once, ~{COMPILE_ESTIMATE_S} s; cached afterwards in {cache_dir()}): "
-          f"{', '.join(missing)}", file=stream, flush=True)
+    print(
+        f"flexrv: compiling numba kernels (once, ~{COMPILE_ESTIMATE_S} s; cached afterwards in {cache_dir()}): "
+        f"{', '.join(missing)}",
+        file=stream,
+        flush=True,
+    )
     return True

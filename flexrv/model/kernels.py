@@ -51,8 +51,14 @@ from flexrv.model.main_bearing_rigid import RigidMainBearing, main_bearing_kerne
 from flexrv.model.pins import PinContacts, pin_body_kernel
 
 #: slots of the fused kernel, in call order, and the group class of each
-KINDS = (("gear", GearMeshes), ("supports", CrankSupports), ("needles", NeedleBearings), ("pins", PinContacts),
-         ("main_bearing", RigidMainBearing), ("loads", OutputLoads))
+KINDS = (
+    ("gear", GearMeshes),
+    ("supports", CrankSupports),
+    ("needles", NeedleBearings),
+    ("pins", PinContacts),
+    ("main_bearing", RigidMainBearing),
+    ("loads", OutputLoads),
+)
 
 
 @njit(cache=True)
@@ -74,8 +80,7 @@ def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, ma
 
 
 @njit(cache=True)
-def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needles, pins, main_bearing, loads, src,
-                  dst):
+def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needles, pins, main_bearing, loads, src, dst):
     """:func:`fused_kernel` at every sample i of a time history (qs, vs: (T, n);
     tsun, wsun: (T,) sun angle and speed; loads_t: (T, len(load)) the loads group's
     load vector, written into its pack before each call), without Jacobians;
@@ -88,8 +93,9 @@ def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needle
     for i in range(qs.shape[0]):
         if load.shape[0] > 0:
             load[:] = loads_t[i]
-        fused_kernel(qs[i], vs[i], f, jq, jv, False, tsun[i], wsun[i], gear, supports, needles, pins, main_bearing,
-                     loads)
+        fused_kernel(
+            qs[i], vs[i], f, jq, jv, False, tsun[i], wsun[i], gear, supports, needles, pins, main_bearing, loads
+        )
         for r in range(len(src)):
             dst[r][i, :] = src[r]
 
@@ -187,15 +193,25 @@ class FusedForces:
             local[name] = pos
             pos += model.members[name].n
         self.n = pos
-        self.index = np.concatenate([np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n)
-                                     for m in names]).astype(np.int64) if names else np.zeros(0, np.int64)
+        self.index = (
+            np.concatenate(
+                [np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n) for m in names]
+            ).astype(np.int64)
+            if names
+            else np.zeros(0, np.int64)
+        )
         self.is_full = self.n == model.n and np.array_equal(self.index, np.arange(model.n))
         #: each kind's group and the positions of its local coordinates in the element's vector
         self.slots = []
         for kind, cls in KINDS:
             g = by_kind.get(kind)
-            idx = None if g is None else np.concatenate(
-                [np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(np.int64)
+            idx = (
+                None
+                if g is None
+                else np.concatenate([np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(
+                    np.int64
+                )
+            )
             self.slots.append((cls, g, idx))
         self.packs = self._packs(history=False)
         self.gear, self.loads = by_kind.get("gear"), by_kind.get("loads")
@@ -238,8 +254,11 @@ class FusedForces:
         drive = gear.time_inputs_many(t) if gear is not None else np.zeros((nt, 2))
         drive = np.ascontiguousarray(np.broadcast_to(drive, (nt, 2)))
         load = packs[[k for k, _ in KINDS].index("loads")][1]
-        loads_t = (np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
-                   if self.loads is not None else np.zeros((nt, 0)))
+        loads_t = (
+            np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
+            if self.loads is not None
+            else np.zeros((nt, 0))
+        )
         srcs, dsts, keys = [], [], []
         for g, key, a in self.record_entries():
             srcs.append(a.reshape(-1))
@@ -249,9 +268,19 @@ class FusedForces:
         pin_ctr = packs[[k for k, _ in KINDS].index("pins")][0][-1]  # (pin pack, rim compliance, rim state)
         before = int(pin_ctr[2])
         if nt and srcs:
-            fused_history(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
-                          np.ascontiguousarray(drive[:, 0]), np.ascontiguousarray(drive[:, 1]), loads_t, f, self.jq,
-                          self.jv, *packs, tuple(srcs), tuple(dsts))
+            fused_history(
+                np.ascontiguousarray(q, dtype=float),
+                np.ascontiguousarray(v, dtype=float),
+                np.ascontiguousarray(drive[:, 0]),
+                np.ascontiguousarray(drive[:, 1]),
+                loads_t,
+                f,
+                self.jq,
+                self.jv,
+                *packs,
+                tuple(srcs),
+                tuple(dsts),
+            )
         if int(pin_ctr[2]) != before:
             from flexrv.errors import ConvergenceError
 
@@ -318,8 +347,13 @@ class FusedForces:
         those the last residual call computed if it was at exactly (t, q, v), else a kernel call."""
         self.stats[1] += 1
         m = self.memo
-        if (self._jac_ready and m is not None and m[0] == t and m[1].tobytes() == q.tobytes()
-                and m[2].tobytes() == v.tobytes()):
+        if (
+            self._jac_ready
+            and m is not None
+            and m[0] == t
+            and m[1].tobytes() == q.tobytes()
+            and m[2].tobytes() == v.tobytes()
+        ):
             return self.jq, self.jv
         self.memo = None  # until the call has filled the records
         self._call(t, q, v, True)
@@ -361,8 +395,9 @@ class FusedForces:
             np.multiply(dv, f_v, out=tmp)
             return np.subtract(out, tmp, out=out)
 
-        return mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn,
-                                               jacobianUserFunction=jac_fn))
+        return mbs.AddObject(
+            ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=force_fn, jacobianUserFunction=jac_fn)
+        )
 
 
 class HistoryRecorder:
@@ -391,8 +426,9 @@ class HistoryRecorder:
         #: per element: (element, index of its coordinates in the model's vector (empty: all),
         #: [(group, key, shape)], flat live arrays, history buffers (n_out, size))
         self.sources = []
-        elements = [] if model.fused is None else [(model.fused, model.fused.member_names,
-                                                   model.fused.record_entries())]
+        elements = (
+            [] if model.fused is None else [(model.fused, model.fused.member_names, model.fused.record_entries())]
+        )
         for g in model.groups:
             elements += g.recorded_elements()
         for element, members, entries in elements:
@@ -401,13 +437,21 @@ class HistoryRecorder:
             for g, key, a in entries:
                 if a.dtype != np.float64 or not a.flags.c_contiguous:
                     raise TypeError(f"{g.name} record {key!r} must be float64 and C-contiguous")
-            index = np.concatenate([np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n)
-                                    for m in members]).astype(np.int64)
+            index = np.concatenate(
+                [np.arange(model.members[m].offset, model.members[m].offset + model.members[m].n) for m in members]
+            ).astype(np.int64)
             if np.array_equal(index, np.arange(model.n)):
                 index = np.zeros(0, np.int64)  # all of the model's coordinates, in order
             src = tuple(a.reshape(-1) for _, _, a in entries)
-            self.sources.append((element, index, [(g, key, a.shape) for g, key, a in entries], src,
-                                 tuple(np.empty((n_out, a.size)) for a in src)))
+            self.sources.append(
+                (
+                    element,
+                    index,
+                    [(g, key, a.shape) for g, key, a in entries],
+                    src,
+                    tuple(np.empty((n_out, a.size)) for a in src),
+                )
+            )
         self.valid = np.zeros((len(self.sources), n_out), dtype=bool)
         #: compiled entry point of copy_records_if_same per element (set on the first call)
         self._entry = [None] * len(self.sources)
@@ -438,8 +482,12 @@ class HistoryRecorder:
         """Rows 0..k0-1 from a checkpoint (:meth:`arrays` of the interrupted run)."""
         dst = [d for *_, ds in self.sources for d in ds]
         valid = np.asarray(valid)
-        if (len(arrays) != len(dst) or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, dst))
-                or valid.ndim != 2 or valid.shape[0] != len(self.sources)):
+        if (
+            len(arrays) != len(dst)
+            or any(a.shape[1:] != d.shape[1:] for a, d in zip(arrays, dst))
+            or valid.ndim != 2
+            or valid.shape[0] != len(self.sources)
+        ):
             return  # another model's records: those rows are left to the history pass
         for a, d in zip(arrays, dst):
             d[:k0] = a[:k0]

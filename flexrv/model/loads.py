@@ -107,8 +107,14 @@ class OutputLoads(KernelGroup):
     kind = "loads"
     members = ("carrier",)
 
-    def __init__(self, torque, radial: float = 0.0, axial: float = 0.0, tilt: float = 0.0,
-                 ramp: tuple[float, float] | None = None):
+    def __init__(
+        self,
+        torque,
+        radial: float = 0.0,
+        axial: float = 0.0,
+        tilt: float = 0.0,
+        ramp: tuple[float, float] | None = None,
+    ):
         self.torque = torque
         self.const = np.array([radial, 0.0, 0.0, axial, tilt, 0.0])
         #: the external forces/moment ramp in with step(t, t1, 0, t2, 1) (None: from t = 0)

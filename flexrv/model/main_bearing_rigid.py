@@ -60,8 +60,12 @@ class RigidMainBearing(KernelGroup):
 
     def outputs(self, t, rec):
         f = rec["f"]
-        return {"main_bearing_radial_force": Output(np.hypot(f[..., 0], f[..., 1]), ("time",), "N",
-                                                    "radial reaction of the main bearing on the carrier"),
-                "main_bearing_axial_force": Output(f[..., 3], ("time",), "N", "axial reaction on the carrier"),
-                "main_bearing_tilting_moment": Output(np.hypot(f[..., 4], f[..., 5]), ("time",), "N m",
-                                                      "tilting reaction moment on the carrier")}
+        return {
+            "main_bearing_radial_force": Output(
+                np.hypot(f[..., 0], f[..., 1]), ("time",), "N", "radial reaction of the main bearing on the carrier"
+            ),
+            "main_bearing_axial_force": Output(f[..., 3], ("time",), "N", "axial reaction on the carrier"),
+            "main_bearing_tilting_moment": Output(
+                np.hypot(f[..., 4], f[..., 5]), ("time",), "N m", "tilting reaction moment on the carrier"
+            ),
+        }

@@ -143,26 +143,58 @@ def _angular_momentum(model, t, q, v):
 #: outputs derived from the member states and the drive, in result order; ``position`` says
 #: where each goes among the other outputs (see :func:`model_outputs`)
 DERIVED_OUTPUTS: tuple[DerivedOutput, ...] = (
-    DerivedOutput("theta_in", ("time",), "rad", "input angle",
-                  lambda model, t, q, v: np.asarray(model.input_angle(t), dtype=float)),
+    DerivedOutput(
+        "theta_in",
+        ("time",),
+        "rad",
+        "input angle",
+        lambda model, t, q, v: np.asarray(model.input_angle(t), dtype=float),
+    ),
     DerivedOutput("theta_out", ("time",), "rad", "output angle", _theta_out),
     DerivedOutput("omega_in", ("time",), "rad/s", "input speed", lambda model, t, q, v: _input_speed(model, t)),
     DerivedOutput("omega_out", ("time",), "rad/s", "output speed", _omega_out),
-    DerivedOutput("crank_speed_relative", ("time", "crank"), "rad/s", "crank speed relative to the carrier",
-                  _crank_speed_relative),
-    DerivedOutput("carrier_tilt", ("time",), "rad", "carrier tilt (magnitude of the rotations about x and y)",
-                  _carrier_tilt),
-    DerivedOutput("output_torque", ("time",), "N m", "output (load) torque",
-                  lambda model, t, q, v: np.asarray(model.load_torque(t), dtype=float)),
+    DerivedOutput(
+        "crank_speed_relative", ("time", "crank"), "rad/s", "crank speed relative to the carrier", _crank_speed_relative
+    ),
+    DerivedOutput(
+        "carrier_tilt", ("time",), "rad", "carrier tilt (magnitude of the rotations about x and y)", _carrier_tilt
+    ),
+    DerivedOutput(
+        "output_torque",
+        ("time",),
+        "N m",
+        "output (load) torque",
+        lambda model, t, q, v: np.asarray(model.load_torque(t), dtype=float),
+    ),
     DerivedOutput("kinetic_energy", ("time",), "J", "kinetic energy", _kinetic_energy),
-    DerivedOutput("angular_momentum", ("time",), "N m s",
-                  "angular momentum of the rigid members and massive balls about the axis", _angular_momentum),
+    DerivedOutput(
+        "angular_momentum",
+        ("time",),
+        "N m s",
+        "angular momentum of the rigid members and massive balls about the axis",
+        _angular_momentum,
+    ),
 )
 
 #: result order of the member and drive outputs (group outputs follow ``carrier_tilt``)
-_ORDER = ("theta_in", "theta_out", "omega_in", "omega_out", "crank_speed", "crank_speed_relative",
-          "crank_angle", "crank_x", "crank_y", "disc_x", "disc_y", "disc_speed", "carrier_x", "carrier_y",
-          "carrier_z", "carrier_tilt")
+_ORDER = (
+    "theta_in",
+    "theta_out",
+    "omega_in",
+    "omega_out",
+    "crank_speed",
+    "crank_speed_relative",
+    "crank_angle",
+    "crank_x",
+    "crank_y",
+    "disc_x",
+    "disc_y",
+    "disc_speed",
+    "carrier_x",
+    "carrier_y",
+    "carrier_z",
+    "carrier_tilt",
+)
 
 
 #: the groups' friction outputs (dissipated power [W], >= 0, issue 14): pin-disc/pin-seat friction per
@@ -212,7 +244,7 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
         if len(todo):
             ix = fused.index
             for a in range(0, len(todo), chunk):
-                rows = todo[a:a + chunk]
+                rows = todo[a : a + chunk]
                 part = fused.history(t[rows], q[rows][:, ix], v[rows][:, ix])
                 for g in fused_groups:
                     dst = fused_recs.setdefault(g, {})
@@ -272,8 +304,9 @@ def model_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     out.update(groups)
     fric = [o.values.reshape(len(t), -1).sum(axis=1) for name, o in groups.items() if name in FRICTION_OUTPUTS]
     if fric:
-        out["friction_power"] = Output(np.sum(fric, axis=0), ("time",), "W",
-                                       "power dissipated by friction, all groups (pins, needle bearings)")
+        out["friction_power"] = Output(
+            np.sum(fric, axis=0), ("time",), "W", "power dissipated by friction, all groups (pins, needle bearings)"
+        )
     w_in = out["omega_in"].values
     acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)
     sun = groups["sun_torque"].values if "sun_torque" in groups else 0.0

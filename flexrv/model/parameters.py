@@ -34,11 +34,11 @@ import numpy as np
 
 from flexrv.analysis.pin_load import pin_contact_constant
 from flexrv.analysis.torsional import housing_model_compliance, support_constants
-from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness, LINE_EXPONENT
+from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
 from flexrv.contact.laws import effective_pin_friction
-from flexrv.units import M_PER_MM
 from flexrv.geometry.as_built import as_built
 from flexrv.geometry.kinematics import member_speeds, total_ratio
+from flexrv.units import M_PER_MM
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,9 @@ class RigidParameters:
     carrier_inertia: float
     input_inertia: float
     # compliances
-    support_stiffness: float  #: linear support law only: radial stiffness of one crank (two bearings) [N/m]; NaN otherwise
+    support_stiffness: (
+        float  #: linear support law only: radial stiffness of one crank (two bearings) [N/m]; NaN otherwise
+    )
     support_damping: float
     support_law: np.ndarray  #: (7,) constants of flexrv.contact.tapered_roller.crank_support_force
     support_roller_angles: np.ndarray  #: (Z,) roller spacing of a support bearing [rad] (empty: linear law)
@@ -174,12 +176,14 @@ def with_bodies(reducer, bodies) -> object:
     one ``rigid`` (the one parameter route of ``--parts``: the switches are design
     fields)."""
     bodies = set(bodies)
-    ss = reducer.second_stage.model_copy(update={"disc_body_model": "condensed_fe" if "cycloid_disc" in bodies
-                                                 else "rigid"})
+    ss = reducer.second_stage.model_copy(
+        update={"disc_body_model": "condensed_fe" if "cycloid_disc" in bodies else "rigid"}
+    )
     update = {"second_stage": ss}
     if reducer.carrier is not None:
         update["carrier"] = reducer.carrier.model_copy(
-            update={"body_model": "condensed_fe" if "carrier" in bodies else "rigid"})
+            update={"body_model": "condensed_fe" if "carrier" in bodies else "rigid"}
+        )
     elif "carrier" in bodies:
         from flexrv.errors import ConfigError
 
@@ -220,12 +224,16 @@ def rigid_parameters(reducer) -> RigidParameters:
     rho_d = reducer.material("cycloid_disc").density_kg_m3
     r_pitch_p = 0.5 * fs.module * z_p
     m_planet = rho_g * math.pi * r_pitch_p**2 * fs.face_width
-    parts = [(cs.gear_seat_diameter_mm, cs.gear_seat_length_mm, 1), (cs.support_journal_diameter_mm, cs.support_journal_length_mm, 2),
-             (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm, nd)]
+    parts = [
+        (cs.gear_seat_diameter_mm, cs.gear_seat_length_mm, 1),
+        (cs.support_journal_diameter_mm, cs.support_journal_length_mm, 2),
+        (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm, nd),
+    ]
     m_shaft = sum(k * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) for d, l, k in parts)
     crank_mass = m_planet + m_shaft
-    crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2
-                                                        for d, l, k in parts)
+    crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(
+        k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2 for d, l, k in parts
+    )
     d_seat, l_seat = cs.gear_seat_diameter_mm * 1e-3, cs.gear_seat_length_mm * 1e-3
     m_seat = _cyl_mass(rho_c, d_seat, l_seat)
     planet_mass = m_planet + m_seat
@@ -247,8 +255,12 @@ def rigid_parameters(reducer) -> RigidParameters:
     else:  # impact law with the seeds' exponent, matched to the Hertz line law at penetration d
         pin_e = ct.impact_exponent
         pin_k = k_line * depth ** (LINE_EXPONENT - pin_e)
-    e_nb = effective_modulus(reducer.material("crankshaft").youngs_modulus, reducer.material("crankshaft").poisson_ratio,
-                             reducer.material("rolling_elements").youngs_modulus, reducer.material("rolling_elements").poisson_ratio)
+    e_nb = effective_modulus(
+        reducer.material("crankshaft").youngs_modulus,
+        reducer.material("crankshaft").poisson_ratio,
+        reducer.material("rolling_elements").youngs_modulus,
+        reducer.material("rolling_elements").poisson_ratio,
+    )
     k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
     roller_k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
     d_roll = nb.roller_diameter_mm * 1e-3
@@ -258,42 +270,92 @@ def rigid_parameters(reducer) -> RigidParameters:
     k_r = mb.rigid_radial_stiffness_N_per_m
     s = mb.row_spacing_mm * 1e-3
     kmb = np.array([k_r, k_r, mb.rigid_axial_stiffness_N_per_m, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
-    cmb = 2.0 * mb.rigid_damping_ratio * np.sqrt(kmb * np.array([reducer.inertia.carrier_mass_kg] * 3
-                                              + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2))
+    cmb = (
+        2.0
+        * mb.rigid_damping_ratio
+        * np.sqrt(
+            kmb * np.array([reducer.inertia.carrier_mass_kg] * 3 + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2)
+        )
+    )
     carrier_c, disc_c = body_compliance_matrices(reducer)
     return RigidParameters(
-        n_cranks=n, n_discs=nd, z_s=z_s, z_p=z_p, z_c=z_c, z_rp=z_rp, ratio=ratio,
-        base_radius_sun=rb_s, base_radius_planet=rb_p, center_distance=a_w, working_pressure_angle=alpha_w,
-        normal_backlash=fs.backlash * math.cos(alpha_w), crank_angles=beta,
-        eccentricity=ss.eccentricity, pin_circle_radius=ss.pin_circle_radius, pin_radius=ss.pin_radius,
-        d_radius=ss.modification_shift, d_pin_radius=ss.modification_equidistant, d_rotation=ss.modification_rotation,
-        disc_width=b, pins=ab.pins, chi0=ab.chi0, disc_rot0=ab.disc_rot0, holes=ab.holes,
-        crank_mass=crank_mass, crank_inertia=crank_inertia, planet_mass=planet_mass, planet_inertia=planet_inertia,
-        disc_mass=disc_mass, disc_inertia=disc_inertia,
-        carrier_mass=reducer.inertia.carrier_mass_kg, carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
+        n_cranks=n,
+        n_discs=nd,
+        z_s=z_s,
+        z_p=z_p,
+        z_c=z_c,
+        z_rp=z_rp,
+        ratio=ratio,
+        base_radius_sun=rb_s,
+        base_radius_planet=rb_p,
+        center_distance=a_w,
+        working_pressure_angle=alpha_w,
+        normal_backlash=fs.backlash * math.cos(alpha_w),
+        crank_angles=beta,
+        eccentricity=ss.eccentricity,
+        pin_circle_radius=ss.pin_circle_radius,
+        pin_radius=ss.pin_radius,
+        d_radius=ss.modification_shift,
+        d_pin_radius=ss.modification_equidistant,
+        d_rotation=ss.modification_rotation,
+        disc_width=b,
+        pins=ab.pins,
+        chi0=ab.chi0,
+        disc_rot0=ab.disc_rot0,
+        holes=ab.holes,
+        crank_mass=crank_mass,
+        crank_inertia=crank_inertia,
+        planet_mass=planet_mass,
+        planet_inertia=planet_inertia,
+        disc_mass=disc_mass,
+        disc_inertia=disc_inertia,
+        carrier_mass=reducer.inertia.carrier_mass_kg,
+        carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
         input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
         support_stiffness=(2.0 * cs.support_bearing_radial_stiffness_N_per_m if support_linear else float("nan")),
         support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
-        support_law=support_law, support_roller_angles=support_angles, support_linear=support_linear,
-        main_bearing_stiffness=kmb, main_bearing_damping=cmb,
-        pin_k=pin_k, pin_exponent=pin_e, pin_c_max=ct.pin_max_damping_Ns_per_m, contact_depth=depth,
+        support_law=support_law,
+        support_roller_angles=support_angles,
+        support_linear=support_linear,
+        main_bearing_stiffness=kmb,
+        main_bearing_damping=cmb,
+        pin_k=pin_k,
+        pin_exponent=pin_e,
+        pin_c_max=ct.pin_max_damping_Ns_per_m,
+        contact_depth=depth,
         pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
         needle_penetration_limit=ct.needle_penetration_limit_um * 1e-6,
-        needle_clearance=nb.radial_clearance_um * 1e-6, needle_roller_count=nb.roller_count, needle_roller_k=roller_k,
-        needle_pitch_ratio=d_roll / dm, needle_c_max=ct.pin_max_damping_Ns_per_m,
-        input_speed=op.input_speed, speed_ramp_time=op.speed_ramp_time_s, load_torque=op.load_torque_Nm,
-        load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s), rated_torque=op.rated_torque_Nm,
-        external_axial_force=op.external_axial_force_N, external_radial_force=op.external_radial_force_N,
+        needle_clearance=nb.radial_clearance_um * 1e-6,
+        needle_roller_count=nb.roller_count,
+        needle_roller_k=roller_k,
+        needle_pitch_ratio=d_roll / dm,
+        needle_c_max=ct.pin_max_damping_Ns_per_m,
+        input_speed=op.input_speed,
+        speed_ramp_time=op.speed_ramp_time_s,
+        load_torque=op.load_torque_Nm,
+        load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s),
+        rated_torque=op.rated_torque_Nm,
+        external_axial_force=op.external_axial_force_N,
+        external_radial_force=op.external_radial_force_N,
         tilting_moment=op.tilting_moment_Nm,
-        pin_radii=ab.pin_radii, disc_profile=ab.disc_profile, profile_harmonics=ab.profile_harmonics,
-        eccentricities=ab.eccentricities, eccentric_phase_errors=ab.eccentric_phase_errors,
-        crank_bores=ab.crank_bores, needle_clearances=ab.needle_clearances,
-        support_clearances=ab.support_clearances, sun_runout=ab.sun_runout, planet_runout=ab.planet_runout,
-        planet_phase_errors=ab.planet_phase_errors, carrier_compliance=carrier_c, disc_compliance=disc_c,
+        pin_radii=ab.pin_radii,
+        disc_profile=ab.disc_profile,
+        profile_harmonics=ab.profile_harmonics,
+        eccentricities=ab.eccentricities,
+        eccentric_phase_errors=ab.eccentric_phase_errors,
+        crank_bores=ab.crank_bores,
+        needle_clearances=ab.needle_clearances,
+        support_clearances=ab.support_clearances,
+        sun_runout=ab.sun_runout,
+        planet_runout=ab.planet_runout,
+        planet_phase_errors=ab.planet_phase_errors,
+        carrier_compliance=carrier_c,
+        disc_compliance=disc_c,
         housing_compliance=housing_model_compliance(reducer),
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
         pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
-        if ct.friction else 0.0,
+        if ct.friction
+        else 0.0,
         needle_friction=ct.needle_friction_coefficient if ct.friction else 0.0,
         needle_friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
         friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,

@@ -199,8 +199,9 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     P0y) of the last exact evaluation. Friction (module docstring): mu, v_reg in
     sc[-2], sc[-1]; per (disc, pin) the friction force on the disc along t = z x n
     into out_ft and its power f_t v_t (<= 0) into out_pw."""
-    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw,
-     ctr) = pack
+    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw, ctr) = (
+        pack
+    )
     z_rp, R_p, r_nom, ecc, k, expo, c_max, depth = int(sc[0]), sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
     mu, v_reg = sc[sc.shape[0] - 2], sc[sc.shape[0] - 1]  # friction: effective coefficient, regularisation speed
     fric = mu > 0.0 and v_reg > 0.0
@@ -229,13 +230,15 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
                     out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
                     continue
             start = np.nan if cold else phi[kd, i]
-            ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol,
-                                                               max_iter)
+            ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
+                px, py, start, z_rp, radius, ecc, max_step, tol, max_iter
+            )
             if ok and not cold and not (0.0 <= dist < sc[11 + 2 * kd] or 0.0 < -dist < sc[12 + 2 * kd]):
                 # a warm-started local minimum beyond the curve's reach on its side may not be the
                 # nearest point (another flank): find it from the cold starts (_curve_reach)
-                ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, np.nan, z_rp, radius, ecc, max_step,
-                                                                   tol, max_iter)
+                ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
+                    px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter
+                )
             if not ok:
                 ctr[2] += 1
             phi[kd, i] = ph
@@ -268,8 +271,9 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             else:
                 out_ft[kd, i], out_pw[kd, i] = 0.0, 0.0
             if jac and (force != 0.0 or dfg != 0.0 or dfr != 0.0):
-                h, w0, w1, w2, b, s02, s12, s22 = _gap_curvature(ph, d1x, d1y, d2x, d2y, dist, nlx, nly, cr, sr, c,
-                                                                 s, rx, ry, nx, ny, harm, kd)
+                h, w0, w1, w2, b, s02, s12, s22 = _gap_curvature(
+                    ph, d1x, d1y, d2x, d2y, dist, nlx, nly, cr, sr, c, s, rx, ry, nx, ny, harm, kd
+                )
                 # dF/dgap g (G + b w)^T: the force's change; the exact gap gradient includes the harmonics' b w
                 _add_outer3ab(jq, ix, iy, ip, dfg, g0, g1, g2, g0 + b * w0, g1 + b * w1, g2 + b * w2)
                 # F dG/dq = F (h w w^T + S): the turn of the normal and of the arm (curvature terms)
@@ -295,8 +299,9 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
                     _add_outer3ab(jq, ix, iy, ip, a_s * dfg, tx, ty, wt2, g0 + b * w0, g1 + b * w1, g2 + b * w2)
                     _add_outer3ab(jq, ix, iy, ip, a_s * dfr, tx, ty, wt2, hv0, hv1, hv2)
                     # d(v_t)/dq = (dW/dq)^T v = h w' (N . v) + T v
-                    _add_outer3ab(jq, ix, iy, ip, a_d, tx, ty, wt2, h * tx * nv + tv0, h * ty * nv + tv1,
-                                  h * w2t * nv + tv2)
+                    _add_outer3ab(
+                        jq, ix, iy, ip, a_d, tx, ty, wt2, h * tx * nv + tv0, h * ty * nv + tv1, h * w2t * nv + tv2
+                    )
                     _add_outer3ab(jq, ix, iy, ip, ft * h, nx, ny, rxn, tx, ty, w2t)
                     jq[ix, ip] -= ft * nx
                     jq[ip, ix] -= ft * nx
@@ -436,10 +441,10 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     mm = m * m
     ch = hs[0] if hs.shape[0] > 0 else 0.0
     st = wk[0:4]
-    vec = wk[4:4 + 14 * m].reshape((14, m))  # the layout of pin_work_size: 14 vectors, then 11 matrices
+    vec = wk[4 : 4 + 14 * m].reshape((14, m))  # the layout of pin_work_size: 14 vectors, then 11 matrices
     qp, vp, qfc, dlast, qh, vh, ql = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6]
     fl, delta, base, step, res, av, qf = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13]
-    mat = wk[4 + 14 * m:4 + 14 * m + 11 * mm].reshape((11, m, m))
+    mat = wk[4 + 14 * m : 4 + 14 * m + 11 * mm].reshape((11, m, m))
     sq, sv, jc, jvc, jl, jvl = mat[0], mat[1], mat[2], mat[3], mat[4], mat[5]
     cm, nm, tmp, dd, t2 = mat[6], mat[7], mat[8], mat[9], mat[10]
     for r in range(m):
@@ -643,13 +648,26 @@ class PinContacts(KernelGroup):
         self.k, self.e = p.pin_k, p.pin_exponent
         self.c_max, self.depth = p.pin_c_max, p.contact_depth
         self.limit = params.pin_penetration_limit  # design contact.pin_penetration_limit_um
-        reach = [_curve_reach(int(p.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(p.eccentricity))
-                 for kd in range(self.nd)]
-        self.sc = np.array([float(p.z_rp), p.pin_circle_radius, p.pin_radius, p.eccentricity, p.pin_k,
-                            p.pin_exponent, p.pin_c_max, p.contact_depth,
-                            *closest_point_settings(p.z_rp, p.pin_circle_radius),
-                            *np.ravel(reach),  # sc[11 + 2 k], sc[12 + 2 k]: disc k's reach outside, inside
-                            p.pin_friction, p.friction_velocity])  # sc[-2], sc[-1]: friction (0: off)
+        reach = [
+            _curve_reach(int(p.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(p.eccentricity))
+            for kd in range(self.nd)
+        ]
+        self.sc = np.array(
+            [
+                float(p.z_rp),
+                p.pin_circle_radius,
+                p.pin_radius,
+                p.eccentricity,
+                p.pin_k,
+                p.pin_exponent,
+                p.pin_c_max,
+                p.contact_depth,
+                *closest_point_settings(p.z_rp, p.pin_circle_radius),
+                *np.ravel(reach),  # sc[11 + 2 k], sc[12 + 2 k]: disc k's reach outside, inside
+                p.pin_friction,
+                p.friction_velocity,
+            ]
+        )  # sc[-2], sc[-1]: friction (0: off)
         self.mu, self.v_reg = p.pin_friction, p.friction_velocity
         z = len(self.pins)
         self.phi = np.full((self.nd, z), np.nan)
@@ -696,17 +714,54 @@ class PinContacts(KernelGroup):
             self.dstate[:] = 0.0
             self.work[0] = 0.0  # the solver's predictor state no longer matches dstate
         work = np.zeros_like(self.work) if history else self.work
-        rest = (self.sc, self.pins, self.radii, self.profile, self.harmonics, phi, last, self.gap, self.force,
-                self.nx, self.ny, self.rxn, self.ft, self.pw, ctr)
+        rest = (
+            self.sc,
+            self.pins,
+            self.radii,
+            self.profile,
+            self.harmonics,
+            phi,
+            last,
+            self.gap,
+            self.force,
+            self.nx,
+            self.ny,
+            self.rxn,
+            self.ft,
+            self.pw,
+            ctr,
+        )
         return (idx, *rest), self.disc_c, self.dstate, self.hstate, self.idx_rim, work
 
     @staticmethod
     def empty_pack():
         z2 = np.zeros((0, 0))
-        pins = (np.zeros(0, np.int64), np.zeros(13), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)),
-                np.zeros((0, 0, 3)), z2, np.zeros((0, 0, 3)), z2, z2, z2, z2, z2, z2, z2,
-                np.array([1, 0, 0, 0], dtype=np.int64))
-        return pins, np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(2), np.zeros(0, np.int64), np.zeros(pin_work_size(0))
+        pins = (
+            np.zeros(0, np.int64),
+            np.zeros(13),
+            np.zeros((0, 2)),
+            np.zeros(0),
+            np.zeros((0, 3)),
+            np.zeros((0, 0, 3)),
+            z2,
+            np.zeros((0, 0, 3)),
+            z2,
+            z2,
+            z2,
+            z2,
+            z2,
+            z2,
+            z2,
+            np.array([1, 0, 0, 0], dtype=np.int64),
+        )
+        return (
+            pins,
+            np.zeros((0, 3, 3)),
+            np.zeros((0, 3)),
+            np.zeros(2),
+            np.zeros(0, np.int64),
+            np.zeros(pin_work_size(0)),
+        )
 
     def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
         ctr = pack[0][-1]
@@ -720,31 +775,68 @@ class PinContacts(KernelGroup):
         return float(self.gap.min()) if self.ctr[0] > 0 else np.inf
 
     def record_sources(self):
-        return {"gap": self.gap, "force": self.force, "nx": self.nx, "ny": self.ny, "rxn": self.rxn,
-                "ft": self.ft, "pw": self.pw, "rim": self.dstate, "housing": self.hstate}
+        return {
+            "gap": self.gap,
+            "force": self.force,
+            "nx": self.nx,
+            "ny": self.ny,
+            "rxn": self.rxn,
+            "ft": self.ft,
+            "pw": self.pw,
+            "rim": self.dstate,
+            "housing": self.hstate,
+        }
 
     def outputs(self, t, rec):
         f, nx, ny = rec["force"], rec["nx"], rec["ny"]
         dims = ("time", "disc", "pin")
-        out = {} if self.mu <= 0.0 else {
-            "pin_friction_force": Output(rec["ft"], dims, "N", "pin-disc friction force on the disc along t = z x n"),
-            "pin_friction_power": Output(-rec["pw"].sum(axis=-1), ("time", "disc"), "W",
-                                         "power dissipated by the pin-disc friction of each disc (>= 0)")}
-        out = out | {"pin_force": Output(f, dims, "N", "pin-disc contact force"),
-                "pin_gap": Output(rec["gap"], dims, "m", "signed pin-profile gap (negative = penetration); "
-                                  "of a pin proved open by the solver: a positive lower bound"),
-                "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
-                "disc_pin_torque": Output(-(f * rec["rxn"]).sum(axis=-1), ("time", "disc"), "N m",
-                                          "torque of the pin normal forces on each disc about its centre (the friction "
-                                          "forces' torque not included)"),
-                "housing_pin_torque": Output(self._housing_torque(rec), ("time", "disc"), "N m",
-                                             "torque of each disc's pin forces (normal and friction) on the "
-                                             "housing about the axis")}
+        out = (
+            {}
+            if self.mu <= 0.0
+            else {
+                "pin_friction_force": Output(
+                    rec["ft"], dims, "N", "pin-disc friction force on the disc along t = z x n"
+                ),
+                "pin_friction_power": Output(
+                    -rec["pw"].sum(axis=-1),
+                    ("time", "disc"),
+                    "W",
+                    "power dissipated by the pin-disc friction of each disc (>= 0)",
+                ),
+            }
+        )
+        out = out | {
+            "pin_force": Output(f, dims, "N", "pin-disc contact force"),
+            "pin_gap": Output(
+                rec["gap"],
+                dims,
+                "m",
+                "signed pin-profile gap (negative = penetration); "
+                "of a pin proved open by the solver: a positive lower bound",
+            ),
+            "pins_in_contact": Output((f > 0).sum(axis=-1), ("time", "disc"), "1", "pins in contact per disc"),
+            "disc_pin_torque": Output(
+                -(f * rec["rxn"]).sum(axis=-1),
+                ("time", "disc"),
+                "N m",
+                "torque of the pin normal forces on each disc about its centre (the friction "
+                "forces' torque not included)",
+            ),
+            "housing_pin_torque": Output(
+                self._housing_torque(rec),
+                ("time", "disc"),
+                "N m",
+                "torque of each disc's pin forces (normal and friction) on the housing about the axis",
+            ),
+        }
         if self.elastic_housing:
             hs = rec["housing"]
-            out["housing_rotation"] = Output(hs[..., 1], ("time",), "rad",
-                                             "elastic rotation phi_h of the pin housing about the axis (c_h times "
-                                             "the pins' torque on the housing)")
+            out["housing_rotation"] = Output(
+                hs[..., 1],
+                ("time",),
+                "rad",
+                "elastic rotation phi_h of the pin housing about the axis (c_h times the pins' torque on the housing)",
+            )
         if self.elastic_discs:
             rim = rec["rim"]
             if "housing" in rec and self.elastic_housing:  # the disc body's part: the housing's -phi_h a_k removed
@@ -753,11 +845,19 @@ class PinContacts(KernelGroup):
                 rim[..., 2] += hs[..., 1][..., None]
                 rim[..., 0] -= hs[..., 2::2]
                 rim[..., 1] -= hs[..., 3::2]
-            out["disc_rim_rotation"] = Output(rim[..., 2], ("time", "disc"), "rad",
-                                              "rotation of each disc's tooth region (rim) relative to its crank "
-                                              "holes (hub): the elastic disc body's twist")
-            out["disc_rim_offset"] = Output(np.hypot(rim[..., 0], rim[..., 1]), ("time", "disc"), "m",
-                                            "translation of each disc's rim relative to its hub")
+            out["disc_rim_rotation"] = Output(
+                rim[..., 2],
+                ("time", "disc"),
+                "rad",
+                "rotation of each disc's tooth region (rim) relative to its crank "
+                "holes (hub): the elastic disc body's twist",
+            )
+            out["disc_rim_offset"] = Output(
+                np.hypot(rim[..., 0], rim[..., 1]),
+                ("time", "disc"),
+                "m",
+                "translation of each disc's rim relative to its hub",
+            )
         return out
 
     def _housing_torque(self, rec):
@@ -783,6 +883,8 @@ class PinContacts(KernelGroup):
 
     def check(self) -> str | None:
         if self.min_gap < -self.limit:
-            return (f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
-                    f"{self.limit * 1e6:.3g} um")
+            return (
+                f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
+                f"{self.limit * 1e6:.3g} um"
+            )
         return None

@@ -71,7 +71,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexrv.errors import ConvergenceError, InputError
-from flexrv.units import ARCSEC_PER_RAD, ARCMIN_PER_RAD
+from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD
 
 
 @dataclass(frozen=True)
@@ -98,8 +98,10 @@ class StaticOptions:
             raise InputError(f"unknown static-solver option(s) {unknown}: allowed {sorted(known)}")
         out = cls(**options)
         if not (0 < out.force_tol < 1e-2 and 0 < out.step_tol < 1e-6 and 1 <= out.max_iter <= 1000):
-            raise InputError(f"static-solver options {out} out of range: 0 < force_tol < 1e-2, "
-                             "0 < step_tol < 1e-6, 1 <= max_iter <= 1000")
+            raise InputError(
+                f"static-solver options {out} out of range: 0 < force_tol < 1e-2, "
+                "0 < step_tol < 1e-6, 1 <= max_iter <= 1000"
+            )
         return out
 
 
@@ -115,8 +117,9 @@ class StaticModel:
         self.reducer = reducer
         self.options = options if isinstance(options, StaticOptions) else StaticOptions.from_dict(options)
         self._torque = [0.0]
-        self.model = build_model(reducer, "rigid", drive="position", exudyn=False,
-                                 torque=lambda t: np.full(np.shape(t), self._torque[0]))
+        self.model = build_model(
+            reducer, "rigid", drive="position", exudyn=False, torque=lambda t: np.full(np.shape(t), self._torque[0])
+        )
         m = self.model
         self.p = m.params
         self.n = m.n
@@ -308,8 +311,10 @@ class StaticModel:
             # cycling across a contact's onset kink within 10x the force tolerance: the best
             # iterate locates the equilibrium (see the docstring for the output-angle error)
             return best[1], o.max_iter
-        raise ConvergenceError(f"static equilibrium at input angle {theta_in:.6g} rad not found in {o.max_iter} "
-                               f"iterations (residual {min(r, best[0]):.3g} N, tolerance {tol:.3g} N)")
+        raise ConvergenceError(
+            f"static equilibrium at input angle {theta_in:.6g} rad not found in {o.max_iter} "
+            f"iterations (residual {min(r, best[0]):.3g} N, tolerance {tol:.3g} N)"
+        )
 
     def fd_jacobian(self, theta_in: float, q: np.ndarray, step: float = 1e-10) -> np.ndarray:
         """dR/dq by central differences (steps ``step`` [m] on the crank circle), for
@@ -360,8 +365,9 @@ class StaticModel:
         parts = {}
         zero = np.zeros(self.n)
         for g in m.groups:
-            idx = np.arange(self.n)[group_index([m.members[x].offset for x in g.members],
-                                                [m.members[x].n for x in g.members])]
+            idx = np.arange(self.n)[
+                group_index([m.members[x].offset for x in g.members], [m.members[x].n for x in g.members])
+            ]
             g.new_step()
             jq, _ = g.jacobian(theta_in, q[idx], zero[idx])
             k = np.zeros((self.n, self.n))
@@ -456,13 +462,18 @@ def characteristic_orders(reducer) -> dict[str, float]:
     fs, ss = reducer.first_stage, reducer.second_stage
     f = characteristic_frequencies(1.0, fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
     out = float(f.carrier)
-    return {"crank rotation": float(f.crank_rotation) / out, "crank, absolute": float(f.crank_absolute) / out,
-            "cycloid mesh": float(f.cycloid_mesh) / out, "first-stage mesh": float(f.first_stage_mesh) / out,
-            "input rotation": float(f.input) / out}
+    return {
+        "crank rotation": float(f.crank_rotation) / out,
+        "crank, absolute": float(f.crank_absolute) / out,
+        "cycloid mesh": float(f.cycloid_mesh) / out,
+        "first-stage mesh": float(f.first_stage_mesh) / out,
+        "input rotation": float(f.input) / out,
+    }
 
 
-def positions_for(reducer, output_revolutions: float | None = None, crank_revolutions: float | None = None,
-                  points_per_mesh: int = 8) -> np.ndarray:
+def positions_for(
+    reducer, output_revolutions: float | None = None, crank_revolutions: float | None = None, points_per_mesh: int = 8
+) -> np.ndarray:
     """Input angles [rad] covering the requested range with ``points_per_mesh``
     points per cycloid-mesh period (the pin-mesh period of the TE ripple).
     ``crank_revolutions`` counts crank revolutions relative to the carrier."""
@@ -515,8 +526,10 @@ def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, m
         last = k
     failed = int(np.sum(its < 0))
     if failed > max_failed_fraction * len(angles):
-        raise ConvergenceError(f"static equilibrium not found at {failed} of {len(angles)} positions "
-                               f"(torque {sm.torque:.6g} N m): more than {100 * max_failed_fraction:g} %")
+        raise ConvergenceError(
+            f"static equilibrium not found at {failed} of {len(angles)} positions "
+            f"(torque {sm.torque:.6g} N m): more than {100 * max_failed_fraction:g} %"
+        )
     return qs, its
 
 
@@ -552,8 +565,9 @@ def ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, step
     return q
 
 
-def _catalog_levels(sm: StaticModel, th: float, q: np.ndarray, torque: float, rated: float,
-                    t_small: float) -> dict[str, float]:
+def _catalog_levels(
+    sm: StaticModel, th: float, q: np.ndarray, torque: float, rated: float, t_small: float
+) -> dict[str, float]:
     """Output angles at rated, half, +3 %, +T0, -3 % and -T0 torque at one input
     angle (input locked). The reversed load starts from the mirror image of the
     +3 % pose about the kinematic pose (symmetric clearances give nearly that)
@@ -579,9 +593,17 @@ def _catalog_levels(sm: StaticModel, th: float, q: np.ndarray, torque: float, ra
     return levels
 
 
-def loaded_te(reducer, torque: float | None = None, output_revolutions: float | None = None,
-              crank_revolutions: float | None = None, points_per_mesh: int = 8, no_load_fraction: float = 1e-2,
-              catalog_positions: int = 6, options: dict | None = None, progress=None) -> LoadedTE:
+def loaded_te(
+    reducer,
+    torque: float | None = None,
+    output_revolutions: float | None = None,
+    crank_revolutions: float | None = None,
+    points_per_mesh: int = 8,
+    no_load_fraction: float = 1e-2,
+    catalog_positions: int = 6,
+    options: dict | None = None,
+    progress=None,
+) -> LoadedTE:
     """Loaded and no-load TE over the requested input range, catalog lost motion,
     backlash and rigidity (see module docstring).
 
@@ -654,13 +676,29 @@ def loaded_te(reducer, torque: float | None = None, output_revolutions: float | 
     if not lm:
         raise ConvergenceError("no catalog position (lost motion, backlash, rigidity) converged")
     wall = _time.perf_counter() - t_start
-    catalog = {"lost_motion_rad": float(np.max(lm)), "backlash_rad": float(np.max(bl)),
-               "lost_motion_positions_rad": np.asarray(lm), "backlash_positions_rad": np.asarray(bl),
-               "rigidity_secant_Nm_per_rad": float(np.mean(k_sec)),
-               "rigidity_low_Nm_per_rad": float(np.mean(k_low)),
-               "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)), "catalog_input_angles": angles[cat_idx],
-               "compliance_budget": {g: float(np.mean([b_[g] for b_ in budgets])) for g in budgets[0]},
-               "catalog_positions_used": len(lm)}
-    return LoadedTE(input_angle=angles, output_angle=th_out, te=te, te_no_load=te_nl, torque=float(torque),
-                    ratio=ratio, outputs=outs, catalog=catalog, iterations=np.r_[its, its_nl],
-                    solve_time_s=wall, orders=characteristic_orders(reducer), no_load_torque=t_small)
+    catalog = {
+        "lost_motion_rad": float(np.max(lm)),
+        "backlash_rad": float(np.max(bl)),
+        "lost_motion_positions_rad": np.asarray(lm),
+        "backlash_positions_rad": np.asarray(bl),
+        "rigidity_secant_Nm_per_rad": float(np.mean(k_sec)),
+        "rigidity_low_Nm_per_rad": float(np.mean(k_low)),
+        "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)),
+        "catalog_input_angles": angles[cat_idx],
+        "compliance_budget": {g: float(np.mean([b_[g] for b_ in budgets])) for g in budgets[0]},
+        "catalog_positions_used": len(lm),
+    }
+    return LoadedTE(
+        input_angle=angles,
+        output_angle=th_out,
+        te=te,
+        te_no_load=te_nl,
+        torque=float(torque),
+        ratio=ratio,
+        outputs=outs,
+        catalog=catalog,
+        iterations=np.r_[its, its_nl],
+        solve_time_s=wall,
+        orders=characteristic_orders(reducer),
+        no_load_torque=t_small,
+    )

@@ -19,25 +19,50 @@ from flexrv.post.format import fmt as _fmt
 
 def summary_markdown(res, summ: dict) -> str:
     """summary.md: run info, kinematic validation table, TE statistics."""
-    lines = [f"# Simulation {summ['preset']} ({summ['model']} model)", "",
-             f"status: **{summ['status']}**" + (f" — {summ['failure']}" if summ.get("failure") else ""), "",
-             f"steady window: {summ['steady_window_s'][0]:.4g} – {summ['steady_window_s'][1]:.4g} s, "
-             f"dt = {res.attrs.get('dt_s')} s, needle model {res.attrs.get('needle_model')}, "
-             f"pin law {res.attrs.get('pin_law')}", "",
-             *[f"> {note}\n" for note in summ.get("notes", [])],
-             "## Kinematic validation (mean over the steady window)", "",
-             "| quantity | unit | theory | simulated | error [%] |", "|---|---|---|---|---|"]
+    lines = [
+        f"# Simulation {summ['preset']} ({summ['model']} model)",
+        "",
+        f"status: **{summ['status']}**" + (f" — {summ['failure']}" if summ.get("failure") else ""),
+        "",
+        f"steady window: {summ['steady_window_s'][0]:.4g} – {summ['steady_window_s'][1]:.4g} s, "
+        f"dt = {res.attrs.get('dt_s')} s, needle model {res.attrs.get('needle_model')}, "
+        f"pin law {res.attrs.get('pin_law')}",
+        "",
+        *[f"> {note}\n" for note in summ.get("notes", [])],
+        "## Kinematic validation (mean over the steady window)",
+        "",
+        "| quantity | unit | theory | simulated | error [%] |",
+        "|---|---|---|---|---|",
+    ]
     for row in summ["kinematics"]:
-        lines.append(f"| {row['quantity']} | {row['unit']} | {_fmt(row['theory'])} | {_fmt(row['simulated'])} | "
-                     f"{_fmt(row['error_percent'])} |")
-    lines += ["", "## Transmission error TE = theta_out - theta_in / i (steady window)", "",
-              "| quantity | value | unit |", "|---|---|---|"]
-    for key, unit in (("te_min_arcsec", "arcsec"), ("te_max_arcsec", "arcsec"), ("te_pp_arcsec", "arcsec"),
-                      ("te_mean_arcsec", "arcsec"), ("te_rms_fluctuation_arcsec", "arcsec"),
-                      ("max_pin_force_N", "N"), ("pins_in_contact_mean", "-"), ("pins_in_contact_max", "-"),
-                      ("mean_input_power_W", "W"), ("mean_output_power_W", "W"), ("mean_dissipation_W", "W"),
-                      ("efficiency", "-"), ("mean_friction_power_W", "W"), ("mean_pin_friction_power_W", "W"),
-                      ("mean_needle_friction_power_W", "W")):
+        lines.append(
+            f"| {row['quantity']} | {row['unit']} | {_fmt(row['theory'])} | {_fmt(row['simulated'])} | "
+            f"{_fmt(row['error_percent'])} |"
+        )
+    lines += [
+        "",
+        "## Transmission error TE = theta_out - theta_in / i (steady window)",
+        "",
+        "| quantity | value | unit |",
+        "|---|---|---|",
+    ]
+    for key, unit in (
+        ("te_min_arcsec", "arcsec"),
+        ("te_max_arcsec", "arcsec"),
+        ("te_pp_arcsec", "arcsec"),
+        ("te_mean_arcsec", "arcsec"),
+        ("te_rms_fluctuation_arcsec", "arcsec"),
+        ("max_pin_force_N", "N"),
+        ("pins_in_contact_mean", "-"),
+        ("pins_in_contact_max", "-"),
+        ("mean_input_power_W", "W"),
+        ("mean_output_power_W", "W"),
+        ("mean_dissipation_W", "W"),
+        ("efficiency", "-"),
+        ("mean_friction_power_W", "W"),
+        ("mean_pin_friction_power_W", "W"),
+        ("mean_needle_friction_power_W", "W"),
+    ):
         if key not in summ:
             continue
         lines.append(f"| {key} | {_fmt(summ.get(key))} | {unit} |")
@@ -96,8 +121,15 @@ def save_checkpoint(directory, t, q, v, meta: dict, reducer, a_last=None, record
         extra["rec_valid"] = np.asarray(valid, dtype=bool)
         extra.update({f"rec_{i}": np.asarray(a, dtype=float) for i, a in enumerate(arrays)})
     buf = io.BytesIO()
-    np.savez(buf, t=np.asarray(t, dtype=float), q=np.asarray(q, dtype=float), v=np.asarray(v, dtype=float),
-             meta=np.array(json.dumps(to_jsonable(meta))), config=np.array(to_toml(reducer)), **extra)
+    np.savez(
+        buf,
+        t=np.asarray(t, dtype=float),
+        q=np.asarray(q, dtype=float),
+        v=np.asarray(v, dtype=float),
+        meta=np.array(json.dumps(to_jsonable(meta))),
+        config=np.array(to_toml(reducer)),
+        **extra,
+    )
     return atomic_write_bytes(Path(directory) / CHECKPOINT, buf.getvalue())
 
 
@@ -110,12 +142,21 @@ def load_checkpoint(directory) -> dict:
 
     path = Path(directory) / CHECKPOINT
     if not path.is_file():
-        raise InputError(f"--resume {directory}: no {CHECKPOINT} there (not a run directory of flexrv simulate, "
-                         "or the run was killed before its first checkpoint)")
+        raise InputError(
+            f"--resume {directory}: no {CHECKPOINT} there (not a run directory of flexrv simulate, "
+            "or the run was killed before its first checkpoint)"
+        )
     try:
         with np.load(path, allow_pickle=False) as z:
-            data = {"t": z["t"], "q": z["q"], "v": z["v"], "meta": json.loads(str(z["meta"])),
-                    "config": str(z["config"]), "a": z["a"] if "a" in z.files else None, "records": None}
+            data = {
+                "t": z["t"],
+                "q": z["q"],
+                "v": z["v"],
+                "meta": json.loads(str(z["meta"])),
+                "config": str(z["config"]),
+                "a": z["a"] if "a" in z.files else None,
+                "records": None,
+            }
             if "rec_valid" in z.files:
                 n_rec = sum(1 for f in z.files if f.startswith("rec_") and f != "rec_valid")
                 data["records"] = ([z[f"rec_{i}"] for i in range(n_rec)], z["rec_valid"])
@@ -144,7 +185,9 @@ def read_run(directory):
     except FileNotFoundError:
         raise InputError(f"{d} is not a result folder (no results.nc)") from None
     except Exception as exc:  # not NetCDF / truncated
-        raise InputError(f"{d / 'results.nc'} is not a readable flexrv NetCDF file "
-                         f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+        raise InputError(
+            f"{d / 'results.nc'} is not a readable flexrv NetCDF file "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})"
+        ) from None
     reducer = load(d / "config.toml") if (d / "config.toml").exists() else None
     return ds, reducer

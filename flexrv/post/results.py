@@ -30,7 +30,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 import xarray as xr
 
 from flexrv.cache import to_jsonable
@@ -118,8 +117,10 @@ class Results:
         return cls(ds, reducer=reducer)
 
     def __repr__(self) -> str:
-        return f"Results({self.attrs.get('preset')}, model={self.attrs.get('model')}, {len(self.time)} samples, " \
-               f"status={self.attrs.get('status')})"
+        return (
+            f"Results({self.attrs.get('preset')}, model={self.attrs.get('model')}, {len(self.time)} samples, "
+            f"status={self.attrs.get('status')})"
+        )
 
 
 def _var(values, dims, units, long_name):
@@ -144,8 +145,9 @@ class SteadyWindow:
     note: str  #: why the window is (not) steady, in words
 
 
-def steady_window_rule(ramps_end_s: float, t_end: float, crank_period_s: float,
-                       settle_s: float = STEADY_SETTLE_S) -> SteadyWindow:
+def steady_window_rule(
+    ramps_end_s: float, t_end: float, crank_period_s: float, settle_s: float = STEADY_SETTLE_S
+) -> SteadyWindow:
     """The steady window chosen from the drive program.
 
     Rule: the window may start at ``ramps_end_s + settle_s`` (the later of the speed and the
@@ -166,25 +168,44 @@ def steady_window_rule(ramps_end_s: float, t_end: float, crank_period_s: float,
     t_ready = ramps_end_s + settle_s
     if not (math.isfinite(crank_period_s) and crank_period_s > 0):
         t0 = t_ready if t_end - t_ready > 0 else 0.5 * t_end
-        return SteadyWindow(t0, t_end, False, 0, float("inf"),
-                            "no input rotation (locked or zero-speed drive): no crank revolution to average over")
+        return SteadyWindow(
+            t0,
+            t_end,
+            False,
+            0,
+            float("inf"),
+            "no input rotation (locked or zero-speed drive): no crank revolution to average over",
+        )
     n = int(math.floor((t_end - t_ready) / crank_period_s + 1e-9)) if t_end > t_ready else 0
     if n >= 1:
-        return SteadyWindow(t_end - n * crank_period_s, t_end, True, n, crank_period_s,
-                            f"{n} whole crank revolution{'s' if n > 1 else ''} (relative to the carrier, "
-                            f"{crank_period_s:.4g} s each) after the ramps (end {ramps_end_s:.4g} s) and "
-                            f"{settle_s:.3g} s settle time")
+        return SteadyWindow(
+            t_end - n * crank_period_s,
+            t_end,
+            True,
+            n,
+            crank_period_s,
+            f"{n} whole crank revolution{'s' if n > 1 else ''} (relative to the carrier, "
+            f"{crank_period_s:.4g} s each) after the ramps (end {ramps_end_s:.4g} s) and "
+            f"{settle_s:.3g} s settle time",
+        )
     t0 = t_ready if t_end - t_ready > 0 else 0.5 * t_end
-    where = ("inside the speed/load ramps" if t0 < ramps_end_s else "shorter than one crank revolution")
-    return SteadyWindow(t0, t_end, False, 0, crank_period_s,
-                        f"NOT STEADY: the run ends at {t_end:.4g} s; the window {t0:.4g} - {t_end:.4g} s is {where}. "
-                        f"A steady state needs t_end >= {t_ready + crank_period_s:.4g} s (ramps end "
-                        f"{ramps_end_s:.4g} s + settle {settle_s:.3g} s + one crank revolution "
-                        f"{crank_period_s:.4g} s); the statistics below are NOT steady-state values")
+    where = "inside the speed/load ramps" if t0 < ramps_end_s else "shorter than one crank revolution"
+    return SteadyWindow(
+        t0,
+        t_end,
+        False,
+        0,
+        crank_period_s,
+        f"NOT STEADY: the run ends at {t_end:.4g} s; the window {t0:.4g} - {t_end:.4g} s is {where}. "
+        f"A steady state needs t_end >= {t_ready + crank_period_s:.4g} s (ramps end "
+        f"{ramps_end_s:.4g} s + settle {settle_s:.3g} s + one crank revolution "
+        f"{crank_period_s:.4g} s); the statistics below are NOT steady-state values",
+    )
 
 
-def steady_window_for(reducer, t_end: float, input_speed: float | None = None,
-                      settle: float = STEADY_SETTLE_S) -> SteadyWindow:
+def steady_window_for(
+    reducer, t_end: float, input_speed: float | None = None, settle: float = STEADY_SETTLE_S
+) -> SteadyWindow:
     """:func:`steady_window_rule` for a reducer's drive program: ramps from
     ``reducer.operating``, crank period from the input speed at the end of the run
     (``input_speed`` [rad/s], default the operating point's) and the tooth counts
@@ -199,8 +220,18 @@ def steady_window_for(reducer, t_end: float, input_speed: float | None = None,
     return steady_window_rule(max(op.speed_ramp_time_s, op.load_ramp_end_s), t_end, period, settle)
 
 
-def results_from_states(model, t, q, v, dt: float, status: str = "completed", timing: dict | None = None,
-                        chunk: int = 1000, cls: type[Results] = Results, records: dict | None = None) -> Results:
+def results_from_states(
+    model,
+    t,
+    q,
+    v,
+    dt: float,
+    status: str = "completed",
+    timing: dict | None = None,
+    chunk: int = 1000,
+    cls: type[Results] = Results,
+    records: dict | None = None,
+) -> Results:
     """Build :class:`Results` (or the subclass ``cls``) from recorded states (T,), (T, n), (T, n).
 
     The variables are the model's declared outputs (:func:`flexrv.model.outputs.model_outputs`,
@@ -218,8 +249,10 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
         if not keep.all():  # else (the usual case) no copies of the states and records
             t, q, v = t[keep], q[keep], v[keep]
             if records is not None:
-                records = {"valid": {g: np.asarray(m)[keep] for g, m in records["valid"].items()},
-                           "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()}}
+                records = {
+                    "valid": {g: np.asarray(m)[keep] for g, m in records["valid"].items()},
+                    "data": {g: {k: a[keep] for k, a in d.items()} for g, d in records["data"].items()},
+                }
     data: dict[str, xr.Variable] = {}
     for name, o in model_outputs(model, t, q, v, chunk=chunk, records=records).items():
         data[name] = _var(o.values, o.dims, o.units, o.long_name)
@@ -227,8 +260,9 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
             th_in, th_out = data["theta_in"].values, data["theta_out"].values
             data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC_PER_RAD, ("time",), "arcsec", "TE")
         elif name == "output_torque":
-            data["power_in"] = _var(data["input_torque"].values * data["omega_in"].values, ("time",), "W",
-                                    "input power")
+            data["power_in"] = _var(
+                data["input_torque"].values * data["omega_in"].values, ("time",), "W", "input power"
+            )
             data["power_out"] = _var(o.values * data["omega_out"].values, ("time",), "W", "output power")
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
     red = model.reducer
@@ -237,15 +271,27 @@ def results_from_states(model, t, q, v, dt: float, status: str = "completed", ti
     win = steady_window_for(red, t_end, input_speed=w_end)
     s0, s1 = win.start_s, win.end_s
     ks = member_speeds(1.0, p.z_s, p.z_p, p.z_c, p.z_rp)
-    ds.attrs.update({
-        "preset": red.name, "model": model.name, "status": status, "dt_s": dt, "ratio": p.ratio,
-        "rated_input_speed_rad_s": p.input_speed, "steady_start_s": s0, "steady_end_s": s1,
-        "steady": int(win.steady), "steady_revolutions": win.revolutions, "steady_note": win.note,
-        "crank_period_s": win.crank_period_s,
-        "crank_relative_per_input": float(ks.crank_relative), "crank_absolute_per_input": float(ks.crank_absolute),
-        "needle_model": red.needle_bearing.model, "pin_law": red.contact.pin_law,
-        "timing": json.dumps(to_jsonable(timing or {})),
-    })
+    ds.attrs.update(
+        {
+            "preset": red.name,
+            "model": model.name,
+            "status": status,
+            "dt_s": dt,
+            "ratio": p.ratio,
+            "rated_input_speed_rad_s": p.input_speed,
+            "steady_start_s": s0,
+            "steady_end_s": s1,
+            "steady": int(win.steady),
+            "steady_revolutions": win.revolutions,
+            "steady_note": win.note,
+            "crank_period_s": win.crank_period_s,
+            "crank_relative_per_input": float(ks.crank_relative),
+            "crank_absolute_per_input": float(ks.crank_absolute),
+            "needle_model": red.needle_bearing.model,
+            "pin_law": red.contact.pin_law,
+            "timing": json.dumps(to_jsonable(timing or {})),
+        }
+    )
     for key, value in model.info.items():  # e.g. flexible_bodies: how to rebuild the reduced bodies
         if isinstance(value, bool):  # (NetCDF has no boolean attributes: 0 / 1)
             value = int(value)

@@ -36,7 +36,12 @@ def te_spectrum(res):
     red = res.reducer
     th = res.steady("theta_in").values
     w_in = mean_speed(th, t)
-    cf = characteristic_frequencies(w_in, red.first_stage.sun_teeth, red.first_stage.planet_teeth,
-                                    red.second_stage.disc_teeth, red.second_stage.pin_count)
+    cf = characteristic_frequencies(
+        w_in,
+        red.first_stage.sun_teeth,
+        red.first_stage.planet_teeth,
+        red.second_stage.disc_teeth,
+        red.second_stage.pin_count,
+    )
     marks = {k: float(getattr(cf, k)) for k in ("crank_rotation", "first_stage_mesh", "cycloid_mesh", "input")}
     return freq, amp, marks

@@ -36,12 +36,14 @@ def kinematic_table(res) -> list[dict]:
     crank_abs = float(np.mean(sel["crank_speed"].values)) if len(t) else float("nan")
     crank_rel = float(np.mean(sel["crank_speed_relative"].values)) if len(t) else float("nan")
     disc = float(np.mean(sel["disc_speed"].values)) if len(t) else float("nan")
-    rows = [("input speed", "rad/s", float(th.input), w_in),
-            ("output speed", "rad/s", float(th.carrier), w_out),
-            ("crank speed, absolute", "rad/s", float(th.crank_absolute), crank_abs),
-            ("crank speed, relative to carrier", "rad/s", float(th.crank_relative), crank_rel),
-            ("disc rotation speed", "rad/s", float(th.disc_rotation), disc),
-            ("total ratio", "-", float(th.ratio), w_in / w_out if w_out else float("nan"))]
+    rows = [
+        ("input speed", "rad/s", float(th.input), w_in),
+        ("output speed", "rad/s", float(th.carrier), w_out),
+        ("crank speed, absolute", "rad/s", float(th.crank_absolute), crank_abs),
+        ("crank speed, relative to carrier", "rad/s", float(th.crank_relative), crank_rel),
+        ("disc rotation speed", "rad/s", float(th.disc_rotation), disc),
+        ("total ratio", "-", float(th.ratio), w_in / w_out if w_out else float("nan")),
+    ]
     out = []
     for name, unit, theory, sim in rows:
         err = 100.0 * (sim - theory) / theory if theory else float("nan")
@@ -68,7 +70,9 @@ def summary(res) -> dict:
     fric = float(np.mean(sel["friction_power"].values)) if ("friction_power" in sel and len(te)) else None
     balance = power_balance(p_in, p_out, dke, steady=steady, friction=fric)
     out = {
-        "preset": res.attrs.get("preset"), "model": res.attrs.get("model"), "status": res.attrs.get("status"),
+        "preset": res.attrs.get("preset"),
+        "model": res.attrs.get("model"),
+        "status": res.attrs.get("status"),
         "steady_window_s": [t0, t1],
         "steady_state": steady,
         "steady_revolutions": int(res.attrs.get("steady_revolutions", 0)),
@@ -84,7 +88,8 @@ def summary(res) -> dict:
         "max_pin_force_N": float(pin.max()) if finite else None,
         "pins_in_contact_mean": float(np.mean(in_contact)) if finite else None,
         "pins_in_contact_max": int(np.max(in_contact)) if finite else None,
-        "mean_input_power_W": p_in, "mean_output_power_W": p_out,
+        "mean_input_power_W": p_in,
+        "mean_output_power_W": p_out,
         "mean_kinetic_energy_rate_W": dke,
         "mean_dissipation_W": balance["dissipation_W"],
         **efficiency_summary(sel, p_in, p_out),
@@ -99,16 +104,28 @@ def summary(res) -> dict:
 
 
 #: summary key -> the result variable whose ``units`` attribute it carries
-_UNIT_SOURCE = {"te_min_arcsec": "te", "te_max_arcsec": "te", "te_pp_arcsec": "te", "te_mean_arcsec": "te",
-                "te_rms_fluctuation_arcsec": "te", "max_pin_force_N": "pin_force", "mean_input_power_W": "power_in",
-                "mean_output_power_W": "power_out", "mean_dissipation_W": "power_in",
-                "mean_friction_power_W": "friction_power", "mean_pin_friction_power_W": "pin_friction_power",
-                "mean_needle_friction_power_W": "needle_friction_power",
-                "mean_kinetic_energy_rate_W": "power_in", "max_ball_load_N": "ball_load_inner",
-                "max_ring_deformation_m": "ring_deformation_outer", "max_inner_ring_deformation_m":
-                "ring_deformation_inner", "max_ball_pressure_Pa": "ball_max_pressure",
-                "min_film_thickness_m": "ball_film_thickness", "pins_in_contact_mean": "pins_in_contact",
-                "pins_in_contact_max": "pins_in_contact"}
+_UNIT_SOURCE = {
+    "te_min_arcsec": "te",
+    "te_max_arcsec": "te",
+    "te_pp_arcsec": "te",
+    "te_mean_arcsec": "te",
+    "te_rms_fluctuation_arcsec": "te",
+    "max_pin_force_N": "pin_force",
+    "mean_input_power_W": "power_in",
+    "mean_output_power_W": "power_out",
+    "mean_dissipation_W": "power_in",
+    "mean_friction_power_W": "friction_power",
+    "mean_pin_friction_power_W": "pin_friction_power",
+    "mean_needle_friction_power_W": "needle_friction_power",
+    "mean_kinetic_energy_rate_W": "power_in",
+    "max_ball_load_N": "ball_load_inner",
+    "max_ring_deformation_m": "ring_deformation_outer",
+    "max_inner_ring_deformation_m": "ring_deformation_inner",
+    "max_ball_pressure_Pa": "ball_max_pressure",
+    "min_film_thickness_m": "ball_film_thickness",
+    "pins_in_contact_mean": "pins_in_contact",
+    "pins_in_contact_max": "pins_in_contact",
+}
 
 
 def efficiency_summary(sel, p_in: float, p_out: float) -> dict:
@@ -147,8 +164,9 @@ def _split(d: float, friction: float | None) -> str:
     return f"friction {friction:.4g} W + contact damping and elastic storage {d - friction:.3g} W"
 
 
-def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True,
-                  friction: float | None = None) -> dict:
+def power_balance(
+    p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, steady: bool = True, friction: float | None = None
+) -> dict:
     """Mean power balance over a window: dissipation D = P_in - P_out - dE_kin/dt [W]
     (every term the window mean; dE_kin/dt = (E_kin(t1) - E_kin(t0)) / (t1 - t0) is exactly
     the mean of the rate). ``note`` says in words what the numbers mean: D < 0 beyond
@@ -162,32 +180,43 @@ def power_balance(p_in: float, p_out: float, dke_dt: float, tol: float = 0.01, s
     if not all(map(math.isfinite, (p_in, p_out, dke_dt))):
         note = "power balance not available"
     elif abs(d) <= tol * scale:
-        note = (f"power balance closes: P_in {p_in:.4g} W = P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W "
-                f"+ remainder {d:.3g} W; the remainder is within {100 * tol:.0f} % of the power, the accuracy of "
-                "the window means (P_in uses the numerically differentiated input speed): the contact damping "
-                "dissipates less than that")
+        note = (
+            f"power balance closes: P_in {p_in:.4g} W = P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W "
+            f"+ remainder {d:.3g} W; the remainder is within {100 * tol:.0f} % of the power, the accuracy of "
+            "the window means (P_in uses the numerically differentiated input speed): the contact damping "
+            "dissipates less than that"
+        )
     elif d > 0:
-        note = (f"power balance: P_in {p_in:.4g} W - P_out {p_out:.4g} W - dE_kin/dt {dke_dt:.3g} W = "
-                f"{d:.4g} W dissipated ({_split(d, friction)}), efficiency P_out/P_in = {p_out / p_in:.4f}"
-                if p_in else f"power balance: {d:.4g} W dissipated")
+        note = (
+            f"power balance: P_in {p_in:.4g} W - P_out {p_out:.4g} W - dE_kin/dt {dke_dt:.3g} W = "
+            f"{d:.4g} W dissipated ({_split(d, friction)}), efficiency P_out/P_in = {p_out / p_in:.4f}"
+            if p_in
+            else f"power balance: {d:.4g} W dissipated"
+        )
     else:
-        note = (f"power balance: P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W exceeds P_in {p_in:.4g} W by "
-                f"{-d:.4g} W: not a negative dissipation but energy released from elastic storage (contact "
-                "and mesh deflections, not counted in E_kin) — the window is not in steady state (ramps) or "
-                "too short")
+        note = (
+            f"power balance: P_out {p_out:.4g} W + dE_kin/dt {dke_dt:.3g} W exceeds P_in {p_in:.4g} W by "
+            f"{-d:.4g} W: not a negative dissipation but energy released from elastic storage (contact "
+            "and mesh deflections, not counted in E_kin) — the window is not in steady state (ramps) or "
+            "too short"
+        )
     if not steady:
-        note += ("; the window is NOT steady: energy stored elastically in the contacts while the load ramps "
-                 "is not part of E_kin, so the balance above is not a dissipation measurement")
+        note += (
+            "; the window is NOT steady: energy stored elastically in the contacts while the load ramps "
+            "is not part of E_kin, so the balance above is not a dissipation measurement"
+        )
     return {"dissipation_W": float(d), "note": note}
 
 
 def _bearing_summary(sel, finite: bool) -> dict:
     """Steady-window extremes of the ball-resolved / flexible bearing outputs."""
     out = {}
-    for key, var, fn in (("max_ball_load_N", "ball_load_inner", np.max),
-                         ("max_ring_deformation_m", "ring_deformation_outer", np.max),
-                         ("max_inner_ring_deformation_m", "ring_deformation_inner", np.max),
-                         ("max_ball_pressure_Pa", "ball_max_pressure", np.max)):
+    for key, var, fn in (
+        ("max_ball_load_N", "ball_load_inner", np.max),
+        ("max_ring_deformation_m", "ring_deformation_outer", np.max),
+        ("max_inner_ring_deformation_m", "ring_deformation_inner", np.max),
+        ("max_ball_pressure_Pa", "ball_max_pressure", np.max),
+    ):
         if var in sel and finite:
             out[key] = float(fn(sel[var].values))
     if "ball_film_thickness" in sel and finite:

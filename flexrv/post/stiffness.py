@@ -30,7 +30,6 @@ import numpy as np
 from flexrv.units import ARCMIN_PER_RAD
 
 
-
 @dataclass(frozen=True)
 class StiffnessTest:
     """Figures of a stiffness test (angles in arcmin, torques in N m)."""
@@ -117,41 +116,82 @@ def evaluate_stiffness_test(time, torque, angle, times, friction_power=None) -> 
         prog = (time >= t0) & (time <= te)
         e_fric = float(np.trapezoid(np.asarray(friction_power, dtype=float)[prog], time[prog]))
     k_low = 0.5 * (_fit_slope(torque[up], a[up], d3, 0.5 * rated) + _fit_slope(torque[neg], a[neg], d3, 0.5 * rated))
-    return StiffnessTest(rated_torque=rated, rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
-                         rigidity_positive_Nm_per_arcmin=k_pos, rigidity_negative_Nm_per_arcmin=k_neg,
-                         lost_motion_arcmin=mid_p - mid_n, hysteresis_arcmin=a_down0 - a_back0,
-                         angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
-                         fit_range_low_Nm=0.5 * rated, lost_motion_torque_Nm=d3,
-                         lost_motion_negative_arcmin=mid_n, lost_motion_positive_arcmin=mid_p,
-                         hysteresis_returning_arcmin=a_back0, hysteresis_descending_arcmin=a_down0,
-                         hysteresis_loss_J=loss, friction_energy_J=e_fric,
-                         rigidity_low_Nm_per_arcmin=k_low, low_range_low_Nm=d3)
+    return StiffnessTest(
+        rated_torque=rated,
+        rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
+        rigidity_positive_Nm_per_arcmin=k_pos,
+        rigidity_negative_Nm_per_arcmin=k_neg,
+        lost_motion_arcmin=mid_p - mid_n,
+        hysteresis_arcmin=a_down0 - a_back0,
+        angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
+        fit_range_low_Nm=0.5 * rated,
+        lost_motion_torque_Nm=d3,
+        lost_motion_negative_arcmin=mid_n,
+        lost_motion_positive_arcmin=mid_p,
+        hysteresis_returning_arcmin=a_back0,
+        hysteresis_descending_arcmin=a_down0,
+        hysteresis_loss_J=loss,
+        friction_energy_J=e_fric,
+        rigidity_low_Nm_per_arcmin=k_low,
+        low_range_low_Nm=d3,
+    )
 
 
 #: (variable, StiffnessTest field, units, long name) of the saved figures
-_FIGURES = (("rated_torque", "rated_torque", "N m", "rated (peak) torque of the loop"),
-            ("torsional_rigidity", "rigidity_Nm_per_arcmin", "N m/arcmin",
-             "torsional rigidity, mean of the +T_r and -T_r branch slopes over T_r/2 <= abs(T) <= T_r"),
-            ("torsional_rigidity_positive", "rigidity_positive_Nm_per_arcmin", "N m/arcmin",
-             "slope of the +T_r loading branch over T in [T_r/2, T_r]"),
-            ("torsional_rigidity_negative", "rigidity_negative_Nm_per_arcmin", "N m/arcmin",
-             "slope of the -T_r branch over -T in [T_r/2, T_r]"),
-            ("lost_motion", "lost_motion_arcmin", "arcmin",
-             "lost motion: rotation between +3 % and -3 % of T_r on the mean curve"),
-            ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
-            ("hysteresis_loss", "hysteresis_loss_J", "J", "hysteresis loss: energy dissipated per load cycle, "
-             "the loop area (twice the measured lower half)"),
-            ("friction_energy", "friction_energy_J", "J", "energy dissipated by friction over the test program "
-             "(0 -> +T_r -> -T_r -> 0), integral of friction_power; 0 without friction"),
-            ("torsional_rigidity_low", "rigidity_low_Nm_per_arcmin", "N m/arcmin",
-             "low-torque rigidity, mean of the +T_r and -T_r branch slopes over 3 % T_r <= abs(T) <= T_r/2"),
-            ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
-            ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
-            ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
-            ("lost_motion_negative_angle", "lost_motion_negative_arcmin", "arcmin", "mean-curve angle at -3 % T_r"),
-            ("lost_motion_positive_angle", "lost_motion_positive_arcmin", "arcmin", "mean-curve angle at +3 % T_r"),
-            ("hysteresis_returning_angle", "hysteresis_returning_arcmin", "arcmin", "returning branch at T = 0"),
-            ("hysteresis_descending_angle", "hysteresis_descending_arcmin", "arcmin", "descending branch at T = 0"))
+_FIGURES = (
+    ("rated_torque", "rated_torque", "N m", "rated (peak) torque of the loop"),
+    (
+        "torsional_rigidity",
+        "rigidity_Nm_per_arcmin",
+        "N m/arcmin",
+        "torsional rigidity, mean of the +T_r and -T_r branch slopes over T_r/2 <= abs(T) <= T_r",
+    ),
+    (
+        "torsional_rigidity_positive",
+        "rigidity_positive_Nm_per_arcmin",
+        "N m/arcmin",
+        "slope of the +T_r loading branch over T in [T_r/2, T_r]",
+    ),
+    (
+        "torsional_rigidity_negative",
+        "rigidity_negative_Nm_per_arcmin",
+        "N m/arcmin",
+        "slope of the -T_r branch over -T in [T_r/2, T_r]",
+    ),
+    (
+        "lost_motion",
+        "lost_motion_arcmin",
+        "arcmin",
+        "lost motion: rotation between +3 % and -3 % of T_r on the mean curve",
+    ),
+    ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
+    (
+        "hysteresis_loss",
+        "hysteresis_loss_J",
+        "J",
+        "hysteresis loss: energy dissipated per load cycle, the loop area (twice the measured lower half)",
+    ),
+    (
+        "friction_energy",
+        "friction_energy_J",
+        "J",
+        "energy dissipated by friction over the test program "
+        "(0 -> +T_r -> -T_r -> 0), integral of friction_power; 0 without friction",
+    ),
+    (
+        "torsional_rigidity_low",
+        "rigidity_low_Nm_per_arcmin",
+        "N m/arcmin",
+        "low-torque rigidity, mean of the +T_r and -T_r branch slopes over 3 % T_r <= abs(T) <= T_r/2",
+    ),
+    ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
+    ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
+    ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
+    ("lost_motion_negative_angle", "lost_motion_negative_arcmin", "arcmin", "mean-curve angle at -3 % T_r"),
+    ("lost_motion_positive_angle", "lost_motion_positive_arcmin", "arcmin", "mean-curve angle at +3 % T_r"),
+    ("hysteresis_returning_angle", "hysteresis_returning_arcmin", "arcmin", "returning branch at T = 0"),
+    ("hysteresis_descending_angle", "hysteresis_descending_arcmin", "arcmin", "descending branch at T = 0"),
+)
 
 
 def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=None):
@@ -161,12 +201,18 @@ def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=N
     (the run's dataset) if given."""
     import xarray as xr
 
-    data = {name: xr.Variable((), float(getattr(figures, field)), {"units": units, "long_name": long})
-            for name, field, units, long in _FIGURES}
-    data["loop_torque"] = xr.Variable(("time",), np.asarray(torque, dtype=float),
-                                      {"units": "N m", "long_name": "output torque of the test loop"})
-    data["loop_angle"] = xr.Variable(("time",), np.asarray(angle_arcmin, dtype=float),
-                                     {"units": "arcmin", "long_name": "output rotation of the test loop"})
+    data = {
+        name: xr.Variable((), float(getattr(figures, field)), {"units": units, "long_name": long})
+        for name, field, units, long in _FIGURES
+    }
+    data["loop_torque"] = xr.Variable(
+        ("time",), np.asarray(torque, dtype=float), {"units": "N m", "long_name": "output torque of the test loop"}
+    )
+    data["loop_angle"] = xr.Variable(
+        ("time",),
+        np.asarray(angle_arcmin, dtype=float),
+        {"units": "arcmin", "long_name": "output rotation of the test loop"},
+    )
     ds = xr.Dataset(data, coords={"time": ("time", np.asarray(time, dtype=float), {"units": "s"})})
     if base is not None:
         ds = base.assign(**{k: ds[k] for k in ds.data_vars})
@@ -177,26 +223,44 @@ def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=N
 
 def stiffness_json(figures: StiffnessTest) -> dict:
     """JSON-ready figures: ``{name: {"value", "units", "description"}}``."""
-    return {name: {"value": float(getattr(figures, field)), "units": units, "description": long}
-            for name, field, units, long in _FIGURES}
+    return {
+        name: {"value": float(getattr(figures, field)), "units": units, "description": long}
+        for name, field, units, long in _FIGURES
+    }
 
 
-def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, quarter_time: float,
-                               dt: float, plot: str | None = "hysteresis.png", budget: dict | None = None) -> str:
+def stiffness_summary_markdown(
+    figures: StiffnessTest,
+    preset: str,
+    model: str,
+    quarter_time: float,
+    dt: float,
+    plot: str | None = "hysteresis.png",
+    budget: dict | None = None,
+) -> str:
     """summary.md of a stiffness test (not the time-simulation template): the program,
     the figures with units and how each is read, the loop plot, References."""
     f = figures
-    lines = [f"# Stiffness test {preset} ({model} model)", "",
-             f"Input locked; output torque 0 -> +{f.rated_torque:.4g} -> -{f.rated_torque:.4g} -> 0 N m, each "
-             f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
-             "catalogue and seed004 (average slope of the loading and unloading curves).", "",
-             "| quantity | value | unit | how it is read |", "|---|---|---|---|"]
+    lines = [
+        f"# Stiffness test {preset} ({model} model)",
+        "",
+        f"Input locked; output torque 0 -> +{f.rated_torque:.4g} -> -{f.rated_torque:.4g} -> 0 N m, each "
+        f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
+        "catalogue and seed004 (average slope of the loading and unloading curves).",
+        "",
+        "| quantity | value | unit | how it is read |",
+        "|---|---|---|---|",
+    ]
     for name, field, units, long in _FIGURES[:9]:
         lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
-    lines += ["", f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
-              f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
-              f"{f.lost_motion_positive_arcmin:.4g} arcmin); hysteresis at T = 0 ({f.hysteresis_returning_arcmin:.4g}"
-              f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).", ""]
+    lines += [
+        "",
+        f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
+        f"at T = +-{f.lost_motion_torque_Nm:.3g} N m ({f.lost_motion_negative_arcmin:.4g} .. "
+        f"{f.lost_motion_positive_arcmin:.4g} arcmin); hysteresis at T = 0 ({f.hysteresis_returning_arcmin:.4g}"
+        f" .. {f.hysteresis_descending_arcmin:.4g} arcmin).",
+        "",
+    ]
     if plot:
         lines += [f"![torque vs output rotation loop]({plot})", ""]
     if budget and not budget.get("compliances"):
@@ -206,20 +270,33 @@ def stiffness_summary_markdown(figures: StiffnessTest, preset: str, model: str, 
 
         comp = budget["compliances"]
         total = sum(comp.values())
-        lines += [f"## Stiffness budget at {budget['torque']:.4g} N m", "",
-                  "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
-                  "stiffness_test_budget), the same elements as `flexrv te` and `flexrv design`.", "",
-                  "| element | compliance [arcsec/(N m)] | share [%] |", "|---|---|---|"]
+        lines += [
+            f"## Stiffness budget at {budget['torque']:.4g} N m",
+            "",
+            "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
+            "stiffness_test_budget), the same elements as `flexrv te` and `flexrv design`.",
+            "",
+            "| element | compliance [arcsec/(N m)] | share [%] |",
+            "|---|---|---|",
+        ]
         for name, c in sorted(comp.items(), key=lambda kv: -kv[1]):
             lines.append(f"| {name.replace('_', ' ')} | {c * ARCSEC_PER_RAD:.4g} | {100 * c / total:.3g} |")
-        lines += [f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |", "",
-                  f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
-                  f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin, "
-                  f"{budget['measured_with_unmodelled_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin with the elements "
-                  f"the model does not contain ({', '.join(budget['unmodelled']) or 'none'}) in series."]
+        lines += [
+            f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |",
+            "",
+            f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
+            f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin, "
+            f"{budget['measured_with_unmodelled_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin with the elements "
+            f"the model does not contain ({', '.join(budget['unmodelled']) or 'none'}) in series.",
+        ]
         lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
-    lines += ["Files: results.nc (the run plus the figures as variables with units, and the loop), "
-              "stiffness.json, config.toml.", "", "## References", "",
-              "seed004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv "
-              "repository.", ""]
+    lines += [
+        "Files: results.nc (the run plus the figures as variables with units, and the loop), "
+        "stiffness.json, config.toml.",
+        "",
+        "## References",
+        "",
+        "seed004 (RV-40E torsional stiffness): key `seed004` of `docs/references.md` in the flexrv repository.",
+        "",
+    ]
     return "\n".join(lines)

@@ -28,20 +28,34 @@ def te_dataset(result, reducer) -> xr.Dataset:
     """
     data = {
         "te": (("position",), result.te * ARCSEC_PER_RAD, {"units": "arcsec", "long_name": "loaded TE"}),
-        "te_no_load": (("position",), result.te_no_load * ARCSEC_PER_RAD,
-                       {"units": "arcsec", "long_name": "no-load (kinematic) TE"}),
+        "te_no_load": (
+            ("position",),
+            result.te_no_load * ARCSEC_PER_RAD,
+            {"units": "arcsec", "long_name": "no-load (kinematic) TE"},
+        ),
         "output_angle": (("position",), result.output_angle, {"units": "rad", "long_name": "output angle"}),
-        "output_revolutions": (("position",), result.input_angle / result.ratio / (2.0 * np.pi),
-                               {"units": "1", "long_name": "nominal output revolutions"}),
+        "output_revolutions": (
+            ("position",),
+            result.input_angle / result.ratio / (2.0 * np.pi),
+            {"units": "1", "long_name": "nominal output revolutions"},
+        ),
     }
     for name, o in result.outputs.items():
         data[name] = (o.dims, np.asarray(o.values), {"units": o.units, "long_name": o.long_name})
-    ds = xr.Dataset(data, coords={"position": ("position", result.input_angle,
-                                               {"units": "rad", "long_name": "input angle"})})
+    ds = xr.Dataset(
+        data, coords={"position": ("position", result.input_angle, {"units": "rad", "long_name": "input angle"})}
+    )
     s = result.summary()
-    ds.attrs.update({"preset": reducer.name, "kind": "quasi-static loaded TE", "ratio": result.ratio,
-                     "torque_Nm": result.torque, "orders": json.dumps(result.orders),
-                     "summary": json.dumps(to_jsonable(s))})
+    ds.attrs.update(
+        {
+            "preset": reducer.name,
+            "kind": "quasi-static loaded TE",
+            "ratio": result.ratio,
+            "torque_Nm": result.torque,
+            "orders": json.dumps(result.orders),
+            "summary": json.dumps(to_jsonable(s)),
+        }
+    )
     return ds
 
 
@@ -100,8 +114,12 @@ def te_summary(ds: xr.Dataset) -> dict:
     s["spectrum_lines"] = spectrum_lines(order, amp, json.loads(ds.attrs["orders"]))
     s["spectral_resolution_orders"] = float(order[1] - order[0]) if len(order) > 1 else None
     s["output_revolutions"] = revs
-    for name, key in (("pin_force", "max_pin_force_N"), ("needle_force", "max_needle_force_N"),
-                      ("crank_support_force", "max_support_force_N"), ("mesh_force", "max_mesh_force_N")):
+    for name, key in (
+        ("pin_force", "max_pin_force_N"),
+        ("needle_force", "max_needle_force_N"),
+        ("crank_support_force", "max_support_force_N"),
+        ("mesh_force", "max_mesh_force_N"),
+    ):
         if name in ds:
             s[key] = float(np.max(ds[name].values))
     if "pins_in_contact" in ds:
@@ -113,23 +131,32 @@ def te_summary(ds: xr.Dataset) -> dict:
 def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
     """summary.md of a ``flexrv te`` run, every number from ``summary``."""
     s = summary
-    rows = [("loaded TE, peak to peak", s["te_pp_arcsec"], "arcsec"),
-            ("loaded TE, mean (wind-up)", s["te_mean_arcsec"], "arcsec"),
-            ("no-load TE, peak to peak", s["no_load_te_pp_arcsec"], "arcsec"),
-            ("lost motion (±3 % rated torque)", s["lost_motion_arcmin"], "arcmin"),
-            (f"backlash (±{s['no_load_torque_Nm']:.3g} N m)", s["backlash_arcmin"], "arcmin"),
-            ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("torsional rigidity, 3–50 % rated (low torque)", s.get("low_torque_rigidity_Nm_per_arcmin", float("nan")),
-             "N m/arcmin"),
-            ("max pin force", s.get("max_pin_force_N"), "N"),
-            ("max needle-bearing force", s.get("max_needle_force_N"), "N"),
-            ("max crank-support force", s.get("max_support_force_N"), "N"),
-            ("pins in contact per disc", f"{s.get('pins_in_contact_min')}–{s.get('pins_in_contact_max')}", "-")]
-    lines = [f"# Quasi-static loaded TE: {reducer.name}", "",
-             f"Output torque {s['torque_Nm']:.6g} N m, {s['positions']} positions over "
-             f"{s['output_revolutions']:.4g} output revolutions, solved in {s['solve_time_s']:.3g} s "
-             f"({s['mean_iterations']:.2f} Newton iterations per position).", ""]
+    rows = [
+        ("loaded TE, peak to peak", s["te_pp_arcsec"], "arcsec"),
+        ("loaded TE, mean (wind-up)", s["te_mean_arcsec"], "arcsec"),
+        ("no-load TE, peak to peak", s["no_load_te_pp_arcsec"], "arcsec"),
+        ("lost motion (±3 % rated torque)", s["lost_motion_arcmin"], "arcmin"),
+        (f"backlash (±{s['no_load_torque_Nm']:.3g} N m)", s["backlash_arcmin"], "arcmin"),
+        ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+        ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+        (
+            "torsional rigidity, 3–50 % rated (low torque)",
+            s.get("low_torque_rigidity_Nm_per_arcmin", float("nan")),
+            "N m/arcmin",
+        ),
+        ("max pin force", s.get("max_pin_force_N"), "N"),
+        ("max needle-bearing force", s.get("max_needle_force_N"), "N"),
+        ("max crank-support force", s.get("max_support_force_N"), "N"),
+        ("pins in contact per disc", f"{s.get('pins_in_contact_min')}–{s.get('pins_in_contact_max')}", "-"),
+    ]
+    lines = [
+        f"# Quasi-static loaded TE: {reducer.name}",
+        "",
+        f"Output torque {s['torque_Nm']:.6g} N m, {s['positions']} positions over "
+        f"{s['output_revolutions']:.4g} output revolutions, solved in {s['solve_time_s']:.3g} s "
+        f"({s['mean_iterations']:.2f} Newton iterations per position).",
+        "",
+    ]
     if errors_note:
         lines += [errors_note, ""]
     lines += ["| quantity | value | unit |", "|---|---|---|"]
@@ -138,19 +165,33 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
         lines.append(f"| {name} | {v} | {unit} |")
     budget = s.get("compliance_budget_percent") or {}
     if budget:
-        lines += ["", "## Compliance budget at the operating torque (share of the torsional compliance)", "",
-                  "| element | share [%] |", "|---|---|"]
+        lines += [
+            "",
+            "## Compliance budget at the operating torque (share of the torsional compliance)",
+            "",
+            "| element | share [%] |",
+            "|---|---|",
+        ]
         for name, share in sorted(budget.items(), key=lambda kv: -kv[1]):
             lines.append(f"| {name.replace('_', ' ')} | {share:.1f} |")
-    lines += ["", "## Largest TE spectrum lines (orders of the output rotation)", "",
-              f"Resolution {s['spectral_resolution_orders']:.3g} orders.", "",
-              "| order | amplitude [arcsec] | nearest characteristic order |", "|---|---|---|"]
+    lines += [
+        "",
+        "## Largest TE spectrum lines (orders of the output rotation)",
+        "",
+        f"Resolution {s['spectral_resolution_orders']:.3g} orders.",
+        "",
+        "| order | amplitude [arcsec] | nearest characteristic order |",
+        "|---|---|---|",
+    ]
     for line in s["spectrum_lines"]:
         lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
-    lines += ["", f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; lost "
-              "motion and backlash are the output rotations between the reversed loads at ±3 % of the rated torque "
-              f"and at ±{s['no_load_torque_Nm']:.3g} N m with the input locked (largest over the evaluated "
-              f"positions); rigidity in N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad)."]
+    lines += [
+        "",
+        f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; lost "
+        "motion and backlash are the output rotations between the reversed loads at ±3 % of the rated torque "
+        f"and at ±{s['no_load_torque_Nm']:.3g} N m with the input locked (largest over the evaluated "
+        f"positions); rigidity in N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad).",
+    ]
     return "\n".join(lines) + "\n"
 
 

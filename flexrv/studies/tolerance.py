@@ -116,8 +116,14 @@ import numpy as np
 from flexrv.errors import ConfigError, InputError
 
 #: Outputs of one evaluation (keys of :meth:`flexrv.model.quasi_static.LoadedTE.summary`).
-OUTPUTS = ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motion_arcmin", "backlash_arcmin",
-           "torsional_rigidity_Nm_per_arcmin")
+OUTPUTS = (
+    "te_pp_arcsec",
+    "te_mean_arcsec",
+    "no_load_te_pp_arcsec",
+    "lost_motion_arcmin",
+    "backlash_arcmin",
+    "torsional_rigidity_Nm_per_arcmin",
+)
 
 #: Default resolution of one evaluation (accuracy and cost measured in the module
 #: docstring): one crank revolution at 2 points per pin-mesh period. force_tol
@@ -125,8 +131,14 @@ OUTPUTS = ("te_pp_arcsec", "te_mean_arcsec", "no_load_te_pp_arcsec", "lost_motio
 #: against 1e-7 on the example error set: TE p-p and mean TE change by < 1e-6
 #: arcsec) and max_iter 200: with errors, the solver's default 1e-7 / 60 stalled
 #: just above its tolerance at some positions (measured 0.0013 N vs 0.0011 N).
-DEFAULT_RESOLUTION = {"crank_revolutions": 1.0, "output_revolutions": None, "points_per_mesh": 2,
-                      "force_tol": 1e-6, "max_iter": 200, "torque": None}
+DEFAULT_RESOLUTION = {
+    "crank_revolutions": 1.0,
+    "output_revolutions": None,
+    "points_per_mesh": 2,
+    "force_tol": 1e-6,
+    "max_iter": 200,
+    "torque": None,
+}
 
 _SPEC = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+0-9.eEinfINFaA]+)\s*$")
 
@@ -136,9 +148,15 @@ _SPEC = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+0-9.eEinfI
 SOLVER_LADDER = ((1.0, 1.0), (0.1, 1.0), (1.0, 5.0))
 
 
-def te_task(reducer, crank_revolutions: float | None = 1.0, output_revolutions: float | None = None,
-            points_per_mesh: int = 2, force_tol: float = 1e-6, max_iter: int = 200,
-            torque: float | None = None) -> dict[str, float]:
+def te_task(
+    reducer,
+    crank_revolutions: float | None = 1.0,
+    output_revolutions: float | None = None,
+    points_per_mesh: int = 2,
+    force_tol: float = 1e-6,
+    max_iter: int = 200,
+    torque: float | None = None,
+) -> dict[str, float]:
     """One tolerance sample: the quasi-static loaded TE summary numbers (:data:`OUTPUTS`).
 
     With errors the static solver sometimes stalls a little above its residual
@@ -157,9 +175,14 @@ def te_task(reducer, crank_revolutions: float | None = 1.0, output_revolutions: 
     last = None
     for attempt, (f_tol, f_it) in enumerate(SOLVER_LADDER):
         try:
-            res = loaded_te(reducer, torque=torque, output_revolutions=output_revolutions,
-                            crank_revolutions=crank_revolutions, points_per_mesh=points_per_mesh,
-                            options={"force_tol": force_tol * f_tol, "max_iter": int(max_iter * f_it)})
+            res = loaded_te(
+                reducer,
+                torque=torque,
+                output_revolutions=output_revolutions,
+                crank_revolutions=crank_revolutions,
+                points_per_mesh=points_per_mesh,
+                options={"force_tol": force_tol * f_tol, "max_iter": int(max_iter * f_it)},
+            )
             break
         except ConvergenceError as exc:
             last = exc
@@ -284,17 +307,21 @@ class TolerancePlan:
     def saltelli(self, n: int) -> np.ndarray:
         """SALib Saltelli design (first and total order) on grouped variables:
         n (G + 2) rows, block layout [A, AB_1..AB_G, B] per base sample."""
-        from SALib.sample import sobol as sobol_sample
-
         import warnings
+
+        from SALib.sample import sobol as sobol_sample
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return sobol_sample.sample(self.salib_problem(), n, calc_second_order=False, seed=self.seed)
 
     def salib_problem(self) -> dict[str, Any]:
-        return {"num_vars": self.dim, "names": [c.label for c in self.columns],
-                "bounds": [[0.0, 1.0]] * self.dim, "groups": [c.entry for c in self.columns]}
+        return {
+            "num_vars": self.dim,
+            "names": [c.label for c in self.columns],
+            "bounds": [[0.0, 1.0]] * self.dim,
+            "groups": [c.entry for c in self.columns],
+        }
 
     # --- unit -> values
     def correlate(self, u: np.ndarray) -> np.ndarray:
@@ -399,8 +426,16 @@ def percentiles(y: np.ndarray) -> dict[str, float]:
     if y.size == 0:
         return {"n": 0}
     p50, p95, p997 = np.percentile(y, [50.0, 95.0, 99.7])
-    return {"n": int(y.size), "mean": float(np.mean(y)), "std": float(np.std(y, ddof=1)) if y.size > 1 else 0.0,
-            "min": float(np.min(y)), "P50": float(p50), "P95": float(p95), "P99.7": float(p997), "max": float(np.max(y))}
+    return {
+        "n": int(y.size),
+        "mean": float(np.mean(y)),
+        "std": float(np.std(y, ddof=1)) if y.size > 1 else 0.0,
+        "min": float(np.min(y)),
+        "P50": float(p50),
+        "P95": float(p95),
+        "P99.7": float(p997),
+        "max": float(np.max(y)),
+    }
 
 
 def yield_estimate(ys: dict[str, np.ndarray], specs: list[Spec], confidence: float = 0.95) -> dict[str, Any] | None:
@@ -420,8 +455,15 @@ def yield_estimate(ys: dict[str, np.ndarray], specs: list[Spec], confidence: flo
     if n == 0:
         return {"n": 0, "passed": 0, "yield": None, "ci_low": None, "ci_high": None, "specs": [str(s) for s in specs]}
     ci = binomtest(k, n).proportion_ci(confidence_level=confidence, method="exact")
-    return {"n": n, "passed": k, "yield": k / n, "ci_low": float(ci.low), "ci_high": float(ci.high),
-            "confidence": confidence, "specs": [str(s) for s in specs]}
+    return {
+        "n": n,
+        "passed": k,
+        "yield": k / n,
+        "ci_low": float(ci.low),
+        "ci_high": float(ci.high),
+        "confidence": confidence,
+        "specs": [str(s) for s in specs],
+    }
 
 
 def _src(features: np.ndarray, names: list[str], y: np.ndarray, entries: list[str]) -> dict[str, Any] | None:
@@ -439,8 +481,12 @@ def _src(features: np.ndarray, names: list[str], y: np.ndarray, entries: list[st
     r2 = 1.0 - float(resid @ resid) / float(ys @ ys)
     kept = [g for g, k in zip(names, keep) if k]
     share = {e: float(sum(b * b for g, b in zip(kept, beta) if g == e)) for e in entries}
-    return {"r2": r2, "r2_adjusted": 1.0 - (1.0 - r2) * (n - 1) / (n - p - 1), "features": p,
-            "indices": dict(sorted(share.items(), key=lambda kv: -kv[1]))}
+    return {
+        "r2": r2,
+        "r2_adjusted": 1.0 - (1.0 - r2) * (n - 1) / (n - p - 1),
+        "features": p,
+        "indices": dict(sorted(share.items(), key=lambda kv: -kv[1])),
+    }
 
 
 def src_indices(x: np.ndarray, y: np.ndarray, plan: "TolerancePlan") -> dict[str, Any]:
@@ -473,17 +519,25 @@ def src_indices(x: np.ndarray, y: np.ndarray, plan: "TolerancePlan") -> dict[str
 
 def sobol_indices(problem: dict[str, Any], y: np.ndarray, seed: int = 0) -> dict[str, Any]:
     """First-order and total Sobol' indices per group (SALib, Saltelli estimators)."""
-    from SALib.analyze import sobol as sobol_analyze
-
     import warnings
+
+    from SALib.analyze import sobol as sobol_analyze
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = sobol_analyze.analyze(problem, np.asarray(y, dtype=float), calc_second_order=False, seed=seed,
-                                    print_to_console=False)
+        res = sobol_analyze.analyze(
+            problem, np.asarray(y, dtype=float), calc_second_order=False, seed=seed, print_to_console=False
+        )
     names = list(dict.fromkeys(problem.get("groups") or problem["names"]))
-    out = {name: {"S1": float(res["S1"][i]), "S1_conf": float(res["S1_conf"][i]), "ST": float(res["ST"][i]),
-                  "ST_conf": float(res["ST_conf"][i])} for i, name in enumerate(names)}
+    out = {
+        name: {
+            "S1": float(res["S1"][i]),
+            "S1_conf": float(res["S1_conf"][i]),
+            "ST": float(res["ST"][i]),
+            "ST_conf": float(res["ST_conf"][i]),
+        }
+        for i, name in enumerate(names)
+    }
     return dict(sorted(out.items(), key=lambda kv: -kv[1]["ST"]))
 
 
@@ -586,8 +640,11 @@ def plan_cases(cfg: StudyConfig, reducer, tol) -> tuple[TolerancePlan, dict[str,
     cases = [("sample", i, "", 1.0, plan.errors_for(x[i])) for i in range(len(x))]
     if cfg.sobol and plan.dim:
         done = set(parts["plain_in_saltelli"].tolist())
-        cases += [("saltelli", i, "", 1.0, plan.errors_for(parts["saltelli_x"][i]))
-                  for i in range(len(parts["saltelli_x"])) if i not in done]
+        cases += [
+            ("saltelli", i, "", 1.0, plan.errors_for(parts["saltelli_x"][i]))
+            for i in range(len(parts["saltelli_x"]))
+            if i not in done
+        ]
     m = min(cfg.what_if_samples, len(x))
     what_if = list(tol.entries) if cfg.what_if_entries is None else list(cfg.what_if_entries)
     unknown = [k for k in what_if if k not in tol.entries]
@@ -616,8 +673,12 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     res = {**DEFAULT_RESOLUTION, **cfg.resolution}
     from flexrv.model.quasi_static import positions_for
 
-    positions_for(reducer, res["output_revolutions"], None if res["output_revolutions"] else res["crank_revolutions"],
-                  res["points_per_mesh"])  # bad resolution -> InputError now, not on every worker
+    positions_for(
+        reducer,
+        res["output_revolutions"],
+        None if res["output_revolutions"] else res["crank_revolutions"],
+        res["points_per_mesh"],
+    )  # bad resolution -> InputError now, not on every worker
     plan, parts = plan_cases(cfg, reducer, tol)
     preset = cfg.design
     if design_data is not None:  # the design file carries [tolerances]: the sweep reads the design without it
@@ -625,13 +686,20 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
 
         preset = str(out / "design.toml")
         atomic_write_text(preset, tomli_w.dumps(design_data))
-    spec = SweepSpec(name=f"tolerance-{reducer.name}", preset=preset, task="flexrv.studies.tolerance:te_task",
-                     outputs=list(OUTPUTS), options=res, cases=[{"errors": c[4]} for c in parts["cases"]],
-                     description="flexrv tolerance study samples")
+    spec = SweepSpec(
+        name=f"tolerance-{reducer.name}",
+        preset=preset,
+        task="flexrv.studies.tolerance:te_task",
+        outputs=list(OUTPUTS),
+        options=res,
+        cases=[{"errors": c[4]} for c in parts["cases"]],
+        description="flexrv tolerance study samples",
+    )
     t0 = time.perf_counter()
     workers = cfg.workers or min(2, os.cpu_count() or 1)
-    summary_sweep = run_sweep(spec, out_dir=out / "runs", scheduler=cfg.scheduler, n_workers=workers,
-                              progress=progress, plots=False)  # the study draws its own figures
+    summary_sweep = run_sweep(
+        spec, out_dir=out / "runs", scheduler=cfg.scheduler, n_workers=workers, progress=progress, plots=False
+    )  # the study draws its own figures
     wall = time.perf_counter() - t0
     ids = [c.case_id for c in build_cases(spec)]
     records = []
@@ -648,22 +716,33 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     y_plain = y[:n_plain]
     ys = {k: y_plain[:, j] for j, k in enumerate(OUTPUTS)}
     result: dict[str, Any] = {
-        "design": reducer.name, "samples": n_plain, "seed": cfg.seed,
-        "sampler": "saltelli (sobol)" if cfg.sobol else cfg.sampler, "variables": plan.dim,
-        "evaluations": len(records), "computed_now": summary_sweep.computed, "skipped_existing": summary_sweep.skipped,
-        "failed": int(sum(s != "ok" for s in status)), "failed_plain": int(sum(s != "ok" for s in status[:n_plain])),
-        "wall_time_s": wall, "resolution": res, "tolerances": tol.to_dict(),
+        "design": reducer.name,
+        "samples": n_plain,
+        "seed": cfg.seed,
+        "sampler": "saltelli (sobol)" if cfg.sobol else cfg.sampler,
+        "variables": plan.dim,
+        "evaluations": len(records),
+        "computed_now": summary_sweep.computed,
+        "skipped_existing": summary_sweep.skipped,
+        "failed": int(sum(s != "ok" for s in status)),
+        "failed_plain": int(sum(s != "ok" for s in status[:n_plain])),
+        "wall_time_s": wall,
+        "resolution": res,
+        "tolerances": tol.to_dict(),
         "percentiles": {k: percentiles(ys[k]) for k in OUTPUTS},
         "yield": yield_estimate(ys, specs),
     }
-    result["sensitivity_src"] = {k: src_indices(parts["x"], ys[k], plan)
-                                 for k in ("te_pp_arcsec", "te_mean_arcsec", "lost_motion_arcmin")} if plan.dim else {}
+    result["sensitivity_src"] = (
+        {k: src_indices(parts["x"], ys[k], plan) for k in ("te_pp_arcsec", "te_mean_arcsec", "lost_motion_arcmin")}
+        if plan.dim
+        else {}
+    )
     if cfg.sobol and plan.dim:
         n_salt = len(parts["saltelli_x"])
         y_salt = np.full((n_salt, len(OUTPUTS)), np.nan)
         y_salt[parts["plain_in_saltelli"]] = y_plain
         extra = [i for i in range(n_salt) if i not in set(parts["plain_in_saltelli"].tolist())]
-        y_salt[extra] = y[n_plain:n_plain + len(extra)]
+        y_salt[extra] = y[n_plain : n_plain + len(extra)]
         sob, used = {}, {}
         step = len(plan.groups) + 2
         for j, k in enumerate(OUTPUTS[:4]):
@@ -714,14 +793,29 @@ def _what_if(parts, y, specs) -> dict[str, Any]:
         blocks = [y[:m], y[pos], y[idx[(key, 2.0)]]]
         ok = np.all([np.all(np.isfinite(b[:, need]), axis=1) for b in blocks], axis=0)
         (p0, y0, l0), (ph, yh, lh), (pd, yd, ld) = (stats(b[ok]) for b in blocks)
-        rows.append({"tolerance": key, "samples_used": int(ok.sum()), "p95_te_pp_arcsec": p0,
-                     "p95_te_pp_arcsec_halved": ph, "p95_te_pp_arcsec_doubled": pd,
-                     "yield": y0, "yield_halved": yh, "yield_doubled": yd, "p50_lost_motion_arcmin": l0,
-                     "p50_lost_motion_arcmin_halved": lh, "p50_lost_motion_arcmin_doubled": ld})
+        rows.append(
+            {
+                "tolerance": key,
+                "samples_used": int(ok.sum()),
+                "p95_te_pp_arcsec": p0,
+                "p95_te_pp_arcsec_halved": ph,
+                "p95_te_pp_arcsec_doubled": pd,
+                "yield": y0,
+                "yield_halved": yh,
+                "yield_doubled": yd,
+                "p50_lost_motion_arcmin": l0,
+                "p50_lost_motion_arcmin_halved": lh,
+                "p50_lost_motion_arcmin_doubled": ld,
+            }
+        )
     rows.sort(key=lambda r: -abs((r["p95_te_pp_arcsec_doubled"] or 0.0) - (r["p95_te_pp_arcsec_halved"] or 0.0)))
-    return {"samples": m, "method": "re-evaluation of the first M plain samples with the tolerance's deviations "
-                                    "scaled by 0.5 / 2, paired with the same samples unscaled (samples with a "
-                                    "failed evaluation left out of that row)", "rows": rows}
+    return {
+        "samples": m,
+        "method": "re-evaluation of the first M plain samples with the tolerance's deviations "
+        "scaled by 0.5 / 2, paired with the same samples unscaled (samples with a "
+        "failed evaluation left out of that row)",
+        "rows": rows,
+    }
 
 
 def _ranking(result) -> dict[str, list[dict[str, Any]]]:
@@ -734,8 +828,10 @@ def _ranking(result) -> dict[str, list[dict[str, Any]]]:
             out[k] = [{"tolerance": e, "ST": s["ST"], "S1": s["S1"], "method": "sobol"} for e, s in sob[k].items()]
         elif v.get("best"):
             fit = v[v["best"]]
-            out[k] = [{"tolerance": e, "src2": s, "method": f"src ({v['best']})", "r2": fit["r2"]}
-                      for e, s in fit["indices"].items()]
+            out[k] = [
+                {"tolerance": e, "src2": s, "method": f"src ({v['best']})", "r2": fit["r2"]}
+                for e, s in fit["indices"].items()
+            ]
         else:
             out[k] = []
     return out
@@ -754,18 +850,32 @@ def _write_outputs(out: Path, cfg, plan, parts, y, status, ids, specs, result) -
     from flexrv.cache import atomic_path, atomic_write_text
 
     n = len(y)
-    data = {"u": (("sample", "variable"), np.asarray(parts["u"], dtype=float)),
-            "x": (("sample", "variable"), np.asarray(parts["x"], dtype=float)),
-            "status": ("sample", np.asarray(status, dtype=str)), "case_id": ("sample", np.asarray(ids, dtype=str))}
+    data = {
+        "u": (("sample", "variable"), np.asarray(parts["u"], dtype=float)),
+        "x": (("sample", "variable"), np.asarray(parts["x"], dtype=float)),
+        "status": ("sample", np.asarray(status, dtype=str)),
+        "case_id": ("sample", np.asarray(ids, dtype=str)),
+    }
     for j, k in enumerate(OUTPUTS):
         data[k] = ("sample", y[:, j])
-    ds = xr.Dataset(data, coords={"sample": np.arange(n), "variable": [c.label for c in plan.columns],
-                                  "tolerance": ("variable", [c.entry for c in plan.columns])},
-                    attrs={"design": plan.reducer.name, "seed": cfg.seed, "sampler": result["sampler"],
-                           "tolerances": json.dumps(plan.tol.to_dict()), "resolution": json.dumps(result["resolution"]),
-                           "batch_values": json.dumps({k: v.tolist() for k, v in plan.batch_values.items()}),
-                           "x_units": "each variable in the unit of its error field (um or arcmin)",
-                           "specs": json.dumps([str(s) for s in specs])})
+    ds = xr.Dataset(
+        data,
+        coords={
+            "sample": np.arange(n),
+            "variable": [c.label for c in plan.columns],
+            "tolerance": ("variable", [c.entry for c in plan.columns]),
+        },
+        attrs={
+            "design": plan.reducer.name,
+            "seed": cfg.seed,
+            "sampler": result["sampler"],
+            "tolerances": json.dumps(plan.tol.to_dict()),
+            "resolution": json.dumps(result["resolution"]),
+            "batch_values": json.dumps({k: v.tolist() for k, v in plan.batch_values.items()}),
+            "x_units": "each variable in the unit of its error field (um or arcmin)",
+            "specs": json.dumps([str(s) for s in specs]),
+        },
+    )
     with atomic_path(out / "samples.nc") as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
     plots = [_histograms(out, y, specs), _tornado(out, result)]
@@ -811,8 +921,9 @@ def _tornado(out: Path, result) -> Path | None:
         ax.barh(names, hi, color="C3", label="tolerance doubled")
         ax.barh(names, lo, color="C0", label="tolerance halved")
         ax.axvline(0.0, color="k", lw=1)
-        ax.set_xlabel(f"change of P95 TE p-p [arcsec] (paired, up to {result['what_if']['samples']} "
-                      "re-evaluated samples per row)")
+        ax.set_xlabel(
+            f"change of P95 TE p-p [arcsec] (paired, up to {result['what_if']['samples']} re-evaluated samples per row)"
+        )
         ax.legend(fontsize=8)
     else:
         ranking = result["ranked_sensitivities"].get("te_pp_arcsec", [])
@@ -826,30 +937,49 @@ def _tornado(out: Path, result) -> Path | None:
 
 
 def _markdown(r: dict[str, Any]) -> str:
-    lines = [f"# Tolerance study: {r['design']}", "",
-             f"{r['samples']} samples ({r['sampler']}, seed {r['seed']}), {r['variables']} variables, "
-             f"{r['evaluations']} evaluations ({r['failed']} failed), resolution {json.dumps(r['resolution'])}.", "",
-             "| output | P50 | P95 | P99.7 | mean | std |", "|---|---|---|---|---|---|"]
+    lines = [
+        f"# Tolerance study: {r['design']}",
+        "",
+        f"{r['samples']} samples ({r['sampler']}, seed {r['seed']}), {r['variables']} variables, "
+        f"{r['evaluations']} evaluations ({r['failed']} failed), resolution {json.dumps(r['resolution'])}.",
+        "",
+        "| output | P50 | P95 | P99.7 | mean | std |",
+        "|---|---|---|---|---|---|",
+    ]
     for k, p in r["percentiles"].items():
         if p.get("n"):
-            lines.append(f"| {k} | {p['P50']:.4g} | {p['P95']:.4g} | {p['P99.7']:.4g} | {p['mean']:.4g} | {p['std']:.3g} |")
+            lines.append(
+                f"| {k} | {p['P50']:.4g} | {p['P95']:.4g} | {p['P99.7']:.4g} | {p['mean']:.4g} | {p['std']:.3g} |"
+            )
     y = r["yield"]
     if y and y["yield"] is not None:
-        lines += ["", f"Yield ({', '.join(y['specs'])}): {y['passed']}/{y['n']} = {y['yield']:.3f}, "
-                      f"95 % Clopper-Pearson interval {y['ci_low']:.3f}..{y['ci_high']:.3f}."]
+        lines += [
+            "",
+            f"Yield ({', '.join(y['specs'])}): {y['passed']}/{y['n']} = {y['yield']:.3f}, "
+            f"95 % Clopper-Pearson interval {y['ci_low']:.3f}..{y['ci_high']:.3f}.",
+        ]
     lines += ["", "## Ranked sensitivities of TE p-p", ""]
     for row in r["ranked_sensitivities"].get("te_pp_arcsec", [])[:10]:
-        val = f"ST {row['ST']:.3f}, S1 {row['S1']:.3f}" if row["method"] == "sobol" else \
-            f"SRC^2 {row['src2']:.3f} ({row['method']}, R^2 {row['r2']:.2f})"
+        val = (
+            f"ST {row['ST']:.3f}, S1 {row['S1']:.3f}"
+            if row["method"] == "sobol"
+            else f"SRC^2 {row['src2']:.3f} ({row['method']}, R^2 {row['r2']:.2f})"
+        )
         lines.append(f"- {row['tolerance']}: {val}")
     w = r["what_if"]
     if w["rows"]:
-        lines += ["", f"## What if ({w['method']}; M = {w['samples']})", "",
-                  "| tolerance | samples | P95 TE p-p | halved | doubled | yield | halved | doubled |",
-                  "|---|---|---|---|---|---|---|---|"]
+        lines += [
+            "",
+            f"## What if ({w['method']}; M = {w['samples']})",
+            "",
+            "| tolerance | samples | P95 TE p-p | halved | doubled | yield | halved | doubled |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
         for row in w["rows"]:
             f = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
-            lines.append(f"| {row['tolerance']} | {row['samples_used']} | {f(row['p95_te_pp_arcsec'])} | {f(row['p95_te_pp_arcsec_halved'])} | "
-                         f"{f(row['p95_te_pp_arcsec_doubled'])} | {f(row['yield'])} | {f(row['yield_halved'])} | "
-                         f"{f(row['yield_doubled'])} |")
+            lines.append(
+                f"| {row['tolerance']} | {row['samples_used']} | {f(row['p95_te_pp_arcsec'])} | {f(row['p95_te_pp_arcsec_halved'])} | "
+                f"{f(row['p95_te_pp_arcsec_doubled'])} | {f(row['yield'])} | {f(row['yield_halved'])} | "
+                f"{f(row['yield_doubled'])} |"
+            )
     return "\n".join(lines) + "\n"

@@ -64,8 +64,9 @@ def plot_ball_loads(res, path) -> Path:
     angle = np.arange(n_ball) * 360.0 / n_ball
     fig, axes = plt.subplots(1, loads.shape[1], figsize=(10, 3.8), sharey=True, squeeze=False)
     for k, ax in enumerate(axes[0]):
-        ax.plot(angle, loads.values[i_start, k], "o-", ms=4, lw=1.6, alpha=0.8,
-                label=f"start-up, t = {t[i_start]:.3f} s")
+        ax.plot(
+            angle, loads.values[i_start, k], "o-", ms=4, lw=1.6, alpha=0.8, label=f"start-up, t = {t[i_start]:.3f} s"
+        )
         ax.plot(angle, loads.values[-1, k], "s--", ms=3, lw=1.0, label=f"end of run, t = {t[-1]:.3f} s")
         ax.set_title(f"row {k + 1}")
         ax.set_xlabel("ball pocket angle in the cage [deg]")
@@ -86,8 +87,13 @@ def plot_ring_deformation(res, path) -> Path:
             continue
         da = res[name]
         for k in range(da.shape[1]):
-            ax.plot(da["time"], 1e6 * da.values[:, k], lw=1.4 if k == 0 else 0.8, ls="-" if k == 0 else "--",
-                    label=f"{name.split('_')[-1]} ring, row {k + 1}")
+            ax.plot(
+                da["time"],
+                1e6 * da.values[:, k],
+                lw=1.4 if k == 0 else 0.8,
+                ls="-" if k == 0 else "--",
+                label=f"{name.split('_')[-1]} ring, row {k + 1}",
+            )
     ax.set_xlabel("time [s]")
     ax.set_ylabel("deflection at the most-loaded ball [µm]")
     ax.legend(fontsize=7)

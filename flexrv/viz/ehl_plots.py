@@ -75,7 +75,10 @@ def ehl_figure(result, title: str = ""):
     ax.set_xlabel("x (entrainment) [mm]")
     ax.set_ylabel("y (transverse) [mm]")
     ax.set_title("film thickness (equal aspect)")
-    fig.suptitle(title or f"EHL: h_c = {result.h_central * 1e9:.1f} nm, h_min = {result.h_min * 1e9:.1f} nm, "
-                 f"p_max = {result.p_max * 1e-9:.3f} GPa (p_H = {result.hertz_pressure * 1e-9:.3f} GPa)")
+    fig.suptitle(
+        title
+        or f"EHL: h_c = {result.h_central * 1e9:.1f} nm, h_min = {result.h_min * 1e9:.1f} nm, "
+        f"p_max = {result.p_max * 1e-9:.3f} GPa (p_H = {result.hertz_pressure * 1e-9:.3f} GPa)"
+    )
     fig.tight_layout()
     return fig

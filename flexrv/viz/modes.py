@@ -27,12 +27,26 @@ def _pyvista():
 
 #: scalar-bar placement of every 3-D view: vertical at the right, title above the bar
 #: (never over a tick label), three significant figures
-SCALAR_BAR = {"vertical": True, "position_x": 0.86, "position_y": 0.12, "width": 0.06, "height": 0.7,
-              "title_font_size": 14, "label_font_size": 12, "fmt": "%.3g"}
+SCALAR_BAR = {
+    "vertical": True,
+    "position_x": 0.86,
+    "position_y": 0.12,
+    "width": 0.06,
+    "height": 0.7,
+    "title_font_size": 14,
+    "label_font_size": 12,
+    "fmt": "%.3g",
+}
 
 
-def surface_polydata(nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray | None = None,
-                     scale: float = 1.0, scalars: np.ndarray | None = None, name: str = "|u|"):
+def surface_polydata(
+    nodes: np.ndarray,
+    tris6: np.ndarray,
+    displacement: np.ndarray | None = None,
+    scale: float = 1.0,
+    scalars: np.ndarray | None = None,
+    name: str = "|u|",
+):
     """pyvista PolyData of the boundary (corner triangles of the Tri6 faces), nodes
     moved by ``scale * displacement``; point scalars default to |displacement|."""
     pv = _pyvista()
@@ -57,9 +71,16 @@ def warp_scale(nodes: np.ndarray, displacement: np.ndarray, fraction: float = 0.
     return 0.0 if umax == 0 else fraction * float(np.ptp(nodes, axis=0).max()) / umax
 
 
-def render_mode_png(path: str | os.PathLike, nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray,
-                    title: str = "", scalars: np.ndarray | None = None, scalar_name: str = "|u|",
-                    window_size=(900, 700)) -> Path:
+def render_mode_png(
+    path: str | os.PathLike,
+    nodes: np.ndarray,
+    tris6: np.ndarray,
+    displacement: np.ndarray,
+    title: str = "",
+    scalars: np.ndarray | None = None,
+    scalar_name: str = "|u|",
+    window_size=(900, 700),
+) -> Path:
     """Render a mode shape (warped, coloured by |u| or ``scalars``, e.g. von Mises)
     off-screen to a PNG, written atomically. Returns the path."""
     pv = _pyvista()
@@ -69,8 +90,13 @@ def render_mode_png(path: str | os.PathLike, nodes: np.ndarray, tris6: np.ndarra
     plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
     try:
         plotter.add_mesh(ref, style="wireframe", color="grey", opacity=0.15)
-        plotter.add_mesh(poly, scalars=scalar_name, cmap="viridis", show_edges=False,
-                         scalar_bar_args={"title": scalar_name, **SCALAR_BAR})
+        plotter.add_mesh(
+            poly,
+            scalars=scalar_name,
+            cmap="viridis",
+            show_edges=False,
+            scalar_bar_args={"title": scalar_name, **SCALAR_BAR},
+        )
         if title:
             plotter.add_text(title, font_size=10)
         return save_screenshot(plotter, path)
@@ -102,8 +128,14 @@ def show_mode(nodes: np.ndarray, tris6: np.ndarray, displacement: np.ndarray, ti
     return True
 
 
-def export_modes_vtu(path: str | os.PathLike, nodes: np.ndarray, tets: np.ndarray, modes: np.ndarray,
-                     frequencies_hz=None, prefix: str = "mode") -> Path:
+def export_modes_vtu(
+    path: str | os.PathLike,
+    nodes: np.ndarray,
+    tets: np.ndarray,
+    modes: np.ndarray,
+    frequencies_hz=None,
+    prefix: str = "mode",
+) -> Path:
     """Write the Tet10 mesh with each mode as a point vector ``mode_<k>_<f>Hz`` to a
     VTU file for ParaView (meshio, atomic). ``modes`` is (3N, m) node-wise."""
     import meshio

@@ -89,15 +89,22 @@ def plot_pin_forces(res, path) -> Path:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("largest pin force [N]")
     ax.legend(loc="best", fontsize=8)
-    axes[0].set_title(f"Pin forces, {res.attrs.get('preset')} ({res.attrs.get('model')} model), "
-                      f"{n_pin} pins, {n_disc} discs")
+    axes[0].set_title(
+        f"Pin forces, {res.attrs.get('preset')} ({res.attrs.get('model')} model), {n_pin} pins, {n_disc} discs"
+    )
     return _save(fig, Path(path))
 
 
 #: characteristic frequencies in words (plot labels)
-FREQUENCY_LABELS = {"crank_rotation": "crank revolution (rel. carrier)", "first_stage_mesh": "first-stage mesh",
-                    "cycloid_mesh": "cycloid mesh", "input": "input shaft", "carrier": "output (carrier)",
-                    "pin_passing": "pin passing", "crank_absolute": "crank (absolute)"}
+FREQUENCY_LABELS = {
+    "crank_rotation": "crank revolution (rel. carrier)",
+    "first_stage_mesh": "first-stage mesh",
+    "cycloid_mesh": "cycloid mesh",
+    "input": "input shaft",
+    "carrier": "output (carrier)",
+    "pin_passing": "pin passing",
+    "crank_absolute": "crank (absolute)",
+}
 
 
 def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None = None, decades: float = 4.0):
@@ -109,8 +116,8 @@ def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None
     if len(freq) > 1:
         f, a = freq[1:], amp[1:]
         top = float(a.max()) if a.size and a.max() > 0 else 1.0
-        line = ax.semilogy(f, np.maximum(a, top * 10 ** -decades), lw=0.8, label=label)[0]
-        ax.set_ylim(top * 10 ** -decades, top * 3.0)
+        line = ax.semilogy(f, np.maximum(a, top * 10**-decades), lw=0.8, label=label)[0]
+        ax.set_ylim(top * 10**-decades, top * 3.0)
         hi = max(marks.values()) if marks else f[-1]
         ax.set_xlim(0, min(f[-1], 1.25 * hi))
     res_hz = float(freq[1] - freq[0]) if len(freq) > 1 else float("nan")
@@ -123,9 +130,17 @@ def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None
         ax.axvline(f0, ls="--", lw=0.6, color="0.5")
         level = sum(1 for p in placed if f0 - p < 0.25 * span)  # stagger: a label is ~1/4 of the axis wide
         placed.append(f0)
-        ax.annotate(f"{FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz", (f0, y_top),
-                    xytext=(3, -4 - 11 * level), textcoords="offset points", rotation=0, va="top", ha="left",
-                    fontsize=7, color="0.25")
+        ax.annotate(
+            f"{FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz",
+            (f0, y_top),
+            xytext=(3, -4 - 11 * level),
+            textcoords="offset points",
+            rotation=0,
+            va="top",
+            ha="left",
+            fontsize=7,
+            color="0.25",
+        )
     ax.set_xlabel("frequency [Hz]")
     ax.set_title(f"window {window_s:.3g} s, resolution {res_hz:.3g} Hz (Hann)", fontsize=9)
     return line
@@ -143,8 +158,15 @@ def plot_te_spectrum(res, path) -> Path:
     spectrum_axis(ax, freq, amp, marks, t1 - t0)
     ax.set_ylabel("TE amplitude [arcsec]")
     if not getattr(res, "is_steady", True):
-        ax.text(0.5, 0.5, "NOT STEADY: window in the ramps or < 1 crank revolution", transform=ax.transAxes,
-                ha="center", color="red", fontsize=9)
+        ax.text(
+            0.5,
+            0.5,
+            "NOT STEADY: window in the ramps or < 1 crank revolution",
+            transform=ax.transAxes,
+            ha="center",
+            color="red",
+            fontsize=9,
+        )
     fig.suptitle(f"TE spectrum, {res.attrs.get('preset')} ({res.attrs.get('model')} model)", fontsize=10)
     fig.tight_layout()
     return _save(fig, Path(path))
@@ -165,20 +187,43 @@ def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteres
         lo, hi = f.fit_range_low_Nm, f.rated_torque
         for sgn in (1, -1):
             ax.axhspan(sgn * lo, sgn * hi, color="C2", alpha=0.12, lw=0)
-        ax.plot([], [], color="C2", alpha=0.4, lw=6,
-                label=f"rigidity fit |T| {lo:.3g}..{hi:.3g} N m: {f.rigidity_Nm_per_arcmin:.4g} N m/arcmin")
+        ax.plot(
+            [],
+            [],
+            color="C2",
+            alpha=0.4,
+            lw=6,
+            label=f"rigidity fit |T| {lo:.3g}..{hi:.3g} N m: {f.rigidity_Nm_per_arcmin:.4g} N m/arcmin",
+        )
         low = getattr(f, "low_range_low_Nm", float("nan"))
         if np.isfinite(low):
             for sgn in (1, -1):
                 ax.axhspan(sgn * low, sgn * lo, color="C4", alpha=0.10, lw=0)
-            ax.plot([], [], color="C4", alpha=0.4, lw=6,
-                    label=f"low-torque fit |T| {low:.3g}..{lo:.3g} N m: {f.rigidity_low_Nm_per_arcmin:.4g} N m/arcmin")
-        ax.plot([f.lost_motion_negative_arcmin, f.lost_motion_positive_arcmin],
-                [-f.lost_motion_torque_Nm, f.lost_motion_torque_Nm], "o-", color="C3", ms=4,
-                label=f"lost motion (±3 % T_r): {f.lost_motion_arcmin:.3g} arcmin")
-        ax.plot([f.hysteresis_returning_arcmin, f.hysteresis_descending_arcmin], [0.0, 0.0], "s-", color="C1",
-                ms=4, label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin, "
-                f"loss {getattr(f, 'hysteresis_loss_J', float('nan')):.3g} J per cycle")
+            ax.plot(
+                [],
+                [],
+                color="C4",
+                alpha=0.4,
+                lw=6,
+                label=f"low-torque fit |T| {low:.3g}..{lo:.3g} N m: {f.rigidity_low_Nm_per_arcmin:.4g} N m/arcmin",
+            )
+        ax.plot(
+            [f.lost_motion_negative_arcmin, f.lost_motion_positive_arcmin],
+            [-f.lost_motion_torque_Nm, f.lost_motion_torque_Nm],
+            "o-",
+            color="C3",
+            ms=4,
+            label=f"lost motion (±3 % T_r): {f.lost_motion_arcmin:.3g} arcmin",
+        )
+        ax.plot(
+            [f.hysteresis_returning_arcmin, f.hysteresis_descending_arcmin],
+            [0.0, 0.0],
+            "s-",
+            color="C1",
+            ms=4,
+            label=f"hysteresis (at T = 0): {f.hysteresis_arcmin:.3g} arcmin, "
+            f"loss {getattr(f, 'hysteresis_loss_J', float('nan')):.3g} J per cycle",
+        )
         ax.axhline(0, color="0.6", lw=0.5)
         ax.axvline(0, color="0.6", lw=0.5)
         ax.legend(loc="upper left", fontsize=8)

@@ -52,8 +52,10 @@ def ring_bodies(res, stress: bool = False, rebuild: bool = False) -> dict:
 
     raw = res.attrs.get("flexible_bodies")
     if raw is None:
-        raise InputError(f"result of model {res.attrs.get('model')!r} has no flexible rings to show: run "
-                         "`flexrv simulate PRESET --model flexible` (main_bearing flexible)")
+        raise InputError(
+            f"result of model {res.attrs.get('model')!r} has no flexible rings to show: run "
+            "`flexrv simulate PRESET --model flexible` (main_bearing flexible)"
+        )
     settings = json.loads(raw) if isinstance(raw, str) else raw
     out = {}
     for part, opts in settings.items():
@@ -61,9 +63,11 @@ def ring_bodies(res, stress: bool = False, rebuild: bool = False) -> dict:
         identity = opts.pop("identity", None)
         if not (stress or rebuild):
             if identity is None:
-                raise InputError(f"this result does not record which reduced {part} it used (saved before "
-                                 "flexrv recorded body identities): `flexrv view --rebuild` meshes and reduces it "
-                                 "again from the saved design")
+                raise InputError(
+                    f"this result does not record which reduced {part} it used (saved before "
+                    "flexrv recorded body identities): `flexrv view --rebuild` meshes and reduces it "
+                    "again from the saved design"
+                )
             out[part.split("_")[0]] = load_cached_body(identity)
             continue
         if res.reducer is None:
@@ -72,8 +76,9 @@ def ring_bodies(res, stress: bool = False, rebuild: bool = False) -> dict:
     return out
 
 
-def ring_states(res, time: float | None = None, stress: bool = False, bodies: dict | None = None,
-                rebuild: bool = False) -> list[RingState]:
+def ring_states(
+    res, time: float | None = None, stress: bool = False, bodies: dict | None = None, rebuild: bool = False
+) -> list[RingState]:
     """The deformed rings at the record nearest ``time`` [s] (default: last)."""
     from flexrv.geometry.bearing import BallBearingGeometry
 
@@ -108,12 +113,21 @@ def ring_states(res, time: float | None = None, stress: bool = False, bodies: di
 def _polydata(state: RingState, scale: float, field: str):
     if field == "von_mises":
         if state.von_mises is None:
-            raise InputError("field von_mises needs the rings' stress modes: they are built on request "
-                             "(flexrv view ... --field von_mises rebuilds them, ~1 min per ring)")
-        return surface_polydata(state.nodes, state.tris, state.displacement, scale, 1e-6 * state.von_mises,
-                                FIELD_TITLES["von_mises"])
-    return surface_polydata(state.nodes, state.tris, state.displacement, scale,
-                            1e6 * np.linalg.norm(state.displacement, axis=1), FIELD_TITLES["displacement"])
+            raise InputError(
+                "field von_mises needs the rings' stress modes: they are built on request "
+                "(flexrv view ... --field von_mises rebuilds them, ~1 min per ring)"
+            )
+        return surface_polydata(
+            state.nodes, state.tris, state.displacement, scale, 1e-6 * state.von_mises, FIELD_TITLES["von_mises"]
+        )
+    return surface_polydata(
+        state.nodes,
+        state.tris,
+        state.displacement,
+        scale,
+        1e6 * np.linalg.norm(state.displacement, axis=1),
+        FIELD_TITLES["displacement"],
+    )
 
 
 #: scalar-bar titles (one unit style: quantity [unit], engineering units for display)
@@ -139,9 +153,15 @@ def auto_scale(states: list[RingState], fraction: float = 0.03) -> float:
     return 0.0 if umax == 0 else fraction * size / umax
 
 
-def render_rings_png(res, path, time: float | None = None, scale: float | None = None, field: str = "displacement",
-                     rebuild: bool = False,
-                     window_size=(1000, 800)) -> Path:
+def render_rings_png(
+    res,
+    path,
+    time: float | None = None,
+    scale: float | None = None,
+    field: str = "displacement",
+    rebuild: bool = False,
+    window_size=(1000, 800),
+) -> Path:
     """Render the deformed rings (coloured by |u| or von Mises) off-screen to a PNG."""
     if field not in FIELDS:
         raise InputError(f"field = {field!r} is not allowed: choose one of {', '.join(FIELDS)}")
@@ -152,21 +172,28 @@ def render_rings_png(res, path, time: float | None = None, scale: float | None =
     try:
         name = FIELD_TITLES[field]
         for st in states:
-            plotter.add_mesh(_polydata(st, scale, field), scalars=name, cmap="viridis", show_edges=False,
-                             scalar_bar_args={"title": name, **SCALAR_BAR})
+            plotter.add_mesh(
+                _polydata(st, scale, field),
+                scalars=name,
+                cmap="viridis",
+                show_edges=False,
+                scalar_bar_args={"title": name, **SCALAR_BAR},
+            )
         pts, labels = ring_label_points(states)
         plotter.add_point_labels(pts, labels, font_size=12, point_size=6, always_visible=True)
         t = res.time
         i = len(t) - 1 if time is None else int(np.argmin(np.abs(t - time)))
-        plotter.add_text(f"{res.attrs.get('preset')} main-bearing rings, t = {t[i]:.4f} s, scale x{scale:.3g}",
-                         font_size=10)
+        plotter.add_text(
+            f"{res.attrs.get('preset')} main-bearing rings, t = {t[i]:.4f} s, scale x{scale:.3g}", font_size=10
+        )
         return save_screenshot(plotter, path)
     finally:
         plotter.close()
 
 
-def show_rings(res, time: float | None = None, scale: float | None = None, field: str = "displacement",
-               rebuild: bool = False) -> bool:
+def show_rings(
+    res, time: float | None = None, scale: float | None = None, field: str = "displacement", rebuild: bool = False
+) -> bool:
     """Interactive window if a display exists; False (nothing done) when headless."""
     if not os.environ.get("DISPLAY"):
         return False
@@ -180,8 +207,7 @@ def show_rings(res, time: float | None = None, scale: float | None = None, field
     return True
 
 
-def write_pvd(res, directory, every: int = 10, field: str = "displacement", notice=None,
-              rebuild: bool = False) -> Path:
+def write_pvd(res, directory, every: int = 10, field: str = "displacement", notice=None, rebuild: bool = False) -> Path:
     """Write the ring surfaces of every ``every``-th record as VTU files (point data
     ``displacement`` [m] and |u| [µm], undeformed coordinates: warp in ParaView) and a
     ParaView PVD collection ``rings.pvd`` with the simulation times. Atomic writes.
@@ -210,8 +236,12 @@ def write_pvd(res, directory, every: int = 10, field: str = "displacement", noti
             fname = f"{st.label}_row{st.row}_{i:06d}.vtu"
             grid = poly.cast_to_unstructured_grid()
             if i == 0:
-                frame_bytes += (grid.points.nbytes + sum(grid.point_data[k].nbytes for k in grid.point_data.keys())
-                                + grid.cells.nbytes + grid.celltypes.nbytes)
+                frame_bytes += (
+                    grid.points.nbytes
+                    + sum(grid.point_data[k].nbytes for k in grid.point_data.keys())
+                    + grid.cells.nbytes
+                    + grid.celltypes.nbytes
+                )
             with atomic_path(d / fname) as tmp:
                 grid.save(str(tmp), binary=True)
             entries.append((float(t[i]), f"{st.label}_row{st.row}", fname))

@@ -29,8 +29,9 @@ def plot_te_curve(ds, path) -> Path:
     if 1 < len(marks) <= 60:
         for m in marks[1:]:
             ax.axvline(m, color="0.8", lw=0.6, zorder=0)
-        ax.text(0.99, 0.02, "grey lines: crank revolutions", transform=ax.transAxes, ha="right", fontsize=8,
-                color="0.4")
+        ax.text(
+            0.99, 0.02, "grey lines: crank revolutions", transform=ax.transAxes, ha="right", fontsize=8, color="0.4"
+        )
     ax.set_xlabel("output angle [deg]")
     ax.set_ylabel("TE − mean [arcsec]")
     ax.set_title(f"Quasi-static transmission error, {ds.attrs['preset']}")
@@ -50,15 +51,25 @@ def plot_te_spectrum(ds, summary: dict, path) -> Path:
     if len(order):
         ax.vlines(order[1:], 0.0, amp[1:], lw=0.8)
         for line in summary["spectrum_lines"][:6]:
-            ax.annotate(f"{line['label']} ({line['order']:.4g})", (line["order"], line["amplitude_arcsec"]),
-                        textcoords="offset points", xytext=(3, 3), fontsize=7, rotation=20)
+            ax.annotate(
+                f"{line['label']} ({line['order']:.4g})",
+                (line["order"], line["amplitude_arcsec"]),
+                textcoords="offset points",
+                xytext=(3, 3),
+                fontsize=7,
+                rotation=20,
+            )
         ax.set_xlim(0, order[-1])
         ax.set_ylim(0, 1.25 * max(amp[1:].max(), 1e-12))
     ax.set_xlabel("order [cycles per output revolution]")
     ax.set_ylabel("TE amplitude [arcsec]")
     res = summary.get("spectral_resolution_orders")
-    ax.set_title(f"TE spectrum, {ds.attrs['preset']} ({summary['output_revolutions']:.3g} output revolutions, "
-                 f"resolution {res:.3g} orders)" if res else f"TE spectrum, {ds.attrs['preset']}")
+    ax.set_title(
+        f"TE spectrum, {ds.attrs['preset']} ({summary['output_revolutions']:.3g} output revolutions, "
+        f"resolution {res:.3g} orders)"
+        if res
+        else f"TE spectrum, {ds.attrs['preset']}"
+    )
     fig.tight_layout()
     return _save(fig, Path(path))
 
@@ -73,8 +84,16 @@ def plot_pin_force_map(ds, path) -> Path:
     vmax = max(float(f.max()), 1e-9)
     for k in range(nd):
         ax = axes[k, 0]
-        im = ax.imshow(f[:, k, :].T, aspect="auto", origin="lower", cmap="viridis", vmin=0.0, vmax=vmax,
-                       extent=(deg[0], deg[-1], -0.5, f.shape[2] - 0.5), interpolation="nearest")
+        im = ax.imshow(
+            f[:, k, :].T,
+            aspect="auto",
+            origin="lower",
+            cmap="viridis",
+            vmin=0.0,
+            vmax=vmax,
+            extent=(deg[0], deg[-1], -0.5, f.shape[2] - 0.5),
+            interpolation="nearest",
+        )
         ax.set_ylabel(f"disc {k}: pin")
     axes[-1, 0].set_xlabel("output angle [deg]")
     fig.colorbar(im, ax=axes[:, 0].tolist(), label="pin force [N]")
@@ -85,5 +104,8 @@ def plot_pin_force_map(ds, path) -> Path:
 def te_plots(ds, summary: dict, directory) -> list[Path]:
     """All three plots into ``directory``."""
     d = Path(directory)
-    return [plot_te_curve(ds, d / "te.png"), plot_te_spectrum(ds, summary, d / "te_spectrum.png"),
-            plot_pin_force_map(ds, d / "pin_forces.png")]
+    return [
+        plot_te_curve(ds, d / "te.png"),
+        plot_te_spectrum(ds, summary, d / "te_spectrum.png"),
+        plot_pin_force_map(ds, d / "pin_forces.png"),
+    ]

@@ -31,8 +31,21 @@ from pathlib import Path
 import numpy as np
 
 #: ISO 286-1 IT5 [um] by nominal size range (upper bound of the range [mm], IT5)
-IT5_UM = ((3, 4), (6, 5), (10, 6), (18, 8), (30, 9), (50, 11), (80, 13), (120, 15), (180, 18), (250, 20),
-          (315, 23), (400, 25), (500, 27))
+IT5_UM = (
+    (3, 4),
+    (6, 5),
+    (10, 6),
+    (18, 8),
+    (30, 9),
+    (50, 11),
+    (80, 13),
+    (120, 15),
+    (180, 18),
+    (250, 20),
+    (315, 23),
+    (400, 25),
+    (500, 27),
+)
 
 
 def it5_um(size_mm: float) -> float:
@@ -46,8 +59,12 @@ def it5_um(size_mm: float) -> float:
 def iso1328_grade5_um(m: float, d: float) -> dict[str, float]:
     """ISO 1328-1:1995 grade-5 limits [um] for module m and reference diameter d [mm]."""
     f_p = 0.3 * m + 1.25 * math.sqrt(d) + 7.0
-    return {"f_pt": 0.3 * (m + 0.4 * math.sqrt(d)) + 4.0, "F_p": f_p,
-            "f_falpha": 2.5 * math.sqrt(m) + 0.17 * math.sqrt(d) + 0.5, "F_r": 0.8 * f_p}
+    return {
+        "f_pt": 0.3 * (m + 0.4 * math.sqrt(d)) + 4.0,
+        "F_p": f_p,
+        "f_falpha": 2.5 * math.sqrt(m) + 0.17 * math.sqrt(d) + 0.5,
+        "F_r": 0.8 * f_p,
+    }
 
 
 def _fmt(a) -> str:
@@ -91,7 +108,7 @@ def iso_grade5_toml(preset: str, seed: int = 2026) -> str:
 # assumptions in its docstring). Load it with
 #     flexrv.design.with_errors("{preset}", load_error_set("iso_grade5_{preset}"))
 # ISO 1328-1:1995 grade 5 of the pin ring / disc teeth (m = 2 R_p / z_rp = {m_pin:.3g} mm, d = {d_pin:g} mm):
-#   f_pt = {g['f_pt']:.2f} um, F_p = {g['F_p']:.2f} um, f_falpha = {g['f_falpha']:.2f} um.
+#   f_pt = {g["f_pt"]:.2f} um, F_p = {g["F_p"]:.2f} um, f_falpha = {g["f_falpha"]:.2f} um.
 
 [errors.pins]
 # ISO 286-1 IT5 pin rollers ({2 * ss.pin_radius_mm:g} mm): diameter within +-{it_pin / 2:g} um -> radius within +-{it_pin / 4:g} um
@@ -104,8 +121,8 @@ pin_tangential_position_um = {_fmt(sym(half_pt, z))}
         h1, hz = amp(g["F_p"] / 2), amp(g["f_falpha"] / 2)
         text += f"""
 [[errors.discs]]
-# disc {k}: order-1 harmonic = cumulative pitch error, amplitude within F_p/2 = {g['F_p'] / 2:.2f} um;
-# order-z_c ({zc}) harmonic = tooth-periodic profile form error, amplitude within f_falpha/2 = {g['f_falpha'] / 2:.2f} um;
+# disc {k}: order-1 harmonic = cumulative pitch error, amplitude within F_p/2 = {g["F_p"] / 2:.2f} um;
+# order-z_c ({zc}) harmonic = tooth-periodic profile form error, amplitude within f_falpha/2 = {g["f_falpha"] / 2:.2f} um;
 # crank-hole positions within +-f_pt/2 = +-{half_pt:.2f} um (assumption: jig-ground class)
 harmonics = [{{ order = 1, amplitude_um = {h1[0]:g}, phase_deg = {h1[1]:g} }}, {{ order = {zc}, amplitude_um = {hz[0]:g}, phase_deg = {hz[1]:g} }}]
 hole_radial_um = {_fmt(sym(half_pt, n))}
@@ -130,13 +147,13 @@ bore_tangential_um = {_fmt(sym(half_pt, n))}
     pl_p = np.round(rng.uniform(0.0, 360.0, n), 1)
     text += f"""
 [errors.first_stage]
-# radial runout within F_r/2 (grade 5: sun F_r = {g_sun['F_r']:.2f} um, planet F_r = {g_pl['F_r']:.2f} um), projected on the
+# radial runout within F_r/2 (grade 5: sun F_r = {g_sun["F_r"]:.2f} um, planet F_r = {g_pl["F_r"]:.2f} um), projected on the
 # line of action (x sin {fs.pressure_angle_deg:g} deg): sun within {sun_top:.2f} um, planets within {pl_top:.2f} um
 sun_runout_um = {sun[0]:g}
 sun_runout_phase_deg = {sun[1]:g}
 planet_runout_um = {_fmt(pl_a)}
 planet_runout_phase_deg = {_fmt(pl_p)}
-# planet assembly phase on its crank: +-f_pt/2 of the planet ({g_pl['f_pt']:.2f} um) on its base radius
+# planet assembly phase on its crank: +-f_pt/2 of the planet ({g_pl["f_pt"]:.2f} um) on its base radius
 # {rb_p_mm:.2f} mm -> +-{phase_pl:.2f} arcmin
 planet_phase_arcmin = {_fmt(sym(phase_pl, n))}
 

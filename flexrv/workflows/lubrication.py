@@ -43,17 +43,23 @@ def _case(red, model: str, t_end: float, label: str, value: float) -> dict:
     film = sel["ball_film_thickness"].values
     loaded = load > 0.05 * load.max() if load.max() > 0 else load > 0
     te = sel["te"].values
-    return {label: value, "ehl": red.contact.ehl,
-            "min central film [um]": 1e6 * float(film[loaded].min()) if loaded.any() else 0.0,
-            "film at max load [um]": 1e6 * float(film.reshape(-1)[np.argmax(load)]),
-            "max contact pressure [GPa]": 1e-9 * float(sel["ball_max_pressure"].values.max()),
-            "max ball load [N]": float(load.max()),
-            "TE min [arcsec]": float(te.min()), "TE max [arcsec]": float(te.max()),
-            "TE mean [arcsec]": float(te.mean()), "TE p-p [arcsec]": float(te.max() - te.min())}
+    return {
+        label: value,
+        "ehl": red.contact.ehl,
+        "min central film [um]": 1e6 * float(film[loaded].min()) if loaded.any() else 0.0,
+        "film at max load [um]": 1e6 * float(film.reshape(-1)[np.argmax(load)]),
+        "max contact pressure [GPa]": 1e-9 * float(sel["ball_max_pressure"].values.max()),
+        "max ball load [N]": float(load.max()),
+        "TE min [arcsec]": float(te.min()),
+        "TE max [arcsec]": float(te.max()),
+        "TE mean [arcsec]": float(te.mean()),
+        "TE p-p [arcsec]": float(te.max() - te.min()),
+    }
 
 
-def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None,
-        model: str | None = None) -> WorkflowResult:
+def run(
+    out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None, model: str | None = None
+) -> WorkflowResult:
     """Lubrication study on ``preset``; saves to ``results/lubrication``."""
     import xarray as xr
 
@@ -66,8 +72,12 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     model = model or (SMOKE["model"] if smoke else "flexible")
     viscosities = SMOKE["viscosities"] if smoke else VISCOSITIES
     radial = SMOKE["radial_loads"] if smoke else RADIAL_LOADS
-    r = WorkflowResult(NAME, f"Main-bearing lubrication and TE ({base.name}, model {model})",
-                       ["000 (rigid vs flexible TE)", "001 (lubrication table)"], smoke=smoke)
+    r = WorkflowResult(
+        NAME,
+        f"Main-bearing lubrication and TE ({base.name}, model {model})",
+        ["000 (rigid vs flexible TE)", "001 (lubrication table)"],
+        smoke=smoke,
+    )
     film_rows = [_case(override(base, {"contact.ehl": "dry"}), model, t_end, "viscosity [Pa s]", 0.0)]
     for eta in viscosities:
         red = override(base, {"contact.ehl": "hamrock_dowson", "lubricant.viscosity_Pa_s": eta})
@@ -79,31 +89,44 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     r.tables["film: lubricant viscosity (first row: dry Hertz)"] = film_rows
     r.tables["pressure: external radial load"] = pressure_rows
     for (h_mm, p_gpa, (lo, hi)), row in zip(SEED_TABLE, film_rows[1:] + [None] * 3):
-        r.compare(f"film thickness (seed case {h_mm} mm)", "um", 1e3 * h_mm,
-                  None if row is None else row["film at max load [um]"],
-                  "seed's mm-scale 'film' is not an EHL film (EHL: 0.01-1 um); flexrv: Hamrock-Dowson h_c "
-                  "at the most-loaded ball for the viscosity of this row")
-        r.compare(f"TE range (seed case {h_mm} mm)", "arcsec", f"{lo} .. {hi}",
-                  None if row is None else f"{row['TE min [arcsec]']:.2f} .. {row['TE max [arcsec]']:.2f}",
-                  f"seed peak pressure {p_gpa} GPa")
+        r.compare(
+            f"film thickness (seed case {h_mm} mm)",
+            "um",
+            1e3 * h_mm,
+            None if row is None else row["film at max load [um]"],
+            "seed's mm-scale 'film' is not an EHL film (EHL: 0.01-1 um); flexrv: Hamrock-Dowson h_c "
+            "at the most-loaded ball for the viscosity of this row",
+        )
+        r.compare(
+            f"TE range (seed case {h_mm} mm)",
+            "arcsec",
+            f"{lo} .. {hi}",
+            None if row is None else f"{row['TE min [arcsec]']:.2f} .. {row['TE max [arcsec]']:.2f}",
+            f"seed peak pressure {p_gpa} GPa",
+        )
     te_span = [row["TE mean [arcsec]"] for row in film_rows]
     h_span = [row["min central film [um]"] for row in film_rows[1:]]
     p_span = [row["max contact pressure [GPa]"] for row in pressure_rows]
-    r.numbers = {"film": film_rows, "pressure": pressure_rows,
-                 "te_mean_spread_over_films_arcsec": float(np.ptp(te_span))}
+    r.numbers = {
+        "film": film_rows,
+        "pressure": pressure_rows,
+        "te_mean_spread_over_films_arcsec": float(np.ptp(te_span)),
+    }
     r.text.append(
         "seed000/seed001 set 'minimum film thickness' to 0.01-0.18 mm. An elastohydrodynamic film in a "
         "ball-raceway contact at GPa pressures is 0.01-1 um thick (Hamrock-Dowson; the numerical EHL solver of "
         "flexrv agrees within 6-11 %); a 0.1 mm film would separate the surfaces hydrodynamically and carry no "
         "GPa pressure. The seed's film values are therefore not used as films; flexrv varies the viscosity, "
         f"giving central films of {min(h_span):.3g}-{max(h_span):.3g} um here (at the carrier's entrainment "
-        "speed of only a few mm/s).")
+        "speed of only a few mm/s)."
+    )
     r.text.append(
         f"Effect on TE: the film adds h_c to every contact's approach in series with Hertz (a slightly larger "
         f"effective preload); the TE mean changes by {np.ptp(te_span):.3g} arcsec over dry..thickest film — "
         "negligible against the cycloid stage's wind-up. The seed's non-monotonic TE-vs-film trend (a few "
         "arcsec) is not reproduced; flexrv finds no mechanism for it in the main bearing. Maximum contact "
-        f"pressure over the radial-load cases: {min(p_span):.3g}-{max(p_span):.3g} GPa (seed: 0.98-1.25 GPa).")
+        f"pressure over the radial-load cases: {min(p_span):.3g}-{max(p_span):.3g} GPa (seed: 0.98-1.25 GPa)."
+    )
     if len(pressure_rows) > 1:
         r.text.append(
             "TE vs pressure: the maximum contact pressure rises with the external radial load, and so does the "
@@ -111,26 +134,38 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
             " arcsec) — not because of the pressure or the film, but because the radial load shifts the carrier "
             "(and with it cranks and discs) against the pin ring by tens of um (see the ring_deformation "
             "workflow). At zero external load the balls carry only the preload: "
-            f"{film_rows[0]['max ball load [N]']:.0f} N dry (seed001: steady main-bearing contact force ~93.7 N).")
+            f"{film_rows[0]['max ball load [N]']:.0f} N dry (seed001: steady main-bearing contact force ~93.7 N)."
+        )
     keys = [k for k in film_rows[0] if k != "ehl"]
     r.datasets["lubrication_film"] = xr.Dataset({k: ("case", [row[k] for row in film_rows]) for k in keys})
     keys = [k for k in pressure_rows[0] if k != "ehl"]
     r.datasets["lubrication_pressure"] = xr.Dataset({k: ("case", [row[k] for row in pressure_rows]) for k in keys})
     fig, ax = new_figure(1, 2, figsize=(11, 4))
     films = [row["min central film [um]"] for row in film_rows[1:]]
-    ax[0].errorbar(films, [row["TE mean [arcsec]"] for row in film_rows[1:]],
-                   yerr=[[row["TE mean [arcsec]"] - row["TE min [arcsec]"] for row in film_rows[1:]],
-                         [row["TE max [arcsec]"] - row["TE mean [arcsec]"] for row in film_rows[1:]]], fmt="o-",
-                   label="flexrv (TE mean, min..max)")
+    ax[0].errorbar(
+        films,
+        [row["TE mean [arcsec]"] for row in film_rows[1:]],
+        yerr=[
+            [row["TE mean [arcsec]"] - row["TE min [arcsec]"] for row in film_rows[1:]],
+            [row["TE max [arcsec]"] - row["TE mean [arcsec]"] for row in film_rows[1:]],
+        ],
+        fmt="o-",
+        label="flexrv (TE mean, min..max)",
+    )
     ax[0].axhline(film_rows[0]["TE mean [arcsec]"], color="k", ls=":", label="dry Hertz")
     ax[0].set_xscale("log")
     ax[0].set_xlabel("minimum central film h_c [µm]")
     ax[0].set_ylabel("TE [arcsec]")
     ax[0].legend(fontsize=8)
-    ax[1].errorbar([row["max contact pressure [GPa]"] for row in pressure_rows],
-                   [row["TE mean [arcsec]"] for row in pressure_rows],
-                   yerr=[[row["TE mean [arcsec]"] - row["TE min [arcsec]"] for row in pressure_rows],
-                         [row["TE max [arcsec]"] - row["TE mean [arcsec]"] for row in pressure_rows]], fmt="s-")
+    ax[1].errorbar(
+        [row["max contact pressure [GPa]"] for row in pressure_rows],
+        [row["TE mean [arcsec]"] for row in pressure_rows],
+        yerr=[
+            [row["TE mean [arcsec]"] - row["TE min [arcsec]"] for row in pressure_rows],
+            [row["TE max [arcsec]"] - row["TE mean [arcsec]"] for row in pressure_rows],
+        ],
+        fmt="s-",
+    )
     ax[1].set_xlabel("maximum contact pressure [GPa]")
     ax[1].set_ylabel("TE [arcsec]")
     fig.tight_layout()

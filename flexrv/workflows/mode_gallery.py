@@ -48,22 +48,39 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
             freq[f"{p}/{part}"] = [float(f) for f in pm.free_hz[:n_modes]]
             for k, f in enumerate(pm.free_hz[:n_modes]):
                 name = f"{p}_{part}_mode{k + 1:02d}.png"
-                render_mode_png(out / name, m.nodes, m.tris, pm.free_modes[:, k].reshape(-1, 3),
-                                title=f"{p} {part} free mode {k + 1}: {f:.1f} Hz")
+                render_mode_png(
+                    out / name,
+                    m.nodes,
+                    m.tris,
+                    pm.free_modes[:, k].reshape(-1, 3),
+                    title=f"{p} {part} free mode {k + 1}: {f:.1f} Hz",
+                )
                 gallery.append(f"![{p} {part} mode {k + 1}]({name})")
                 cf = float(pm.constrained_hz[k]) if k < len(pm.constrained_hz) else None
-                rows.append({"preset": p, "part": part, "mode": k + 1, "free-free [Hz]": float(f),
-                             "constrained [Hz]": cf, "nodes": int(m.n_nodes), "png": name})
+                rows.append(
+                    {
+                        "preset": p,
+                        "part": part,
+                        "mode": k + 1,
+                        "free-free [Hz]": float(f),
+                        "constrained [Hz]": cf,
+                        "nodes": int(m.n_nodes),
+                        "png": name,
+                    }
+                )
     r.tables["eigenfrequencies"] = rows
     r.numbers["frequencies_hz"] = freq
     r.numbers["pngs"] = [row["png"] for row in rows]
-    r.text.append("Free-free modes (6 rigid-body modes dropped) of the second-order tetrahedral FE models "
-                  "(flexrv.fem.body.part_modes); constrained: the part's interfaces clamped. "
-                  f"Mesh size: {'%.1f mm' % (size * 1e3) if size else 'each part default'}.")
+    r.text.append(
+        "Free-free modes (6 rigid-body modes dropped) of the second-order tetrahedral FE models "
+        "(flexrv.fem.body.part_modes); constrained: the part's interfaces clamped. "
+        f"Mesh size: {'%.1f mm' % (size * 1e3) if size else 'each part default'}."
+    )
     r.text.append("## Gallery\n\n" + "\n".join(gallery))
     r.datasets["frequencies"] = xr.Dataset(
         {"free_hz": (("case", "mode"), np.array([freq[c] for c in freq]), {"units": "Hz"})},
-        coords={"case": list(freq), "mode": np.arange(1, n_modes + 1)})
+        coords={"case": list(freq), "mode": np.arange(1, n_modes + 1)},
+    )
     fig, ax = new_figure(figsize=(8, 3.5))
     for j, c in enumerate(freq):
         ax.plot(np.arange(1, n_modes + 1), freq[c], "o-", label=c)

@@ -28,8 +28,9 @@ SEED_DEFORMATION_UM = (0.35, 0.50, 0.65)
 SMOKE = {"t_end": 0.01, "cases": CASES[:1], "ring_options": {"size": 0.015}}
 
 
-def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None,
-        cases=None) -> WorkflowResult:
+def run(
+    out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None, cases=None
+) -> WorkflowResult:
     """:cite:`seed001` load cases on ``preset``; saves to ``results/ring_deformation``."""
     import xarray as xr
 
@@ -42,8 +43,12 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     if t_end is None:
         t_end = SMOKE["t_end"] if smoke else max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.1
     ring_options = SMOKE["ring_options"] if smoke else {}
-    r = WorkflowResult(NAME, f"Main-bearing ring deformation vs external load ({base.name})",
-                       ["001 (flexible main bearing, load cases 15/20, 20/25, 25/30 kN)"], smoke=smoke)
+    r = WorkflowResult(
+        NAME,
+        f"Main-bearing ring deformation vs external load ({base.name})",
+        ["001 (flexible main bearing, load cases 15/20, 20/25, 25/30 kN)"],
+        smoke=smoke,
+    )
     rows, te_series = [], {}
     for k, (fa, fr) in enumerate(cases):
         red = override(base, {"operating.external_axial_force_N": fa, "operating.external_radial_force_N": fr})
@@ -58,18 +63,23 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
         sel_f = flex.ds.sel(time=slice(t0, None))
         sel_r = rigid.ds.sel(time=slice(t0, None))
         te_f, te_r = sel_f["te"].values, sel_r["te"].values
-        row = {"axial [kN]": fa / 1e3, "radial [kN]": fr / 1e3,
-               "seed deformation [um]": SEED_DEFORMATION_UM[CASES.index((fa, fr))] if (fa, fr) in CASES else None,
-               "outer ring deflection [um]": 1e6 * float(sel_f["ring_deformation_outer"].values.max()),
-               "inner ring deflection [um]": 1e6 * float(sel_f["ring_deformation_inner"].values.max()),
-               "max ball load [N]": float(sel_f["ball_load_inner"].values.max()),
-               "max ball load, rigid rings [N]": float(sel_r["ball_load_inner"].values.max()),
-               "TE min, flexible [arcsec]": float(te_f.min()), "TE max, flexible [arcsec]": float(te_f.max()),
-               "TE min, rigid rings [arcsec]": float(te_r.min()), "TE max, rigid rings [arcsec]": float(te_r.max()),
-               "carrier radial shift, flexible [um]": 1e6 * float(np.hypot(sel_f["carrier_x"].values,
-                                                                          sel_f["carrier_y"].values).max()),
-               "carrier radial shift, rigid rings [um]": 1e6 * float(np.hypot(sel_r["carrier_x"].values,
-                                                                             sel_r["carrier_y"].values).max())}
+        row = {
+            "axial [kN]": fa / 1e3,
+            "radial [kN]": fr / 1e3,
+            "seed deformation [um]": SEED_DEFORMATION_UM[CASES.index((fa, fr))] if (fa, fr) in CASES else None,
+            "outer ring deflection [um]": 1e6 * float(sel_f["ring_deformation_outer"].values.max()),
+            "inner ring deflection [um]": 1e6 * float(sel_f["ring_deformation_inner"].values.max()),
+            "max ball load [N]": float(sel_f["ball_load_inner"].values.max()),
+            "max ball load, rigid rings [N]": float(sel_r["ball_load_inner"].values.max()),
+            "TE min, flexible [arcsec]": float(te_f.min()),
+            "TE max, flexible [arcsec]": float(te_f.max()),
+            "TE min, rigid rings [arcsec]": float(te_r.min()),
+            "TE max, rigid rings [arcsec]": float(te_r.max()),
+            "carrier radial shift, flexible [um]": 1e6
+            * float(np.hypot(sel_f["carrier_x"].values, sel_f["carrier_y"].values).max()),
+            "carrier radial shift, rigid rings [um]": 1e6
+            * float(np.hypot(sel_r["carrier_x"].values, sel_r["carrier_y"].values).max()),
+        }
         rows.append(row)
         te_series[k] = (flex["te"], rigid["te"])
     r.tables["load cases (last 50 ms of the run)"] = rows
@@ -77,50 +87,73 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     rows_seed = [row for row in rows if row["seed deformation [um]"] is not None]
     for row in rows_seed:
         case = f"{row['axial [kN]']:.0f}/{row['radial [kN]']:.0f} kN"
-        r.compare(f"ring elastic deformation, {case}", "um", row["seed deformation [um]"],
-                  row["outer ring deflection [um]"],
-                  "flexrv: outer-raceway deflection at the most-loaded ball along the contact normal (ring "
-                  "clamped at its fit in a rigid housing; FE-verified to 1 % in tests)")
-        r.compare(f"TE range, {case}", "arcsec", None,
-                  f"{row['TE min, flexible [arcsec]']:.2f} .. {row['TE max, flexible [arcsec]']:.2f}",
-                  f"rigid rings: {row['TE min, rigid rings [arcsec]']:.2f} .. {row['TE max, rigid rings [arcsec]']:.2f}")
+        r.compare(
+            f"ring elastic deformation, {case}",
+            "um",
+            row["seed deformation [um]"],
+            row["outer ring deflection [um]"],
+            "flexrv: outer-raceway deflection at the most-loaded ball along the contact normal (ring "
+            "clamped at its fit in a rigid housing; FE-verified to 1 % in tests)",
+        )
+        r.compare(
+            f"TE range, {case}",
+            "arcsec",
+            None,
+            f"{row['TE min, flexible [arcsec]']:.2f} .. {row['TE max, flexible [arcsec]']:.2f}",
+            f"rigid rings: {row['TE min, rigid rings [arcsec]']:.2f} .. {row['TE max, rigid rings [arcsec]']:.2f}",
+        )
     growth = [row["outer ring deflection [um]"] for row in rows_seed]
     loads = [row["max ball load [N]"] for row in rows_seed]
-    d_te = max(max(abs(row["TE min, flexible [arcsec]"] - row["TE min, rigid rings [arcsec]"]),
-                   abs(row["TE max, flexible [arcsec]"] - row["TE max, rigid rings [arcsec]"])) for row in rows_seed)
-    d_shift = [row["carrier radial shift, flexible [um]"] - row["carrier radial shift, rigid rings [um]"]
-               for row in rows_seed]
-    text = ("The seed does not define its 'elastic deformation'; flexrv reports the raceway deflection under the "
-            "most-loaded ball along its contact normal (the ring clamped at its fit), which is what changes the "
-            "contact geometry. ")
+    d_te = max(
+        max(
+            abs(row["TE min, flexible [arcsec]"] - row["TE min, rigid rings [arcsec]"]),
+            abs(row["TE max, flexible [arcsec]"] - row["TE max, rigid rings [arcsec]"]),
+        )
+        for row in rows_seed
+    )
+    d_shift = [
+        row["carrier radial shift, flexible [um]"] - row["carrier radial shift, rigid rings [um]"] for row in rows_seed
+    ]
+    text = (
+        "The seed does not define its 'elastic deformation'; flexrv reports the raceway deflection under the "
+        "most-loaded ball along its contact normal (the ring clamped at its fit), which is what changes the "
+        "contact geometry. "
+    )
     if len(rows_seed) > 1:
-        text += (f"It grows from {growth[0]:.2f} to {growth[-1]:.2f} um (x{growth[-1] / growth[0]:.2f}), exactly "
-                 f"as the maximum ball load does (x{loads[-1] / loads[0]:.2f}): the ring is linear-elastic, so its "
-                 "deflection is proportional to the ball load. The seed's 0.35 -> 0.65 um (x1.86) grows faster than "
-                 "its loads (x1.5 radial, x1.67 axial) would allow for a linear-elastic ring — a sign that its "
-                 "numbers are not from the same kind of quantity; flexrv's are ~2x larger in magnitude. ")
-    text += (f"TE: flexible and rigid rings differ by at most {d_te:.2f} arcsec in the TE range; the ring "
-             f"compliance adds {min(d_shift):.2f}-{max(d_shift):.2f} um to the carrier's radial shift (of "
-             f"{rows_seed[0]['carrier radial shift, rigid rings [um]']:.1f}-"
-             f"{rows_seed[-1]['carrier radial shift, rigid rings [um]']:.1f}"
-             " um from the balls' Hertz compliance). With the rings clamped at their fits, their deformation is "
-             "local (lowest fit-clamped ring mode ~47 kHz for rv221) and small next to the Hertz approach, so the "
-             "seed's doubling of the TE range with flexible rings is not reproduced; it would need a compliant "
-             "housing or carrier, or clearance, which the seed does not describe. What does move TE is the "
-             "carrier's radial shift under the external load itself (tens of um against a 165 mm pin circle), "
-             "present with rigid rings too")
+        text += (
+            f"It grows from {growth[0]:.2f} to {growth[-1]:.2f} um (x{growth[-1] / growth[0]:.2f}), exactly "
+            f"as the maximum ball load does (x{loads[-1] / loads[0]:.2f}): the ring is linear-elastic, so its "
+            "deflection is proportional to the ball load. The seed's 0.35 -> 0.65 um (x1.86) grows faster than "
+            "its loads (x1.5 radial, x1.67 axial) would allow for a linear-elastic ring — a sign that its "
+            "numbers are not from the same kind of quantity; flexrv's are ~2x larger in magnitude. "
+        )
+    text += (
+        f"TE: flexible and rigid rings differ by at most {d_te:.2f} arcsec in the TE range; the ring "
+        f"compliance adds {min(d_shift):.2f}-{max(d_shift):.2f} um to the carrier's radial shift (of "
+        f"{rows_seed[0]['carrier radial shift, rigid rings [um]']:.1f}-"
+        f"{rows_seed[-1]['carrier radial shift, rigid rings [um]']:.1f}"
+        " um from the balls' Hertz compliance). With the rings clamped at their fits, their deformation is "
+        "local (lowest fit-clamped ring mode ~47 kHz for rv221) and small next to the Hertz approach, so the "
+        "seed's doubling of the TE range with flexible rings is not reproduced; it would need a compliant "
+        "housing or carrier, or clearance, which the seed does not describe. What does move TE is the "
+        "carrier's radial shift under the external load itself (tens of um against a 165 mm pin circle), "
+        "present with rigid rings too"
+    )
     if reference:
         ref = reference[0]
-        text += (f": without external load the TE range is {ref['TE min, flexible [arcsec]']:.2f} .. "
-                 f"{ref['TE max, flexible [arcsec]']:.2f} arcsec, with seed001's loads it moves to "
-                 f"{rows_seed[0]['TE min, flexible [arcsec]']:.2f} .. {rows_seed[-1]['TE max, flexible [arcsec]']:.2f}"
-                 " arcsec.")
+        text += (
+            f": without external load the TE range is {ref['TE min, flexible [arcsec]']:.2f} .. "
+            f"{ref['TE max, flexible [arcsec]']:.2f} arcsec, with seed001's loads it moves to "
+            f"{rows_seed[0]['TE min, flexible [arcsec]']:.2f} .. {rows_seed[-1]['TE max, flexible [arcsec]']:.2f}"
+            " arcsec."
+        )
     else:
         text += "."
     r.text.append(text)
     r.numbers = {"cases": rows}
-    ds = xr.Dataset({key: ("case", [row[key] for row in rows]) for key in rows[0]},
-                    coords={"case": np.arange(len(rows))})
+    ds = xr.Dataset(
+        {key: ("case", [row[key] for row in rows]) for key in rows[0]}, coords={"case": np.arange(len(rows))}
+    )
     r.datasets["ring_deformation"] = ds
     fig, ax = new_figure(1, 2, figsize=(11, 4))
     x = np.arange(len(rows))

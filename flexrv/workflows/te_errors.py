@@ -45,11 +45,17 @@ def _case(reducer, label: str, span: dict) -> tuple[dict, object]:
 
     r = loaded_te(reducer, catalog_positions=2, **span)
     s = r.summary()
-    row = {"case": label, "TE p-p [arcsec]": s["te_pp_arcsec"], "TE mean [arcsec]": s["te_mean_arcsec"],
-           "no-load TE p-p [arcsec]": s["no_load_te_pp_arcsec"], "lost motion [arcmin]": s["lost_motion_arcmin"],
-           "rigidity [N m/arcmin]": s["torsional_rigidity_Nm_per_arcmin"],
-           "max pin force [N]": float(np.nanmax(r.outputs["pin_force"].values)),
-           "unconverged positions": s["unconverged_positions"], "solve time [s]": s["solve_time_s"]}
+    row = {
+        "case": label,
+        "TE p-p [arcsec]": s["te_pp_arcsec"],
+        "TE mean [arcsec]": s["te_mean_arcsec"],
+        "no-load TE p-p [arcsec]": s["no_load_te_pp_arcsec"],
+        "lost motion [arcmin]": s["lost_motion_arcmin"],
+        "rigidity [N m/arcmin]": s["torsional_rigidity_Nm_per_arcmin"],
+        "max pin force [N]": float(np.nanmax(r.outputs["pin_force"].values)),
+        "unconverged positions": s["unconverged_positions"],
+        "solve time [s]": s["solve_time_s"],
+    }
     return row, r
 
 
@@ -63,8 +69,12 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
     from flexrv.units import ARCSEC_PER_RAD
 
     span = SMOKE if smoke else FULL
-    r = WorkflowResult(NAME, "Transmission error with manufacturing and assembly errors (quasi-static)",
-                       ["measured RV TE, Yang et al. 2021 (yang2021)"], smoke=smoke)
+    r = WorkflowResult(
+        NAME,
+        "Transmission error with manufacturing and assembly errors (quasi-static)",
+        ["measured RV TE, Yang et al. 2021 (yang2021)"],
+        smoke=smoke,
+    )
     fig, axes = new_figure(len(presets), 2, figsize=(12, 3.8 * len(presets)))
     axes = np.atleast_2d(axes)
     for row_i, preset in enumerate(presets):
@@ -88,17 +98,32 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
         lines = spectrum_lines(order, amp, full.orders, count=6)
         r.tables[f"{preset}: largest TE lines, all errors"] = [
             {"order": ln["order"], "amplitude [arcsec]": ln["amplitude_arcsec"], "nearest characteristic": ln["label"]}
-            for ln in lines]
+            for ln in lines
+        ]
         singles = [row for row in rows[1:-1]]
         driver = max(singles, key=lambda x: x["TE p-p [arcsec]"]) if singles else all_row
         lo, hi = MEASURED_RANGE_ARCSEC
-        where = ("inside" if lo <= all_row["TE p-p [arcsec]"] <= hi else
-                 "below" if all_row["TE p-p [arcsec]"] < lo else "above")
-        r.compare(f"{preset}: loaded TE p-p, one output revolution", "arcsec", f"{lo:g}-{hi:g} (RV-80E, measured)",
-                  all_row["TE p-p [arcsec]"], f"{where} the measured range; ideal geometry "
-                  f"{ideal_row['TE p-p [arcsec]']:.3g}")
-        r.compare(f"{preset}: lost motion (+-3 % rated torque)", "arcmin", "<= 1 (catalog)",
-                  all_row["lost motion [arcmin]"], f"ideal geometry {ideal_row['lost motion [arcmin]']:.3g}")
+        where = (
+            "inside"
+            if lo <= all_row["TE p-p [arcsec]"] <= hi
+            else "below"
+            if all_row["TE p-p [arcsec]"] < lo
+            else "above"
+        )
+        r.compare(
+            f"{preset}: loaded TE p-p, one output revolution",
+            "arcsec",
+            f"{lo:g}-{hi:g} (RV-80E, measured)",
+            all_row["TE p-p [arcsec]"],
+            f"{where} the measured range; ideal geometry {ideal_row['TE p-p [arcsec]']:.3g}",
+        )
+        r.compare(
+            f"{preset}: lost motion (+-3 % rated torque)",
+            "arcmin",
+            "<= 1 (catalog)",
+            all_row["lost motion [arcmin]"],
+            f"ideal geometry {ideal_row['lost motion [arcmin]']:.3g}",
+        )
         r.text.append(
             f"**{preset}**: with every error of the grade-5 set the loaded TE spans {all_row['TE p-p [arcsec]']:.3g} "
             f"arcsec over {revs:.3g} output revolutions ({where} the 30-70 arcsec measured on RV-80E prototypes), "
@@ -111,10 +136,13 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
             f"against {ideal_row['lost motion [arcmin]']:.3g} ideal: where the disc's cumulative pitch error "
             "exceeds the 5 um modification clearance, pins are preloaded at assembly (the error set is accepted: "
             "its interference stays below the 20 um limit), which removes play and raises the pin forces "
-            f"(max {all_row['max pin force [N]']:.4g} N against {ideal_row['max pin force [N]']:.4g} N ideal).")
+            f"(max {all_row['max pin force [N]']:.4g} N against {ideal_row['max pin force [N]']:.4g} N ideal)."
+        )
         if all_row["unconverged positions"]:
-            r.text.append(f"{preset}: {all_row['unconverged positions']} positions of the no-load paths did not "
-                          "converge and are left out of the statistics (below 1 % of them).")
+            r.text.append(
+                f"{preset}: {all_row['unconverged positions']} positions of the no-load paths did not "
+                "converge and are left out of the statistics (below 1 % of them)."
+            )
         x = np.degrees(full.input_angle / full.ratio)
         ax = axes[row_i, 0]
         ax.plot(x, te, lw=0.8, label="all errors")
@@ -132,18 +160,23 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
         ax.legend(fontsize=8)
         r.numbers[preset] = {"rows": rows, "spectrum_lines": lines, "driver": driver["case"]}
         r.datasets[f"te_{preset}"] = xr.Dataset(
-            {"te_all_errors": ("position", te, {"units": "arcsec"}),
-             "te_ideal": ("position", ideal.te * ARCSEC_PER_RAD, {"units": "arcsec"}),
-             "te_no_load_all_errors": ("position", full.te_no_load * ARCSEC_PER_RAD, {"units": "arcsec"})},
-            coords={"output_angle": ("position", x, {"units": "deg"})})
-    r.text.append("Why the result can differ from a measurement: one sampled reducer is not a batch (the "
-                  "tolerance study gives the distribution); the quasi-static model's compliances (tapered-roller "
-                  "crank supports, crank bending, needles, pins in their seats, and the FE carrier, disc and "
-                  "housing as condensed series compliances) are small against the errors' geometry, so the error "
-                  "TE is mostly kinematic (ideal geometry gives well under 1 % of it), and the bodies' local "
-                  "deformation under an error's load is only represented through those condensed compliances; "
-                  "and a bench measures under its own load and speed. No value of the error set was adjusted "
-                  "to approach the measured range.")
+            {
+                "te_all_errors": ("position", te, {"units": "arcsec"}),
+                "te_ideal": ("position", ideal.te * ARCSEC_PER_RAD, {"units": "arcsec"}),
+                "te_no_load_all_errors": ("position", full.te_no_load * ARCSEC_PER_RAD, {"units": "arcsec"}),
+            },
+            coords={"output_angle": ("position", x, {"units": "deg"})},
+        )
+    r.text.append(
+        "Why the result can differ from a measurement: one sampled reducer is not a batch (the "
+        "tolerance study gives the distribution); the quasi-static model's compliances (tapered-roller "
+        "crank supports, crank bending, needles, pins in their seats, and the FE carrier, disc and "
+        "housing as condensed series compliances) are small against the errors' geometry, so the error "
+        "TE is mostly kinematic (ideal geometry gives well under 1 % of it), and the bodies' local "
+        "deformation under an error's load is only represented through those condensed compliances; "
+        "and a bench measures under its own load and speed. No value of the error set was adjusted "
+        "to approach the measured range."
+    )
     fig.tight_layout()
     r.figures["te_errors"] = fig
     r.save(out_dir)

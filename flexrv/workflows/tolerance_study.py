@@ -55,8 +55,14 @@ SMOKE = {"samples": 20, "what_if_samples": 4}
 TOP = 3
 
 
-def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_samples: int | None = None,
-        workers: int | None = None, seed: int = 0) -> WorkflowResult:
+def run(
+    out_dir=None,
+    smoke: bool = False,
+    samples: int | None = None,
+    what_if_samples: int | None = None,
+    workers: int | None = None,
+    seed: int = 0,
+) -> WorkflowResult:
     """The tolerance study of rv40e; saves to ``results/tolerance_study`` (the study's own
     files, samples.nc, summary.json, histograms, under ``study/`` there)."""
     from pathlib import Path
@@ -74,104 +80,182 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
         size["what_if_samples"] = what_if_samples
     out = Path(out_dir) if out_dir else default_out(NAME, smoke)
     study_dir = out / "study"
-    r = WorkflowResult(NAME, "Tolerance study: TE and lost-motion distribution of an rv40e batch",
-                       ["measured RV-80E TE, Yang et al. 2021 (yang2021)", "Nabtesco RV-E catalog (lost motion)"],
-                       smoke=smoke)
-    base = StudyConfig(design=PRESET, tolerances=PRESET, samples=size["samples"], seed=seed, sampler="sobol",
-                       specs=list(SPECS), workers=workers, what_if_samples=0, out=str(study_dir),
-                       resolution=dict(DEFAULT_RESOLUTION))
+    r = WorkflowResult(
+        NAME,
+        "Tolerance study: TE and lost-motion distribution of an rv40e batch",
+        ["measured RV-80E TE, Yang et al. 2021 (yang2021)", "Nabtesco RV-E catalog (lost motion)"],
+        smoke=smoke,
+    )
+    base = StudyConfig(
+        design=PRESET,
+        tolerances=PRESET,
+        samples=size["samples"],
+        seed=seed,
+        sampler="sobol",
+        specs=list(SPECS),
+        workers=workers,
+        what_if_samples=0,
+        out=str(study_dir),
+        resolution=dict(DEFAULT_RESOLUTION),
+    )
     first = run_study(base, progress=False)
     ranking = first["ranked_sensitivities"].get("te_pp_arcsec", [])
     top = [row["tolerance"] for row in ranking[:TOP]]
     if len(top) < TOP:  # too few samples for the regression (not in the full run): table order
-        top += [k for k in first["tolerances"] if k not in top][:TOP - len(top)]
+        top += [k for k in first["tolerances"] if k not in top][: TOP - len(top)]
     cfg = StudyConfig(**{**base.__dict__, "what_if_samples": size["what_if_samples"], "what_if_entries": top})
     res = run_study(cfg, progress=False)  # the plain samples are reused (same case ids), the what-if rows added
     pct = res["percentiles"]
     te, lm = pct["te_pp_arcsec"], pct["lost_motion_arcmin"]
     y = res["yield"]
     n = res["samples"]
-    r.compare("loaded TE p-p, P50 (P95) of the batch", "arcsec", f"about {PUBLISHED_TE_PP_ARCSEC:g} (RV-80E, measured)",
-              te.get("P50"), f"P95 {te.get('P95', float('nan')):.3g}, P99.7 {te.get('P99.7', float('nan')):.3g}; "
-              "one crank revolution (the measurement: one output revolution)")
-    r.compare("lost motion (+-3 % rated), P50 (P95)", "arcmin", f"<= {CATALOG_LOST_MOTION_ARCMIN:g} (catalog)",
-              lm.get("P50"), f"P95 {lm.get('P95', float('nan')):.3g}, P99.7 {lm.get('P99.7', float('nan')):.3g}")
+    r.compare(
+        "loaded TE p-p, P50 (P95) of the batch",
+        "arcsec",
+        f"about {PUBLISHED_TE_PP_ARCSEC:g} (RV-80E, measured)",
+        te.get("P50"),
+        f"P95 {te.get('P95', float('nan')):.3g}, P99.7 {te.get('P99.7', float('nan')):.3g}; "
+        "one crank revolution (the measurement: one output revolution)",
+    )
+    r.compare(
+        "lost motion (+-3 % rated), P50 (P95)",
+        "arcmin",
+        f"<= {CATALOG_LOST_MOTION_ARCMIN:g} (catalog)",
+        lm.get("P50"),
+        f"P95 {lm.get('P95', float('nan')):.3g}, P99.7 {lm.get('P99.7', float('nan')):.3g}",
+    )
     if y and y["yield"] is not None:
-        r.compare("yield (TE p-p <= 60 arcsec and lost motion <= 1 arcmin)", "-", "-", y["yield"],
-                  f"{y['passed']}/{y['n']}, 95 % CI {y['ci_low']:.3f}..{y['ci_high']:.3f}")
+        r.compare(
+            "yield (TE p-p <= 60 arcsec and lost motion <= 1 arcmin)",
+            "-",
+            "-",
+            y["yield"],
+            f"{y['passed']}/{y['n']}, 95 % CI {y['ci_low']:.3f}..{y['ci_high']:.3f}",
+        )
     src = first["sensitivity_src"].get("te_pp_arcsec", {})
     fit = src.get(src.get("best") or "", None) or {}
     for out_key, label in (("te_pp_arcsec", "TE p-p"), ("lost_motion_arcmin", "lost motion")):
         r.tables[f"the tolerances that matter most for {label}"] = [
-            {"rank": i + 1, "tolerance": row["tolerance"], "SRC^2": row.get("src2"), "R^2 of the fit": row.get("r2"),
-             "method": row["method"], "source": first["tolerances"].get(row["tolerance"], {}).get("source", "")}
-            for i, row in enumerate(first["ranked_sensitivities"].get(out_key, [])[:TOP])]
+            {
+                "rank": i + 1,
+                "tolerance": row["tolerance"],
+                "SRC^2": row.get("src2"),
+                "R^2 of the fit": row.get("r2"),
+                "method": row["method"],
+                "source": first["tolerances"].get(row["tolerance"], {}).get("source", ""),
+            }
+            for i, row in enumerate(first["ranked_sensitivities"].get(out_key, [])[:TOP])
+        ]
     rows = [w for w in res["what_if"]["rows"] if w["tolerance"] in top]
     r.tables["what if (first M samples re-evaluated)"] = [
-        {"tolerance": w["tolerance"], "samples": w["samples_used"], "P95 TE p-p [arcsec]": w["p95_te_pp_arcsec"],
-         "halved": w["p95_te_pp_arcsec_halved"], "doubled": w["p95_te_pp_arcsec_doubled"],
-         "P50 lost motion [arcmin]": w.get("p50_lost_motion_arcmin"),
-         "LM halved": w.get("p50_lost_motion_arcmin_halved"), "LM doubled": w.get("p50_lost_motion_arcmin_doubled"),
-         "yield": w["yield"], "yield halved": w["yield_halved"], "yield doubled": w["yield_doubled"]} for w in rows]
+        {
+            "tolerance": w["tolerance"],
+            "samples": w["samples_used"],
+            "P95 TE p-p [arcsec]": w["p95_te_pp_arcsec"],
+            "halved": w["p95_te_pp_arcsec_halved"],
+            "doubled": w["p95_te_pp_arcsec_doubled"],
+            "P50 lost motion [arcmin]": w.get("p50_lost_motion_arcmin"),
+            "LM halved": w.get("p50_lost_motion_arcmin_halved"),
+            "LM doubled": w.get("p50_lost_motion_arcmin_doubled"),
+            "yield": w["yield"],
+            "yield halved": w["yield_halved"],
+            "yield doubled": w["yield_doubled"],
+        }
+        for w in rows
+    ]
     # the nominal reducer (no errors) at the same resolution, for the lost-motion context
     nominal = te_task(load(PRESET), **DEFAULT_RESOLUTION)
     r.tables["distribution"] = [
-        {"output": k, "P50": p.get("P50"), "P95": p.get("P95"), "P99.7": p.get("P99.7"), "mean": p.get("mean"),
-         "std": p.get("std"), "samples": p.get("n")} for k, p in pct.items()]
-    best = max(rows, key=lambda w: (w["p95_te_pp_arcsec"] or 0.0) - (w["p95_te_pp_arcsec_halved"] or 0.0),
-               default=None)
-    text = (f"{n} rv40e reducers drawn (scrambled Sobol', seed {seed}) from the ISO grade-5 tolerance set "
-            f"({res['variables']} variables, {res['failed_plain']} failed evaluations). Loaded TE p-p over one crank "
-            f"revolution: P50 {te.get('P50', float('nan')):.3g}, P95 {te.get('P95', float('nan')):.3g} arcsec against "
-            f"the about {PUBLISHED_TE_PP_ARCSEC:g} arcsec measured on RV-80E prototypes over one output revolution; "
-            f"lost motion P50 {lm.get('P50', float('nan')):.3g}, P95 {lm.get('P95', float('nan')):.3g} arcmin against "
-            f"the catalog's {CATALOG_LOST_MOTION_ARCMIN:g} arcmin.")
+        {
+            "output": k,
+            "P50": p.get("P50"),
+            "P95": p.get("P95"),
+            "P99.7": p.get("P99.7"),
+            "mean": p.get("mean"),
+            "std": p.get("std"),
+            "samples": p.get("n"),
+        }
+        for k, p in pct.items()
+    ]
+    best = max(rows, key=lambda w: (w["p95_te_pp_arcsec"] or 0.0) - (w["p95_te_pp_arcsec_halved"] or 0.0), default=None)
+    text = (
+        f"{n} rv40e reducers drawn (scrambled Sobol', seed {seed}) from the ISO grade-5 tolerance set "
+        f"({res['variables']} variables, {res['failed_plain']} failed evaluations). Loaded TE p-p over one crank "
+        f"revolution: P50 {te.get('P50', float('nan')):.3g}, P95 {te.get('P95', float('nan')):.3g} arcsec against "
+        f"the about {PUBLISHED_TE_PP_ARCSEC:g} arcsec measured on RV-80E prototypes over one output revolution; "
+        f"lost motion P50 {lm.get('P50', float('nan')):.3g}, P95 {lm.get('P95', float('nan')):.3g} arcmin against "
+        f"the catalog's {CATALOG_LOST_MOTION_ARCMIN:g} arcmin."
+    )
     if y and y["yield"] is not None:
-        text += (f" {100 * y['yield']:.1f} % of the batch meets both (95 % interval {100 * y['ci_low']:.1f}.."
-                 f"{100 * y['ci_high']:.1f} %).")
+        text += (
+            f" {100 * y['yield']:.1f} % of the batch meets both (95 % interval {100 * y['ci_low']:.1f}.."
+            f"{100 * y['ci_high']:.1f} %)."
+        )
     ds = xr.load_dataset(study_dir / "samples.nc", engine="h5netcdf")
     te_all, lm_all = ds["te_pp_arcsec"].values, ds["lost_motion_arcmin"].values
     fail_te = float(np.mean(~(te_all <= PUBLISHED_TE_PP_ARCSEC)))
     fail_lm = float(np.mean(~(lm_all <= CATALOG_LOST_MOTION_ARCMIN)))
-    text += (f" Beyond the specs: {100 * fail_te:.1f} % for TE p-p, {100 * fail_lm:.1f} % for lost motion; the nominal "
-             f"rv40e without errors has TE p-p {nominal['te_pp_arcsec']:.3g} arcsec and lost motion "
-             f"{nominal['lost_motion_arcmin']:.3g} arcmin at this resolution.")
+    text += (
+        f" Beyond the specs: {100 * fail_te:.1f} % for TE p-p, {100 * fail_lm:.1f} % for lost motion; the nominal "
+        f"rv40e without errors has TE p-p {nominal['te_pp_arcsec']:.3g} arcsec and lost motion "
+        f"{nominal['lost_motion_arcmin']:.3g} arcmin at this resolution."
+    )
     r.text.append(text)
     if top:
         strong = [row["tolerance"] for row in ranking[:TOP] if (row.get("src2") or 0.0) >= 0.01]
-        para = (f"The tolerances that matter most for TE p-p: {', '.join(top)}"
-                + (f" (SRC on the {src.get('best')} basis, R^2 {fit.get('r2', float('nan')):.2f}: the linear fit "
-                   "explains that share of the variance)" if fit else "")
-                + f"; {len(strong)} of them reach{'es' if len(strong) == 1 else ''} an SRC^2 of 0.01" + (f" ({', '.join(strong)})." if strong else "."))
+        para = (
+            f"The tolerances that matter most for TE p-p: {', '.join(top)}"
+            + (
+                f" (SRC on the {src.get('best')} basis, R^2 {fit.get('r2', float('nan')):.2f}: the linear fit "
+                "explains that share of the variance)"
+                if fit
+                else ""
+            )
+            + f"; {len(strong)} of them reach{'es' if len(strong) == 1 else ''} an SRC^2 of 0.01"
+            + (f" ({', '.join(strong)})." if strong else ".")
+        )
         if best is not None and best["p95_te_pp_arcsec"] is not None and best["p95_te_pp_arcsec_halved"] is not None:
-            para += (f" Halving {best['tolerance']} alone moves P95 TE p-p from {best['p95_te_pp_arcsec']:.3g} to "
-                     f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec (doubling: {best['p95_te_pp_arcsec_doubled']:.3g}) "
-                     f"on the first {best['samples_used']} samples.")
+            para += (
+                f" Halving {best['tolerance']} alone moves P95 TE p-p from {best['p95_te_pp_arcsec']:.3g} to "
+                f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec (doubling: {best['p95_te_pp_arcsec_doubled']:.3g}) "
+                f"on the first {best['samples_used']} samples."
+            )
         for w in rows:
-            lm3 = (w.get("p50_lost_motion_arcmin_halved"), w.get("p50_lost_motion_arcmin"),
-                   w.get("p50_lost_motion_arcmin_doubled"))
+            lm3 = (
+                w.get("p50_lost_motion_arcmin_halved"),
+                w.get("p50_lost_motion_arcmin"),
+                w.get("p50_lost_motion_arcmin_doubled"),
+            )
             if None in (w["yield"], w["yield_halved"], w["yield_doubled"], *lm3):
                 continue
             if w["yield_halved"] < w["yield"] < w["yield_doubled"]:
-                para += (f" Tightening {w['tolerance']} LOWERS the yield ({w['yield']:.2f} -> {w['yield_halved']:.2f}; "
-                         f"doubled {w['yield_doubled']:.2f})")
+                para += (
+                    f" Tightening {w['tolerance']} LOWERS the yield ({w['yield']:.2f} -> {w['yield_halved']:.2f}; "
+                    f"doubled {w['yield_doubled']:.2f})"
+                )
                 if lm3[0] >= lm3[1] >= lm3[2]:
-                    para += (f": the median lost motion goes {lm3[1]:.3g} -> {lm3[0]:.3g} arcmin (doubled {lm3[2]:.3g}), "
-                             "i.e. in this model larger errors of this kind take up clearance and lower the lost "
-                             "motion, which limits the yield.")
+                    para += (
+                        f": the median lost motion goes {lm3[1]:.3g} -> {lm3[0]:.3g} arcmin (doubled {lm3[2]:.3g}), "
+                        "i.e. in this model larger errors of this kind take up clearance and lower the lost "
+                        "motion, which limits the yield."
+                    )
                 else:
                     para += "."
         r.text.append(para)
-    r.text.append("Why the numbers can differ from a measurement: the range is one crank revolution (cost: the "
-                  "output revolution is 24x dearer per sample), the elastic bodies (carrier, discs, housing) enter as "
-                  "design-level condensed compliances shared by every sample, not with their local deformation "
-                  "under each sample's errors, "
-                  "the tolerance set is a stated ISO grade (not a measured process), and a bench measures under its "
-                  "own load and speed. Nothing is tuned to the published values.")
+    r.text.append(
+        "Why the numbers can differ from a measurement: the range is one crank revolution (cost: the "
+        "output revolution is 24x dearer per sample), the elastic bodies (carrier, discs, housing) enter as "
+        "design-level condensed compliances shared by every sample, not with their local deformation "
+        "under each sample's errors, "
+        "the tolerance set is a stated ISO grade (not a measured process), and a bench measures under its "
+        "own load and speed. Nothing is tuned to the published values."
+    )
     # figures: the two distributions with the published values, the what-if bars
     fig, axes = new_figure(1, 3, figsize=(15, 4.2))
-    for ax, key, ref, unit in ((axes[0], "te_pp_arcsec", PUBLISHED_TE_PP_ARCSEC, "arcsec"),
-                               (axes[1], "lost_motion_arcmin", CATALOG_LOST_MOTION_ARCMIN, "arcmin")):
+    for ax, key, ref, unit in (
+        (axes[0], "te_pp_arcsec", PUBLISHED_TE_PP_ARCSEC, "arcsec"),
+        (axes[1], "lost_motion_arcmin", CATALOG_LOST_MOTION_ARCMIN, "arcmin"),
+    ):
         v = ds[key].values
         v = v[np.isfinite(v)]
         if v.size:
@@ -186,9 +270,11 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
     if rows:
         names = [w["tolerance"] for w in rows][::-1]
         pos = np.arange(len(names))
-        for off, key, color, label in ((0.27, "p95_te_pp_arcsec_doubled", "C3", "doubled"),
-                                       (0.0, "p95_te_pp_arcsec", "0.5", "as drawn"),
-                                       (-0.27, "p95_te_pp_arcsec_halved", "C0", "halved")):
+        for off, key, color, label in (
+            (0.27, "p95_te_pp_arcsec_doubled", "C3", "doubled"),
+            (0.0, "p95_te_pp_arcsec", "0.5", "as drawn"),
+            (-0.27, "p95_te_pp_arcsec_halved", "C0", "halved"),
+        ):
             ax.barh(pos + off, [w[key] or 0.0 for w in rows][::-1], height=0.25, color=color, label=label)
         ax.set_yticks(pos, names)
         ax.set_xlabel("P95 TE p-p [arcsec]")
@@ -198,10 +284,18 @@ def run(out_dir=None, smoke: bool = False, samples: int | None = None, what_if_s
     fig.tight_layout()
     r.figures["tolerance_study"] = fig
     r.datasets["samples"] = ds[[k for k in OUTPUTS] + ["x"]]
-    r.numbers = {"samples": n, "percentiles": pct, "yield": y, "top_tolerances": top, "what_if": rows,
-                 "nominal": nominal, "beyond_spec_fraction": {"te_pp_arcsec": fail_te, "lost_motion_arcmin": fail_lm},
-                 "failed": res["failed"], "wall_time_s": first["wall_time_s"] + res["wall_time_s"],
-                 "study_dir": str(study_dir)}
+    r.numbers = {
+        "samples": n,
+        "percentiles": pct,
+        "yield": y,
+        "top_tolerances": top,
+        "what_if": rows,
+        "nominal": nominal,
+        "beyond_spec_fraction": {"te_pp_arcsec": fail_te, "lost_motion_arcmin": fail_lm},
+        "failed": res["failed"],
+        "wall_time_s": first["wall_time_s"] + res["wall_time_s"],
+        "study_dir": str(study_dir),
+    }
     r.save(out)
     return r
 

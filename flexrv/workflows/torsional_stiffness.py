@@ -32,26 +32,40 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     import xarray as xr
 
     from flexrv.analysis.pin_load import reducer_pin_loads
-    from flexrv.analysis.torsional import (SEED004_CC_NMM, SEED004_CW_NMM, SEED004_KTC_NMM, identify_meshing_zone,
-                                           required_mesh_stiffness, second_stage_stiffness,
-                                           seed004_pin_contributions)
+    from flexrv.analysis.torsional import (
+        SEED004_CC_NMM,
+        SEED004_CW_NMM,
+        SEED004_KTC_NMM,
+        identify_meshing_zone,
+        required_mesh_stiffness,
+        second_stage_stiffness,
+        seed004_pin_contributions,
+    )
     from flexrv.design import load
-    from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
     from flexrv.simulation import stiffness_test
+    from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
 
     red = load(preset)
     ss = red.second_stage
     t_rated = red.operating.rated_torque_Nm
-    r = WorkflowResult(NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke)
+    r = WorkflowResult(
+        NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke
+    )
 
     # ---- per-pin contributions
     th, ktc = seed004_pin_contributions(red)
     seed_ktc = SEED004_KTC_NMM * NMM
     n = min(len(th), len(seed_ktc))
     r.tables["per-pin equivalent torsional stiffness KTC_j [N m/rad]"] = [
-        {"pin": j + 1, "phase [deg]": float(np.degrees(th[j])), "seed004": float(seed_ktc[j]),
-         "flexrv": float(ktc[j]), "flexrv/seed": float(ktc[j] / seed_ktc[j]) if seed_ktc[j] > 0 else None}
-        for j in range(n)]
+        {
+            "pin": j + 1,
+            "phase [deg]": float(np.degrees(th[j])),
+            "seed004": float(seed_ktc[j]),
+            "flexrv": float(ktc[j]),
+            "flexrv/seed": float(ktc[j] / seed_ktc[j]) if seed_ktc[j] > 0 else None,
+        }
+        for j in range(n)
+    ]
     pos = seed_ktc[:n] > 0
     factor = float(np.median(ktc[:n][pos] / seed_ktc[:n][pos]))
 
@@ -60,19 +74,39 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     c_w = SEED004_CW_NMM * NMM
     c_c_seed = SEED004_CC_NMM * NMM
     c_c_flexrv = float(required_mesh_stiffness(c_w, ss_st.c_bearings))
-    z_seed4 = identify_meshing_zone(seed_ktc, c_c_seed, np.degrees(th[:len(seed_ktc)]), n_pins=SEED_ZONE_PINS)
-    z_seed = identify_meshing_zone(seed_ktc, c_c_seed, np.degrees(th[:len(seed_ktc)]))
+    z_seed4 = identify_meshing_zone(seed_ktc, c_c_seed, np.degrees(th[: len(seed_ktc)]), n_pins=SEED_ZONE_PINS)
+    z_seed = identify_meshing_zone(seed_ktc, c_c_seed, np.degrees(th[: len(seed_ktc)]))
     z_fx = identify_meshing_zone(ktc, c_c_seed, np.degrees(th))
-    r.compare("meshing zone, seed table, 4 pins", "pin", "6-9", f"{z_seed4.first}-{z_seed4.last}",
-              f"sum {z_seed4.total:.4g} N m/rad vs C_c = {c_c_seed:.4g} ({z_seed4.rel_error * 100:+.1f} %)")
-    r.compare("meshing zone, seed table, any size", "pin", "6-9", f"{z_seed.first}-{z_seed.last}",
-              f"free search over all consecutive sets fits C_c better ({z_seed.rel_error * 100:+.1f} %): the "
-              "identification is not unique")
-    r.compare("meshing zone, flexrv KTC_j", "pin", "6-9", f"{z_fx.first}-{z_fx.last}",
-              f"flexrv's KTC_j are {factor:.3g}x the seed's (design width and E', SI units), so a single pin "
-              "already exceeds C_c: the zone cannot be identified from the measured stiffness")
-    r.compare("C_c required (C_W with bearings removed)", "N m/rad", c_c_seed, c_c_flexrv,
-              f"flexrv's needle-bearing C_Hc = {ss_st.c_bearings:.4g} N m/rad at rated torque")
+    r.compare(
+        "meshing zone, seed table, 4 pins",
+        "pin",
+        "6-9",
+        f"{z_seed4.first}-{z_seed4.last}",
+        f"sum {z_seed4.total:.4g} N m/rad vs C_c = {c_c_seed:.4g} ({z_seed4.rel_error * 100:+.1f} %)",
+    )
+    r.compare(
+        "meshing zone, seed table, any size",
+        "pin",
+        "6-9",
+        f"{z_seed.first}-{z_seed.last}",
+        f"free search over all consecutive sets fits C_c better ({z_seed.rel_error * 100:+.1f} %): the "
+        "identification is not unique",
+    )
+    r.compare(
+        "meshing zone, flexrv KTC_j",
+        "pin",
+        "6-9",
+        f"{z_fx.first}-{z_fx.last}",
+        f"flexrv's KTC_j are {factor:.3g}x the seed's (design width and E', SI units), so a single pin "
+        "already exceeds C_c: the zone cannot be identified from the measured stiffness",
+    )
+    r.compare(
+        "C_c required (C_W with bearings removed)",
+        "N m/rad",
+        c_c_seed,
+        c_c_flexrv,
+        f"flexrv's needle-bearing C_Hc = {ss_st.c_bearings:.4g} N m/rad at rated torque",
+    )
 
     # ---- pins in contact: analytic distribution
     pl = reducer_pin_loads(red, t_rated)
@@ -81,9 +115,15 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     seed_no, phase_deg = _seed_pin_number(psi[idx], 0.0, ss.pin_count)
     r.tables["pins in contact at rated torque (analytic Palmgren distribution, one disc)"] = [
         {"pin index": int(i), "phase [deg]": float(p), "seed pin no.": int(s), "force [N]": float(pl.forces[i])}
-        for i, s, p in zip(idx, seed_no, phase_deg)]
-    r.compare("pins in contact (one disc)", "-", "4 (6-9)", f"{pl.n_contact} ({seed_no.min()}-{seed_no.max()})",
-              "analytic pin-load distribution with the design's clearance modification (Palmgren line contact)")
+        for i, s, p in zip(idx, seed_no, phase_deg)
+    ]
+    r.compare(
+        "pins in contact (one disc)",
+        "-",
+        "4 (6-9)",
+        f"{pl.n_contact} ({seed_no.min()}-{seed_no.max()})",
+        "analytic pin-load distribution with the design's clearance modification (Palmgren line contact)",
+    )
 
     # ---- stiffness test (contact simulation)
     test = dict(SMOKE_TEST if smoke else FULL_TEST)
@@ -95,53 +135,95 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     tq = res["output_torque"].values
     k_max = int(np.argmax(tq))
     n_sim = int(np.max(np.atleast_1d(res["pins_in_contact"].values[k_max]))) if "pins_in_contact" in res else None
-    r.compare("pins in contact, contact simulation at +T_rated", "-", "4", n_sim,
-              "rigid multibody with penalty pin contacts (per disc, maximum over discs)")
+    r.compare(
+        "pins in contact, contact simulation at +T_rated",
+        "-",
+        "4",
+        n_sim,
+        "rigid multibody with penalty pin contacts (per disc, maximum over discs)",
+    )
 
     # ---- stiffness
     to_am = RAD_PER_ARCMIN
-    r.compare("torsional stiffness, measured vs series model", "N m/arcmin", c_w * to_am, ss_st.c_w_seed * to_am,
-              f"series C_Hc ({ss_st.c_bearings * to_am:.4g}) with C_c from seed-type K_cj over the loaded pins "
-              f"({ss_st.c_mesh_seed * to_am:.4g}); {ss_st.c_w_seed / c_w:.3g}x the measurement")
-    r.compare("torsional stiffness, measured vs series (tangent mesh)", "N m/arcmin", c_w * to_am,
-              ss_st.c_w_tangent * to_am, "mesh stiffness = dT/dbeta of the Palmgren distribution")
-    r.compare("torsional stiffness, measured vs stiffness test", "N m/arcmin", c_w * to_am,
-              st.rigidity_Nm_per_arcmin,
-              f"virtual bench (input locked, +-{st.rated_torque:.0f} N m, quarter {test['quarter_time']} s); "
-              "missing compliances: crankshaft bending and torsion, pin bending, carrier/flange deflection and "
-              "the support (taper) bearings, which together would roughly triple the compliance (estimated)")
-    r.text.append(f"seed004 measured C_W = 3.06e8 N mm/rad = {c_w * to_am:.1f} N m/arcmin. flexrv's seed-type "
-                  "series model (needle bearings in series with the pin mesh) is about ten times stiffer and the "
-                  "rigid-body contact bench three times: both omit the shaft, pin, carrier and support-bearing "
-                  "compliances that dominate a real reducer.")
-    r.numbers.update({"zone_seed_4": [z_seed4.first, z_seed4.last], "zone_seed_free": [z_seed.first, z_seed.last],
-                      "zone_flexrv": [z_fx.first, z_fx.last], "ktc_factor": factor,
-                      "pins_in_contact_analytic": int(pl.n_contact), "pins_in_contact_sim": n_sim,
-                      "c_w_measured_Nm_per_arcmin": c_w * to_am, "c_w_series_Nm_per_arcmin": ss_st.c_w_seed * to_am,
-                      "rigidity_test_Nm_per_arcmin": st.rigidity_Nm_per_arcmin,
-                      "lost_motion_arcmin": st.lost_motion_arcmin, "hysteresis_arcmin": st.hysteresis_arcmin})
+    r.compare(
+        "torsional stiffness, measured vs series model",
+        "N m/arcmin",
+        c_w * to_am,
+        ss_st.c_w_seed * to_am,
+        f"series C_Hc ({ss_st.c_bearings * to_am:.4g}) with C_c from seed-type K_cj over the loaded pins "
+        f"({ss_st.c_mesh_seed * to_am:.4g}); {ss_st.c_w_seed / c_w:.3g}x the measurement",
+    )
+    r.compare(
+        "torsional stiffness, measured vs series (tangent mesh)",
+        "N m/arcmin",
+        c_w * to_am,
+        ss_st.c_w_tangent * to_am,
+        "mesh stiffness = dT/dbeta of the Palmgren distribution",
+    )
+    r.compare(
+        "torsional stiffness, measured vs stiffness test",
+        "N m/arcmin",
+        c_w * to_am,
+        st.rigidity_Nm_per_arcmin,
+        f"virtual bench (input locked, +-{st.rated_torque:.0f} N m, quarter {test['quarter_time']} s); "
+        "missing compliances: crankshaft bending and torsion, pin bending, carrier/flange deflection and "
+        "the support (taper) bearings, which together would roughly triple the compliance (estimated)",
+    )
+    r.text.append(
+        f"seed004 measured C_W = 3.06e8 N mm/rad = {c_w * to_am:.1f} N m/arcmin. flexrv's seed-type "
+        "series model (needle bearings in series with the pin mesh) is about ten times stiffer and the "
+        "rigid-body contact bench three times: both omit the shaft, pin, carrier and support-bearing "
+        "compliances that dominate a real reducer."
+    )
+    r.numbers.update(
+        {
+            "zone_seed_4": [z_seed4.first, z_seed4.last],
+            "zone_seed_free": [z_seed.first, z_seed.last],
+            "zone_flexrv": [z_fx.first, z_fx.last],
+            "ktc_factor": factor,
+            "pins_in_contact_analytic": int(pl.n_contact),
+            "pins_in_contact_sim": n_sim,
+            "c_w_measured_Nm_per_arcmin": c_w * to_am,
+            "c_w_series_Nm_per_arcmin": ss_st.c_w_seed * to_am,
+            "rigidity_test_Nm_per_arcmin": st.rigidity_Nm_per_arcmin,
+            "lost_motion_arcmin": st.lost_motion_arcmin,
+            "hysteresis_arcmin": st.hysteresis_arcmin,
+        }
+    )
 
     ang = -res["theta_out"].values * ARCMIN_PER_RAD
     r.datasets["per_pin"] = xr.Dataset(
-        {"ktc_flexrv": ("phase", ktc[:n], {"units": "N m/rad"}), "ktc_seed": ("phase", seed_ktc[:n], {"units": "N m/rad"})},
-        coords={"phase": ("phase", np.degrees(th[:n]), {"units": "deg"})})
+        {
+            "ktc_flexrv": ("phase", ktc[:n], {"units": "N m/rad"}),
+            "ktc_seed": ("phase", seed_ktc[:n], {"units": "N m/rad"}),
+        },
+        coords={"phase": ("phase", np.degrees(th[:n]), {"units": "deg"})},
+    )
     r.datasets["stiffness_loop"] = xr.Dataset(
         {"torque": ("time", tq, {"units": "N m"}), "twist": ("time", ang, {"units": "arcmin"})},
-        coords={"time": ("time", res.time, {"units": "s"})})
+        coords={"time": ("time", res.time, {"units": "s"})},
+    )
 
     fig, (a1, a2) = new_figure(1, 2, figsize=(11, 4))
     a1.semilogy(np.degrees(th[:n]), seed_ktc[:n], "o-", label="seed004")
     a1.semilogy(np.degrees(th[:n]), ktc[:n], "s-", label="flexrv")
-    a1.axvspan(np.degrees(th[z_seed4.first - 1]), np.degrees(th[z_seed4.last - 1]), color="C0", alpha=0.2,
-               label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}")
+    a1.axvspan(
+        np.degrees(th[z_seed4.first - 1]),
+        np.degrees(th[z_seed4.last - 1]),
+        color="C0",
+        alpha=0.2,
+        label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}",
+    )
     k_top = float(max(np.max(seed_ktc[:n]), np.max(ktc[:n])))
     a1.set_ylim(k_top * 1e-4, k_top * 3)  # 4 decades: the loaded pins, not the numerically unloaded ones
     a1.set_xlabel("meshing phase [deg]"), a1.set_ylabel("pin stiffness KTC_j [N m/rad]"), a1.legend(fontsize=7)
     a2.plot(ang, tq, lw=0.8)
     a2.set_xlabel("twist [arcmin]"), a2.set_ylabel("output torque [N m]")
-    a2.set_title(f"stiffness test: rigidity {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin,\n"
-                 f"lost motion {st.lost_motion_arcmin:.3g} arcmin, hysteresis {st.hysteresis_arcmin:.3g} arcmin",
-                 fontsize=9)
+    a2.set_title(
+        f"stiffness test: rigidity {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin,\n"
+        f"lost motion {st.lost_motion_arcmin:.3g} arcmin, hysteresis {st.hysteresis_arcmin:.3g} arcmin",
+        fontsize=9,
+    )
     a2.grid(True, lw=0.3)
     fig.tight_layout()
     r.figures["stiffness"] = fig

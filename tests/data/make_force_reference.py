@@ -41,14 +41,21 @@ def legacy_supports(r, name: str):
 
     data = r.model_dump()
     data.pop("housing", None)
-    cs = {k: v for k, v in data["crankshaft"].items() if not k.startswith("support_bearing_")
-          or k == "support_bearing_damping_Ns_per_m"}
-    cs.update(support_bearing_model="linear", bending_model="rigid",
-              support_bearing_radial_stiffness_N_per_m=LEGACY_SUPPORT_N_PER_M[name])
+    cs = {
+        k: v
+        for k, v in data["crankshaft"].items()
+        if not k.startswith("support_bearing_") or k == "support_bearing_damping_Ns_per_m"
+    }
+    cs.update(
+        support_bearing_model="linear",
+        bending_model="rigid",
+        support_bearing_radial_stiffness_N_per_m=LEGACY_SUPPORT_N_PER_M[name],
+    )
     # frictionless, as when the references were written (issue 14 added friction, default on in the presets)
     contact = dict(data["contact"], friction=False)
-    return from_dict({**data, "crankshaft": cs, "contact": contact},
-                     source=f"{name} with the legacy crank supports, frictionless")
+    return from_dict(
+        {**data, "crankshaft": cs, "contact": contact}, source=f"{name} with the legacy crank supports, frictionless"
+    )
 
 
 def short_run_reducer(name: str = "rv40e"):
@@ -68,8 +75,14 @@ def te_statistics(name: str = "rv40e", t_end: float = 0.05, dt: float = 1e-4) ->
     res = Simulation(short_run_reducer(name)).run(t_end=t_end, dt=dt)
     te = res["te"]
     sel = te.values[te["time"].values > 0.02]
-    return {"preset": name, "t_end": t_end, "dt": dt, "te_mean_arcsec": float(np.mean(sel)),
-            "te_pp_arcsec": float(np.ptp(sel)), "samples": int(len(sel))}
+    return {
+        "preset": name,
+        "t_end": t_end,
+        "dt": dt,
+        "te_mean_arcsec": float(np.mean(sel)),
+        "te_pp_arcsec": float(np.ptp(sel)),
+        "samples": int(len(sel)),
+    }
 
 
 def variant(name: str, needle: str):
@@ -80,11 +93,18 @@ def variant(name: str, needle: str):
     from flexrv.model.parameters import with_bodies
 
     r = with_bodies(legacy_supports(load(name), name), [])  # rigid carrier and discs (issue 14: tests/test_bodies.py)
-    op = r.operating.model_copy(update={"load_ramp_start_s": 0.0, "load_ramp_end_s": 0.004,
-                                        "external_radial_force_N": 5000.0, "external_axial_force_N": 2000.0,
-                                        "tilting_moment_Nm": 300.0})
-    return r.model_copy(update={"needle_bearing": r.needle_bearing.model_copy(update={"model": needle}),
-                                "operating": op})
+    op = r.operating.model_copy(
+        update={
+            "load_ramp_start_s": 0.0,
+            "load_ramp_end_s": 0.004,
+            "external_radial_force_N": 5000.0,
+            "external_axial_force_N": 2000.0,
+            "tilting_moment_Nm": 300.0,
+        }
+    )
+    return r.model_copy(
+        update={"needle_bearing": r.needle_bearing.model_copy(update={"model": needle}), "operating": op}
+    )
 
 
 def states(model, seed: int):
@@ -137,8 +157,9 @@ def main() -> None:
     from flexrv.model.factory import build_model
 
     arrays: dict[str, np.ndarray] = {}
-    for seed, (name, needle) in enumerate([("rv40e", "empirical"), ("rv40e", "rollers"),
-                                           ("rv221", "empirical"), ("rv221", "rollers")]):
+    for seed, (name, needle) in enumerate(
+        [("rv40e", "empirical"), ("rv40e", "rollers"), ("rv221", "empirical"), ("rv221", "rollers")]
+    ):
         model = build_model(variant(name, needle), exudyn=False)
         t, q, v = states(model, seed)
         key = f"{name}-{needle}"
