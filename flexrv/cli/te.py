@@ -10,6 +10,8 @@ import typer
 
 from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
 from flexrv.cli.design import analytic_budget, budget_table
+from flexrv.post.definitions import DEFINITIONS
+from flexrv.post.te import TE_ROWS
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -56,12 +58,12 @@ def te(
     )
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)
-    save_te(ds, summary, reducer, out)
+    budget = quasi_static_budget(summary, result.outputs, reducer)
+    save_te(budget.merged_into(ds), summary, reducer, out)
     te_plots(ds, summary, out)
-    data = {"output_dir": str(out), **summary}
-    data["stiffness_budget"] = quasi_static_budget(summary, result.outputs, reducer)
+    data = {"output_dir": str(out), **summary, "stiffness_budget": budget.to_dict()}
     analytic = analytic_budget(reducer, summary["torque_Nm"])
-    data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
+    data["stiffness_budget"]["analytic_budget_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
     data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
         analytic["total_compliance_arcsec_per_Nm"] / data["stiffness_budget"]["total_compliance_arcsec_per_Nm"] - 1.0
     )
@@ -71,11 +73,12 @@ def te(
             ("loaded TE p-p", d["te_pp_arcsec"], "arcsec"),
             ("loaded TE mean", d["te_mean_arcsec"], "arcsec"),
             ("no-load TE p-p", d["no_load_te_pp_arcsec"], "arcsec"),
-            ("lost motion (±3 % rated)", d["lost_motion_arcmin"], "arcmin"),
-            (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
-            ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
+            *[(k, d.get(k), DEFINITIONS[k][0]) for k in TE_ROWS],
+            (
+                f"lost_motion_small_torque (±{d['no_load_torque_Nm']:.3g} N m)",
+                d["lost_motion_small_torque_arcmin"],
+                "arcmin",
+            ),
             ("max pin force", d.get("max_pin_force_N"), "N"),
             ("positions", d["positions"], "-"),
             ("solve time", d["solve_time_s"], "s"),
@@ -93,29 +96,22 @@ def te(
     emit(data, json, render)
 
 
-def quasi_static_budget(summary: dict, outputs: dict, reducer=None) -> dict:
-    """Stiffness budget of the quasi-static solution in the elements of ``flexrv
-    design`` (:func:`flexrv.cli.design.budget_dict`): each force group's share of the
-    tangent compliance 1 / k_t (strain-energy fractions,
-    :meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`) times 1 / k_t;
-    the crank-support group (bearings and crank bending in series, one element) is
-    split by its bending share of the tangential compliance (output
-    ``crank_bending_fraction``, mean over positions and cranks); with the ``reducer``,
-    the pin path split and the unmodelled housing added
-    (:func:`flexrv.analysis.torsional.budget_from_group_shares`)."""
-    from flexrv.analysis.torsional import budget_from_group_shares
-    from flexrv.cli.design import budget_dict
+def quasi_static_budget(summary: dict, outputs: dict, reducer):
+    """The stiffness budget of the quasi-static solution (:func:`flexrv.analysis.budget.
+    stiffness_budget` with the model's strain-energy shares, :meth:`flexrv.model.quasi_static.
+    StaticModel.compliance_budget`, times its tangent compliance; the crank-support group split
+    by the mean of the output ``crank_bending_fraction``); the elements no model contains are
+    added in series."""
+    from flexrv.analysis.budget import ModelShares, stiffness_budget
     from flexrv.units import RAD_PER_ARCMIN
 
-    total = RAD_PER_ARCMIN / summary["torsional_rigidity_Nm_per_arcmin"]
-    shares = {k: 0.01 * v for k, v in summary.get("compliance_budget_percent", {}).items()}
     bend = outputs.get("crank_bending_fraction")
-    frac = float(np.nanmean(bend.values)) if bend is not None else 0.0
-    comp, notes = budget_from_group_shares(shares, total, frac, reducer, summary["torque_Nm"])
-    out = budget_dict(comp, summary["torque_Nm"])
-    if notes:
-        out["notes"] = list(notes)
-    return out
+    model = ModelShares(
+        shares={k: 0.01 * v for k, v in summary.get("compliance_budget_percent", {}).items()},
+        tangent_compliance=RAD_PER_ARCMIN / summary["rigidity_tangent_Nm_per_arcmin"],
+        bending_fraction=float(np.nanmean(bend.values)) if bend is not None else 0.0,
+    )
+    return stiffness_budget(reducer, summary["torque_Nm"], model=model, route="quasi_static")
 
 
 def register(app: typer.Typer) -> None:
