@@ -10,7 +10,7 @@ import typer
 
 from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
 from flexrv.cli.design import analytic_budget, budget_table
-from flexrv.post.definitions import DEFINITIONS
+from flexrv.post.definitions import DEFINITIONS, PLAY_FRACTIONS
 from flexrv.post.te import TE_ROWS
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
@@ -55,6 +55,7 @@ def te(
         output_revolutions=output_revolutions,
         crank_revolutions=crank_revolutions,
         points_per_mesh=points_per_mesh,
+        play_fractions=PLAY_FRACTIONS,
     )
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)

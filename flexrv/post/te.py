@@ -57,8 +57,22 @@ def te_dataset(result, reducer) -> xr.Dataset:
             np.asarray(c[key]) * ARCMIN_PER_RAD,
             {"units": "arcmin", "long_name": long},
         )
+    play = np.asarray(c.get("play_positions_rad", np.zeros((len(c["lost_motion_positions_rad"]), 0))))
+    data["catalog_play"] = (
+        ("catalog_position", "play_fraction"),
+        play * ARCMIN_PER_RAD,
+        {"units": "arcmin", "long_name": "rotation between -f T_r and +f T_r (input locked)"},
+    )
     ds = xr.Dataset(
-        data, coords={"position": ("position", result.input_angle, {"units": "rad", "long_name": "input angle"})}
+        data,
+        coords={
+            "position": ("position", result.input_angle, {"units": "rad", "long_name": "input angle"}),
+            "play_fraction": (
+                "play_fraction",
+                np.asarray(c.get("play_fractions", np.zeros(0)), dtype=float),
+                {"units": "1", "long_name": "fraction of the rated torque of the play"},
+            ),
+        },
     )
     s = result.summary()
     ds.attrs.update(
@@ -130,9 +144,10 @@ _UNNAMED = (
 
 def named_figures(ds: xr.Dataset, s: dict) -> dict:
     """The named figures (:mod:`flexrv.post.definitions`) of the quasi-static route: the
-    plays at +-3 % and +-T0 of each catalog position (input locked) give the lost motions
-    and the geometric backlash (:func:`flexrv.post.definitions.extrapolated_play`, per
-    position, the largest over the positions as for the lost motion); the rigidities are the
+    plays at +-3 %, +-T0 and +-T0/2 of each catalog position (input locked) give the lost
+    motions and the geometric backlash (from T0/2 and T0,
+    :func:`flexrv.post.definitions.extrapolated_play`, per position, the largest over the
+    positions as for the lost motion); the rigidities are the
     model's tangent (condensed Jacobian, at the operating torque), its 50-100 % and 3-50 %
     secants, and the loop secant 2 T_r / (theta(+T_r) - theta(-T_r)) of the loop these make
     with the largest lost motion, the loading branches point-symmetric:
@@ -141,7 +156,6 @@ def named_figures(ds: xr.Dataset, s: dict) -> dict:
     t0 = float(s["no_load_torque_Nm"])
     lm = ds["catalog_lost_motion"].values
     small = ds["catalog_lost_motion_small"].values
-    t3 = defs.LOST_MOTION_FRACTION * rated
     k50 = s["catalog_rigidity_Nm_per_arcmin"]
     k_low = s.get("low_torque_rigidity_Nm_per_arcmin", float("nan"))
     span = 2.0 * ((0.5 - defs.LOST_MOTION_FRACTION) * rated / k_low + 0.5 * rated / k50) + float(np.max(lm))
@@ -152,16 +166,28 @@ def named_figures(ds: xr.Dataset, s: dict) -> dict:
         "rigidity_loop_secant_Nm_per_arcmin": defs.loop_secant(rated, span),
         "lost_motion_arcmin": float(np.max(lm)),
         "lost_motion_small_torque_arcmin": float(np.max(small)),
-        "backlash_arcmin": float(np.max([defs.extrapolated_play(t0, p0, t3, p3) for p0, p3 in zip(small, lm)])),
+        "backlash_arcmin": _backlash(ds, rated),
         "tangent_torque_Nm": s["torque_Nm"],
     }
-    if abs(t0 - defs.PLAY_FRACTIONS[0] * rated) <= 1e-9 * rated:
+    if abs(t0 - defs.ONE_PERCENT * rated) <= 1e-9 * rated:
         out["lost_motion_1pct_arcmin"] = out["lost_motion_small_torque_arcmin"]
     out.update(defs.te_figures(ds["position"].values, ds["te"].values / ARCSEC_PER_RAD))
     for key in _UNNAMED:
         s.pop(key, None)
     s.pop("backlash_arcmin", None)
     return out
+
+
+def _backlash(ds: xr.Dataset, rated: float) -> float:
+    """The geometric backlash of the quasi-static route: the plays at the two smallest
+    ``play_fraction`` of each catalog position extrapolated to zero torque, the largest over
+    the positions (NaN without two play fractions)."""
+    if ds.sizes.get("play_fraction", 0) < 2:
+        return float("nan")
+    f = ds["play_fraction"].values
+    p = ds["catalog_play"].values
+    (i1, i2) = np.argsort(f)[:2]
+    return float(np.max(defs.extrapolated_play(f[i1] * rated, p[:, i1], f[i2] * rated, p[:, i2])))
 
 
 def te_summary(ds: xr.Dataset) -> dict:
