@@ -204,6 +204,12 @@ def stiffness_test_cmd(
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    uncertainty: int = typer.Option(
+        None,
+        "--uncertainty",
+        help="Also propagate the design's [ranges] (estimated inputs) with N samples by the quasi-static route: "
+        "median, 90 % interval and top contributors of the rigidities, lost motion and backlash (uncertainty.json).",
+    ),
 ) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
     torsional rigidity, lost motion, hysteresis loop PNG."""
@@ -222,12 +228,21 @@ def stiffness_test_cmd(
         if bar:
             bar.stop()
     data = {"output_dir": str(out), **fig.named(), "stiffness_budget": _budget(res)}
+    if uncertainty is not None:
+        from flexrv.cli.te import uncertainty_report
+        from flexrv.design import load
+
+        data["uncertainty"] = uncertainty_report(load(preset), uncertainty, out, quiet=json)
 
     def render(d):
         from flexrv.cli.design import budget_table
 
-        rows = [(*_label_unit(k), v) for k, v in d.items() if k != "stiffness_budget"]
+        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in ("stiffness_budget", "uncertainty")]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
+        if "uncertainty" in d:
+            from flexrv.cli.te import uncertainty_table
+
+            console.print(uncertainty_table(d["uncertainty"]))
         b = d["stiffness_budget"]
         if not b.get("elements"):
             for note in b.get("notes", []):

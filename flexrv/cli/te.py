@@ -12,6 +12,7 @@ from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, cons
 from flexrv.cli.design import analytic_budget, budget_table
 from flexrv.post.definitions import DEFINITIONS, PLAY_FRACTIONS
 from flexrv.post.te import TE_ROWS
+from flexrv.units import RAD_PER_ARCMIN
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -31,6 +32,12 @@ def te(
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    uncertainty: int = typer.Option(
+        None,
+        "--uncertainty",
+        help="Also propagate the design's [ranges] (estimated inputs) with N samples: median, 90 % interval and "
+        "top contributors of the rigidities, lost motion, backlash and TE p-p (uncertainty.json).",
+    ),
 ) -> None:
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
     output torque: loaded and no-load TE, lost motion, backlash, torsional rigidity, contact forces,
@@ -63,6 +70,11 @@ def te(
     save_te(budget.merged_into(ds), summary, reducer, out)
     te_plots(ds, summary, out)
     data = {"output_dir": str(out), **summary, "stiffness_budget": budget.to_dict()}
+    c_added = sum(budget.added.values()) / RAD_PER_ARCMIN  # arcmin per N m
+    for key in [k for k in summary if k.startswith("rigidity_") and k.endswith("_Nm_per_arcmin")]:
+        data[key[: -len("_Nm_per_arcmin")] + "_with_added_Nm_per_arcmin"] = 1.0 / (1.0 / summary[key] + c_added)
+    if uncertainty is not None:
+        data["uncertainty"] = uncertainty_report(reducer, uncertainty, out, quiet=json)
     analytic = analytic_budget(reducer, summary["torque_Nm"])
     data["stiffness_budget"]["analytic_budget_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
     data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
@@ -93,6 +105,8 @@ def te(
         )
         lines = [(f"{x['label']}", x["amplitude_arcsec"], f"order {x['order']:.4g}") for x in d["spectrum_lines"]]
         console.print(kv_table("largest TE lines [arcsec]", lines))
+        if "uncertainty" in d:
+            console.print(uncertainty_table(d["uncertainty"]))
 
     emit(data, json, render)
 
@@ -104,7 +118,6 @@ def quasi_static_budget(summary: dict, outputs: dict, reducer):
     by the mean of the output ``crank_bending_fraction``); the elements no model contains are
     added in series."""
     from flexrv.analysis.budget import ModelShares, stiffness_budget
-    from flexrv.units import RAD_PER_ARCMIN
 
     bend = outputs.get("crank_bending_fraction")
     model = ModelShares(
@@ -113,6 +126,41 @@ def quasi_static_budget(summary: dict, outputs: dict, reducer):
         bending_fraction=float(np.nanmean(bend.values)) if bend is not None else 0.0,
     )
     return stiffness_budget(reducer, summary["torque_Nm"], model=model, route="quasi_static")
+
+
+def uncertainty_report(reducer, n: int, out: Path, quiet: bool = False) -> dict:
+    """:func:`flexrv.studies.uncertainty.design_uncertainty` with ``n`` samples, written to
+    ``out/uncertainty.json``; returns it without the per-sample table."""
+    import json as _json
+
+    from flexrv.cache import atomic_write_text, to_jsonable
+    from flexrv.studies.uncertainty import design_uncertainty
+
+    def progress(i, total):
+        if not quiet:
+            console.print(f"uncertainty sample {i}/{total}", end="\r")
+
+    res = design_uncertainty(reducer, n, progress=progress)
+    atomic_write_text(Path(out) / "uncertainty.json", _json.dumps(to_jsonable(res), indent=2))
+    return {k: v for k, v in res.items() if k != "samples"}
+
+
+def uncertainty_table(u: dict):
+    """Table output | median | 5 % | 95 % | top contributors (SRC^2) of an uncertainty report."""
+    from rich.table import Table
+
+    table = Table(title=f"prediction intervals from the estimated inputs ({u['n']} samples)", title_justify="left")
+    for col in ("output", "median", "5 %", "95 %", "top contributors (SRC^2)"):
+        table.add_column(col)
+    for name, r in u["outputs"].items():
+        if not r.get("n"):
+            continue
+        c = r.get("contributors") or {}
+        top = ", ".join(f"{k} {v:.2f}" for k, v in list(c.get("src2", {}).items())[:3])
+        table.add_row(name, f"{r['median']:.4g}", f"{r['p05']:.4g}", f"{r['p95']:.4g}", top)
+    if u.get("failed"):
+        table.caption = f"{len(u['failed'])} samples failed (see uncertainty.json)"
+    return table
 
 
 def register(app: typer.Typer) -> None:

@@ -885,8 +885,8 @@ class PathEstimates(_Strict):
         ge=1.0, le=10.0, description="Joint's bending resilience over VDI 2230's solid substitute body [-]"
     )
     support_ring_seat_factor: float = Field(
-        ge=0.0,
-        le=1.0,
+        gt=0.0,
+        le=10.0,
         description="Winkler modulus of the support rings' seats over E b / R [-]",
     )
     planet_spline_teeth: int = Field(ge=6, le=200, description="Teeth of the planet-to-crank spline [-]")
@@ -906,7 +906,7 @@ class PlausibleRange(_Strict):
     reason: str = Field(min_length=3)
 
 
-def _field_value(reducer, path: str):
+def field_value(reducer, path: str):
     """The value of a dotted field path of a design (``section.field``), or raise ValueError."""
     obj = reducer
     for part in path.split("."):
@@ -994,7 +994,7 @@ class Reducer(_Strict):
         """A range names a numeric field (or an unused optional one) and has low < high; the
         value itself may leave it (an override, a sweep)."""
         for path, r in self.ranges.items():
-            value = _field_value(self, path)
+            value = field_value(self, path)
             if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
                 raise _bad(f"ranges.{path!r}", value, "must name a numeric field of the design")
             if not r.low < r.high:
