@@ -71,3 +71,20 @@ def test_te_cli_uncertainty(tmp_path):
     assert set(u["inputs"]) == set(load("rv40e").ranges)
     assert (out / "uncertainty.json").stat().st_size > 1000
     assert d["rigidity_tangent_with_added_Nm_per_arcmin"] < d["rigidity_tangent_Nm_per_arcmin"]
+
+
+def test_preset_ranges_cover_their_estimates():
+    """Every [ranges] entry of the presets names an estimated field (its provenance says
+    "estimate"), contains the preset's value and gives a reason; both ends make a valid design."""
+    from flexrv.design import load, override
+    from flexrv.design.model import field_value
+
+    for name in ("rv40e", "rv221"):
+        r = load(name)
+        assert len(r.ranges) >= 10
+        for path, rg in r.ranges.items():
+            assert "estimate" in r.provenance[path].lower(), (name, path)
+            value = field_value(r, path)
+            assert rg.low <= value <= rg.high and len(rg.reason) > 10, (name, path)
+            for v in (rg.low, rg.high):
+                override(r, {path: int(round(v)) if isinstance(value, int) else float(v)})

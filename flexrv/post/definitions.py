@@ -29,7 +29,11 @@ bench's, :cite:`seed004`):
   torques (one contact after another closes), so the two torques must be small: on rv40e with
   a 10 um equidistant modification the play reads 78.42 arcsec at 0.01 %, 78.90 at 0.1 %,
   80.69 at 0.5 %, 82.32 at 1 %; extrapolated from 0.5 % and 1 % it gave 79.05 (+0.8 %), from
-  1 % and 3 % 79.27;
+  1 % and 3 % 79.27. A loop with friction crosses the play only where the torque exceeds the
+  friction band: its mid curve at small torques lags, and the figure reads the play less the
+  friction's wind-up (a Coulomb band f in series with a spring k: b - 2 f / k; rv40e's
+  dynamic loop with friction reads 0.32 arcmin where the frictionless quasi-static route
+  reads 1.25);
 * ``hysteresis_arcmin``: the loop's width at T = 0 (descending minus ascending branch);
 * ``hysteresis_loss_J``: the energy dissipated per cycle, the loop's area (twice the lower
   half, :func:`loop_energy`).
