@@ -257,3 +257,28 @@ def test_default_loop_is_quasi_static():
     catalog = res.catalog["rigidity_secant_Nm_per_rad"] * RAD_PER_ARCMIN
     assert fig.rigidity_Nm_per_arcmin == pytest.approx(catalog, rel=0.05)
     assert fig.lost_motion_arcmin == pytest.approx(res.catalog["lost_motion_rad"] * ARCMIN_PER_RAD, rel=0.15)
+
+
+def test_budget_dataset_round_trip_and_measured_reference():
+    """The measured-data path: the analytic budget with a measured rigidity beside it
+    (``reference``); stored as a dataset over ``budget_element`` and read back equal (rel
+    1e-12), the reference in N m/arcmin under its name; a model-route budget carries its added
+    elements with ``in_model`` 0 and the reference's rigidity with them in series."""
+    from flexrv.analysis.budget import ModelShares, budget_from_dataset
+    from flexrv.analysis.budget import stiffness_budget as budget
+    from flexrv.units import RAD_PER_ARCMIN
+
+    r = load("rv40e")
+    measured = 89.0 / RAD_PER_ARCMIN  # seed004's rigidity [N m/rad]
+    b = budget(r, reference={"measured_loop_secant": measured}, route="measured")
+    back = budget_from_dataset(b.to_dataset())
+    assert back.compliances == pytest.approx(b.compliances, rel=1e-12) and back.added == {}
+    assert back.route == "measured" and back.reference["measured_loop_secant"] == pytest.approx(measured)
+    assert b.to_dict()["measured_loop_secant_Nm_per_arcmin"] == pytest.approx(89.0, rel=1e-12)
+    m = budget(r, model=ModelShares({"pins": 0.5, "needle_bearings": 0.5}, 1e-6), reference={"loop": 1e6})
+    ds = m.to_dataset()
+    assert set(ds["budget_element"].values[ds["budget_in_model"].values == 0]) == set(m.added)
+    d = m.to_dict()
+    assert d["loop_with_added_Nm_per_arcmin"] == pytest.approx(
+        RAD_PER_ARCMIN / (1e-6 + sum(m.added.values())), rel=1e-12
+    )

@@ -907,9 +907,12 @@ class PlausibleRange(_Strict):
 
 
 def field_value(reducer, path: str):
-    """The value of a dotted field path of a design (``section.field``), or raise ValueError."""
+    """The value of a dotted field path of a design (``section.field``; None inside an optional
+    table the design leaves out), or raise ValueError."""
     obj = reducer
     for part in path.split("."):
+        if obj is None:  # an optional table the design leaves out: the field is unused
+            return None
         if isinstance(obj, dict) and part in obj:
             obj = obj[part]
         elif hasattr(obj, part) and not part.startswith("_"):
