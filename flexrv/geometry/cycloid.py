@@ -388,8 +388,8 @@ def profile_curvature_radius(
 
     rho_profile = 1/kappa_C - (r_rp + dr_rp), kappa_C the signed curvature of the
     pin-centre curve (:func:`center_curve_curvature`); offset curves share centres
-    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of :cite:`seed004`'s rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an
-    unmodified profile.
+    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of :cite:`seed004`'s
+    rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an unmodified profile.
     """
     kappa = center_curve_curvature(phi, z_rp, pin_circle_radius + d_radius, eccentricity)
     with np.errstate(divide="ignore"):
