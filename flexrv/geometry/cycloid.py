@@ -224,8 +224,8 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     The warm start's half-lobe test needs no arctangent: with theta = atan2(px,
     py), |phi - theta| (mod 2 pi) <= lobe/2 is cos(phi - theta) |P| = px sin(phi)
     + py cos(phi) >= cos(lobe/2) |P|, and sin(phi), cos(phi) follow from C and C'
-    at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (issue
-    15: the arctangent was 1.5 % of a rigid run)."""
+    at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (an
+    arctangent per call would cost about 1.5 % of a rigid run)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
     if np.isfinite(phi0):
         phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(
