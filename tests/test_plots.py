@@ -181,8 +181,9 @@ def test_compare_plots(tmp_path, captured):
 
 
 def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
-    """An 8:1 elliptic film/pressure field: both maps drawn with equal aspect, labels in µm;
-    the PNG is not blank."""
+    """An 8:1 elliptic film/pressure field: both maps drawn with equal aspect, labels in µm,
+    the maps wide (the contact's long axis horizontal: each map at least 4x wider than high
+    on the page) and no two tick labels of a map overlapping; the PNG is not blank."""
     import matplotlib.pyplot as plt
 
     from flexrv.viz.ehl_plots import ehl_figure, plot_ehl_solution
@@ -194,11 +195,29 @@ def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
     p = 1.5e9 * np.sqrt(np.clip(1 - r2, 0, None))
     h = 0.2e-6 + 1e-6 * np.clip(r2 - 1, 0, None)
     result = SimpleNamespace(
-        x=x, y=y, pressure=p, film=h, h_central=0.2e-6, h_min=0.18e-6, p_max=1.5e9, hertz_pressure=1.5e9
+        x=x,
+        y=y,
+        pressure=p,
+        film=h,
+        h_central=0.2e-6,
+        h_min=0.18e-6,
+        p_max=1.5e9,
+        hertz_pressure=1.5e9,
+        hertz_a=8e-4,
+        hertz_b=1e-4,
     )
     fig = ehl_figure(result)
     maps = [ax for ax in fig.axes if ax.get_title().startswith(("pressure", "film thickness"))]
     assert len(maps) == 2 and all(ax.get_aspect() == 1.0 for ax in maps)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in maps:
+        box = ax.get_window_extent(renderer)
+        assert box.width > 4 * box.height, (box.width, box.height)
+        for ticks in (ax.get_xticklabels(), ax.get_yticklabels()):
+            boxes = [t.get_window_extent(renderer) for t in ticks if t.get_text() and t.get_visible()]
+            assert len(boxes) >= 3
+            assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1 :])
     labels = " ".join(ax.get_ylabel() for ax in fig.axes)
     assert "µm" in labels and "um]" not in labels
     plt.close(fig)
