@@ -86,7 +86,8 @@ def test_pin_force_map_shows_every_disc_aligned(run, tmp_path, captured):
 
 def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captured):
     """A 2 arcsec sine at the rv40e cycloid-mesh frequency (390 Hz at 1215 r/min, :cite:`seed002`):
-    the plotted peak is 2 +- 0.1 arcsec; labels are words, not snake_case; the title states
+    the plotted peak is 2 +- 0.1 arcsec; every characteristic line is numbered and named in
+    words (not snake_case) with its frequency in the key; the title states
     the window (0.3 s) and resolution (1/0.3 s); the log axis spans 4 decades, not 1e-9..1."""
     import xarray as xr
 
@@ -110,7 +111,11 @@ def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captur
     x = ax.lines[0].get_xdata()
     assert x[np.argmax(y)] == pytest.approx(390.0, abs=4.0)
     texts = [tx.get_text() for tx in ax.texts]
-    assert any(tx.startswith("cycloid mesh 390") for tx in texts) and not any("_" in tx for tx in texts)
+    key = "\n".join(texts).splitlines()
+    assert any(line.split(None, 1)[1].startswith("cycloid mesh 390") for line in key if " " in line)
+    assert not any("_" in tx for tx in texts)
+    numbers = [tx.get_text() for tx in ax.texts if tx.get_text().isdigit()]
+    assert numbers == [str(k) for k in range(1, len(numbers) + 1)] and len(numbers) >= 3  # each mark numbered
     assert "window 0.3 s" in ax.get_title() and "resolution 3.33 Hz" in ax.get_title()
     lo, hi = ax.get_ylim()
     assert hi / lo == pytest.approx(3e4, rel=1e-6)

@@ -110,37 +110,45 @@ FREQUENCY_LABELS = {
 def spectrum_axis(ax, freq, amp, marks: dict, window_s: float, label: str | None = None, decades: float = 4.0):
     """Draw an amplitude spectrum on ``ax``: log amplitude axis limited to ``decades``
     below the peak (not down to numerical zero), the characteristic frequencies as
-    dashed lines labelled in words and staggered so that labels do not overlap, and the
-    window length and frequency resolution in the title."""
+    numbered dashed lines with a key beside the axes giving each one's name in words and
+    its frequency (numbers of coinciding lines are staggered, never overprinted), and the
+    window length and frequency resolution in the title. A call without ``marks`` (a
+    second spectrum on the same axes) keeps the frequency range of the first."""
     line = None
     if len(freq) > 1:
         f, a = freq[1:], amp[1:]
         top = float(a.max()) if a.size and a.max() > 0 else 1.0
+        first = not ax.lines
         line = ax.semilogy(f, np.maximum(a, top * 10**-decades), lw=0.8, label=label)[0]
-        ax.set_ylim(top * 10**-decades, top * 3.0)
-        hi = max(marks.values()) if marks else f[-1]
-        ax.set_xlim(0, min(f[-1], 1.25 * hi))
+        if first:
+            ax.set_ylim(top * 10**-decades, top * 3.0)
+        if marks or first:
+            hi = max(marks.values()) if marks else f[-1]
+            ax.set_xlim(0, min(f[-1], 1.25 * hi))
     res_hz = float(freq[1] - freq[0]) if len(freq) > 1 else float("nan")
-    y_top = ax.get_ylim()[1]
-    placed = []
-    span = ax.get_xlim()[1] - ax.get_xlim()[0]
-    for name, f0 in sorted(marks.items(), key=lambda kv: kv[1]):
-        if not (ax.get_xlim()[0] <= f0 <= ax.get_xlim()[1]):
-            continue
+    lo_x, hi_x = ax.get_xlim()
+    shown = [(n, f0) for n, f0 in sorted(marks.items(), key=lambda kv: kv[1]) if lo_x <= f0 <= hi_x]
+    placed: list[float] = []
+    key = []
+    for k, (name, f0) in enumerate(shown, start=1):
         ax.axvline(f0, ls="--", lw=0.6, color="0.5")
-        level = sum(1 for p in placed if f0 - p < 0.25 * span)  # stagger: a label is ~1/4 of the axis wide
+        level = sum(1 for p in placed if abs(f0 - p) < 0.03 * (hi_x - lo_x))
         placed.append(f0)
         ax.annotate(
-            f"{FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz",
-            (f0, y_top),
-            xytext=(3, -4 - 11 * level),
+            str(k),
+            (f0, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(2, -3 - 9 * level),
             textcoords="offset points",
-            rotation=0,
             va="top",
             ha="left",
             fontsize=7,
             color="0.25",
+            fontweight="bold",
         )
+        key.append(f"{k}  {FREQUENCY_LABELS.get(name, name.replace('_', ' '))} {f0:.4g} Hz")
+    if key:
+        ax.text(1.01, 1.0, "\n".join(key), transform=ax.transAxes, va="top", ha="left", fontsize=7, color="0.25")
     ax.set_xlabel("frequency [Hz]")
     ax.set_title(f"window {window_s:.3g} s, resolution {res_hz:.3g} Hz (Hann)", fontsize=9)
     return line
@@ -154,7 +162,7 @@ def plot_te_spectrum(res, path) -> Path:
     plt = _plt()
     freq, amp, marks = te_spectrum(res)
     t0, t1 = res.steady_window()
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig, ax = plt.subplots(figsize=(10, 3.8))
     spectrum_axis(ax, freq, amp, marks, t1 - t0)
     ax.set_ylabel("TE amplitude [arcsec]")
     if not getattr(res, "is_steady", True):
