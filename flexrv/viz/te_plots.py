@@ -155,28 +155,48 @@ def plot_te_spectrum(ds, summary: dict, path) -> Path:
 
 
 def plot_pin_force_map(ds, path) -> Path:
-    """Pin force [N] over pin number and output angle, one panel per disc."""
+    """Pin force [N] over pin number and output angle, one row per disc; with more than
+    one crank revolution a right-hand column repeats the crank revolution zoomed in the TE
+    plot (the load zone sweeps once around the pins per crank revolution, too fast to
+    follow over a whole output revolution)."""
     plt = _plt()
     f = ds["pin_force"].values  # (position, disc, pin)
     deg = np.degrees(ds["output_revolutions"].values * 2.0 * np.pi)
     nd = f.shape[1]
-    fig, axes = plt.subplots(nd, 1, figsize=(9, 2.4 * nd + 0.8), sharex=True, squeeze=False)
+    period = 360.0 / json.loads(ds.attrs["orders"])["crank rotation"]
+    zoom = (deg[-1] - deg[0]) / period > 1.5
+    cols = 2 if zoom else 1
+    fig, axes = plt.subplots(
+        nd,
+        cols,
+        figsize=(11 if zoom else 9, 2.4 * nd + 0.9),
+        squeeze=False,
+        gridspec_kw={"width_ratios": [2.2, 1] if zoom else [1]},
+    )
     vmax = max(float(f.max()), 1e-9)
-    for k in range(nd):
-        ax = axes[k, 0]
-        im = ax.imshow(
-            f[:, k, :].T,
-            aspect="auto",
-            origin="lower",
-            cmap="viridis",
-            vmin=0.0,
-            vmax=vmax,
-            extent=(deg[0], deg[-1], -0.5, f.shape[2] - 0.5),
-            interpolation="nearest",
-        )
-        ax.set_ylabel(f"disc {k}: pin")
-    axes[-1, 0].set_xlabel("output angle [deg]")
-    fig.colorbar(im, ax=axes[:, 0].tolist(), label="pin force [N]")
+    windows = [(deg[0], deg[-1])]
+    if zoom:
+        windows.append(_zoom_window(deg, ds["te"].values, period))
+    for c, (a, b) in enumerate(windows):
+        sel = (deg >= a) & (deg <= b)
+        for k in range(nd):
+            ax = axes[k, c]
+            im = ax.imshow(
+                f[sel, k, :].T,
+                aspect="auto",
+                origin="lower",
+                cmap="viridis",
+                vmin=0.0,
+                vmax=vmax,
+                extent=(deg[sel][0], deg[sel][-1], 0.5, f.shape[2] + 0.5),
+                interpolation="nearest",
+            )
+            ax.set_ylabel(f"disc {k + 1}: pin number" if c == 0 else "")
+            if k < nd - 1:
+                ax.tick_params(labelbottom=False)
+        axes[0, c].set_title("whole run" if c == 0 else f"one crank revolution, {a:.4g}–{b:.4g}°", fontsize=10)
+        axes[-1, c].set_xlabel("output angle [deg]")
+    fig.colorbar(im, ax=axes.ravel().tolist(), label="pin force [N]", fraction=0.03, pad=0.02)
     fig.suptitle(f"Pin forces, {ds.attrs['preset']} at {ds.attrs['torque_Nm']:.4g} N m")
     return _save(fig, Path(path))
 
