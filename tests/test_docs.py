@@ -126,4 +126,4 @@ def test_docs_build_strict(tmp_path):
     commands = (site / "commands" / "index.html").read_text(encoding="utf-8")
     for name in typer.main.get_command(app).commands:
         assert f"flexrv {name}" in commands, name
-    assert (site / "img" / "te_rv40e.png").stat().st_size > 10_000
+    assert (site / "img" / "te_rv40e_grade5.png").stat().st_size > 10_000
