@@ -45,7 +45,8 @@ def mesh(
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
     compliance: bool = typer.Option(False, "--compliance", help=COMPLIANCE_HELP),
 ) -> None:
-    """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
+    """Mesh a part with second-order tetrahedra (cached in the user cache directory,
+    $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
     from flexrv.errors import InputError
     from flexrv.meshing import build_mesh
