@@ -127,3 +127,18 @@ def test_docs_build_strict(tmp_path):
     for name in typer.main.get_command(app).commands:
         assert f"flexrv {name}" in commands, name
     assert (site / "img" / "te_rv40e_grade5.png").stat().st_size > 10_000
+
+
+def test_docs_name_only_existing_files():
+    """Every test file, benchmark and module path a documentation page or the README names
+    exists (a glob such as ``tests/test_ehl_*.py`` must match at least one file)."""
+    import re
+
+    pages = [*sorted((ROOT / "docs").glob("*.md")), ROOT / "README.md"]
+    missing = []
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        for path in set(re.findall(r"\b((?:tests|benchmarks|flexrv|docs)/[\w/*.-]+\.(?:py|md|toml|png))\b", text)):
+            if not list(ROOT.glob(path)):
+                missing.append(f"{page.name}: {path}")
+    assert not missing, missing
