@@ -23,7 +23,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 
 CHILD = r"""
 import json, os, resource, sys, time
@@ -97,7 +96,6 @@ def main() -> None:
     for p in args.presets:
         for b in args.bodies:
             size = args.carrier_size if b == "carrier" else args.disc_size
-            t0 = time.perf_counter()
             d = run(p, b, size)
             total += d["cpu"]
             print(

@@ -3,31 +3,14 @@ plots, summary), optionally from a cold cache (meshing and CMS of the rings incl
 
     python benchmarks/bench_compare.py [--preset rv221] [--t-end 1.0] [--cold] [--parts main_bearing]
 
-Goal (issue 15): ``flexrv compare rv221 --t-end 1`` from a cold mesh/CMS cache in
+Goal: ``flexrv compare rv221 --t-end 1`` from a cold mesh/CMS cache in
 <= 60 s (2 cores, one BLAS thread; the numba cache is warm: see
 bench_first_run.py for the first compile). Prints the wall time of each phase,
 the process CPU time (``time.process_time``; quote it on a shared machine) and
 the TE statistics of both models (so speed never buys a different answer).
 
-Measured 2026-11-24 (rv221, --t-end 1, cold, condensed rings): 87 s CPU (217 s
-wall on the loaded machine): rigid 6.6 s, flexible 206 s wall incl. the cold
-ring build (31 s CPU for both rings without fixed-interface eigenmodes, was
-54 s with 12). README before: 178 s wall. TE mean / p-p: rigid -20.4171 /
-3.1418 arcsec, flexible -20.4168 / 3.1197 arcsec. Goal not reached.
-
-After the row-kernel speed-ups (issue 15, same day, load average ~2): **49.3 s
-CPU** (62.7 s wall): rigid 4.5 s wall; flexible 56.2 s wall, of which the cold
-build of the two rings is ~31 s CPU (rv221 outer ring, 100.6k DOF: FE assembly
-(scikit-fem K and the order-4 consistent mass) ~7.6 s, sparse LU of K_ii
-(SuperLU, MMD on A^T + A, the best of the orderings scipy offers: COLAMD and
-MMD on A^T A fill 1.8-1.9x more) ~5 s, the 115 attachment-mode solves ~3 s,
-gmsh ~2 s; inner ring alike) and the 1 s solve + outputs ~16 s CPU; plots 2 s.
-TE mean / p-p: rigid -20.3166 / 2.7503 arcsec, flexible -20.2902 / 3.3201 arcsec
-(rv221's light-load bistability: see bench_flexible_model.py). Goal (60 s) met
-in CPU. What this does NOT include: numba's first compile. The numba cache lives
-beside the sources (``__pycache__``) and is cold in a fresh clone (CI): the
-flexible model's first run compiles its kernels in ~41 s CPU (measured with an
-empty NUMBA_CACHE_DIR, rv221 --t-end 0.002: 42.9 s user against 1.8 s warm).
+The numba cache is not included: a fresh clone's first flexible run compiles its kernels
+(bench_first_run.py). Measured figures with date and machine: docs/benchmarks.md.
 """
 
 from __future__ import annotations

@@ -12,30 +12,20 @@ timing measures steady operation under the preset's load torque. Printed per pre
 * ``compiled kernel``: wall µs per time step inside the compiled entry point of the
   fused kernel (the physics), and everything else of the solve per step (Exudyn's
   own work, the Python glue of every call, the pre-step hook): the real-time factor
-  the model would have at zero physics cost. Measured 2026-11-24 (0.3 s): kernel
-  100 / 101 µs per step (3.34 / 3.98 calls), the rest 79 / 81 µs per step (rv40e /
-  rv221), i.e. real-time factor 0.79 / 0.81 without any physics: issue 15's goal
-  (<= 1) would leave the kernel ~20 µs per step, ~6 µs per call. 2026-11-24, with the
-  Jacobians made by the step's first residual call (``FusedForces.jacobian_each_step``):
-  kernel 90 / 94-96 µs per step (2.34 / 3.05 calls), the rest 81-82 / 84-87 µs. Where the
-  rest goes (rv40e, 0.2 s, timed around each layer): the pre-step hook 22 µs (its records
-  copy ~10 of it), the element's Python methods around the kernel 5 µs per residual call,
-  the Exudyn user functions' list conversions and Jacobian combination plus Exudyn itself
-  ~38 µs per step, of which Exudyn with trivial Python user functions (two residual, one
-  Jacobian and one pre-step call per step, 21 coordinates, dense LU) takes 9-10 µs;
+  the model would have at zero physics cost;
 * ``generalized_forces``: µs per call of ``AssembledModel.generalized_forces`` with
   the Jacobian at a loaded state (the quasi-static solver's path);
 * real-time factor = solve wall s per simulated s, and post-processing wall s
   (outputs of every group recomputed from the recorded states; one-time imports
   excluded);
 * CPU seconds (time.process_time, robust on a shared machine) of the solve and of
-  the outputs, and the real-time factor of both together (issue 15's goal: <= 1);
+  the outputs, and the real-time factor of both together (goal: <= 1);
 * TE mean and peak-to-peak over t > 0.02 s [arcsec].
 
-It runs unchanged on the code before issue 15 (one Python element per group) and
-after (one fused compiled element), so both sides of a comparison come from the
-same script. One-time numba compilation/loading (the kernels and the outputs'
-paths: a 20-step run in 5-step segments) is done before timing.
+It runs unchanged on a model of Python force elements and on the fused compiled
+element, so both sides of a comparison come from the same script. One-time numba
+compilation/loading (the kernels and the outputs' paths: a 20-step run in 5-step
+segments) is done before timing.
 """
 
 from __future__ import annotations

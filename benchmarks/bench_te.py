@@ -6,7 +6,7 @@ points), Newton iterations per position and the TE statistics, so speed never
 buys a different answer. BLAS is pinned to one thread (the 21x21 solves are
 far too small for threads).
 
-Goal (issue: loaded TE solver): one output revolution of rv40e with 8 points per
+Goal: one output revolution of rv40e with 8 points per
 cycloid-mesh period (12,480 positions) in <= 2 s on one core.
 
     python benchmarks/bench_te.py [--crank-revolutions N] [--full]

@@ -12,8 +12,8 @@ N / rate into
   cache load on each worker, sampling, NetCDF and plots) and
 * the steady rate (samples per second) = (N2 - N1) / (T(N2) - T(N1)),
 
-and projects 1,000 samples as T0 + 1000 / rate (issue 13's target: <= 10 min on
-this machine's 2 cores). Wall time on a shared machine is noisy; the CPU time of
+and projects 1,000 samples as T0 + 1000 / rate (target: <= 10 min on 2 cores). Wall
+time on a shared machine is noisy; the CPU time of
 the study (this process and its worker processes, which are reaped when the
 cluster closes: getrusage SELF + CHILDREN) is printed beside it, with its own
 per-sample value (CPU s per sample, the same on 1 or 2 workers if the scaling is

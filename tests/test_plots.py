@@ -86,7 +86,8 @@ def test_pin_force_map_shows_every_disc_aligned(run, tmp_path, captured):
 
 def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captured):
     """A 2 arcsec sine at the rv40e cycloid-mesh frequency (390 Hz at 1215 r/min, :cite:`seed002`):
-    the plotted peak is 2 +- 0.1 arcsec; labels are words, not snake_case; the title states
+    the plotted peak is 2 +- 0.1 arcsec; every characteristic line is numbered and named in
+    words (not snake_case) with its frequency in the key; the title states
     the window (0.3 s) and resolution (1/0.3 s); the log axis spans 4 decades, not 1e-9..1."""
     import xarray as xr
 
@@ -110,7 +111,11 @@ def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captur
     x = ax.lines[0].get_xdata()
     assert x[np.argmax(y)] == pytest.approx(390.0, abs=4.0)
     texts = [tx.get_text() for tx in ax.texts]
-    assert any(tx.startswith("cycloid mesh 390") for tx in texts) and not any("_" in tx for tx in texts)
+    key = "\n".join(texts).splitlines()
+    assert any(line.split(None, 1)[1].startswith("cycloid mesh 390") for line in key if " " in line)
+    assert not any("_" in tx for tx in texts)
+    numbers = [tx.get_text() for tx in ax.texts if tx.get_text().isdigit()]
+    assert numbers == [str(k) for k in range(1, len(numbers) + 1)] and len(numbers) >= 3  # each mark numbered
     assert "window 0.3 s" in ax.get_title() and "resolution 3.33 Hz" in ax.get_title()
     lo, hi = ax.get_ylim()
     assert hi / lo == pytest.approx(3e4, rel=1e-6)
@@ -181,8 +186,9 @@ def test_compare_plots(tmp_path, captured):
 
 
 def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
-    """An 8:1 elliptic film/pressure field: both maps drawn with equal aspect, labels in µm;
-    the PNG is not blank."""
+    """An 8:1 elliptic film/pressure field: both maps drawn with equal aspect, labels in µm,
+    the maps wide (the contact's long axis horizontal: each map at least 4x wider than high
+    on the page) and no two tick labels of a map overlapping; the PNG is not blank."""
     import matplotlib.pyplot as plt
 
     from flexrv.viz.ehl_plots import ehl_figure, plot_ehl_solution
@@ -194,11 +200,29 @@ def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
     p = 1.5e9 * np.sqrt(np.clip(1 - r2, 0, None))
     h = 0.2e-6 + 1e-6 * np.clip(r2 - 1, 0, None)
     result = SimpleNamespace(
-        x=x, y=y, pressure=p, film=h, h_central=0.2e-6, h_min=0.18e-6, p_max=1.5e9, hertz_pressure=1.5e9
+        x=x,
+        y=y,
+        pressure=p,
+        film=h,
+        h_central=0.2e-6,
+        h_min=0.18e-6,
+        p_max=1.5e9,
+        hertz_pressure=1.5e9,
+        hertz_a=8e-4,
+        hertz_b=1e-4,
     )
     fig = ehl_figure(result)
     maps = [ax for ax in fig.axes if ax.get_title().startswith(("pressure", "film thickness"))]
     assert len(maps) == 2 and all(ax.get_aspect() == 1.0 for ax in maps)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in maps:
+        box = ax.get_window_extent(renderer)
+        assert box.width > 4 * box.height, (box.width, box.height)
+        for ticks in (ax.get_xticklabels(), ax.get_yticklabels()):
+            boxes = [t.get_window_extent(renderer) for t in ticks if t.get_text() and t.get_visible()]
+            assert len(boxes) >= 3
+            assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1 :])
     labels = " ".join(ax.get_ylabel() for ax in fig.axes)
     assert "µm" in labels and "um]" not in labels
     plt.close(fig)
@@ -229,3 +253,139 @@ def test_mode_png_offscreen(tmp_path):
     disp = np.zeros_like(nodes)
     disp[3] = [0.1, 0.1, 0.2]
     _not_blank(render_mode_png(tmp_path / "mode.png", nodes, tris, disp, title="test mode"), min_var=1e-4)
+
+
+def test_hysteresis_rebound_marked_near_zero_only():
+    """A bilinear loop with a decaying 0.1 arcmin oscillation (the rebound after crossing the
+    clearance) added just after each torque reversal: :func:`rebound_mask` flags the ringing
+    samples near T = 0 and nothing on the loaded parts of the loop; the same loop without
+    the oscillation has nothing flagged."""
+    from flexrv.viz.plots import rebound_mask
+
+    t = np.linspace(0, 4, 8001)
+    torque = np.interp(t, [0, 1, 3, 4], [0, 400.0, -400.0, 0])
+    clean = torque / 100.0 + np.sign(torque) * 0.5
+    crossing = t > 2.0
+    ring = np.where(crossing, 0.1 * np.exp(-(t - 2.0) / 0.02) * np.sin(2 * np.pi * (t - 2.0) / 0.004), 0.0)
+    mask = rebound_mask(clean + ring, torque, 100.0)
+    assert mask[(t > 2.0) & (t < 2.02)].mean() > 0.9  # the first ring-down time constant
+    assert not mask[np.abs(torque) > 150.0].any()
+    assert not rebound_mask(clean, torque, 100.0).any()
+
+
+def _te_dataset(crank_revolutions: int = 3, per_rev: int = 400):
+    """A synthetic quasi-static TE record: pin-mesh ripple (39 per crank revolution) whose
+    amplitude is largest in the second crank revolution."""
+    import json
+
+    import xarray as xr
+
+    n = crank_revolutions * per_rev
+    rev_out = np.arange(n) / (per_rev * 40.0)  # output revolutions: 40 crank revolutions per output revolution
+    crank = rev_out * 40.0
+    amp = np.where((crank >= 1) & (crank < 2), 0.3, 0.1)
+    te = -160.0 + amp * np.sin(2 * np.pi * 39 * crank)
+    ds = xr.Dataset(
+        {
+            "te": ("position", te),
+            "te_no_load": ("position", -40.0 + 0.05 * np.sin(2 * np.pi * 39 * crank)),
+            "output_revolutions": ("position", rev_out),
+        }
+    )
+    ds.attrs.update(
+        {
+            "preset": "rv40e",
+            "torque_Nm": 412.0,
+            "orders": json.dumps({"crank rotation": 40.0, "cycloid mesh": 1560.0, "first-stage mesh": 1280.0}),
+        }
+    )
+    return ds
+
+
+def test_te_curve_envelope_and_one_crank_revolution_zoom(tmp_path, monkeypatch):
+    """Three crank revolutions: two panels; the upper spans the whole record (envelope), the
+    lower exactly one crank revolution (9 deg of output), the one with the largest TE range
+    (the second), at full resolution; the legend states p-p and mean."""
+    import flexrv.viz.te_plots as tp
+
+    figs = []
+    monkeypatch.setattr(tp, "_save", lambda fig, path: figs.append(fig) or path)
+    tp.plot_te_curve(_te_dataset(), tmp_path / "te.png")
+    fig = figs[0]
+    top, bottom = fig.axes[:2]
+    a, b = bottom.get_xlim()
+    assert b - a == pytest.approx(9.0, rel=1e-3) and a == pytest.approx(9.0, abs=0.05)
+    assert len(bottom.lines[0].get_xdata()) >= 399
+    assert top.get_xlim()[1] == pytest.approx(27.0, abs=0.1)
+    legend = " ".join(t.get_text() for t in top.get_legend().get_texts())
+    assert "p-p 0.6" in legend and "mean -160" in legend
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    monkeypatch.undo()
+    _not_blank(tp.plot_te_curve(_te_dataset(), tmp_path / "te.png"))
+
+
+def test_te_order_spectrum_names_every_line_with_its_order(tmp_path, monkeypatch):
+    """Lines at a mesh order, a crank harmonic and a crank sideband of the first-stage mesh
+    (1280 + 2 x 40 = 1360): every line is named (no "-") and the key gives its order."""
+    from flexrv.post.te import order_spectrum, spectrum_lines
+
+    n = 12480
+    x = np.arange(n) / n
+    te = 0.06 * np.sin(2 * np.pi * 1560 * x) + 0.05 * np.sin(2 * np.pi * 240 * x) + 0.02 * np.sin(2 * np.pi * 1360 * x)
+    orders = {"crank rotation": 40.0, "cycloid mesh": 1560.0, "first-stage mesh": 1280.0}
+    order, amp = order_spectrum(te, 1.0)
+    lines = spectrum_lines(order, amp, orders, count=3)
+    labels = {round(line["order"]): line["label"] for line in lines}
+    assert labels == {1560: "cycloid mesh", 240: "6 x crank rotation", 1360: "first-stage mesh + 2 x crank rotation"}
+    import xarray as xr
+
+    import flexrv.viz.te_plots as tp
+
+    figs = []
+    monkeypatch.setattr(tp, "_save", lambda fig, path: figs.append(fig) or path)
+    ds = xr.Dataset({"te": ("position", te)}, attrs={"preset": "rv40e"})
+    summary = {"output_revolutions": 1.0, "spectrum_lines": lines, "spectral_resolution_orders": 1.0}
+    tp.plot_te_spectrum(ds, summary, tmp_path / "s.png")
+    key = " ".join(t.get_text() for t in figs[0].axes[0].texts)
+    for line in lines:
+        assert line["label"] in key and f"order {line['order']:.5g}" in key
+
+
+def test_part_modes_render_free_and_constrained(tmp_path):
+    """render_part_modes writes one PNG per free-free and per constrained mode, named by kind."""
+    pytest.importorskip("pyvista")
+    from flexrv.viz.modes import render_part_modes
+
+    nodes = np.array(
+        [
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [0.5, 0, 0],
+            [0.5, 0.5, 0],
+            [0, 0.5, 0],
+            [0, 0, 0.5],
+            [0.5, 0, 0.5],
+            [0, 0.5, 0.5],
+        ],
+        float,
+    )
+    tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
+    modes = np.zeros((30, 2))
+    modes[9:12, 0] = [0.1, 0.1, 0.2]
+    modes[3:6, 1] = [0.2, 0.0, 0.1]
+    pm = SimpleNamespace(
+        mesh=SimpleNamespace(nodes=nodes, tris=tris),
+        free_hz=np.array([100.0, 200.0]),
+        free_modes=modes,
+        constrained_hz=np.array([300.0]),
+        constrained_modes=modes[:, :1],
+        interfaces=["fit"],
+    )
+    files = render_part_modes(tmp_path, "ring", pm)
+    assert [p.name for p in files] == ["ring_free_mode01.png", "ring_free_mode02.png", "ring_constrained_mode01.png"]
+    for p in files:
+        _not_blank(p, min_var=1e-4)

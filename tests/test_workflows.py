@@ -256,7 +256,7 @@ def test_te_errors_smoke(tmp_path):
         assert rows["ideal geometry"]["TE p-p [arcsec]"] == pytest.approx(ideal_pp, rel=0.02)
         assert rows["all errors"]["TE p-p [arcsec]"] > 10 * ideal_pp
         singles = [v for k, v in rows.items() if k.endswith(" only")]
-        assert min(singles, key=lambda x: x["TE p-p [arcsec]"]) is rows["first_stage only"]
+        assert min(singles, key=lambda x: x["TE p-p [arcsec]"]) is rows["first stage only"]
     rows = {row["case"]: row for row in r.numbers["rv40e"]["rows"]}
     assert rows["all errors"]["TE p-p [arcsec]"] == pytest.approx(55.07, rel=0.01)
     assert (tmp_path / "te_errors" / "summary.md").read_text().startswith("# Transmission error")

@@ -34,11 +34,12 @@ def emit(data: Any, as_json: bool, render: Callable[[Any], None]) -> None:
 
 
 def kv_table(title: str, rows: list[tuple[str, Any, str]]) -> Table:
-    """A three-column table (quantity, value, unit)."""
+    """A three-column table (quantity, value, unit); long cells wrap, never cut, so that
+    names and paths can be copied."""
     table = Table(title=title, title_justify="left")
-    table.add_column("quantity")
-    table.add_column("value", justify="right")
-    table.add_column("unit")
+    table.add_column("quantity", overflow="fold")
+    table.add_column("value", justify="right", overflow="fold")
+    table.add_column("unit", overflow="fold")
     for name, value, unit in rows:
         table.add_row(name, fmt(value), unit)
     return table
@@ -150,7 +151,7 @@ def _render_records(name: str, records: list[dict[str, Any]]) -> None:
     table = Table(title=name, title_justify="left")
     columns = list(records[0].keys())
     for col in columns:
-        table.add_column(col, justify="right")
+        table.add_column(col, justify="right", overflow="fold")
     for rec in records[:60]:
         table.add_row(*(fmt(_compact(rec.get(c))) for c in columns))
     console.print(table)

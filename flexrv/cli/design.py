@@ -69,9 +69,9 @@ def show(
             if not isinstance(values, dict) or section in ("provenance", "errors"):
                 continue
             table = Table(title=section, title_justify="left")
-            table.add_column("field")
-            table.add_column("value", justify="right")
-            table.add_column("provenance")
+            table.add_column("field", overflow="fold")  # wrapped, never cut: a name to copy
+            table.add_column("value", justify="right", overflow="fold")
+            table.add_column("provenance", overflow="fold")
             for key, value in values.items():
                 if isinstance(value, dict):
                     value = ", ".join(f"{k}={fmt(v)}" for k, v in value.items())

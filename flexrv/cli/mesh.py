@@ -45,7 +45,8 @@ def mesh(
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
     compliance: bool = typer.Option(False, "--compliance", help=COMPLIANCE_HELP),
 ) -> None:
-    """Mesh a part with second-order tetrahedra (cached in the user cache directory, $FLEXRV_CACHE_DIR to override): files and counts."""
+    """Mesh a part with second-order tetrahedra (cached in the user cache directory,
+    $FLEXRV_CACHE_DIR to override): files and counts."""
     from flexrv.design import load
     from flexrv.errors import InputError
     from flexrv.meshing import build_mesh
@@ -102,7 +103,9 @@ def modes(
     n: int = typer.Option(10, "--n", help="Number of elastic modes."),
     size: Optional[float] = SIZE_OPT,
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
-    png: Optional[Path] = typer.Option(None, "--png", help="Render each free mode to PNGs in this folder."),
+    png: Optional[Path] = typer.Option(
+        None, "--png", help="Render each free-free and constrained mode to PNGs in this folder."
+    ),
     show: bool = typer.Option(False, "--show", help="Open an interactive window (needs a display)."),
     vtu: Optional[Path] = typer.Option(None, "--vtu", help="Write the modes as VTU for ParaView to this folder."),
 ) -> None:
@@ -121,18 +124,9 @@ def modes(
     m = pm.mesh
     files = []
     if png is not None:
-        from flexrv.viz.modes import render_mode_png
+        from flexrv.viz.modes import render_part_modes
 
-        png.mkdir(parents=True, exist_ok=True)
-        for k, f in enumerate(pm.free_hz):
-            p = render_mode_png(
-                png / f"{part.value}_free_mode{k + 1:02d}.png",
-                m.nodes,
-                m.tris,
-                pm.free_modes[:, k].reshape(-1, 3),
-                title=f"{part.value} free mode {k + 1}: {f:.1f} Hz",
-            )
-            files.append(str(p))
+        files += [str(p) for p in render_part_modes(png, part.value, pm)]
     if vtu is not None:
         from flexrv.viz.modes import export_modes_vtu
 

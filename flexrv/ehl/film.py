@@ -62,7 +62,7 @@ def ellipticity(rx, ry):
 
     This is the k of the Hamrock–Dowson formulas: their own curve fit k ~ 1.0339 (ry/rx)^0.636
     (:func:`ellipticity_approx`) gives 1.0339 for a circular contact, +1.0 % on h_c and +2.3 %
-    on h_min there (issue 17 (2)).
+    on h_min there.
     """
     from flexrv.contact.hertz import point_contact
 
@@ -191,9 +191,8 @@ def moes_dimensionless(moes_m, moes_l, curvature_ratio):
 
     Limits (tests/test_ehl_film.py): L -> 0 gives (H_RI^(3/2) + H_EI^(3/2))^(2/3) (H_RI at light
     load, H_EI at heavy load); large L gives min(H_RP, H_EP) (H_RP at light, H_EP at heavy load).
-    H_00 = 1.8/lambda only caps H_EI at extremely light loads. (Earlier flexrv versions used
-    0.1^-4 in place of H_00^-4, which capped the isoviscous branch at H = 0.1 and made the
-    elastic-isoviscous asymptote unreachable — up to +7 % on h_c at M ~ 260 once corrected.)
+    H_00 = 1.8/lambda only caps H_EI at extremely light loads (a constant cap such as 0.1
+    would make the elastic-isoviscous asymptote unreachable).
     """
     h_ri, h_ei, h_rp, h_ep = moes_asymptotes(moes_m, moes_l, curvature_ratio)
     lam = np.asarray(curvature_ratio, dtype=float)

@@ -1,9 +1,8 @@
 """Linear-elastic P2 stiffness and mass matrices of a Tet10 mesh (scikit-fem).
 
-Choice of assembler (measured on this machine, rv221 outer ring, 33.5k nodes /
-100k DOF): scikit-fem assembles the isoparametric P2 (``MeshTet2`` +
-``ElementVector(ElementTetP2)``) stiffness in ~3 s and the consistent mass in
-~0.6 s, fully vectorised. ``exudyn.FEM`` has no assembler for Tet10: its
+Choice of assembler: scikit-fem assembles the isoparametric P2 (``MeshTet2`` +
+``ElementVector(ElementTetP2)``) stiffness and consistent mass fully vectorised, in
+seconds for a 100k-DOF ring (``benchmarks/bench_cms.py``). ``exudyn.FEM`` has no assembler for Tet10: its
 ``FEMinterface`` imports K and M (Abaqus/Ansys files, or NGsolve), and its
 ``Tet4`` class only serves stress post-processing; NGsolve is not installed and
 would add a heavy dependency. Hence scikit-fem assembles, Exudyn reduces.

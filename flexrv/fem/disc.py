@@ -30,8 +30,8 @@ adds the body's compliance below the contact zone. What the FE still counts of
 the near field between b and the patch width is the logarithmic half-plane term
 ~ 2 F (1 - nu^2) ln(patch / b) / (pi E L) per pin, stated as the remaining
 overlap with the contact law (Johnson, Contact Mechanics 1985, sec. 2.8).
-Measured on the rv40e disc (crank angle 0; the former 1.29 mm flank mesh and
-lumped patch loads, 2026-11-23): patch half-width 0.75, 1.5, 3 mm give c_d =
+Measured on the rv40e disc (crank angle 0; a 1.29 mm flank mesh and lumped patch
+loads): patch half-width 0.75, 1.5, 3 mm give c_d =
 1.470, 1.357, 1.278e-7 rad/(N m) (+8 % / -6 % about the default): the body value
 carries this +-8 % modelling band.
 
@@ -77,7 +77,7 @@ from flexrv.design.manufacturing import nominal_design
 from flexrv.errors import InputError
 from flexrv.units import RAD_PER_ARCMIN
 
-FORMAT_VERSION = 2  # 2: consistent pin-patch loads (2026-11-24)
+FORMAT_VERSION = 2  # cached-file layout; 2: consistent pin-patch loads
 
 #: held components of a crank-hole master: x, y, z, rx, ry (rz free)
 HELD = (0, 1, 2, 3, 4)

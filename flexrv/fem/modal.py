@@ -6,13 +6,12 @@ factorised once with SuperLU using the MMD(A^T + A) column ordering and
 symmetric mode (measured on 100k DOF: 7.9 s and 65M factor entries vs 31 s and
 156M with SciPy's default COLAMD, which ``eigsh(sigma=...)`` would use).
 
-Free-free bodies: the six rigid-body modes are *deflated* (issue 18). With the shift
+Free-free bodies: the six rigid-body modes are *deflated*. With the shift
 sigma = -(2 pi 1 Hz)^2 next to the rigid-body cluster (lambda = 0), the shift-inverted
 rigid-body eigenvalues 1/(0 - sigma) exceed the elastic ones 1/(lambda_el - sigma) by ~1e8-1e10,
-and the elastic Ritz values came out with the round-off of that cluster: the lowest free-free
-frequency of the rv40e crankshaft read 20122.8 / 20110.1 / 20128.3 Hz run to run (ARPACK's
-random start vector; 0.1-0.5 % scatter on the first modes). Now the rigid-body subspace R is
-found first by subspace iteration with the same factorisation (three steps: its eigenvalues of
+so without deflation the elastic Ritz values carry the round-off of that cluster (ARPACK's
+random start vector gives a 0.1-0.5 % scatter on the first modes from run to run). So the
+rigid-body subspace R is found first by subspace iteration with the same factorisation (three steps: its eigenvalues of
 (K - sigma M)^-1 M dominate the elastic ones by that factor of ~1e8, so the subspace is exact
 to round-off after two) and a Rayleigh–Ritz step; the elastic modes are then computed with the
 M-orthogonal projector P = I - R R^T M applied on both sides of the shift-invert operator,

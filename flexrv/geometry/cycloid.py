@@ -224,8 +224,8 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     The warm start's half-lobe test needs no arctangent: with theta = atan2(px,
     py), |phi - theta| (mod 2 pi) <= lobe/2 is cos(phi - theta) |P| = px sin(phi)
     + py cos(phi) >= cos(lobe/2) |P|, and sin(phi), cos(phi) follow from C and C'
-    at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (issue
-    15: the arctangent was 1.5 % of a rigid run)."""
+    at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (an
+    arctangent per call would cost about 1.5 % of a rigid run)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
     if np.isfinite(phi0):
         phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(
@@ -388,8 +388,8 @@ def profile_curvature_radius(
 
     rho_profile = 1/kappa_C - (r_rp + dr_rp), kappa_C the signed curvature of the
     pin-centre curve (:func:`center_curve_curvature`); offset curves share centres
-    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of :cite:`seed004`'s rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an
-    unmodified profile.
+    of curvature (Litvin & Fuentes 2004, ch. 6). Equal to the negative of :cite:`seed004`'s
+    rho_i (:func:`seed004_curvature_radius`) at theta = z_c phi for an unmodified profile.
     """
     kappa = center_curve_curvature(phi, z_rp, pin_circle_radius + d_radius, eccentricity)
     with np.errstate(divide="ignore"):

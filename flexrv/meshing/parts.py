@@ -144,12 +144,12 @@ class CycloidDiscSpec:
     def profile_size(self, size: float) -> float:
         """Mesh size at the tooth flanks [m]: <= the pin radius r_rp, i.e. twice the
         pin patch half-width r_rp / 2 of :mod:`flexrv.fem.disc` (about a third of the
-        tooth pitch on the presets; before 2026-11-24 an eighth of it).
+        tooth pitch on the presets).
 
         Chosen from a convergence study of the disc body's torsional compliance as
         the models and the budget use it (mean over six crank angles of
         :func:`flexrv.fem.disc.disc_torsion_sweep`, consistent patch loads, default
-        global size, flank sizes in ratio sqrt 2; 2026-11-24):
+        global size, flank sizes in ratio sqrt 2):
 
         * rv40e, 4.24 / 3 / 2.12 mm (11.3k / 16.9k / 28.8k nodes): 1.45218 /
           1.46257 / 1.46803e-7 rad/(N m), observed order 1.86, Richardson value

@@ -113,7 +113,8 @@ def order_spectrum(te_arcsec: np.ndarray, output_revolutions: float):
 def spectrum_lines(order, amp, orders: dict[str, float], count: int = 8, harmonics: int = 12) -> list[dict]:
     """The ``count`` largest spectral lines (local maxima), each labelled with the
     characteristic order or harmonic ``h x name`` (h <= ``harmonics``) nearest to
-    it within half a bin; ``-`` where none is (e.g. sidebands)."""
+    it within half a bin, else the simplest sideband ``h x name +- n x crank rotation``
+    (n <= 6); ``-`` where none is."""
     if len(order) < 2:
         return []
     df = order[1] - order[0]
@@ -130,6 +131,20 @@ def spectrum_lines(order, amp, orders: dict[str, float], count: int = 8, harmoni
                 d = abs(order[i] - h * o)
                 if d <= 0.5 * df + 1e-9 and (best is None or (d, h) < best[:2]):
                     best = (d, h, name if h == 1 else f"{h} x {name}")
+        if best is None:  # a sideband: h x mesh +- n x crank rotation (else the slowest order)
+            base = "crank rotation" if "crank rotation" in orders else min(orders, key=orders.get)
+            for name, o in orders.items():
+                for h in range(1, harmonics + 1):
+                    n = int(round((order[i] - h * o) / orders[base]))
+                    d = abs(order[i] - h * o - n * orders[base])
+                    if (
+                        name != base
+                        and 1 <= abs(n) <= 6
+                        and d <= 0.5 * df + 1e-9
+                        and (best is None or (d, abs(n) + h) < best[:2])
+                    ):
+                        head = name if h == 1 else f"{h} x {name}"
+                        best = (d, abs(n) + h, f"{head} {'+' if n > 0 else '-'} {abs(n)} x {base}")
         out.append({"order": float(order[i]), "amplitude_arcsec": float(a[i]), "label": best[2] if best else "-"})
     return out
 

@@ -33,7 +33,7 @@ def plot_te_spectra(rigid, flexible, path) -> Path:
     from flexrv.viz.plots import spectrum_axis
 
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(9, 4.2))
+    fig, ax = plt.subplots(figsize=(10.5, 4.2))
     spectra = {label: te_spectrum(res) for res, label in ((rigid, "rigid"), (flexible, "flexible"))}
     top = max((float(a[1:].max()) for f, a, _ in spectra.values() if len(a) > 1), default=1.0)
     t0, t1 = rigid.steady_window()

@@ -32,7 +32,7 @@ SCALAR_BAR = {
     "position_x": 0.86,
     "position_y": 0.12,
     "width": 0.06,
-    "height": 0.7,
+    "height": 0.66,
     "title_font_size": 14,
     "label_font_size": 12,
     "fmt": "%.3g",
@@ -71,6 +71,40 @@ def warp_scale(nodes: np.ndarray, displacement: np.ndarray, fraction: float = 0.
     return 0.0 if umax == 0 else fraction * float(np.ptp(nodes, axis=0).max()) / umax
 
 
+#: colour-bar title of a mode shape: displacement magnitude over its largest value, dimensionless
+#: (VTK's fonts drop "|", so the bar says it in words)
+MODE_SCALAR = "relative displacement [-]"
+
+
+def render_part_modes(folder, part: str, pm) -> list[Path]:
+    """PNGs of every free-free and every constrained mode of a part
+    (:class:`flexrv.fem.body.PartModes`) into ``folder``: ``<part>_free_mode<k>.png`` and
+    ``<part>_constrained_mode<k>.png``, each titled with the part, the boundary condition
+    and the frequency."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    m = pm.mesh
+    clamped = ", ".join(pm.interfaces) if pm.interfaces else "interfaces"
+    sets = (
+        ("free", "free-free", pm.free_hz, pm.free_modes),
+        ("constrained", f"constrained ({clamped} clamped)", pm.constrained_hz, pm.constrained_modes),
+    )
+    files = []
+    for tag, words, freqs, shapes in sets:
+        for k, f in enumerate(freqs):
+            files.append(
+                render_mode_png(
+                    folder / f"{part}_{tag}_mode{k + 1:02d}.png",
+                    m.nodes,
+                    m.tris,
+                    shapes[:, k].reshape(-1, 3),
+                    title=f"{part}, {words} mode {k + 1}: {f:.1f} Hz\n"
+                    "colour: displacement magnitude / its largest value; shape exaggerated to 8 % of the body",
+                )
+            )
+    return files
+
+
 def render_mode_png(
     path: str | os.PathLike,
     nodes: np.ndarray,
@@ -78,12 +112,20 @@ def render_mode_png(
     displacement: np.ndarray,
     title: str = "",
     scalars: np.ndarray | None = None,
-    scalar_name: str = "|u|",
+    scalar_name: str = MODE_SCALAR,
     window_size=(900, 700),
 ) -> Path:
-    """Render a mode shape (warped, coloured by |u| or ``scalars``, e.g. von Mises)
-    off-screen to a PNG, written atomically. Returns the path."""
+    """Render a mode shape off-screen to a PNG, written atomically; returns the path.
+
+    The surface is warped (largest displacement 8 % of the body size) and coloured by
+    ``scalars`` (e.g. von Mises stress, named with its unit in ``scalar_name``) or, by
+    default, by the displacement magnitude relative to its largest value, |u| / max |u|
+    [-]: an eigenvector's amplitude is arbitrary, so only the relative shape has a unit
+    that means something. The undeformed surface is drawn as a faint wireframe."""
     pv = _pyvista()
+    if scalars is None:
+        mag = np.linalg.norm(displacement, axis=1)
+        scalars = mag / mag.max() if mag.max() > 0 else mag
     scale = warp_scale(nodes, displacement)
     poly = surface_polydata(nodes, tris6, displacement, scale, scalars, scalar_name)
     ref = surface_polydata(nodes, tris6)

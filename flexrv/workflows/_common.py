@@ -101,7 +101,8 @@ class WorkflowResult:
         lines = [f"# {self.title}" + (" (SMOKE RUN)" if self.smoke else ""), ""]
         if self.smoke:
             lines += [SMOKE_BANNER, ""]
-        lines += [f"Seeds: {', '.join(self.seeds)} (see References)", ""]
+        if self.seeds:  # a workflow of flexrv's own (e.g. the mode gallery) reproduces no seed
+            lines += [f"Seeds: {', '.join(self.seeds)} (see References)", ""]
         if self.comparisons:
             lines += ["| quantity | unit | seed | flexrv | note |", "|---|---|---|---|---|"]
             for c in self.comparisons:

@@ -349,15 +349,19 @@ def run(
     r.datasets["roller_forces"] = xr.Dataset(
         {"roller_force": res["roller_force"].isel(crank=0), "roller_angle": res["roller_angle"].isel(crank=0)}
     )
+    from matplotlib.ticker import MaxNLocator
+
     fig, ax = new_figure(1, 3, figsize=(15, 4))
     tt = res["roller_force"]["time"].values
     for n in range(f.size):
         ax[0].plot(tt, res["roller_force"].values[:, 0, k, n], lw=0.6)
-    ax[0].axvline(res.time[i], color="k", ls=":")
+    ax[0].axvline(res.time[i], color="k", ls=":", label=f"instant of the middle and right panels, {res.time[i]:.4f} s")
+    ax[0].xaxis.set_major_locator(MaxNLocator(5))
     ax[0].set_xlabel("time [s]")
+    ax[0].legend(loc="upper left", fontsize=7)
     ax[0].set_ylabel(f"roller forces, crank 0 bearing {k} [N]")
     ax[1].bar(np.arange(1, f.size + 1), f)
-    ax[1].set_xlabel("roller")
+    ax[1].set_xlabel("roller number")
     ax[1].set_ylabel(f"force at t = {res.time[i]:.4f} s [N]")
     ax[2].remove()
     axp = fig.add_subplot(1, 3, 3, projection="polar")  # roller forces at their contact directions (housing frame)

@@ -114,7 +114,8 @@ def run(out_dir=None, smoke: bool = False, presets=None, t_end=None, dt=None) ->
             "deg/s",
             "40.72",
             _g(sim_out),
-            f"rigid flexrv run scaled to 9000 deg/s; steady window {summ['steady_window_s'][0]:.3g}-{summ['steady_window_s'][1]:.3g} s; "
+            "rigid flexrv run scaled to 9000 deg/s; steady window "
+            f"{summ['steady_window_s'][0]:.3g}-{summ['steady_window_s'][1]:.3g} s; "
             "residual from contact compliance/clearance oscillation in the window",
         )
     fs = red.first_stage

@@ -9,7 +9,8 @@ pressure in a real bearing, over physically meaningful ranges:
   VG 1000 at the operating temperature), EHL law ``hamrock_dowson``, plus the dry
   Hertz reference — central films of ~0.01-0.5 um at the carrier's slow
   entrainment speed;
-* **pressure**: the external radial load on the output flange, 0-30 kN (:cite:`seed001`'s range), which sets the maximum Hertz pressure.
+* **pressure**: the external radial load on the output flange, 0-30 kN (:cite:`seed001`'s
+  range), which sets the maximum Hertz pressure.
 
 Each case runs the reducer with the flexible main bearing (``model="flexible"``)
 and records the minimum central film over the loaded balls, the maximum contact

@@ -1,4 +1,4 @@
-"""Mode gallery (issue 7 item 8): free-free eigenfrequencies and off-screen pyvista
+"""Mode gallery: free-free eigenfrequencies and off-screen pyvista
 renderings of the first modes of every flexible part of both presets.
 
 Uses :func:`flexrv.fem.body.part_modes` and :func:`flexrv.viz.modes.render_mode_png`
@@ -38,7 +38,7 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
     presets, parts, n_modes = tuple(presets or PRESETS), tuple(parts or PARTS), int(n_modes or N_MODES)
     out = Path(out_dir) if out_dir else default_out(NAME, smoke)
     out.mkdir(parents=True, exist_ok=True)
-    r = WorkflowResult(NAME, "Mode gallery: free-free modes of the flexible parts", ["issue 7 item 8"], smoke=smoke)
+    r = WorkflowResult(NAME, "Mode gallery: free-free modes of the flexible parts", [], smoke=smoke)
     rows, gallery, freq = [], [], {}
     for p in presets:
         red = load(p)
@@ -84,7 +84,12 @@ def run(out_dir=None, smoke: bool = False, presets=None, parts=None, n_modes=Non
     fig, ax = new_figure(figsize=(8, 3.5))
     for j, c in enumerate(freq):
         ax.plot(np.arange(1, n_modes + 1), freq[c], "o-", label=c)
+    from matplotlib.ticker import LogLocator, ScalarFormatter
+
     ax.set_xlabel("mode number"), ax.set_ylabel("free-free frequency [Hz]"), ax.set_yscale("log"), ax.legend(fontsize=7)
+    ax.yaxis.set_major_formatter(ScalarFormatter())  # plain numbers in Hz, not 2.1 x 10^4
+    ax.yaxis.set_minor_formatter(ScalarFormatter())
+    ax.yaxis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
     ax.set_xticks(np.arange(1, n_modes + 1))  # whole mode numbers only
     fig.tight_layout()
     r.figures["frequencies"] = fig

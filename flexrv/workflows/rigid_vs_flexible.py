@@ -83,8 +83,9 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | 
     )
     r.text.append((cmp.out_dir / "summary.md").read_text().split("\n", 2)[2])
     r.text.append(
-        f"flexrv: the flexible main bearing changes the steady TE range by {nf['te_pp_arcsec'] - nr['te_pp_arcsec']:+.2f}"
-        f" arcsec peak-to-peak and its mean by {nf['te_mean_arcsec'] - nr['te_mean_arcsec']:+.2f} arcsec; the seeds' "
+        "flexrv: the flexible main bearing changes the steady TE range by "
+        f"{nf['te_pp_arcsec'] - nr['te_pp_arcsec']:+.2f} arcsec peak-to-peak and its mean by "
+        f"{nf['te_mean_arcsec'] - nr['te_mean_arcsec']:+.2f} arcsec; the seeds' "
         "near-doubling of the TE range is not reproduced (see the ring_deformation workflow for why: fit-clamped "
         "rings deform locally by ~1 um; what moves TE is the carrier's shift under external load)."
     )

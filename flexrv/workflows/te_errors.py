@@ -87,7 +87,7 @@ def run(out_dir=None, smoke: bool = False, presets=PRESETS) -> WorkflowResult:
             part = errors.only(group)
             if not part.nonzero_items():
                 continue
-            row, _ = _case(with_errors(base, part), f"{group} only", span)
+            row, _ = _case(with_errors(base, part), f"{group.replace('_', ' ')} only", span)
             rows.append(row)
         all_row, full = _case(with_errors(base, errors), "all errors", span)
         rows.append(all_row)

@@ -1,4 +1,4 @@
-"""Tolerance study of a production batch of rv40e reducers (issue 13).
+"""Tolerance study of a production batch of rv40e reducers.
 
 A batch of rv40e reducers is drawn from the tolerance set
 ``flexrv/design/presets/tolerances/rv40e.toml`` (every entry states its source:
