@@ -4,16 +4,19 @@ same machinery, resumability, and the rv40e search re-evaluated by the full solv
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
-from flexrv.studies._opt_expr import Variable
+from flexrv.errors import InputError
+from flexrv.studies._opt_expr import Variable, parse_constraint, parse_objective, parse_vary
 from flexrv.studies.optimize import (
     OptimizeConfig,
     Problem,
     attach_goals,
+    batch_metrics,
     non_dominated,
     run_optimize,
 )
@@ -151,3 +154,153 @@ def test_resume_after_interruption(tmp_path):
     r = run_optimize(_cfg(tmp_path, budget=60), progress=False, mode="inline", problem=_analytic_problem())
     assert r["reused"] >= 24 and r["computed_now"] == ref["computed_now"] - 24
     assert [q["x1"] for q in r["pareto"]] == [q["x1"] for q in ref["pareto"]]
+
+
+# ----------------------------------------------------------------------------- parsing
+def test_parse_objective_constraint_vary():
+    """Objective senses, a constraint's violation (relative, <= 0 where it holds), and the
+    rejection of executable text: a call, an attribute, a lambda are not parsed."""
+    names = ["lost_motion_p95_arcmin", "no_preload_yield", "rigidity_median_Nm_per_arcmin"]
+    assert parse_objective("rigidity_median_Nm_per_arcmin:max", names).sense == "max"
+    assert parse_objective("lost_motion_p95_arcmin", names).sense == "min"
+    c = parse_constraint("no_preload_yield >= 0.99", names)
+    assert c.holds({"no_preload_yield": 0.995}) and not c.holds({"no_preload_yield": 0.98})
+    assert c.violation({"no_preload_yield": 0.98}) == pytest.approx(0.01 / 0.99)
+    c2 = parse_constraint("2 * lost_motion_p95_arcmin - 0.5 < 1.5", names)
+    assert c2.holds({"lost_motion_p95_arcmin": 0.9}) and not c2.holds({"lost_motion_p95_arcmin": 1.0})
+    for bad in ("__import__('os').system('true') <= 1", "lost_motion_p95_arcmin.real <= 1", "(lambda: 1)() <= 1"):
+        with pytest.raises(InputError, match="not allowed|unknown"):
+            parse_constraint(bad, names)
+    base = {"second_stage": {"modification_shift_mm": 0.0, "disc_body_model": "rigid"}}
+    v = parse_vary("second_stage.modification_shift_mm=-0.01:0.02", base)
+    assert (v.lo, v.hi, v.integer) == (-0.01, 0.02, False)
+
+
+@pytest.mark.parametrize(
+    "args, word",
+    [
+        (["--vary", "second_stage.modification_colour_mm=0:1"], "unknown design field"),
+        (["--vary", "second_stage.modification_shift_mm=0.01:-0.01"], "must be below"),
+        (["--vary", "second_stage.disc_body_model=0:1"], "not a number"),
+        (["--vary", "second_stage.modification_shift_mm=0:0.5"], "modification_shift_mm"),
+        (["--objective", "lost_motion_p96_arcmin"], "unknown metric"),
+        (["--objective", "lost_motion_p95_arcmin:maximise"], "bad syntax"),
+        (["--constraint", "pin_contact_pressure_p95_MPa <="], "not an expression"),
+        (["--constraint", "pin_contact_pressure_p95_MPa"], "one comparison"),
+        (["--constraint", "open('x') <= 1"], "not allowed"),
+        (["--budget", "0"], "--budget"),
+        (["--samples-per-design", "0"], "--samples-per-design"),
+        (["--spec", "lost_motion<=1"], "unknown quantity"),
+    ],
+)
+def test_cli_bad_input_exit_2(tmp_path, capsys, args, word):
+    """Each bad option: one message on stderr naming the culprit, exit code 2, before any
+    evaluation (no output folder is written)."""
+    from flexrv.cli import main
+
+    base = {
+        "--vary": "second_stage.modification_shift_mm=-0.01:0.01",
+        "--objective": "lost_motion_p95_arcmin:min",
+        "--budget": "2",
+        "--samples-per-design": "1",
+    }
+    argv = ["optimize", "rv40e", "--tolerances", "rv40e", *args]
+    for k, v in base.items():
+        if k not in args:
+            argv += [k, v]
+    with pytest.raises(SystemExit) as exc:
+        main(argv + ["--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2, err
+    assert word in " ".join(err.split()), err
+    assert "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_constraint_no_design_meets(tmp_path):
+    """A constraint no design in the box can meet (f1 + f2 <= 0.2 on ZDT1, whose front has
+    f1 + f2 >= 0.75) ends with one InputError naming it (exit 2 from the CLI), after the
+    outputs are written."""
+    p = _analytic_problem(constraints=["f1_mean + f2_mean <= 0.2"])
+    with pytest.raises(InputError, match=r"f1_mean \+ f2_mean <= 0.2.*no design in the box meets it"):
+        run_optimize(_cfg(tmp_path, budget=40), progress=False, mode="inline", problem=p)
+    assert (tmp_path / "run" / "evaluations.csv").exists()
+
+
+def test_batch_metrics_names_and_values():
+    """Metric names <quantity>_<stat>_<unit> and their values on a hand-made batch: P95 by
+    linear interpolation (numpy), the yield of a per-build rule, a failed draw (NaN)
+    excluded from the statistics and counted as not passing."""
+    from flexrv.studies._opt_expr import BuildRule
+
+    res = {"nominal": {"lost_motion": 0.5}, "draws": {"lost_motion": [0.2, 0.4, 0.6, 0.8, float("nan")]}}
+    m = batch_metrics(res, {"lost_motion": "arcmin"}, {"fit": [BuildRule("lost_motion", "<=", 0.5, "x")]})
+    assert m["lost_motion_p95_arcmin"] == pytest.approx(np.percentile([0.2, 0.4, 0.6, 0.8], 95))
+    assert m["lost_motion_median_arcmin"] == pytest.approx(0.5)
+    assert m["lost_motion_nominal_arcmin"] == 0.5
+    assert m["fit_yield"] == pytest.approx(2 / 5) and m["failed_fraction"] == pytest.approx(1 / 5)
+
+
+# ----------------------------------------------------------------------------- rv40e
+def test_pin_contact_pressure_closed_form():
+    """The nominal pose maps the loaded pins onto the profile: at every position of rv40e
+    (no errors) each pin's nominal gap equals the equidistant modification (5 um, to
+    1e-9 m), and a pin force F gives Hertz's p = sqrt(F E' / (2 pi L R)) (Johnson 1985,
+    eq. 4.45) with the reported r_eff, to 1e-12 relative."""
+    from flexrv.analysis.pin_load import disc_effective_modulus
+    from flexrv.design import load
+    from flexrv.studies._modification_eval import contact_parameters, pin_contact_pressure
+
+    red = load("rv40e")
+    angles = np.linspace(0.0, 2.0, 5)
+    r_eff, gap = contact_parameters(red, angles)
+    assert np.allclose(gap, red.second_stage.modification_equidistant_mm * 1e-3, atol=1e-9)
+    f = np.full(r_eff.shape, 500.0)
+    p = pin_contact_pressure(red, angles, f)
+    e = disc_effective_modulus(red)
+    ref = np.sqrt(500.0 * e / (2.0 * np.pi * red.second_stage.disc_width * r_eff))
+    ok = r_eff > 0
+    assert np.allclose(p[ok], ref[ok], rtol=1e-12)
+
+
+def test_rv40e_points_reevaluate_within_stated_error(tmp_path):
+    """The issue's command on a tiny budget (2 designs, 1 draw, in-process): every reported
+    Pareto point, re-evaluated by the full solver with the same draw, matches its reported
+    figures within CHEAP_ERROR (per build, which bounds every batch statistic) and has the
+    same no-preload yield (the same geometric function in both)."""
+    from flexrv.studies._modification_eval import modification_task
+    from flexrv.studies._opt_expr import STATS, metric_name
+    from flexrv.studies.optimize import CHEAP_ERROR, FULL_RESOLUTION, build_problem
+
+    cfg = OptimizeConfig(
+        design="rv40e",
+        tolerances="rv40e",
+        vary=["second_stage.modification_equidistant_mm=0:0.015", "second_stage.modification_shift_mm=-0.015:0.015"],
+        objectives=["lost_motion_p95_arcmin:min", "rigidity_median_Nm_per_arcmin:max"],
+        constraints=["pin_contact_pressure_p95_MPa <= 4000"],
+        samples_per_design=1,
+        budget=2,
+        population=2,
+        out=str(tmp_path / "rv"),
+        reevaluate=False,
+    )
+    r = run_optimize(cfg, progress=False, mode="inline")
+    assert r["pareto"]
+    problem, _, _ = build_problem(cfg)
+    fields = [v.path for v in problem.variables]
+    for point in r["pareto"]:
+        design = problem.design_for([point[f] for f in fields])
+        full = batch_metrics(
+            modification_task(design, problem.draws, {"resolution": FULL_RESOLUTION}), problem.quantities, problem.rules
+        )
+        for q, unit in problem.quantities.items():
+            for stat in STATS:
+                if stat == "std":
+                    continue
+                name = metric_name(q, stat, unit)
+                assert abs(full[name] - point[name]) <= CHEAP_ERROR[q], (name, full[name], point[name])
+        assert full["no_preload_yield"] == point["no_preload_yield"]
+    summary = json.loads((tmp_path / "rv" / "summary.json").read_text())
+    assert summary["pareto"] == r["pareto"]
+    for name in ("pareto.csv", "pareto.nc", "pareto.png", "summary.md", "evaluations.csv"):
+        assert (tmp_path / "rv" / name).exists()
