@@ -156,7 +156,8 @@ def markdown(r: dict[str, Any]) -> str:
         f"Objectives: {', '.join(r['objectives'])}. Constraints: {', '.join(cons) if cons else 'none'}.",
         f"{r['samples_per_design']} tolerance draws per design (the same draws for every design, seed {r['seed']}); "
         f"{r['evaluations']} designs evaluated ({r['feasible']} feasible; {r['computed_now']} computed now, "
-        f"{r['reused']} read from earlier runs), NSGA-II population {r['population']}, wall time {r['wall_time_s']:.0f} s.",
+        f"{r['reused']} read from earlier runs), NSGA-II population {r['population']}, "
+        f"wall time {r['wall_time_s']:.0f} s.",
         f"Search resolution {json.dumps(r['resolution'])}; re-evaluated at {json.dumps(r['full_resolution'])}.",
         "",
         "## Recommended designs (search figures / full re-evaluation, same draws)",
@@ -193,7 +194,8 @@ def markdown(r: dict[str, Any]) -> str:
             lines.append(f"- {k}: {txt}")
     lines += [
         "",
-        f"Cheap-evaluation error bound per build (|cheap - full|, unit of each quantity): {json.dumps(r['cheap_error'])}.",
+        "Cheap-evaluation error bound per build (|cheap - full|, unit of each quantity): "
+        f"{json.dumps(r['cheap_error'])}.",
         "",
         f"## Pareto set ({len(r['pareto'])} designs)",
         "",

@@ -341,7 +341,10 @@ def infeasibility_message(problem: Problem, cands: list[Candidate]) -> str:
             f"--constraint {con.text!r}: no design in the box meets it ({len(ok)} candidates evaluated; "
             f"the closest misses by {100 * best:.3g} % of the limit)"
         )
-    return f"no design in the box meets all constraints together ({len(ok)} candidates evaluated; fewest met: {con.text!r})"
+    return (
+        f"no design in the box meets all constraints together ({len(ok)} candidates evaluated; "
+        f"fewest met: {con.text!r})"
+    )
 
 
 # ----------------------------------------------------------------------------- the study
