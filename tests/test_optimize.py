@@ -304,3 +304,18 @@ def test_rv40e_points_reevaluate_within_stated_error(tmp_path):
     assert summary["pareto"] == r["pareto"]
     for name in ("pareto.csv", "pareto.nc", "pareto.png", "summary.md", "evaluations.csv"):
         assert (tmp_path / "rv" / name).exists()
+
+
+def test_modification_design_smoke(tmp_path):
+    """Workflow ``modification_design`` in smoke size (in-process: 2 designs x 1 draw): the
+    summary carries the preset's point, the recommended designs or the constraint that no
+    design meets, and numbers that match the search's own summary.json."""
+    from flexrv.workflows.modification_design import run
+
+    r = run(out_dir=tmp_path, smoke=True, budget=2, samples=1, mode="inline")
+    text = (tmp_path / "summary.md").read_text()
+    assert "SMOKE RUN" in text and "P95 lost motion of the preset's batch" in text
+    search = json.loads((tmp_path / "search" / "summary.json").read_text())
+    assert r.numbers["preset"] == search["preset"]
+    assert r.numbers["infeasible"] or r.numbers["recommended"]
+    assert (tmp_path / "search" / "evaluations.csv").exists()
