@@ -85,16 +85,19 @@ CHEAP_RESOLUTION = {
 #: as ``flexrv tolerance`` (:data:`flexrv.studies.tolerance.DEFAULT_RESOLUTION`)
 FULL_RESOLUTION = {**CHEAP_RESOLUTION, "crank_revolutions": 1.0, "catalog_positions": 6}
 
-#: largest |cheap - full| of one build's quantity (unit of the quantity), measured by
-#: benchmarks/bench_optimize.py --compare on rv40e (see docs/optimize.md); bounds every
-#: batch statistic (module docstring, point 5). The assembly penetration is the same
-#: geometric function in both.
+#: bound of |cheap - full| of one build's quantity (unit of the quantity). Measured by
+#: benchmarks/bench_optimize.py --compare on rv40e over 54 builds (6 modifications of the
+#: equidistant / shift box x (8 grade-5 draws + the nominal build)): largest differences
+#: lost motion 0.251 arcmin (mean 0.066), backlash 0.391 (0.100), rigidity 1.72 N m/arcmin
+#: (0.52), TE p-p 13.9 arcsec (4.1), pin force 323 N (61), pin contact pressure 172 MPa (34),
+#: assembly penetration 0 (the same geometric function); stated here rounded up. It bounds
+#: every batch statistic (module docstring, point 5) of builds like the measured ones.
 CHEAP_ERROR = {
-    "lost_motion": 0.2,
-    "backlash": 0.2,
+    "lost_motion": 0.3,
+    "backlash": 0.45,
     "rigidity": 2.0,
-    "te_pp": 15.0,
-    "pin_force": 150.0,
+    "te_pp": 16.0,
+    "pin_force": 400.0,
     "pin_contact_pressure": 200.0,
     "assembly_penetration": 1e-9,
 }
