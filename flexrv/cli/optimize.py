@@ -8,7 +8,7 @@ from typing import List, Optional
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, console, emit, kv_table
+from flexrv.cli._common import JSON_HELP, console, emit, kv_table, split_unit
 
 PRESET_HELP = "Preset name or design TOML (its [tolerances] table is used unless --tolerances is given)."
 
@@ -102,7 +102,7 @@ def _render(d: dict) -> None:
     for label, p in [("as given", d["preset"])] + list(d["recommended"].items()):
         full = p.get("full", {})
         prow = [(f, p.get(f), "") for f in fields]
-        prow += [(o + (" (full)" if o in full else ""), full.get(o, p.get(o)), "") for o in objs]
+        prow += [(o + (" (full)" if o in full else ""), full.get(o, p.get(o)), split_unit(o)[1]) for o in objs]
         console.print(kv_table(label, prow))
     lm = d.get("lost_motion_target")
     if lm:
