@@ -24,7 +24,7 @@ def optimize(
         help="NAME[:min|max], a batch metric <quantity>_<stat>_<unit>, e.g. lost_motion_p95_arcmin:min (repeatable).",
     ),
     constraint: Optional[List[str]] = typer.Option(
-        None, "--constraint", help='Inequality of metrics, e.g. "pin_contact_pressure_p95_MPa <= 1800" (repeatable).'
+        None, "--constraint", help='Inequality of metrics, e.g. "pin_contact_pressure_p95_MPa <= 1900" (repeatable).'
     ),
     spec: Optional[List[str]] = typer.Option(
         None, "--spec", help="Per-build spec of the metric spec_yield, e.g. lost_motion_arcmin<=1 (repeatable)."
