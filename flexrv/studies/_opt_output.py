@@ -100,8 +100,17 @@ def _plot(out: Path, problem, cands, front, rec, result) -> Path | None:
         sc = ax.scatter([c.metrics[n1] for c in front], [c.metrics[n2] for c in front], s=40, label="Pareto set", **kw)
         if len(objs) > 2:
             fig.colorbar(sc, ax=ax, label=objs[2].name)
-    for k, c in rec.items():
-        ax.annotate(k, (c.metrics[n1], c.metrics[n2]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    labels: dict[int, list[str]] = {}
+    for k, c in rec.items():  # one label per point (several trade-offs may pick the same design)
+        labels.setdefault(id(c), []).append(k)
+    for c in {id(c): c for c in rec.values()}.values():
+        ax.annotate(
+            ", ".join(labels[id(c)]),
+            (c.metrics[n1], c.metrics[n2]),
+            fontsize=7,
+            xytext=(4, 4),
+            textcoords="offset points",
+        )
     pre = result["preset"]
     if pre.get(n1) is not None and pre.get(n2) is not None:
         ax.scatter([pre[n1]], [pre[n2]], marker="*", s=220, color="C3", label=f"{result['design']} as given")
