@@ -320,3 +320,39 @@ def test_modification_design_smoke(tmp_path):
     assert r.numbers["preset"] == search["preset"]
     assert r.numbers["infeasible"] or r.numbers["recommended"]
     assert (tmp_path / "search" / "evaluations.csv").exists()
+
+
+@pytest.mark.slow
+def test_issue_command_cli(tmp_path):
+    """(slow: a LocalCluster and 6 designs x 3 builds, 2-4 min.) The issue's command from the
+    CLI with --json: a non-empty Pareto set, each point with both varied fields and every
+    objective and constraint metric by name, no point dominating another."""
+    import subprocess
+    import sys
+
+    args = [
+        sys.executable, "-m", "flexrv", "optimize", "rv40e", "--tolerances", "rv40e",
+        "--vary", "second_stage.modification_equidistant_mm=0:0.015",
+        "--vary", "second_stage.modification_shift_mm=-0.015:0.015",
+        "--objective", "lost_motion_p95_arcmin:min", "--objective", "rigidity_median_Nm_per_arcmin:max",
+        "--constraint", "pin_contact_pressure_p95_MPa <= 1900",
+        "--samples-per-design", "2", "--budget", "6", "--population", "3", "--workers", "2",
+        "--out", str(tmp_path / "o"), "--json",
+    ]  # fmt: skip
+    res = subprocess.run(args, capture_output=True, text=True, timeout=900)
+    assert res.returncode == 0, res.stderr[-2000:]
+    d = json.loads(res.stdout)
+    pts = d["pareto"]
+    assert pts
+    for p in pts:
+        for k in (
+            "second_stage.modification_equidistant_mm",
+            "second_stage.modification_shift_mm",
+            "lost_motion_p95_arcmin",
+            "rigidity_median_Nm_per_arcmin",
+            "pin_contact_pressure_p95_MPa",
+        ):
+            assert isinstance(p[k], float)
+        assert p["pin_contact_pressure_p95_MPa"] <= 1900
+    f = np.array([[p["lost_motion_p95_arcmin"], -p["rigidity_median_Nm_per_arcmin"]] for p in pts])
+    assert non_dominated(f).all()
