@@ -264,7 +264,7 @@ def test_pin_contact_pressure_closed_form():
 
 
 def test_rv40e_points_reevaluate_within_stated_error(tmp_path):
-    """The issue's command (the pressure limit: the preset's own P95, same draws) on a tiny budget
+    """The documented rv40e command (the pressure limit: the preset's own P95, same draws) on a tiny budget
     (2 designs, 1 draw, in-process): every reported
     Pareto point, re-evaluated by the full solver with the same draw, matches its reported
     figures within CHEAP_ERROR (per build, which bounds every batch statistic) and has the
@@ -323,8 +323,8 @@ def test_modification_design_smoke(tmp_path):
 
 
 @pytest.mark.slow
-def test_issue_command_cli(tmp_path):
-    """(slow: a LocalCluster and 6 designs x 3 builds, 2-4 min.) The issue's command from the
+def test_documented_command_cli(tmp_path):
+    """(slow: a LocalCluster and 6 designs x 3 builds, 2-4 min.) The documented rv40e command from the
     CLI with --json: a non-empty Pareto set, each point with both varied fields and every
     objective and constraint metric by name, no point dominating another."""
     import subprocess
