@@ -19,7 +19,8 @@ under the constraint that no pin is preloaded at assembly in at least 99 % of th
 designs are re-evaluated at the full resolution and their yields (no preload; lost motion
 <= 1 arcmin) are set against the preset's.
 
-The full run (120 designs x 16 draws) takes about 15-30 min on 2 cores; ``--smoke`` runs 4
+The full run (80 designs x 16 draws) took 25 min on 2 cores shared with other jobs (load
+average 10-20; docs/optimize.md gives its result); ``--smoke`` runs 4
 designs x 2 draws (a check that the workflow runs, not a result).
 
 Run: ``flexrv workflow modification_design`` or ``python -m flexrv.workflows.modification_design``.
@@ -39,7 +40,7 @@ SPECS = ["lost_motion_arcmin<=1"]
 CATALOG_LOST_MOTION_ARCMIN = 1.0
 #: contact stress at the fatigue load limit of bearing steel [MPa] (ISO 281:2007)
 ISO281_FATIGUE_STRESS_MPA = 1500.0
-FULL = {"budget": 120, "samples": 16, "population": 20}
+FULL = {"budget": 80, "samples": 16, "population": 20}
 SMOKE = {"budget": 4, "samples": 2, "population": 2}
 
 
