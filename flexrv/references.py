@@ -49,12 +49,16 @@ SECTIONS: dict[str, dict[str, str]] = {
         "the code as *Mech. Mach. Theory* 2011; venue and title not verified.",
         "blanche1989": "Blanche, J. G., Yang, D. C. H. (1989). Cycloid drives with machining tolerances. "
         "*J. Mech. Transm. Autom. Des.* 111(3), 337-344.",
+        "blank2020pymoo": "Blank, J., Deb, K. (2020). pymoo: Multi-objective optimization in Python. "
+        "*IEEE Access* 8, 89497-89509.",
         "blevins1979": "Blevins, R. D. (1979). *Formulas for Natural Frequency and Mode Shape*. "
         "Van Nostrand Reinhold, New York.",
         "chen2008": "Chen et al. (2008). Cycloid-drive force analysis with initial clearances. As cited in the "
         "code; authors, title and venue not verified.",
         "craig1968": "Craig, R. R., Bampton, M. C. C. (1968). Coupling of substructures for dynamic analyses. "
         "*AIAA Journal* 6(7), 1313-1319.",
+        "deb2002nsga2": "Deb, K., Pratap, A., Agarwal, S., Meyarivan, T. (2002). A fast and elitist "
+        "multiobjective genetic algorithm: NSGA-II. *IEEE Transactions on Evolutionary Computation* 6(2), 182-197.",
         "dowson1966": "Dowson, D., Higginson, G. R. (1966). *Elasto-hydrodynamic Lubrication: The Fundamentals "
         "of Roller and Gear Lubrication*. Pergamon Press, Oxford.",
         "george1973": "George, A. (1973). Nested dissection of a regular finite element mesh. "

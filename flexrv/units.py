@@ -38,5 +38,7 @@ M_PER_MM = 1e-3
 M_PER_UM = 1e-6
 #: micrometres per metre
 UM_PER_M = 1e6
+#: pascals per megapascal
+PA_PER_MPA = 1e6
 #: full turn [rad]
 TWO_PI = 2.0 * math.pi
