@@ -37,7 +37,6 @@ import math
 import os
 import re
 import time
-import tomllib
 import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -102,15 +101,12 @@ def _require(cond: bool, path, key: str, message: str) -> None:
 def load_spec(path: str | os.PathLike) -> SweepSpec:
     """Read and validate a sweep spec TOML completely (before any case runs);
     :class:`ConfigError` names the key, the value and what is allowed."""
-    from flexrv.design import read_text_file
+    from flexrv.design import parse_toml, read_text_file
 
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"sweep spec {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(read_text_file(path, "sweep spec"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: invalid TOML: {exc}") from None
+    data = parse_toml(read_text_file(path, "sweep spec"), str(path))
     unknown = set(data) - _SPEC_KEYS
     if unknown:
         raise ConfigError(f"{path}: unknown sweep field(s) {sorted(unknown)}; allowed: {sorted(_SPEC_KEYS)}")

@@ -148,10 +148,31 @@ def usage_message(exc, argv: list[str]) -> str:
     return f"{command}: {msg}"
 
 
+def empty_value_message(argv: list[str]) -> str | None:
+    """The message for an empty option value (``--out ""``, ``--out=``) or an empty
+    argument (``design ""``), or None: no option or argument of flexrv may be empty (an
+    empty path would mean the current directory, an empty name nothing)."""
+    command = next((a for a in argv if not a.startswith("-")), "")
+    where = f"flexrv {command}" if command else "flexrv"
+    for i, arg in enumerate(argv):
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            return f"{where}: empty value for {arg[:-1]}; give a value"
+        if arg.strip() == "":
+            prev = argv[i - 1] if i > 0 else ""
+            if prev.startswith("-") and "=" not in prev:
+                return f"{where}: empty value {arg!r} for {prev}; give a value"
+            return f"{where}: empty argument {arg!r} (argument {i + 1}); give a value"
+    return None
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app, map user errors to exit code 2,
     Ctrl-C to 130; the exit code of a command (``typer.Exit``) is passed on."""
     args = list(sys.argv[1:] if argv is None else argv)
+    empty = empty_value_message(args)
+    if empty:
+        print_error(empty)
+        sys.exit(USAGE_EXIT)
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")
     click_exit = _types("Exit")

@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import Field, model_serializer, model_validator
+from pydantic import Field, field_validator, model_serializer, model_validator
 
-from flexrv.design._base import _bad, _Strict
+from flexrv.design._base import _bad, _Strict, floor
 from flexrv.units import M_PER_UM, RAD_PER_DEG
 
 #: allowed transverse contact ratio of the first stage: below 1 the mesh loses
@@ -38,7 +38,12 @@ class FirstStage(_Strict):
     pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="Pressure angle alpha_n [deg]")
     sun_profile_shift: float = Field(ge=-1.0, le=1.5, description="Sun profile shift coefficient x_1 [-]")
     planet_profile_shift: float = Field(ge=-1.5, le=1.5, description="Planet profile shift coefficient x_2 [-]")
-    face_width_mm: float = Field(gt=0.0, le=200.0, description="Common face width b [mm]")
+    face_width_mm: float = Field(
+        ge=1.0,
+        le=200.0,
+        description="Common face width b [mm]",
+        json_schema_extra=floor("a gear face narrower than 1 mm carries no load and cannot be meshed"),
+    )
     n_planets: int = Field(ge=2, le=6, description="Number of planets = crankshafts [-]")
     backlash_um: float = Field(ge=0.0, le=500.0, description="Circumferential backlash on the pitch circle [um]")
     mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Mesh damping ratio xi_12 [-]")
@@ -779,12 +784,31 @@ class Lubricant(_Strict):
         return self.pressure_viscosity_1_per_GPa * 1e-9
 
 
+#: reason of the lower bounds of the mass properties
+_LIGHT = (
+    "lighter than %s: the member's frequency on its contact stiffness would exceed what the "
+    "implicit integrator converges on at the time steps flexrv uses"
+)
+
+
 class Inertia(_Strict):
     """Mass properties not derivable from the modelled geometry."""
 
-    input_shaft_inertia_kg_m2: float = Field(gt=0.0, le=10.0, description="Input shaft + sun about its axis")
-    carrier_mass_kg: float = Field(gt=0.0, le=1000.0)
-    carrier_inertia_kg_m2: float = Field(gt=0.0, le=100.0, description="Carrier + output flange about the axis")
+    input_shaft_inertia_kg_m2: float = Field(
+        ge=1e-7,
+        le=10.0,
+        description="Input shaft + sun about its axis",
+        json_schema_extra=floor(_LIGHT % "a steel shaft of 5 mm diameter and 20 mm length (1e-7 kg m2)"),
+    )
+    carrier_mass_kg: float = Field(
+        ge=0.01, le=1000.0, json_schema_extra=floor(_LIGHT % "a 10 g carrier (0.01 kg)")
+    )
+    carrier_inertia_kg_m2: float = Field(
+        ge=1e-6,
+        le=100.0,
+        description="Carrier + output flange about the axis",
+        json_schema_extra=floor(_LIGHT % "a 10 g carrier of 20 mm radius (1e-6 kg m2)"),
+    )
 
 
 class ContactSettings(_Strict):
@@ -838,7 +862,15 @@ class OperatingPoint(_Strict):
     load_torque_Nm: float = Field(ge=-1e5, le=1e5, description="Load torque on the output")
     load_ramp_start_s: float = Field(ge=0.0, le=100.0)
     load_ramp_end_s: float = Field(ge=0.0, le=100.0)
-    rated_torque_Nm: float = Field(gt=0.0, le=1e5, description="Rated output torque (stiffness test range)")
+    rated_torque_Nm: float = Field(
+        ge=1.0,
+        le=1e5,
+        description="Rated output torque (stiffness test range)",
+        json_schema_extra=floor(
+            "the smallest cycloidal drives are rated at a few N m; the no-load and lost-motion torques are "
+            "fractions of the rated torque and would fall below the contact laws' force resolution"
+        ),
+    )
     external_axial_force_N: float = Field(ge=-1e6, le=1e6)
     external_radial_force_N: float = Field(ge=-1e6, le=1e6)
     tilting_moment_Nm: float = Field(ge=-1e6, le=1e6)
@@ -862,6 +894,16 @@ class OperatingPoint(_Strict):
 
 # --------------------------------------------------------------------------- reducer
 from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
+
+
+def _has_path(data: dict, dotted: str) -> bool:
+    """Whether ``dotted`` (``"first_stage.module_mm"``) addresses a value of ``data``."""
+    node = data
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
 
 
 class Reducer(_Strict):
@@ -918,6 +960,32 @@ class Reducer(_Strict):
         """Radius of a crank-bearing hole in the disc = needle outer raceway [m]."""
         nb, cs = self.needle_bearing, self.crankshaft
         return 0.5e-3 * (cs.eccentric_journal_diameter_mm + 2.0 * nb.roller_diameter_mm) + nb.radial_clearance_um * 1e-6
+
+    @field_validator("name")
+    @classmethod
+    def _printable_name(cls, value: str) -> str:
+        bad = [c for c in value if not c.isprintable()]
+        if bad or not value.strip():
+            raise _bad(
+                "name",
+                value,
+                "must be printable text, not blank (no newline, tab or control characters)",
+                "the name appears in file names, table titles and result attributes",
+            )
+        return value
+
+    @model_validator(mode="after")
+    def _known_provenance(self) -> "Reducer":
+        data = self.model_dump(exclude={"provenance"})
+        unknown = [k for k in self.provenance if not _has_path(data, k)]
+        if unknown:
+            raise _bad(
+                "provenance",
+                unknown[0],
+                f"{len(unknown)} of {len(self.provenance)} provenance key(s) name no field of the design "
+                f"(first: {unknown[0][:80]!r}); each key is the dotted path of a field, e.g. 'first_stage.module_mm'",
+            )
+        return self
 
     @model_validator(mode="after")
     def _cross(self) -> "Reducer":
