@@ -107,6 +107,21 @@ SEGMENT_STEPS = 1000
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
 
+def check_time_options(reducer, t_end: float | None, dt: float = DEFAULT_DT) -> float:
+    """The end time of a run (default: load ramp end + 0.2 s) after checking ``t_end``
+    and ``dt`` (finite, 0 < dt <= t_end, dt <= 5e-4 s); InputError naming the value."""
+    op = reducer.operating
+    if t_end is None:
+        t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
+    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)) or not (math.isfinite(t_end) and t_end > 0):
+        raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not (math.isfinite(dt) and 0 < dt <= t_end):
+        raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
+    if dt > 5e-4:
+        raise InputError(f"dt = {dt:g} s is not allowed: must be <= 5e-4 s to resolve the pin-mesh period")
+    return t_end
+
+
 def check_step_count(
     t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None, t_start: float = 0.0
 ) -> int:
@@ -233,15 +248,7 @@ class Simulation:
         s CPU per simulated s).
         """
 
-        op = self.reducer.operating
-        if t_end is None:
-            t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
-        if not (math.isfinite(t_end) and t_end > 0):
-            raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
-        if not (math.isfinite(dt) and 0 < dt <= t_end):
-            raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
-        if dt > 5e-4:
-            raise InputError(f"dt = {dt:g} s is not allowed: must be <= 5e-4 s to resolve the pin-mesh period")
+        t_end = check_time_options(self.reducer, t_end, dt)
         seg = int(segment_steps)
         if seg < 1:
             raise InputError(f"segment_steps = {segment_steps!r} is not allowed: must be an integer >= 1")

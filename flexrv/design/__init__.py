@@ -62,7 +62,9 @@ def load(preset_or_path: str | Path | Reducer) -> Reducer:
         return preset_or_path
     text_name = str(preset_or_path)
     if not text_name.strip():
-        raise ConfigError(f"design {text_name!r} is empty: give a preset name {list_presets()} or a path to a .toml file")
+        raise ConfigError(
+            f"design {text_name!r} is empty: give a preset name {list_presets()} or a path to a .toml file"
+        )
     path = Path(text_name)
     if text_name in list_presets():
         path = preset_path(text_name)
@@ -367,7 +369,6 @@ def read_named_table(name_or_path: str, folder: str, table: str, what: str) -> d
     name) or of any TOML file (by path), as a plain dict; ConfigError naming the
     file for a missing file, an unreadable one or one without the table. ``what``
     names the kind of file in the messages (e.g. "error set")."""
-    import tomllib
     from pathlib import Path
 
     text_name = str(name_or_path)

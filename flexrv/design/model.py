@@ -800,9 +800,7 @@ class Inertia(_Strict):
         description="Input shaft + sun about its axis",
         json_schema_extra=floor(_LIGHT % "a steel shaft of 5 mm diameter and 20 mm length (1e-7 kg m2)"),
     )
-    carrier_mass_kg: float = Field(
-        ge=0.01, le=1000.0, json_schema_extra=floor(_LIGHT % "a 10 g carrier (0.01 kg)")
-    )
+    carrier_mass_kg: float = Field(ge=0.01, le=1000.0, json_schema_extra=floor(_LIGHT % "a 10 g carrier (0.01 kg)"))
     carrier_inertia_kg_m2: float = Field(
         ge=1e-6,
         le=100.0,
