@@ -269,7 +269,7 @@ class Simulation:
         if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
             newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
 
-        from flexrv.model.kernel_cache import announce_compile
+        from flexrv.model.kernel_cache import announce_compile, stop_now
 
         kinds = (["fused"] if model.fused is not None else []) + (
             ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
@@ -387,6 +387,8 @@ class Simulation:
         def on_stop(signum, frame):
             state["stop"] = True
             state["signal"] = signal.Signals(signum).name
+            if state["step"] == 0:  # nothing integrated yet (numba may compile for minutes): nothing to keep
+                stop_now(signum)
 
         old = {}
         for name in STOP_SIGNALS:

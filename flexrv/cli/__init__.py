@@ -165,14 +165,33 @@ def empty_value_message(argv: list[str]) -> str | None:
     return None
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the process is (like Ctrl-C's KeyboardInterrupt), so every
+    phase of a command stops the same way: cleanup handlers run, exit code 143."""
+
+    signum = 15
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app, map user errors to exit code 2,
-    Ctrl-C to 130; the exit code of a command (``typer.Exit``) is passed on."""
+    Ctrl-C to 130 and SIGTERM to 143 in every phase (a run that is integrating installs
+    its own handlers and keeps its partial results); the exit code of a command
+    (``typer.Exit``) is passed on."""
+    import signal
+
     args = list(sys.argv[1:] if argv is None else argv)
     empty = empty_value_message(args)
     if empty:
         print_error(empty)
         sys.exit(USAGE_EXIT)
+    try:
+        signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:  # not the main thread (an embedding application): its own handling applies
+        pass
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")
     click_exit = _types("Exit")
@@ -188,8 +207,8 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(USAGE_EXIT)
     except (typer.Exit, *click_exit) as exc:
         sys.exit(exc.exit_code)
-    except (typer.Abort, *click_abort, KeyboardInterrupt):
-        sys.exit(130)
+    except (typer.Abort, *click_abort, KeyboardInterrupt) as exc:
+        sys.exit(128 + getattr(exc, "signum", 2))
     except no_args as exc:  # bare `flexrv` / a command given no arguments: help, usage exit code
         print(exc.format_message(), file=sys.stderr)
         sys.exit(USAGE_EXIT)
