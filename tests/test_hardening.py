@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -65,3 +64,98 @@ def test_signal_during_first_compile_exits_within_5s(tmp_path, sig, code):
     assert elapsed < 5.0, elapsed
     assert "Traceback" not in stderr
     assert not out.exists()
+
+
+# ----------------------------------------------------------------- pin loads: every pose
+def _valid_stage(z_rp, radius, k1, pin_fraction):
+    """(eccentricity, pin radius) of a cycloid stage free of undercut and pin overlap,
+    or None: shortening coefficient K1 < 1, pins narrower than their spacing, pin
+    radius below the epitrochoid's smallest convex curvature radius (the checks of
+    :class:`flexrv.design.model.SecondStage`)."""
+    from flexrv.geometry.cycloid import min_convex_curvature_radius
+
+    e = k1 * radius / z_rp
+    r_pin = pin_fraction * radius * np.sin(np.pi / z_rp)
+    if r_pin >= 0.95 * min_convex_curvature_radius(z_rp, radius, e, samples=801):
+        return None
+    return e, r_pin
+
+
+@pytest.mark.parametrize("law", ["palmgren", "linear"])
+def test_degenerate_no_load_pose_of_a_small_unmodified_drive(law):
+    """18 pins, 17 lobes, R_p 60-85 mm, e 0.9-1.6 mm, r_rp 2.5 mm, no modification: at the
+    nominal pose every pin touches at once (gaps are round-off of either sign). The
+    no-load pose is found at every one of 240 crank angles, and the pin forces balance
+    the torque (sum F_i l_i = T to 1e-9, the Brent tolerance)."""
+    from flexrv.analysis.pin_load import pin_load_distribution
+
+    for radius, e in ((0.060, 0.0009), (0.070, 0.0012), (0.085, 0.0016)):
+        for chi in np.linspace(0.0, 2.0 * np.pi, 240, endpoint=False):
+            r = pin_load_distribution(50.0, 18, radius, 0.0025, e, 0.01, 2.2e11, crank_angle=chi, law=law)
+            assert r.n_contact >= 1
+            assert abs(np.sum(r.forces * r.arms) - 50.0) <= 1e-9 * 50.0
+
+
+try:
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+except ImportError:  # pragma: no cover
+    given = None
+
+
+if given is not None:
+
+    @settings(max_examples=12, deadline=None, derandomize=True)
+    @given(
+        z_rp=st.integers(12, 60),
+        radius=st.floats(0.03, 0.2),
+        k1=st.floats(0.4, 0.9),
+        pin_fraction=st.floats(0.2, 0.7),
+        modified=st.booleans(),
+        shift_um=st.floats(-20.0, 0.0),
+        equidistant_um=st.floats(0.0, 20.0),
+        rotation_deg=st.floats(-0.05, 0.05),
+        torque=st.floats(1.0, 2000.0),
+    )
+    def test_pin_loads_at_every_crank_angle(
+        z_rp, radius, k1, pin_fraction, modified, shift_um, equidistant_um, rotation_deg, torque
+    ):
+        """Random valid stages (12-60 pins, with and without modifications that leave the
+        disc a clearance: equidistant >= 0, shift <= 0, any rotation): the no-load pose and
+        a load distribution that balances the torque exist at every crank angle tried (24
+        per stage). The pose stays within a fraction of the pin pitch."""
+        from hypothesis import assume
+
+        from flexrv.analysis.pin_load import pin_load_distribution
+
+        stage = _valid_stage(z_rp, radius, k1, pin_fraction)
+        assume(stage is not None)
+        e, r_pin = stage
+        mods = (shift_um * 1e-6, equidistant_um * 1e-6, np.radians(rotation_deg)) if modified else (0.0, 0.0, 0.0)
+        for chi in np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False):
+            r = pin_load_distribution(
+                torque, z_rp, radius, r_pin, e, 0.01, 2.2e11, *mods, crank_angle=chi, law="palmgren"
+            )
+            assert r.n_contact >= 1 and np.all(np.isfinite(r.forces))
+            assert abs(np.sum(r.forces * r.arms) - torque) <= 1e-8 * torque
+            assert abs(r.rotation) < 2.0 * np.pi / z_rp
+
+
+def test_interference_fit_is_named():
+    """A disc that overlaps every pin (equidistant modification -11 um, no clearance
+    anywhere) has no no-load pose: a clear InputError, not a pose radians away."""
+    from flexrv.analysis.pin_load import pin_load_distribution
+    from flexrv.errors import InputError
+
+    refused = 0
+    for chi in np.linspace(0.0, 2.0 * np.pi / 40, 6, endpoint=False):
+        try:
+            r = pin_load_distribution(
+                1.0, 40, 0.125, 0.0049, 0.0015625, 0.01, 2.2e11, 0.0, -11e-6, 0.0, crank_angle=chi
+            )
+        except InputError as exc:
+            assert "interference fit" in str(exc) and "11 um" in str(exc)
+            refused += 1
+        else:  # a preloaded pose near the nominal one (Brent balances the preload), never radians away
+            assert abs(r.rotation) < 1e-4
+    assert refused >= 1

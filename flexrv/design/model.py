@@ -13,7 +13,7 @@ message naming the field, the value and the allowed range.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_serializer, model_validator
 
@@ -894,13 +894,28 @@ class OperatingPoint(_Strict):
 from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
 
 
-def _has_path(data: dict, dotted: str) -> bool:
-    """Whether ``dotted`` (``"first_stage.module_mm"``) addresses a value of ``data``."""
-    node = data
-    for part in dotted.split("."):
-        if not isinstance(node, dict) or part not in node:
+def _names_field(model: type, dotted: str) -> bool:
+    """Whether ``dotted`` (``"first_stage.module_mm"``, ``"materials.steel.poisson_ratio"``)
+    names a field of the pydantic ``model`` (optional tables and fields included)."""
+    import typing
+
+    parts = dotted.split(".")
+    current: Any = model
+    i = 0
+    while i < len(parts):
+        fields = getattr(current, "model_fields", None)
+        if not fields or parts[i] not in fields:
             return False
-        node = node[part]
+        ann = fields[parts[i]].annotation
+        i += 1
+        args = [a for a in typing.get_args(ann) if a is not type(None)]
+        if typing.get_origin(ann) is dict:  # dict[str, Model]: a free key, then the model's fields
+            if i == len(parts):
+                return True
+            i += 1
+            current = args[-1]
+        else:
+            current = next((a for a in args if hasattr(a, "model_fields")), ann)
     return True
 
 
@@ -974,8 +989,7 @@ class Reducer(_Strict):
 
     @model_validator(mode="after")
     def _known_provenance(self) -> "Reducer":
-        data = self.model_dump(exclude={"provenance"})
-        unknown = [k for k in self.provenance if not _has_path(data, k)]
+        unknown = [k for k in self.provenance if not _names_field(type(self), k)]
         if unknown:
             raise _bad(
                 "provenance",
