@@ -153,21 +153,54 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
     ('complete', False)
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_temp_files(target.parent)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp" + target.suffix, dir=target.parent
-    )
-    os.close(fd)
+    with _naming(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_temp_files(target.parent)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp" + target.suffix, dir=target.parent
+        )
+        os.close(fd)
     tmp_path = Path(tmp)
     try:
-        yield tmp_path
-        os.chmod(tmp_path, 0o666 & ~_umask())
-        os.replace(tmp_path, target)
+        with _naming(target):
+            yield tmp_path
+            os.chmod(tmp_path, 0o666 & ~_umask())
+            os.replace(tmp_path, target)
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+
+
+@contextlib.contextmanager
+def _naming(target: Path) -> Iterator[None]:
+    """Re-raise an OSError that names no file (a full disk, a read-only file system seen
+    by a library writing through a temporary name) as one naming ``target``. HDF5's
+    errors (netCDF files) carry no errno: their reason is read from the message."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None and Path(exc.filename) == target:
+            raise
+        errno_ = exc.errno
+        if errno_ is None:
+            import errno as errnos
+
+            text = str(exc).lower()
+            errno_ = next(
+                (
+                    code
+                    for code, word in (
+                        (errnos.ENOSPC, "no space"),
+                        (errnos.EROFS, "read-only"),
+                        (errnos.EACCES, "permission"),
+                    )
+                    if word in text
+                ),
+                errnos.EIO,
+            )
+        reason = os.strerror(errno_) if errno_ else (exc.strerror or str(exc))
+        raise OSError(errno_, f"cannot write {target.name}: {reason}", str(target)) from exc
 
 
 def atomic_write_text(target: str | os.PathLike, text: str) -> Path:

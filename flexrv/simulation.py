@@ -637,9 +637,18 @@ class _Checkpointer:
             )
             save_partial(res, self.directory)
         except Exception as exc:  # a full disk (or any save error) must not kill the run; the next one retries
-            import warnings
+            import sys
 
-            warnings.warn(f"checkpoint to {self.directory} failed: {exc}", RuntimeWarning, stacklevel=2)
+            if not getattr(self, "failed", 0):  # one line, at the first failure
+                where = getattr(exc, "filename", None) or self.directory
+                reason = getattr(exc, "strerror", None) or exc
+                print(
+                    f"flexrv: warning: checkpoint not written ({reason}: {where}); the run goes on, "
+                    "the last checkpoint is kept",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            self.failed = getattr(self, "failed", 0) + 1
         took = _time.perf_counter() - now
         self.spent += took
         self.count += 1

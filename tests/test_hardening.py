@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -159,3 +161,149 @@ def test_interference_fit_is_named():
         else:  # a preloaded pose near the nominal one (Brent balances the preload), never radians away
             assert abs(r.rotation) < 1e-4
     assert refused >= 1
+
+
+# ----------------------------------------------------------------- full and read-only disks
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 64 KiB tmpfs mounted for the test (skipped where the test may not mount one)."""
+    mnt = tmp_path / "disk"
+    mnt.mkdir()
+    proc = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mnt)], capture_output=True, text=True)
+    if proc.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here (needs root): {proc.stderr.strip() or proc.returncode}")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+def test_atomic_write_on_full_and_read_only_disk_names_the_path(small_disk):
+    """A write that does not fit fails naming the target file (not a temporary name,
+    not a bare 'No space left on device'), keeps the earlier file intact and leaves no
+    temporary file; the same on a file system remounted read-only."""
+    import errno
+
+    from flexrv.cache import atomic_write_bytes
+
+    target = small_disk / "checkpoint.npz"
+    atomic_write_bytes(target, b"old checkpoint" * 100)
+    with pytest.raises(OSError) as info:
+        atomic_write_bytes(target, os.urandom(200_000))
+    assert info.value.errno == errno.ENOSPC
+    assert info.value.filename == str(target) and "checkpoint.npz" in info.value.strerror
+    assert target.read_bytes() == b"old checkpoint" * 100
+    assert list(small_disk.iterdir()) == [target]
+    ro = subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], capture_output=True, text=True)
+    if ro.returncode != 0:
+        pytest.skip(f"cannot remount read-only: {ro.stderr.strip()}")
+    with pytest.raises(OSError) as info:
+        atomic_write_bytes(target, b"new")
+    assert info.value.errno == errno.EROFS and info.value.filename == str(target)
+    assert target.read_bytes() == b"old checkpoint" * 100
+
+
+def test_disk_full_run_names_path_and_leaves_no_folder(small_disk):
+    """``flexrv simulate`` onto a full disk: exit 2, one message naming the file it could
+    not write, no traceback, and no empty run folder left behind."""
+    out = small_disk / "run"
+    proc = subprocess.run(
+        [sys.executable, "-m", "flexrv", "simulate", "rv40e", "--t-end", "0.05", "--out", str(out)],
+        cwd=small_disk.parent,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr and "Warning" not in proc.stderr
+    assert "No space left on device" in proc.stderr and str(out) + "/" in proc.stderr
+    assert not out.exists()
+
+
+# ----------------------------------------------------------------- cluster endpoints
+class _Server:
+    """A local TCP server of another protocol, started and stopped by the test: ``http``
+    (an HTTP server: waits for a request, says nothing) or ``banner`` (sends a text line
+    at once, as SSH does, whose first 8 bytes spell a length of exabytes)."""
+
+    def __init__(self, kind: str):
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(8)
+        self.port = self.sock.getsockname()[1]
+        self.kind = kind
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self):
+        self.sock.settimeout(0.2)
+        conns = []
+        while not self.stop.is_set():
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                continue
+            conns.append(conn)
+            if self.kind == "banner":
+                conn.sendall(b"SSH-2.0-OpenSSH_9.6\r\n")
+        for c in conns:
+            c.close()
+
+    def close(self):
+        self.stop.set()
+        self.thread.join(5)
+        self.sock.close()
+
+
+@pytest.mark.parametrize("kind", ["http", "banner"])
+@pytest.mark.parametrize("command", ["sweep", "tolerance"])
+def test_scheduler_that_is_not_dask_is_refused_quickly(tmp_path, kind, command):
+    """``--scheduler`` at a server that accepts the TCP connection but is no dask
+    scheduler: exit 2 within the 5 s handshake timeout (+ start-up), a message naming
+    --scheduler and saying it is not a dask scheduler; no hang, no huge allocation."""
+    server = _Server(kind)
+    try:
+        address = f"tcp://127.0.0.1:{server.port}"
+        if command == "sweep":
+            spec = tmp_path / "s.toml"
+            spec.write_text(
+                'name = "hs"\npreset = "rv40e"\ntask = "design"\noutputs = ["kinematics.ratio"]\n'
+                '[grid]\n"second_stage.eccentricity_mm" = [1.0]\n'
+            )
+            argv = ["sweep", str(spec), "--scheduler", address, "--out", str(tmp_path / "out")]
+        else:
+            argv = ["tolerance", "rv40e", "--tolerances", "rv40e", "--samples", "2", "--scheduler", address]
+            argv += ["--out", str(tmp_path / "out")]
+        t0 = time.monotonic()
+        proc = subprocess.run(
+            [sys.executable, "-m", "flexrv", *argv],
+            cwd=tmp_path,
+            env=_env(),
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        elapsed = time.monotonic() - t0
+    finally:
+        server.close()
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    text = " ".join(proc.stderr.split())
+    assert "--scheduler" in text and "not a dask scheduler" in text, text
+    assert "Traceback" not in proc.stderr
+    assert elapsed < 60.0
+    assert not (tmp_path / "out").exists()
+
+
+def test_real_scheduler_handshake_is_accepted():
+    """The probe accepts a real dask scheduler (its handshake frame), so the check does
+    not refuse what it guards."""
+    from dask.distributed import LocalCluster
+
+    from flexrv.sweep import check_scheduler
+
+    with LocalCluster(
+        n_workers=0, processes=False, protocol="tcp://", dashboard_address=None, silence_logs=40
+    ) as cluster:
+        check_scheduler(cluster.scheduler_address)

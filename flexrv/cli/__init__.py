@@ -197,13 +197,18 @@ def main(argv: list[str] | None = None) -> None:
     click_exit = _types("Exit")
     click_abort = _types("Abort")
     try:
-        rv = app(args=args, prog_name="flexrv", standalone_mode=False)
+        try:
+            rv = app(args=args, prog_name="flexrv", standalone_mode=False)
+        finally:  # a command that failed or was stopped before writing leaves no empty run folder
+            from flexrv.cli._common import remove_unused_outputs
+
+            remove_unused_outputs()
     except FlexrvError as exc:
         print_error(str(exc))
         sys.exit(USAGE_EXIT)
-    except OSError as exc:  # a file the user named cannot be read or written
-        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
-        print_error(f"{exc.strerror or exc}:{where}" if where else f"{exc.strerror or exc}")
+    except OSError as exc:  # a file the user named cannot be read or written (disk full, read-only)
+        where = getattr(exc, "filename", None)
+        print_error(f"{exc.strerror or exc}: {where}" if where else f"{exc.strerror or exc}")
         sys.exit(USAGE_EXIT)
     except (typer.Exit, *click_exit) as exc:
         sys.exit(exc.exit_code)
