@@ -307,3 +307,104 @@ def test_real_scheduler_handshake_is_accepted():
         n_workers=0, processes=False, protocol="tcp://", dashboard_address=None, silence_logs=40
     ) as cluster:
         check_scheduler(cluster.scheduler_address)
+
+
+# ----------------------------------------------------------------- tolerance studies
+def test_sigma_fraction_is_accepted():
+    """``sigma_fraction``, listed as an allowed key of a band tolerance, is read as the
+    band's sigma fraction (sigma = 0.5 x 2 um = 1 um: the truncated normal's standard
+    deviation on +-2 sigma is 0.880 x sigma, scipy.stats.truncnorm)."""
+    from flexrv.design import load
+    from flexrv.design.tolerances import parse_tolerances
+
+    table = {"pins.pin_radius_um": {"distribution": "band", "band_um": 2.0, "sigma_fraction": 0.5}}
+    tol = parse_tolerances(table, load("rv40e"))
+    assert tol.entries["pins.pin_radius_um"].sigma_fraction == 0.5
+    # standard deviation of a normal of sigma 1 um truncated at +-2 sigma: 0.8796 um (closed form:
+    # sqrt(1 - 2 c phi(c) / (2 Phi(c) - 1)) with c = 2, phi/Phi the standard normal pdf/cdf)
+    assert abs(tol.sigma_of("pins.pin_radius_um") - 0.8796) < 1e-4
+
+
+def test_failed_evaluations_exit_nonzero_with_the_count(monkeypatch, capsys):
+    """``flexrv tolerance``: a study with failed evaluations prints them with the count
+    and exits 1 (0 only when every evaluation succeeded)."""
+    import flexrv.studies.tolerance as study
+    from flexrv.cli import main
+
+    def fake_run_study(cfg, progress=True):
+        return {
+            "design": "rv40e",
+            "output_dir": "/x/out",
+            "samples": 4,
+            "sampler": "sobol",
+            "seed": 0,
+            "variables": 1,
+            "evaluations": 4,
+            "computed_now": 4,
+            "skipped_existing": 0,
+            "failed": 3,
+            "wall_time_s": 0.1,
+            "percentiles": {},
+            "yield": None,
+            "ranked_sensitivities": {},
+            "what_if": {},
+        }
+
+    monkeypatch.setattr(study, "run_study", fake_run_study)
+    with pytest.raises(SystemExit) as info:
+        main(["tolerance", "rv40e", "--samples", "4", "--json"])
+    assert info.value.code == 1
+    assert "3 of 4 evaluations failed" in " ".join(capsys.readouterr().err.split())
+
+
+def test_all_failed_study_draws_no_histograms(tmp_path):
+    """Without one successful sample the study writes its data and summary but no
+    histogram or tornado figure (an empty histogram says nothing), and removes those
+    of an earlier run of the same folder."""
+    from types import SimpleNamespace
+
+    import flexrv.studies.tolerance as study
+
+    (tmp_path / "histograms.png").write_bytes(b"old")
+    plan = SimpleNamespace(
+        columns=[SimpleNamespace(label="pin r", entry="pins.pin_radius_um")],
+        reducer=SimpleNamespace(name="rv40e"),
+        tol=SimpleNamespace(to_dict=lambda: {}),
+        batch_values={},
+    )
+    n = 3
+    parts = {"u": np.zeros((n, 1)), "x": np.zeros((n, 1))}
+    y = np.full((n, len(study.OUTPUTS)), np.nan)
+    result = {"sampler": "random", "resolution": {}, "ranked_sensitivities": {}}
+    cfg = SimpleNamespace(seed=0)
+    orig = study._markdown
+    try:
+        study._markdown = lambda r: "summary"
+        study._write_outputs(tmp_path, cfg, plan, parts, y, ["failed"] * n, ["a", "b", "c"], [], result)
+    finally:
+        study._markdown = orig
+    assert result["plots"] == []
+    assert not (tmp_path / "histograms.png").exists() and not (tmp_path / "tornado.png").exists()
+    assert (tmp_path / "samples.nc").exists() and (tmp_path / "summary.md").read_text() == "summary"
+
+
+# ----------------------------------------------------------------- te: a run too short for a spectrum
+def test_te_too_short_for_a_spectrum_writes_its_summary(tmp_path):
+    """``flexrv te rv40e --crank-revolutions 0.05 --points-per-mesh 2``: 4 positions, fewer
+    than the 8 a spectrum needs. The run ends normally with every output except the
+    spectrum, and says why there is none."""
+    out = tmp_path / "te"
+    proc = subprocess.run(
+        [sys.executable, "-m", "flexrv", "te", "rv40e", "--crank-revolutions", "0.05", "--points-per-mesh", "2"]
+        + ["--out", str(out), "--json"],
+        cwd=tmp_path,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert {"results.nc", "summary.json", "summary.md", "te.png", "pin_forces.png"} <= {p.name for p in out.iterdir()}
+    assert not (out / "te_spectrum.png").exists()
+    md = (out / "summary.md").read_text()
+    assert "no TE spectrum: 4 positions, a spectrum needs at least 8" in md
