@@ -2,10 +2,16 @@
 subprocess with a timeout): every one must end with exit code 2, one clear
 message naming the option/field (and, where there is one, the value), and no
 traceback. Covers usage errors, undecodable files, markup-like text, strict types,
-infeasible designs, step bounds, output paths checked before work, and sweep specs.
+infeasible designs, step bounds, output paths checked before work, sweep specs, and
+one case per cause of the third hardening round: TOML nested too deep or with a key
+given twice, empty option values, duplicate or empty ``--parts``, a missing report
+folder, EHL contacts larger than their radii, provenance keys naming no field, a
+name with a newline, physical lower bounds (face width, masses, rated torque, the
+``te`` torque), and sweep / tolerance limits found before any cluster starts (case
+count, workers beyond the cores, every case's values and the task's options).
 
-The cases run six at a time (each is a fresh interpreter, ~1 s) so the table stays
-well under a minute; only the unreachable-scheduler case waits for its 5 s timeout.
+The cases run six at a time (each is a fresh interpreter, ~1 s on an idle machine);
+only the unreachable-scheduler case waits for its 5 s timeout.
 """
 
 from __future__ import annotations
