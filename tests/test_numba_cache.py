@@ -64,10 +64,15 @@ def _damage_nbc(tmp_path: Path) -> None:
 
 
 def _damage_nbi(tmp_path: Path) -> None:
+    import io
+    import pickle
+
     (nbi,) = _files(tmp_path, ".nbi")
     data = bytearray(nbi.read_bytes())
     # keep numba's version header (a pickled string), corrupt the pickled index after it
-    start = data.index(b".") + 1
+    stream = io.BytesIO(bytes(data))
+    pickle.load(stream)
+    start = stream.tell() + 8
     data[start : start + 16] = b"\xfe" * 16
     nbi.write_bytes(bytes(data))
 
