@@ -16,8 +16,11 @@ A sweep is described by a TOML spec::
     [[cases]]                             # and/or an explicit list of variations
     "second_stage.eccentricity_mm" = 1.0
 
-Each case is the base design with its overrides applied and validated (a case whose
-design is invalid is recorded as failed with the validation message). Cases are
+Each case is the base design with its overrides applied. Before any case runs (and
+before a cluster starts) every case's design is validated and the task's options are
+checked (types, finite numbers, and the task's own ``check``, e.g. the step count of
+``simulate``): a bad case refuses the sweep with a ConfigError naming the case, its
+overrides and the field. At most :data:`MAX_CASES` cases. Cases are
 identified by a hash of (design, task, options), so re-running the same spec skips
 every case whose result file exists: kill the sweep at any point and run the same
 command again to finish only the missing cases. Failed cases are recorded with their
