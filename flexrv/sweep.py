@@ -554,7 +554,7 @@ def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
             sock.settimeout(max(deadline - time.monotonic(), 0.01))
             chunk = sock.recv(n - len(data))
             if not chunk:
-                raise ConnectionError("the server closed the connection")
+                raise ValueError("it closed the connection during dask's handshake")
             data += chunk
         return data
 
