@@ -7,6 +7,9 @@ Pipeline: design (validated presets; geometry checks) -> geometry -> meshing -> 
 from __future__ import annotations
 
 from flexrv._version import __version__  # noqa: F401
+from flexrv.cache import configure_numba_cache
+
+configure_numba_cache()  # numba's kernel cache beside flexrv's other caches, damaged entries healed
 
 #: Layer order of the package, lowest first: a module may import from its own layer and the
 #: layers below it, never from a layer above (tests/test_layers.py checks every import,
@@ -30,7 +33,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("cli",),  # command line
 )
 
-from flexrv.design import list_presets, load  # noqa: F401
+from flexrv.design import list_presets, load  # noqa: E402, F401  (after the numba cache is configured)
 
 
 def __getattr__(name: str):

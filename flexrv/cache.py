@@ -153,21 +153,54 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
     ('complete', False)
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_temp_files(target.parent)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp" + target.suffix, dir=target.parent
-    )
-    os.close(fd)
+    with _naming(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_temp_files(target.parent)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp" + target.suffix, dir=target.parent
+        )
+        os.close(fd)
     tmp_path = Path(tmp)
     try:
-        yield tmp_path
-        os.chmod(tmp_path, 0o666 & ~_umask())
-        os.replace(tmp_path, target)
+        with _naming(target):
+            yield tmp_path
+            os.chmod(tmp_path, 0o666 & ~_umask())
+            os.replace(tmp_path, target)
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+
+
+@contextlib.contextmanager
+def _naming(target: Path) -> Iterator[None]:
+    """Re-raise an OSError that names no file (a full disk, a read-only file system seen
+    by a library writing through a temporary name) as one naming ``target``. HDF5's
+    errors (netCDF files) carry no errno: their reason is read from the message."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None and Path(exc.filename) == target:
+            raise
+        errno_ = exc.errno
+        if errno_ is None:
+            import errno as errnos
+
+            text = str(exc).lower()
+            errno_ = next(
+                (
+                    code
+                    for code, word in (
+                        (errnos.ENOSPC, "no space"),
+                        (errnos.EROFS, "read-only"),
+                        (errnos.EACCES, "permission"),
+                    )
+                    if word in text
+                ),
+                errnos.EIO,
+            )
+        reason = os.strerror(errno_) if errno_ else (exc.strerror or str(exc))
+        raise OSError(errno_, f"cannot write {target.name}: {reason}", str(target)) from exc
 
 
 def atomic_write_text(target: str | os.PathLike, text: str) -> Path:
@@ -343,3 +376,118 @@ def cached_dataclass(path, key: str, cls, compute, enabled: bool = True):
 
     value, _ = cached_entry([path], key, lambda: cls(**json.loads(path.read_text())), build, enabled=enabled)
     return value
+
+
+# ------------------------------------------------------------------ numba's compiled kernels
+#: environment variable of numba's on-disk cache folder (read by numba when it is imported)
+NUMBA_CACHE_ENV = "NUMBA_CACHE_DIR"
+
+
+def numba_cache_dir() -> Path:
+    """Folder of numba's compiled kernels: ``$NUMBA_CACHE_DIR`` if set, else
+    ``<cache_dir()>/numba/<flexrv version>`` beside the meshes and reduced bodies (a new
+    flexrv starts an empty folder; numba's index also checks each source file's stamp)."""
+    env = os.environ.get(NUMBA_CACHE_ENV)
+    if env:
+        return Path(env)
+    root = os.environ.get(CACHE_ENV) or os.environ.get("FLEXRV_CACHE")
+    if not root:
+        root = str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "flexrv")
+        try:
+            from platformdirs import user_cache_dir
+
+            root = user_cache_dir("flexrv", appauthor=False)
+        except ImportError:
+            pass
+    return Path(root) / "numba" / flexrv_version()
+
+
+def configure_numba_cache() -> None:
+    """Point numba's cache at :func:`numba_cache_dir` (before numba is imported) and guard
+    its loading (:func:`guard_numba_cache`, now if numba is imported, else when it is)."""
+    os.environ.setdefault(NUMBA_CACHE_ENV, str(numba_cache_dir()))
+    import sys
+
+    if "numba.core.caching" in sys.modules:
+        guard_numba_cache()
+    elif not any(isinstance(f, _NumbaCachingHook) for f in sys.meta_path):
+        sys.meta_path.insert(0, _NumbaCachingHook())
+
+
+class _NumbaCachingHook:
+    """Import hook: runs :func:`guard_numba_cache` right after ``numba.core.caching`` is
+    imported (by the first kernel module), so flexrv never imports numba itself."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "numba.core.caching":
+            return None
+        from importlib.machinery import PathFinder
+
+        spec = PathFinder.find_spec(name, path)
+        if spec is None or spec.loader is None:
+            return spec
+        loader = spec.loader
+        exec_module = loader.exec_module
+
+        def exec_and_guard(module):
+            exec_module(module)
+            guard_numba_cache(module)
+
+        loader.exec_module = exec_and_guard
+        return spec
+
+
+#: damaged numba cache entries discarded by this process (one warning for all of them)
+_DISCARDED: list[str] = []
+
+
+def guard_numba_cache(caching=None) -> None:
+    """Make a damaged numba cache entry heal itself: an entry whose index (``.nbi``) or
+    data (``.nbc``) cannot be read back (truncated, corrupted: any exception while
+    numba loads or rebuilds it) is deleted and the kernel compiled again, with one
+    warning per process. Numba itself only tolerates a missing file."""
+    if caching is None:
+        import numba.core.caching as caching
+    cls = caching.Cache
+    if getattr(cls.load_overload, "_flexrv_guard", False):
+        return
+    load, save = cls.load_overload, cls.save_overload
+
+    def load_overload(self, sig, target_context):
+        try:
+            return load(self, sig, target_context)
+        except Exception as exc:
+            _discard_numba_entry(self, exc)
+            return None
+
+    def save_overload(self, sig, data):
+        try:
+            return save(self, sig, data)
+        except Exception as exc:  # e.g. an unreadable index: discard it, save again
+            _discard_numba_entry(self, exc)
+            with contextlib.suppress(Exception):
+                save(self, sig, data)
+
+    load_overload._flexrv_guard = True
+    cls.load_overload, cls.save_overload = load_overload, save_overload
+
+
+def _discard_numba_entry(cache, exc: Exception) -> None:
+    """Delete the index and data files of one numba cache entry; warn once per process."""
+    import sys
+
+    cache_file = getattr(cache, "_cache_file", None)
+    index = Path(getattr(cache_file, "_index_path", "") or "")
+    if index.name:
+        pattern = getattr(cache_file, "_data_name_pattern", "").replace("{number:d}", "*")
+        for path in [index, *(index.parent.glob(pattern) if pattern else [])]:
+            with contextlib.suppress(OSError):
+                path.unlink()
+    _DISCARDED.append(str(index))
+    if len(_DISCARDED) == 1:
+        print(
+            f"flexrv: warning: discarded a damaged numba cache entry ({index.name}: {type(exc).__name__}); "
+            "its kernel is compiled again",
+            file=sys.stderr,
+            flush=True,
+        )

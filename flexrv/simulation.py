@@ -107,6 +107,21 @@ SEGMENT_STEPS = 1000
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
 
+def check_time_options(reducer, t_end: float | None, dt: float = DEFAULT_DT) -> float:
+    """The end time of a run (default: load ramp end + 0.2 s) after checking ``t_end``
+    and ``dt`` (finite, 0 < dt <= t_end, dt <= 5e-4 s); InputError naming the value."""
+    op = reducer.operating
+    if t_end is None:
+        t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
+    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)) or not (math.isfinite(t_end) and t_end > 0):
+        raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not (math.isfinite(dt) and 0 < dt <= t_end):
+        raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
+    if dt > 5e-4:
+        raise InputError(f"dt = {dt:g} s is not allowed: must be <= 5e-4 s to resolve the pin-mesh period")
+    return t_end
+
+
 def check_step_count(
     t_end: float, dt: float, output_every: int = 1, n_coordinates: int | None = None, t_start: float = 0.0
 ) -> int:
@@ -233,15 +248,7 @@ class Simulation:
         s CPU per simulated s).
         """
 
-        op = self.reducer.operating
-        if t_end is None:
-            t_end = max(op.load_ramp_end_s, op.speed_ramp_time_s) + 0.2
-        if not (math.isfinite(t_end) and t_end > 0):
-            raise InputError(f"t_end = {t_end!r} s is not allowed: must be > 0")
-        if not (math.isfinite(dt) and 0 < dt <= t_end):
-            raise InputError(f"dt = {dt!r} s is not allowed: must lie in (0, t_end = {t_end:g}]")
-        if dt > 5e-4:
-            raise InputError(f"dt = {dt:g} s is not allowed: must be <= 5e-4 s to resolve the pin-mesh period")
+        t_end = check_time_options(self.reducer, t_end, dt)
         seg = int(segment_steps)
         if seg < 1:
             raise InputError(f"segment_steps = {segment_steps!r} is not allowed: must be an integer >= 1")
@@ -262,7 +269,7 @@ class Simulation:
         if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
             newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
 
-        from flexrv.model.kernel_cache import announce_compile
+        from flexrv.model.kernel_cache import announce_compile, stop_now
 
         kinds = (["fused"] if model.fused is not None else []) + (
             ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
@@ -380,6 +387,8 @@ class Simulation:
         def on_stop(signum, frame):
             state["stop"] = True
             state["signal"] = signal.Signals(signum).name
+            if state["step"] == 0:  # nothing integrated yet (numba may compile for minutes): nothing to keep
+                stop_now(signum)
 
         old = {}
         for name in STOP_SIGNALS:
@@ -628,9 +637,18 @@ class _Checkpointer:
             )
             save_partial(res, self.directory)
         except Exception as exc:  # a full disk (or any save error) must not kill the run; the next one retries
-            import warnings
+            import sys
 
-            warnings.warn(f"checkpoint to {self.directory} failed: {exc}", RuntimeWarning, stacklevel=2)
+            if not getattr(self, "failed", 0):  # one line, at the first failure
+                where = getattr(exc, "filename", None) or self.directory
+                reason = getattr(exc, "strerror", None) or exc
+                print(
+                    f"flexrv: warning: checkpoint not written ({reason}: {where}); the run goes on, "
+                    "the last checkpoint is kept",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            self.failed = getattr(self, "failed", 0) + 1
         took = _time.perf_counter() - now
         self.spent += took
         self.count += 1

@@ -16,8 +16,11 @@ A sweep is described by a TOML spec::
     [[cases]]                             # and/or an explicit list of variations
     "second_stage.eccentricity_mm" = 1.0
 
-Each case is the base design with its overrides applied and validated (a case whose
-design is invalid is recorded as failed with the validation message). Cases are
+Each case is the base design with its overrides applied. Before any case runs (and
+before a cluster starts) every case's design is validated and the task's options are
+checked (types, finite numbers, and the task's own ``check``, e.g. the step count of
+``simulate``): a bad case refuses the sweep with a ConfigError naming the case, its
+overrides and the field. At most :data:`MAX_CASES` cases. Cases are
 identified by a hash of (design, task, options), so re-running the same spec skips
 every case whose result file exists: kill the sweep at any point and run the same
 command again to finish only the missing cases. Failed cases are recorded with their
@@ -37,7 +40,6 @@ import math
 import os
 import re
 import time
-import tomllib
 import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -61,6 +63,27 @@ def simulate_task(reducer, model: str = "rigid", t_end: float = 0.5, dt: float |
     options = {} if dt is None else {"dt": dt}
     results = Simulation(reducer, model=model).run(t_end=t_end, progress=False, **options)
     return results.summary()
+
+
+def _check_simulate(reducer, model: str = "rigid", t_end: float = 0.5, dt: float | None = None) -> None:
+    """The checks of :func:`simulate_task`'s options that need no model: the model name
+    and the number of time steps (:func:`flexrv.simulation.check_step_count`)."""
+    from flexrv.model.factory import MODELS
+    from flexrv.simulation import DEFAULT_DT, check_step_count, check_time_options
+
+    if model not in MODELS:
+        raise ConfigError(f"options.model = {model!r}: allowed {sorted(MODELS)}")
+    step = DEFAULT_DT if dt is None else dt
+    check_step_count(check_time_options(reducer, t_end, step), step)
+
+
+#: a task function may carry ``check(reducer, **options)``: the checks of its options that
+#: need no work (run for the base design before any cluster starts)
+simulate_task.check = _check_simulate
+
+#: most cases one sweep may run (grid product plus [[cases]]); each case is validated
+#: before any cluster starts, and a larger study is split into several sweeps
+MAX_CASES = 20_000
 
 
 _SPEC_KEYS = {"name", "preset", "task", "outputs", "options", "grid", "cases", "description"}
@@ -102,15 +125,12 @@ def _require(cond: bool, path, key: str, message: str) -> None:
 def load_spec(path: str | os.PathLike) -> SweepSpec:
     """Read and validate a sweep spec TOML completely (before any case runs);
     :class:`ConfigError` names the key, the value and what is allowed."""
-    from flexrv.design import read_text_file
+    from flexrv.design import parse_toml, read_text_file
 
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"sweep spec {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(read_text_file(path, "sweep spec"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: invalid TOML: {exc}") from None
+    data = parse_toml(read_text_file(path, "sweep spec"), str(path))
     unknown = set(data) - _SPEC_KEYS
     if unknown:
         raise ConfigError(f"{path}: unknown sweep field(s) {sorted(unknown)}; allowed: {sorted(_SPEC_KEYS)}")
@@ -193,12 +213,24 @@ def check_task(spec: SweepSpec) -> Callable[..., dict]:
         sig = inspect.signature(func)
     except (TypeError, ValueError):
         return func
-    params = list(sig.parameters.values())[1:]
+    all_params = list(sig.parameters.values())
+    if not all_params or all_params[0].kind not in (all_params[0].POSITIONAL_ONLY, all_params[0].POSITIONAL_OR_KEYWORD):
+        raise ConfigError(f"task {spec.task!r} takes no design: a task is a function task(reducer, **options) -> dict")
+    params = all_params[1:]
     if not any(p.kind is p.VAR_KEYWORD for p in params):
         allowed = [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
         bad = sorted(set(spec.options) - set(allowed))
         if bad:
             raise ConfigError(f"options.{bad[0]}: not an option of task {spec.task!r}; allowed: {allowed}")
+        from flexrv.errors import InputError, check_options, signature_options
+
+        try:
+            check_options("options", spec.options, signature_options(func, skip=1))
+        except InputError as exc:
+            raise ConfigError(str(exc)) from None
+    for key, value in spec.options.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ConfigError(f"options.{key} = {value!r}: must be a finite number")
     return func
 
 
@@ -295,18 +327,54 @@ class Case:
     design: dict[str, Any]
 
 
-def build_cases(spec: SweepSpec) -> list[Case]:
-    """Expand the spec into cases with stable ids (hash of design, task, options)."""
+def case_count(spec: SweepSpec) -> int:
+    """Number of cases of a spec (grid product plus [[cases]]), without expanding it."""
+    return (math.prod(len(v) for v in spec.grid.values()) if spec.grid else 0) + len(spec.cases)
+
+
+def build_cases(spec: SweepSpec, validate: bool = False) -> list[Case]:
+    """Expand the spec into cases with stable ids (hash of design, task, options).
+
+    With ``validate`` every case's design is validated and the task's option checks
+    (a ``check`` attribute of the task function) run for it: ConfigError naming the
+    case, its overrides and the field, before any case runs. More than
+    :data:`MAX_CASES` cases are refused."""
     from flexrv.cache import flexrv_version
     from flexrv.design import load
 
+    n = case_count(spec)
+    if n > MAX_CASES:
+        raise ConfigError(
+            f"the sweep has {n} cases (grid product {case_count(SweepSpec(**{**spec.__dict__, 'cases': []}))} "
+            f"+ {len(spec.cases)} [[cases]]); at most {MAX_CASES} are allowed: split it into several sweeps"
+        )
     base = load(spec.preset).model_dump(mode="python")
+    check = getattr(check_task(spec), "check", None) if validate else None
     cases = []
-    for overrides in spec.variations():
+    for i, overrides in enumerate(spec.variations()):
         design = apply_overrides(base, overrides)
+        if validate:
+            _validate_case(i, overrides, design, spec, check)
         cid = content_hash(design, spec.task, spec.options, flexrv_version(), length=12)
         cases.append(Case(case_id=cid, overrides=overrides, design=design))
     return cases
+
+
+def _validate_case(i: int, overrides: dict, design: dict, spec: SweepSpec, check) -> None:
+    from flexrv.design import from_dict
+
+    shown = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
+    if len(shown) > 200:
+        shown = shown[:200] + " ..."
+    try:
+        reducer = from_dict(design, source=f"case {i} ({shown})")
+        if check is not None:
+            check(reducer, **spec.options)
+    except FlexrvError as exc:
+        text = str(exc)
+        if not text.startswith("case "):
+            text = f"case {i} ({shown}): {text}"
+        raise ConfigError(text) from None
 
 
 def case_file(out_dir: Path, case: Case) -> Path:
@@ -356,6 +424,7 @@ def run_sweep(
     retry_failed: bool = False,
     progress: bool = True,
     plots: bool = True,
+    force: bool = False,
 ) -> SweepSummary:
     """Run the missing cases of a sweep on dask.distributed and write the table.
 
@@ -368,20 +437,20 @@ def run_sweep(
     retry_failed : recompute cases recorded as failed.
     plots : draw one PNG per output against the first varied parameter (studies whose
         cases are random draws, e.g. the tolerance study, draw their own figures).
+    force : allow more local workers than the machine has cores.
     """
     from dask.distributed import Client, LocalCluster, as_completed
 
     from flexrv.design import load
 
-    if n_workers is not None and (isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1):
-        raise ConfigError(f"--workers {n_workers!r}: must be an integer >= 1")
+    check_workers(n_workers, force)
     out = Path(out_dir) if out_dir else Path("results") / spec.name
-    # everything checked before any case runs: design overrides, task, options, outputs
-    cases = build_cases(spec)
+    # everything checked before any case runs: every case's design, task, options, outputs
+    cases = build_cases(spec, validate=True)
     output_keys = known_outputs(spec, load(spec.preset))
     check_outputs(spec, output_keys)
-    if scheduler:  # reachable? (before anything is written)
-        connect_scheduler(scheduler).close()
+    if scheduler:  # a dask scheduler answering its handshake? (before anything is written)
+        check_scheduler(scheduler)
     out.mkdir(parents=True, exist_ok=True)
     spec_json = json.dumps(spec.__dict__, indent=1, default=str)
     spec_path = out / "spec.json"
@@ -440,11 +509,83 @@ def run_sweep(
     )
 
 
+def check_workers(n_workers, force: bool = False) -> None:
+    """ConfigError naming --workers unless it is an integer >= 1 and, without ``force``,
+    at most the machine's cores (more worker processes than cores only compete)."""
+    if n_workers is None:
+        return
+    if isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1:
+        raise ConfigError(f"--workers {n_workers!r}: must be an integer >= 1")
+    cores = os.cpu_count() or 1
+    if n_workers > cores and not force:
+        raise ConfigError(
+            f"--workers {n_workers}: this machine has {cores} cores; at most {cores} local workers "
+            "(pass --force to start more)"
+        )
+
+
+#: address forms of a dask scheduler flexrv connects to
+_ADDRESS_RE = re.compile(r"^(?:(tcp|tls)://)?\[?([^\]/]+?)\]?:(\d+)/?$")
+#: largest first message of a dask scheduler's handshake [bytes] (its info dict, ~300 B)
+_MAX_HANDSHAKE_BYTES = 1 << 20
+
+
+def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
+    """ConfigError naming --scheduler within about ``timeout_s`` unless a dask scheduler
+    answers at ``address``: the TCP connection must open, and (tcp://) the server must
+    send the first frame of dask's handshake, an 8-byte length of at most 1 MiB followed
+    by that many bytes. A server of another protocol (an HTTP server waits for a request,
+    an SSH server sends a text banner) fails here instead of hanging the run or making
+    dask allocate the length its banner spells."""
+    import socket
+    import struct
+
+    m = _ADDRESS_RE.match(address.strip())
+    if not m:
+        raise ConfigError(f"--scheduler {address!r}: expected an address like tcp://127.0.0.1:8786")
+    scheme, host, port = m.group(1) or "tcp", m.group(2), int(m.group(3))
+    if port > 65535:
+        raise ConfigError(f"--scheduler {address!r}: port {port} is not a TCP port (1-65535)")
+    deadline = time.monotonic() + timeout_s
+
+    def _recv(sock, n: int) -> bytes:
+        data = b""
+        while len(data) < n:
+            sock.settimeout(max(deadline - time.monotonic(), 0.01))
+            chunk = sock.recv(n - len(data))
+            if not chunk:
+                raise ValueError("it closed the connection during dask's handshake")
+            data += chunk
+        return data
+
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s) as sock:
+            if scheme == "tcp":
+                (length,) = struct.unpack("<Q", _recv(sock, 8))
+                if not 0 < length <= _MAX_HANDSHAKE_BYTES:
+                    raise ValueError(f"its first message announces {length} bytes")
+                _recv(sock, length)
+    except socket.timeout:
+        raise ConfigError(
+            f"--scheduler {address}: the server at {host}:{port} accepted the connection but sent no dask "
+            f"handshake within {timeout_s:g} s; it is not a dask scheduler"
+        ) from None
+    except ValueError as exc:
+        raise ConfigError(
+            f"--scheduler {address}: the server at {host}:{port} is not a dask scheduler ({exc})"
+        ) from None
+    except OSError as exc:
+        raise ConfigError(
+            f"--scheduler {address}: no dask scheduler reachable ({exc.strerror or type(exc).__name__}: {exc})"
+        ) from None
+
+
 def connect_scheduler(address: str, timeout_s: float = 5.0):
-    """A dask Client of the scheduler at ``address``; ConfigError within
-    ``timeout_s`` if it cannot be reached."""
+    """A dask Client of the scheduler at ``address`` (checked first by
+    :func:`check_scheduler`); ConfigError within about ``timeout_s`` if it cannot be reached."""
     from dask.distributed import Client
 
+    check_scheduler(address, timeout_s)
     try:
         return Client(address, timeout=timeout_s)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:

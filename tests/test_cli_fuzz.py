@@ -2,10 +2,16 @@
 subprocess with a timeout): every one must end with exit code 2, one clear
 message naming the option/field (and, where there is one, the value), and no
 traceback. Covers usage errors, undecodable files, markup-like text, strict types,
-infeasible designs, step bounds, output paths checked before work, and sweep specs.
+infeasible designs, step bounds, output paths checked before work, sweep specs, and
+one case per cause of the third hardening round: TOML nested too deep or with a key
+given twice, empty option values, duplicate or empty ``--parts``, a missing report
+folder, EHL contacts larger than their radii, provenance keys naming no field, a
+name with a newline, physical lower bounds (face width, masses, rated torque, the
+``te`` torque), and sweep / tolerance limits found before any cluster starts (case
+count, workers beyond the cores, every case's values and the task's options).
 
-The cases run six at a time (each is a fresh interpreter, ~1 s) so the table stays
-well under a minute; only the unreachable-scheduler case waits for its 5 s timeout.
+The cases run six at a time (each is a fresh interpreter, ~1 s on an idle machine);
+only the unreachable-scheduler case waits for its 5 s timeout.
 """
 
 from __future__ import annotations
@@ -29,6 +35,9 @@ def _design(path: Path, preset: str = "rv40e", **changes) -> str:
     """Write a preset with changed fields (``section__field=value``) to ``path``."""
     data = load(preset).model_dump(mode="python")
     for key, value in changes.items():
+        if "__" not in key:  # a top-level field (name, description)
+            data[key] = value
+            continue
         section, field = key.split("__")
         data[section][field] = value
     path.write_text(tomli_w.dumps(data))
@@ -42,6 +51,18 @@ def _spec(path: Path, body: str) -> str:
 
 _GRID = '[grid]\n"second_stage.eccentricity_mm" = [1.0]\n'
 _HEAD = 'name = "fz"\npreset = "rv40e"\ntask = "design"\noutputs = ["kinematics.ratio"]\n'
+_SIM = 'name = "fzs"\npreset = "rv40e"\ntask = "simulate"\noutputs = ["te_pp_arcsec"]\n'
+#: six design fields: a grid of ten values each is a 10^6-case sweep
+_SIX_FIELDS = (
+    "second_stage.eccentricity_mm",
+    "second_stage.disc_width_mm",
+    "first_stage.face_width_mm",
+    "operating.load_torque_Nm",
+    "operating.input_speed_rpm",
+    "contact.pin_friction_coefficient",
+)
+#: what a refused worker count must say: the option, the bound and the way past it
+_CORES = ["--workers 1000", f"{os.cpu_count()} cores", "--force"]
 
 
 def _cases(d: Path) -> list[tuple[str, list[str], list[str]]]:
@@ -61,7 +82,93 @@ def _cases(d: Path) -> list[tuple[str, list[str], list[str]]]:
     (d / "binary.toml").write_bytes(bytes(range(256)))
     (d / "sweep_u16.toml").write_bytes(_HEAD.encode("utf-16"))
     out = str(d / "new_out")
+    base_text = Path(_design(d / "base.toml")).read_text()
+    (d / "deep_arrays.toml").write_text(base_text + "\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    (d / "deep_dotted.toml").write_text(base_text + "\n[" + ".".join(["t"] * 2000) + "]\nx = 1\n")
+    (d / "dup.toml").write_text(
+        base_text.replace("face_width_mm = 10.0\n", "face_width_mm = 10.0\nface_width_mm = 11.0\n")
+    )
+    flood = load("rv40e").model_dump(mode="python")
+    flood["provenance"] = {f"unknown_{i}": "x" for i in range(100_000)}
+    (d / "flood.toml").write_text(tomli_w.dumps(flood))
+    big_grid = "[grid]\n" + "".join(f'"{k}" = [{", ".join(["1.0"] * 10)}]\n' for k in _SIX_FIELDS)
+    tol = ["tolerance", "rv40e", "--tolerances", "rv40e", "--samples", "2"]
     return [
+        # --- hardening round 3: one case per cause
+        ("toml_deep_arrays", ["show", str(d / "deep_arrays.toml")], ["deep_arrays.toml", "nested 5000 levels"]),
+        ("toml_deep_dotted", ["design", str(d / "deep_dotted.toml")], ["deep_dotted.toml", "levels", "at most 32"]),
+        ("toml_duplicate_key", ["show", str(d / "dup.toml")], ["dup.toml", "'face_width_mm'", "twice"]),
+        ("design_empty_name", ["design", ""], ["flexrv design", "empty argument"]),
+        ("out_empty", ["simulate", "rv40e", "--out", ""], ["--out", "empty value"]),
+        ("out_empty_equals", ["te", "rv40e", "--out="], ["--out", "empty value"]),
+        (
+            "parts_duplicate",
+            ["simulate", "rv40e", "--model", "flexible", "--parts", "carrier,carrier", "--out", out],
+            ["carrier given twice"],
+        ),
+        ("parts_empty_item", ["simulate", "rv40e", "--parts", "carrier,", "--out", out], ["empty part name"]),
+        ("report_missing_folder", ["report", "--results", str(d / "MISSING")], ["--results", "does not exist"]),
+        (
+            "ehl_radius_huge",
+            ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.005", "--ry-m", "1e30"],
+            ["--ry-m 1e+30", "half-space"],
+        ),
+        ("provenance_flood", ["show", str(d / "flood.toml")], ["provenance", "100000 of 100000"]),
+        ("name_newline", ["show", _design(d / "nl.toml", name="a\nb")], ["name", "printable"]),
+        (
+            "rated_torque_tiny",
+            ["design", _design(d / "rt.toml", operating__rated_torque_Nm=1e-300)],
+            ["operating.rated_torque_Nm", "1e-300", "smallest cycloidal drives"],
+        ),
+        (
+            "face_width_subnormal",
+            ["show", _design(d / "fw.toml", first_stage__face_width_mm=5e-324)],
+            ["first_stage.face_width_mm", "5e-324", "narrower than 1 mm"],
+        ),
+        (
+            "carrier_mass_tiny",
+            ["design", _design(d / "cm.toml", inertia__carrier_mass_kg=1e-9)],
+            ["inertia.carrier_mass_kg", "1e-09", "lighter than"],
+        ),
+        ("te_torque_tiny", ["te", "rv40e", "--torque-nm", "1e-300", "--out", out], ["torque", "1e-300", "no-load"]),
+        (
+            "sweep_grid_huge",
+            ["sweep", _spec(d / "gh.toml", _HEAD + big_grid)],
+            ["1000000 cases", "at most 20000"],
+        ),
+        ("sweep_workers_beyond_cores", ["sweep", _spec(d / "wc.toml", _HEAD + _GRID), "--workers", "1000"], _CORES),
+        ("tolerance_workers_beyond_cores", [*tol, "--workers", "1000", "--out", out], _CORES),
+        ("tolerance_samples_huge", [*tol[:-1], "10000000", "--out", out], ["--samples", "20000"]),
+        (
+            "sweep_value_nan",
+            ["sweep", _spec(d / "vn.toml", _HEAD + '[grid]\n"second_stage.eccentricity_mm" = [1.0, nan]\n')],
+            ["case 1", "second_stage.eccentricity_mm", "nan"],
+        ),
+        (
+            "sweep_value_string",
+            ["sweep", _spec(d / "vs.toml", _HEAD + '[[cases]]\n"first_stage.face_width_mm" = "wide"\n')],
+            ["case 0", "first_stage.face_width_mm", "wide"],
+        ),
+        (
+            "sweep_simulate_t_end_huge",
+            ["sweep", _spec(d / "st.toml", _SIM + "[options]\nt_end = 1e9\n" + _GRID)],
+            ["case 0", "t_end", "time steps"],
+        ),
+        (
+            "sweep_simulate_dt_nan",
+            ["sweep", _spec(d / "sd.toml", _SIM + "[options]\ndt = nan\n" + _GRID)],
+            ["options.dt", "nan"],
+        ),
+        (
+            "sweep_simulate_option_type",
+            ["sweep", _spec(d / "so.toml", _SIM + '[options]\nt_end = "long"\n' + _GRID)],
+            ["options.t_end", "'long'"],
+        ),
+        (
+            "sweep_task_takes_no_design",
+            ["sweep", _spec(d / "tn.toml", _HEAD.replace('"design"', '"os:getcwd"') + _GRID)],
+            ["os:getcwd", "takes no design"],
+        ),
         # --- usage errors (typer's vendored click exceptions)
         ("bare", [], ["Usage"]),
         ("dt_not_number", ["simulate", "rv40e", "--dt", "abc"], ["--dt", "abc"]),

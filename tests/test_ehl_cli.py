@@ -79,15 +79,17 @@ def test_ehl_grid_refinement_reported():
 
 
 def test_explicit_case_outside_the_model_is_flagged():
-    """A contact whose Hertz semi-axis reaches the radius of curvature (ry -> 1e30 m:
-    a = 34.7 m on rx = 5 mm) is reported with a warning naming the assumption; a
-    speed the solver cannot handle is one InputError naming the inputs, not a LinAlgError."""
+    """A contact whose Hertz semi-axis exceeds the radius of curvature (ry -> 1e30 m:
+    a = 34.7 m on rx = 5 mm) is refused before solving, naming the options and the
+    half-space assumption (between HERTZ_SIZE_LIMIT x the radius and the radius a result
+    carries a warning); a contact well inside it carries none; a speed the solver cannot
+    handle is one InputError naming the inputs, not a LinAlgError."""
     from flexrv.cli.ehl import HERTZ_SIZE_LIMIT, ehl_case
     from flexrv.errors import InputError
 
-    report, res = ehl_case("rv221", load_n=1000.0, speed_m_s=1.0, rx_m=0.005, ry_m=1e30, grid=65, grid_tol=None)
-    assert res.hertz_a > 0.005 and HERTZ_SIZE_LIMIT < 1
-    assert any("Hertz" in w for w in report["warnings"])
+    with pytest.raises(InputError, match=r"--ry-m 1e\+30.*half-space"):
+        ehl_case("rv221", load_n=1000.0, speed_m_s=1.0, rx_m=0.005, ry_m=1e30, grid=65, grid_tol=None)
+    assert HERTZ_SIZE_LIMIT < 1
     report, _ = ehl_case("rv221", load_n=1000.0, speed_m_s=1.0, rx_m=0.005, ry_m=0.05, grid=65, grid_tol=None)
     assert not any("Hertz" in w for w in report.get("warnings", []))
     with pytest.raises(InputError, match="--speed-m-s"):

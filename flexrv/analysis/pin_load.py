@@ -11,7 +11,9 @@ approach, here with EXACT clearances of the actual pins to the actual profile):
    (:func:`flexrv.geometry.as_built.as_built_pin_gap`: actual pin centres and
    radii, the disc's modifications and profile-error harmonics) and beta0 is the
    root of min_i gap_i(beta) / l_i(beta) over the pins approaching the profile
-   (Newton steps on the exact gaps until |step| < 1e-15 rad).
+   (Newton steps on the exact gaps until a step moves the pins by less than the
+   gaps' resolution, :data:`GAP_RESOLUTION`; an unmodified profile is degenerate
+   there: every pin touches at once).
 2. The initial normal clearance delta_i of pin i is its exact gap at beta0, along
    the contact normal n_i whose moment arm about the disc centre is
    l_i = (P_i x n_i)_z (equal to :cite:`seed000`'s r'_c sin(phi)/sqrt(1 + K^2 - 2K cos(phi))
@@ -103,6 +105,15 @@ def _law(law: str, width: float, e_eff: float):
     raise InputError(f"law = {law!r} must be 'palmgren' or 'linear'")
 
 
+#: resolution of the exact pin gaps [m]: the closest-point iteration accepts a foot point whose
+#: first-order residual is below 1e-12 m (:func:`flexrv.geometry.cycloid.pin_gap`); the
+#: no-load pose is converged when its last rotation step moves the pins by less than this
+GAP_RESOLUTION = 1e-12
+#: pins whose moment arm is below this fraction of the largest arm do not define the no-load pose
+#: (they carry at most this fraction of a pin's torque per unit force)
+FIRST_CONTACT_ARM_FRACTION = 0.02
+
+
 def pin_load_distribution(
     torque,
     z_rp: int,
@@ -186,17 +197,32 @@ def pin_load_distribution(
 
     # no-load pose: first contact, Newton steps on the exact gaps
     gap, normal, phi, arms = state(0.0)
+    overlap = -float(np.min(gap))  # at the nominal pose
     tiny = 1e-9 * pin_circle_radius
     beta0 = 0.0
     for _ in range(40):
         sarm = sign * arms
-        pos = sarm > tiny
+        # pins that the rotation moves towards the profile; a pin near the line of centres
+        # (arm -> 0) defines no rotation: its gap over its arm is round-off (or, under an
+        # interference fit, a step of radians), so the pose comes from the pins with a real arm
+        pos = sarm > max(tiny, FIRST_CONTACT_ARM_FRACTION * float(np.max(sarm)))
         if not np.any(pos):
             raise ConvergenceError("pin_load_distribution: no pin has a positive moment arm")
         step = float(np.min(gap[pos] / sarm[pos]))
-        if abs(step) <= 1e-15 + 1e-12 * abs(beta0):
+        if abs(step) * pin_circle_radius <= GAP_RESOLUTION or abs(step) <= 1e-15 + 1e-12 * abs(beta0):
+            # the step moves no pin by more than the gaps are resolved: first contact found. In the
+            # degenerate pose of an unmodified profile every pin touches at once and the gaps are
+            # round-off of either sign, so the steps never fall below an absolute 1e-15 rad
             break
         beta0 += step
+        if abs(beta0) > 0.25 * 2.0 * np.pi / z_rp:
+            raise InputError(
+                f"pin_load_distribution: no no-load pose within a quarter pin pitch ({np.degrees(beta0):.3g} deg "
+                f"reached at crank angle {crank_angle:g} rad): the modifications or errors make the disc overlap "
+                "the pins on both sides (interference fit, largest overlap at the nominal pose "
+                f"{1e6 * overlap:.3g} um); "
+                "the initial-clearance method needs a clearance somewhere"
+            )
         gap, normal, phi, arms = state(beta0, phi0=phi if abs(step) < 1e-3 else None)
     else:
         raise ConvergenceError(f"pin_load_distribution: no-load pose not found (last step {step:.3g} rad)")

@@ -149,27 +149,72 @@ def usage_message(exc, argv: list[str]) -> str:
     return f"{command}: {msg}"
 
 
+def empty_value_message(argv: list[str]) -> str | None:
+    """The message for an empty option value (``--out ""``, ``--out=``) or an empty
+    argument (``design ""``), or None: no option or argument of flexrv may be empty (an
+    empty path would mean the current directory, an empty name nothing)."""
+    command = next((a for a in argv if not a.startswith("-")), "")
+    where = f"flexrv {command}" if command else "flexrv"
+    for i, arg in enumerate(argv):
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            return f"{where}: empty value for {arg[:-1]}; give a value"
+        if arg.strip() == "":
+            prev = argv[i - 1] if i > 0 else ""
+            if prev.startswith("-") and "=" not in prev:
+                return f"{where}: empty value {arg!r} for {prev}; give a value"
+            return f"{where}: empty argument {arg!r} (argument {i + 1}); give a value"
+    return None
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the process is (like Ctrl-C's KeyboardInterrupt), so every
+    phase of a command stops the same way: cleanup handlers run, exit code 143."""
+
+    signum = 15
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app, map user errors to exit code 2,
-    Ctrl-C to 130; the exit code of a command (``typer.Exit``) is passed on."""
+    Ctrl-C to 130 and SIGTERM to 143 in every phase (a run that is integrating installs
+    its own handlers and keeps its partial results); the exit code of a command
+    (``typer.Exit``) is passed on."""
+    import signal
+
     args = list(sys.argv[1:] if argv is None else argv)
+    empty = empty_value_message(args)
+    if empty:
+        print_error(empty)
+        sys.exit(USAGE_EXIT)
+    try:
+        signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:  # not the main thread (an embedding application): its own handling applies
+        pass
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")
     click_exit = _types("Exit")
     click_abort = _types("Abort")
     try:
-        rv = app(args=args, prog_name="flexrv", standalone_mode=False)
+        try:
+            rv = app(args=args, prog_name="flexrv", standalone_mode=False)
+        finally:  # a command that failed or was stopped before writing leaves no empty run folder
+            from flexrv.cli._common import remove_unused_outputs
+
+            remove_unused_outputs()
     except FlexrvError as exc:
         print_error(str(exc))
         sys.exit(USAGE_EXIT)
-    except OSError as exc:  # a file the user named cannot be read or written
-        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
-        print_error(f"{exc.strerror or exc}:{where}" if where else f"{exc.strerror or exc}")
+    except OSError as exc:  # a file the user named cannot be read or written (disk full, read-only)
+        where = getattr(exc, "filename", None)
+        print_error(f"{exc.strerror or exc}: {where}" if where else f"{exc.strerror or exc}")
         sys.exit(USAGE_EXIT)
     except (typer.Exit, *click_exit) as exc:
         sys.exit(exc.exit_code)
-    except (typer.Abort, *click_abort, KeyboardInterrupt):
-        sys.exit(130)
+    except (typer.Abort, *click_abort, KeyboardInterrupt) as exc:
+        sys.exit(128 + getattr(exc, "signum", 2))
     except no_args as exc:  # bare `flexrv` / a command given no arguments: help, usage exit code
         print(exc.format_message(), file=sys.stderr)
         sys.exit(USAGE_EXIT)

@@ -188,6 +188,42 @@ def _probe_writable(directory: Path, option: str) -> None:
         raise InputError(f"{option} {directory}: not writable ({d}: {exc.strerror or exc})") from None
 
 
+#: output folders of this process that did not exist before it (the first new ancestor
+#: of each): :func:`remove_unused_outputs` deletes them again if a failed or stopped
+#: command left them empty
+_NEW_OUTPUTS: list[Path] = []
+
+
+def _register_new(path: Path) -> None:
+    top = None
+    d = Path(path).absolute()
+    while not d.exists() and d.parent != d:
+        top, d = d, d.parent
+    if top is not None:
+        _NEW_OUTPUTS.append(top)
+
+
+def remove_unused_outputs() -> list[Path]:
+    """Delete the output folders this process created (:func:`check_output_dir`) that
+    hold no file (a command that failed or was stopped before writing anything leaves
+    no empty run folder). Returns the removed folders."""
+    removed = []
+    for top in _NEW_OUTPUTS:
+        if not top.is_dir():
+            continue
+        dirs = sorted((p for p in top.rglob("*") if p.is_dir()), key=lambda p: -len(p.parts)) + [top]
+        if any(p.is_file() or p.is_symlink() for p in top.rglob("*")):
+            continue
+        for d in dirs:
+            try:
+                d.rmdir()
+                removed.append(d)
+            except OSError:
+                break
+    _NEW_OUTPUTS.clear()
+    return removed
+
+
 def check_output_dir(path: Path, option: str = "--out", overwrite: bool = False, allow_existing: bool = False) -> Path:
     """Check an output directory before any work: it must be a directory (or not
     exist) and be writable; an existing non-empty directory is refused unless
@@ -208,6 +244,7 @@ def check_output_dir(path: Path, option: str = "--out", overwrite: bool = False,
         for png in path.glob("*.png"):
             png.unlink()
     _probe_writable(path, option)
+    _register_new(path)
     return path
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 from pathlib import Path
@@ -10,7 +11,7 @@ from typing import Any, Optional
 import typer
 
 from flexrv.cli._common import JSON_HELP, check_output_file, console, emit, kv_table
-from flexrv.errors import InputError
+from flexrv.errors import ConvergenceError, InputError
 
 PRESET_HELP = (
     "Preset name or design TOML. Without explicit --load-n/--speed-m-s/--rx-m/--ry-m: the main "
@@ -65,6 +66,25 @@ def operating_contact(reducer) -> dict[str, Any]:
     }
 
 
+def check_half_space(case: dict[str, Any]) -> None:
+    """InputError naming the options when the Hertz contact of an explicit case is larger
+    than the radii of curvature that carry it (a semi-axis beyond min(rx, ry)): the
+    half-space theory of Hertz and of the film solver does not describe such a contact
+    (Johnson, Contact Mechanics, sec. 4.1: a << R), so no film is computed."""
+    from flexrv.contact.hertz import point_contact
+
+    pc = point_contact(case["load"], case["rx"], case["ry"], case["e_eff"])
+    a, b = float(pc.a), float(pc.b)
+    overall = max(a, b) / min(case["rx"], case["ry"])
+    if not math.isfinite(overall) or overall > 1.0:
+        raise InputError(
+            f"--load-n {case['load']:g} --rx-m {case['rx']:g} --ry-m {case['ry']:g}: the Hertz contact "
+            f"(semi-axes {a:.3g} m along y, {b:.3g} m along x) is {overall:.3g} times the smaller radius of "
+            "curvature; the half-space theory needs semi-axes <= min(rx, ry) (and <= "
+            f"{HERTZ_SIZE_LIMIT:g} x the radius for physical results): reduce the load or the radius ratio"
+        )
+
+
 def _reduced_modulus(reducer, effective_modulus) -> float:
     ball = reducer.material("rolling_elements")
     ring = reducer.material("bearing_rings")
@@ -94,8 +114,6 @@ def ehl_case(
         missing = [k for k, v in explicit.items() if v is None]
         raise InputError(f"explicit case needs all of --load-n --speed-m-s --rx-m --ry-m; missing {', '.join(missing)}")
     if given:
-        import math
-
         for opt, value in explicit.items():
             if not (math.isfinite(value) and value > 0):
                 raise InputError(f"{opt} {value!r}: must be a finite number > 0")
@@ -107,6 +125,7 @@ def ehl_case(
             "e_eff": _reduced_modulus(reducer, effective_modulus),
         }
         source = f"explicit; materials and lubricant from preset {preset}"
+        check_half_space(case)
     else:
         case = operating_contact(reducer)
         source = (
@@ -131,7 +150,7 @@ def ehl_case(
                 grid_tol=grid_tol,
                 max_grid=max_grid,
             )
-        except (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError) as exc:
+        except (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError, ConvergenceError) as exc:
             raise InputError(
                 f"EHL solve failed for load {case['load']:g} N, speed {case['speed']:g} m/s, "
                 f"rx {case['rx']:g} m, ry {case['ry']:g} m ({type(exc).__name__}: {exc}); the case is "

@@ -9,6 +9,8 @@ import typer
 
 from flexrv.cli._common import JSON_HELP, console, emit, kv_table
 
+FORCE_HELP = "Allow more local workers than the machine has CPU cores."
+
 
 def sweep(
     spec: Path = typer.Argument(..., help="Sweep specification TOML (see flexrv.sweep)."),
@@ -17,21 +19,29 @@ def sweep(
         None, "--scheduler", help="Address of an existing dask scheduler (default: a LocalCluster)."
     ),
     workers: Optional[int] = typer.Option(
-        None, "--workers", min=1, help="LocalCluster worker processes, >= 1 (default: CPU count)."
+        None, "--workers", min=1, help="LocalCluster worker processes, 1 to the CPU count (default: CPU count)."
     ),
     retry_failed: bool = typer.Option(False, "--retry-failed", help="Recompute cases recorded as failed."),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
     """Run a grid/list of design variations of a task; killed sweeps resume where they stopped.
     Exit code 1 if any case failed (recorded in table.csv with its error)."""
     from flexrv.cli._common import check_output_dir
-    from flexrv.sweep import load_spec, run_sweep
+    from flexrv.sweep import check_workers, load_spec, run_sweep
 
+    check_workers(workers, force)
     sweep_spec = load_spec(spec)
     target = out if out is not None else Path("results") / sweep_spec.name
     check_output_dir(target, "--out", allow_existing=True)  # an existing sweep directory is resumed
     summary = run_sweep(
-        sweep_spec, out_dir=target, scheduler=scheduler, n_workers=workers, retry_failed=retry_failed, progress=not json
+        sweep_spec,
+        out_dir=target,
+        scheduler=scheduler,
+        n_workers=workers,
+        retry_failed=retry_failed,
+        progress=not json,
+        force=force,
     )
     data = {
         "out_dir": str(summary.out_dir),

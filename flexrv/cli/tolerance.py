@@ -39,11 +39,12 @@ def tolerance(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Output directory (default results/<design>_tolerance_s<seed>)."
     ),
+    force: bool = typer.Option(False, "--force", help="Allow more local workers than the machine has CPU cores."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
     """Distribution of TE p-p, mean TE, lost motion, backlash and rigidity over a batch drawn from the
     tolerances; yield against --spec with its confidence interval; sensitivities and a what-if table.
-    A killed study resumes where it stopped (same command)."""
+    A killed study resumes where it stopped (same command). Exit code 1 if any evaluation failed."""
     from flexrv.errors import InputError
     from flexrv.studies.tolerance import DEFAULT_RESOLUTION, StudyConfig, run_study
 
@@ -68,6 +69,7 @@ def tolerance(
         out=str(out) if out else None,
         what_if_samples=what_if_samples,
         resolution=res,
+        force=force,
     )
     result = run_study(cfg, progress=not json)
     data = {
@@ -103,7 +105,8 @@ def tolerance(
             for k, p in d["percentiles"].items()
             if p.get("n")
         ]
-        console.print(kv_table("distribution", prow))
+        if prow:
+            console.print(kv_table("distribution", prow))
         y = d["yield"]
         if y and y["yield"] is not None:
             console.print(
@@ -128,6 +131,14 @@ def tolerance(
         )
 
     emit(data, json, render)
+    if result["failed"]:
+        from flexrv.cli import print_error
+
+        print_error(
+            f"{result['failed']} of {result['evaluations']} evaluations failed "
+            f"(see the error of each in {Path(result['output_dir']) / 'runs' / 'table.csv'})"
+        )
+        raise typer.Exit(1)
 
 
 def register(app: typer.Typer) -> None:

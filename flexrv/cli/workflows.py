@@ -89,6 +89,11 @@ def report(
     from flexrv.workflows._common import SMOKE_SUFFIX, collect_report, is_workflow_summary, results_root
 
     root = Path(results) if results else results_root()
+    if results is not None and not root.is_dir():
+        from flexrv.errors import InputError
+
+        what = "is not a directory" if root.exists() else "does not exist"
+        raise InputError(f"--results {root}: {what}; give the folder the workflows wrote into")
     path = collect_report(root, smoke=smoke)
     data = {
         "path": str(path),

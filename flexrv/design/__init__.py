@@ -32,6 +32,7 @@ __all__ = [
     "override",
     "apply_overrides",
     "read_text_file",
+    "parse_toml",
 ]
 
 _PRESET_PACKAGE = "flexrv.design.presets"
@@ -60,6 +61,10 @@ def load(preset_or_path: str | Path | Reducer) -> Reducer:
     if isinstance(preset_or_path, Reducer):
         return preset_or_path
     text_name = str(preset_or_path)
+    if not text_name.strip():
+        raise ConfigError(
+            f"design {text_name!r} is empty: give a preset name {list_presets()} or a path to a .toml file"
+        )
     path = Path(text_name)
     if text_name in list_presets():
         path = preset_path(text_name)
@@ -95,11 +100,88 @@ def read_text_file(path: str | Path, what: str) -> str:
 
 def loads(text: str, source: str = "<string>") -> Reducer:
     """Parse and validate a design from TOML text."""
+    return from_dict(parse_toml(text, source), source=source)
+
+
+#: deepest nesting a flexrv TOML file may have (arrays, inline tables, dotted keys and
+#: table headers counted alike): the design has 4 levels, a sweep spec or a tolerance
+#: table 5; the parser recurses once per level, so a deeper file is refused before parsing
+MAX_TOML_DEPTH = 32
+#: largest flexrv TOML file [characters] (the largest preset is ~12 kB)
+MAX_TOML_CHARS = 2_000_000
+
+
+def toml_depth(text: str) -> int:
+    """Deepest nesting of ``text`` read as TOML without parsing it: brackets and braces
+    outside strings and comments, plus the parts of a dotted key or table header.
+    A cheap upper bound of what the parser would recurse into."""
+    depth = deepest = 0
+    i, n = 0, len(text)
+    key_parts, at_line_start = 1, True
+    while i < n:
+        c = text[i]
+        if c in "\"'":
+            triple = text.startswith(c * 3, i)
+            end_tok = c * 3 if triple else c
+            j = i + len(end_tok)
+            while j < n and not text.startswith(end_tok, j):
+                j += 2 if (c == '"' and text[j] == "\\") else 1
+                if not triple and j < n and text[j] == "\n":
+                    break
+            i = j + len(end_tok)
+            continue
+        if c == "#":
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+            continue
+        if c == "\n":
+            at_line_start, key_parts = True, 1
+        elif c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth = max(depth - 1, 0)
+        elif c == ".":
+            key_parts += 1
+        elif c == "=":
+            at_line_start = False
+        deepest = max(deepest, depth + (key_parts - 1 if at_line_start else 0))
+        i += 1
+    return deepest
+
+
+def parse_toml(text: str, source: str = "<string>") -> dict[str, Any]:
+    """Parse flexrv TOML text; ConfigError naming ``source`` for invalid TOML, a file
+    nested deeper than :data:`MAX_TOML_DEPTH` or larger than :data:`MAX_TOML_CHARS`
+    (both refused before parsing), and a key given twice (named, with its line)."""
+    if len(text) > MAX_TOML_CHARS:
+        raise ConfigError(f"{source}: {len(text)} characters; a flexrv TOML file may have at most {MAX_TOML_CHARS}")
+    depth = toml_depth(text)
+    if depth > MAX_TOML_DEPTH:
+        raise ConfigError(
+            f"{source}: nested {depth} levels deep (arrays, tables or dotted keys); "
+            f"a flexrv TOML file may nest at most {MAX_TOML_DEPTH} levels"
+        )
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: invalid TOML: {exc}") from None
-    return from_dict(data, source=source)
+        raise ConfigError(f"{source}: invalid TOML: {_toml_message(exc, text)}") from None
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply to parse") from None
+
+
+def _toml_message(exc: Exception, text: str) -> str:
+    """tomllib's message, with the key named where it says a value is given twice."""
+    import re
+
+    msg = str(exc)
+    m = re.search(r"\(at line (\d+), column \d+\)", msg)
+    if m and ("overwrite" in msg or "twice" in msg):
+        lines = text.splitlines()
+        k = int(m.group(1)) - 1
+        line = lines[k].strip() if 0 <= k < len(lines) else ""
+        key = line.split("=", 1)[0].strip() if "=" in line else line.strip("[] ")
+        return f"key {key!r} is defined twice (line {k + 1}: {line[:80]!r}); each key may appear once"
+    return msg
 
 
 def from_dict(data: dict[str, Any], source: str = "<dict>") -> Reducer:
@@ -258,6 +340,9 @@ def format_validation_error(exc: ValidationError, source: str) -> str:
             text = f"  {field} = {shown!r}: {err['msg']}"
             if rng:
                 text += f" (allowed: {rng})"
+            why = (getattr(info, "json_schema_extra", None) or {}).get("floor_reason")
+            if why and kind in ("greater_than", "greater_than_equal"):
+                text += f": {why}"
             lines.append(text)
     return "\n".join(lines)
 
@@ -284,7 +369,6 @@ def read_named_table(name_or_path: str, folder: str, table: str, what: str) -> d
     name) or of any TOML file (by path), as a plain dict; ConfigError naming the
     file for a missing file, an unreadable one or one without the table. ``what``
     names the kind of file in the messages (e.g. "error set")."""
-    import tomllib
     from pathlib import Path
 
     text_name = str(name_or_path)
@@ -299,10 +383,7 @@ def read_named_table(name_or_path: str, folder: str, table: str, what: str) -> d
             if p.name.endswith(".toml")
         )
         raise ConfigError(f"unknown {what} {text_name!r}: choose one of {known} or give a TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot read {what} {str(path)!r}: {exc}") from None
+    data = parse_toml(read_text_file(path, what), str(path))
     if not isinstance(data.get(table), dict):
         raise ConfigError(f"{what} {str(path)!r} has no [{table}] table")
     return data[table]

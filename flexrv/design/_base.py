@@ -22,3 +22,9 @@ def _bad(field: str, value, allowed: str, why: str = "") -> ValueError:
     if why:
         msg += f" ({why})"
     return ValueError(msg)
+
+
+def floor(why: str) -> dict:
+    """Field metadata of a physical lower bound: the reason, printed with the bound when a
+    value falls below it (``Field(ge=1.0, json_schema_extra=floor("..."))``)."""
+    return {"floor_reason": why}

@@ -13,11 +13,11 @@ message naming the field, the value and the allowed range.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import Field, model_serializer, model_validator
+from pydantic import Field, field_validator, model_serializer, model_validator
 
-from flexrv.design._base import _bad, _Strict
+from flexrv.design._base import _bad, _Strict, floor
 from flexrv.units import M_PER_UM, RAD_PER_DEG
 
 #: allowed transverse contact ratio of the first stage: below 1 the mesh loses
@@ -38,7 +38,12 @@ class FirstStage(_Strict):
     pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="Pressure angle alpha_n [deg]")
     sun_profile_shift: float = Field(ge=-1.0, le=1.5, description="Sun profile shift coefficient x_1 [-]")
     planet_profile_shift: float = Field(ge=-1.5, le=1.5, description="Planet profile shift coefficient x_2 [-]")
-    face_width_mm: float = Field(gt=0.0, le=200.0, description="Common face width b [mm]")
+    face_width_mm: float = Field(
+        ge=1.0,
+        le=200.0,
+        description="Common face width b [mm]",
+        json_schema_extra=floor("a gear face narrower than 1 mm carries no load and cannot be meshed"),
+    )
     n_planets: int = Field(ge=2, le=6, description="Number of planets = crankshafts [-]")
     backlash_um: float = Field(ge=0.0, le=500.0, description="Circumferential backlash on the pitch circle [um]")
     mesh_damping_ratio: float = Field(ge=0.0, le=0.5, description="Mesh damping ratio xi_12 [-]")
@@ -789,12 +794,29 @@ class Lubricant(_Strict):
         return self.pressure_viscosity_1_per_GPa * 1e-9
 
 
+#: reason of the lower bounds of the mass properties
+_LIGHT = (
+    "lighter than %s: the member's frequency on its contact stiffness would exceed what the "
+    "implicit integrator converges on at the time steps flexrv uses"
+)
+
+
 class Inertia(_Strict):
     """Mass properties not derivable from the modelled geometry."""
 
-    input_shaft_inertia_kg_m2: float = Field(gt=0.0, le=10.0, description="Input shaft + sun about its axis")
-    carrier_mass_kg: float = Field(gt=0.0, le=1000.0)
-    carrier_inertia_kg_m2: float = Field(gt=0.0, le=100.0, description="Carrier + output flange about the axis")
+    input_shaft_inertia_kg_m2: float = Field(
+        ge=1e-7,
+        le=10.0,
+        description="Input shaft + sun about its axis",
+        json_schema_extra=floor(_LIGHT % "a steel shaft of 5 mm diameter and 20 mm length (1e-7 kg m2)"),
+    )
+    carrier_mass_kg: float = Field(ge=0.01, le=1000.0, json_schema_extra=floor(_LIGHT % "a 10 g carrier (0.01 kg)"))
+    carrier_inertia_kg_m2: float = Field(
+        ge=1e-6,
+        le=100.0,
+        description="Carrier + output flange about the axis",
+        json_schema_extra=floor(_LIGHT % "a 10 g carrier of 20 mm radius (1e-6 kg m2)"),
+    )
 
 
 class ContactSettings(_Strict):
@@ -848,7 +870,15 @@ class OperatingPoint(_Strict):
     load_torque_Nm: float = Field(ge=-1e5, le=1e5, description="Load torque on the output")
     load_ramp_start_s: float = Field(ge=0.0, le=100.0)
     load_ramp_end_s: float = Field(ge=0.0, le=100.0)
-    rated_torque_Nm: float = Field(gt=0.0, le=1e5, description="Rated output torque (stiffness test range)")
+    rated_torque_Nm: float = Field(
+        ge=1.0,
+        le=1e5,
+        description="Rated output torque (stiffness test range)",
+        json_schema_extra=floor(
+            "the smallest cycloidal drives are rated at a few N m; the no-load and lost-motion torques are "
+            "fractions of the rated torque and would fall below the contact laws' force resolution"
+        ),
+    )
     external_axial_force_N: float = Field(ge=-1e6, le=1e6)
     external_radial_force_N: float = Field(ge=-1e6, le=1e6)
     tilting_moment_Nm: float = Field(ge=-1e6, le=1e6)
@@ -924,6 +954,31 @@ def field_value(reducer, path: str):
 
 # --------------------------------------------------------------------------- reducer
 from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
+
+
+def _names_field(model: type, dotted: str) -> bool:
+    """Whether ``dotted`` (``"first_stage.module_mm"``, ``"materials.steel.poisson_ratio"``)
+    names a field of the pydantic ``model`` (optional tables and fields included)."""
+    import typing
+
+    parts = dotted.split(".")
+    current: Any = model
+    i = 0
+    while i < len(parts):
+        fields = getattr(current, "model_fields", None)
+        if not fields or parts[i] not in fields:
+            return False
+        ann = fields[parts[i]].annotation
+        i += 1
+        args = [a for a in typing.get_args(ann) if a is not type(None)]
+        if typing.get_origin(ann) is dict:  # dict[str, Model]: a free key, then the model's fields
+            if i == len(parts):
+                return True
+            i += 1
+            current = args[-1]
+        else:
+            current = next((a for a in args if hasattr(a, "model_fields")), ann)
+    return True
 
 
 class Reducer(_Strict):
@@ -1002,6 +1057,31 @@ class Reducer(_Strict):
                 raise _bad(f"ranges.{path!r}", value, "must name a numeric field of the design")
             if not r.low < r.high:
                 raise _bad(f"ranges.{path!r}", [r.low, r.high], "must have low < high")
+        return self
+
+    @field_validator("name")
+    @classmethod
+    def _printable_name(cls, value: str) -> str:
+        bad = [c for c in value if not c.isprintable()]
+        if bad or not value.strip():
+            raise _bad(
+                "name",
+                value,
+                "must be printable text, not blank (no newline, tab or control characters)",
+                "the name appears in file names, table titles and result attributes",
+            )
+        return value
+
+    @model_validator(mode="after")
+    def _known_provenance(self) -> "Reducer":
+        unknown = [k for k in self.provenance if not _names_field(type(self), k)]
+        if unknown:
+            raise _bad(
+                "provenance",
+                unknown[0],
+                f"{len(unknown)} of {len(self.provenance)} provenance key(s) name no field of the design "
+                f"(first: {unknown[0][:80]!r}); each key is the dotted path of a field, e.g. 'first_stage.module_mm'",
+            )
         return self
 
     @model_validator(mode="after")

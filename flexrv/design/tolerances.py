@@ -64,7 +64,6 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -271,7 +270,7 @@ def _entry(key: str, raw: Any, info: FieldInfo) -> Tolerance:
     u = info.unit
     for k in list(data):
         m = re.match(r"^(sigma|band|mean)_(\w+)$", k)
-        if m:
+        if m and k != "sigma_fraction":
             if m.group(2) != u:
                 raise ConfigError(f"{where}.{k}: wrong unit for this field: use {m.group(1)}_{u}")
             val = data.pop(k)
@@ -395,9 +394,8 @@ def design_tolerance_table(path: str | Path) -> tuple[dict | None, dict | None]:
     p = Path(str(path))
     if not p.is_file():
         return None, None
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot read design file {str(p)!r}: {exc}") from None
+    from flexrv.design import parse_toml, read_text_file
+
+    data = parse_toml(read_text_file(p, "design file"), str(p))
     table = data.pop("tolerances", None)
     return (table, data) if table is not None else (None, None)

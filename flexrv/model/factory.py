@@ -336,10 +336,15 @@ def parse_parts(parts) -> tuple[str, ...]:
     """Validate a list (or comma-separated string) of flexible part names; ``none``
     alone: no elastic part (every body rigid)."""
     if isinstance(parts, str):
-        parts = [p.strip() for p in parts.split(",") if p.strip()]
+        parts = [p.strip() for p in parts.split(",")] if parts.strip() else []
     parts = tuple(parts)
     if parts == ("none",):
         return ()
+    if "" in parts:
+        raise ConfigError(f"parts = {','.join(parts)!r} is not allowed: an empty part name (stray comma)")
+    twice = sorted({p for p in parts if parts.count(p) > 1})
+    if twice:
+        raise ConfigError(f"parts = {','.join(parts)} is not allowed: {', '.join(twice)} given twice")
     bad = [p for p in parts if p not in FLEXIBLE_PARTS]
     if bad or not parts:
         raise ConfigError(

@@ -1,10 +1,13 @@
 """First-run notice for the numba kernels.
 
 The hot kernels (closest point of the pin gap, the impact law, the ball-bearing row)
-are compiled by numba on their first call and cached on disk (``cache=True``; the
-folder is numba's default ``__pycache__`` next to the sources, or ``NUMBA_CACHE_DIR``).
-The first run of a fresh install therefore spends most of its time compiling, with
-no progress: :func:`announce_compile` prints one line before that happens.
+are compiled by numba on their first call and cached on disk (``cache=True``) in
+``NUMBA_CACHE_DIR``, which flexrv sets to ``<user cache>/flexrv/numba/<version>``
+(:func:`flexrv.cache.numba_cache_dir`; a damaged entry is discarded and compiled
+again, :func:`flexrv.cache.guard_numba_cache`). The first run of a fresh install
+therefore spends most of its time compiling, with no progress:
+:func:`announce_compile` prints one short line before that happens. Ctrl-C or
+SIGTERM during the compilation end the run at once (:func:`stop_now`).
 
 Measured (``benchmarks/bench_first_run.py``: ``flexrv simulate rv40e --t-end 0.01``,
 fresh ``NUMBA_CACHE_DIR``, 2 shared cores, numba 0.68, after the force groups became
@@ -64,14 +67,29 @@ def uncached_kernels(modules: dict | None = None) -> list[str]:
 
 
 def cache_dir() -> str:
-    """Where numba writes its cache (``NUMBA_CACHE_DIR`` or ``__pycache__`` beside the sources)."""
-    return os.environ.get("NUMBA_CACHE_DIR") or str(Path(__file__).resolve().parents[1] / "**" / "__pycache__")
+    """Where numba writes its cache (``NUMBA_CACHE_DIR``, set by flexrv at import)."""
+    from flexrv.cache import numba_cache_dir
+
+    return str(numba_cache_dir())
+
+
+def stop_now(signum: int) -> None:
+    """End the process at once with exit code 128 + ``signum`` (130 Ctrl-C, 143 SIGTERM),
+    after flushing stdout and stderr: for a signal that arrives before a run has
+    integrated its first step (numba compiling its kernels for a minute holds the run
+    in that step), when there are no partial results to keep."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(128 + int(signum))
 
 
 def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bool:
-    """Print ``flexrv: compiling numba kernels (once, ~15 s) ...`` on stderr if a kernel
-    the run calls (:data:`RUN_ENTRY_POINTS` of ``kinds``, default all) is not cached yet;
-    returns whether it printed."""
+    """Print one short line, ``flexrv: compiling numba kernels (once, ~15 s or more; ...)``, on
+    stderr if a kernel the run calls (:data:`RUN_ENTRY_POINTS` of ``kinds``, default all)
+    is not cached yet; returns whether it printed."""
     missing = uncached_kernels(modules)
     kinds = RUN_ENTRY_POINTS if kinds is None else kinds
     entries = {name for kind in kinds for name in RUN_ENTRY_POINTS[kind]}
@@ -80,8 +98,7 @@ def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bo
         return False
     stream = sys.stderr if stream is None else stream
     print(
-        f"flexrv: compiling numba kernels (once, ~{COMPILE_ESTIMATE_S} s; cached afterwards in {cache_dir()}): "
-        f"{', '.join(missing)}",
+        f"flexrv: compiling numba kernels (once, ~{COMPILE_ESTIMATE_S} s or more; cached in {cache_dir()})",
         file=stream,
         flush=True,
     )

@@ -626,10 +626,15 @@ def loaded_te(
     rated = op.rated_torque_Nm
     if torque is None:
         torque = rated
-    if not (math.isfinite(torque) and 0 < torque <= 3.0 * rated):
-        raise InputError(f"torque = {torque!r} N m is not allowed: must lie in (0, 3 x rated = {3 * rated:g}] N m")
     if not (0 < no_load_fraction <= 0.03):
         raise InputError(f"no_load_fraction = {no_load_fraction!r} is not allowed: must lie in (0, 0.03]")
+    t_min = no_load_fraction * rated
+    if not (math.isfinite(torque) and t_min <= torque <= 3.0 * rated):
+        raise InputError(
+            f"torque = {torque!r} N m is not allowed: must lie in [{t_min:g}, {3 * rated:g}] N m: at least the "
+            f"no-load torque ({no_load_fraction:g} x rated), against which the loaded TE is measured, and at most "
+            "3 x rated, beyond which the Hertz laws leave their range"
+        )
     angles = positions_for(reducer, output_revolutions, crank_revolutions, points_per_mesh)
     sm = StaticModel(reducer, options)
     t_start = _time.perf_counter()

@@ -89,6 +89,11 @@ def te_dataset(result, reducer) -> xr.Dataset:
     return ds
 
 
+#: fewest positions of a TE spectrum: below, the DFT has fewer than four orders and no
+#: line can be told from its neighbours (a run that short gets its summary without a spectrum)
+MIN_SPECTRUM_POSITIONS = 8
+
+
 def order_spectrum(te_arcsec: np.ndarray, output_revolutions: float):
     """Amplitude spectrum of TE sampled uniformly over ``output_revolutions``.
 
@@ -100,7 +105,7 @@ def order_spectrum(te_arcsec: np.ndarray, output_revolutions: float):
     """
     x = np.asarray(te_arcsec, dtype=float)
     n = len(x)
-    if n < 8:
+    if n < MIN_SPECTRUM_POSITIONS:
         return np.zeros(0), np.zeros(0)
     x = x - x.mean()
     whole = abs(output_revolutions - round(output_revolutions)) < 1e-9 and round(output_revolutions) >= 1
@@ -215,6 +220,11 @@ def te_summary(ds: xr.Dataset) -> dict:
     order, amp = order_spectrum(ds["te"].values, revs)
     s["spectrum_lines"] = spectrum_lines(order, amp, json.loads(ds.attrs["orders"]))
     s["spectral_resolution_orders"] = float(order[1] - order[0]) if len(order) > 1 else None
+    if len(order) < 2:
+        s["spectrum_note"] = (
+            f"no TE spectrum: {n} positions, a spectrum needs at least {MIN_SPECTRUM_POSITIONS} "
+            "(a longer range or more points per mesh period)"
+        )
     s["output_revolutions"] = revs
     for name, key in (
         ("pin_force", "max_pin_force_N"),
@@ -284,17 +294,18 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
         ]
         for name, share in sorted(budget.items(), key=lambda kv: -kv[1]):
             lines.append(f"| {name.replace('_', ' ')} | {share:.1f} |")
-    lines += [
-        "",
-        "## Largest TE spectrum lines (orders of the output rotation)",
-        "",
-        f"Resolution {s['spectral_resolution_orders']:.3g} orders.",
-        "",
-        "| order | amplitude [arcsec] | nearest characteristic order |",
-        "|---|---|---|",
-    ]
-    for line in s["spectrum_lines"]:
-        lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
+    lines += ["", "## Largest TE spectrum lines (orders of the output rotation)", ""]
+    if s.get("spectral_resolution_orders") is None:
+        lines.append(s.get("spectrum_note", "no TE spectrum") + ".")
+    else:
+        lines += [
+            f"Resolution {s['spectral_resolution_orders']:.3g} orders.",
+            "",
+            "| order | amplitude [arcsec] | nearest characteristic order |",
+            "|---|---|---|",
+        ]
+        for line in s["spectrum_lines"]:
+            lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
     lines += [
         "",
         f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; every "

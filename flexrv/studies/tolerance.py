@@ -105,7 +105,6 @@ import json
 import math
 import os
 import re
-import socket
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -560,30 +559,22 @@ class StudyConfig:
     #: tolerance entries of the what-if table (None: every entry; cost 2 M per entry)
     what_if_entries: list[str] | None = None
     resolution: dict[str, Any] = field(default_factory=lambda: dict(DEFAULT_RESOLUTION))
-
-
-def check_scheduler(address: str, timeout: float = 3.0) -> None:
-    """InputError within ``timeout`` seconds if nothing listens at a scheduler address."""
-    m = re.match(r"^(?:(tcp|tls)://)?\[?([^\]/]+?)\]?:(\d+)/?$", address.strip())
-    if not m:
-        raise InputError(f"--scheduler {address!r}: expected an address like tcp://127.0.0.1:8786")
-    host, port = m.group(2), int(m.group(3))
-    try:
-        with socket.create_connection((host, port), timeout=timeout):
-            pass
-    except OSError as exc:
-        raise InputError(f"--scheduler {address!r}: no dask scheduler reachable ({exc})") from None
+    #: allow more local workers than the machine has cores
+    force: bool = False
 
 
 def _validate(cfg: StudyConfig) -> list[Spec]:
-    if not isinstance(cfg.samples, int) or cfg.samples < 1 or cfg.samples > 10_000_000:
-        raise InputError(f"--samples {cfg.samples!r}: must be an integer >= 1")
+    from flexrv.sweep import MAX_CASES, check_scheduler, check_workers
+
+    if isinstance(cfg.samples, bool) or not isinstance(cfg.samples, int) or not 1 <= cfg.samples <= MAX_CASES:
+        raise InputError(
+            f"--samples {cfg.samples!r}: must be an integer from 1 to {MAX_CASES} (the most cases one sweep may run)"
+        )
     if cfg.sobol and cfg.samples < 2:
         raise InputError(f"--samples {cfg.samples}: a Saltelli design needs at least 2 base samples")
     if cfg.sampler not in ("random", "sobol", "lhs"):
         raise InputError(f"--sampler {cfg.sampler!r}: allowed random, sobol, lhs")
-    if cfg.workers is not None and cfg.workers < 1:
-        raise InputError(f"--workers {cfg.workers}: must be >= 1")
+    check_workers(cfg.workers, cfg.force)
     if cfg.what_if_samples < 0:
         raise InputError(f"--what-if-samples {cfg.what_if_samples}: must be >= 0")
     if cfg.what_if_entries is not None and not isinstance(cfg.what_if_entries, (list, tuple)):
@@ -661,15 +652,30 @@ def plan_cases(cfg: StudyConfig, reducer, tol) -> tuple[TolerancePlan, dict[str,
 def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     """Run (or resume) a tolerance study; returns the summary dict (also written
     to ``<out>/summary.json``)."""
-    from flexrv.cache import atomic_write_text
-    from flexrv.sweep import SweepSpec, build_cases, run_sweep
 
     specs = _validate(cfg)
     reducer, tol, design_data = load_design_and_tolerances(cfg.design, cfg.tolerances)
     out = Path(cfg.out) if cfg.out else Path("results") / f"{Path(cfg.design).stem}_tolerance_s{cfg.seed}"
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is an existing file: give a directory")
+    created = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
+    try:
+        return _run_in(out, cfg, specs, reducer, tol, design_data, progress)
+    except BaseException:
+        # a study refused (or stopped) before its first evaluation leaves no folder behind
+        if created and not any((out / "runs" / "cases").glob("*.json")):
+            import shutil
+
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+
+
+def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progress: bool) -> dict[str, Any]:
+    """The body of :func:`run_study` once the output folder exists."""
+    from flexrv.cache import atomic_write_text
+    from flexrv.sweep import SweepSpec, build_cases, run_sweep
+
     res = {**DEFAULT_RESOLUTION, **cfg.resolution}
     from flexrv.model.quasi_static import positions_for
 
@@ -698,7 +704,13 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     t0 = time.perf_counter()
     workers = cfg.workers or min(2, os.cpu_count() or 1)
     summary_sweep = run_sweep(
-        spec, out_dir=out / "runs", scheduler=cfg.scheduler, n_workers=workers, progress=progress, plots=False
+        spec,
+        out_dir=out / "runs",
+        scheduler=cfg.scheduler,
+        n_workers=workers,
+        progress=progress,
+        plots=False,
+        force=cfg.force,
     )  # the study draws its own figures
     wall = time.perf_counter() - t0
     ids = [c.case_id for c in build_cases(spec)]
@@ -878,7 +890,11 @@ def _write_outputs(out: Path, cfg, plan, parts, y, status, ids, specs, result) -
     )
     with atomic_path(out / "samples.nc") as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
-    plots = [_histograms(out, y, specs), _tornado(out, result)]
+    # no figure of a study without one successful sample (an empty histogram says nothing)
+    plots = [_histograms(out, y, specs), _tornado(out, result)] if np.isfinite(y).any() else []
+    for stale in ("histograms.png", "tornado.png"):
+        if not plots:
+            (out / stale).unlink(missing_ok=True)
     result["plots"] = [str(p) for p in plots if p]
     atomic_write_text(out / "summary.md", _markdown(result))
 

@@ -204,8 +204,9 @@ def plot_pin_force_map(ds, path) -> Path:
 def te_plots(ds, summary: dict, directory) -> list[Path]:
     """All three plots into ``directory``."""
     d = Path(directory)
+    spectrum = summary.get("spectral_resolution_orders") is not None  # a run too short has none
     return [
         plot_te_curve(ds, d / "te.png"),
-        plot_te_spectrum(ds, summary, d / "te_spectrum.png"),
+        *([plot_te_spectrum(ds, summary, d / "te_spectrum.png")] if spectrum else []),
         plot_pin_force_map(ds, d / "pin_forces.png"),
     ]
