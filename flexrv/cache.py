@@ -9,7 +9,9 @@ crash never leaves a half-written file under the final name.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
+import hmac
 import json
 import math
 import os
@@ -74,17 +76,22 @@ def flexrv_version() -> str:
 def library_versions(*names: str) -> dict[str, str]:
     """Installed versions of the named distributions, and always flexrv's own
     version (part of every cache key: a new flexrv never serves an old entry)."""
+    return {"flexrv": flexrv_version(), **dict(_distribution_versions(tuple(n for n in names if n != "flexrv")))}
+
+
+@functools.lru_cache(maxsize=None)
+def _distribution_versions(names: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
+    """(name, version) of installed distributions, read once per process (package
+    metadata does not change under a running process; reading it costs milliseconds)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    out = {"flexrv": flexrv_version()}
+    out = []
     for name in names:
-        if name == "flexrv":
-            continue
         try:
-            out[name] = version(name)
+            out.append((name, version(name)))
         except PackageNotFoundError:
-            out[name] = "absent"
-    return out
+            out.append((name, "absent"))
+    return tuple(out)
 
 
 def content_hash(*parts: Any, length: int = 16) -> str:
@@ -259,17 +266,64 @@ def _stamp_path(path: Path) -> Path:
     return path.with_name(path.name + STAMP_SUFFIX)
 
 
+#: name of the cache's signing key (random, per cache folder): stamps carry an HMAC made with it
+SIGNING_KEY_NAME = "signing.key"
+_KEY_BYTES = 32
+
+
+def _signing_key() -> bytes:
+    """The cache folder's secret signing key, created on first use (O_EXCL, mode 0600).
+    A damaged key is replaced: every entry signed with the old one is then rebuilt."""
+    path = cache_dir() / SIGNING_KEY_NAME
+    for _ in range(3):
+        try:
+            data = path.read_bytes()
+            if len(data) == _KEY_BYTES:
+                return data
+            path.unlink(missing_ok=True)  # damaged: a new key, the entries it signed are rebuilt
+        except FileNotFoundError:
+            pass
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except FileExistsError:
+            continue  # another process is writing it: read it on the next pass
+        try:
+            os.write(fd, os.urandom(_KEY_BYTES))
+        finally:
+            os.close(fd)
+    data = path.read_bytes()
+    if len(data) != _KEY_BYTES:
+        raise OSError(f"cache signing key {path} could not be created")
+    return data
+
+
+def _signature(key: str, size: int, sha256: str, version: str) -> str:
+    """HMAC-SHA256 of an entry's key, size, content hash and flexrv version under the
+    cache's signing key: a file whose stamp was rewritten to match altered content
+    (or copied from another cache) does not carry it."""
+    message = "\0".join((key, str(size), sha256, version)).encode()
+    return hmac.new(_signing_key(), message, hashlib.sha256).hexdigest()
+
+
 def stamp_entry(paths, key: str) -> None:
-    """Record, next to each file of a freshly written cache entry, the entry's key
-    and the file's size and sha256 (read back by :func:`entry_problem`)."""
+    """Record, next to each file of a freshly written cache entry, the entry's key,
+    the file's size and sha256, and their signature (read back by :func:`entry_problem`)."""
     for path in map(Path, paths):
-        stamp = {"key": key, "size": path.stat().st_size, "sha256": _sha256(path), "flexrv": flexrv_version()}
+        size, sha, version = path.stat().st_size, _sha256(path), flexrv_version()
+        stamp = {
+            "key": key,
+            "size": size,
+            "sha256": sha,
+            "flexrv": version,
+            "signature": _signature(key, size, sha, version),
+        }
         atomic_write_text(_stamp_path(path), json.dumps(stamp))
 
 
 def entry_problem(paths, key: str) -> str | None:
     """None if every file of a cache entry exists and matches its stamp (same key,
-    size and sha256); otherwise why not ("missing" if no file exists at all)."""
+    size and sha256, signed with this cache's key); otherwise why not ("missing" if
+    no file exists at all)."""
     paths = [Path(p) for p in paths]
     if not any(p.exists() for p in paths):
         return "missing"
@@ -281,13 +335,17 @@ def entry_problem(paths, key: str) -> str | None:
             stamp = json.loads(stamp_file.read_text())
         except (OSError, ValueError):
             return f"{path.name} has no valid stamp (written by an older flexrv or interrupted)"
-        if stamp.get("key") != key:
-            return f"{path.name} belongs to another key ({stamp.get('key')!r})"
+        if not isinstance(stamp, dict) or stamp.get("key") != key:
+            return f"{path.name} belongs to another key ({stamp.get('key') if isinstance(stamp, dict) else None!r})"
         size = path.stat().st_size
         if size != stamp.get("size"):
             return f"{path.name} is truncated or altered ({size} bytes, {stamp.get('size')} expected)"
-        if _sha256(path) != stamp.get("sha256"):
+        sha = _sha256(path)
+        if sha != stamp.get("sha256"):
             return f"{path.name} content does not match its hash"
+        expected = _signature(key, size, sha, str(stamp.get("flexrv")))
+        if not hmac.compare_digest(str(stamp.get("signature", "")), expected):
+            return f"{path.name} was not written by this cache (its stamp's signature does not match)"
     return None
 
 

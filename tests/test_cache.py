@@ -1,5 +1,5 @@
-"""Caches that heal: every entry is stamped with its key, size and sha256 and
-verified on read; a truncated, emptied, altered or foreign entry is rebuilt with a
+"""Caches that heal: every entry is stamped with its key, size and sha256 (signed with the
+cache's own key) and verified on read; a truncated, emptied, altered or foreign entry is rebuilt with a
 one-line notice; keys include flexrv's version; concurrent builders of one entry
 build it once. Atomic writes respect the umask and clean stale temp files."""
 
@@ -82,6 +82,48 @@ def test_corrupt_entries_are_rebuilt_with_a_notice(cache_root, capsys):
     assert cached_entry([path], "k2", load, _counting_build(path, counter, 7.0)) == (7.0, False)
     assert "another key" in capsys.readouterr().err
     assert counter.read_text() == "x" * 5
+
+
+def test_altered_entry_with_a_matching_stamp_is_rebuilt(cache_root, capsys):
+    """Provenance, not only integrity: an entry whose file was altered AND whose stamp
+    was rewritten with the altered file's size and sha256 (a forger without the cache's
+    signing key, or an entry copied from another cache) is refused and rebuilt; the
+    signing key is private to its folder (mode 0600) and a damaged key only forces
+    rebuilds."""
+    import hashlib
+
+    path = cache_dir() / "entry.json"
+    counter = cache_root / "count"
+    load = lambda: json.loads(path.read_text())["value"]  # noqa: E731
+    build = _counting_build(path, counter, 1.5)
+    assert cached_entry([path], "k1", load, build) == (1.5, False)
+    key_file = cache_dir() / cache.SIGNING_KEY_NAME
+    assert key_file.stat().st_mode & 0o777 == 0o600 and len(key_file.read_bytes()) == 32
+    path.write_text(json.dumps({"value": 9.5}))
+    stamp_file = path.with_name(path.name + cache.STAMP_SUFFIX)
+    stamp = json.loads(stamp_file.read_text())
+    data = path.read_bytes()
+    stamp.update(size=len(data), sha256=hashlib.sha256(data).hexdigest())
+    stamp_file.write_text(json.dumps(stamp))
+    assert cache.entry_problem([path], "k1") is not None and "signature" in cache.entry_problem([path], "k1")
+    assert cached_entry([path], "k1", load, build) == (1.5, False)
+    assert "signature" in capsys.readouterr().err
+    assert cached_entry([path], "k1", load, build) == (1.5, True)
+    key_file.write_bytes(b"short")  # damaged key: replaced, the entry it signed is rebuilt once
+    assert cached_entry([path], "k1", load, build) == (1.5, False)
+    assert cached_entry([path], "k1", load, build) == (1.5, True)
+    assert counter.read_text() == "x" * 3
+
+
+def test_library_versions_read_once(monkeypatch):
+    """Package metadata is read once per process: the second call reads nothing."""
+    import importlib.metadata as md
+
+    library_versions("numpy", "scipy")
+    calls = []
+    monkeypatch.setattr(md, "version", lambda name: calls.append(name) or "0")
+    v = library_versions("numpy", "scipy")
+    assert calls == [] and v["numpy"] == np.__version__ and v["flexrv"] == flexrv.__version__
 
 
 def test_truncated_mesh_files_rebuilt(cache_root, capsys):
