@@ -56,6 +56,7 @@ def _options(
 #: Command modules; each defines ``register(app)``. A module that is not present
 #: (capability not installed yet) is skipped.
 _COMMAND_MODULES = ("design", "ehl", "mesh", "simulate", "te", "compare", "view", "sweep", "tolerance", "workflows")
+_COMMAND_MODULES += ("measured", "validate", "calibrate")
 
 for _name in _COMMAND_MODULES:
     try:

@@ -203,6 +203,7 @@ def stiffness_test_cmd(
     parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    csv: Path = typer.Option(None, "--csv", help="Also write the loop as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
@@ -224,6 +225,12 @@ def stiffness_test_cmd(
         if bar:
             bar.stop()
     data = {"output_dir": str(out), **asdict(fig), "stiffness_budget": _budget(res)}
+    if csv is not None:  # the loop in the measured-data format (flexrv.measured.writer)
+        from flexrv.measured.writer import export_stiffness_test
+
+        data["csv"] = str(
+            export_stiffness_test(csv, res, f"flexrv stiffness-test {preset} --model {model}", quarter_time)
+        )
 
     def render(d):
         from flexrv.cli.design import budget_table

@@ -28,6 +28,7 @@ def te(
     ),
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    csv: Path = typer.Option(None, "--csv", help="Also write the loaded TE as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
@@ -59,6 +60,10 @@ def te(
     save_te(ds, summary, reducer, out)
     te_plots(ds, summary, out)
     data = {"output_dir": str(out), **summary}
+    if csv is not None:  # the loaded TE in the measured-data format (flexrv.measured.writer)
+        from flexrv.measured.writer import export_te
+
+        data["csv"] = str(export_te(csv, result, reducer.name, f"flexrv te {preset} --torque-nm {result.torque:.17g}"))
     data["stiffness_budget"] = quasi_static_budget(summary, result.outputs, reducer)
     analytic = analytic_budget(reducer, summary["torque_Nm"])
     data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
