@@ -118,6 +118,13 @@ SECTIONS: dict[str, dict[str, str]] = {
         "yang2021": "Yang, Zhou, Chang, Chen (2021). *Mechanism and Machine Theory* 163, 104384. Title and "
         "first names not verified; not yet cited in the code.",
     },
+    "Manufacturers' catalogues": {
+        "nabtesco_rv": "Nabtesco Corporation. *Precision Reduction Gear RV: E Series / C Series / Original "
+        "Series* (catalogue): rating table (rated torque, torsional rigidity, lost motion) and its "
+        "definitions on the hysteresis curve of a torsion test with the input locked: rigidity as the "
+        "slope between 50 % and 100 % of the rated torque, lost motion as the rotation at the midpoint of "
+        "the curve's width between +-3 % of the rated torque, hysteresis loss. Edition not verified.",
+    },
     "Standards": {
         "iso76": "ISO 76:2006. Rolling bearings — Static load ratings. International Organization for "
         "Standardization, Geneva.",

@@ -208,8 +208,6 @@ def stiffness_test_cmd(
 ) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
     torsional rigidity, lost motion, hysteresis loop PNG."""
-    from dataclasses import asdict
-
     from flexrv.simulation import DEFAULT_DT, DEFAULT_QUARTER_TIME, stiffness_test
 
     dt = DEFAULT_DT if dt is None else dt
@@ -224,7 +222,7 @@ def stiffness_test_cmd(
     finally:
         if bar:
             bar.stop()
-    data = {"output_dir": str(out), **asdict(fig), "stiffness_budget": _budget(res)}
+    data = {"output_dir": str(out), **fig.named(), "stiffness_budget": _budget(res)}
     if csv is not None:  # the loop in the measured-data format (flexrv.measured.writer)
         from flexrv.measured.writer import export_stiffness_test
 

@@ -1,196 +1,108 @@
 """Evaluation of the virtual torsional-stiffness test (:cite:`seed004` test bench):
 input locked, output torque 0 -> +T_r -> -T_r -> 0 quasi-statically.
 
-Definitions (Nabtesco RV catalogue conventions, :cite:`seed004` "average slope of the
-loading and unloading curves"):
-
-* torsional rigidity [N m/arcmin]: mean of the slopes dT/dtheta of the +T_r
-  loading branch and of the -T_r branch, each a least-squares line over
-  |T| in [T_r/2, T_r];
-* lost motion [arcmin]: rotation between T = +3 % and T = -3 % of T_r on the
-  mean (loading/unloading averaged) curve;
-* hysteresis [arcmin]: width of the loop at T = 0 (descending minus returning
-  branch), the "hysteresis loss" angle of the catalogues;
-* low-torque rigidity [N m/arcmin]: the same mean of the two branches' least-squares
-  slopes over |T| in [3 %, 50 %] of T_r, from the edge of the lost-motion band to the
-  start of the catalogue range: the lower of the piecewise-linear torsional stiffness
-  regions that Harmonic Drive catalogues give as K1/K2 (the RV catalogue gives the
-  50-100 % slope only; the low range here is flexrv's definition, stated with its
-  bounds in the figures);
-* hysteresis loss [J]: the energy dissipated per load cycle, the loop's area
-  oint T dtheta (:func:`loop_energy`).
+The figures are the named definitions of :mod:`flexrv.post.definitions` (rigidities by
+their reading: 50-100 % slope, tangent at rated, low-torque slope, loop secant; lost motion
+at +-3 % and +-1 %; the geometric backlash; hysteresis width and loss), read from the loop by
+:func:`flexrv.post.definitions.loop_figures`, the same function that reads a measured loop.
+This module adds the test program's bookkeeping (which samples are the loop, the friction
+energy over the program) and the files of a test run.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexrv.units import ARCMIN_PER_RAD
+from flexrv.post import definitions as defs
+
+#: names of older readers -> the named figure they are
+_ALIASES = {
+    "rigidity_Nm_per_arcmin": "rigidity_slope_50_100_Nm_per_arcmin",
+    "rigidity_positive_Nm_per_arcmin": "rigidity_slope_50_100_positive_Nm_per_arcmin",
+    "rigidity_negative_Nm_per_arcmin": "rigidity_slope_50_100_negative_Nm_per_arcmin",
+    "rigidity_low_Nm_per_arcmin": "rigidity_low_torque_Nm_per_arcmin",
+    "rated_torque": "rated_torque_Nm",
+    "lost_motion_negative_arcmin": "lost_motion_negative_angle_arcmin",
+    "lost_motion_positive_arcmin": "lost_motion_positive_angle_arcmin",
+    "hysteresis_returning_arcmin": "hysteresis_ascending_angle_arcmin",
+    "hysteresis_descending_arcmin": "hysteresis_descending_angle_arcmin",
+}
 
 
 @dataclass(frozen=True)
 class StiffnessTest:
-    """Figures of a stiffness test (angles in arcmin, torques in N m)."""
+    """Figures of a stiffness test: ``figures`` the named values of
+    :func:`flexrv.post.definitions.loop_figures` (read as attributes too, e.g.
+    ``t.lost_motion_arcmin``), ``friction_energy_J`` the friction dissipation over the
+    program (0 without friction)."""
 
-    rated_torque: float
-    rigidity_Nm_per_arcmin: float
-    rigidity_positive_Nm_per_arcmin: float
-    rigidity_negative_Nm_per_arcmin: float
-    lost_motion_arcmin: float
-    hysteresis_arcmin: float
-    angle_at_rated_arcmin: float
-    #: where the figures are read on the loop (for the plot and the saved file)
-    fit_range_low_Nm: float = float("nan")  #: rigidity fit over |T| in [low, rated]
-    lost_motion_torque_Nm: float = float("nan")  #: the +-3 % band of the lost motion
-    lost_motion_negative_arcmin: float = float("nan")  #: mean-curve angle at -3 % T_r
-    lost_motion_positive_arcmin: float = float("nan")  #: mean-curve angle at +3 % T_r
-    hysteresis_returning_arcmin: float = float("nan")  #: returning branch at T = 0
-    hysteresis_descending_arcmin: float = float("nan")  #: descending branch at T = 0
-    hysteresis_loss_J: float = float("nan")  #: energy dissipated per load cycle, the loop area (loop_energy)
-    friction_energy_J: float = 0.0  #: friction dissipation over the test program (0: no friction)
-    rigidity_low_Nm_per_arcmin: float = float("nan")  #: mean branch slope over |T| in [3 %, 50 %] T_r
-    low_range_low_Nm: float = float("nan")  #: low-torque fit over |T| in [low_range_low, fit_range_low]
+    figures: dict = field(default_factory=dict)
+    friction_energy_J: float = 0.0
 
+    def __getattr__(self, name):
+        figures = self.__dict__.get("figures", {})
+        key = _ALIASES.get(name, name)
+        if key in figures:
+            return figures[key]
+        raise AttributeError(name)
 
-def _fit_slope(torque, angle, lo, hi):
-    sel = (np.abs(torque) >= lo) & (np.abs(torque) <= hi)
-    if sel.sum() < 3:
-        return float("nan")
-    return float(np.polyfit(angle[sel], torque[sel], 1)[0])
-
-
-def _angle_at(torque_branch, angle_branch, value):
-    order = np.argsort(torque_branch)
-    return float(np.interp(value, torque_branch[order], angle_branch[order]))
+    def named(self) -> dict:
+        """The named figures of :data:`flexrv.post.definitions.DEFINITIONS` and the friction energy."""
+        out = {k: float(self.figures[k]) for k in defs.DEFINITIONS}
+        out["friction_energy_J"] = float(self.friction_energy_J)
+        return out
 
 
 def loop_energy(torque_down, angle_down, torque_back, angle_back, rated: float, samples: int = 2001) -> float:
-    """Energy dissipated per load cycle [J] = the area of the torque-twist loop,
-    oint T dtheta, from the descending branch (+T_r -> -T_r) and the returning branch
-    (-T_r -> 0) of the test program (angles [rad], torques [N m]):
-
-        E = 2 int_{-T_r}^{0} (theta_down(T) - theta_back(T)) dT,
-
-    the lower half of the loop, where both branches are measured, doubled by the
-    loop's point symmetry (T, theta) -> (-T, -theta) (a reducer without load-direction
-    bias; the upper half would need a second loading from the loop's centre). Trapezoid
-    rule on ``samples`` torques, each branch interpolated at them (angle as a function of
-    torque: monotone ramps). Check (tests/test_friction.py): a Coulomb element (spring
-    k, friction force F_c) gives the parallelogram's 4 F_c (T_r - F_c)/k."""
-    t = np.linspace(-rated, 0.0, samples)
-    a_d = np.array([_angle_at(torque_down, angle_down, x) for x in t])
-    a_b = np.array([_angle_at(torque_back, angle_back, x) for x in t])
-    return float(2.0 * np.trapezoid(a_d - a_b, t))
+    """The loop's area from its descending and returning branches
+    (:func:`flexrv.post.definitions.loop_energy`) [J]."""
+    return defs.loop_energy(
+        [(np.asarray(torque_down, float), np.asarray(angle_down, float))],
+        [(np.asarray(torque_back, float), np.asarray(angle_back, float))],
+        rated,
+        samples,
+    )
 
 
 def evaluate_stiffness_test(time, torque, angle, times, friction_power=None) -> StiffnessTest:
     """Evaluate a loop. ``times`` = (t_start, t_pos, t_neg, t_end): the program
     ramps 0 -> +T_r on [t_start, t_pos], +T_r -> -T_r on [t_pos, t_neg] and
-    -T_r -> 0 on [t_neg, t_end]; ``angle`` is the output rotation [rad].
+    -T_r -> 0 on [t_neg, t_end]; ``angle`` is the output rotation [rad]. The rated torque
+    is the smaller of the loop's two peaks (a recorded step may miss the program's peak).
     ``friction_power`` [W] over ``time`` (the run's output ``friction_power``, if it has
     friction): its integral over [t_start, t_end] is the friction energy of the program
-    [J], the friction part of the dissipation measured directly (trapezoid rule; 0
-    without friction)."""
+    [J], the friction part of the dissipation measured directly (trapezoid rule)."""
     time, torque, angle = (np.asarray(a, dtype=float) for a in (time, torque, angle))
-    a = angle * ARCMIN_PER_RAD
-    t0, tp, tn, te = times
-    rated = float(np.max(np.abs(torque)))
-    up = (time >= t0) & (time <= tp)
-    down = (time >= tp) & (time <= tn)
-    back = (time >= tn) & (time <= te)
-    k_pos = _fit_slope(torque[up], a[up], 0.5 * rated, rated)
-    neg = down & (torque < 0)
-    k_neg = _fit_slope(torque[neg], a[neg], 0.5 * rated, rated)
-    # mean curve near zero: average of descending branch and ascending (up + back) branches
-    asc_t = np.r_[torque[back], torque[up]]
-    asc_a = np.r_[a[back], a[up]]
-    d3 = 0.03 * rated
-    mid_p = 0.5 * (_angle_at(torque[down], a[down], d3) + _angle_at(asc_t, asc_a, d3))
-    mid_n = 0.5 * (_angle_at(torque[down], a[down], -d3) + _angle_at(asc_t, asc_a, -d3))
-    a_down0, a_back0 = _angle_at(torque[down], a[down], 0.0), _angle_at(torque[back], a[back], 0.0)
-    loss = loop_energy(torque[down], angle[down], torque[back], angle[back], rated)
+    t0, _, _, te = times
+    prog = (time >= t0) & (time <= te)
+    rated = float(min(np.max(torque[prog]), -np.min(torque[prog])))
+    figures = defs.loop_figures(torque[prog], angle[prog], rated)
     e_fric = 0.0
     if friction_power is not None:
-        prog = (time >= t0) & (time <= te)
         e_fric = float(np.trapezoid(np.asarray(friction_power, dtype=float)[prog], time[prog]))
-    k_low = 0.5 * (_fit_slope(torque[up], a[up], d3, 0.5 * rated) + _fit_slope(torque[neg], a[neg], d3, 0.5 * rated))
-    return StiffnessTest(
-        rated_torque=rated,
-        rigidity_Nm_per_arcmin=0.5 * (k_pos + k_neg),
-        rigidity_positive_Nm_per_arcmin=k_pos,
-        rigidity_negative_Nm_per_arcmin=k_neg,
-        lost_motion_arcmin=mid_p - mid_n,
-        hysteresis_arcmin=a_down0 - a_back0,
-        angle_at_rated_arcmin=_angle_at(torque[up], a[up], rated),
-        fit_range_low_Nm=0.5 * rated,
-        lost_motion_torque_Nm=d3,
-        lost_motion_negative_arcmin=mid_n,
-        lost_motion_positive_arcmin=mid_p,
-        hysteresis_returning_arcmin=a_back0,
-        hysteresis_descending_arcmin=a_down0,
-        hysteresis_loss_J=loss,
-        friction_energy_J=e_fric,
-        rigidity_low_Nm_per_arcmin=k_low,
-        low_range_low_Nm=d3,
-    )
+    return StiffnessTest(figures=figures, friction_energy_J=e_fric)
 
 
-#: (variable, StiffnessTest field, units, long name) of the saved figures
-_FIGURES = (
-    ("rated_torque", "rated_torque", "N m", "rated (peak) torque of the loop"),
+#: (name, units, long name) of the saved figures: the named definitions and the read points
+_FIGURES = tuple((name, *defs.DEFINITIONS[name][:2]) for name in defs.DEFINITIONS) + (
     (
-        "torsional_rigidity",
-        "rigidity_Nm_per_arcmin",
-        "N m/arcmin",
-        "torsional rigidity, mean of the +T_r and -T_r branch slopes over T_r/2 <= abs(T) <= T_r",
-    ),
-    (
-        "torsional_rigidity_positive",
-        "rigidity_positive_Nm_per_arcmin",
-        "N m/arcmin",
-        "slope of the +T_r loading branch over T in [T_r/2, T_r]",
-    ),
-    (
-        "torsional_rigidity_negative",
-        "rigidity_negative_Nm_per_arcmin",
-        "N m/arcmin",
-        "slope of the -T_r branch over -T in [T_r/2, T_r]",
-    ),
-    (
-        "lost_motion",
-        "lost_motion_arcmin",
-        "arcmin",
-        "lost motion: rotation between +3 % and -3 % of T_r on the mean curve",
-    ),
-    ("hysteresis", "hysteresis_arcmin", "arcmin", "hysteresis: loop width at T = 0"),
-    (
-        "hysteresis_loss",
-        "hysteresis_loss_J",
-        "J",
-        "hysteresis loss: energy dissipated per load cycle, the loop area (twice the measured lower half)",
-    ),
-    (
-        "friction_energy",
         "friction_energy_J",
         "J",
-        "energy dissipated by friction over the test program "
-        "(0 -> +T_r -> -T_r -> 0), integral of friction_power; 0 without friction",
+        "energy dissipated by friction over the test program (0 -> +T_r -> -T_r -> 0), integral of "
+        "friction_power; 0 without friction",
     ),
-    (
-        "torsional_rigidity_low",
-        "rigidity_low_Nm_per_arcmin",
-        "N m/arcmin",
-        "low-torque rigidity, mean of the +T_r and -T_r branch slopes over 3 % T_r <= abs(T) <= T_r/2",
-    ),
-    ("angle_at_rated", "angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
-    ("fit_range_low", "fit_range_low_Nm", "N m", "lower end of the rigidity fit range, abs(T)"),
-    ("lost_motion_torque", "lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
-    ("lost_motion_negative_angle", "lost_motion_negative_arcmin", "arcmin", "mean-curve angle at -3 % T_r"),
-    ("lost_motion_positive_angle", "lost_motion_positive_arcmin", "arcmin", "mean-curve angle at +3 % T_r"),
-    ("hysteresis_returning_angle", "hysteresis_returning_arcmin", "arcmin", "returning branch at T = 0"),
-    ("hysteresis_descending_angle", "hysteresis_descending_arcmin", "arcmin", "descending branch at T = 0"),
+    ("rated_torque_Nm", "N m", "rated (peak) torque of the loop"),
+    ("rigidity_slope_50_100_positive_Nm_per_arcmin", "N m/arcmin", "slope of the +T_r loading branch, 50-100 %"),
+    ("rigidity_slope_50_100_negative_Nm_per_arcmin", "N m/arcmin", "slope of the -T_r loading branch, 50-100 %"),
+    ("angle_at_rated_arcmin", "arcmin", "output rotation at +T_r (loading)"),
+    ("fit_range_low_Nm", "N m", "lower end of the 50-100 % rigidity fit range, abs(T)"),
+    ("lost_motion_torque_Nm", "N m", "torque band of the lost motion, 3 % T_r"),
+    ("lost_motion_negative_angle_arcmin", "arcmin", "mid-curve angle at -3 % T_r"),
+    ("lost_motion_positive_angle_arcmin", "arcmin", "mid-curve angle at +3 % T_r"),
+    ("hysteresis_ascending_angle_arcmin", "arcmin", "ascending branch at T = 0"),
+    ("hysteresis_descending_angle_arcmin", "arcmin", "descending branch at T = 0"),
 )
 
 
@@ -202,8 +114,8 @@ def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=N
     import xarray as xr
 
     data = {
-        name: xr.Variable((), float(getattr(figures, field)), {"units": units, "long_name": long})
-        for name, field, units, long in _FIGURES
+        name: xr.Variable((), float(getattr(figures, name)), {"units": units, "long_name": long})
+        for name, units, long in _FIGURES
     }
     data["loop_torque"] = xr.Variable(
         ("time",), np.asarray(torque, dtype=float), {"units": "N m", "long_name": "output torque of the test loop"}
@@ -224,8 +136,8 @@ def stiffness_dataset(figures: StiffnessTest, time, torque, angle_arcmin, base=N
 def stiffness_json(figures: StiffnessTest) -> dict:
     """JSON-ready figures: ``{name: {"value", "units", "description"}}``."""
     return {
-        name: {"value": float(getattr(figures, field)), "units": units, "description": long}
-        for name, field, units, long in _FIGURES
+        name: {"value": float(getattr(figures, name)), "units": units, "description": long}
+        for name, units, long in _FIGURES
     }
 
 
@@ -245,14 +157,14 @@ def stiffness_summary_markdown(
         f"# Stiffness test {preset} ({model} model)",
         "",
         f"Input locked; output torque 0 -> +{f.rated_torque:.4g} -> -{f.rated_torque:.4g} -> 0 N m, each "
-        f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Definitions as in the RV "
-        "catalogue and seed004 (average slope of the loading and unloading curves).",
+        f"quarter over {quarter_time:.4g} s (quasi-static), dt = {dt:.3g} s. Each figure is named by its "
+        "definition (flexrv.post.definitions; docs/definitions.md).",
         "",
         "| quantity | value | unit | how it is read |",
         "|---|---|---|---|",
     ]
-    for name, field, units, long in _FIGURES[:9]:
-        lines.append(f"| {name.replace('_', ' ')} | {getattr(f, field):.4g} | {units} | {long} |")
+    for name, units, long in _FIGURES[: len(defs.DEFINITIONS) + 1]:
+        lines.append(f"| {name} | {getattr(f, name):.4g} | {units} | {long} |")
     lines += [
         "",
         f"Rigidity fit range: abs(T) = {f.fit_range_low_Nm:.4g} .. {f.rated_torque:.4g} N m; lost motion read "
