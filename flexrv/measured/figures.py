@@ -15,8 +15,18 @@ LOST_MOTION_FIGURES = ("lost_motion_arcmin", "lost_motion_1pct_arcmin", "backlas
 
 
 def rated_torque(m: Measurement) -> float:
-    """The loop's rated torque [N m]: ``rated_torque_Nm`` if the file gives it, else the
-    loop's peak |T| (the stiffness test's convention)."""
+    """The torque [N m] the figures are read at (their T_r): for a loop the smaller of its two
+    peak torques (the stiffness test's convention, :func:`flexrv.post.stiffness.evaluate_stiffness_test`:
+    both tips lie on the loop); for lost-motion points the file's ``rated_torque_Nm``."""
+    if m.kind == "lost_motion":
+        return float(m.meta["rated_torque_Nm"])
+    t = m.columns["torque"]
+    return float(min(np.max(t), -np.min(t)))
+
+
+def program_torque(m: Measurement) -> float:
+    """The peak torque [N m] of the test program that reproduces the file: its
+    ``rated_torque_Nm`` if given, else the largest |T| of the record."""
     if "rated_torque_Nm" in m.meta:
         return float(m.meta["rated_torque_Nm"])
     return float(np.max(np.abs(m.columns["torque"])))

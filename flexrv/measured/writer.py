@@ -82,10 +82,14 @@ def write_te_record(
 
 def export_stiffness_test(path, res, command: str, quarter_time_s: float | None = None) -> Path:
     """The loop of a virtual stiffness test (its Results: ``loop_torque`` [N m], ``loop_angle``
-    [arcmin] over ``time`` [s], read by name) as a ``stiffness_loop`` file labelled simulated."""
+    [arcmin] over ``time`` [s], read by name; the program's peak torque from its
+    ``stiffness_budget`` attribute) as a ``stiffness_loop`` file labelled simulated."""
+    import json
+
     from flexrv.units import RAD_PER_ARCMIN
 
     ds = res.ds
+    peak = json.loads(ds.attrs["stiffness_budget"])["torque"] if "stiffness_budget" in ds.attrs else None
     return write_loop(
         path,
         ds["loop_torque"].values,
@@ -93,6 +97,7 @@ def export_stiffness_test(path, res, command: str, quarter_time_s: float | None 
         time_s=ds["time"].values,
         origin=simulated_origin(command),
         design=ds.attrs.get("preset"),
+        rated_torque_Nm=peak,
         quarter_time_s=None if quarter_time_s is None else float(quarter_time_s),
     )
 
