@@ -151,3 +151,32 @@ def test_calibrate_bad_free_option(tmp_path, capsys):
         assert exc.value.code == 2
         err = " ".join(capsys.readouterr().err.split())
         assert "--free" in err and text in err, err
+
+
+@pytest.mark.slow
+def test_calibration_workflow_coverage_twenty_draws(tmp_path):
+    """The workflow's full study (a): over 20 draws (truths inside the middle 60 % of the
+    plausible ranges, independent noise seeds) each field's 95 % interval covers its truth in
+    at least 17; the series pair is not identifiable; (b) the rv40e estimates give a loop
+    secant far above seed004's 89 N m/arcmin (> 120) and the table holds one row per field."""
+    from flexrv.workflows.calibration import DRAWS, FREE, SEED004_FIELDS, run
+
+    r = run(tmp_path / "calibration")
+    rt = r.numbers["round_trip"]
+    assert rt["draws"] == DRAWS
+    for k in FREE:
+        assert rt["covered"][k] >= 17, (k, rt["covered"])
+    assert not any(v["identifiable"] for v in r.numbers["series_pair"]["identified"].values())
+    s = r.numbers["seed004"]
+    assert s["target_Nm_per_arcmin"] == pytest.approx(89.0, abs=0.05)
+    assert len(s["fields"]) == len(SEED004_FIELDS) and s["fields"][0]["secant_at_estimate"] > 120
+
+
+@pytest.mark.slow
+def test_calibration_workflow_smoke(tmp_path):
+    """`flexrv workflow calibration --smoke`: two draws, both covered; summary written."""
+    from flexrv.workflows.calibration import FREE, run
+
+    r = run(tmp_path / "cal", smoke=True)
+    assert all(r.numbers["round_trip"]["covered"][k] == 2 for k in FREE)
+    assert (tmp_path / "cal" / "summary.md").read_text().startswith("# Calibration")

@@ -28,6 +28,7 @@ class Workflow(str, enum.Enum):
     crank_bearing_forces = "crank_bearing_forces"
     te_errors = "te_errors"
     tolerance_study = "tolerance_study"
+    calibration = "calibration"
 
 
 def workflow(
