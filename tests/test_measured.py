@@ -311,3 +311,40 @@ def test_validate_own_export_zero_and_other_design_differences(tmp_path, capsys)
     assert diff["lost_motion_measured_arcmin"] > zero["lost_motion_measured_arcmin"] + 0.05
     assert diff["lost_motion_difference_arcmin"] < -0.05
     assert (tmp_path / "v" / "validation.json").is_file() and list((tmp_path / "v").glob("*_loop.png"))
+
+
+def test_te_export_validates_with_zero_differences(tmp_path, capsys):
+    """`flexrv te rv40e --csv te.csv` (one crank revolution, 4 points per mesh) read back and
+    validated against rv40e: TE p-p and mean differ by 0 (|d| <= 1e-9 arcsec: the prediction
+    is the same quasi-static run at the file's torque, range and density); the record's
+    spectrum has the cycloid-mesh line labelled when the design is given."""
+    import json
+
+    from flexrv.cli import main
+
+    csv = tmp_path / "te.csv"
+    main(
+        [
+            "te",
+            "rv40e",
+            "--crank-revolutions",
+            "1",
+            "--points-per-mesh",
+            "4",
+            "--out",
+            str(tmp_path / "te"),
+            "--csv",
+            str(csv),
+            "--json",
+        ]
+    )
+    m = read_measured(csv)
+    assert m.kind == "te_record" and m.simulated and m.meta["torque_Nm"] == 412.0
+    capsys.readouterr()
+    main(["validate", "rv40e", "--measured", str(csv), "--out", str(tmp_path / "v"), "--json"])
+    d = json.loads(capsys.readouterr().out)
+    comp = d["files"][0]["comparison"]
+    assert abs(comp["te_pp_difference_arcsec"]) <= 1e-9 and abs(comp["te_mean_difference_arcsec"]) <= 1e-9
+    assert comp["te_pp_measured_arcsec"] > 0
+    assert any(x["label"] == "cycloid mesh" for x in d["files"][0]["spectrum_lines"]["measured"])
+    assert list((tmp_path / "v").glob("*_spectrum.png")) and list((tmp_path / "v").glob("*_te.png"))

@@ -28,6 +28,8 @@ import numpy as np
 from flexrv.units import RAD_PER_ARCMIN, TWO_PI
 
 LOOP_MODELS = ("stiffness-test", "quasi-static")
+#: numbers of a record that describe its sampling, not the reducer (not compared)
+_NOT_FIGURES = ("output_revolutions", "spectral_resolution_orders")
 #: unit suffixes of the figures' names (longest first)
 _UNITS = ("_Nm_per_arcmin", "_arcmin", "_arcsec", "_Nm", "_J")
 
@@ -75,6 +77,8 @@ def predict_te(reducer, m):
     revs = min(max(revs, 1e-3), 100.0)
     mesh = characteristic_orders(reducer)["cycloid mesh"]
     ppm = int(min(max(round(n / (revs * mesh)), 2), 64))
+    if abs(n / (mesh * ppm) - revs) < 1e-3 * revs:  # the record's n points are a whole number per mesh period
+        revs = n / (mesh * ppm)
     torque = float(m.meta["torque_Nm"])
     res = loaded_te(reducer, torque=torque if torque > 0 else None, output_revolutions=revs, points_per_mesh=ppm)
     te = res.te if torque > 0 else res.te_no_load
@@ -87,7 +91,7 @@ def compare(measured: dict, predicted: dict) -> dict:
     scalar figure the measurement has."""
     out = {}
     for key, mv in measured.items():
-        if not isinstance(mv, (int, float)) or key not in predicted:
+        if not isinstance(mv, (int, float)) or key not in predicted or key in _NOT_FIGURES:
             continue
         base, unit = split_name(key)
         pv = float(predicted[key])
