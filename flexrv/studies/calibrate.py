@@ -34,7 +34,9 @@ range) whose p + 1 evaluations run in parallel on dask (the cluster options of
 
 Uncertainty (Bates & Watts 1988 :cite:`bates1988nonlinear`): covariance s^2 (J^T J)^-1 of
 the weighted Jacobian J at the optimum, 95 % intervals x +- t_{0.975, n-p} sigma_x, the
-correlation matrix. Identifiability from the singular values sv_i of the scaled sensitivity
+correlation matrix; each interval's linearity is checked at its ends and the interval is
+widened along the linearised profile path where the objective is visibly flatter than linear
+(:func:`_profile_check`). Identifiability from the singular values sv_i of the scaled sensitivity
 J (unit coordinates, weighted residuals): along the right singular vector v_i the data
 determine the fields to a 95 % half-width t s / sv_i (in plausible ranges); a combination
 with a half-width above :data:`UNRESOLVED_HALF_WIDTH` (the data do not narrow it to half its
@@ -72,6 +74,8 @@ IDENTIFIABLE_RATIO = 1e-6
 UNRESOLVED_HALF_WIDTH = 0.5
 #: weight of a field in a non-identifiable combination above which the field is not identifiable
 COMBINATION_WEIGHT = 0.3
+#: range of the actual / linear objective rise at the Jacobian interval's ends taken as linear
+LINEAR_RISE = (0.7, 1.4)
 #: default plausible range of an estimated field, as factors of its estimate
 DEFAULT_RANGE = (0.5, 1.5)
 
@@ -435,16 +439,18 @@ def calibrate(
         u = sol.x
         r = resid(u)
         jw = jac(u)
+        p = len(names)
+        dof = n - p
+        rss = float(r @ r)
+        if all(s is not None for s in stated):
+            s2, source = 1.0, "stated"
+        else:
+            s2, source = rss / dof, "residual scatter"
+        t95 = float(student_t.ppf(0.975, dof))
+        out = _uncertainty(names, lo, hi, x0, u, jw, s2, t95)
+        _profile_check(out["identified"], names, lo, hi, u, jw, s2, t95, rss, lambda us: [resid(x) for x in us])
     finally:
         ev.close()
-    p = len(names)
-    dof = n - p
-    rss = float(r @ r)
-    if all(s is not None for s in stated):
-        s2, source = 1.0, "stated"
-    else:
-        s2, source = rss / dof, "residual scatter"
-    out = _uncertainty(names, lo, hi, x0, u, jw, s2, student_t.ppf(0.975, dof))
     fitted = y_meas + r * sigma
     rows, k = [], 0
     for t in targets:
@@ -524,6 +530,48 @@ def _uncertainty(names, lo, hi, x0, u, jw, s2: float, t95: float) -> dict:
         "singular_values": sv.tolist(),
         "non_identifiable": combos,
     }
+
+
+def _profile_check(ident: dict, names, lo, hi, u, jw, s2: float, t95: float, rss: float, residuals) -> None:
+    """Nonlinearity check of each identifiable field's interval, widened where the objective is
+    flatter than linear. In linear theory the profile of field j (the others at their
+    conditional optimum) runs along d_j = C e_j / sqrt(C_jj) (C the covariance in unit
+    coordinates) and the objective rises by exactly t^2 at u +- t d_j. The rise is evaluated
+    there (2 evaluations per field): ``nonlinearity`` = actual / expected rise per end. Along
+    this fixed path the others are not re-optimised, so the rise is an upper bound of the
+    profile's: where it is below t^2 (ratio < ``LINEAR_RISE[0]``) the profile interval extends
+    at least to where the path's rise reaches t^2, and the interval is widened to that point
+    (bisection, ``interval_method = "profile path"``); a steeper rise cannot narrow it (that
+    would need the full profile) and the Jacobian's end stays."""
+    cov = s2 * np.linalg.pinv(jw.T @ jw)
+    scale = hi - lo
+    for j, k in enumerate(names):
+        v = ident[k]
+        v["interval_method"] = "jacobian"
+        if not v["identifiable"] or cov[j, j] <= 0:
+            continue
+        d = cov[:, j] / math.sqrt(cov[j, j])
+
+        def rise(a):
+            x = np.clip(u + a * d, 0.0, 1.0)
+            r = residuals([x])[0]
+            return (float(r @ r) - rss) / s2
+
+        ratios = [rise(t95) / t95**2, rise(-t95) / t95**2]
+        v["nonlinearity"] = ratios
+        for sign, ratio in zip((1.0, -1.0), ratios):
+            if ratio >= LINEAR_RISE[0]:
+                continue
+            a_in, a_out = t95, 2 * t95
+            while rise(sign * a_out) < t95**2 and a_out < 16 * t95:
+                a_in, a_out = a_out, 2 * a_out
+            for _ in range(10):
+                mid = 0.5 * (a_in + a_out)
+                a_in, a_out = (mid, a_out) if rise(sign * mid) < t95**2 else (a_in, mid)
+            end = float(lo[j] + np.clip(u[j] + sign * a_out * d[j], 0.0, 1.0) * scale[j])
+            key = "ci95_high" if sign > 0 else "ci95_low"
+            v[key] = max(v[key], end) if sign > 0 else min(v[key], end)
+            v["interval_method"] = "profile path"
 
 
 def calibrated_design(reducer, cal: Calibration, files: list[str]):
