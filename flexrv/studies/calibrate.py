@@ -33,7 +33,8 @@ range) whose p + 1 evaluations run in parallel on dask (the cluster options of
 ``flexrv tolerance``), or in the calling process with ``workers = 0``.
 
 Uncertainty (Bates & Watts 1988 :cite:`bates1988nonlinear`): covariance s^2 (J^T J)^-1 of
-the weighted Jacobian J at the optimum, 95 % intervals x +- t_{0.975, n-p} sigma_x, the
+the weighted Jacobian J at the optimum, 95 % intervals x +- q sigma_x (q = 1.96 for a stated
+sigma, Student's t_{0.975, n-p} for a sigma from the scatter), the
 correlation matrix; each interval's linearity is checked at its ends and the interval is
 widened along the linearised profile path where the objective is visibly flatter than linear
 (:func:`_profile_check`). Identifiability from the singular values sv_i of the scaled sensitivity
@@ -388,6 +389,7 @@ def calibrate(
     the measured loops and lost-motion points (module docstring). Returns the
     :class:`Calibration` (the design itself is not changed; :func:`calibrated_design`)."""
     from scipy.optimize import least_squares
+    from scipy.stats import norm
     from scipy.stats import t as student_t
 
     t_start = time.perf_counter()
@@ -446,7 +448,8 @@ def calibrate(
             s2, source = 1.0, "stated"
         else:
             s2, source = rss / dof, "residual scatter"
-        t95 = float(student_t.ppf(0.975, dof))
+        # known sigma: the normal quantile; sigma from the scatter: Student's t with n - p dof
+        t95 = float(norm.ppf(0.975)) if source == "stated" else float(student_t.ppf(0.975, dof))
         out = _uncertainty(names, lo, hi, x0, u, jw, s2, t95)
         _profile_check(out["identified"], names, lo, hi, u, jw, s2, t95, rss, lambda us: [resid(x) for x in us])
     finally:

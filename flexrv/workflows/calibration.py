@@ -208,7 +208,7 @@ def run(out_dir=None, smoke: bool = False, draws: int | None = None) -> Workflow
         "of them from this number alone would report them not identifiable (table (a)'s series pair). A full "
         "loop (spans at several torques), lost-motion points and TE records separate more.",
         f"Round trips: {n} draws, 0.005 arcmin angle noise, 6 mid-curve spans per loop, 3 free fields; "
-        "intervals from the Jacobian (Student t, 3 degrees of freedom).",
+        "intervals from the Jacobian (stated sigma: normal quantile 1.96).",
     ]
     r.figures["round_trip_intervals"] = _interval_figure(rows)
     r.figures["seed004_single_fields"] = _seed004_figure(single)
