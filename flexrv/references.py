@@ -76,6 +76,8 @@ SECTIONS: dict[str, dict[str, str]] = {
         "harris2007": "Harris, T. A., Kotzalas, M. N. (2007). *Rolling Bearing Analysis*, 5th ed., vol. 1 "
         "*Essential Concepts of Bearing Technology* and vol. 2 *Advanced Concepts of Bearing "
         "Technology*. CRC Press (Taylor & Francis), Boca Raton.",
+        "hetenyi1946": "Hetényi, M. (1946). *Beams on Elastic Foundation: Theory with Applications in the Fields "
+        "of Civil and Mechanical Engineering*. University of Michigan Press, Ann Arbor.",
         "johnson1985": "Johnson, K. L. (1985). *Contact Mechanics*. Cambridge University Press.",
         "jones1960": "Jones, A. B. (1960). A general theory for elastically constrained ball and radial roller "
         "bearings under arbitrary load and speed conditions. *ASME Journal of Basic Engineering* "
@@ -135,6 +137,14 @@ SECTIONS: dict[str, dict[str, str]] = {
         "iso6336": "ISO 6336-1:2006. Calculation of load capacity of spur and helical gears — Part 1: Basic "
         "principles, introduction and general influence factors. International Organization for "
         "Standardization, Geneva.",
+        "iso5593": "ISO 5593:2019. Rolling bearings — Vocabulary (radial internal clearance: the mean radial "
+        "distance by which one ring can move relative to the other from one extreme position to the "
+        "diametrically opposite one, the total play). International Organization for Standardization, Geneva.",
+        "iso5753": "ISO 5753-1:2009. Rolling bearings — Internal clearance — Part 1: Radial internal clearance "
+        "for radial bearings (groups C2, CN, C3, ...). International Organization for Standardization, Geneva.",
+        "vdi2230": "VDI 2230 Blatt 1 (2015). Systematic calculation of highly stressed bolted joints — Joints "
+        "with one cylindrical bolt (resilience of the bolt and of the clamped parts, including their bending "
+        "resilience). Verein Deutscher Ingenieure, Düsseldorf.",
         "iso21771": "ISO 21771:2007. Gears — Cylindrical involute gears and gear pairs — Concepts and "
         "geometry. International Organization for Standardization, Geneva.",
     },

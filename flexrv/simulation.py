@@ -715,37 +715,31 @@ def _progress_callback(progress, t_end):
     return rep
 
 
-def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0) -> dict:
-    """Stiffness budget of the stiffness test (SI): the quasi-static model's
-    strain-energy budget (:meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`,
-    the same force groups and laws as the dynamic rigid model) at the test's pose, the
-    input locked at ``theta_in`` and the output at +``torque`` (static equilibrium
-    reached by torque continuation from the kinematic pose), mapped to the budget's
-    elements by :func:`flexrv.analysis.torsional.budget_from_group_shares` (the mapping
-    of ``flexrv te``). Returns {"compliances" [rad/(N m)], "tangent_rigidity"
-    [N m/rad], "torque" [N m], "notes", "unmodelled": the elements of the budget that
-    the models do not contain, [rad/(N m)] (none since the housing is in the models)}."""
-    from flexrv.analysis.torsional import UNMODELLED_ELEMENTS, budget_from_group_shares
+def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0, reference: dict | None = None):
+    """Stiffness budget of the stiffness test (:class:`flexrv.analysis.budget.Budget`): the
+    quasi-static model's strain-energy budget (:meth:`flexrv.model.quasi_static.StaticModel.
+    compliance_budget`, the same force groups and laws as the dynamic rigid model) at the
+    test's pose, the input locked at ``theta_in`` and the output at +``torque`` (static
+    equilibrium reached by torque continuation from the kinematic pose), through
+    :func:`flexrv.analysis.budget.stiffness_budget` (the elements no model contains added in
+    series); ``reference``: named rigidities [N m/rad] stored with it (the loop's)."""
+    from flexrv.analysis.budget import ModelShares, stiffness_budget
+    from flexrv.model.outputs import model_outputs
     from flexrv.model.quasi_static import StaticModel, ramp_to
 
     sm = StaticModel(reducer)
     sm.torque = 0.0
     q = ramp_to(sm, theta_in, sm.kinematic_pose(theta_in), torque, steps=8)
     k_t = sm.tangent_rigidity(theta_in, q)
-    shares = sm.compliance_budget(theta_in, q)
-    from flexrv.model.outputs import model_outputs
-
     outs = model_outputs(sm.model, np.array([theta_in]), q[None], np.zeros((1, sm.n)))
     bend = outs.get("crank_bending_fraction")
-    frac = float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0
-    comp, notes = budget_from_group_shares(shares, 1.0 / k_t, frac, reducer, torque)
-    return {
-        "compliances": comp,
-        "tangent_rigidity": float(k_t),
-        "torque": float(torque),
-        "notes": list(notes),
-        "unmodelled": {k: v for k, v in comp.items() if k in UNMODELLED_ELEMENTS and k not in shares},
-    }
+    model = ModelShares(
+        shares=sm.compliance_budget(theta_in, q),
+        tangent_compliance=1.0 / k_t,
+        bending_fraction=float(np.nanmean(np.asarray(bend.values, dtype=float))) if bend is not None else 0.0,
+    )
+    ref = {"model_tangent_rigidity": float(k_t), **(reference or {})}
+    return stiffness_budget(reducer, torque, model=model, reference=ref, route="stiffness_test")
 
 
 def stiffness_test(
@@ -766,13 +760,17 @@ def stiffness_test(
 
     Returns (:class:`flexrv.post.stiffness.StiffnessTest`, Results); the Results'
     dataset carries the figures as scalar variables with units (rigidity, lost motion,
-    hysteresis, ...) and the loop (``loop_torque``, ``loop_angle``), and in its attribute
-    ``stiffness_budget`` (JSON, SI) the budget of :func:`stiffness_test_budget` at +T
-    with the loop's measured rigidity (``measured_rigidity`` [N m/rad]). Written to
+    hysteresis, ...; :mod:`flexrv.post.definitions`), the loop (``loop_torque``,
+    ``loop_angle``) and the budget of :func:`stiffness_test_budget` at +T with the loop's
+    rigidities beside it (``budget_*`` over ``budget_element``,
+    :meth:`flexrv.analysis.budget.Budget.to_dataset`). Written to
     ``save_to`` if given: ``results.nc`` (that dataset), ``stiffness.json``,
     ``config.toml``, the test's own ``summary.md`` and ``hysteresis.png`` (loop with the
     rigidity fit range, lost motion and hysteresis marked).
     """
+    import dataclasses
+    import json
+
     from flexrv.model.loads import piecewise_torque
     from flexrv.post.stiffness import (
         evaluate_stiffness_test,
@@ -801,31 +799,22 @@ def stiffness_test(
         friction_power=(res["friction_power"].values if "friction_power" in res.ds else None),
     )
     res.ds = stiffness_dataset(figures, res.time, tq, angle * ARCMIN_PER_RAD, base=res.ds)
-    import json
-
+    loop = {
+        "loop_" + k[: -len("_Nm_per_arcmin")]: v * ARCMIN_PER_RAD
+        for k, v in figures.named().items()
+        if k.startswith("rigidity_")
+    }
     try:
-        budget = stiffness_test_budget(reducer, t_r)
+        budget = stiffness_test_budget(reducer, t_r, reference=loop)
+        if model != "rigid":
+            note = f"budget of the rigid quasi-static model at the test's pose (the loop ran the {model} model)"
+            budget = dataclasses.replace(budget, notes=budget.notes + (note,))
+        res.ds = budget.merged_into(res.ds)
     except ConvergenceError as exc:  # the figures stand without it
-        budget = {
-            "compliances": {},
-            "tangent_rigidity": float("nan"),
-            "torque": float(t_r),
-            "unmodelled": {},
-            "notes": [
-                f"stiffness budget not available: the quasi-static equilibrium at +{t_r:g} N m did not converge ({exc})"
-            ],
-        }
-    if model != "rigid":
-        budget["notes"].append(
-            f"budget of the rigid quasi-static model at the test's pose (the loop ran the {model} model)"
+        budget = None
+        res.ds.attrs["budget_notes"] = (
+            f"stiffness budget not available: the quasi-static equilibrium at +{t_r:g} N m did not converge ({exc})"
         )
-    budget["measured_rigidity"] = figures.rigidity_Nm_per_arcmin * ARCMIN_PER_RAD
-    #: the loop's rigidity with the elements the model lacks in series (none: the housing is in the model)
-    budget["measured_with_unmodelled_rigidity"] = 1.0 / (
-        1.0 / budget["measured_rigidity"] + sum(budget["unmodelled"].values())
-    )
-    budget["model"] = model
-    res.ds.attrs["stiffness_budget"] = json.dumps(budget)
     if save_to is not None:
         from flexrv.cache import atomic_path, atomic_write_text
         from flexrv.design import to_toml
@@ -845,7 +834,7 @@ def stiffness_test(
                     "quarter_time_s": quarter_time,
                     "dt_s": dt,
                     "figures": stiffness_json(figures),
-                    "stiffness_budget_SI": budget,
+                    "stiffness_budget": budget.to_dict() if budget is not None else None,
                 },
                 indent=2,
             ),
@@ -858,6 +847,9 @@ def stiffness_test(
             title=f"{reducer.name} stiffness test ({model} model)",
         )
         atomic_write_text(
-            d / "summary.md", stiffness_summary_markdown(figures, reducer.name, model, quarter_time, dt, budget=budget)
+            d / "summary.md",
+            stiffness_summary_markdown(
+                figures, reducer.name, model, quarter_time, dt, budget=budget.to_dict() if budget is not None else None
+            ),
         )
     return figures, res

@@ -40,7 +40,7 @@ def test_report_numbers_rv40e(rv40e_report):
     for case in rep["pin_loads"].values():
         assert abs(case["torque_balance_error_Nm"]) < 1e-6 * abs(case["disc_torque_Nm"])
     assert rep["pin_loads"]["rated_torque_ideal_profile"]["pins_in_contact"] in (19, 20, 21)
-    t = rep["torsional_stiffness"]
+    t = rep["second_stage_series_models"]
     c1, c2 = t["C_Hc_Nm_per_rad"], t["C_c_palmgren_tangent_Nm_per_rad"]
     assert np.isclose(t["C_W_palmgren_Nm_per_rad"], c1 * c2 / (c1 + c2))
     assert rep["meshing_zone"]["seed_table"]["best_four_pins"] == [6, 9]

@@ -76,7 +76,9 @@ def test_zero_errors_as_built_is_nominal_exactly(name):
             ab.holes[k], np.stack([c * bores[:, 0] + s * bores[:, 1], -s * bores[:, 0] + c * bores[:, 1]], -1)
         )
     np.testing.assert_array_equal(ab.eccentricities, np.full((n, nd), ss.eccentricity))
-    np.testing.assert_array_equal(ab.needle_clearances, np.full((n, nd), r.needle_bearing.radial_clearance_um * 1e-6))
+    np.testing.assert_array_equal(
+        ab.needle_clearances, np.full((n, nd), 0.5 * r.needle_bearing.radial_clearance_um * 1e-6)
+    )
     for arr in (
         ab.eccentric_phase_errors,
         ab.support_clearances,
@@ -211,7 +213,7 @@ def test_crank_disc_errors_land_at_crank_disc():
         }
     )
     ab, nom = as_built(r), as_built(load("rv40e"))
-    a, c0 = r.second_stage.eccentricity, r.needle_bearing.radial_clearance_um * 1e-6
+    a, c0 = r.second_stage.eccentricity, 0.5 * r.needle_bearing.radial_clearance_um * 1e-6
     expected = np.full((N, ND), a)
     expected[2, 1] += 3e-6
     np.testing.assert_array_equal(ab.eccentricities, expected)

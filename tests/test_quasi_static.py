@@ -233,7 +233,7 @@ def test_cli_te_json_matches_saved_results(tmp_path):
         "no_load_te_pp_arcsec",
         "lost_motion_arcmin",
         "backlash_arcmin",
-        "torsional_rigidity_Nm_per_arcmin",
+        "rigidity_tangent_Nm_per_arcmin",
         "positions",
         "solve_time_s",
         "spectrum_lines",

@@ -89,7 +89,7 @@ def _pin_case(reducer, torque: float, law: str = "palmgren", d_pin_radius=None) 
         "max_pin_force_N": res.max_force,
         "max_hertz_pressure_Pa": res.max_pressure,
         "disc_rotation_rad": res.rotation,
-        "lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD,
+        "pins_share_of_lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD,
         "torsional_stiffness_per_disc_Nm_per_rad": res.torsional_stiffness,
         "torsional_stiffness_all_discs_Nm_per_rad": n_discs * res.torsional_stiffness,
         "pin_resultant_N": float(np.linalg.norm(res.resultant)),
@@ -149,7 +149,7 @@ def _modification_sweep(reducer, torque: float) -> dict:
         out[f"{dr_um:g}um"] = {
             "pins_in_contact": res.n_contact,
             "max_pin_force_N": res.max_force,
-            "lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD,
+            "pins_share_of_lost_motion_arcsec": res.backlash_rotation * ARCSEC_PER_RAD,
         }
     return out
 
@@ -179,8 +179,10 @@ def _torsional(reducer) -> dict:
         "C_W_palmgren_over_crank_angle_Nm_per_rad": {"min": float(cw_tan.min()), "max": float(cw_tan.max())},
         "C_W_seed004_over_crank_angle_Nm_per_rad": {"min": float(cw_seed.min()), "max": float(cw_seed.max())},
         "pins_in_contact": first.n_contact,
-        "model": "seed004 series model: needle bearings (empirical K_Hc) in series with the pin contacts; "
-        "crankshaft, pin bending, carrier and first stage compliances are neglected",
+        "model": "the second stage's series models, not the reducer's rigidity (that is the stiffness budget's): "
+        "seed004's model (needle bearings, empirical K_Hc, in series with seed004's pin contacts) and the same "
+        "with the Palmgren pin-load tangent; both neglect the crank supports, crank bending and torsion, pin "
+        "seats, housing, carrier and its joints, discs and the first stage",
     }
 
 
@@ -342,7 +344,8 @@ def design_report(reducer) -> dict:
     operating point (nested dict of floats/ints/lists/str, SI; keys with
     non-SI-obvious units carry a suffix). Sections: kinematics, involute_stage,
     cycloid_stage, pin_loads (load and rated torque, ideal profile), modification
-    sweep, torsional_stiffness (:cite:`seed004` model), meshing_zone (vs the measured
+    sweep, second_stage_series_models (:cite:`seed004`'s model and the Palmgren series model of
+    the second stage alone; the reducer's rigidity is the stiffness budget's), meshing_zone (vs the measured
     3.06e5 N m/rad of :cite:`seed004`), main_bearing (ball loads, contact angles, Hertz,
     Hamrock–Dowson film, L10)."""
     op = reducer.operating
@@ -361,7 +364,7 @@ def design_report(reducer) -> dict:
     report["pin_loads"] = pins
     report["modification_sweep_rated_torque"] = _modification_sweep(reducer, op.rated_torque_Nm)
     tors = _torsional(reducer)
-    report["torsional_stiffness"] = tors
+    report["second_stage_series_models"] = tors
     report["meshing_zone"] = _meshing_zone(reducer, tors["C_Hc_Nm_per_rad"], SEED004_MEASURED_CW)
     report["meshing_zone"]["note"] = (
         "seed004 procedure; the measured value is the RV-40E's (seed004) and is meaningful only for rv40e"

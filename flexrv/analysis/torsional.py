@@ -759,7 +759,7 @@ def stiffness_budget(
         k_bear += t @ np.array([[kxx, kxy], [kxy, kyy]]) @ t
     nb, nd = reducer.needle_bearing, reducer.second_stage.n_discs
     c_emp = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * M_PER_MM))  # K_Hc = C F^0.1
-    clear = nb.radial_clearance_um * M_PER_UM
+    clear = nb.clearance_per_side
     k_needle = 0.0
     pins = reducer_pin_loads(reducer, torque, crank_angle)
     for k in range(nd):

@@ -120,11 +120,26 @@ def design(
     if warnings:
         report["warnings"] = warnings
     report["stiffness_budget"] = analytic_budget(reducer)
+    report = {
+        "rigidity_tangent_Nm_per_arcmin": report["stiffness_budget"]["rigidity_Nm_per_arcmin"],
+        "rigidity_definition": "tangent at the rated torque of the analytic stiffness budget (every element of the "
+        "torque path in series, flexrv.analysis.budget); the second-stage series models below are not it",
+        **report,
+    }
 
     def render(rep):
+        console.print(
+            f"torsional rigidity (tangent at {rep['stiffness_budget']['torque_Nm']:.6g} N m, stiffness budget): "
+            f"{rep['rigidity_tangent_Nm_per_arcmin']:.4g} N m/arcmin",
+            style="bold",
+        )
         render_nested(
             f"Design report: {reducer.name}",
-            {k: v for k, v in rep.items() if k not in ("warnings", "stiffness_budget")},
+            {
+                k: v
+                for k, v in rep.items()
+                if k not in ("warnings", "stiffness_budget", "rigidity_tangent_Nm_per_arcmin", "rigidity_definition")
+            },
         )
         console.print(
             budget_table(
@@ -138,34 +153,12 @@ def design(
     emit(report, json, render)
 
 
-def budget_dict(compliances: dict[str, float], torque: float) -> dict:
-    """Stiffness budget in engineering units: per element its torsional compliance
-    at the output [arcsec/(N m)] and share [%], the total and the rigidity
-    [N m/arcmin] (``flexrv design`` and ``flexrv te`` print the same dict)."""
-    from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
-
-    total = sum(compliances.values())
-    return {
-        "elements": {
-            k: {"compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD, "share_percent": 100.0 * v / total}
-            for k, v in compliances.items()
-        },
-        "total_compliance_arcsec_per_Nm": total * ARCSEC_PER_RAD,
-        "rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / total,
-        "torque_Nm": torque,
-    }
-
-
 def analytic_budget(reducer, torque: float | None = None) -> dict:
-    """:func:`budget_dict` of :func:`flexrv.analysis.torsional.stiffness_budget` at
-    ``torque`` [N m] (default: the rated torque)."""
-    from flexrv.analysis.torsional import stiffness_budget
+    """The analytic stiffness budget (:func:`flexrv.analysis.budget.stiffness_budget` with the
+    design's elastic bodies) in engineering units (:meth:`flexrv.analysis.budget.Budget.to_dict`)."""
+    from flexrv.analysis.budget import stiffness_budget
 
-    b = stiffness_budget(reducer, torque, bodies=elastic_body_compliances(reducer))
-    out = budget_dict(b.compliances, b.torque)
-    if b.notes:
-        out["notes"] = list(b.notes)
-    return out
+    return stiffness_budget(reducer, torque, bodies=elastic_body_compliances(reducer)).to_dict()
 
 
 def elastic_body_compliances(reducer) -> dict:
@@ -189,20 +182,24 @@ def elastic_body_compliances(reducer) -> dict:
 
 
 def budget_table(title: str, budget: dict) -> Table:
-    """Table element | compliance | share of a :func:`budget_dict`, with the total."""
+    """Table element | compliance | share | in the model of a budget dict
+    (:meth:`flexrv.analysis.budget.Budget.to_dict`), with the totals and the rigidities."""
     table = Table(title=title, title_justify="left")
-    for col, just in (("element", "left"), ("compliance [arcsec/(N m)]", "right"), ("share [%]", "right")):
+    for col, just in (
+        ("element", "left"),
+        ("compliance [arcsec/(N m)]", "right"),
+        ("share [%]", "right"),
+        ("in the model", "left"),
+    ):
         table.add_column(col, justify=just)
     for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
-        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]))
-    table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100")
-    table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "")
-    if "analytic_rigidity_Nm_per_arcmin" in budget:
-        table.add_row(
-            "analytic series model (flexrv design) [N m/arcmin]",
-            fmt(budget["analytic_rigidity_Nm_per_arcmin"]),
-            f"{budget['analytic_difference_percent']:+.3g} % total",
-        )
+        where = "yes" if e["in_model"] else "no: estimate added in series"
+        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]), where)
+    table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100", "")
+    table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "", "")
+    for key, value in budget.items():
+        if key.endswith("_Nm_per_arcmin") and key not in ("rigidity_Nm_per_arcmin",):
+            table.add_row(key[: -len("_Nm_per_arcmin")].replace("_", " ") + " [N m/arcmin]", fmt(value), "", "")
     if budget.get("notes"):
         table.caption = "; ".join(budget["notes"])
     return table

@@ -205,6 +205,12 @@ def stiffness_test_cmd(
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     csv: Path = typer.Option(None, "--csv", help="Also write the loop as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    uncertainty: int = typer.Option(
+        None,
+        "--uncertainty",
+        help="Also propagate the design's [ranges] (estimated inputs) with N samples by the quasi-static route: "
+        "median, 90 % interval and top contributors of the rigidities, lost motion and backlash (uncertainty.json).",
+    ),
 ) -> None:
     """Virtual stiffness test: input locked, output torque 0 -> +rated -> -rated -> 0;
     torsional rigidity, lost motion, hysteresis loop PNG."""
@@ -229,24 +235,29 @@ def stiffness_test_cmd(
         data["csv"] = str(
             export_stiffness_test(csv, res, f"flexrv stiffness-test {preset} --model {model}", quarter_time)
         )
+    if uncertainty is not None:
+        from flexrv.cli.te import uncertainty_report
+        from flexrv.design import load
+
+        data["uncertainty"] = uncertainty_report(load(preset), uncertainty, out, quiet=json)
 
     def render(d):
         from flexrv.cli.design import budget_table
 
-        rows = [(*_label_unit(k), v) for k, v in d.items() if k != "stiffness_budget"]
+        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in ("stiffness_budget", "uncertainty")]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
+        if "uncertainty" in d:
+            from flexrv.cli.te import uncertainty_table
+
+            console.print(uncertainty_table(d["uncertainty"]))
         b = d["stiffness_budget"]
-        if not b["elements"]:
+        if not b.get("elements"):
             for note in b.get("notes", []):
                 console.print(f"note: {note}", style="yellow")
             return
         console.print(
             budget_table(
-                f"stiffness budget (quasi-static model at the test's pose, strain energy) at "
-                f"{b['torque_Nm']:.6g} N m; measured loop rigidity "
-                f"{b['measured_rigidity_Nm_per_arcmin']:.4g} N m/arcmin "
-                f"({b['measured_with_unmodelled_Nm_per_arcmin']:.4g} with the unmodelled "
-                "elements in series)",
+                f"stiffness budget (quasi-static model at the test's pose, strain energy) at {b['torque_Nm']:.6g} N m",
                 b,
             )
         )
@@ -255,29 +266,13 @@ def stiffness_test_cmd(
 
 
 def _budget(res) -> dict:
-    """The stiffness test's budget (Results attribute ``stiffness_budget``,
-    :func:`flexrv.simulation.stiffness_test_budget`) in the units of ``flexrv design``
-    (:func:`flexrv.cli.design.budget_dict`), with the loop's measured rigidity."""
-    import json
+    """The stiffness test's budget stored in its results (:func:`flexrv.analysis.budget.
+    budget_from_dataset`) in engineering units; only its notes if it could not be computed."""
+    from flexrv.analysis.budget import budget_from_dataset
 
-    from flexrv.cli.design import budget_dict
-    from flexrv.units import RAD_PER_ARCMIN
-
-    b = json.loads(res.attrs["stiffness_budget"])
-    if not b["compliances"]:
-        return {
-            "elements": {},
-            "torque_Nm": b["torque"],
-            "notes": b.get("notes", []),
-            "measured_rigidity_Nm_per_arcmin": b["measured_rigidity"] * RAD_PER_ARCMIN,
-        }
-    out = budget_dict(b["compliances"], b["torque"])
-    out["measured_rigidity_Nm_per_arcmin"] = b["measured_rigidity"] * RAD_PER_ARCMIN
-    out["tangent_rigidity_Nm_per_arcmin"] = b["tangent_rigidity"] * RAD_PER_ARCMIN
-    out["measured_with_unmodelled_Nm_per_arcmin"] = b["measured_with_unmodelled_rigidity"] * RAD_PER_ARCMIN
-    if b.get("notes"):
-        out["notes"] = b["notes"]
-    return out
+    if "budget_element" not in res.ds.dims:
+        return {"elements": {}, "notes": [n for n in res.ds.attrs.get("budget_notes", "").split("\n") if n]}
+    return budget_from_dataset(res.ds).to_dict()
 
 
 def _label_unit(key: str) -> tuple[str, str]:

@@ -10,6 +10,9 @@ import typer
 
 from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
 from flexrv.cli.design import analytic_budget, budget_table
+from flexrv.post.definitions import DEFINITIONS, PLAY_FRACTIONS
+from flexrv.post.te import TE_ROWS
+from flexrv.units import RAD_PER_ARCMIN
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -30,6 +33,12 @@ def te(
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     csv: Path = typer.Option(None, "--csv", help="Also write the loaded TE as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    uncertainty: int = typer.Option(
+        None,
+        "--uncertainty",
+        help="Also propagate the design's [ranges] (estimated inputs) with N samples: median, 90 % interval and "
+        "top contributors of the rigidities, lost motion, backlash and TE p-p (uncertainty.json).",
+    ),
 ) -> None:
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
     output torque: loaded and no-load TE, lost motion, backlash, torsional rigidity, contact forces,
@@ -54,19 +63,25 @@ def te(
         output_revolutions=output_revolutions,
         crank_revolutions=crank_revolutions,
         points_per_mesh=points_per_mesh,
+        play_fractions=PLAY_FRACTIONS,
     )
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)
-    save_te(ds, summary, reducer, out)
+    budget = quasi_static_budget(summary, result.outputs, reducer)
+    save_te(budget.merged_into(ds), summary, reducer, out)
     te_plots(ds, summary, out)
-    data = {"output_dir": str(out), **summary}
+    data = {"output_dir": str(out), **summary, "stiffness_budget": budget.to_dict()}
     if csv is not None:  # the loaded TE in the measured-data format (flexrv.measured.writer)
         from flexrv.measured.writer import export_te
 
         data["csv"] = str(export_te(csv, result, reducer.name, f"flexrv te {preset} --torque-nm {result.torque:.17g}"))
-    data["stiffness_budget"] = quasi_static_budget(summary, result.outputs, reducer)
+    c_added = sum(budget.added.values()) / RAD_PER_ARCMIN  # arcmin per N m
+    for key in [k for k in summary if k.startswith("rigidity_") and k.endswith("_Nm_per_arcmin")]:
+        data[key[: -len("_Nm_per_arcmin")] + "_with_added_Nm_per_arcmin"] = 1.0 / (1.0 / summary[key] + c_added)
+    if uncertainty is not None:
+        data["uncertainty"] = uncertainty_report(reducer, uncertainty, out, quiet=json)
     analytic = analytic_budget(reducer, summary["torque_Nm"])
-    data["stiffness_budget"]["analytic_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
+    data["stiffness_budget"]["analytic_budget_rigidity_Nm_per_arcmin"] = analytic["rigidity_Nm_per_arcmin"]
     data["stiffness_budget"]["analytic_difference_percent"] = 100.0 * (
         analytic["total_compliance_arcsec_per_Nm"] / data["stiffness_budget"]["total_compliance_arcsec_per_Nm"] - 1.0
     )
@@ -76,11 +91,12 @@ def te(
             ("loaded TE p-p", d["te_pp_arcsec"], "arcsec"),
             ("loaded TE mean", d["te_mean_arcsec"], "arcsec"),
             ("no-load TE p-p", d["no_load_te_pp_arcsec"], "arcsec"),
-            ("lost motion (±3 % rated)", d["lost_motion_arcmin"], "arcmin"),
-            (f"backlash (±{d['no_load_torque_Nm']:.3g} N m)", d["backlash_arcmin"], "arcmin"),
-            ("rigidity, tangent", d["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("rigidity, 50-100 % rated", d["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-            ("rigidity, 3-50 % rated (low torque)", d.get("low_torque_rigidity_Nm_per_arcmin"), "N m/arcmin"),
+            *[(k, d.get(k), DEFINITIONS[k][0]) for k in TE_ROWS],
+            (
+                f"lost_motion_small_torque (±{d['no_load_torque_Nm']:.3g} N m)",
+                d["lost_motion_small_torque_arcmin"],
+                "arcmin",
+            ),
             ("max pin force", d.get("max_pin_force_N"), "N"),
             ("positions", d["positions"], "-"),
             ("solve time", d["solve_time_s"], "s"),
@@ -94,33 +110,62 @@ def te(
         )
         lines = [(f"{x['label']}", x["amplitude_arcsec"], f"order {x['order']:.4g}") for x in d["spectrum_lines"]]
         console.print(kv_table("largest TE lines [arcsec]", lines))
+        if "uncertainty" in d:
+            console.print(uncertainty_table(d["uncertainty"]))
 
     emit(data, json, render)
 
 
-def quasi_static_budget(summary: dict, outputs: dict, reducer=None) -> dict:
-    """Stiffness budget of the quasi-static solution in the elements of ``flexrv
-    design`` (:func:`flexrv.cli.design.budget_dict`): each force group's share of the
-    tangent compliance 1 / k_t (strain-energy fractions,
-    :meth:`flexrv.model.quasi_static.StaticModel.compliance_budget`) times 1 / k_t;
-    the crank-support group (bearings and crank bending in series, one element) is
-    split by its bending share of the tangential compliance (output
-    ``crank_bending_fraction``, mean over positions and cranks); with the ``reducer``,
-    the pin path split and the unmodelled housing added
-    (:func:`flexrv.analysis.torsional.budget_from_group_shares`)."""
-    from flexrv.analysis.torsional import budget_from_group_shares
-    from flexrv.cli.design import budget_dict
-    from flexrv.units import RAD_PER_ARCMIN
+def quasi_static_budget(summary: dict, outputs: dict, reducer):
+    """The stiffness budget of the quasi-static solution (:func:`flexrv.analysis.budget.
+    stiffness_budget` with the model's strain-energy shares, :meth:`flexrv.model.quasi_static.
+    StaticModel.compliance_budget`, times its tangent compliance; the crank-support group split
+    by the mean of the output ``crank_bending_fraction``); the elements no model contains are
+    added in series."""
+    from flexrv.analysis.budget import ModelShares, stiffness_budget
 
-    total = RAD_PER_ARCMIN / summary["torsional_rigidity_Nm_per_arcmin"]
-    shares = {k: 0.01 * v for k, v in summary.get("compliance_budget_percent", {}).items()}
     bend = outputs.get("crank_bending_fraction")
-    frac = float(np.nanmean(bend.values)) if bend is not None else 0.0
-    comp, notes = budget_from_group_shares(shares, total, frac, reducer, summary["torque_Nm"])
-    out = budget_dict(comp, summary["torque_Nm"])
-    if notes:
-        out["notes"] = list(notes)
-    return out
+    model = ModelShares(
+        shares={k: 0.01 * v for k, v in summary.get("compliance_budget_percent", {}).items()},
+        tangent_compliance=RAD_PER_ARCMIN / summary["rigidity_tangent_Nm_per_arcmin"],
+        bending_fraction=float(np.nanmean(bend.values)) if bend is not None else 0.0,
+    )
+    return stiffness_budget(reducer, summary["torque_Nm"], model=model, route="quasi_static")
+
+
+def uncertainty_report(reducer, n: int, out: Path, quiet: bool = False) -> dict:
+    """:func:`flexrv.studies.uncertainty.design_uncertainty` with ``n`` samples, written to
+    ``out/uncertainty.json``; returns it without the per-sample table."""
+    import json as _json
+
+    from flexrv.cache import atomic_write_text, to_jsonable
+    from flexrv.studies.uncertainty import design_uncertainty
+
+    def progress(i, total):
+        if not quiet:
+            console.print(f"uncertainty sample {i}/{total}", end="\r")
+
+    res = design_uncertainty(reducer, n, progress=progress)
+    atomic_write_text(Path(out) / "uncertainty.json", _json.dumps(to_jsonable(res), indent=2))
+    return {k: v for k, v in res.items() if k != "samples"}
+
+
+def uncertainty_table(u: dict):
+    """Table output | median | 5 % | 95 % | top contributors (SRC^2) of an uncertainty report."""
+    from rich.table import Table
+
+    table = Table(title=f"prediction intervals from the estimated inputs ({u['n']} samples)", title_justify="left")
+    for col in ("output", "median", "5 %", "95 %", "top contributors (SRC^2)"):
+        table.add_column(col)
+    for name, r in u["outputs"].items():
+        if not r.get("n"):
+            continue
+        c = r.get("contributors") or {}
+        top = ", ".join(f"{k} {v:.2f}" for k, v in list(c.get("src2", {}).items())[:3])
+        table.add_row(name, f"{r['median']:.4g}", f"{r['p05']:.4g}", f"{r['p95']:.4g}", top)
+    if u.get("failed"):
+        table.caption = f"{len(u['failed'])} samples failed (see uncertainty.json)"
+    return table
 
 
 def register(app: typer.Typer) -> None:

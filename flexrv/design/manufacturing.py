@@ -133,10 +133,16 @@ class ClearanceErrors(_Strict):
     """Bearing clearances: needle bearings [crank][disc], crank supports per crank."""
 
     needle_extra_clearance_um: float | list[list[float]] = _meta(
-        "crank_disc", "disp", "Added to the design's needle radial clearance (total >= 0) [um]"
+        "crank_disc",
+        "disp",
+        "Added to each side's gap of the needle bearing, half the design's radial internal clearance (ISO 5593 "
+        "total play); the gap stays >= 0 [um]",
     )
     support_clearance_um: float | list[float] = _meta(
-        "crank", "clear", "Radial clearance of each crank's support bearings [um]"
+        "crank",
+        "clear",
+        "Free radial travel of each crank in its support bearings from the centred position, per side: half "
+        "their radial internal clearance as ISO 5593 defines it (the total play) [um]",
     )
 
 
@@ -327,7 +333,7 @@ class ManufacturingErrors(_Strict):
                     _length(f"{path}.{name}", value, n, f"one list per crank, N = {n}")
                     for j, row in enumerate(value):
                         _length(f"{path}.{name}[{j}]", row, nd, f"one value per disc, n_discs = {nd}")
-        c0 = reducer.needle_bearing.radial_clearance_um
+        c0 = 0.5 * reducer.needle_bearing.radial_clearance_um  # the per-side gap the extra clearance adds to
         extra = self.clearances.needle_extra_clearance_um
         rows = extra if isinstance(extra, list) else [[extra]]
         for j, row in enumerate(rows):

@@ -369,7 +369,17 @@ class NeedleBearing(_Strict):
     roller_count: int = Field(ge=6, le=80)
     roller_diameter_mm: float = Field(gt=0.5, le=50.0)
     roller_length_mm: float = Field(gt=0.5, le=100.0)
-    radial_clearance_um: float = Field(ge=0.0, le=100.0)
+    radial_clearance_um: float = Field(
+        ge=0.0,
+        le=100.0,
+        description="Radial internal clearance as ISO 5593 defines it: the total radial play of the eccentric "
+        "in its hole (diametral, one extreme position to the opposite one) [um]; each side has half",
+    )
+
+    @property
+    def clearance_per_side(self) -> float:
+        """Half the radial internal clearance [m]: the gap on one side with the eccentric centred."""
+        return 0.5 * self.radial_clearance_um * M_PER_UM
     model: Literal["empirical", "rollers"] = Field(description="seed004 empirical stiffness or roller-resolved Hertz")
 
 
@@ -860,6 +870,58 @@ class OperatingPoint(_Strict):
         return self.input_speed_rpm * 2.0 * math.pi / 60.0
 
 
+class PathEstimates(_Strict):
+    """Estimated inputs of the torque-path compliances no model contains yet
+    (:mod:`flexrv.analysis.path_compliances`): carrier pillar joints, support-bearing rings,
+    planet spline (the crank torsion needs only the crank's geometry)."""
+
+    carrier_joint_torque_fraction: float = Field(
+        gt=0.0, le=1.0, description="Fraction of the output torque that passes the pillar-to-plate joints [-]"
+    )
+    carrier_joint_clamp_length_mm: float = Field(
+        gt=0.5, le=300.0, description="Clamp length l_K of a pillar joint's bolt (VDI 2230) [mm]"
+    )
+    carrier_joint_compliance_factor: float = Field(
+        ge=1.0, le=10.0, description="Joint's bending resilience over VDI 2230's solid substitute body [-]"
+    )
+    support_ring_seat_factor: float = Field(
+        gt=0.0,
+        le=10.0,
+        description="Winkler modulus of the support rings' seats over E b / R [-]",
+    )
+    planet_spline_teeth: int = Field(ge=6, le=200, description="Teeth of the planet-to-crank spline [-]")
+    planet_spline_engaged_fraction: float = Field(
+        gt=0.0, le=1.0, description="Fraction of the spline's teeth that carry load [-]"
+    )
+    spline_tooth_stiffness_N_per_mm_um: float = Field(
+        gt=0.5, le=50.0, description="Stiffness of one engaged tooth pair per unit face width c' [N/(mm um)]"
+    )
+
+
+class PlausibleRange(_Strict):
+    """The plausible range of an estimated value and why (the prediction intervals sample it)."""
+
+    low: float
+    high: float
+    reason: str = Field(min_length=3)
+
+
+def field_value(reducer, path: str):
+    """The value of a dotted field path of a design (``section.field``; None inside an optional
+    table the design leaves out), or raise ValueError."""
+    obj = reducer
+    for part in path.split("."):
+        if obj is None:  # an optional table the design leaves out: the field is unused
+            return None
+        if isinstance(obj, dict) and part in obj:
+            obj = obj[part]
+        elif hasattr(obj, part) and not part.startswith("_"):
+            obj = getattr(obj, part)
+        else:
+            raise _bad(f"ranges.{path!r}", path, "must name a numeric field of the design (section.field)")
+    return obj
+
+
 # --------------------------------------------------------------------------- reducer
 from flexrv.design.manufacturing import ManufacturingErrors  # noqa: E402
 
@@ -898,15 +960,26 @@ class Reducer(_Strict):
         "ring around the pins; optional: without it the pins "
         "are rigidly seated and the housing rigid",
     )
+    path_estimates: PathEstimates | None = Field(
+        default=None,
+        description="Estimated inputs of the torque-path compliances no model contains yet (carrier joints, "
+        "support-bearing rings, planet spline); optional: without it the budget leaves them out",
+    )
+    ranges: dict[str, PlausibleRange] = Field(
+        default_factory=dict,
+        description="field path -> plausible range of an estimated value with its reason (prediction intervals)",
+    )
 
     @model_serializer(mode="wrap")
     def _omit_absent_carrier(self, handler):
         """A design without a [carrier] table dumps without the key (TOML has no null)."""
         data = handler(self)
         if isinstance(data, dict):
-            for key in ("carrier", "housing"):
+            for key in ("carrier", "housing", "path_estimates"):
                 if key in data and data[key] is None:
                     data.pop(key)
+            if "ranges" in data and not data["ranges"]:
+                data.pop("ranges")
         return data
 
     def material(self, part: str) -> Material:
@@ -917,7 +990,19 @@ class Reducer(_Strict):
     def crank_hole_radius(self) -> float:
         """Radius of a crank-bearing hole in the disc = needle outer raceway [m]."""
         nb, cs = self.needle_bearing, self.crankshaft
-        return 0.5e-3 * (cs.eccentric_journal_diameter_mm + 2.0 * nb.roller_diameter_mm) + nb.radial_clearance_um * 1e-6
+        return 0.5e-3 * (cs.eccentric_journal_diameter_mm + 2.0 * nb.roller_diameter_mm) + nb.clearance_per_side
+
+    @model_validator(mode="after")
+    def _ranges(self) -> "Reducer":
+        """A range names a numeric field (or an unused optional one) and has low < high; the
+        value itself may leave it (an override, a sweep)."""
+        for path, r in self.ranges.items():
+            value = field_value(self, path)
+            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+                raise _bad(f"ranges.{path!r}", value, "must name a numeric field of the design")
+            if not r.low < r.high:
+                raise _bad(f"ranges.{path!r}", [r.low, r.high], "must have low < high")
+        return self
 
     @model_validator(mode="after")
     def _cross(self) -> "Reducer":

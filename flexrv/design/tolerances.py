@@ -235,7 +235,7 @@ def field_info(reducer, key: str) -> FieldInfo:
     if bound == "clear":
         lower = 0.0
     elif key == "clearances.needle_extra_clearance_um":
-        lower = -reducer.needle_bearing.radial_clearance_um
+        lower = -0.5 * reducer.needle_bearing.radial_clearance_um
     return FieldInfo(key, unit, shape, lab, vector, lower)
 
 

@@ -566,9 +566,10 @@ def ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, step
 
 
 def _catalog_levels(
-    sm: StaticModel, th: float, q: np.ndarray, torque: float, rated: float, t_small: float
+    sm: StaticModel, th: float, q: np.ndarray, torque: float, rated: float, t_small: float, play=()
 ) -> dict[str, float]:
-    """Output angles at rated, half, +3 %, +T0, -3 % and -T0 torque at one input
+    """Output angles at rated, half, +3 %, +T0, -3 % and -T0 torque, and at +-f rated for each
+    fraction f of ``play`` (keys ("plus", f) / ("minus", f)), at one input
     angle (input locked). The reversed load starts from the mirror image of the
     +3 % pose about the kinematic pose (symmetric clearances give nearly that)
     instead of creeping through the clearances; where that fails (errors make the
@@ -581,6 +582,9 @@ def _catalog_levels(
         levels[name] = q[sm.i_theta]
         if name == "plus3":
             q_plus3 = q
+    for f in sorted(play, reverse=True):
+        q = ramp_to(sm, th, q, f * rated, steps=1)
+        levels["plus", f] = q[sm.i_theta]
     q_kin = sm.kinematic_pose(th)
     sm.torque = -0.03 * rated
     try:
@@ -590,6 +594,9 @@ def _catalog_levels(
     levels["minus3"] = q[sm.i_theta]
     q = ramp_to(sm, th, q, -t_small, steps=2)
     levels["minus0"] = q[sm.i_theta]
+    for f in sorted(play, reverse=True):
+        q = ramp_to(sm, th, q, -f * rated, steps=1)
+        levels["minus", f] = q[sm.i_theta]
     return levels
 
 
@@ -602,12 +609,15 @@ def loaded_te(
     no_load_fraction: float = 1e-2,
     catalog_positions: int = 6,
     options: dict | None = None,
+    play_fractions: tuple = (),
     progress=None,
 ) -> LoadedTE:
     """Loaded and no-load TE over the requested input range, catalog lost motion,
     backlash and rigidity (see module docstring).
 
-    ``torque`` [N m] defaults to the design's rated torque; it must be positive and
+    ``play_fractions``: fractions of the rated torque at which the play between -f and +f
+    is read too (catalog ``play_positions_rad``; the geometric backlash's extrapolation,
+    :mod:`flexrv.post.definitions`). ``torque`` [N m] defaults to the design's rated torque; it must be positive and
     at most 3x the rated torque (beyond that the Hertz laws leave their range).
     """
     from flexrv.model.base import Output
@@ -659,15 +669,16 @@ def loaded_te(
     # catalog quantities at a few converged positions spread over the range
     good = np.flatnonzero(ok)
     cat_idx = good[np.unique(np.linspace(0, len(good) - 1, max(1, min(catalog_positions, len(good)))).astype(int))]
-    lm, bl, k_sec, k_tan, budgets, k_low = [], [], [], [], [], []
+    lm, bl, k_sec, k_tan, budgets, k_low, plays = [], [], [], [], [], [], []
     for i in cat_idx:
         try:
-            levels = _catalog_levels(sm, angles[i], qs[i], torque, rated, t_small)
+            levels = _catalog_levels(sm, angles[i], qs[i], torque, rated, t_small, play_fractions)
         except ConvergenceError:
             continue  # reported through the number of catalog positions used
         # output angle under positive load is smaller (the load acts against +theta)
         lm.append(levels["minus3"] - levels["plus3"])
         bl.append(levels["minus0"] - levels["plus0"])
+        plays.append([levels["minus", f] - levels["plus", f] for f in play_fractions])
         k_sec.append(0.5 * rated / (levels["half"] - levels["rated"]))
         k_low.append(0.47 * rated / (levels["plus3"] - levels["half"]))  # secant 3 % -> 50 % rated
         sm.torque = torque
@@ -681,6 +692,8 @@ def loaded_te(
         "backlash_rad": float(np.max(bl)),
         "lost_motion_positions_rad": np.asarray(lm),
         "backlash_positions_rad": np.asarray(bl),
+        "play_positions_rad": np.asarray(plays).reshape(len(plays), len(play_fractions)),  #: at +-play_fractions
+        "play_fractions": np.asarray(play_fractions, dtype=float),
         "rigidity_secant_Nm_per_rad": float(np.mean(k_sec)),
         "rigidity_low_Nm_per_rad": float(np.mean(k_low)),
         "rigidity_tangent_Nm_per_rad": float(np.mean(k_tan)),

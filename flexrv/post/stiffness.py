@@ -175,33 +175,25 @@ def stiffness_summary_markdown(
     ]
     if plot:
         lines += [f"![torque vs output rotation loop]({plot})", ""]
-    if budget and not budget.get("compliances"):
-        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
-    elif budget:
-        from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
-
-        comp = budget["compliances"]
-        total = sum(comp.values())
+    if budget:
         lines += [
-            f"## Stiffness budget at {budget['torque']:.4g} N m",
+            f"## Stiffness budget at {budget['torque_Nm']:.4g} N m",
             "",
             "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
-            "stiffness_test_budget), the same elements as `flexrv te` and `flexrv design`.",
+            "stiffness_test_budget, flexrv.analysis.budget), the same elements as `flexrv te` and `flexrv design`; "
+            "elements no model contains are added in series from their analytic estimates.",
             "",
-            "| element | compliance [arcsec/(N m)] | share [%] |",
-            "|---|---|---|",
+            "| element | compliance [arcsec/(N m)] | share [%] | in the model |",
+            "|---|---|---|---|",
         ]
-        for name, c in sorted(comp.items(), key=lambda kv: -kv[1]):
-            lines.append(f"| {name.replace('_', ' ')} | {c * ARCSEC_PER_RAD:.4g} | {100 * c / total:.3g} |")
-        lines += [
-            f"| total | {total * ARCSEC_PER_RAD:.4g} | 100 |",
-            "",
-            f"Budget rigidity {RAD_PER_ARCMIN / total:.4g} N m/arcmin; measured in the loop (50-100 % T_r) "
-            f"{budget['measured_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin, "
-            f"{budget['measured_with_unmodelled_rigidity'] * RAD_PER_ARCMIN:.4g} N m/arcmin with the elements "
-            f"the model does not contain ({', '.join(budget['unmodelled']) or 'none'}) in series.",
-        ]
-        lines += [f"Note: {n}" for n in budget.get("notes", [])] + [""]
+        for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
+            lines.append(
+                f"| {name} | {e['compliance_arcsec_per_Nm']:.4g} | {e['share_percent']:.3g} | "
+                f"{'yes' if e['in_model'] else 'no (estimate)'} |"
+            )
+        lines += [f"| total | {budget['total_compliance_arcsec_per_Nm']:.4g} | 100 | |", ""]
+        lines += [f"- {k}: {v:.4g} N m/arcmin" for k, v in budget.items() if k.endswith("_Nm_per_arcmin")]
+        lines += [""] + [f"Note: {n}" for n in budget.get("notes", [])] + [""]
     lines += [
         "Files: results.nc (the run plus the figures as variables with units, and the loop), "
         "stiffness.json, config.toml.",

@@ -15,7 +15,8 @@ import numpy as np
 import xarray as xr
 
 from flexrv.cache import atomic_path, atomic_write_text, to_jsonable
-from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
+from flexrv.post import definitions as defs
+from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
 
 def te_dataset(result, reducer) -> xr.Dataset:
@@ -42,8 +43,36 @@ def te_dataset(result, reducer) -> xr.Dataset:
     }
     for name, o in result.outputs.items():
         data[name] = (o.dims, np.asarray(o.values), {"units": o.units, "long_name": o.long_name})
+    c = result.catalog
+    for name, key, long in (
+        ("catalog_lost_motion", "lost_motion_positions_rad", "rotation between -3 % and +3 % rated torque"),
+        (
+            "catalog_lost_motion_small",
+            "backlash_positions_rad",
+            "rotation between -T0 and +T0 (T0 = no_load_torque_Nm)",
+        ),
+    ):
+        data[name] = (
+            ("catalog_position",),
+            np.asarray(c[key]) * ARCMIN_PER_RAD,
+            {"units": "arcmin", "long_name": long},
+        )
+    play = np.asarray(c.get("play_positions_rad", np.zeros((len(c["lost_motion_positions_rad"]), 0))))
+    data["catalog_play"] = (
+        ("catalog_position", "play_fraction"),
+        play * ARCMIN_PER_RAD,
+        {"units": "arcmin", "long_name": "rotation between -f T_r and +f T_r (input locked)"},
+    )
     ds = xr.Dataset(
-        data, coords={"position": ("position", result.input_angle, {"units": "rad", "long_name": "input angle"})}
+        data,
+        coords={
+            "position": ("position", result.input_angle, {"units": "rad", "long_name": "input angle"}),
+            "play_fraction": (
+                "play_fraction",
+                np.asarray(c.get("play_fractions", np.zeros(0)), dtype=float),
+                {"units": "1", "long_name": "fraction of the rated torque of the play"},
+            ),
+        },
     )
     s = result.summary()
     ds.attrs.update(
@@ -52,6 +81,7 @@ def te_dataset(result, reducer) -> xr.Dataset:
             "kind": "quasi-static loaded TE",
             "ratio": result.ratio,
             "torque_Nm": result.torque,
+            "rated_torque_Nm": reducer.operating.rated_torque_Nm,
             "orders": json.dumps(result.orders),
             "summary": json.dumps(to_jsonable(s)),
         }
@@ -104,9 +134,66 @@ def spectrum_lines(order, amp, orders: dict[str, float], count: int = 8, harmoni
     return out
 
 
+#: the quasi-static model's summary keys replaced by the named figures
+_UNNAMED = (
+    "torsional_rigidity_Nm_per_arcmin",
+    "catalog_rigidity_Nm_per_arcmin",
+    "low_torque_rigidity_Nm_per_arcmin",
+)
+
+
+def named_figures(ds: xr.Dataset, s: dict) -> dict:
+    """The named figures (:mod:`flexrv.post.definitions`) of the quasi-static route: the
+    plays at +-3 %, +-T0 and +-T0/2 of each catalog position (input locked) give the lost
+    motions and the geometric backlash (from T0/2 and T0,
+    :func:`flexrv.post.definitions.extrapolated_play`, per position, the largest over the
+    positions as for the lost motion); the rigidities are the
+    model's tangent (condensed Jacobian, at the operating torque), its 50-100 % and 3-50 %
+    secants, and the loop secant 2 T_r / (theta(+T_r) - theta(-T_r)) of the loop these make
+    with the largest lost motion, the loading branches point-symmetric:
+    theta(+T_r) - theta(-T_r) = 2 (0.47 T_r / k_low + 0.5 T_r / k_50_100) + lost motion."""
+    rated = float(ds.attrs.get("rated_torque_Nm", s["torque_Nm"]))
+    t0 = float(s["no_load_torque_Nm"])
+    lm = ds["catalog_lost_motion"].values
+    small = ds["catalog_lost_motion_small"].values
+    k50 = s["catalog_rigidity_Nm_per_arcmin"]
+    k_low = s.get("low_torque_rigidity_Nm_per_arcmin", float("nan"))
+    span = 2.0 * ((0.5 - defs.LOST_MOTION_FRACTION) * rated / k_low + 0.5 * rated / k50) + float(np.max(lm))
+    out = {
+        "rigidity_tangent_Nm_per_arcmin": s["torsional_rigidity_Nm_per_arcmin"],
+        "rigidity_slope_50_100_Nm_per_arcmin": k50,
+        "rigidity_low_torque_Nm_per_arcmin": k_low,
+        "rigidity_loop_secant_Nm_per_arcmin": defs.loop_secant(rated, span),
+        "lost_motion_arcmin": float(np.max(lm)),
+        "lost_motion_small_torque_arcmin": float(np.max(small)),
+        "backlash_arcmin": _backlash(ds, rated),
+        "tangent_torque_Nm": s["torque_Nm"],
+    }
+    if abs(t0 - defs.ONE_PERCENT * rated) <= 1e-9 * rated:
+        out["lost_motion_1pct_arcmin"] = out["lost_motion_small_torque_arcmin"]
+    out.update(defs.te_figures(ds["position"].values, ds["te"].values / ARCSEC_PER_RAD))
+    for key in _UNNAMED:
+        s.pop(key, None)
+    s.pop("backlash_arcmin", None)
+    return out
+
+
+def _backlash(ds: xr.Dataset, rated: float) -> float:
+    """The geometric backlash of the quasi-static route: the plays at the two smallest
+    ``play_fraction`` of each catalog position extrapolated to zero torque, the largest over
+    the positions (NaN without two play fractions)."""
+    if ds.sizes.get("play_fraction", 0) < 2:
+        return float("nan")
+    f = ds["play_fraction"].values
+    p = ds["catalog_play"].values
+    (i1, i2) = np.argsort(f)[:2]
+    return float(np.max(defs.extrapolated_play(f[i1] * rated, p[:, i1], f[i2] * rated, p[:, i2])))
+
+
 def te_summary(ds: xr.Dataset) -> dict:
     """The numbers ``flexrv te --json`` prints (keys name their unit)."""
     s = json.loads(ds.attrs["summary"])
+    s.update(named_figures(ds, s))
     revs = float(ds["output_revolutions"].values[-1] - ds["output_revolutions"].values[0])
     n = ds.sizes["position"]
     revs = revs * n / max(n - 1, 1)  # the positions span [0, revs) with n uniform points
@@ -128,6 +215,17 @@ def te_summary(ds: xr.Dataset) -> dict:
     return s
 
 
+#: the named figures of a te run's summary table
+TE_ROWS = (
+    "rigidity_tangent_Nm_per_arcmin",
+    "rigidity_slope_50_100_Nm_per_arcmin",
+    "rigidity_low_torque_Nm_per_arcmin",
+    "rigidity_loop_secant_Nm_per_arcmin",
+    "lost_motion_arcmin",
+    "backlash_arcmin",
+)
+
+
 def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
     """summary.md of a ``flexrv te`` run, every number from ``summary``."""
     s = summary
@@ -135,14 +233,11 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
         ("loaded TE, peak to peak", s["te_pp_arcsec"], "arcsec"),
         ("loaded TE, mean (wind-up)", s["te_mean_arcsec"], "arcsec"),
         ("no-load TE, peak to peak", s["no_load_te_pp_arcsec"], "arcsec"),
-        ("lost motion (±3 % rated torque)", s["lost_motion_arcmin"], "arcmin"),
-        (f"backlash (±{s['no_load_torque_Nm']:.3g} N m)", s["backlash_arcmin"], "arcmin"),
-        ("torsional rigidity, tangent at the torque", s["torsional_rigidity_Nm_per_arcmin"], "N m/arcmin"),
-        ("torsional rigidity, 50–100 % rated (catalog)", s["catalog_rigidity_Nm_per_arcmin"], "N m/arcmin"),
+        *[(f"`{k}`: {defs.DEFINITIONS[k][1]}", s.get(k, float("nan")), defs.DEFINITIONS[k][0]) for k in TE_ROWS],
         (
-            "torsional rigidity, 3–50 % rated (low torque)",
-            s.get("low_torque_rigidity_Nm_per_arcmin", float("nan")),
-            "N m/arcmin",
+            f"`lost_motion_small_torque_arcmin`: rotation between ±{s['no_load_torque_Nm']:.3g} N m",
+            s["lost_motion_small_torque_arcmin"],
+            "arcmin",
         ),
         ("max pin force", s.get("max_pin_force_N"), "N"),
         ("max needle-bearing force", s.get("max_needle_force_N"), "N"),
@@ -187,10 +282,10 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
         lines.append(f"| {line['order']:.4g} | {line['amplitude_arcsec']:.3g} | {line['label']} |")
     lines += [
         "",
-        f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; lost "
-        "motion and backlash are the output rotations between the reversed loads at ±3 % of the rated torque "
-        f"and at ±{s['no_load_torque_Nm']:.3g} N m with the input locked (largest over the evaluated "
-        f"positions); rigidity in N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad).",
+        f"Definitions: TE = theta_out - theta_in / i; no-load TE at {s['no_load_torque_Nm']:.3g} N m; every "
+        "other figure is named by its definition (flexrv.post.definitions, docs/definitions.md); lost motion "
+        "and backlash are read with the input locked, the largest over the evaluated positions; the tangent "
+        f"at {s['tangent_torque_Nm']:.6g} N m; rigidity in N m/arcmin (1 arcmin = {RAD_PER_ARCMIN:.4e} rad).",
     ]
     return "\n".join(lines) + "\n"
 

@@ -1,0 +1,168 @@
+"""Compliances of the torque path that no dynamic or quasi-static model contains yet, each a
+closed form referred to the output [rad/(N m)]; the analytic budget lists them as elements,
+the model routes add them in series (:func:`flexrv.analysis.budget.stiffness_budget`).
+
+* ``crank_torsion``: St. Venant torsion of each crank between its planet spline and its
+  eccentrics. The crank torque is M_c = T / (N z_rp) (virtual work: with the planets held by
+  the mesh, an eccentric turned by Delta relative to its planet turns the output by
+  Delta / z_rp, the second stage's ratio of crank rotation relative to the carrier to
+  carrier rotation, :mod:`flexrv.geometry.kinematics`). Energy-equivalent length of the
+  stepped shaft, torque profile m(x) = M(x)/M_c: the spline feeds it in uniformly over the
+  gear seat (int (x/L)^2 = L/3), the support journal carries it whole, the two eccentrics
+  take half each, uniformly (7 L_e / 12 and L_e / 12):
+  c_crank = (1/G) [L_s / (3 J_s) + L_a / J_a + 2 L_e / (3 J_e)], J = pi d^4 / 32
+  :cite:`timoshenko1970`; each eccentric journal twists about its own centroid (the offset
+  adds bending, not twist). At the output: c = c_crank / (N z_rp^2).
+* ``planet_spline``: the N splines with z_sp teeth, a fraction f engaged, each engaged tooth
+  pair of stiffness c' per unit face width (ISO 6336's single-pair stiffness used as the
+  spline tooth's, an estimate) on the mean radius r_m = seat diameter / 2 over the seat length
+  b: k = f z_sp c' b r_m^2 per crank :cite:`iso6336`; at the output 1 / (k N z_rp^2).
+* ``support_bearing_rings``: the cup and the cone of each support bearing bend as rings on
+  the elastic foundation of their seats (carrier bore, crank journal). A roller load Q on a
+  ring of bending stiffness E I (I = b h^3 / 12, b the roller length, h the wall) on a Winkler
+  foundation of modulus k deflects it by Q beta / (2 k), beta = (k / (4 E I))^(1/4)
+  :cite:`hetenyi1946` (the infinite beam: the ring's circumference is many 1/beta); the seat's
+  modulus is k = phi E b / R (phi, preset ``support_ring_seat_factor``, an order-of-magnitude
+  estimate). The most loaded roller carries Q_max = 4.08 F / (Z cos alpha) of a bearing's
+  radial load F (Stribeck's line-contact factor without clearance :cite:`harris2007`), so a
+  bearing's rings give c_r = 4.08 / (Z cos alpha) sum_rings beta / (2 k); the two bearings of
+  a crank in parallel, the N cranks on the crank circle a_w: c = c_r / (2 N a_w^2). Ring
+  walls from the bearing's geometry: the cup from the outer raceway d_m/2 + D/2 to the crank
+  bore, the cone from the support journal to the inner raceway d_m/2 - D/2.
+* ``carrier_joints``: each pillar is bolted to a plate; the joint turns under the pillar's
+  end moment with the compliance c_phi = kappa l_K / (E I_j) of VDI 2230's bending
+  resilience of the clamped parts :cite:`vdi2230`, with the substitute body the pillar's
+  section (I_j = pi d_p^4 / 64), l_K the clamp length and kappa >= 1 the joint's excess
+  over the solid body (contact, dowel fits; an estimate). A pillar of length L (the plate
+  gap), clamped at its other end, sheared by V between plates that do not turn: slope-
+  deflection gives delta / V = L^3 / (12 E I) (1 + 4 kc) / (1 + kc) with k = E I / L, so the
+  joint adds Delta = L^3 / (12 E I) * 3 kc / (1 + kc). A fraction f_T of the output torque
+  passes the joints (the rest goes from the cranks' supports straight into the output plate;
+  an estimate): V = f_T T / (N_p R_p) per pillar, and the joints' strain energy
+  N_p Delta V^2 / 2 = c T^2 / 2 gives c = f_T^2 Delta / (N_p R_p^2).
+"""
+
+from __future__ import annotations
+
+import math
+
+from flexrv.units import M_PER_MM
+
+#: Stribeck's factor: the most loaded roller of a line-contact bearing without clearance carries 4.08 F / (Z cos alpha)
+STRIBECK_LINE = 4.08
+
+
+def shear_modulus(material) -> float:
+    """G = E / (2 (1 + nu)) [Pa] of an isotropic material."""
+    return material.youngs_modulus / (2.0 * (1.0 + material.poisson_ratio))
+
+
+def polar_moment(d: float) -> float:
+    """J = pi d^4 / 32 [m^4] of a solid circle of diameter d [m]."""
+    return math.pi * d**4 / 32.0
+
+
+def crank_torsion_compliance(reducer) -> float:
+    """c_crank [rad/(N m)] of one crank between its spline and its eccentrics (module docstring)."""
+    cs = reducer.crankshaft
+    g = shear_modulus(reducer.material("crankshaft"))
+    ls, ds = cs.gear_seat_length_mm * M_PER_MM, cs.gear_seat_diameter_mm * M_PER_MM
+    la, da = cs.support_journal_length_mm * M_PER_MM, cs.support_journal_diameter_mm * M_PER_MM
+    le, de = cs.eccentric_journal_length_mm * M_PER_MM, cs.eccentric_journal_diameter_mm * M_PER_MM
+    return (ls / (3.0 * polar_moment(ds)) + la / polar_moment(da) + 2.0 * le / (3.0 * polar_moment(de))) / g
+
+
+def _at_output(c_crank: float, reducer) -> float:
+    """A compliance in each crank's rotation referred to the output: c / (N z_rp^2)."""
+    n = reducer.first_stage.n_planets
+    z_rp = reducer.second_stage.pin_count
+    return c_crank / (n * z_rp**2)
+
+
+def crank_torsion(reducer) -> float:
+    """The cranks' torsion at the output [rad/(N m)]."""
+    return _at_output(crank_torsion_compliance(reducer), reducer)
+
+
+def planet_spline(reducer) -> float:
+    """The planet splines at the output [rad/(N m)]."""
+    pe, cs = reducer.path_estimates, reducer.crankshaft
+    c_prime = pe.spline_tooth_stiffness_N_per_mm_um * 1e9  # N/(mm um) -> N/m^2
+    r_m = 0.5 * cs.gear_seat_diameter_mm * M_PER_MM
+    k = (
+        pe.planet_spline_engaged_fraction
+        * pe.planet_spline_teeth
+        * c_prime
+        * cs.gear_seat_length_mm
+        * M_PER_MM
+        * r_m**2
+    )
+    return _at_output(1.0 / k, reducer)
+
+
+def ring_on_foundation(r_in: float, r_out: float, width: float, youngs: float, seat_factor: float) -> float:
+    """Deflection per roller load [m/N] of a ring between radii r_in and r_out [m] of width
+    ``width`` [m] on its seat's Winkler foundation k = seat_factor E b / R: beta / (2 k),
+    beta = (k / (4 E I))^(1/4) (module docstring)."""
+    h = r_out - r_in
+    if h <= 0.0:
+        raise ValueError(f"ring wall {h * 1e3:.3g} mm must be > 0 (radii {r_in * 1e3:.4g}, {r_out * 1e3:.4g} mm)")
+    k = seat_factor * youngs * width / (0.5 * (r_in + r_out))
+    beta = (k / (4.0 * youngs * width * h**3 / 12.0)) ** 0.25
+    return beta / (2.0 * k)
+
+
+def support_ring_radial_compliance(reducer) -> float:
+    """c_r [m/N] of one support bearing's cup and cone on their seats (module docstring)."""
+    cs, c = reducer.crankshaft, reducer.carrier
+    e = reducer.material("bearing_rings").youngs_modulus
+    phi = reducer.path_estimates.support_ring_seat_factor
+    dm, dw = cs.support_bearing_pitch_diameter_mm * M_PER_MM, cs.support_bearing_roller_diameter_mm * M_PER_MM
+    b = cs.support_bearing_roller_length_mm * M_PER_MM
+    cup = ring_on_foundation(0.5 * (dm + dw), 0.5 * c.crank_bore_diameter_mm * M_PER_MM, b, e, phi)
+    cone = ring_on_foundation(0.5 * cs.support_journal_diameter_mm * M_PER_MM, 0.5 * (dm - dw), b, e, phi)
+    cos_a = math.cos(math.radians(cs.support_bearing_contact_angle_deg))
+    return STRIBECK_LINE / (cs.support_bearing_roller_count * cos_a) * (cup + cone)
+
+
+def support_bearing_rings(reducer) -> float:
+    """The support rings at the output [rad/(N m)]: c_r / (2 N a_w^2)."""
+    n, a_w = reducer.first_stage.n_planets, reducer.first_stage.center_distance
+    return support_ring_radial_compliance(reducer) / (2.0 * n * a_w**2)
+
+
+def joint_shear_compliance(length: float, ei: float, c_phi: float) -> float:
+    """Shear compliance [m/N] a rotational joint spring c_phi [rad/(N m)] adds to a beam of
+    length ``length`` and bending stiffness ``ei`` clamped at its other end, between
+    supports that do not turn: L^3/(12 EI) * 3 kc / (1 + kc), k = EI / L."""
+    kc = ei / length * c_phi
+    return length**3 / (12.0 * ei) * 3.0 * kc / (1.0 + kc)
+
+
+def carrier_joints(reducer) -> float:
+    """The pillar-to-plate joints at the output [rad/(N m)]: f_T^2 Delta / (N_p R_p^2) with
+    Delta the joint's shear compliance (:func:`joint_shear_compliance`) and f_T the
+    fraction of the torque through the joints (module docstring)."""
+    c, pe = reducer.carrier, reducer.path_estimates
+    e = reducer.material("carrier").youngs_modulus
+    i = math.pi * (c.pillar_diameter_mm * M_PER_MM) ** 4 / 64.0
+    c_phi = pe.carrier_joint_compliance_factor * pe.carrier_joint_clamp_length_mm * M_PER_MM / (e * i)
+    delta = joint_shear_compliance(c.plate_gap_mm * M_PER_MM, e * i, c_phi)
+    r_p = c.pillar_circle_radius_mm * M_PER_MM
+    return pe.carrier_joint_torque_fraction**2 * delta / (c.pillar_count * r_p**2)
+
+
+def missing_compliances(reducer) -> dict[str, float]:
+    """The elements of :data:`flexrv.analysis.budget.NOT_IN_MODELS` the design has the data
+    for [rad/(N m)]: crank torsion always; the others with a ``[path_estimates]`` table (and
+    the carrier and tapered-roller supports they need)."""
+    out = {"crank_torsion": crank_torsion(reducer)}
+    if reducer.path_estimates is None:
+        return out
+    out["planet_spline"] = planet_spline(reducer)
+    cs = reducer.crankshaft
+    if reducer.carrier is not None and cs.support_bearing_model == "tapered_rollers":
+        out["support_bearing_rings"] = support_bearing_rings(reducer)
+    if reducer.carrier is not None:
+        out["carrier_joints"] = carrier_joints(reducer)
+    return out
