@@ -82,14 +82,13 @@ def write_te_record(
 
 def export_stiffness_test(path, res, command: str, quarter_time_s: float | None = None) -> Path:
     """The loop of a virtual stiffness test (its Results: ``loop_torque`` [N m], ``loop_angle``
-    [arcmin] over ``time`` [s], read by name; the program's peak torque from its
-    ``stiffness_budget`` attribute) as a ``stiffness_loop`` file labelled simulated."""
-    import json
-
+    [arcmin] over ``time`` [s], read by name; the program's peak torque from the stiffness
+    budget's ``budget_torque_Nm`` attribute, the budget being read at the program's peak) as a
+    ``stiffness_loop`` file labelled simulated."""
     from flexrv.units import RAD_PER_ARCMIN
 
     ds = res.ds
-    peak = json.loads(ds.attrs["stiffness_budget"])["torque"] if "stiffness_budget" in ds.attrs else None
+    peak = float(ds.attrs["budget_torque_Nm"]) if "budget_torque_Nm" in ds.attrs else None
     return write_loop(
         path,
         ds["loop_torque"].values,

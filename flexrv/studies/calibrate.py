@@ -264,9 +264,11 @@ def parse_free(texts: list[str], reducer) -> dict[str, tuple[float, float]]:
 
 
 def estimated_fields(reducer) -> dict[str, tuple[float, float]]:
-    """Candidate free fields: every float field whose provenance starts with "estimate", > 0,
-    that changes no FE body's geometry (a new body per evaluation would cost ~20 s), with the
-    plausible range :data:`DEFAULT_RANGE` x its estimate."""
+    """Candidate free fields: every float field whose provenance starts with "estimate" or that
+    the design's ``[ranges]`` table gives a plausible range, > 0 (a range may start at 0),
+    inside its range, and changing no FE body's geometry (a new body per evaluation would cost
+    ~20 s); the range is the design's ``[ranges]`` entry, else :data:`DEFAULT_RANGE` x the
+    estimate."""
     from flexrv.design import override
     from flexrv.fem.disc import body_design
     from flexrv.meshing.parts import spec_for
@@ -278,17 +280,23 @@ def estimated_fields(reducer) -> dict[str, tuple[float, float]]:
         return out
 
     base = specs(reducer)
+    ranges = getattr(reducer, "ranges", None) or {}
+    names = [k for k, note in reducer.provenance.items() if note.lower().startswith("estimate")]
+    names += [k for k in ranges if k not in names]
     out = {}
-    for name, note in reducer.provenance.items():
-        if not note.lower().startswith("estimate"):
-            continue
+    for name in names:
         try:
             value = field_value(reducer, name)
         except InputError:
             continue
-        if isinstance(value, bool) or not isinstance(value, float) or not value > 0:
+        if isinstance(value, bool) or not isinstance(value, float) or not (value > 0 or name in ranges):
             continue
-        lo, hi = DEFAULT_RANGE[0] * value, DEFAULT_RANGE[1] * value
+        if name in ranges:
+            lo, hi = float(ranges[name].low), float(ranges[name].high)
+        else:
+            lo, hi = DEFAULT_RANGE[0] * value, DEFAULT_RANGE[1] * value
+        if not lo <= value <= hi or not lo < hi:
+            continue
         try:
             if specs(override(reducer, {name: hi})) != base:
                 continue

@@ -120,6 +120,8 @@ def seed004_single_field(field: str, target: float) -> dict:
     est = float(field_value(rv, field))
     lo = 0.0 if field.endswith(("_um", "equidistant_mm")) else SEARCH[0] * est
     hi = SEARCH[1] * est
+    rng = rv.ranges.get(field)
+    plausible = (rng.low, rng.high) if rng is not None else (DEFAULT_RANGE[0] * est, DEFAULT_RANGE[1] * est)
 
     def f(x):
         try:
@@ -131,8 +133,9 @@ def seed004_single_field(field: str, target: float) -> dict:
     row = {
         "field": field,
         "estimate": est,
-        "plausible_low": DEFAULT_RANGE[0] * est,
-        "plausible_high": DEFAULT_RANGE[1] * est,
+        "plausible_low": float(plausible[0]),
+        "plausible_high": float(plausible[1]),
+        "plausible_source": rng.reason if rng is not None else f"default {DEFAULT_RANGE} x the estimate",
         "searched": [lo, hi],
         "secant_at_estimate": f(est) + target,
     }
