@@ -70,7 +70,7 @@ def calibrate(
 
         table = Table(title=f"calibration of {d['design']} ({d['sigma_source']})", title_justify="left")
         for col in ("field", "estimate", "value", "95 % low", "95 % high", "identifiable"):
-            table.add_column(col, justify="left" if col == "field" else "right")
+            table.add_column(col, justify="left" if col == "field" else "right", overflow="fold")
         for k, v in d["identified"].items():
             table.add_row(
                 k, fmt(v["estimate"]), fmt(v["value"]), fmt(v["ci95_low"]), fmt(v["ci95_high"]), str(v["identifiable"])
