@@ -37,7 +37,7 @@ def _backlash(r) -> dict:
 
 def test_equidistant_modification_backlash():
     """10 um equidistant modification: the disc's play is 2 dr / l_max (l_max the largest
-    moment arm, flexrv.analysis.pin_load: 81.37 arcsec; the issue's 81.45); at the output with
+    moment arm, flexrv.analysis.pin_load: 81.37 arcsec; 81.45 for the exact gap geometry); at the output with
     the input locked times :func:`locked_input_factor`: 78.36 arcsec. backlash_arcmin within
     1 % (measured 78.60, +0.3 %); the +-1 % figure (lost_motion_1pct_arcmin, 82.3) includes the
     wind-up and lies above it."""
@@ -53,9 +53,10 @@ def test_equidistant_modification_backlash():
 
 
 def test_pins_moved_out_backlash():
-    """Every pin moved radially outward by 10 um: the disc's play 47.58 arcsec (issue's exact
-    geometric value), at the output with the input locked times :func:`locked_input_factor`
-    (45.82 arcsec); backlash_arcmin within 1 % (measured 45.96, +0.3 %; the +-1 % figure reads 49.95)."""
+    """Every pin moved radially outward by 10 um: the disc's play 47.58 arcsec (the exact gap
+    geometry of the case), at the output with the input locked times :func:`locked_input_factor`
+    (45.82 arcsec); backlash_arcmin within 1 % (measured 45.96, +0.3 %; the model's play at
+    0.01 % of rated reads 45.94, the +-1 % figure 49.95)."""
     r0 = override("rv40e", IDEAL)
     z = r0.second_stage.pin_count
     data = r0.model_dump()

@@ -101,7 +101,7 @@ def test_joint_shear_compliance_against_a_beam_element():
 
 def test_missing_compliances_of_the_presets_and_without_estimates():
     """rv40e and rv221 carry all four elements; each lies in (0, 0.05) arcsec/(N m) (the
-    range the issue's hand estimates give: 0.004-0.04); without [path_estimates] only the
+    range of hand estimates from the presets' dimensions: 0.004-0.04); without [path_estimates] only the
     crank torsion (geometry alone) remains."""
     from flexrv.units import ARCSEC_PER_RAD
 

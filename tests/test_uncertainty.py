@@ -88,3 +88,31 @@ def test_preset_ranges_cover_their_estimates():
             assert rg.low <= value <= rg.high and len(rg.reason) > 10, (name, path)
             for v in (rg.low, rg.high):
                 override(r, {path: int(round(v)) if isinstance(value, int) else float(v)})
+
+
+def test_stiffness_test_cli_names_and_uncertainty(tmp_path):
+    """``flexrv stiffness-test rv40e --json --uncertainty 4`` (short loop): the loop's figures
+    under their definition names, the budget with its added elements, and the prediction
+    intervals of the same outputs as ``te``."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from flexrv.cli import app
+    from flexrv.post.definitions import DEFINITIONS
+    from flexrv.studies.uncertainty import OUTPUTS
+
+    args = ["stiffness-test", "rv40e", "--quarter-time", "0.01", "--out", str(tmp_path / "st")]
+    res = CliRunner().invoke(app, [*args, "--json", "--uncertainty", "4"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert set(DEFINITIONS) <= set(d)
+    b = d["stiffness_budget"]
+    assert {k for k, e in b["elements"].items() if not e["in_model"]} == {
+        "carrier_joints",
+        "crank_torsion",
+        "planet_spline",
+        "support_bearing_rings",
+    }
+    assert b["loop_rigidity_slope_50_100_with_added_Nm_per_arcmin"] < b["loop_rigidity_slope_50_100_Nm_per_arcmin"]
+    assert set(OUTPUTS) <= set(d["uncertainty"]["outputs"])

@@ -375,12 +375,12 @@ class NeedleBearing(_Strict):
         description="Radial internal clearance as ISO 5593 defines it: the total radial play of the eccentric "
         "in its hole (diametral, one extreme position to the opposite one) [um]; each side has half",
     )
+    model: Literal["empirical", "rollers"] = Field(description="seed004 empirical stiffness or roller-resolved Hertz")
 
     @property
     def clearance_per_side(self) -> float:
         """Half the radial internal clearance [m]: the gap on one side with the eccentric centred."""
         return 0.5 * self.radial_clearance_um * M_PER_UM
-    model: Literal["empirical", "rollers"] = Field(description="seed004 empirical stiffness or roller-resolved Hertz")
 
 
 class MainBearing(_Strict):
