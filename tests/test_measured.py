@@ -348,3 +348,52 @@ def test_te_export_validates_with_zero_differences(tmp_path, capsys):
     assert comp["te_pp_measured_arcsec"] > 0
     assert any(x["label"] == "cycloid mesh" for x in d["files"][0]["spectrum_lines"]["measured"])
     assert list((tmp_path / "v").glob("*_spectrum.png")) and list((tmp_path / "v").glob("*_te.png"))
+
+
+def test_lost_motion_points_figures(tmp_path):
+    """Lost-motion points of a bilinear element (slope 200 N m/arcmin, play 1 arcmin) at
+    +-0.1, 0.2, 1, 3 and 6 % of 412 N m, loaded up and down: lost motion = play + 2 x 3 % T_r / k
+    (1.1236 arcmin) and backlash (the play extrapolated to T = 0) = 1 arcmin, both exact for
+    straight branches (1e-9)."""
+    from flexrv.measured.figures import measurement_figures
+    from flexrv.measured.writer import write_measured
+
+    tr, k = 412.0, 200.0
+    levels = np.array([0.001, 0.002, 0.01, 0.03, 0.06]) * tr
+    t = np.r_[levels, levels[::-1], -levels, -levels[::-1], levels[:1]]
+    a = (t / k + 0.5 * np.sign(t)) * RAD_PER_ARCMIN
+    p = write_measured(
+        tmp_path / "lm.csv",
+        "lost_motion",
+        {"origin": "measured", "input": "locked", "rated_torque_Nm": tr},
+        [("torque", "N·m", t), ("angle", "arcmin", a)],
+    )
+    f = measurement_figures(read_measured(p))
+    assert f["lost_motion_arcmin"] == pytest.approx(1.0 + 2 * 0.03 * tr / k, rel=1e-9)
+    assert f["backlash_arcmin"] == pytest.approx(1.0, rel=1e-9)
+
+
+def test_te_record_over_time_reads_the_output_angle_from_the_speed(tmp_path):
+    """A TE record over time at 15 rpm output: output angle = speed x time (15 rpm x 4 s = one
+    revolution, 1e-12), and a 5 arcsec sine of order 39 over that revolution shows a 5 arcsec
+    line at order 39 (the DFT of a whole revolution, 1e-6)."""
+    from flexrv.measured.figures import measurement_figures
+    from flexrv.measured.format import te_output_angle
+    from flexrv.measured.writer import write_measured
+
+    n = 512
+    time = np.arange(n) * 4.0 / n
+    te = 5.0 * RAD_PER_ARCSEC * np.sin(2 * np.pi * 39 * time / 4.0)
+    meta = {"origin": "measured", "te_sign": "output_minus_input", "direction": "forward", "torque_Nm": 100.0}
+    p = write_measured(
+        tmp_path / "te_t.csv",
+        "te_record",
+        {**meta, "output_speed_rpm": 15.0},
+        [("time", "s", time), ("te", "arcsec", te)],
+    )
+    m = read_measured(p)
+    x = te_output_angle(m)
+    assert (x[-1] - x[0]) * n / (n - 1) == pytest.approx(2 * np.pi, rel=1e-12)
+    lines = measurement_figures(m)["spectrum_lines"]
+    assert lines[0]["order"] == pytest.approx(39.0, rel=1e-9)
+    assert lines[0]["amplitude_arcsec"] == pytest.approx(5.0, rel=1e-6)

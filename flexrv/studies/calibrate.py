@@ -8,7 +8,7 @@ The quasi-static equilibrium (:class:`flexrv.model.quasi_static.StaticModel`, th
 model's force groups at zero speed) with the input locked at theta_in = 0, as in the
 stiffness test: the output angle at the torques +-f T_r for f in :data:`LOOP_FRACTIONS`,
 assembled into the loop 0 -> +T_r -> -T_r -> 0 (:func:`quasi_static_loop`). One evaluation
-costs about 0.3 s on rv40e (model build from the cached FE bodies 0.2 s, 18 equilibria of a
+costs about 0.3 s on rv40e (model build from the cached FE bodies 0.2 s, 22 equilibria of a
 few ms); a field that changes an FE body's geometry (e.g. the needle clearance, which sizes
 the disc's crank holes) rebuilds that body (20 s) and is not freed by default.
 
@@ -63,7 +63,7 @@ from flexrv.errors import ConvergenceError, InputError
 from flexrv.units import ARCMIN_PER_RAD
 
 #: torque fractions of the rated torque at which the quasi-static loop is solved
-LOOP_FRACTIONS = (0.01, 0.03, 0.1, 0.25, 0.5, 0.75, 0.95, 0.975, 1.0)
+LOOP_FRACTIONS = (0.001, 0.002, 0.01, 0.03, 0.1, 0.25, 0.5, 0.75, 0.95, 0.975, 1.0)
 #: fractions at which a loop's mid-curve spans are observed
 SPAN_FRACTIONS = (0.03, 0.1, 0.25, 0.5, 0.75, 1.0)
 #: forward-difference step of the Jacobian in unit coordinates (1 % of each range)
