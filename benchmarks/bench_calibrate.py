@@ -11,12 +11,12 @@ calibration (:func:`flexrv.studies.calibrate.calibrate`) frees the three fields 
 plausible ranges, starting from the preset's estimates. For every worker count (0: every
 evaluation in this process; N: a dask LocalCluster of N single-threaded workers, start-up
 included) it prints the wall time, the CPU time (this process + reaped workers), the
-evaluations, and each identified value with its 95 % interval beside the truth (one draw: a
-95 % interval misses its truth in one draw of twenty; this draw's clearance lies 2.06 standard
-errors from its truth. Coverage is counted over 20 draws by ``flexrv workflow calibration``).
+evaluations, and each identified value with its 95 % interval beside the truth (one draw; the
+coverage over 20 draws is counted by ``flexrv workflow calibration``).
 
-Measured (load average 7 on the 2 shared cores): 37 evaluations; workers=0 7.4 s wall (4.9 s
-CPU); workers=2 21.2 s wall (13.4 s CPU, LocalCluster start-up included). Goal <= 2 min: met.
+Measured (load average 2 on the 2 shared cores): 38 evaluations; workers=0 5.1 s wall (4.1 s
+CPU); workers=2 14.4 s wall (11.6 s CPU, LocalCluster start-up included); at a load average of 7,
+7.4 s and 21.2 s. Goal <= 2 min: met.
 """
 
 from __future__ import annotations
