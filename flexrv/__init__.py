@@ -27,6 +27,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("fem",),  # FE assembly, modes, reduction
     ("model",),  # Exudyn multibody model: members and force groups
     ("post",),  # results, statistics, spectra, I/O
+    ("measured",),  # bench files in (loops, TE records), their figures by post's definitions
     ("viz",),  # plots and 3-D views
     ("simulation",),  # Simulation: build, run, save
     ("sweep", "studies", "workflows"),  # orchestration of many runs

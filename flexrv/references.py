@@ -45,6 +45,8 @@ SECTIONS: dict[str, dict[str, str]] = {
         "(0 to +-412 N m) and identification of the pins in mesh from it. Authors not given.",
     },
     "Books and papers": {
+        "bates1988nonlinear": "Bates, D. M., Watts, D. G. (1988). *Nonlinear Regression Analysis and Its "
+        "Applications*. Wiley, New York.",
         "blagojevic2011": "Blagojevic, M. et al. (2011). Two-stage cycloidal (RV-type) speed reducer. Cited in "
         "the code as *Mech. Mach. Theory* 2011; venue and title not verified.",
         "blanche1989": "Blanche, J. G., Yang, D. C. H. (1989). Cycloid drives with machining tolerances. "

@@ -55,8 +55,10 @@ def _options(
 
 #: Command modules; each defines ``register(app)``. A module that is not present
 #: (capability not installed yet) is skipped.
-_COMMAND_MODULES = ("design", "ehl", "mesh", "simulate", "te", "compare", "view", "sweep", "tolerance", "workflows")
-_COMMAND_MODULES += ("optimize",)
+_COMMAND_MODULES = (
+    "design", "ehl", "mesh", "simulate", "te", "compare", "view", "sweep", "tolerance", "workflows", "optimize",
+    "measured", "validate", "calibrate",
+)  # fmt: skip
 
 for _name in _COMMAND_MODULES:
     try:

@@ -203,6 +203,7 @@ def stiffness_test_cmd(
     parts: str = typer.Option(None, "--parts", help=PARTS_HELP),
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<run>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    csv: Path = typer.Option(None, "--csv", help="Also write the loop as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
     uncertainty: int = typer.Option(
         None,
@@ -228,6 +229,12 @@ def stiffness_test_cmd(
         if bar:
             bar.stop()
     data = {"output_dir": str(out), **fig.named(), "stiffness_budget": _budget(res)}
+    if csv is not None:  # the loop in the measured-data format (flexrv.measured.writer)
+        from flexrv.measured.writer import export_stiffness_test
+
+        data["csv"] = str(
+            export_stiffness_test(csv, res, f"flexrv stiffness-test {preset} --model {model}", quarter_time)
+        )
     if uncertainty is not None:
         from flexrv.cli.te import uncertainty_report
         from flexrv.design import load

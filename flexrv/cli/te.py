@@ -31,6 +31,7 @@ def te(
     ),
     out: Path = typer.Option(None, "--out", help="Output directory (default results/<design>_te_<time>/)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    csv: Path = typer.Option(None, "--csv", help="Also write the loaded TE as a measured-data CSV (flexrv measured)."),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
     uncertainty: int = typer.Option(
         None,
@@ -70,6 +71,10 @@ def te(
     save_te(budget.merged_into(ds), summary, reducer, out)
     te_plots(ds, summary, out)
     data = {"output_dir": str(out), **summary, "stiffness_budget": budget.to_dict()}
+    if csv is not None:  # the loaded TE in the measured-data format (flexrv.measured.writer)
+        from flexrv.measured.writer import export_te
+
+        data["csv"] = str(export_te(csv, result, reducer.name, f"flexrv te {preset} --torque-nm {result.torque:.17g}"))
     c_added = sum(budget.added.values()) / RAD_PER_ARCMIN  # arcmin per N m
     for key in [k for k in summary if k.startswith("rigidity_") and k.endswith("_Nm_per_arcmin")]:
         data[key[: -len("_Nm_per_arcmin")] + "_with_added_Nm_per_arcmin"] = 1.0 / (1.0 / summary[key] + c_added)

@@ -29,6 +29,7 @@ class Workflow(str, enum.Enum):
     te_errors = "te_errors"
     tolerance_study = "tolerance_study"
     modification_design = "modification_design"
+    calibration = "calibration"
 
 
 def workflow(
