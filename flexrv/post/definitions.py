@@ -182,7 +182,9 @@ def _loading(asc, desc):
     return pos, neg
 
 
-def _mid(asc, desc, value: float) -> float:
+def mid_curve(asc, desc, value: float) -> float:
+    """The loop's mid curve at torque ``value``: the mean of the ascending and descending
+    branches' angles there (the hysteresis taken out)."""
     return 0.5 * (angle_at(asc, value) + angle_at(desc, value))
 
 
@@ -209,7 +211,7 @@ def loop_figures(torque_Nm, angle_rad, rated_torque_Nm: float) -> dict:
     out["angle_at_rated_arcmin"] = tip_p
     plays = {}
     for f in sorted({LOST_MOTION_FRACTION, ONE_PERCENT, *PLAY_FRACTIONS}):
-        lo_, hi_ = _mid(asc, desc, -f * tr), _mid(asc, desc, f * tr)
+        lo_, hi_ = mid_curve(asc, desc, -f * tr), mid_curve(asc, desc, f * tr)
         plays[f] = (lo_, hi_)
     lm_n, lm_p = plays[LOST_MOTION_FRACTION]
     out["lost_motion_arcmin"] = lm_p - lm_n

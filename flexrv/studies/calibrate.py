@@ -108,16 +108,11 @@ def quasi_static_loop(reducer, rated: float, fractions=LOOP_FRACTIONS, theta_in:
 
 def mid_spans(torque, angle_rad, rated: float, fractions=SPAN_FRACTIONS) -> np.ndarray:
     """Mid-curve spans m(+f T_r) - m(-f T_r) [arcmin] of a loop in time order, m the mean of
-    its ascending and descending branches (:func:`flexrv.post.definitions.angle_at`)."""
-    from flexrv.post.definitions import angle_at, split_branches
+    its ascending and descending branches (:func:`flexrv.post.definitions.mid_curve`)."""
+    from flexrv.post.definitions import mid_curve, split_branches
 
     asc, desc = split_branches(torque, np.asarray(angle_rad, dtype=float) * ARCMIN_PER_RAD)
-    out = []
-    for f in fractions:
-        m_p = 0.5 * (angle_at(asc, f * rated) + angle_at(desc, f * rated))
-        m_n = 0.5 * (angle_at(asc, -f * rated) + angle_at(desc, -f * rated))
-        out.append(m_p - m_n)
-    return np.array(out)
+    return np.array([mid_curve(asc, desc, f * rated) - mid_curve(asc, desc, -f * rated) for f in fractions])
 
 
 @dataclass(frozen=True)
