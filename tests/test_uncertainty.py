@@ -30,6 +30,20 @@ def test_series_spring_with_a_uniform_compliance():
     assert out["failed"] == []
 
 
+def test_contributors_with_more_inputs_than_samples():
+    """40 inputs, 32 samples (no joint fit): y = x0 + 0.1 x1 with independent uniform inputs
+    has corr(x0, y)^2 = 1 / 1.01 = 0.990 and corr(x1, y)^2 = 0.0099 (closed form); the marginal
+    SRC^2 ranks x0 first within 0.05 of 0.990, and the 38 ignored inputs score on average about
+    the noise floor 1/(N - 1): N r^2 of an ignored input is about chi^2(1), above its mean 1 with
+    probability 0.32, so fewer than half of them pass it."""
+    ranges = {f"x{i}": (0.0, 1.0) for i in range(40)}
+    out = propagate(lambda v: {"y": v["x0"] + 0.1 * v["x1"]}, ranges, 32, seed=2)
+    c = out["outputs"]["y"]["contributors"]
+    assert c["basis"] == "marginal" and c["noise_floor"] == pytest.approx(1.0 / 31)
+    assert next(iter(c["src2"])) == "x0" and c["src2"]["x0"] == pytest.approx(1.0 / 1.01, abs=0.05)
+    assert len(set(c["src2"]) - {"x0", "x1"}) < 38 / 2
+
+
 def test_failed_samples_are_reported_not_fatal():
     """An evaluation that raises is listed in ``failed`` and leaves NaN; the interval is
     taken over the others."""
