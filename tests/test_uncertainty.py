@@ -44,6 +44,22 @@ def test_contributors_with_more_inputs_than_samples():
     assert len(set(c["src2"]) - {"x0", "x1"}) < 38 / 2
 
 
+def test_screen_drops_only_the_inputs_an_evaluation_ignores():
+    """y = a + b^2 ignores c: moving each input alone to its range end farther from the nominal
+    leaves y unchanged for c only; b's nominal sits at its upper end, so b is moved to the lower
+    end and kept."""
+    from flexrv.studies.uncertainty import screen
+
+    nominal = {"a": 0.5, "b": 1.0, "c": 0.5}
+
+    def ev(v):
+        x = {**nominal, **v}
+        return {"y": x["a"] + x["b"] ** 2}
+
+    ranges = {"a": (0.0, 1.0), "b": (0.0, 1.0), "c": (0.0, 1.0)}
+    assert screen(ev, ranges, nominal) == ["c"]
+
+
 def test_failed_samples_are_reported_not_fatal():
     """An evaluation that raises is listed in ``failed`` and leaves NaN; the interval is
     taken over the others."""
@@ -82,7 +98,9 @@ def test_te_cli_uncertainty(tmp_path):
     for name in OUTPUTS:
         r = u["outputs"][name]
         assert r["p05"] <= r["median"] <= r["p95"]
-    assert set(u["inputs"]) == set(load("rv40e").ranges)
+    assert set(u["inputs"]) == set(load("rv40e").ranges) == set(u["sampled"]) | set(u["no_effect"])
+    assert "main_bearing.cage_damping_Ns_per_m" in u["no_effect"]
+    assert "needle_bearing.radial_clearance_um" in u["sampled"]
     assert (out / "uncertainty.json").stat().st_size > 1000
     assert d["rigidity_tangent_with_added_Nm_per_arcmin"] < d["rigidity_tangent_Nm_per_arcmin"]
 
