@@ -126,6 +126,20 @@ def test_preset_ranges_cover_their_estimates():
                 override(r, {path: int(round(v)) if isinstance(value, int) else float(v)})
 
 
+def test_preset_ranges_are_jointly_valid():
+    """The ranges are sampled together: 128 scrambled Sobol' samples of every preset's ranges
+    are all valid designs (the coupled geometry checks: ring sections, cage fills, pillars on
+    the plates, needles within the disc)."""
+    from flexrv.design import load
+    from flexrv.studies.uncertainty import _with_values
+
+    for name in ("rv40e", "rv221"):
+        r = load(name)
+        ranges = {k: (g.low, g.high) for k, g in r.ranges.items()}
+        out = propagate(lambda v: (_with_values(r, v), {"valid": 1.0})[1], ranges, 128, seed=5)
+        assert out["failed"] == [], (name, out["failed"][:1])
+
+
 def test_stiffness_test_cli_names_and_uncertainty(tmp_path):
     """``flexrv stiffness-test rv40e --json --uncertainty 4`` (short loop): the loop's figures
     under their definition names, the budget with its added elements, and the prediction
