@@ -30,6 +30,36 @@ def test_series_spring_with_a_uniform_compliance():
     assert out["failed"] == []
 
 
+def test_contributors_with_more_inputs_than_samples():
+    """40 inputs, 32 samples (no joint fit): y = x0 + 0.1 x1 with independent uniform inputs
+    has corr(x0, y)^2 = 1 / 1.01 = 0.990 and corr(x1, y)^2 = 0.0099 (closed form); the marginal
+    SRC^2 ranks x0 first within 0.05 of 0.990, and the 38 ignored inputs score on average about
+    the noise floor 1/(N - 1): N r^2 of an ignored input is about chi^2(1), above its mean 1 with
+    probability 0.32, so fewer than half of them pass it."""
+    ranges = {f"x{i}": (0.0, 1.0) for i in range(40)}
+    out = propagate(lambda v: {"y": v["x0"] + 0.1 * v["x1"]}, ranges, 32, seed=2)
+    c = out["outputs"]["y"]["contributors"]
+    assert c["basis"] == "marginal" and c["noise_floor"] == pytest.approx(1.0 / 31)
+    assert next(iter(c["src2"])) == "x0" and c["src2"]["x0"] == pytest.approx(1.0 / 1.01, abs=0.05)
+    assert len(set(c["src2"]) - {"x0", "x1"}) < 38 / 2
+
+
+def test_screen_drops_only_the_inputs_an_evaluation_ignores():
+    """y = a + b^2 ignores c: moving each input alone to its range end farther from the nominal
+    leaves y unchanged for c only; b's nominal sits at its upper end, so b is moved to the lower
+    end and kept."""
+    from flexrv.studies.uncertainty import screen
+
+    nominal = {"a": 0.5, "b": 1.0, "c": 0.5}
+
+    def ev(v):
+        x = {**nominal, **v}
+        return {"y": x["a"] + x["b"] ** 2}
+
+    ranges = {"a": (0.0, 1.0), "b": (0.0, 1.0), "c": (0.0, 1.0)}
+    assert screen(ev, ranges, nominal) == ["c"]
+
+
 def test_failed_samples_are_reported_not_fatal():
     """An evaluation that raises is listed in ``failed`` and leaves NaN; the interval is
     taken over the others."""
@@ -68,26 +98,46 @@ def test_te_cli_uncertainty(tmp_path):
     for name in OUTPUTS:
         r = u["outputs"][name]
         assert r["p05"] <= r["median"] <= r["p95"]
-    assert set(u["inputs"]) == set(load("rv40e").ranges)
+    assert set(u["inputs"]) == set(load("rv40e").ranges) == set(u["sampled"]) | set(u["no_effect"])
+    assert "main_bearing.cage_damping_Ns_per_m" in u["no_effect"]
+    assert "needle_bearing.radial_clearance_um" in u["sampled"]
     assert (out / "uncertainty.json").stat().st_size > 1000
     assert d["rigidity_tangent_with_added_Nm_per_arcmin"] < d["rigidity_tangent_Nm_per_arcmin"]
 
 
 def test_preset_ranges_cover_their_estimates():
-    """Every [ranges] entry of the presets names an estimated field (its provenance says
-    "estimate"), contains the preset's value and gives a reason; both ends make a valid design."""
+    """Every numeric field whose provenance says "estimate" has a [ranges] entry, and every
+    [ranges] entry names an estimated field, contains the preset's value and gives a reason;
+    both ends make a valid design. Text fields (a lubricant's name, a model choice) have no range."""
     from flexrv.design import load, override
     from flexrv.design.model import field_value
 
     for name in ("rv40e", "rv221"):
         r = load(name)
-        assert len(r.ranges) >= 10
+        for path, note in r.provenance.items():
+            value = field_value(r, path) if "estimate" in note.lower() else None
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                assert path in r.ranges, f"{name}: estimated {path} has no [ranges] entry"
         for path, rg in r.ranges.items():
             assert "estimate" in r.provenance[path].lower(), (name, path)
             value = field_value(r, path)
             assert rg.low <= value <= rg.high and len(rg.reason) > 10, (name, path)
             for v in (rg.low, rg.high):
                 override(r, {path: int(round(v)) if isinstance(value, int) else float(v)})
+
+
+def test_preset_ranges_are_jointly_valid():
+    """The ranges are sampled together: 128 scrambled Sobol' samples of every preset's ranges
+    are all valid designs (the coupled geometry checks: ring sections, cage fills, pillars on
+    the plates, needles within the disc)."""
+    from flexrv.design import load
+    from flexrv.studies.uncertainty import _with_values
+
+    for name in ("rv40e", "rv221"):
+        r = load(name)
+        ranges = {k: (g.low, g.high) for k, g in r.ranges.items()}
+        out = propagate(lambda v: (_with_values(r, v), {"valid": 1.0})[1], ranges, 128, seed=5)
+        assert out["failed"] == [], (name, out["failed"][:1])
 
 
 def test_stiffness_test_cli_names_and_uncertainty(tmp_path):

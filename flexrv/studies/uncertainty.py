@@ -92,15 +92,28 @@ def propagate(
     for out in outputs:
         y = np.array([r.get(out, np.nan) for r in rows], dtype=float)
         src = src_indices(u, y, plan)
-        fit = src.get("variables")
         entry = interval(y)
-        entry["contributors"] = (
-            None if fit is None else {"r2": fit["r2"], "src2": {k: v for k, v in fit["indices"].items() if v > 1e-4}}
-        )
+        entry["contributors"] = _contributors(u, y, names, src.get("variables"))
         result["outputs"][out] = entry
     result["failed"] = [r["error"] for r in rows if "error" in r]
     result["samples"] = {"inputs": x.tolist(), "outputs": [[r.get(o, np.nan) for o in outputs] for r in rows]}
     return result
+
+
+def _contributors(u: np.ndarray, y: np.ndarray, names: list[str], fit: dict | None) -> dict | None:
+    """The inputs an output's spread comes from: SRC^2 of the joint linear fit with its R^2, or,
+    with fewer samples than inputs + 3 (no joint fit), each input's own SRC^2 (its squared
+    correlation with the output; ``basis`` "marginal"), kept above the ``noise_floor`` 1/(N - 1)
+    that an input without effect scores on average."""
+    if fit is not None:
+        return {"r2": fit["r2"], "src2": {k: v for k, v in fit["indices"].items() if v > 1e-4}}
+    ok = np.isfinite(y)
+    if ok.sum() < 3 or np.std(y[ok]) == 0.0:
+        return None
+    floor = 1.0 / (ok.sum() - 1)
+    r2 = {k: float(np.corrcoef(u[ok, i], y[ok])[0, 1] ** 2) for i, k in enumerate(names) if np.std(u[ok, i]) > 0}
+    top = sorted(((k, v) for k, v in r2.items() if v > floor), key=lambda kv: -kv[1])
+    return {"r2": None, "basis": "marginal", "noise_floor": float(floor), "src2": dict(top)}
 
 
 def _with_values(reducer, values: dict):
@@ -159,19 +172,50 @@ def te_sample(reducer, bodies: float) -> dict:
     return out
 
 
+def screen(evaluate: Callable[[dict], dict], ranges: dict, nominal: dict) -> list[str]:
+    """The inputs an evaluation does not read: each input moved alone to the end of its range
+    farther from its ``nominal`` value leaves every output bit-identical to the nominal
+    evaluation (a deterministic route gives the same floats). An input whose move raises is kept."""
+    base = evaluate({})
+    inert = []
+    for k, (lo, hi) in ranges.items():
+        v = nominal.get(k)
+        end = hi if v is None or abs(hi - v) >= abs(v - lo) else lo
+        try:
+            moved = evaluate({k: end})
+        except Exception:  # the end alone is outside what the route converges on: the input matters
+            continue
+        if moved == base:
+            inert.append(k)
+    return inert
+
+
 def design_uncertainty(reducer, n: int, seed: int = 0, progress: Callable | None = None) -> dict:
-    """Prediction intervals of :data:`OUTPUTS` from the design's ``[ranges]`` (module docstring)."""
+    """Prediction intervals of :data:`OUTPUTS` from the design's ``[ranges]`` (module docstring).
+    Inputs the quasi-static route does not read (damping, inertia, thresholds of the dynamic
+    models; :func:`screen`) are listed in ``no_effect`` and not sampled."""
+    from flexrv.design.model import field_value
     from flexrv.errors import InputError
 
     if not reducer.ranges:
         raise InputError(f"{reducer.name} has no [ranges] table: no estimated input declares a plausible range")
     ranges = {k: (r.low, r.high) for k, r in reducer.ranges.items()}
     bodies = nominal_body_compliance(reducer)
-    out = propagate(lambda v: te_sample(_with_values(reducer, v), bodies), ranges, n, seed, progress)
+
+    def evaluate(v):
+        return te_sample(_with_values(reducer, v), bodies)
+
+    inert = screen(evaluate, ranges, {k: field_value(reducer, k) for k in ranges})
+    sampled = {k: r for k, r in ranges.items() if k not in inert}
+    out = propagate(evaluate, sampled, n, seed, progress)
+    out["sampled"] = list(sampled)
+    out["inputs"] = {k: list(r) for k, r in ranges.items()}
+    out["no_effect"] = inert
     out["reasons"] = {k: r.reason for k, r in reducer.ranges.items()}
     out["method"] = (
         "quasi-static route at a coarse resolution, FE bodies' nominal compliance and the elements no model "
-        "contains added in series; inputs uniform over their [ranges], scrambled Sobol' samples; median and "
-        "5-95 % interval; contributors: SRC^2 of a linear fit (R^2 given)"
+        "contains added in series; inputs the route does not read screened out (no_effect); the others "
+        "uniform over their [ranges], scrambled Sobol' samples; median and 5-95 % interval; contributors: "
+        "SRC^2 of a linear fit (R^2 given), or each input's own SRC^2 with fewer samples than inputs + 3"
     )
     return out
