@@ -135,8 +135,7 @@ SECTIONS: dict[str, dict[str, str]] = {
         "nabtesco_rv_e_manual": "Nabtesco Corporation. *Precision Reduction Gear RV: E Series* (manual), "
         "appendix 'Design scheme of input gear', table 'Pass-through capacity of input gear' (p. 74): hole "
         "diameters d1, d2 and depths through which the input gear passes, and the speed ratios that allow "
-        "it, per model (RV-40E / RV-30: d1 27 mm, d2 30 mm). Read in a public web copy "
-        "(easymanua.ls/nabtesco/rv-e-series/manual?p=82); edition not verified.",
+        "it, per model (RV-40E / RV-30: d1 27 mm, d2 30 mm). Edition not verified.",
     },
     "Standards": {
         "iso76": "ISO 76:2006. Rolling bearings — Static load ratings. International Organization for "
