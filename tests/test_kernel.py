@@ -576,11 +576,11 @@ def test_curve_reach_and_certified_warm_start():
 
 
 def test_small_dense_algebra_matches_numpy():
-    """The local Newtons' allocation-free algebra (flexrv.model.pins.inv_small,
+    """The local Newtons' allocation-free algebra (flexrv.model.numerics.linalg.inv_small,
     matmul_small; issue 15) against numpy: the inverse of well- and ill-conditioned
     (cond ~1e8, pivoting needed: zero leading entry) matrices within 1e-12 relative
     times the condition number, the product to 1e-14 relative."""
-    from flexrv.model.pins import inv_small, matmul_small
+    from flexrv.model.numerics.linalg import inv_small, matmul_small
 
     rng = np.random.default_rng(3)
     for m, cond in ((3, 1e2), (6, 1e2), (6, 1e8), (12, 1e4)):

@@ -59,6 +59,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.ehl.maps import packed_log_correction
+from flexrv.model.numerics.linalg import adjugate3, cholesky, cholesky_solve
 
 #: law parameters: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m], load and speed
 #: exponents of the film, load floor [N], c_max [N s/m], damping depth [m], Newton steps
@@ -385,39 +386,6 @@ def _local_factors(psi, wtab, zsign, out):
                 out[j, a, k] = w0 * r0[k] + w1 * r1[k] + w2 * r2[k] + w3 * r3[k]
 
 
-@njit(cache=True)
-def _cholesky(m):
-    """In-place lower Cholesky factor of a small SPD matrix m."""
-    n = m.shape[0]
-    for j in range(n):
-        d = m[j, j]
-        for k in range(j):
-            d -= m[j, k] * m[j, k]
-        d = math.sqrt(max(d, 1e-300))
-        m[j, j] = d
-        for i in range(j + 1, n):
-            v = m[i, j]
-            for k in range(j):
-                v -= m[i, k] * m[j, k]
-            m[i, j] = v / d
-
-
-@njit(cache=True)
-def _cholesky_solve(m, b):
-    """b <- m^-1 b with m's lower Cholesky factor (from :func:`_cholesky`)."""
-    n = m.shape[0]
-    for i in range(n):
-        v = b[i]
-        for k in range(i):
-            v -= m[i, k] * b[k]
-        b[i] = v / m[i, i]
-    for i in range(n - 1, -1, -1):
-        v = b[i]
-        for k in range(i + 1, n):
-            v -= m[k, i] * b[k]
-        b[i] = v / m[i, i]
-
-
 def condense_workspace(ball_count: int, n_modes: int) -> np.ndarray:
     """Persistent work array of a condensed ring in a row (see :func:`_split_workspace`):
     the contact deflections (warm start), the last Newton tangent, the scratch
@@ -563,11 +531,11 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
                     smat[j, i] = v
                     smat[i, j] = v
                 smat[j, j] += 1.0
-            _cholesky(smat)
+            cholesky(smat)
             valid[0] = 1.0
         for j in range(nz):
             rhs[j] = sq[j] * (nf[j, 0] * r[j, 0] + nf[j, 1] * r[j, 1] + nf[j, 2] * r[j, 2])
-        _cholesky_solve(smat, rhs)
+        cholesky_solve(smat, rhs)
         # correction C N L y' = W (P^T (L^1/2 z))
         for k in range(m):
             y[k] = 0.0
@@ -1388,22 +1356,6 @@ def row_force_kernel(
 
 
 @njit(cache=True)
-def _adjugate3(k, adj):
-    """The adjugate of the 3x3 block k[:3, :3] into ``adj`` (k^-1 = adj / det); returns
-    det (cofactor expansion along the first row)."""
-    adj[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
-    adj[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
-    adj[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
-    adj[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
-    adj[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-    adj[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
-    adj[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-    adj[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
-    adj[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-    return k[0, 0] * adj[0, 0] + k[0, 1] * adj[1, 0] + k[0, 2] * adj[2, 0]
-
-
-@njit(cache=True)
 def ball_equilibrium(
     q,
     qt,
@@ -1484,7 +1436,7 @@ def ball_equilibrium(
         dv = 0.0
         for j in range(nz):  # -K^-1 f_j and b_t = -K^-1 (K_bx x_t) (3x3, cofactors)
             k = kbb[3 * j : 3 * j + 3]
-            det = _adjugate3(k, adj)
+            det = adjugate3(k, adj)
             for off in (0, 3):  # right-hand sides: the ball's force, then K_bx x_t
                 r0, r1, r2 = (
                     (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else (k[0, 3], k[1, 3], k[2, 3])
@@ -1518,7 +1470,7 @@ def _condense_ball(jl, vl, nx, kx, cx, s_ball, inv, tm):
     change with x (second order, d S / d x x_t) is left out. The balls couple only
     through x, so the Schur complement over all balls is this sum. inv (3, 3), tm
     (3, nx): work."""
-    det = _adjugate3(jl[nx:, nx:], inv)
+    det = adjugate3(jl[nx:, nx:], inv)
     for r in range(3):
         for c in range(3):
             inv[r, c] /= det

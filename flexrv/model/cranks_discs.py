@@ -62,8 +62,8 @@ load, d the bore = eccentric journal diameter; mu = design
 ``contact.needle_friction_coefficient``), regularised like the pin friction:
 M = -mu F (d/2) s(omega_rel d/2) on the crank and +M on the disc, omega_rel =
 dphi_j/dt - dpsi_k/dt, F = |F| the bearing force, s
-:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact): dF = e^T dF-vector, e = F-vector/F,
-with the complete force tangents below, plus the regularisation term
+:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact):
+dF = e^T dF-vector, e = F-vector/F, with the complete force tangents below, plus the regularisation term
 -mu F (d/2)^2 s' on (phi_j, psi_k) of dM/dv.
 
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
@@ -103,7 +103,8 @@ from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
-from flexrv.model.pins import condensed_step, inv_small, matmul_small
+from flexrv.model.numerics.linalg import inv_small, matmul_small
+from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD
 
 
@@ -138,7 +139,13 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk,
 def support_work_size(n: int) -> int:
     """Length of :func:`crank_support_kernel`'s work array for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
-    return 4 + m + n2 * m + n2 + 9 * n + 8 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+
+
+#: the carrier Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
+#: roundoff_abs, roundoff_rel): 60 Newton steps (the evaluation cap 40 per step never binds: halving
+#: ends after 21); round-off: a worse residual at max|R| <= 1e-12 m
+CARRIER_NEWTON = (2400, 60, 1e-12, 0.0)
 
 
 @njit(cache=True)
@@ -152,6 +159,19 @@ def _carrier_residual(u, ch, fs, res):
         res[r] = acc
         r0 = max(r0, abs(acc))
     return r0
+
+
+@njit(cache=True)
+def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res):
+    """The elastic carrier's support forces at d = d0 - u and residual R = u + C_h f_s into
+    ``res`` (tangent K into kk) for :func:`~flexrv.model.numerics.newton.newton_update`;
+    returns (max|R|, max|u|)."""
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    r0 = _carrier_residual(u, ch, fs, res)
+    umax = 0.0
+    for r in range(u.shape[0]):
+        umax = max(umax, abs(u[r]))
+    return r0, umax
 
 
 @njit(cache=True)
@@ -175,7 +195,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     arm r + u. Cost (issue 15): the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
     tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
-    LAPACK (:func:`flexrv.model.pins.inv_small`) and nothing is allocated per call. Measured on rv40e
+    LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
     (a run's 4,000 solver calls replayed, CPU per call, paired with the code before, loaded machine,
     2026-11-24): 9.1-11.7 -> 6.5-6.7 us compiled (11.0-11.2 -> 8.2-8.3 us called from Python); with
     ``carrier.body_model = "rigid"`` 3.0 -> 2.6 us. The elastic carrier's extra cost before was its
@@ -191,7 +211,8 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     m = 3 + 3 * n  # local coordinates: carrier x, y, theta, then crank j's x, y, phi
     elastic = n > 0 and cc.shape[0] == n2
     st = wk[0:4]
-    o = 4
+    nw = wk[4 : 4 + NEWTON_STATE]
+    o = 4 + NEWTON_STATE
     qp = wk[o : o + m]
     o += m
     su = wk[o : o + n2 * m].reshape((n2, m))
@@ -209,7 +230,8 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         wk[o + 6 * n2 : o + 7 * n2],
         wk[o + 7 * n2 : o + 8 * n2],
     )
-    o += 8 * n2
+    ones = wk[o + 8 * n2 : o + 9 * n2]  # the Newton's norms: unweighted
+    o += 9 * n2
     nn = n2 * n2
     kk = wk[o : o + nn].reshape((n2, n2))
     ch = wk[o + nn : o + 2 * nn].reshape((n2, n2))
@@ -248,52 +270,28 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
                 ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
         valid = st[0] > 0.0
+        for r in range(n2):
+            ones[r] = 1.0
         for j in range(n):
             u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
             if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
                 valid = False  # set from outside (reset, history pass): start from it
-        if valid:  # first-order predictor from the previous call, within a tenth of the deflections' size
-            umax, pmax = 0.0, 0.0
+        if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
             for r in range(n2):
                 acc = 0.0
                 for col in range(m):
                     qc = q[idx[col]] if col < 3 else q[idx[col + 3]]
                     acc += su[r, col] * (qc - qp[col])
                 step[r] = acc
-                umax = max(umax, abs(u[r]))
-                pmax = max(pmax, abs(acc))
-            if pmax <= 0.1 * umax:
-                for r in range(n2):
-                    u[r] += step[r]
-    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+            apply_predictor(u, step, ones)
+        newton_start(nw)
+        while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
+            r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
+            if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
+                break
+    else:
+        _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     if elastic:
-        r0 = _carrier_residual(u, ch, fs, res)
-        lam = 1.0
-        for _ in range(60):
-            condensed_step(ch, kk, 1.0, res, tmp, mm, step)  # Newton correction from here: (I + C_h K)^-1 R
-            umax = 0.0
-            for r in range(n2):
-                umax = max(umax, abs(u[r]))
-            tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
-            if r0 <= tol:
-                break
-            lam = 1.0
-            for r in range(n2):
-                u0[r] = u[r]
-            r1 = r0
-            for _h in range(40):  # step halving on max|R| (R is the gradient of a convex energy)
-                for r in range(n2):
-                    u[r] = u0[r] - lam * step[r]
-                _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
-                r1 = _carrier_residual(u, ch, fs, res)
-                if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
-                    break
-                lam *= 0.5
-            stop = r1 >= r0 and r0 <= 1e-12
-            r0 = r1
-            if stop:  # at round-off: the correction from this last evaluation, then stop
-                condensed_step(ch, kk, 1.0, res, tmp, mm, step)
-                break
         # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
         # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
         for r in range(n2):

@@ -139,6 +139,8 @@ from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.errors import ConvergenceError
 from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.numerics.linalg import matmul_small
+from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
 
 
 @njit(cache=True)
@@ -315,72 +317,40 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         f[ip] += fp
 
 
+#: the rim Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
+#: roundoff_abs, roundoff_rel): 80 evaluations; round-off: a worse residual at max|R| <= 100 tol
+RIM_NEWTON = (80, 80, 0.0, 100.0)
+
+
 @njit(cache=True)
-def inv_small(a, out):
-    """out = a^-1 for a small dense square matrix (Gauss-Jordan with partial pivoting;
-    ``a`` is overwritten). No allocation: for the local Newtons' m x m systems (m =
-    3 n_discs, 2 n_cranks) LAPACK's call overhead and work arrays cost more than the
-    arithmetic. Verified against numpy.linalg.inv in tests/test_kernel.py."""
-    m = a.shape[0]
+def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
+    """The rim condensation's residual R = delta - C Q(q_hub + delta) into ``res`` (J = dQ/dq
+    into jl) for :func:`~flexrv.model.numerics.newton.newton_update`; returns (max|R|,
+    max|delta|) weighted (psi times R_p)."""
+    m = delta.shape[0]
     for r in range(m):
+        ql[r] = qh[r] + delta[r]
+        fl[r] = 0.0
         for c in range(m):
-            out[r, c] = 1.0 if r == c else 0.0
-    for k in range(m):
-        p = k
-        big = abs(a[k, k])
-        for r in range(k + 1, m):
-            if abs(a[r, k]) > big:
-                big, p = abs(a[r, k]), r
-        if p != k:
-            for c in range(m):
-                a[k, c], a[p, c] = a[p, c], a[k, c]
-                out[k, c], out[p, c] = out[p, c], out[k, c]
-        d = 1.0 / a[k, k]
+            jl[r, c] = 0.0
+            jvl[r, c] = 0.0
+    pin_kernel(ql, vh, fl, jl, jvl, True, pins_loc)
+    r1 = 0.0
+    scale = 0.0
+    for r in range(m):
+        acc = delta[r]
         for c in range(m):
-            a[k, c] *= d
-            out[k, c] *= d
-        for r in range(m):
-            w = a[r, k]
-            if r != k and w != 0.0:
-                for c in range(m):
-                    a[r, c] -= w * a[k, c]
-                    out[r, c] -= w * out[k, c]
-
-
-@njit(cache=True)
-def matmul_small(a, b, out):
-    """out = a @ b (small dense, no allocation; ``out`` must not alias a or b)."""
-    for r in range(a.shape[0]):
-        for c in range(b.shape[1]):
-            acc = 0.0
-            for k in range(a.shape[1]):
-                acc += a[r, k] * b[k, c]
-            out[r, c] = acc
-
-
-@njit(cache=True)
-def condensed_step(c, j, sign, res, tmp, inv, step):
-    """step = (I + sign C J)^-1 res: the Newton correction of the condensations' local
-    solves (the rim offsets, sign -1: R = delta - C Q(q + delta); the carrier's support
-    points, sign +1: R = u + C f_s(d0 - u)); inv = the inverse (kept for the condensed
-    tangent), tmp: scratch. All (m, m) / (m,), no allocation."""
-    m = res.shape[0]
-    matmul_small(c, j, tmp)
-    for r in range(m):
-        for k in range(m):
-            tmp[r, k] = (1.0 if r == k else 0.0) + sign * tmp[r, k]
-    inv_small(tmp, inv)
-    for r in range(m):
-        acc = 0.0
-        for k in range(m):
-            acc += inv[r, k] * res[k]
-        step[r] = acc
+            acc -= cm[r, c] * fl[c]
+        res[r] = acc
+        r1 = max(r1, abs(acc) * weight[r])
+        scale = max(scale, abs(delta[r]) * weight[r])
+    return r1, scale
 
 
 def pin_work_size(m: int) -> int:
     """Length of the rim condensation's work array (:func:`_pin_condensed_kernel`)
     for m = 3 n_discs local coordinates."""
-    return 4 + 14 * m + 11 * m * m
+    return 4 + NEWTON_STATE + 15 * m + 11 * m * m
 
 
 @njit(cache=True)
@@ -441,10 +411,12 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     mm = m * m
     ch = hs[0] if hs.shape[0] > 0 else 0.0
     st = wk[0:4]
-    vec = wk[4 : 4 + 14 * m].reshape((14, m))  # the layout of pin_work_size: 14 vectors, then 11 matrices
+    nw = wk[4 : 4 + NEWTON_STATE]
+    o = 4 + NEWTON_STATE
+    vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
     qp, vp, qfc, dlast, qh, vh, ql = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6]
-    fl, delta, base, step, res, av, qf = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13]
-    mat = wk[4 + 14 * m : 4 + 14 * m + 11 * mm].reshape((11, m, m))
+    fl, delta, base, step, res, av, qf, weight = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13], vec[14]
+    mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
     sq, sv, jc, jvc, jl, jvl = mat[0], mat[1], mat[2], mat[3], mat[4], mat[5]
     cm, nm, tmp, dd, t2 = mat[6], mat[7], mat[8], mat[9], mat[10]
     for r in range(m):
@@ -480,63 +452,20 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
                 for c in range(3):
                     cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
     for r in range(m):
-        base[r] = dstate[r // 3, r % 3]
-        step[r] = 0.0
-    if valid:  # first-order predictor from the previous call, within a tenth of the offsets' size
-        dmax, pmax = 0.0, 0.0
+        delta[r] = dstate[r // 3, r % 3]
+        weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
+    if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
         for r in range(m):
             acc = 0.0
             for c in range(m):
                 acc += sq[r, c] * (qh[c] - qp[c]) + sv[r, c] * (vh[c] - vp[c])
             step[r] = acc
-            w = r_p if r % 3 == 2 else 1.0
-            dmax = max(dmax, abs(base[r]) * w)
-            pmax = max(pmax, abs(acc) * w)
-        if pmax <= 0.1 * dmax:
-            for r in range(m):
-                base[r] += step[r]
-        for r in range(m):
-            step[r] = 0.0
-    r0 = np.inf
-    lam = 1.0
-    fresh = False
-    for it in range(80):
-        for r in range(m):
-            delta[r] = base[r] - lam * step[r]
-            ql[r] = qh[r] + delta[r]
-            fl[r] = 0.0
-            for c in range(m):
-                jl[r, c] = 0.0
-                jvl[r, c] = 0.0
-        pin_kernel(ql, vh, fl, jl, jvl, True, pins_loc)
-        r1 = 0.0
-        scale = 0.0
-        for r in range(m):
-            acc = delta[r]
-            for c in range(m):
-                acc -= cm[r, c] * fl[c]
-            res[r] = acc
-            w = r_p if r % 3 == 2 else 1.0
-            r1 = max(r1, abs(acc) * w)
-            scale = max(scale, abs(delta[r]) * w)
-        tol = max(1e-15, 1e-10 * scale)  # 1e-13 m or better (round-off of the gap: ~1e-17 m)
-        fresh = False
-        if it > 0 and r1 >= r0:
-            if r0 <= 100.0 * tol:  # at round-off: accept
-                break
-            if lam > 1e-6:  # step halving on max|R| (R: gradient of a convex energy)
-                lam *= 0.5
-                continue
-        r0 = r1
-        condensed_step(cm, jl, -1.0, res, tmp, nm, step)  # N = (I - C J)^-1, the Newton correction N R
-        fresh = True
-        if r1 <= tol:
+        apply_predictor(delta, step, weight)
+    newton_start(nw)
+    while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
+        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
+        if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
             break
-        for r in range(m):
-            base[r] = delta[r]
-        lam = 1.0
-    if not fresh:  # stopped on a halved step at round-off: the correction from the last evaluation
-        condensed_step(cm, jl, -1.0, res, tmp, nm, step)
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
@@ -788,7 +717,7 @@ class PinContacts(KernelGroup):
         }
 
     def outputs(self, t, rec):
-        f, nx, ny = rec["force"], rec["nx"], rec["ny"]
+        f = rec["force"]
         dims = ("time", "disc", "pin")
         out = (
             {}
