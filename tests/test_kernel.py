@@ -564,13 +564,13 @@ def test_curve_reach_and_certified_warm_start():
     gap_ref = g.gap.copy()
     phi_ref = g.phi.copy()
     for reach, ok in ((1.0, False), (None, True)):  # reach 1 m: every warm start trusted (before the check)
-        sc = g.sc.copy()
+        saved = g.reach.copy()
         if reach:
-            g.sc[11:] = reach
+            g.reach[:] = reach
         g.phi[:] = phi_ref + 0.06  # every warm start on the neighbouring flank's side
         g.last[:] = np.nan  # nothing skipped
         f, _ = g.evaluate(0.0, qg, vg)
-        g.sc[:] = sc
+        g.reach[:] = saved
         assert (np.abs(g.gap - gap_ref).max() <= 1e-12) == ok
     assert np.abs(f - f_ref).max() <= 1e-9 * np.abs(f_ref).max()
 

@@ -18,7 +18,7 @@ carrier's moment, (r . f) on (theta, theta); the terms of the bore's rotation wi
 theta in the damper are dropped, and for the linear law also in the spring (its
 Jacobian is kept as in tests/data/force_reference.npz).
 
-Carrier (issue 14; design ``carrier.body_model = "condensed_fe"``): the carrier's
+Carrier (design ``carrier.body_model = "condensed_fe"``): the carrier's
 end plates and pillars are elastic. Its FE condensation
 (:func:`flexrv.fem.carrier.crank_support_compliance`) gives the (2N x 2N)
 compliance C of the cranks' support points (each crank's force split over its two
@@ -56,7 +56,7 @@ d = E - H and the as-built radial clearance c_r = c_jk (``needle_clearances``):
   g = D/d_m (Harris & Kotzalas 2007, ch. 8). Rollers are massless (their
   inertia is negligible against the disc's).
 
-Friction (issue 14): a constant-coefficient rolling-bearing friction moment
+Friction: a constant-coefficient rolling-bearing friction moment
 between eccentric and disc hole (SKF/JTEKT model M = mu P d/2, P the radial
 load, d the bore = eccentric journal diameter; mu = design
 ``contact.needle_friction_coefficient``), regularised like the pin friction:
@@ -69,7 +69,7 @@ dF = e^T dF-vector, e = F-vector/F, with the complete force tangents below, plus
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
 Generalized forces are Q = -B^T F (B = dd/dq over crank x, y, phi and disc x, y,
 psi; F the bearing force on the disc). The analytic Jacobian is the exact
-derivative of Q as computed (issue 15: with the arm rotations dropped, Newton
+derivative of Q as computed (with the arm rotations dropped, Newton
 converged only linearly at running speeds): dQ/dq = -B^T G - (dB^T/dq) F with
 G = dF/dq = K B + D W + c g, K the contact tangent (empirical law: spring,
 rotation F/|d| of the direction d/|d| and the damper's rate turning with it,
@@ -103,9 +103,73 @@ from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import inv_small, matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD
+
+_F, _I = np.float64, np.int64
+#: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law
+SupportLaw = law_type("SupportLaw", damping=float, linear=bool)
+#: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
+#: the tapered-roller pair's law vector (:mod:`flexrv.contact.tapered_roller`, read by its SC_ names),
+#: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
+#: crank, bearing displacement = Newton start, bending share), the elastic carrier's support-point
+#: compliance (2N, 2N) (empty: rigid), its deflections (N, 4) and the work array (:func:`support_work_size`)
+SupportPack = pack_type(
+    "SupportPack",
+    ("idx", (_I, (6,))),
+    ("law", SupportLaw),
+    ("roller_law", (_F, (SC_G + 1,))),
+    ("bores", (_F, 2)),
+    ("clear", (_F, 1)),
+    ("angles", (_F, 1)),
+    ("fx", (_F, 1)),
+    ("fy", (_F, 1)),
+    ("bstate", (_F, 2)),
+    ("bend", (_F, 1)),
+    ("carrier_c", (_F, 2)),
+    ("ustate", (_F, 2)),
+    ("work", (_F, 1)),
+)
+#: the needle bearings' scalar law: contact K, exponent, c_max, depth, roller-resolved model (else the
+#: empirical radial law), pitch ratio g = D/d_m, disc teeth z_c, friction coefficient, friction radius
+#: d/2 [m], regularisation speed
+NeedleLaw = law_type(
+    "NeedleLaw",
+    k=float,
+    exponent=float,
+    c_max=float,
+    depth=float,
+    rollers=bool,
+    pitch_ratio=float,
+    z_c=float,
+    mu=float,
+    friction_radius=float,
+    v_reg=float,
+)
+#: :func:`needle_kernel`'s pack: indices (each crank's x, y, phi, then each disc's x, y, psi), law,
+#: disc eccentric phases chi0, as-built eccentricities, phase errors, hole centres x, y (cranks,
+#: discs), clearances, roller angles, outputs per bearing (force x, y, rollers' forces and angles,
+#: friction power) and state (min gap, each disc's departure from its conjugate rotation)
+NeedlePack = pack_type(
+    "NeedlePack",
+    ("idx", (_I, 1)),
+    ("law", NeedleLaw),
+    ("chi0", (_F, 1)),
+    ("ecc", (_F, 2)),
+    ("err", (_F, 2)),
+    ("hx", (_F, 2)),
+    ("hy", (_F, 2)),
+    ("clear", (_F, 2)),
+    ("roller_angles", (_F, 1)),
+    ("fx", (_F, 2)),
+    ("fy", (_F, 2)),
+    ("roll", (_F, 3)),
+    ("angle", (_F, 3)),
+    ("pw", (_F, 2)),
+    ("state", (_F, (1,))),
+)
 
 
 @njit(cache=True)
@@ -192,17 +256,16 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     last correction c applied linearised (f_s + K du, exact to O(|R|^2)); the condensed tangent is df_s =
     M (-K dd0 + H dgamma) - M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
-    arm r + u. Cost (issue 15): the Newton starts from the first-order predictor u_prev + S (q - q_prev),
+    arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
     tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
     LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
-    (a run's 4,000 solver calls replayed, CPU per call, paired with the code before, loaded machine,
-    2026-11-24): 9.1-11.7 -> 6.5-6.7 us compiled (11.0-11.2 -> 8.2-8.3 us called from Python); with
-    ``carrier.body_model = "rigid"`` 3.0 -> 2.6 us. The elastic carrier's extra cost before was its
-    Newton (two or more support evaluations per call), LAPACK/BLAS calls on 6 x 6 matrices and ~20
-    array allocations per call."""
-    idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend, cc, ustate, wk = pack
-    cd, linear = dc[0], dc[1] > 0.5
+    (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
+    called from Python); with ``carrier.body_model = "rigid"`` 2.6 us."""
+    idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
+    out_fx, out_fy, bstate, out_bend = pack.fx, pack.fy, pack.bstate, pack.bend
+    cc, ustate, wk = pack.carrier_c, pack.ustate, pack.work
+    cd, linear = pack.law.damping, pack.law.linear
     kb, g = sc[SC_K_BEND], sc[SC_G]
     th, om = q[idx[2]], v[idx[2]]
     c, s = np.cos(th), np.sin(th)
@@ -421,6 +484,7 @@ class CrankSupports(KernelGroup):
 
     name = "crank_supports"
     kind = "supports"
+    kernel = staticmethod(crank_support_kernel)
 
     def __init__(self, params):
         p = params
@@ -432,7 +496,7 @@ class CrankSupports(KernelGroup):
         self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
         self.linear = bool(p.support_linear)
         self.c = p.support_damping
-        self.dc = np.array([self.c, float(self.linear)])
+        self.law = SupportLaw.of(damping=self.c, linear=self.linear)
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
@@ -449,10 +513,10 @@ class CrankSupports(KernelGroup):
         return self.carrier_c.size > 0
 
     def pack(self, idx, history=False):
-        return (
+        return SupportPack(
             idx,
+            self.law,
             self.sc,
-            self.dc,
             self.bores,
             self.clear,
             self.angles,
@@ -467,25 +531,7 @@ class CrankSupports(KernelGroup):
 
     @staticmethod
     def empty_pack():
-        z = np.zeros(0)
-        return (
-            np.zeros(6, np.int64),
-            np.zeros(7),
-            np.zeros(2),
-            np.zeros((0, 2)),
-            z,
-            z,
-            z,
-            z,
-            np.zeros((0, 2)),
-            z,
-            np.zeros((0, 0)),
-            np.zeros((0, 4)),
-            np.zeros(support_work_size(0)),
-        )
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        crank_support_kernel(q, v, f, jq, jv, jac, pack)
+        return empty_pack(SupportPack)
 
     def reset(self) -> None:
         """Forget the bearing displacements of earlier evaluations (the inner Newton's
@@ -540,9 +586,13 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     per-bearing force on the disc into out_fx, out_fy, roller forces and angles
     (rollers model) into out_roll, out_angle; state[0] = min gap [m], state[1 + k]
     = disc k's departure from its conjugate rotation [rad]."""
-    idx, sc, chi0, ecc, err, hx, hy, clear, roller_angles, out_fx, out_fy, out_roll, out_angle, out_pw, state = pack
-    k_c, expo, c_max, depth, rollers, g_ratio, z_c = sc[0], sc[1], sc[2], sc[3], sc[4] > 0.5, sc[5], sc[6]
-    mu_b, r_b, v_reg = sc[7], sc[8], sc[9]  # friction moment (module docstring): coefficient, d/2, v_reg
+    idx, chi0, ecc, err, hx, hy = pack.idx, pack.chi0, pack.ecc, pack.err, pack.hx, pack.hy
+    clear, roller_angles = pack.clear, pack.roller_angles
+    out_fx, out_fy, out_roll, out_angle, out_pw, state = pack.fx, pack.fy, pack.roll, pack.angle, pack.pw, pack.state
+    law = pack.law
+    k_c, expo, c_max, depth, rollers = law.k, law.exponent, law.c_max, law.depth, law.rollers
+    g_ratio, z_c = law.pitch_ratio, law.z_c
+    mu_b, r_b, v_reg = law.mu, law.friction_radius, law.v_reg  # friction moment (module docstring)
     fric = mu_b > 0.0 and v_reg > 0.0
     nc, nd = ecc.shape[0], ecc.shape[1]
     min_gap = np.inf
@@ -693,6 +743,8 @@ class NeedleBearings(KernelGroup):
 
     name = "needle_bearings"
     kind = "needles"
+    kernel = staticmethod(needle_kernel)
+    friction_outputs = ("needle_friction_power",)
 
     def __init__(self, params, model: str, k_empirical: float | None = None):
         p = params
@@ -718,19 +770,17 @@ class NeedleBearings(KernelGroup):
             z = p.needle_roller_count
             self.roller_angles = 2.0 * np.pi * np.arange(z) / z
         g = p.needle_pitch_ratio
-        self.sc = np.array(
-            [
-                self.k,
-                LINE_EXPONENT,
-                p.needle_c_max,
-                p.contact_depth,
-                float(model == "rollers"),
-                g,
-                float(p.z_c),
-                p.needle_friction,
-                p.needle_friction_radius,
-                p.friction_velocity,
-            ]
+        self.law = NeedleLaw.of(
+            k=self.k,
+            exponent=LINE_EXPONENT,
+            c_max=p.needle_c_max,
+            depth=p.contact_depth,
+            rollers=model == "rollers",
+            pitch_ratio=g,
+            z_c=p.z_c,
+            mu=p.needle_friction,
+            friction_radius=p.needle_friction_radius,
+            v_reg=p.friction_velocity,
         )
         self.mu = p.needle_friction if p.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
@@ -741,9 +791,9 @@ class NeedleBearings(KernelGroup):
         self.reset()
 
     def pack(self, idx, history=False):
-        return (
+        return NeedlePack(
             idx,
-            self.sc,
+            self.law,
             self.chi0,
             self.ecc,
             self.err,
@@ -761,11 +811,7 @@ class NeedleBearings(KernelGroup):
 
     @staticmethod
     def empty_pack():
-        z1, z2, z3 = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0, 0))
-        return (np.zeros(0, np.int64), np.zeros(10), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, z2, np.zeros(1))
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        needle_kernel(q, v, f, jq, jv, jac, pack)
+        return empty_pack(NeedlePack)
 
     @property
     def min_gap(self) -> float:
@@ -806,7 +852,7 @@ class NeedleBearings(KernelGroup):
 
     def check(self) -> str | None:
         # a skipped pin first: it is the cause, and the needle penetration it then produces the symptom
-        # (on Python floats: numpy's reductions on these few values cost ~4 us per step, issue 15)
+        # (on Python floats: numpy's reductions on these few values cost ~4 us per step)
         state = self.state.tolist()
         limit = math.pi / self.z_rp
         if any(abs(d) > limit for d in state[1:]):  # (NaN: not evaluated yet, never a skip)

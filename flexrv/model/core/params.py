@@ -17,9 +17,15 @@ zeros in an absent element's pack).
 
 from __future__ import annotations
 
+import sys
 from collections import namedtuple
 
 import numpy as np
+
+
+def _caller_module() -> str:
+    """The module that calls :func:`law_type` / :func:`pack_type` (two frames up)."""
+    return sys._getframe(2).f_globals.get("__name__", __name__)
 
 
 def _as_float_array(value) -> np.ndarray:
@@ -30,8 +36,11 @@ def law_type(name: str, **fields: type):
     """A named tuple of scalars (``float``, ``int`` or ``bool`` per field; ``np.ndarray``:
     a flat float64 table, e.g. a film map) with ``of(**values)`` (every field required,
     each converted to its type, unknown names rejected) and ``zero()``. Define it at
-    module level under ``name`` (numba's cache pickles the type by reference)."""
-    cls = namedtuple(name, list(fields))
+    module level under ``name``: the type belongs to the calling module, so that numba's
+    cache pickles it by reference (``module.name``) and finds it again in the next
+    process; a type that cannot be found by name is pickled by value, a new class in
+    every process, and every cached kernel taking it would compile again."""
+    cls = namedtuple(name, list(fields), module=_caller_module())
     cls._types = dict(fields)
     convert = {k: (_as_float_array if t is np.ndarray else t) for k, t in fields.items()}
 
@@ -52,8 +61,8 @@ def law_type(name: str, **fields: type):
 
 def pack_type(name: str, *fields: tuple):
     """A named tuple of kernel arguments; ``fields``: (field name, kind) pairs (module
-    docstring). Define it at module level under ``name``."""
-    cls = namedtuple(name, [f for f, _ in fields])
+    docstring). Define it at module level under ``name`` (see :func:`law_type`)."""
+    cls = namedtuple(name, [f for f, _ in fields], module=_caller_module())
     cls._kinds = dict(fields)
     return cls
 
