@@ -163,10 +163,6 @@ class ForceGroup:
 
 _NO_JACOBIAN = np.zeros((0, 0))
 
-#: count of writes into the elements' live time-input arrays (:meth:`KernelGroup.set_time`, a group's
-#: own evaluate, a history pass): a fused element re-sends its time inputs when another wrote them
-TIME_WRITES = [0]
-
 
 @dataclass(frozen=True)
 class SummaryRow:
@@ -217,13 +213,19 @@ class KernelGroup(ForceGroup):
     #: message of the ConvergenceError raised when :meth:`failure_counter` grows in a call
     failure_message: str = "an inner solve of a force element did not converge"
 
+    def reset(self) -> None:
+        """Forget the state of earlier evaluations; the time inputs are written again."""
+        self._time_last = None
+        super().reset()
+
     def set_time(self, t, array) -> None:
-        """Write the time inputs at t into the pack's live ``array`` (only when they change)."""
+        """Write the time inputs at t into the pack's live ``array`` (skipped while
+        :meth:`time_inputs` returns the same cached object: the array still holds it unless
+        a group's own evaluate or a history pass wrote it, which clear ``_time_last``)."""
         x = self.time_inputs(t)
         if x is not getattr(self, "_time_last", None):
             array[:] = x
             self._time_last = x
-            TIME_WRITES[0] += 1
 
     def failure_counter(self, pack):
         """A live int64 array (1,) of ``pack`` that the kernel increments on a failed inner
@@ -251,7 +253,6 @@ class KernelGroup(ForceGroup):
         if self.time_field:
             getattr(pack, self.time_field)[:] = self.time_inputs(t) if inputs is None else inputs
             self._time_last = None  # the live array no longer holds what set_time wrote
-            TIME_WRITES[0] += 1
         ctr = self.failure_counter(pack)
         before = ctr[0] if ctr is not None else 0
         type(self).kernel(q, v, f, jq, jv, jac, pack)

@@ -242,6 +242,10 @@ class GearMeshes(KernelGroup):
             c = self._drive_cache = (t, float(self.theta_s(t)), float(self.omega_s(t)))
         return c[1], c[2]
 
+    def set_time(self, t, array) -> None:
+        """The drive at t into the pack's live ``array`` (two floats: written every call)."""
+        array[0], array[1] = self.time_inputs(t)
+
     def time_inputs_many(self, ts):
         return np.stack(
             [

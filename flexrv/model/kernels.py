@@ -44,7 +44,7 @@ import os
 import numpy as np
 from numba import njit
 
-from flexrv.model.base import TIME_WRITES, exudyn_vector
+from flexrv.model.base import exudyn_vector
 from flexrv.model.core.registry import ELEMENTS, fused_functions, register, spec_of
 from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
 from flexrv.model.gear_stage import GearMeshes
@@ -179,8 +179,6 @@ class FusedForces:
         self.timed = [(g, getattr(p, g.time_field)) for (g, _), p in zip(self.slots, self.packs) if g.time_field]
         #: the live failure counters of the elements' inner solves: (group, counter)
         self.counters = [(g, c) for (g, _), p in zip(self.slots, self.packs) if (c := g.failure_counter(p)) is not None]
-        #: (time, TIME_WRITES) when the time inputs were last sent
-        self._time_sent = (None, -1)
         self.f = np.zeros(self.n)
         self.jq, self.jv = np.zeros((self.n, self.n)), np.zeros((self.n, self.n))
         self.stats = [0, 0]
@@ -238,7 +236,6 @@ class FusedForces:
             )
         for g, _ in self.timed:
             g._time_last = None  # the history pass overwrote the live time inputs
-        TIME_WRITES[0] += 1
         for (g, c), b in zip(counters, before):
             if c is not None and int(c[0]) != b:
                 from flexrv.errors import ConvergenceError
@@ -250,12 +247,14 @@ class FusedForces:
         return out
 
     def _call(self, t, q, v, jac):
-        if (t, TIME_WRITES[0]) != self._time_sent:  # a new time, or the live time inputs were written elsewhere
-            for g, array in self.timed:  # (the groups cache their time inputs per time)
-                g.set_time(t, array)
-            self._time_sent = (t, TIME_WRITES[0])
+        for g, array in self.timed:  # (the groups cache their time inputs per time)
+            g.set_time(t, array)
         counters = self.counters
-        before = [c[0] for _, c in counters] if counters else None
+        if len(counters) == 1:  # (the usual case, the pins: no list per call)
+            ctr = counters[0][1]
+            before = ctr[0]
+        else:
+            ctr, before = None, [c[0] for _, c in counters]
         entry = self._entry
         if entry is not None and _f8c(q) and _f8c(v):
             entry(q, v, self.f, self.jq, self.jv, jac, *self.packs)
@@ -264,12 +263,19 @@ class FusedForces:
             self.kernel(*args)
             if entry is None:
                 self._entry = _entry_point(self.kernel, args)
-        if counters:
+        if ctr is not None:
+            if ctr[0] != before:
+                self._failed(counters[0][0])
+        elif counters:
             for (g, c), b in zip(counters, before):
                 if c[0] != b:
-                    from flexrv.errors import ConvergenceError
+                    self._failed(g)
 
-                    raise ConvergenceError(g.failure_message)
+    @staticmethod
+    def _failed(group):
+        from flexrv.errors import ConvergenceError
+
+        raise ConvergenceError(group.failure_message)
 
     def record_entries(self) -> list:
         """(group, key, live array) of every per-contact record of this element's groups, in order."""
