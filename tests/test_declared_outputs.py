@@ -174,3 +174,18 @@ def test_member_outputs_match_the_state_vector():
     ke = ke + 0.5 * p.input_inertia * np.asarray(model.input_speed(t)) ** 2
     assert np.allclose(out["kinetic_energy"].values, ke, rtol=1e-13, atol=0)
     assert out["crank_x"].dims == ("time", "crank") and out["disc_y"].values.shape == (len(t), p.n_discs)
+
+
+def test_post_has_no_output_name_triggers():
+    """TE, the powers and the friction sum are declared outputs of the model
+    (flexrv.model.outputs): post/results.py builds the dataset from the declared outputs
+    without computing variables on the sight of a name (``if name == "omega_out"``), and
+    post/stats.py finds the friction outputs by their declared role, not by a list of names."""
+    import re
+    from pathlib import Path
+
+    post = Path(__file__).resolve().parents[1] / "flexrv" / "post"
+    results = (post / "results.py").read_text()
+    assert not re.search(r"if name == \"", results)
+    stats = (post / "stats.py").read_text()
+    assert "pin_friction_power" not in stats and "needle_friction_power" not in stats

@@ -564,23 +564,23 @@ def test_curve_reach_and_certified_warm_start():
     gap_ref = g.gap.copy()
     phi_ref = g.phi.copy()
     for reach, ok in ((1.0, False), (None, True)):  # reach 1 m: every warm start trusted (before the check)
-        sc = g.sc.copy()
+        saved = g.reach.copy()
         if reach:
-            g.sc[11:] = reach
+            g.reach[:] = reach
         g.phi[:] = phi_ref + 0.06  # every warm start on the neighbouring flank's side
         g.last[:] = np.nan  # nothing skipped
         f, _ = g.evaluate(0.0, qg, vg)
-        g.sc[:] = sc
+        g.reach[:] = saved
         assert (np.abs(g.gap - gap_ref).max() <= 1e-12) == ok
     assert np.abs(f - f_ref).max() <= 1e-9 * np.abs(f_ref).max()
 
 
 def test_small_dense_algebra_matches_numpy():
-    """The local Newtons' allocation-free algebra (flexrv.model.pins.inv_small,
+    """The local Newtons' allocation-free algebra (flexrv.model.numerics.linalg.inv_small,
     matmul_small; issue 15) against numpy: the inverse of well- and ill-conditioned
     (cond ~1e8, pivoting needed: zero leading entry) matrices within 1e-12 relative
     times the condition number, the product to 1e-14 relative."""
-    from flexrv.model.pins import inv_small, matmul_small
+    from flexrv.model.numerics.linalg import inv_small, matmul_small
 
     rng = np.random.default_rng(3)
     for m, cond in ((3, 1e2), (6, 1e2), (6, 1e8), (12, 1e4)):

@@ -518,11 +518,11 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
 def _quasi_static_row(preset, tol=None):
     """Row 0 of a preset with quasi-static balls (EHL contacts), its local solve's
     relative tolerance set to ``tol`` (None: the kernel's BALL_FORCE_TOL)."""
-    from flexrv.model.flexible_bearing import kernel_inputs
+    from flexrv.model.flexible_bearing import set_ball_force_tolerance
 
     row = rows_from_design(load(preset), ehl="hamrock_dowson", ball_inertia=False)[0]
     if tol is not None:
-        kernel_inputs(row)[1][13] = tol
+        set_ball_force_tolerance(row, tol)
     return row
 
 

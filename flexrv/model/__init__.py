@@ -3,7 +3,10 @@
 ``flexrv.model.factory.build_model(reducer, "rigid")`` assembles the rigid-member
 model with compliant contacts: members (carrier with its 5-DOF main-bearing
 element, cranks = planets, cycloid discs) as ``NodeGenericODE2`` nodes with
-constant mass matrices, and one vectorised ``ObjectGenericODE2`` per force group:
+constant mass matrices, and the force elements, the compiled ones registered in
+:mod:`.core.registry` and evaluated in ONE generated fused kernel (:mod:`.kernels`), their
+parameters typed and read by name (:mod:`.core.params`), their shared numerics in
+:mod:`.numerics`:
 
 * :mod:`.gear_stage` — sun–planet meshes along the line of action (time-varying
   ISO 6336 stiffness, damping, backlash; the sun angle is prescribed by the drive);

@@ -7,7 +7,7 @@ absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
 crank supports, needle bearings, pins, rigid main bearing, loads) are
 :class:`KernelGroup` s: their physics is one numba-compiled kernel each, and the
 model evaluates all of them in ONE compiled call from ONE ``ObjectGenericODE2``
-(:class:`flexrv.model.kernels.FusedForces`; issue 15: 95 % of a step was Python
+(:class:`flexrv.model.kernels.FusedForces`; 95 % of a step was Python
 overhead with one numpy element per group). Other groups (ball-resolved bearing,
 flexible crank) keep one element each with a Python force function.
 The assembled model (:class:`flexrv.model.assembled.AssembledModel`) lives in its
@@ -32,8 +32,8 @@ class Member:
     """A body of the model: ``n`` coordinates, constant mass matrix, initial state.
 
     ``kind`` says what the coordinates are (used by the declared outputs,
-    :mod:`flexrv.model.outputs`, for the kinetic energy and the angular momentum): ``"planar"`` (x, y, rotation about the
-    axis first, as carrier, cranks and discs), ``"points"`` (x, y, z of point masses,
+    :mod:`flexrv.model.outputs`, for the kinetic energy and the angular momentum): ``"planar"``
+    (x, y, rotation about the axis first, as carrier, cranks and discs), ``"points"`` (x, y, z of point masses,
     e.g. the balls) or ``"modal"`` (elastic modal coordinates of a reduced body, with
     constant ``stiffness_matrix`` and ``damping_matrix`` added to the member's own
     Exudyn element).
@@ -60,18 +60,22 @@ class Output:
     """A named output of a group, evaluated on a time history.
 
     ``values`` has shape (T, *shape of dims[1:]); ``dims`` names every axis, the
-    first being ``time``."""
+    first being ``time``. ``role``: "friction" for dissipated friction power [W] (summed
+    into ``friction_power``), else ""; ``summary``: the run-summary rows read from this
+    output (:class:`SummaryRow`, declared by the element's ``summary_rows``)."""
 
     values: np.ndarray
     dims: tuple[str, ...]
     units: str
     long_name: str
+    role: str = ""
+    summary: tuple = ()
 
 
 def exudyn_vector(values) -> np.ndarray:
     """An Exudyn user function's coordinate list (Exudyn passes Python lists) as a new
     float64 array: ``np.fromiter``, the fastest conversion of a list of floats
-    (issue 15, per conversion: 84 floats 1.3 us instead of 1.6 us with np.array, 120
+    (per conversion: 84 floats 1.3 us instead of 1.6 us with np.array, 120
     floats 1.8 instead of 2.5-3.2 us; two per element call, ~12 row calls per step).
 
     >>> exudyn_vector([1.0, 2.5])
@@ -160,8 +164,22 @@ class ForceGroup:
 _NO_JACOBIAN = np.zeros((0, 0))
 
 
+@dataclass(frozen=True)
+class SummaryRow:
+    """One number of the run summary: ``key`` (with its unit in the name where it has one),
+    ``units``, ``description``, the declared output it reads (``source``) and the reduction
+    over the steady window (``reduce``: "max", "min", "mean", "max_abs" or "p2p" over all
+    samples and axes, or "mean_sum": the window mean of the sum over the non-time axes)."""
+
+    key: str
+    units: str
+    description: str
+    source: str
+    reduce: str = "max"
+
+
 class KernelGroup(ForceGroup):
-    """A force group whose physics is ONE numba-compiled kernel (issue 15).
+    """A force group whose physics is ONE numba-compiled kernel.
 
     The kernel (a module-level function of the group's module, written with
     explicit loops) adds the group's generalized forces, and optionally its
@@ -175,12 +193,44 @@ class KernelGroup(ForceGroup):
     :meth:`outputs` builds the named outputs; a time history (T, n) loops the
     kernel over the samples.
 
-    Subclasses set ``kind`` (their slot in the fused kernel) and implement
-    :meth:`pack`, :meth:`run`, :meth:`record_sources` and :meth:`outputs`.
+    Subclasses set ``kind`` (their name in the element registry,
+    :mod:`flexrv.model.core.registry`) and ``kernel`` (``staticmethod`` of the compiled
+    kernel(q, v, f, jq, jv, jac, pack)), implement :meth:`pack`, :meth:`record_sources`
+    and :meth:`outputs`, and may declare ``time_field`` (the pack's array of time inputs,
+    written by :meth:`set_time`), ``friction_outputs`` and ``summary_rows``.
     """
 
     analytic_jacobian = True
     kind: str = ""
+    #: the compiled kernel, ``staticmethod(kernel)``
+    kernel = None
+    #: field of the pack that holds the time inputs at t (:meth:`time_inputs`), "" if none
+    time_field: str = ""
+    #: names of the outputs that are dissipated friction power [W] (>= 0), summed into ``friction_power``
+    friction_outputs: tuple[str, ...] = ()
+    #: rows of the run summary computed from this element's outputs (:class:`SummaryRow`)
+    summary_rows: tuple = ()
+    #: message of the ConvergenceError raised when :meth:`failure_counter` grows in a call
+    failure_message: str = "an inner solve of a force element did not converge"
+
+    def reset(self) -> None:
+        """Forget the state of earlier evaluations; the time inputs are written again."""
+        self._time_last = None
+        super().reset()
+
+    def set_time(self, t, array) -> None:
+        """Write the time inputs at t into the pack's live ``array`` (skipped while
+        :meth:`time_inputs` returns the same cached object: the array still holds it unless
+        a group's own evaluate or a history pass wrote it, which clear ``_time_last``)."""
+        x = self.time_inputs(t)
+        if x is not getattr(self, "_time_last", None):
+            array[:] = x
+            self._time_last = x
+
+    def failure_counter(self, pack):
+        """A live int64 array (1,) of ``pack`` that the kernel increments on a failed inner
+        solve (a :class:`flexrv.errors.ConvergenceError` is raised when it grows), or None."""
+        return None
 
     def pack(self, idx: np.ndarray, history: bool = False) -> tuple:
         """Kernel arguments for coordinates at ``idx`` (int64); ``history``: fresh
@@ -198,8 +248,18 @@ class KernelGroup(ForceGroup):
 
     def run(self, t, q, v, f, jq, jv, jac: bool, pack: tuple, inputs=None) -> None:
         """Call the compiled kernel: add forces into f (and Jacobians into jq, jv);
-        ``inputs``: precomputed time inputs at t (else :meth:`time_inputs`)."""
-        raise NotImplementedError
+        ``inputs``: precomputed time inputs at t (else :meth:`time_inputs`), written into
+        the pack's ``time_field``; raises ConvergenceError if the kernel's failure counter grew."""
+        if self.time_field:
+            getattr(pack, self.time_field)[:] = self.time_inputs(t) if inputs is None else inputs
+            self._time_last = None  # the live array no longer holds what set_time wrote
+        ctr = self.failure_counter(pack)
+        before = ctr[0] if ctr is not None else 0
+        type(self).kernel(q, v, f, jq, jv, jac, pack)
+        if ctr is not None and ctr[0] != before:
+            from flexrv.errors import ConvergenceError
+
+            raise ConvergenceError(self.failure_message)
 
     def record_sources(self) -> dict:
         """The per-contact result arrays the kernel fills through the pack (live, not

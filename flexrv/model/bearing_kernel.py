@@ -1,5 +1,5 @@
 """Compiled (numba) generalized force and Jacobian of one bearing row — THE
-implementation of the ball-resolved and flexible main bearing (issue 15/16).
+implementation of the ball-resolved and flexible main bearing.
 
 One row element sees the coordinates [frame(6), inner modes, outer modes,
 balls(3Z)]: the inner ring rides on the frame (carrier), the outer ring sits in
@@ -59,11 +59,25 @@ import numpy as np
 from numba import njit
 
 from flexrv.ehl.maps import packed_log_correction
+from flexrv.model.core.params import law_type
+from flexrv.model.numerics.linalg import adjugate3, cholesky, cholesky_solve
 
-#: law parameters: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m], load and speed
-#: exponents of the film, load floor [N], c_max [N s/m], damping depth [m], Newton steps
-LAW_FIELDS = ("k", "h_unit", "load_exponent", "speed_exponent", "load_floor", "c_max", "depth", "iterations")
-N_LAW = len(LAW_FIELDS)
+#: a ball contact's normal law: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m] (0: dry), load and
+#: speed exponents of the film, load floor [N], c_max [N s/m], damping depth [m], the film
+#: iteration's Newton steps, the solver map's packed table (:meth:`flexrv.ehl.maps.FilmMap.packed`;
+#: empty: Hamrock-Dowson or dry)
+PointLaw = law_type(
+    "PointLaw",
+    k=float,
+    h_unit=float,
+    load_exponent=float,
+    speed_exponent=float,
+    load_floor=float,
+    c_max=float,
+    depth=float,
+    iterations=int,
+    film_map=np.ndarray,
+)
 
 #: columns of the per-ball record ``rec`` (Z, len(RECORD_FIELDS)): loads [N], unit
 #: normals (global), ring azimuths [rad], contact force on each ring in the ring's
@@ -118,8 +132,31 @@ BALL_BLOCKS = 2
 #: balls' work array (:func:`ball_workspace`)
 CONDENSED_BALLS = 3
 
+#: a row's geometry and cage (lengths [m]): ball count, inner and outer groove centre radius and z,
+#: inner and outer offsets, ball radius over pitch radius, speed factor, cage ratio, cage stiffness
+#: and damping, pocket stiffness; the balls' model (quasi-static: solved inside the element, else
+#: element coordinates with inertia) and the quasi-static balls' relative force tolerance
+RowGeometry = law_type(
+    "RowGeometry",
+    z=float,
+    inner_center_radius=float,
+    inner_center_z=float,
+    outer_center_radius=float,
+    outer_center_z=float,
+    inner_offset=float,
+    outer_offset=float,
+    ball_radius_pitch=float,
+    speed_factor=float,
+    cage_ratio=float,
+    cage_stiffness=float,
+    cage_damping=float,
+    pocket_stiffness=float,
+    quasi_static_balls=bool,
+    ball_force_tol=float,
+)
+
 #: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
-#: force tolerance (relative to the row's largest contact load, ``geometry[13]``) turns
+#: force tolerance (relative to the row's largest contact load, ``geometry.ball_force_tol``) turns
 #: absolute, and its Newton steps per call before a failure is reported
 BALL_LOAD_SCALE = 1.0
 BALL_MAXIT = 30
@@ -143,33 +180,38 @@ FILM_STEP_STOP = 1e-8
 _REASSOC = {"reassoc", "contract"}
 
 
-def law_parameters(law) -> np.ndarray | None:
-    """Kernel parameters of a normal law (see :data:`LAW_FIELDS`; for an EHL law in
-    mode ``"map"`` the map's packed table, :meth:`flexrv.ehl.maps.FilmMap.packed`,
-    follows them), or None if the kernel does not cover it."""
+def law_parameters(law) -> PointLaw | None:
+    """Kernel parameters of a normal law (:data:`PointLaw`; for an EHL law in mode
+    ``"map"`` with the map's packed table), or None if the kernel does not cover it."""
     from flexrv.contact.ball_raceway import HertzLaw
     from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT
     from flexrv.ehl.law import EHLPointLaw
 
     if isinstance(law, HertzLaw) and np.ndim(law.k) == 0:
-        return np.array([law.k, 0.0, 0.0, 0.0, 1.0, law.c_max, law.depth, 0.0])
+        return PointLaw.of(
+            k=law.k,
+            h_unit=0.0,
+            load_exponent=0.0,
+            speed_exponent=0.0,
+            load_floor=1.0,
+            c_max=law.c_max,
+            depth=law.depth,
+            iterations=0,
+            film_map=np.zeros(0),
+        )
     if isinstance(law, EHLPointLaw) and law.mode in ("dry", "hamrock_dowson", "map") and np.ndim(law.stiffness) == 0:
         h_unit = 0.0 if law.mode == "dry" else float(law._h_unit)
-        p = np.array(
-            [
-                float(law.stiffness),
-                h_unit,
-                HAMROCK_DOWSON_LOAD_EXPONENT,
-                0.67,
-                law.load_floor,
-                law.c_max,
-                law.damping_depth,
-                float(law.iterations),
-            ]
+        return PointLaw.of(
+            k=float(law.stiffness),
+            h_unit=h_unit,
+            load_exponent=HAMROCK_DOWSON_LOAD_EXPONENT,
+            speed_exponent=0.67,
+            load_floor=law.load_floor,
+            c_max=law.c_max,
+            depth=law.damping_depth,
+            iterations=law.iterations,
+            film_map=law.film_map.packed if law.mode == "map" else np.zeros(0),
         )
-        if law.mode == "map":
-            p = np.concatenate([p, law.film_map.packed])
-        return p
     return None
 
 
@@ -180,8 +222,8 @@ def _film(q, hu, lexp, lu, law):
     map's correction exp(c(ln q, lu)) when the law carries a map
     (flexrv.ehl.law.EHLPointLaw.film; c from flexrv.ehl.maps.packed_log_correction)."""
     h = hu * q**lexp
-    if law.shape[0] > N_LAW:
-        c, dc = packed_log_correction(law[N_LAW:], math.log(q), lu)
+    if law.film_map.shape[0] > 0:
+        c, dc = packed_log_correction(law.film_map, math.log(q), lu)
         return h * math.exp(c), lexp + dc
     return h, lexp
 
@@ -191,11 +233,11 @@ def _law_speed(speed, law):
     """Speed terms of the law, shared by all contacts of a row at one entrainment
     speed u [m/s]: (h at 1 N and u [m] (0: dry / at rest), ln u, film at the load
     floor [m])."""
-    if not (law[1] > 0.0 and speed > 0.0):
+    if not (law.h_unit > 0.0 and speed > 0.0):
         return 0.0, 0.0, 0.0
-    hu = law[1] * speed ** law[3]
+    hu = law.h_unit * speed**law.speed_exponent
     lu = math.log(speed)
-    h_floor, _ = _film(law[4], hu, law[2], lu, law)
+    h_floor, _ = _film(law.load_floor, hu, law.load_exponent, lu, law)
     return hu, lu, h_floor
 
 
@@ -224,7 +266,7 @@ def _normal_load(delta, rate, hu, lu, h_floor, law, h_start=0.0):
     FILM_STEP_STOP and ONE film evaluation gives the same fixed point (the error
     bound above holds from any start; measured: the same loads within ~1e-15
     relative, tests/test_model_flexible_rings.py::test_film_warm_start_same_fixed_point)."""
-    k, lexp, floor, c_max, depth, iters = law[0], law[2], law[4], law[5], law[6], int(law[7])
+    k, lexp, floor, c_max, depth, iters = law.k, law.load_exponent, law.load_floor, law.c_max, law.depth, law.iterations
     dphi = 1.0
     h = 0.0
     if hu == 0.0:
@@ -385,39 +427,6 @@ def _local_factors(psi, wtab, zsign, out):
                 out[j, a, k] = w0 * r0[k] + w1 * r1[k] + w2 * r2[k] + w3 * r3[k]
 
 
-@njit(cache=True)
-def _cholesky(m):
-    """In-place lower Cholesky factor of a small SPD matrix m."""
-    n = m.shape[0]
-    for j in range(n):
-        d = m[j, j]
-        for k in range(j):
-            d -= m[j, k] * m[j, k]
-        d = math.sqrt(max(d, 1e-300))
-        m[j, j] = d
-        for i in range(j + 1, n):
-            v = m[i, j]
-            for k in range(j):
-                v -= m[i, k] * m[j, k]
-            m[i, j] = v / d
-
-
-@njit(cache=True)
-def _cholesky_solve(m, b):
-    """b <- m^-1 b with m's lower Cholesky factor (from :func:`_cholesky`)."""
-    n = m.shape[0]
-    for i in range(n):
-        v = b[i]
-        for k in range(i):
-            v -= m[i, k] * b[k]
-        b[i] = v / m[i, i]
-    for i in range(n - 1, -1, -1):
-        v = b[i]
-        for k in range(i + 1, n):
-            v -= m[k, i] * b[k]
-        b[i] = v / m[i, i]
-
-
 def condense_workspace(ball_count: int, n_modes: int) -> np.ndarray:
     """Persistent work array of a condensed ring in a row (see :func:`_split_workspace`):
     the contact deflections (warm start), the last Newton tangent, the scratch
@@ -563,11 +572,11 @@ def _condense(e0, w0, wl, offset, speed, law, ws, loads, normals, dq, cd, length
                     smat[j, i] = v
                     smat[i, j] = v
                 smat[j, j] += 1.0
-            _cholesky(smat)
+            cholesky(smat)
             valid[0] = 1.0
         for j in range(nz):
             rhs[j] = sq[j] * (nf[j, 0] * r[j, 0] + nf[j, 1] * r[j, 1] + nf[j, 2] * r[j, 2])
-        _cholesky_solve(smat, rhs)
+        cholesky_solve(smat, rhs)
         # correction C N L y' = W (P^T (L^1/2 z))
         for k in range(m):
             y[k] = 0.0
@@ -706,13 +715,13 @@ def row_kernel(
 ):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n) (new arrays; :func:`row_eval`
-    with its outputs allocated here). Quasi-static balls (``geometry[13]`` > 0):
+    with its outputs allocated here). Quasi-static balls (``geometry.quasi_static_balls``):
     q, q_t, the force and the Jacobians cover the frame and modal coordinates only
     (:func:`quasi_static_balls`, warm-started from and updating ``balls``)."""
     nb = 3 * ball_ref.shape[0]
     n = 6 + tab_i.shape[2] + tab_o.shape[2] + nb
     f = np.empty(n)
-    if geometry[13] > 0.0:
+    if geometry.quasi_static_balls:
         nx = n - nb
         qf = np.zeros(n)
         vf = np.zeros(n)
@@ -815,9 +824,9 @@ def _add_speed_column(jac, kb, t, b, x0, nx, col, dx, dy, dz):
 def _film_speed_gain(law, speed, film):
     """d h_c / d u [s] of a contact's film at entrainment speed u > 0 (Hamrock-Dowson
     h ~ u^0.67; a map's own speed dependence is left out: Jacobian only)."""
-    if speed <= 0.0 or law[1] <= 0.0:
+    if speed <= 0.0 or law.h_unit <= 0.0:
         return 0.0
-    return law[3] * film / speed
+    return law.speed_exponent * film / speed
 
 
 @njit(cache=True)
@@ -898,10 +907,7 @@ def row_eval(
     only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
     sum of the local iterations, local solves, then the same four of the
     quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
-    (0, N_RECORD). geometry: (14,) [z, inner centre radius and z, outer centre
-    radius and z, inner and outer offsets, ball pitch radius, speed factor, cage
-    ratio, cage stiffness and damping, pocket stiffness, the quasi-static balls'
-    relative force tolerance (0: the balls are element coordinates)].
+    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
 
     ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
     CONDENSED_BALLS (the quasi-static balls' modes, see there).
@@ -914,23 +920,15 @@ def row_eval(
     terms of the frame rotation are dropped; the modified Newton iteration
     converges on the residual, which is exact). The azimuths' cosines and sines
     are the normalised in-plane coordinates (no sin/cos of the atan2)."""
-    z_row, ci_r, ci_z, co_r, co_z, off_i, off_o, rb = (
-        geometry[0],
-        geometry[1],
-        geometry[2],
-        geometry[3],
-        geometry[4],
-        geometry[5],
-        geometry[6],
-        geometry[7],
+    z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
+    co_r, co_z, off_i, off_o = (
+        geometry.outer_center_radius,
+        geometry.outer_center_z,
+        geometry.inner_offset,
+        geometry.outer_offset,
     )
-    speed_factor, cage_ratio, cage_k, cage_c, pocket_k = (
-        geometry[8],
-        geometry[9],
-        geometry[10],
-        geometry[11],
-        geometry[12],
-    )
+    rb, speed_factor, cage_ratio = geometry.ball_radius_pitch, geometry.speed_factor, geometry.cage_ratio
+    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
     cond_i = comp_i.shape[0] > 0
@@ -1319,7 +1317,7 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
     matrix S = I + P P^T, P = V^T W: (I - K C)^-1 K = -V S^-1 V^T, and by Woodbury
     (I - K C)^-1 N = N - V S^-1 P (W^T N), so one 2Z x 2Z inverse and BLAS products
     of 2Z x m and m x Z replace the 3Z x 3Z Gram matrix W W^T and the inverse of
-    I - K C (issue 15: rv40e's rings, Z = 38, m = 165-181: 360 -> 190 us per ring
+    I - K C (rv40e's rings, Z = 38, m = 165-181: 360 -> 190 us per ring
     and Jacobian, benchmarks/bench_flexible_model.py). Exact for the rank-2 blocks;
     tests/test_model_flexible_rings.py checks it against the direct solution."""
     nz = normals.shape[0]
@@ -1388,22 +1386,6 @@ def row_force_kernel(
 
 
 @njit(cache=True)
-def _adjugate3(k, adj):
-    """The adjugate of the 3x3 block k[:3, :3] into ``adj`` (k^-1 = adj / det); returns
-    det (cofactor expansion along the first row)."""
-    adj[0, 0] = k[1, 1] * k[2, 2] - k[1, 2] * k[2, 1]
-    adj[0, 1] = k[0, 2] * k[2, 1] - k[0, 1] * k[2, 2]
-    adj[0, 2] = k[0, 1] * k[1, 2] - k[0, 2] * k[1, 1]
-    adj[1, 0] = k[1, 2] * k[2, 0] - k[1, 0] * k[2, 2]
-    adj[1, 1] = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-    adj[1, 2] = k[0, 2] * k[1, 0] - k[0, 0] * k[1, 2]
-    adj[2, 0] = k[1, 0] * k[2, 1] - k[1, 1] * k[2, 0]
-    adj[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
-    adj[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
-    return k[0, 0] * adj[0, 0] + k[0, 1] * adj[1, 0] + k[0, 2] * adj[2, 0]
-
-
-@njit(cache=True)
 def ball_equilibrium(
     q,
     qt,
@@ -1445,7 +1427,7 @@ def ball_equilibrium(
     b0 = q.shape[0] - 3 * nz
     recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
     jv = np.empty((0, 0))
-    damping = max(law_i[5], law_o[5], geometry[11], 1e-300)
+    damping = max(law_i.c_max, law_o.c_max, geometry.cage_damping, 1e-300)
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
@@ -1484,7 +1466,7 @@ def ball_equilibrium(
         dv = 0.0
         for j in range(nz):  # -K^-1 f_j and b_t = -K^-1 (K_bx x_t) (3x3, cofactors)
             k = kbb[3 * j : 3 * j + 3]
-            det = _adjugate3(k, adj)
+            det = adjugate3(k, adj)
             for off in (0, 3):  # right-hand sides: the ball's force, then K_bx x_t
                 r0, r1, r2 = (
                     (f[b0 + 3 * j], f[b0 + 3 * j + 1], f[b0 + 3 * j + 2]) if off == 0 else (k[0, 3], k[1, 3], k[2, 3])
@@ -1518,7 +1500,7 @@ def _condense_ball(jl, vl, nx, kx, cx, s_ball, inv, tm):
     change with x (second order, d S / d x x_t) is left out. The balls couple only
     through x, so the Schur complement over all balls is this sum. inv (3, 3), tm
     (3, nx): work."""
-    det = _adjugate3(jl[nx:, nx:], inv)
+    det = adjugate3(jl[nx:, nx:], inv)
     for r in range(3):
         for c in range(3):
             inv[r, c] /= det
@@ -1603,7 +1585,7 @@ def quasi_static_balls(
     of any size: a history pass may jump), then b += S (x - x_last) over the other
     coordinates and b_t = b_t,last + S (x_t - x_t,last) (S: the static sensitivity d b /
     d x of the last Jacobian call, zero before it), and are solved by
-    :func:`ball_equilibrium` (relative force tolerance ``geometry[13]``,
+    :func:`ball_equilibrium` (relative force tolerance ``geometry.ball_force_tol``,
     :data:`BALL_MAXIT` steps; if the prediction fails, once more from b_last; a
     failure is counted in state[4], flagged in state[5] and not stored). Out: f[:nx]
     the force on x (f (n,) work), the per-ball records ``rec`` and, with
@@ -1626,7 +1608,7 @@ def quasi_static_balls(
             q[nx + e] = b[e]
             qt[nx + e] = bt[e]
     else:
-        turn = geometry[9] * (q[5] - xl[5])
+        turn = geometry.cage_ratio * (q[5] - xl[5])
         ct, st = math.cos(turn), math.sin(turn)
         for j in range(nz):
             px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
@@ -1659,7 +1641,7 @@ def quasi_static_balls(
             ws_o,
             balls,
             state,
-            geometry[13],
+            geometry.ball_force_tol,
             BALL_MAXIT,
             f,
             kbb,
@@ -1686,7 +1668,7 @@ def quasi_static_balls(
                 ws_o,
                 balls,
                 state,
-                geometry[13],
+                geometry.ball_force_tol,
                 BALL_MAXIT,
                 f,
                 kbb,
@@ -1737,7 +1719,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     Per row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
     vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
     reference ``ball_ref`` is subtracted), then :func:`row_eval` -- or, for
-    quasi-static balls (``geometry[13]`` > 0; idx covers the frame and modal
+    quasi-static balls (``geometry.quasi_static_balls``; idx covers the frame and modal
     coordinates only, qe / ve are the full work vectors), :func:`quasi_static_balls`;
     the rows' results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
     f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
@@ -1785,7 +1767,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
         for e in range(n):
             qe[e] = qn[idx[e]]
             ve[e] = vn[idx[e]]
-        if geometry[13] > 0.0:
+        if geometry.quasi_static_balls:
             quasi_static_balls(
                 qe,
                 ve,
@@ -1865,7 +1847,7 @@ def row_history(
     nt = qs.shape[0]
     out = np.zeros(qs.shape)
     empty = np.empty((0, 0))
-    if geometry[13] > 0.0:
+    if geometry.quasi_static_balls:
         nx = qs.shape[1]
         nb = 3 * ball_ref.shape[0]
         qf = np.zeros(nx + nb)

@@ -18,7 +18,7 @@ carrier's moment, (r . f) on (theta, theta); the terms of the bore's rotation wi
 theta in the damper are dropped, and for the linear law also in the spring (its
 Jacobian is kept as in tests/data/force_reference.npz).
 
-Carrier (issue 14; design ``carrier.body_model = "condensed_fe"``): the carrier's
+Carrier (design ``carrier.body_model = "condensed_fe"``): the carrier's
 end plates and pillars are elastic. Its FE condensation
 (:func:`flexrv.fem.carrier.crank_support_compliance`) gives the (2N x 2N)
 compliance C of the cranks' support points (each crank's force split over its two
@@ -56,20 +56,20 @@ d = E - H and the as-built radial clearance c_r = c_jk (``needle_clearances``):
   g = D/d_m (Harris & Kotzalas 2007, ch. 8). Rollers are massless (their
   inertia is negligible against the disc's).
 
-Friction (issue 14): a constant-coefficient rolling-bearing friction moment
+Friction: a constant-coefficient rolling-bearing friction moment
 between eccentric and disc hole (SKF/JTEKT model M = mu P d/2, P the radial
 load, d the bore = eccentric journal diameter; mu = design
 ``contact.needle_friction_coefficient``), regularised like the pin friction:
 M = -mu F (d/2) s(omega_rel d/2) on the crank and +M on the disc, omega_rel =
 dphi_j/dt - dpsi_k/dt, F = |F| the bearing force, s
-:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact): dF = e^T dF-vector, e = F-vector/F,
-with the complete force tangents below, plus the regularisation term
+:func:`flexrv.contact.laws._friction_one`; its power M omega_rel <= 0. Jacobian (exact):
+dF = e^T dF-vector, e = F-vector/F, with the complete force tangents below, plus the regularisation term
 -mu F (d/2)^2 s' on (phi_j, psi_k) of dM/dv.
 
 Both use the impact-law damping ramp of :func:`flexrv.contact.laws.impact_force`.
 Generalized forces are Q = -B^T F (B = dd/dq over crank x, y, phi and disc x, y,
 psi; F the bearing force on the disc). The analytic Jacobian is the exact
-derivative of Q as computed (issue 15: with the arm rotations dropped, Newton
+derivative of Q as computed (with the arm rotations dropped, Newton
 converged only linearly at running speeds): dQ/dq = -B^T G - (dB^T/dq) F with
 G = dF/dq = K B + D W + c g, K the contact tangent (empirical law: spring,
 rotation F/|d| of the direction d/|d| and the damper's rate turning with it,
@@ -103,8 +103,73 @@ from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output
-from flexrv.model.pins import condensed_step, inv_small, matmul_small
+from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.numerics.linalg import inv_small, matmul_small
+from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD
+
+_F, _I = np.float64, np.int64
+#: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law
+SupportLaw = law_type("SupportLaw", damping=float, linear=bool)
+#: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
+#: the tapered-roller pair's law vector (:mod:`flexrv.contact.tapered_roller`, read by its SC_ names),
+#: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
+#: crank, bearing displacement = Newton start, bending share), the elastic carrier's support-point
+#: compliance (2N, 2N) (empty: rigid), its deflections (N, 4) and the work array (:func:`support_work_size`)
+SupportPack = pack_type(
+    "SupportPack",
+    ("idx", (_I, (6,))),
+    ("law", SupportLaw),
+    ("roller_law", (_F, (SC_G + 1,))),
+    ("bores", (_F, 2)),
+    ("clear", (_F, 1)),
+    ("angles", (_F, 1)),
+    ("fx", (_F, 1)),
+    ("fy", (_F, 1)),
+    ("bstate", (_F, 2)),
+    ("bend", (_F, 1)),
+    ("carrier_c", (_F, 2)),
+    ("ustate", (_F, 2)),
+    ("work", (_F, 1)),
+)
+#: the needle bearings' scalar law: contact K, exponent, c_max, depth, roller-resolved model (else the
+#: empirical radial law), pitch ratio g = D/d_m, disc teeth z_c, friction coefficient, friction radius
+#: d/2 [m], regularisation speed
+NeedleLaw = law_type(
+    "NeedleLaw",
+    k=float,
+    exponent=float,
+    c_max=float,
+    depth=float,
+    rollers=bool,
+    pitch_ratio=float,
+    z_c=float,
+    mu=float,
+    friction_radius=float,
+    v_reg=float,
+)
+#: :func:`needle_kernel`'s pack: indices (each crank's x, y, phi, then each disc's x, y, psi), law,
+#: disc eccentric phases chi0, as-built eccentricities, phase errors, hole centres x, y (cranks,
+#: discs), clearances, roller angles, outputs per bearing (force x, y, rollers' forces and angles,
+#: friction power) and state (min gap, each disc's departure from its conjugate rotation)
+NeedlePack = pack_type(
+    "NeedlePack",
+    ("idx", (_I, 1)),
+    ("law", NeedleLaw),
+    ("chi0", (_F, 1)),
+    ("ecc", (_F, 2)),
+    ("err", (_F, 2)),
+    ("hx", (_F, 2)),
+    ("hy", (_F, 2)),
+    ("clear", (_F, 2)),
+    ("roller_angles", (_F, 1)),
+    ("fx", (_F, 2)),
+    ("fy", (_F, 2)),
+    ("roll", (_F, 3)),
+    ("angle", (_F, 3)),
+    ("pw", (_F, 2)),
+    ("state", (_F, (1,))),
+)
 
 
 @njit(cache=True)
@@ -138,7 +203,13 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk,
 def support_work_size(n: int) -> int:
     """Length of :func:`crank_support_kernel`'s work array for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
-    return 4 + m + n2 * m + n2 + 9 * n + 8 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+
+
+#: the carrier Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
+#: roundoff_abs, roundoff_rel): 60 Newton steps (the evaluation cap 40 per step never binds: halving
+#: ends after 21); round-off: a worse residual at max|R| <= 1e-12 m
+CARRIER_NEWTON = (2400, 60, 1e-12, 0.0)
 
 
 @njit(cache=True)
@@ -152,6 +223,19 @@ def _carrier_residual(u, ch, fs, res):
         res[r] = acc
         r0 = max(r0, abs(acc))
     return r0
+
+
+@njit(cache=True)
+def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res):
+    """The elastic carrier's support forces at d = d0 - u and residual R = u + C_h f_s into
+    ``res`` (tangent K into kk) for :func:`~flexrv.model.numerics.newton.newton_update`;
+    returns (max|R|, max|u|)."""
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    r0 = _carrier_residual(u, ch, fs, res)
+    umax = 0.0
+    for r in range(u.shape[0]):
+        umax = max(umax, abs(u[r]))
+    return r0, umax
 
 
 @njit(cache=True)
@@ -172,17 +256,16 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     last correction c applied linearised (f_s + K du, exact to O(|R|^2)); the condensed tangent is df_s =
     M (-K dd0 + H dgamma) - M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
-    arm r + u. Cost (issue 15): the Newton starts from the first-order predictor u_prev + S (q - q_prev),
+    arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
     tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
-    LAPACK (:func:`flexrv.model.pins.inv_small`) and nothing is allocated per call. Measured on rv40e
-    (a run's 4,000 solver calls replayed, CPU per call, paired with the code before, loaded machine,
-    2026-11-24): 9.1-11.7 -> 6.5-6.7 us compiled (11.0-11.2 -> 8.2-8.3 us called from Python); with
-    ``carrier.body_model = "rigid"`` 3.0 -> 2.6 us. The elastic carrier's extra cost before was its
-    Newton (two or more support evaluations per call), LAPACK/BLAS calls on 6 x 6 matrices and ~20
-    array allocations per call."""
-    idx, sc, dc, bores, clear, angles, out_fx, out_fy, bstate, out_bend, cc, ustate, wk = pack
-    cd, linear = dc[0], dc[1] > 0.5
+    LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
+    (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
+    called from Python); with ``carrier.body_model = "rigid"`` 2.6 us."""
+    idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
+    out_fx, out_fy, bstate, out_bend = pack.fx, pack.fy, pack.bstate, pack.bend
+    cc, ustate, wk = pack.carrier_c, pack.ustate, pack.work
+    cd, linear = pack.law.damping, pack.law.linear
     kb, g = sc[SC_K_BEND], sc[SC_G]
     th, om = q[idx[2]], v[idx[2]]
     c, s = np.cos(th), np.sin(th)
@@ -191,7 +274,8 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     m = 3 + 3 * n  # local coordinates: carrier x, y, theta, then crank j's x, y, phi
     elastic = n > 0 and cc.shape[0] == n2
     st = wk[0:4]
-    o = 4
+    nw = wk[4 : 4 + NEWTON_STATE]
+    o = 4 + NEWTON_STATE
     qp = wk[o : o + m]
     o += m
     su = wk[o : o + n2 * m].reshape((n2, m))
@@ -209,7 +293,8 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         wk[o + 6 * n2 : o + 7 * n2],
         wk[o + 7 * n2 : o + 8 * n2],
     )
-    o += 8 * n2
+    ones = wk[o + 8 * n2 : o + 9 * n2]  # the Newton's norms: unweighted
+    o += 9 * n2
     nn = n2 * n2
     kk = wk[o : o + nn].reshape((n2, n2))
     ch = wk[o + nn : o + 2 * nn].reshape((n2, n2))
@@ -248,52 +333,28 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
                 ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
                 ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
         valid = st[0] > 0.0
+        for r in range(n2):
+            ones[r] = 1.0
         for j in range(n):
             u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
             if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
                 valid = False  # set from outside (reset, history pass): start from it
-        if valid:  # first-order predictor from the previous call, within a tenth of the deflections' size
-            umax, pmax = 0.0, 0.0
+        if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
             for r in range(n2):
                 acc = 0.0
                 for col in range(m):
                     qc = q[idx[col]] if col < 3 else q[idx[col + 3]]
                     acc += su[r, col] * (qc - qp[col])
                 step[r] = acc
-                umax = max(umax, abs(u[r]))
-                pmax = max(pmax, abs(acc))
-            if pmax <= 0.1 * umax:
-                for r in range(n2):
-                    u[r] += step[r]
-    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+            apply_predictor(u, step, ones)
+        newton_start(nw)
+        while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
+            r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
+            if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
+                break
+    else:
+        _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     if elastic:
-        r0 = _carrier_residual(u, ch, fs, res)
-        lam = 1.0
-        for _ in range(60):
-            condensed_step(ch, kk, 1.0, res, tmp, mm, step)  # Newton correction from here: (I + C_h K)^-1 R
-            umax = 0.0
-            for r in range(n2):
-                umax = max(umax, abs(u[r]))
-            tol = max(1e-15, 1e-10 * umax)  # 1e-13 m or better
-            if r0 <= tol:
-                break
-            lam = 1.0
-            for r in range(n2):
-                u0[r] = u[r]
-            r1 = r0
-            for _h in range(40):  # step halving on max|R| (R is the gradient of a convex energy)
-                for r in range(n2):
-                    u[r] = u0[r] - lam * step[r]
-                _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
-                r1 = _carrier_residual(u, ch, fs, res)
-                if r1 < r0 or lam < 1e-6 or r0 <= 1e-12:  # (at round-off: accept)
-                    break
-                lam *= 0.5
-            stop = r1 >= r0 and r0 <= 1e-12
-            r0 = r1
-            if stop:  # at round-off: the correction from this last evaluation, then stop
-                condensed_step(ch, kk, 1.0, res, tmp, mm, step)
-                break
         # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
         # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
         for r in range(n2):
@@ -423,6 +484,7 @@ class CrankSupports(KernelGroup):
 
     name = "crank_supports"
     kind = "supports"
+    kernel = staticmethod(crank_support_kernel)
 
     def __init__(self, params):
         p = params
@@ -434,7 +496,7 @@ class CrankSupports(KernelGroup):
         self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
         self.linear = bool(p.support_linear)
         self.c = p.support_damping
-        self.dc = np.array([self.c, float(self.linear)])
+        self.law = SupportLaw.of(damping=self.c, linear=self.linear)
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
@@ -451,10 +513,10 @@ class CrankSupports(KernelGroup):
         return self.carrier_c.size > 0
 
     def pack(self, idx, history=False):
-        return (
+        return SupportPack(
             idx,
+            self.law,
             self.sc,
-            self.dc,
             self.bores,
             self.clear,
             self.angles,
@@ -469,25 +531,7 @@ class CrankSupports(KernelGroup):
 
     @staticmethod
     def empty_pack():
-        z = np.zeros(0)
-        return (
-            np.zeros(6, np.int64),
-            np.zeros(7),
-            np.zeros(2),
-            np.zeros((0, 2)),
-            z,
-            z,
-            z,
-            z,
-            np.zeros((0, 2)),
-            z,
-            np.zeros((0, 0)),
-            np.zeros((0, 4)),
-            np.zeros(support_work_size(0)),
-        )
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        crank_support_kernel(q, v, f, jq, jv, jac, pack)
+        return empty_pack(SupportPack)
 
     def reset(self) -> None:
         """Forget the bearing displacements of earlier evaluations (the inner Newton's
@@ -542,9 +586,13 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     per-bearing force on the disc into out_fx, out_fy, roller forces and angles
     (rollers model) into out_roll, out_angle; state[0] = min gap [m], state[1 + k]
     = disc k's departure from its conjugate rotation [rad]."""
-    idx, sc, chi0, ecc, err, hx, hy, clear, roller_angles, out_fx, out_fy, out_roll, out_angle, out_pw, state = pack
-    k_c, expo, c_max, depth, rollers, g_ratio, z_c = sc[0], sc[1], sc[2], sc[3], sc[4] > 0.5, sc[5], sc[6]
-    mu_b, r_b, v_reg = sc[7], sc[8], sc[9]  # friction moment (module docstring): coefficient, d/2, v_reg
+    idx, chi0, ecc, err, hx, hy = pack.idx, pack.chi0, pack.ecc, pack.err, pack.hx, pack.hy
+    clear, roller_angles = pack.clear, pack.roller_angles
+    out_fx, out_fy, out_roll, out_angle, out_pw, state = pack.fx, pack.fy, pack.roll, pack.angle, pack.pw, pack.state
+    law = pack.law
+    k_c, expo, c_max, depth, rollers = law.k, law.exponent, law.c_max, law.depth, law.rollers
+    g_ratio, z_c = law.pitch_ratio, law.z_c
+    mu_b, r_b, v_reg = law.mu, law.friction_radius, law.v_reg  # friction moment (module docstring)
     fric = mu_b > 0.0 and v_reg > 0.0
     nc, nd = ecc.shape[0], ecc.shape[1]
     min_gap = np.inf
@@ -695,6 +743,8 @@ class NeedleBearings(KernelGroup):
 
     name = "needle_bearings"
     kind = "needles"
+    kernel = staticmethod(needle_kernel)
+    friction_outputs = ("needle_friction_power",)
 
     def __init__(self, params, model: str, k_empirical: float | None = None):
         p = params
@@ -720,19 +770,17 @@ class NeedleBearings(KernelGroup):
             z = p.needle_roller_count
             self.roller_angles = 2.0 * np.pi * np.arange(z) / z
         g = p.needle_pitch_ratio
-        self.sc = np.array(
-            [
-                self.k,
-                LINE_EXPONENT,
-                p.needle_c_max,
-                p.contact_depth,
-                float(model == "rollers"),
-                g,
-                float(p.z_c),
-                p.needle_friction,
-                p.needle_friction_radius,
-                p.friction_velocity,
-            ]
+        self.law = NeedleLaw.of(
+            k=self.k,
+            exponent=LINE_EXPONENT,
+            c_max=p.needle_c_max,
+            depth=p.contact_depth,
+            rollers=model == "rollers",
+            pitch_ratio=g,
+            z_c=p.z_c,
+            mu=p.needle_friction,
+            friction_radius=p.needle_friction_radius,
+            v_reg=p.friction_velocity,
         )
         self.mu = p.needle_friction if p.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
@@ -743,9 +791,9 @@ class NeedleBearings(KernelGroup):
         self.reset()
 
     def pack(self, idx, history=False):
-        return (
+        return NeedlePack(
             idx,
-            self.sc,
+            self.law,
             self.chi0,
             self.ecc,
             self.err,
@@ -763,11 +811,7 @@ class NeedleBearings(KernelGroup):
 
     @staticmethod
     def empty_pack():
-        z1, z2, z3 = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0, 0))
-        return (np.zeros(0, np.int64), np.zeros(10), z1, z2, z2, z2, z2, z2, z1, z2, z2, z3, z3, z2, np.zeros(1))
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        needle_kernel(q, v, f, jq, jv, jac, pack)
+        return empty_pack(NeedlePack)
 
     @property
     def min_gap(self) -> float:
@@ -808,7 +852,7 @@ class NeedleBearings(KernelGroup):
 
     def check(self) -> str | None:
         # a skipped pin first: it is the cause, and the needle penetration it then produces the symptom
-        # (on Python floats: numpy's reductions on these few values cost ~4 us per step, issue 15)
+        # (on Python floats: numpy's reductions on these few values cost ~4 us per step)
         state = self.state.tolist()
         limit = math.pi / self.z_rp
         if any(abs(d) > limit for d in state[1:]):  # (NaN: not evaluated yet, never a skip)

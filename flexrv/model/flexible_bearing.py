@@ -12,7 +12,7 @@ Members per row of the back-to-back pair:
   FFRF body is needed for the inner rings either;
 * the **outer ring** sits in the housing (fixed frame), modal coordinates ``q_o``;
 * **balls** are point masses (3 DOF each; why: :mod:`flexrv.contact.ball_raceway`)
-  or, with ``ball_inertia=False`` (the ball model's default, issue 15),
+  or, with ``ball_inertia=False`` (the ball model's default),
   **quasi-static**: massless, in force equilibrium at every instant, solved inside
   the row kernel (:func:`flexrv.model.bearing_kernel.quasi_static_balls`, a Newton
   per ball warm-started from a prediction; the element then has the frame's and
@@ -34,7 +34,7 @@ Members per row of the back-to-back pair:
   is carried by the kinematic constraint, not by the frame.
 
 Rings given as ``None`` are rigid. A flexible ring (:class:`ModalRing`) is by
-default quasi-static AND **condensed** (issue 15): its massless modal
+default quasi-static AND **condensed**: its massless modal
 coordinates are not system coordinates; the row kernel solves the contact
 deflections from the ring's compliance at the ball contacts
 (:mod:`flexrv.model.bearing_kernel`), and the ring's modal amplitudes are
@@ -63,6 +63,7 @@ from flexrv.model.bearing_kernel import (
     BALL_FORCE_TOL,
     N_RECORD,
     RECORD_FIELDS,
+    RowGeometry,
     ball_workspace,
     condense_workspace,
     film_workspace,
@@ -310,23 +311,22 @@ def kernel_inputs(model: RowModel) -> tuple:
     tab_i, zs_i, comp_i, ws_i = _ring_arrays(model.inner, model.ball_count)
     tab_o, zs_o, comp_o, ws_o = _ring_arrays(model.outer, model.ball_count)
     row = model.row
-    geometry = np.array(
-        [
-            model.z,
-            row.inner_center_radius,
-            row.inner_center_z,
-            row.outer_center_radius,
-            row.outer_center_z,
-            row.inner_offset,
-            row.outer_offset,
-            row.ball_radius_pitch,
-            model.speed_factor,
-            model.cage_ratio,
-            model.cage_stiffness,
-            model.cage_damping,
-            model.pocket_stiffness,
-            0.0 if model.ball_inertia else BALL_FORCE_TOL,
-        ]
+    geometry = RowGeometry.of(
+        z=model.z,
+        inner_center_radius=row.inner_center_radius,
+        inner_center_z=row.inner_center_z,
+        outer_center_radius=row.outer_center_radius,
+        outer_center_z=row.outer_center_z,
+        inner_offset=row.inner_offset,
+        outer_offset=row.outer_offset,
+        ball_radius_pitch=row.ball_radius_pitch,
+        speed_factor=model.speed_factor,
+        cage_ratio=model.cage_ratio,
+        cage_stiffness=model.cage_stiffness,
+        cage_damping=model.cage_damping,
+        pocket_stiffness=model.pocket_stiffness,
+        quasi_static_balls=not model.ball_inertia,
+        ball_force_tol=0.0 if model.ball_inertia else BALL_FORCE_TOL,
     )
     # quasi-static balls: the local solve's work array, its first warm start the preload
     # equilibrium; with ball inertia the balls are element coordinates
@@ -352,6 +352,15 @@ def kernel_inputs(model: RowModel) -> tuple:
     )
     model._kernel_inputs = inputs
     return inputs
+
+
+def set_ball_force_tolerance(model: RowModel, tol: float) -> None:
+    """Set the relative force tolerance of a row's quasi-static balls (:data:`BALL_FORCE_TOL`
+    by default) in its prepared kernel inputs: for studies of the local solve's tolerance."""
+    inputs = kernel_inputs(model)
+    if not inputs[1].quasi_static_balls:
+        raise ValueError("the row's balls are element coordinates (ball inertia): no local solve")
+    model._kernel_inputs = (inputs[0], inputs[1]._replace(ball_force_tol=float(tol)), *inputs[2:])
 
 
 def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
@@ -515,7 +524,7 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
 
 
 class RowElement:
-    """THE Exudyn glue of the bearing rows (issue 15): one Exudyn element for one or
+    """THE Exudyn glue of the bearing rows: one Exudyn element for one or
     more rows (the reducer model: one per row, or one for all rows with quasi-static
     balls, see :meth:`BallBearingGroup.add_to`), one compiled call
     (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
@@ -535,7 +544,7 @@ class RowElement:
     :attr:`memo` = (t, q, q_t) of the call they belong to, so a run records the
     bearing's outputs from the integrator's own calls
     (:class:`flexrv.model.kernels.HistoryRecorder`) instead of evaluating the rows
-    again per sample (issue 15: ~23 us per row and sample)."""
+    again per sample (~23 us per row and sample)."""
 
     def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None, record: bool = False):
         rows = [rows] if isinstance(rows, RowModel) else list(rows)
@@ -811,7 +820,7 @@ def flexible_rings(
     The default K is the reduction's patch-width rule (57 for rv221).
 
     ``condense`` (default True): quasi-static rings are condensed into the row
-    elements (no modal system coordinates; issue 15); False keeps their massless
+    elements (no modal system coordinates); False keeps their massless
     modal coordinates (the uncondensed formulation, for verification).
 
     ``n_eig`` (None: :data:`RING_EIGENMODES` for dynamic rings,
@@ -821,7 +830,7 @@ def flexible_rings(
     eigenmodes were 45 % of the cold build of the rv221 rings (23 of 54 s CPU)
     and 12 of the 127 modes the condensed kernel carries. The recorded lowest
     mode (``lowest_mode_hz``) is then the Ritz estimate of the attachment basis
-    (an upper bound; measured rv221 outer ring: see the report of issue 15).
+    (an upper bound; measured rv221 outer ring: bench_flexible_model).
     """
     from flexrv.fem.body import body_identity, reduce_part
 
@@ -896,7 +905,7 @@ class BallBearingGroup(ForceGroup):
         converts, copies and scans the element's dense Jacobian, which grows as
         (6 + 6Z)^2 instead of 2 (6 + 3Z)^2: on two dense 120-coordinate blocks (the
         condensed rows of rv40e) a synthetic system took 1.86 s instead of 1.31 s
-        for 1000 Jacobians (issue 15). Rows with quasi-static balls between rigid
+        for 1000 Jacobians. Rows with quasi-static balls between rigid
         rings act on the carrier's six coordinates only: then ONE element carries
         all rows (a 6 x 6 Jacobian; one Python call per evaluation instead of one
         per row). Returns the first row's object number."""

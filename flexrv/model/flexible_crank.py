@@ -24,9 +24,9 @@ interfaces clamped is > 20 kHz for both presets (``lowest_clamped_hz``; rv40e:
 the drive (:cite:`seed002`'s Table 4 tops at 400 Hz),
 so the shaft's own inertia between the interfaces does not act dynamically;
 the planet's torsional vibration on the crank (sqrt(k_t / J_red), J_red the
-reduced inertia of planet and crank: ~22 kHz for rv40e) is kept. Neglected: the x/y anisotropy of the lateral stiffness (the eccentrics
-make the shaft slightly unsymmetric; measured |k_x - k_y| / k < 4 %), the
-coupling of the gear seat's lateral motion and twist (off-diagonal terms of the
+reduced inertia of planet and crank: ~22 kHz for rv40e) is kept. Neglected: the x/y
+anisotropy of the lateral stiffness (the eccentrics make the shaft slightly unsymmetric;
+measured |k_x - k_y| / k < 4 %), the coupling of the gear seat's lateral motion and twist (off-diagonal terms of the
 condensed 6x6 compliance, not carried), and bending between the eccentrics and the support
 journals (the needle and support bearings are 10-100x softer).
 

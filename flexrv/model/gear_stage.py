@@ -57,32 +57,54 @@ from numba import njit
 
 from flexrv.analysis.mesh_stiffness import mesh_stiffness_ramped
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.units import TWO_PI
 
-#: order of the scalars in the kernel's ``sc`` array
-SCALARS = ("rbs", "rbp", "sin_alpha_w", "a_w", "z_s", "b_n", "k_single", "eps_alpha", "ramp", "c", "A_sun", "ph_sun")
+#: the meshes' scalar law: base radii of sun and planet, sin of the working pressure angle, centre
+#: distance, sun teeth, normal backlash, single-pair stiffness, contact ratio, stiffness ramp
+#: fraction, mesh damping, sun runout amplitude and phase
+GearLaw = law_type(
+    "GearLaw",
+    rbs=float,
+    rbp=float,
+    sin_alpha_w=float,
+    a_w=float,
+    z_s=float,
+    b_n=float,
+    k_single=float,
+    eps_alpha=float,
+    ramp=float,
+    c=float,
+    A_sun=float,
+    ph_sun=float,
+)
+_F, _I = np.float64, np.int64
+#: :func:`gear_stage_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
+#: the drive at t (sun angle, sun speed: the time inputs), crank angles in the carrier, planet
+#: (runout amplitude, phase, assembly phase error), per-mesh outputs
+GearPack = pack_type(
+    "GearPack",
+    ("idx", (_I, (6,))),
+    ("law", GearLaw),
+    ("drive", (_F, (2,))),
+    ("beta0", (_F, 1)),
+    ("planet", (_F, 2)),
+    ("force", (_F, 1)),
+    ("deflection", (_F, 1)),
+    ("stiffness", (_F, 1)),
+)
 
 
 @njit(cache=True)
-def gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack):
-    """Sun–planet meshes (module docstring) at sun angle ``ts`` and speed ``ws``:
+def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
+    """Sun–planet meshes (module docstring) at the sun angle and speed ``pack.drive``:
     adds Q into f[idx] and, if ``jac``, dQ/dq, dQ/dv into jq, jv. Per-mesh force,
     deflection and stiffness go to the pack's output arrays."""
-    idx, sc, beta0, planet, out_f, out_d, out_k = pack
-    rbs, rbp, sw, aw, zs, bn, ks, eps, ramp, c, a_s, ph_s = (
-        sc[0],
-        sc[1],
-        sc[2],
-        sc[3],
-        sc[4],
-        sc[5],
-        sc[6],
-        sc[7],
-        sc[8],
-        sc[9],
-        sc[10],
-        sc[11],
-    )
+    idx, law, beta0, planet = pack.idx, pack.law, pack.beta0, pack.planet
+    ts, ws = pack.drive[0], pack.drive[1]
+    out_f, out_d, out_k = pack.force, pack.deflection, pack.stiffness
+    rbs, rbp, sw, aw, zs, bn = law.rbs, law.rbp, law.sin_alpha_w, law.a_w, law.z_s, law.b_n
+    ks, eps, ramp, c, a_s, ph_s = law.k_single, law.eps_alpha, law.ramp, law.c, law.A_sun, law.ph_sun
     r = rbs + rbp
     th_c = q[idx[2]]
     for j in range(beta0.shape[0]):
@@ -162,6 +184,8 @@ class GearMeshes(KernelGroup):
 
     name = "gear_stage"
     kind = "gear"
+    kernel = staticmethod(gear_stage_kernel)
+    time_field = "drive"
 
     def __init__(self, params, stage, input_angle, input_speed, ramp_fraction: float = 0.2):
         p = params
@@ -174,21 +198,19 @@ class GearMeshes(KernelGroup):
         w1 = stage.eps_alpha - 1.0
         ramp = ramp_fraction * min(w1, 1.0 - w1)
         sun = np.asarray(p.sun_runout, dtype=float)
-        self.sc = np.array(
-            [
-                p.base_radius_sun,
-                p.base_radius_planet,
-                np.sin(p.working_pressure_angle),
-                p.center_distance,
-                float(p.z_s),
-                p.normal_backlash,
-                stage.k_single,
-                stage.eps_alpha,
-                ramp,
-                stage.c12,
-                sun[0],
-                sun[1],
-            ]
+        self.law = GearLaw.of(
+            rbs=p.base_radius_sun,
+            rbp=p.base_radius_planet,
+            sin_alpha_w=np.sin(p.working_pressure_angle),
+            a_w=p.center_distance,
+            z_s=p.z_s,
+            b_n=p.normal_backlash,
+            k_single=stage.k_single,
+            eps_alpha=stage.eps_alpha,
+            ramp=ramp,
+            c=stage.c12,
+            A_sun=sun[0],
+            ph_sun=sun[1],
         )
         #: (N, 3): planet runout amplitude [m], phase [rad], assembly phase error [rad]
         self.planet = np.ascontiguousarray(
@@ -202,14 +224,15 @@ class GearMeshes(KernelGroup):
         self.theta_s, self.omega_s = input_angle, input_speed
         self._drive_cache = None
         self.force, self.deflection, self.stiffness = np.zeros(self.n), np.zeros(self.n), np.zeros(self.n)
+        #: the drive at the time of the last call: sun angle [rad], sun speed [rad/s]
+        self.drive = np.zeros(2)
 
     def pack(self, idx, history=False):
-        return (idx, self.sc, self.beta0, self.planet, self.force, self.deflection, self.stiffness)
+        return GearPack(idx, self.law, self.drive, self.beta0, self.planet, self.force, self.deflection, self.stiffness)
 
     @staticmethod
     def empty_pack():
-        z = np.zeros(0)
-        return (np.zeros(6, np.int64), np.zeros(len(SCALARS)), z, np.zeros((0, 3)), z, z, z)
+        return empty_pack(GearPack)
 
     def time_inputs(self, t):
         """(sun angle, sun speed) at t; cached (all Newton iterations of a step
@@ -219,6 +242,10 @@ class GearMeshes(KernelGroup):
             c = self._drive_cache = (t, float(self.theta_s(t)), float(self.omega_s(t)))
         return c[1], c[2]
 
+    def set_time(self, t, array) -> None:
+        """The drive at t into the pack's live ``array`` (two floats: written every call)."""
+        array[0], array[1] = self.time_inputs(t)
+
     def time_inputs_many(self, ts):
         return np.stack(
             [
@@ -227,10 +254,6 @@ class GearMeshes(KernelGroup):
             ],
             axis=-1,
         )
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        ts, ws = self.time_inputs(t) if inputs is None else inputs
-        gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, pack)
 
     def record_sources(self):
         return {"force": self.force, "deflection": self.deflection, "stiffness": self.stiffness}

@@ -1,10 +1,11 @@
-"""One compiled residual and Jacobian for the rigid reducer's force groups (issue 15).
+"""One compiled residual and Jacobian for the rigid reducer's force groups.
 
-:class:`FusedForces` evaluates every :class:`~flexrv.model.base.KernelGroup` of a
-model — gear stage, crank supports, needle bearings, pins, rigid main bearing,
-loads — in ONE call of :func:`fused_kernel`, a numba function that calls the
-groups' own compiled kernels (the physics stays in the groups' modules: one
-formula, one executor) on the model's coordinate vector. It backs both the single
+:class:`FusedForces` evaluates every registered compiled force element
+(:mod:`flexrv.model.core.registry`; here: gear stage, crank supports, needle bearings,
+pins, rigid main bearing, loads) of a model in ONE call of the fused kernel generated
+for the elements present, a numba function that calls the elements' own compiled
+kernels (the physics stays in the elements' modules: one formula, one executor) on
+the model's coordinate vector. It backs both the single
 Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 :meth:`FusedForces.add_to`) and :meth:`flexrv.model.assembled.AssembledModel.generalized_forces`.
 Groups of other kinds (ball bearing, flexible crank) keep their own elements.
@@ -17,7 +18,7 @@ in a run, where the closest points and the supports' inner solves move). Measure
 in benchmarks/bench_rigid.py.
 
 Outputs: :meth:`FusedForces.history` evaluates the same kernels over a recorded
-time history in ONE compiled loop (:func:`fused_history`), copying each group's
+time history in ONE compiled loop (the generated ``fused_history``), copying each group's
 per-contact arrays (:meth:`~flexrv.model.base.KernelGroup.record_sources`) per
 sample: bit for bit the groups' own per-sample evaluate, without its ~50 us of
 Python per sample. What remains (~22-28 us per sample) is the kernels' own work,
@@ -30,9 +31,9 @@ lower bound) and uses this pass only where that record is missing or with
 
 Numba's on-disk cache (``cache=True``) keys each function on its OWN source file
 only: after editing a kernel that other modules' compiled functions call (e.g.
-:func:`flexrv.geometry.cycloid._foot_point` from the pins kernel, or any group
-kernel from :func:`fused_kernel`), delete the ``__pycache__/*.nbi``/``*.nbc``
-files, or the callers keep the old machine code.
+:func:`flexrv.geometry.cycloid._foot_point` from the pins kernel), delete the
+``__pycache__/*.nbi``/``*.nbc`` files, or the callers keep the old machine code. The
+generated fused kernel is exempt: its file name carries a hash of its callees' sources.
 """
 
 from __future__ import annotations
@@ -44,60 +45,16 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.base import exudyn_vector
-from flexrv.model.cranks_discs import CrankSupports, NeedleBearings, crank_support_kernel, needle_kernel
-from flexrv.model.gear_stage import GearMeshes, gear_stage_kernel
-from flexrv.model.loads import OutputLoads, loads_kernel
-from flexrv.model.main_bearing_rigid import RigidMainBearing, main_bearing_kernel
-from flexrv.model.pins import PinContacts, pin_body_kernel
+from flexrv.model.core.registry import ELEMENTS, fused_functions, register, spec_of
+from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
+from flexrv.model.gear_stage import GearMeshes
+from flexrv.model.loads import OutputLoads
+from flexrv.model.main_bearing_rigid import RigidMainBearing
+from flexrv.model.pins import PinContacts
 
-#: slots of the fused kernel, in call order, and the group class of each
-KINDS = (
-    ("gear", GearMeshes),
-    ("supports", CrankSupports),
-    ("needles", NeedleBearings),
-    ("pins", PinContacts),
-    ("main_bearing", RigidMainBearing),
-    ("loads", OutputLoads),
-)
-
-
-@njit(cache=True)
-def fused_kernel(q, v, f, jq, jv, jac, ts, ws, gear, supports, needles, pins, main_bearing, loads):
-    """All kernel groups at one state: f = sum of their generalized forces and, if
-    ``jac``, jq = dF/dq, jv = dF/dv (all zeroed first). ``ts``, ``ws``: sun angle
-    and speed; each remaining argument is one group's pack (an absent group has an
-    empty pack and adds nothing)."""
-    f[:] = 0.0
-    if jac:
-        jq[:, :] = 0.0
-        jv[:, :] = 0.0
-    gear_stage_kernel(ts, ws, q, v, f, jq, jv, jac, gear)
-    crank_support_kernel(q, v, f, jq, jv, jac, supports)
-    needle_kernel(q, v, f, jq, jv, jac, needles)
-    pin_body_kernel(q, v, f, jq, jv, jac, pins)
-    main_bearing_kernel(q, v, f, jq, jv, jac, main_bearing)
-    loads_kernel(q, v, f, jq, jv, jac, loads)
-
-
-@njit(cache=True)
-def fused_history(qs, vs, tsun, wsun, loads_t, f, jq, jv, gear, supports, needles, pins, main_bearing, loads, src, dst):
-    """:func:`fused_kernel` at every sample i of a time history (qs, vs: (T, n);
-    tsun, wsun: (T,) sun angle and speed; loads_t: (T, len(load)) the loads group's
-    load vector, written into its pack before each call), without Jacobians;
-    after each call the per-contact result arrays ``src`` (flat views of the
-    groups' :meth:`~flexrv.model.base.KernelGroup.record_sources`) are copied into
-    row i of ``dst`` (T, size). Exactly the per-sample calls of the groups'
-    evaluate, in one compiled loop (issue 15: the Python loop over samples cost
-    ~50 us per sample)."""
-    load = loads[1]
-    for i in range(qs.shape[0]):
-        if load.shape[0] > 0:
-            load[:] = loads_t[i]
-        fused_kernel(
-            qs[i], vs[i], f, jq, jv, False, tsun[i], wsun[i], gear, supports, needles, pins, main_bearing, loads
-        )
-        for r in range(len(src)):
-            dst[r][i, :] = src[r]
+#: the compiled force elements, in the fused kernel's call order (one registry line each)
+for _element in (GearMeshes, CrankSupports, NeedleBearings, PinContacts, RigidMainBearing, OutputLoads):
+    register(_element)
 
 
 @njit(cache=True)
@@ -127,7 +84,7 @@ def _f8c(a) -> bool:
 
 
 def _entry_point(fn, args):
-    """The compiled function of the numba dispatcher ``fn`` (:func:`fused_kernel`,
+    """The compiled function of the numba dispatcher ``fn`` (the fused kernel,
     :func:`copy_records_if_same`) for the types of ``args``, to be called directly
     (None if not found). Skips numba's dispatch, i.e. typing the ~50 arguments on
     every call (~1.7 us of a ~9 us call, measured); valid while the arguments keep
@@ -143,7 +100,7 @@ def _entry_point(fn, args):
 def blas_threads() -> int | None:
     """BLAS threads inside simulations: FLEXRV_BLAS_THREADS if set (``0`` or empty:
     leave the library default), else 1. OpenBLAS's default threads spin on a
-    loaded machine (issue 15: 1.9-2.4x wall on 2 cores)."""
+    loaded machine (1.9-2.4x wall on 2 cores)."""
     env = os.environ.get("FLEXRV_BLAS_THREADS")
     if env is None:
         return 1
@@ -172,7 +129,7 @@ class FusedForces:
 
     def __init__(self, model, groups=None):
         if groups is None:
-            groups = [g for g in model.groups if type(g) in dict((c, k) for k, c in KINDS)]
+            groups = [g for g in model.groups if spec_of(g) is not None]
         by_kind = {}
         for g in groups:
             if g.kind in by_kind:
@@ -201,25 +158,27 @@ class FusedForces:
             else np.zeros(0, np.int64)
         )
         self.is_full = self.n == model.n and np.array_equal(self.index, np.arange(model.n))
-        #: each kind's group and the positions of its local coordinates in the element's vector
-        self.slots = []
-        for kind, cls in KINDS:
-            g = by_kind.get(kind)
-            idx = (
-                None
-                if g is None
-                else np.concatenate([np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(
+        unknown = [g.name for g in groups if spec_of(g) is None]
+        if unknown:
+            raise ValueError(f"groups {unknown} are not registered compiled elements (flexrv.model.core.registry)")
+        #: the present elements in the registry's (= call) order: (group, positions of its local
+        #: coordinates in the element's vector)
+        self.slots = [
+            (
+                g,
+                np.concatenate([np.arange(local[m], local[m] + model.members[m].n) for m in g.members]).astype(
                     np.int64
-                )
+                ),
             )
-            self.slots.append((cls, g, idx))
+            for g in (by_kind[k] for k in ELEMENTS if k in by_kind)
+        ]
+        #: the generated compiled functions of these elements (flexrv.model.core.registry)
+        self.kernel, self.history_kernel = fused_functions([spec_of(g) for g, _ in self.slots])
         self.packs = self._packs(history=False)
-        self.gear, self.loads = by_kind.get("gear"), by_kind.get("loads")
-        self.pins = by_kind.get("pins")
-        #: the pins' counters (ctr[2]: closest-point failures), None without pins
-        self._pin_ctr = self.pins.ctr if self.pins is not None else None
-        #: the time inputs of the last call: sun angle and speed, the loads group's load vector (its cache object)
-        self._ts, self._ws, self._load = 0.0, 0.0, None
+        #: (group, its pack's live time-input array) of the elements with time inputs
+        self.timed = [(g, getattr(p, g.time_field)) for (g, _), p in zip(self.slots, self.packs) if g.time_field]
+        #: the live failure counters of the elements' inner solves: (group, counter)
+        self.counters = [(g, c) for (g, _), p in zip(self.slots, self.packs) if (c := g.failure_counter(p)) is not None]
         self.f = np.zeros(self.n)
         self.jq, self.jv = np.zeros((self.n, self.n)), np.zeros((self.n, self.n))
         self.stats = [0, 0]
@@ -239,41 +198,35 @@ class FusedForces:
 
     def _packs(self, history: bool) -> list:
         """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
-        return [cls.empty_pack() if g is None else g.pack(idx, history=history) for cls, g, idx in self.slots]
+        return [g.pack(idx, history=history) for g, idx in self.slots]
 
     def history(self, t, q, v) -> dict:
         """Per-sample records of every group of this element over a time history t (T,),
         q, v (T, n) on the element's coordinates: {group: {key: (T, *shape)}}, as the
         groups' own evaluate of the history would stack them (the same kernels on the
         same inputs, bit for bit: fresh history packs, the vectorised time inputs), in
-        one compiled loop (:func:`fused_history`)."""
+        one compiled loop (the generated ``fused_history``)."""
         t = np.ascontiguousarray(t, dtype=float)
         nt = len(t)
         packs = self._packs(history=True)
-        gear = self.gear
-        drive = gear.time_inputs_many(t) if gear is not None else np.zeros((nt, 2))
-        drive = np.ascontiguousarray(np.broadcast_to(drive, (nt, 2)))
-        load = packs[[k for k, _ in KINDS].index("loads")][1]
-        loads_t = (
-            np.ascontiguousarray(np.broadcast_to(self.loads.time_inputs_many(t), (nt, len(load))))
-            if self.loads is not None
-            else np.zeros((nt, 0))
-        )
+        tables = []  # the time inputs at every sample, per element with time inputs
+        for (g, _), p in zip(self.slots, packs):
+            if g.time_field:
+                size = getattr(p, g.time_field).size
+                tables.append(np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(t), (nt, size)), dtype=float))
         srcs, dsts, keys = [], [], []
         for g, key, a in self.record_entries():
             srcs.append(a.reshape(-1))
             dsts.append(np.empty((nt, a.size)))
             keys.append((g, key, a.shape))
         f = np.zeros(self.n)
-        pin_ctr = packs[[k for k, _ in KINDS].index("pins")][0][-1]  # (pin pack, rim compliance, rim state)
-        before = int(pin_ctr[2])
+        counters = [(g, g.failure_counter(p)) for (g, _), p in zip(self.slots, packs)]
+        before = [None if c is None else int(c[0]) for _, c in counters]
         if nt and srcs:
-            fused_history(
+            self.history_kernel(
                 np.ascontiguousarray(q, dtype=float),
                 np.ascontiguousarray(v, dtype=float),
-                np.ascontiguousarray(drive[:, 0]),
-                np.ascontiguousarray(drive[:, 1]),
-                loads_t,
+                *tables,
                 f,
                 self.jq,
                 self.jv,
@@ -281,37 +234,48 @@ class FusedForces:
                 tuple(srcs),
                 tuple(dsts),
             )
-        if int(pin_ctr[2]) != before:
-            from flexrv.errors import ConvergenceError
+        for g, _ in self.timed:
+            g._time_last = None  # the history pass overwrote the live time inputs
+        for (g, c), b in zip(counters, before):
+            if c is not None and int(c[0]) != b:
+                from flexrv.errors import ConvergenceError
 
-            raise ConvergenceError("pin gap: closest-point iteration did not converge")
+                raise ConvergenceError(g.failure_message)
         out = {g: {} for g in self.recorded}
         for (g, key, shape), d in zip(keys, dsts):
             out[g][key] = d.reshape((nt,) + shape)
         return out
 
     def _call(self, t, q, v, jac):
-        if self.gear is not None:  # the groups cache their time inputs per time
-            self._ts, self._ws = self.gear.time_inputs(t)
-        if self.loads is not None:
-            load = self.loads.time_inputs(t)
-            if load is not self._load:  # a new load vector (new time, or the group was reset)
-                self.loads.load[:] = load
-                self._load = load
-        ctr = self._pin_ctr
-        before = ctr[2] if ctr is not None else 0
+        for g, array in self.timed:  # (the groups cache their time inputs per time)
+            g.set_time(t, array)
+        counters = self.counters
+        if len(counters) == 1:  # (the usual case, the pins: no list per call)
+            ctr = counters[0][1]
+            before = ctr[0]
+        else:
+            ctr, before = None, [c[0] for _, c in counters]
         entry = self._entry
         if entry is not None and _f8c(q) and _f8c(v):
-            entry(q, v, self.f, self.jq, self.jv, jac, self._ts, self._ws, *self.packs)
+            entry(q, v, self.f, self.jq, self.jv, jac, *self.packs)
         else:
-            args = (q, v, self.f, self.jq, self.jv, bool(jac), float(self._ts), float(self._ws), *self.packs)
-            fused_kernel(*args)
+            args = (q, v, self.f, self.jq, self.jv, bool(jac), *self.packs)
+            self.kernel(*args)
             if entry is None:
-                self._entry = _entry_point(fused_kernel, args)
-        if ctr is not None and ctr[2] != before:
-            from flexrv.errors import ConvergenceError
+                self._entry = _entry_point(self.kernel, args)
+        if ctr is not None:
+            if ctr[0] != before:
+                self._failed(counters[0][0])
+        elif counters:
+            for (g, c), b in zip(counters, before):
+                if c[0] != b:
+                    self._failed(g)
 
-            raise ConvergenceError("pin gap: closest-point iteration did not converge")
+    @staticmethod
+    def _failed(group):
+        from flexrv.errors import ConvergenceError
+
+        raise ConvergenceError(group.failure_message)
 
     def record_entries(self) -> list:
         """(group, key, live array) of every per-contact record of this element's groups, in order."""
@@ -331,7 +295,7 @@ class FusedForces:
         Jacobian every step asks for them next, at that same state (the rigid model's calls per
         step are R J R [R ...]; every Jacobian call of a 0.1 s rv40e / rv221 run, 1266 / 1119,
         came at the previous call's state), and :meth:`jacobian` then returns them without a
-        second kernel call (issue 15, bench_rigid: rv40e kernel 100-103 -> 90 us per step)."""
+        second kernel call (bench_rigid: rv40e kernel 100-103 -> 90 us per step)."""
         self.stats[0] += 1
         self.memo = None  # until the call has filled the records
         first = self.jacobian_each_step and t != self._t_last
@@ -402,7 +366,7 @@ class FusedForces:
 
 class HistoryRecorder:
     """The per-contact records at every recorded sample of a run, taken from what the
-    integrator computed (issue 15), for every recording element of a model: the fused
+    integrator computed, for every recording element of a model: the fused
     element (:class:`FusedForces`) and the groups' own (``recorded_elements()``, e.g.
     the bearing rows of :class:`flexrv.model.flexible_bearing.BallBearingGroup`). At
     each recorded state an element's last call (its ``memo`` = (t, q, v) on its own

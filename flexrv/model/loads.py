@@ -18,13 +18,17 @@ from numba import njit
 
 from flexrv.contact.laws import _step_and_slope, adams_step
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.core.params import empty_pack, pack_type
+
+#: :func:`loads_kernel`'s pack: the carrier's 6 indices and the generalized load vector at t
+LoadsPack = pack_type("LoadsPack", ("idx", (np.int64, 1)), ("load", (np.float64, 1)))
 
 
 def ramp_drive(speed: float, ramp_time: float):
     """(theta(t), omega(t)) of the Adams-STEP speed ramp; vectorised in t."""
 
     def omega(t):
-        if isinstance(t, float):  # the solver's scalar path: no array round trip (issue 15)
+        if isinstance(t, float):  # the solver's scalar path: no array round trip
             return speed * _step_and_slope(t, 0.0, 0.0, ramp_time, 1.0)[0] if ramp_time > 0 else speed
         t = np.asarray(t, dtype=float)
         if ramp_time <= 0:
@@ -98,6 +102,14 @@ def piecewise_torque(times, values):
     return torque
 
 
+@njit(cache=True)
+def loads_kernel(q, v, f, jq, jv, jac, pack):
+    """f[idx] += load (no state dependence: no Jacobian)."""
+    idx, load = pack.idx, pack.load
+    for i in range(idx.shape[0]):
+        f[idx[i]] += load[i]
+
+
 class OutputLoads(KernelGroup):
     """Load torque and external forces on the carrier (member ``carrier``:
     x, y, theta, z, rx, ry). The loads depend on time only: :meth:`time_inputs`
@@ -105,6 +117,8 @@ class OutputLoads(KernelGroup):
 
     name = "loads"
     kind = "loads"
+    kernel = staticmethod(loads_kernel)
+    time_field = "load"
     members = ("carrier",)
 
     def __init__(
@@ -142,18 +156,14 @@ class OutputLoads(KernelGroup):
         return self._cache[1]
 
     def pack(self, idx, history=False):
-        return (idx, self.load)
+        return LoadsPack(idx, self.load)
 
     @staticmethod
     def empty_pack():
-        return (np.zeros(0, np.int64), np.zeros(0))
+        return empty_pack(LoadsPack)
 
     def time_inputs_many(self, ts):
         return self._forces(ts, ts.shape + (6,))
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        self.load[:] = self.time_inputs(t) if inputs is None else inputs
-        loads_kernel(q, v, f, jq, jv, jac, pack)
 
     def record_sources(self):
         return {"load": self.load}
@@ -164,11 +174,3 @@ class OutputLoads(KernelGroup):
     def reset(self) -> None:
         self._cache = None
         super().reset()
-
-
-@njit(cache=True)
-def loads_kernel(q, v, f, jq, jv, jac, pack):
-    """f[idx] += load (no state dependence: no Jacobian)."""
-    idx, load = pack
-    for i in range(idx.shape[0]):
-        f[idx[i]] += load[i]

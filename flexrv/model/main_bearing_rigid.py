@@ -13,6 +13,16 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.core.params import empty_pack, pack_type
+
+#: :func:`main_bearing_kernel`'s pack: the carrier's 6 indices, diagonal stiffness and damping, reaction
+MainBearingPack = pack_type(
+    "MainBearingPack",
+    ("idx", (np.int64, 1)),
+    ("k", (np.float64, 1)),
+    ("c", (np.float64, 1)),
+    ("force", (np.float64, 1)),
+)
 
 #: carrier coordinate order (see :mod:`flexrv.model.parameters`)
 CARRIER_COORDS = ("x", "y", "theta", "z", "rx", "ry")
@@ -21,7 +31,7 @@ CARRIER_COORDS = ("x", "y", "theta", "z", "rx", "ry")
 @njit(cache=True)
 def main_bearing_kernel(q, v, f, jq, jv, jac, pack):
     """f[idx] -= K q + C v (diagonal K, C), force into out; Jacobians -K, -C."""
-    idx, k, c, out = pack
+    idx, k, c, out = pack.idx, pack.k, pack.c, pack.force
     for i in range(idx.shape[0]):
         ii = idx[i]
         out[i] = -k[i] * q[ii] - c[i] * v[ii]
@@ -36,6 +46,7 @@ class RigidMainBearing(KernelGroup):
 
     name = "main_bearing"
     kind = "main_bearing"
+    kernel = staticmethod(main_bearing_kernel)
     members = ("carrier",)
 
     def __init__(self, params):
@@ -46,14 +57,11 @@ class RigidMainBearing(KernelGroup):
         self.force = np.zeros(6)
 
     def pack(self, idx, history=False):
-        return (idx, self.kd, self.cd, self.force)
+        return MainBearingPack(idx, self.kd, self.cd, self.force)
 
     @staticmethod
     def empty_pack():
-        return (np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0))
-
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        main_bearing_kernel(q, v, f, jq, jv, jac, pack)
+        return empty_pack(MainBearingPack)
 
     def record_sources(self):
         return {"f": self.force}

@@ -2,7 +2,7 @@
 of the members, the drive or the force groups, with its name, dimensions, unit and long name.
 
 Post-processing (:func:`flexrv.post.results.results_from_states`) reads these outputs by name
-and never sees the state layout or the member names (issue 16, PyBaMM's ``model.variables``
+and never sees the state layout or the member names (PyBaMM's ``model.variables``
 pattern). Three kinds:
 
 * **member-state outputs** (:data:`STATE_OUTPUTS`): one coordinate of the position ``q`` or the
@@ -11,8 +11,8 @@ pattern). Three kinds:
 * **derived outputs** (:data:`DERIVED_OUTPUTS`): functions of the member states and the drive
   (output angle and speed, relative crank speed, carrier tilt, input and load torque,
   kinetic energy, angular momentum);
-* **friction output** ``friction_power``: the sum of the groups' :data:`FRICTION_OUTPUTS` [W]
-  (present when friction is on);
+* **friction output** ``friction_power``: the sum of the outputs the groups declare as
+  friction (``friction_outputs``) [W] (present when friction is on);
 * **group outputs**: the named :class:`flexrv.model.base.Output` s of every force group
   (contact forces, film thickness, ...), evaluated over the time history in chunks
   (the compiled groups' taken from what the integrator computed where the run recorded
@@ -30,6 +30,7 @@ from typing import Callable
 import numpy as np
 
 from flexrv.model.base import Output
+from flexrv.units import ARCSEC_PER_RAD
 
 #: member roles: role -> (member-name prefix, dimension of the result axis or None, count attribute
 #: of the model parameters). ``carrier`` is one member; ``crank`` j and ``disc`` k are numbered.
@@ -100,6 +101,12 @@ def _omega_out(model, t, q, v):
     return _coordinate(model, v, "carrier", 2)
 
 
+def _te(model, t, q, v):
+    """Transmission error theta_out - theta_in / i [arcsec]."""
+    th_in = np.asarray(model.input_angle(t), dtype=float)
+    return (_theta_out(model, t, q, v) - th_in / model.params.ratio) * ARCSEC_PER_RAD
+
+
 def _crank_speed_relative(model, t, q, v):
     return _coordinate(model, v, "crank", 2) - _omega_out(model, t, q, v)[:, None]
 
@@ -153,6 +160,7 @@ DERIVED_OUTPUTS: tuple[DerivedOutput, ...] = (
     DerivedOutput("theta_out", ("time",), "rad", "output angle", _theta_out),
     DerivedOutput("omega_in", ("time",), "rad/s", "input speed", lambda model, t, q, v: _input_speed(model, t)),
     DerivedOutput("omega_out", ("time",), "rad/s", "output speed", _omega_out),
+    DerivedOutput("te", ("time",), "arcsec", "TE", _te),
     DerivedOutput(
         "crank_speed_relative", ("time", "crank"), "rad/s", "crank speed relative to the carrier", _crank_speed_relative
     ),
@@ -182,6 +190,7 @@ _ORDER = (
     "theta_out",
     "omega_in",
     "omega_out",
+    "te",
     "crank_speed",
     "crank_speed_relative",
     "crank_angle",
@@ -197,10 +206,20 @@ _ORDER = (
 )
 
 
-#: the groups' friction outputs (dissipated power [W], >= 0, issue 14): pin-disc/pin-seat friction per
-#: disc (:mod:`flexrv.model.pins`) and the needle-bearing friction moment per bearing
-#: (:mod:`flexrv.model.cranks_discs`); their sum over the groups is the output ``friction_power``
-FRICTION_OUTPUTS = ("pin_friction_power", "needle_friction_power")
+def declare_element_outputs(model, outputs: dict) -> None:
+    """Mark the group outputs the model's elements declare: their friction outputs (``role``
+    "friction", :attr:`flexrv.model.base.KernelGroup.friction_outputs`) and the summary rows
+    that read them (``summary``, :attr:`~flexrv.model.base.KernelGroup.summary_rows`)."""
+    from dataclasses import replace
+
+    for g in model.groups:
+        for name in getattr(g, "friction_outputs", ()):
+            if name in outputs:
+                outputs[name] = replace(outputs[name], role="friction")
+        for row in getattr(g, "summary_rows", ()):
+            if row.source in outputs:
+                o = outputs[row.source]
+                outputs[row.source] = replace(o, summary=o.summary + (row,))
 
 
 def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
@@ -213,6 +232,8 @@ def declared_outputs() -> dict[str, tuple[tuple[str, ...], str, str]]:
     for d in DERIVED_OUTPUTS:
         out[d.name] = (d.dims, d.units, d.long_name)
     out["input_torque"] = (("time",), "N m", "input torque")
+    out["power_in"] = (("time",), "W", "input power")
+    out["power_out"] = (("time",), "W", "output power")
     return out
 
 
@@ -282,9 +303,10 @@ def group_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
 
 def model_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None) -> dict[str, Output]:
     """Every declared output of ``model`` on the recorded history t (T,), q, v (T, n), by name,
-    in result order: drive and member outputs, group outputs, ``input_torque`` (the sun's
-    torque from the gear-stage group plus J_in d(omega_in)/dt), ``output_torque``,
-    ``kinetic_energy``, ``angular_momentum``. ``records``: see :func:`group_outputs`."""
+    in result order: drive and member outputs (with ``te``), group outputs, ``input_torque``
+    (the sun's torque from the gear-stage group plus J_in d(omega_in)/dt), ``output_torque``,
+    ``power_in`` (input torque times input speed), ``power_out`` (output torque times output
+    speed), ``kinetic_energy``, ``angular_momentum``. ``records``: see :func:`group_outputs`."""
     t = np.asarray(t, dtype=float)
     declared = declared_outputs()
     computed: dict[str, np.ndarray] = {}
@@ -301,17 +323,24 @@ def model_outputs(model, t, q, v, chunk: int = 1000, records: dict | None = None
     for name in _ORDER:
         put(name)
     groups = group_outputs(model, t, q, v, chunk, records)
+    declare_element_outputs(model, groups)
     out.update(groups)
-    fric = [o.values.reshape(len(t), -1).sum(axis=1) for name, o in groups.items() if name in FRICTION_OUTPUTS]
+    fric = {name: o.values.reshape(len(t), -1).sum(axis=1) for name, o in groups.items() if o.role == "friction"}
     if fric:
         out["friction_power"] = Output(
-            np.sum(fric, axis=0), ("time",), "W", "power dissipated by friction, all groups (pins, needle bearings)"
+            np.sum(list(fric.values()), axis=0),
+            ("time",),
+            "W",
+            f"power dissipated by friction, all groups ({', '.join(fric)})",
         )
     w_in = out["omega_in"].values
     acc_in = np.gradient(w_in, t) if len(t) > 1 else np.zeros_like(t)
     sun = groups["sun_torque"].values if "sun_torque" in groups else 0.0
     dims, units, long_name = declared["input_torque"]
     out["input_torque"] = Output(sun + model.params.input_inertia * acc_in, dims, units, long_name)
-    for name in ("output_torque", "kinetic_energy", "angular_momentum"):
+    put("output_torque")
+    out["power_in"] = Output(out["input_torque"].values * out["omega_in"].values, *declared["power_in"])
+    out["power_out"] = Output(out["output_torque"].values * out["omega_out"].values, *declared["power_out"])
+    for name in ("kinetic_energy", "angular_momentum"):
         put(name)
     return out

@@ -58,7 +58,7 @@ above), so dQ/dq is not symmetric when harmonics are present. Verified against
 central differences in tests/test_kernel.py (1e-6 of the largest entry;
 measured 1-2e-8, the differences' round-off).
 
-Friction (issue 14): regularised Coulomb friction along the contact tangent
+Friction: regularised Coulomb friction along the contact tangent
 t = z x n (housing frame). The disc's material point at the contact,
 X = P_i - r_i n, slides past the (fixed) pin at v_t = W . v, W = (t_x, t_y,
 ((X - c_k) x t)_z) = (t, (r x t)_z - r_i) over (x, y, psi) of disc k (n x t = 1);
@@ -79,7 +79,7 @@ T[psi, y] = -n_y, T[psi, psi] = -(r x n)_z. mu = 0 or contact.friction = false
 skips the friction code (the frictionless numbers exactly). Verified against
 central differences in tests/test_friction.py.
 
-Disc body (issue 14; design ``second_stage.disc_body_model = "condensed_fe"``): the
+Disc body (design ``second_stage.disc_body_model = "condensed_fe"``): the
 pins act on the disc's rim (tooth region) whose pose is q_r = q_hub + delta, the
 needle bearings on its hub (the disc member's coordinates); delta = C_d Q(q_r),
 C_d the (3 x 3) rim compliance relative to the crank holes from the disc FE
@@ -89,7 +89,7 @@ wraps :func:`pin_kernel` (unchanged) in a local Newton on delta with the
 condensed Jacobians (I - J C_d)^-1 J and (I - J C_d)^-1 J_v. With C_d = 0 (and a
 rigid housing) it is the plain pin kernel. Verified in tests/test_bodies.py.
 
-Housing (issue 14; design ``housing.body_model = "ring_estimate"``): the pin ring
+Housing (design ``housing.body_model = "ring_estimate"``): the pin ring
 turns elastically about the reducer axis by phi_h = c_h M_h, shared by all discs,
 M_h the torque of all pin forces on the housing about the axis and c_h the
 housing's energy-equivalent torsional compliance
@@ -108,19 +108,19 @@ both bodies; as a_k follows the hub centre, the condensed Jacobian is
 (dA/dq)^T Q); c_h = 0 decouples the discs (C block-diagonal, D = 0). Verified in
 tests/test_housing.py.
 
-Cost (issue 15): in a run the condensation's cost is its pin-kernel evaluations.
+Cost: in a run the condensation's cost is its pin-kernel evaluations.
 Each call starts from a first-order predictor of the offsets (the previous call's
 condensed sensitivities), evaluates the pin kernel on the 3 n_discs local rim
 coordinates (3 x 3 blocks, no n x n arrays) and solves the small systems without
 LAPACK (:func:`inv_small`); a call at exactly the previous call's state (the
 solver's Jacobian after its residual) adds that call's result. Measured on rv40e
-(0.3 s run, 2026-11-24): 1.65 pin-kernel evaluations per solver call instead of
+(0.3 s run): 1.65 pin-kernel evaluations per solver call instead of
 2.32. See :func:`_pin_condensed_kernel`. Per pin the Jacobian's curvature terms
 reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`): the same numbers bit for bit, the
 pins' part of a rv40e solver call 42.9 -> 40.0 us (first call of a step) and
-22.6 -> 20.8 us (later calls), replayed calls, 2026-11-24.
+22.6 -> 20.8 us (later calls), replayed calls.
 
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
@@ -136,9 +136,68 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.errors import ConvergenceError
 from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output
+from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.numerics.linalg import matmul_small
+from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
+
+#: the pin contacts' scalar law: pin count, pin circle radius R_p [m], nominal pin radius [m],
+#: eccentricity [m], contact law K, exponent, c_max, depth, the closest-point Newton's settings
+#: (:func:`flexrv.geometry.cycloid.closest_point_settings`), friction coefficient and speed (0: off)
+PinLaw = law_type(
+    "PinLaw",
+    z_rp=int,
+    pin_circle_radius=float,
+    pin_radius=float,
+    eccentricity=float,
+    k=float,
+    exponent=float,
+    c_max=float,
+    depth=float,
+    max_step=float,
+    tol=float,
+    max_iter=int,
+    mu=float,
+    v_reg=float,
+)
+_F, _I = np.float64, np.int64
+#: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
+#: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
+#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact gaps, outputs per (disc,
+#: pin), counters (calls, cold-restart period, closest-point failures, skip provably open pins)
+PinPack = pack_type(
+    "PinPack",
+    ("idx", (_I, 1)),
+    ("law", PinLaw),
+    ("reach", (_F, 2)),
+    ("pins", (_F, 2)),
+    ("radii", (_F, 1)),
+    ("profile", (_F, 2)),
+    ("harm", (_F, 3)),
+    ("phi", (_F, 2)),
+    ("last", (_F, 3)),
+    ("gap", (_F, 2)),
+    ("force", (_F, 2)),
+    ("nx", (_F, 2)),
+    ("ny", (_F, 2)),
+    ("rxn", (_F, 2)),
+    ("ft", (_F, 2)),
+    ("pw", (_F, 2)),
+    ("ctr", (_I, (4,))),
+)
+#: :func:`pin_body_kernel`'s pack: the pins' pack, rim compliance (n_discs, 3, 3) (empty: rigid
+#: discs), rim offsets (n_discs, 3), housing state (c_h, phi_h, per disc -phi_h a_k), the local
+#: rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
+PinBodyPack = pack_type(
+    "PinBodyPack",
+    ("pins", PinPack),
+    ("disc_c", (_F, 3)),
+    ("dstate", (_F, 2)),
+    ("housing", (_F, 1)),
+    ("idx_rim", (_I, 1)),
+    ("work", (_F, 1)),
+)
 
 
 @njit(cache=True)
@@ -196,16 +255,35 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
     pin whose bound is positive carries no force (and no Jacobian); its closest
     point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
-    P0y) of the last exact evaluation. Friction (module docstring): mu, v_reg in
-    sc[-2], sc[-1]; per (disc, pin) the friction force on the disc along t = z x n
+    P0y) of the last exact evaluation. Friction (module docstring): law.mu,
+    law.v_reg; per (disc, pin) the friction force on the disc along t = z x n
     into out_ft and its power f_t v_t (<= 0) into out_pw."""
-    (idx, sc, pins, radii, profile, harm, phi, last, out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw, ctr) = (
-        pack
+    idx, law, reach, pins, radii, profile, harm, phi, last = (
+        pack.idx,
+        pack.law,
+        pack.reach,
+        pack.pins,
+        pack.radii,
+        pack.profile,
+        pack.harm,
+        pack.phi,
+        pack.last,
     )
-    z_rp, R_p, r_nom, ecc, k, expo, c_max, depth = int(sc[0]), sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
-    mu, v_reg = sc[sc.shape[0] - 2], sc[sc.shape[0] - 1]  # friction: effective coefficient, regularisation speed
+    out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw, ctr = (
+        pack.gap,
+        pack.force,
+        pack.nx,
+        pack.ny,
+        pack.rxn,
+        pack.ft,
+        pack.pw,
+        pack.ctr,
+    )
+    z_rp, R_p, r_nom, ecc = law.z_rp, law.pin_circle_radius, law.pin_radius, law.eccentricity
+    k, expo, c_max, depth = law.k, law.exponent, law.c_max, law.depth
+    mu, v_reg = law.mu, law.v_reg  # friction: effective coefficient, regularisation speed
     fric = mu > 0.0 and v_reg > 0.0
-    max_step, tol, max_iter = sc[8], sc[9], int(sc[10])
+    max_step, tol, max_iter = law.max_step, law.tol, law.max_iter
     cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0
     skip = ctr[3] > 0
     ctr[0] += 1
@@ -233,7 +311,7 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
                 px, py, start, z_rp, radius, ecc, max_step, tol, max_iter
             )
-            if ok and not cold and not (0.0 <= dist < sc[11 + 2 * kd] or 0.0 < -dist < sc[12 + 2 * kd]):
+            if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
                 # a warm-started local minimum beyond the curve's reach on its side may not be the
                 # nearest point (another flank): find it from the cold starts (_curve_reach)
                 ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
@@ -315,72 +393,40 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         f[ip] += fp
 
 
+#: the rim Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
+#: roundoff_abs, roundoff_rel): 80 evaluations; round-off: a worse residual at max|R| <= 100 tol
+RIM_NEWTON = (80, 80, 0.0, 100.0)
+
+
 @njit(cache=True)
-def inv_small(a, out):
-    """out = a^-1 for a small dense square matrix (Gauss-Jordan with partial pivoting;
-    ``a`` is overwritten). No allocation: for the local Newtons' m x m systems (m =
-    3 n_discs, 2 n_cranks) LAPACK's call overhead and work arrays cost more than the
-    arithmetic. Verified against numpy.linalg.inv in tests/test_kernel.py."""
-    m = a.shape[0]
+def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
+    """The rim condensation's residual R = delta - C Q(q_hub + delta) into ``res`` (J = dQ/dq
+    into jl) for :func:`~flexrv.model.numerics.newton.newton_update`; returns (max|R|,
+    max|delta|) weighted (psi times R_p)."""
+    m = delta.shape[0]
     for r in range(m):
+        ql[r] = qh[r] + delta[r]
+        fl[r] = 0.0
         for c in range(m):
-            out[r, c] = 1.0 if r == c else 0.0
-    for k in range(m):
-        p = k
-        big = abs(a[k, k])
-        for r in range(k + 1, m):
-            if abs(a[r, k]) > big:
-                big, p = abs(a[r, k]), r
-        if p != k:
-            for c in range(m):
-                a[k, c], a[p, c] = a[p, c], a[k, c]
-                out[k, c], out[p, c] = out[p, c], out[k, c]
-        d = 1.0 / a[k, k]
+            jl[r, c] = 0.0
+            jvl[r, c] = 0.0
+    pin_kernel(ql, vh, fl, jl, jvl, True, pins_loc)
+    r1 = 0.0
+    scale = 0.0
+    for r in range(m):
+        acc = delta[r]
         for c in range(m):
-            a[k, c] *= d
-            out[k, c] *= d
-        for r in range(m):
-            w = a[r, k]
-            if r != k and w != 0.0:
-                for c in range(m):
-                    a[r, c] -= w * a[k, c]
-                    out[r, c] -= w * out[k, c]
-
-
-@njit(cache=True)
-def matmul_small(a, b, out):
-    """out = a @ b (small dense, no allocation; ``out`` must not alias a or b)."""
-    for r in range(a.shape[0]):
-        for c in range(b.shape[1]):
-            acc = 0.0
-            for k in range(a.shape[1]):
-                acc += a[r, k] * b[k, c]
-            out[r, c] = acc
-
-
-@njit(cache=True)
-def condensed_step(c, j, sign, res, tmp, inv, step):
-    """step = (I + sign C J)^-1 res: the Newton correction of the condensations' local
-    solves (the rim offsets, sign -1: R = delta - C Q(q + delta); the carrier's support
-    points, sign +1: R = u + C f_s(d0 - u)); inv = the inverse (kept for the condensed
-    tangent), tmp: scratch. All (m, m) / (m,), no allocation."""
-    m = res.shape[0]
-    matmul_small(c, j, tmp)
-    for r in range(m):
-        for k in range(m):
-            tmp[r, k] = (1.0 if r == k else 0.0) + sign * tmp[r, k]
-    inv_small(tmp, inv)
-    for r in range(m):
-        acc = 0.0
-        for k in range(m):
-            acc += inv[r, k] * res[k]
-        step[r] = acc
+            acc -= cm[r, c] * fl[c]
+        res[r] = acc
+        r1 = max(r1, abs(acc) * weight[r])
+        scale = max(scale, abs(delta[r]) * weight[r])
+    return r1, scale
 
 
 def pin_work_size(m: int) -> int:
     """Length of the rim condensation's work array (:func:`_pin_condensed_kernel`)
     for m = 3 n_discs local coordinates."""
-    return 4 + 14 * m + 11 * m * m
+    return 4 + NEWTON_STATE + 15 * m + 11 * m * m
 
 
 @njit(cache=True)
@@ -392,12 +438,12 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     offsets delta (x, y, psi) of the last call (output), hs the housing's (c_h,
     phi_h, ...), wk the condensation's work array (:func:`_pin_condensed_kernel`).
     Rigid discs and a rigid housing (c_h = 0): a plain :func:`pin_kernel` call."""
-    pins, cd, dstate, hs, idx_rim, wk = pack
+    pins, cd, hs = pack.pins, pack.disc_c, pack.housing
     if cd.shape[0] == 0 and not (hs.shape[0] > 0 and hs[0] > 0.0):
         pin_kernel(q, v, f, jq, jv, jac, pins)
         return
     # the pin kernel's pack on the local rim coordinates (built here: one array to unbox, not sixteen)
-    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, (idx_rim,) + pins[1:], cd, dstate, hs, wk)
+    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, PinPack(pack.idx_rim, *pins[1:]), cd, pack.dstate, hs, pack.work)
 
 
 @njit(cache=True)
@@ -417,7 +463,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     M_h = -A^T Q into hs[1], the housing's part -phi_h a_k of each rim offset into
     hs[2 + 2 k], hs[3 + 2 k].
 
-    Cost per call (issue 15: in a run the pin-kernel evaluations are the
+    Cost per call (in a run the pin-kernel evaluations are the
     condensation's cost): the Newton starts from the first-order predictor delta_0 =
     delta_prev + S_q dq_hub + S_v dv_hub with the previous call's condensed
     sensitivities S_q = d(delta)/dq = C dQ_eff/dq + D, S_v = C dQ_eff/dv (used where
@@ -434,17 +480,19 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     holds st = (valid, -, -, -), the last call's hub q and v, its condensed force, its
     rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[0] = 0
     (reset, history pass) starts from dstate without the predictor."""
-    idx = pins[0]
-    r_p = pins[1][1]
-    nd = pins[4].shape[0]
+    idx = pins.idx
+    r_p = pins.law.pin_circle_radius
+    nd = pins.profile.shape[0]
     m = 3 * nd
     mm = m * m
     ch = hs[0] if hs.shape[0] > 0 else 0.0
     st = wk[0:4]
-    vec = wk[4 : 4 + 14 * m].reshape((14, m))  # the layout of pin_work_size: 14 vectors, then 11 matrices
+    nw = wk[4 : 4 + NEWTON_STATE]
+    o = 4 + NEWTON_STATE
+    vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
     qp, vp, qfc, dlast, qh, vh, ql = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6]
-    fl, delta, base, step, res, av, qf = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13]
-    mat = wk[4 + 14 * m : 4 + 14 * m + 11 * mm].reshape((11, m, m))
+    fl, delta, base, step, res, av, qf, weight = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13], vec[14]
+    mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
     sq, sv, jc, jvc, jl, jvl = mat[0], mat[1], mat[2], mat[3], mat[4], mat[5]
     cm, nm, tmp, dd, t2 = mat[6], mat[7], mat[8], mat[9], mat[10]
     for r in range(m):
@@ -480,63 +528,20 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
                 for c in range(3):
                     cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
     for r in range(m):
-        base[r] = dstate[r // 3, r % 3]
-        step[r] = 0.0
-    if valid:  # first-order predictor from the previous call, within a tenth of the offsets' size
-        dmax, pmax = 0.0, 0.0
+        delta[r] = dstate[r // 3, r % 3]
+        weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
+    if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
         for r in range(m):
             acc = 0.0
             for c in range(m):
                 acc += sq[r, c] * (qh[c] - qp[c]) + sv[r, c] * (vh[c] - vp[c])
             step[r] = acc
-            w = r_p if r % 3 == 2 else 1.0
-            dmax = max(dmax, abs(base[r]) * w)
-            pmax = max(pmax, abs(acc) * w)
-        if pmax <= 0.1 * dmax:
-            for r in range(m):
-                base[r] += step[r]
-        for r in range(m):
-            step[r] = 0.0
-    r0 = np.inf
-    lam = 1.0
-    fresh = False
-    for it in range(80):
-        for r in range(m):
-            delta[r] = base[r] - lam * step[r]
-            ql[r] = qh[r] + delta[r]
-            fl[r] = 0.0
-            for c in range(m):
-                jl[r, c] = 0.0
-                jvl[r, c] = 0.0
-        pin_kernel(ql, vh, fl, jl, jvl, True, pins_loc)
-        r1 = 0.0
-        scale = 0.0
-        for r in range(m):
-            acc = delta[r]
-            for c in range(m):
-                acc -= cm[r, c] * fl[c]
-            res[r] = acc
-            w = r_p if r % 3 == 2 else 1.0
-            r1 = max(r1, abs(acc) * w)
-            scale = max(scale, abs(delta[r]) * w)
-        tol = max(1e-15, 1e-10 * scale)  # 1e-13 m or better (round-off of the gap: ~1e-17 m)
-        fresh = False
-        if it > 0 and r1 >= r0:
-            if r0 <= 100.0 * tol:  # at round-off: accept
-                break
-            if lam > 1e-6:  # step halving on max|R| (R: gradient of a convex energy)
-                lam *= 0.5
-                continue
-        r0 = r1
-        condensed_step(cm, jl, -1.0, res, tmp, nm, step)  # N = (I - C J)^-1, the Newton correction N R
-        fresh = True
-        if r1 <= tol:
+        apply_predictor(delta, step, weight)
+    newton_start(nw)
+    while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
+        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
+        if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
             break
-        for r in range(m):
-            base[r] = delta[r]
-        lam = 1.0
-    if not fresh:  # stopped on a halved step at round-off: the correction from the last evaluation
-        condensed_step(cm, jl, -1.0, res, tmp, nm, step)
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
@@ -636,6 +641,9 @@ class PinContacts(KernelGroup):
 
     name = "pins"
     kind = "pins"
+    kernel = staticmethod(pin_body_kernel)
+    friction_outputs = ("pin_friction_power",)
+    failure_message = "pin gap: closest-point iteration did not converge"
 
     def __init__(self, params, restart_every: int = 500):
         p = params
@@ -652,22 +660,24 @@ class PinContacts(KernelGroup):
             _curve_reach(int(p.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(p.eccentricity))
             for kd in range(self.nd)
         ]
-        self.sc = np.array(
-            [
-                float(p.z_rp),
-                p.pin_circle_radius,
-                p.pin_radius,
-                p.eccentricity,
-                p.pin_k,
-                p.pin_exponent,
-                p.pin_c_max,
-                p.contact_depth,
-                *closest_point_settings(p.z_rp, p.pin_circle_radius),
-                *np.ravel(reach),  # sc[11 + 2 k], sc[12 + 2 k]: disc k's reach outside, inside
-                p.pin_friction,
-                p.friction_velocity,
-            ]
-        )  # sc[-2], sc[-1]: friction (0: off)
+        max_step, tol, max_iter = closest_point_settings(p.z_rp, p.pin_circle_radius)
+        self.law = PinLaw.of(
+            z_rp=p.z_rp,
+            pin_circle_radius=p.pin_circle_radius,
+            pin_radius=p.pin_radius,
+            eccentricity=p.eccentricity,
+            k=p.pin_k,
+            exponent=p.pin_exponent,
+            c_max=p.pin_c_max,
+            depth=p.contact_depth,
+            max_step=max_step,
+            tol=tol,
+            max_iter=max_iter,
+            mu=p.pin_friction,
+            v_reg=p.friction_velocity,
+        )
+        #: per disc the pin-centre curve's reach outside, inside [m] (:func:`_curve_reach`)
+        self.reach = np.array(reach, dtype=float).reshape(self.nd, 2)
         self.mu, self.v_reg = p.pin_friction, p.friction_velocity
         z = len(self.pins)
         self.phi = np.full((self.nd, z), np.nan)
@@ -714,61 +724,35 @@ class PinContacts(KernelGroup):
             self.dstate[:] = 0.0
             self.work[0] = 0.0  # the solver's predictor state no longer matches dstate
         work = np.zeros_like(self.work) if history else self.work
-        rest = (
-            self.sc,
-            self.pins,
-            self.radii,
-            self.profile,
-            self.harmonics,
-            phi,
-            last,
-            self.gap,
-            self.force,
-            self.nx,
-            self.ny,
-            self.rxn,
-            self.ft,
-            self.pw,
-            ctr,
+        pins = PinPack(
+            idx=idx,
+            law=self.law,
+            reach=self.reach,
+            pins=self.pins,
+            radii=self.radii,
+            profile=self.profile,
+            harm=self.harmonics,
+            phi=phi,
+            last=last,
+            gap=self.gap,
+            force=self.force,
+            nx=self.nx,
+            ny=self.ny,
+            rxn=self.rxn,
+            ft=self.ft,
+            pw=self.pw,
+            ctr=ctr,
         )
-        return (idx, *rest), self.disc_c, self.dstate, self.hstate, self.idx_rim, work
+        return PinBodyPack(
+            pins=pins, disc_c=self.disc_c, dstate=self.dstate, housing=self.hstate, idx_rim=self.idx_rim, work=work
+        )
 
     @staticmethod
     def empty_pack():
-        z2 = np.zeros((0, 0))
-        pins = (
-            np.zeros(0, np.int64),
-            np.zeros(13),
-            np.zeros((0, 2)),
-            np.zeros(0),
-            np.zeros((0, 3)),
-            np.zeros((0, 0, 3)),
-            z2,
-            np.zeros((0, 0, 3)),
-            z2,
-            z2,
-            z2,
-            z2,
-            z2,
-            z2,
-            z2,
-            np.array([1, 0, 0, 0], dtype=np.int64),
-        )
-        return (
-            pins,
-            np.zeros((0, 3, 3)),
-            np.zeros((0, 3)),
-            np.zeros(2),
-            np.zeros(0, np.int64),
-            np.zeros(pin_work_size(0)),
-        )
+        return empty_pack(PinBodyPack)
 
-    def run(self, t, q, v, f, jq, jv, jac, pack, inputs=None):
-        ctr = pack[0][-1]
-        before = ctr[2]
-        pin_body_kernel(q, v, f, jq, jv, jac, pack)
-        if ctr[2] != before:
-            raise ConvergenceError("pin gap: closest-point iteration did not converge")
+    def failure_counter(self, pack):
+        return pack.pins.ctr[2:3]  # closest-point failures
 
     @property
     def min_gap(self) -> float:
@@ -788,7 +772,7 @@ class PinContacts(KernelGroup):
         }
 
     def outputs(self, t, rec):
-        f, nx, ny = rec["force"], rec["nx"], rec["ny"]
+        f = rec["force"]
         dims = ("time", "disc", "pin")
         out = (
             {}

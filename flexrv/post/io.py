@@ -60,12 +60,17 @@ def summary_markdown(res, summ: dict) -> str:
         ("mean_dissipation_W", "W"),
         ("efficiency", "-"),
         ("mean_friction_power_W", "W"),
-        ("mean_pin_friction_power_W", "W"),
-        ("mean_needle_friction_power_W", "W"),
+        *((key, "W") for key in summ.get("friction_keys", ())),  # per group: the declared friction outputs
     ):
         if key not in summ:
             continue
         lines.append(f"| {key} | {_fmt(summ.get(key))} | {unit} |")
+    rows = summ.get("elements") or {}
+    if rows:
+        lines += ["", "## Force elements (steady window)", "", "| quantity | value | unit | description |"]
+        lines.append("|---|---|---|---|")
+        for key, row in rows.items():
+            lines.append(f"| {key} | {_fmt(row['value'])} | {row['units']} | {row['description']} |")
     return "\n".join(lines) + "\n"
 
 

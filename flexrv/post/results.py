@@ -33,7 +33,6 @@ import numpy as np
 import xarray as xr
 
 from flexrv.cache import to_jsonable
-from flexrv.units import ARCSEC_PER_RAD
 
 
 class Results:
@@ -123,8 +122,16 @@ class Results:
         )
 
 
-def _var(values, dims, units, long_name):
-    return xr.Variable(dims, np.asarray(values), attrs={"units": units, "long_name": long_name})
+def _var(values, dims, units, long_name, role="", summary=()):
+    """A result variable with its declared metadata: units, long name and, if the element
+    declared them, its ``role`` ("friction") and its summary rows (JSON list of [key, units,
+    description, reduce], read by :func:`flexrv.post.stats.element_summary`)."""
+    attrs = {"units": units, "long_name": long_name}
+    if role:
+        attrs["role"] = role
+    if summary:
+        attrs["summary_rows"] = json.dumps([[r.key, r.units, r.description, r.reduce] for r in summary])
+    return xr.Variable(dims, np.asarray(values), attrs=attrs)
 
 
 #: settle time [s] after the end of the speed and load ramps before the steady window may
@@ -235,8 +242,8 @@ def results_from_states(
     """Build :class:`Results` (or the subclass ``cls``) from recorded states (T,), (T, n), (T, n).
 
     The variables are the model's declared outputs (:func:`flexrv.model.outputs.model_outputs`,
-    read by name: this module never sees the state layout or the member names), plus
-    TE = (theta_out - theta_in / i) in arcsec and the input and output power. ``records``:
+    read by name: this module never sees the state layout or the member names; TE and the
+    input and output power are among them). ``records``:
     the groups' records the integrator computed at the T samples
     (:meth:`flexrv.model.kernels.HistoryRecorder.records`), used where valid."""
     from flexrv.geometry.kinematics import member_speeds
@@ -255,15 +262,7 @@ def results_from_states(
                 }
     data: dict[str, xr.Variable] = {}
     for name, o in model_outputs(model, t, q, v, chunk=chunk, records=records).items():
-        data[name] = _var(o.values, o.dims, o.units, o.long_name)
-        if name == "omega_out":
-            th_in, th_out = data["theta_in"].values, data["theta_out"].values
-            data["te"] = _var((th_out - th_in / p.ratio) * ARCSEC_PER_RAD, ("time",), "arcsec", "TE")
-        elif name == "output_torque":
-            data["power_in"] = _var(
-                data["input_torque"].values * data["omega_in"].values, ("time",), "W", "input power"
-            )
-            data["power_out"] = _var(o.values * data["omega_out"].values, ("time",), "W", "output power")
+        data[name] = _var(o.values, o.dims, o.units, o.long_name, o.role, o.summary)
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})})
     red = model.reducer
     t_end = float(t[-1]) if len(t) else 0.0

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -98,6 +99,7 @@ def summary(res) -> dict:
         "kinematics": table,
         "failure": res.attrs.get("failure"),
         **_bearing_summary(sel, finite),
+        "elements": element_summary(sel),
     }
     out["units"] = summary_units(res, out)
     return out
@@ -115,8 +117,6 @@ _UNIT_SOURCE = {
     "mean_output_power_W": "power_out",
     "mean_dissipation_W": "power_in",
     "mean_friction_power_W": "friction_power",
-    "mean_pin_friction_power_W": "pin_friction_power",
-    "mean_needle_friction_power_W": "needle_friction_power",
     "mean_kinetic_energy_rate_W": "power_in",
     "max_ball_load_N": "ball_load_inner",
     "max_ring_deformation_m": "ring_deformation_outer",
@@ -131,15 +131,47 @@ _UNIT_SOURCE = {
 def efficiency_summary(sel, p_in: float, p_out: float) -> dict:
     """Efficiency of a driven run over a window ``sel`` (the steady window): eta =
     mean output power / mean input power (both the window means of ``power_out`` and
-    ``power_in``), and the mean friction dissipation [W] per group and in total when the
-    run has friction outputs (:data:`flexrv.model.outputs.FRICTION_OUTPUTS`). eta is NaN
-    when the input does no work (P_in <= 0, e.g. a locked input)."""
+    ``power_in``), and the mean friction dissipation [W] per group (keys listed in
+    ``friction_keys``) and in total when the run has friction outputs (the variables the
+    model declared with ``role`` "friction"). eta is NaN when the input does no work (P_in <= 0,
+    e.g. a locked input)."""
     out = {"efficiency": float(p_out / p_in) if (math.isfinite(p_in) and p_in > 0.0) else float("nan")}
     if "friction_power" in sel and sel.sizes.get("time", 0):
         out["mean_friction_power_W"] = float(np.mean(sel["friction_power"].values))
-        for name in ("pin_friction_power", "needle_friction_power"):
-            if name in sel:
-                out[f"mean_{name}_W"] = float(np.mean(sel[name].values.reshape(sel.sizes["time"], -1).sum(axis=1)))
+        for name in friction_variables(sel):
+            out[f"mean_{name}_W"] = float(np.mean(sel[name].values.reshape(sel.sizes["time"], -1).sum(axis=1)))
+        out["friction_keys"] = [f"mean_{name}_W" for name in friction_variables(sel)]
+    return out
+
+
+def friction_variables(ds) -> list[str]:
+    """Names of the variables declared as friction power (attribute ``role`` = "friction")."""
+    return [name for name, var in ds.data_vars.items() if var.attrs.get("role") == "friction"]
+
+
+#: the reductions of a declared summary row over the steady window
+_REDUCE = {
+    "max": lambda a: float(np.max(a)),
+    "min": lambda a: float(np.min(a)),
+    "mean": lambda a: float(np.mean(a)),
+    "max_abs": lambda a: float(np.max(np.abs(a))),
+    "p2p": lambda a: float(np.max(a) - np.min(a)),
+    "mean_sum": lambda a: float(np.mean(a.reshape(a.shape[0], -1).sum(axis=1))),
+}
+
+
+def element_summary(sel) -> dict:
+    """The summary rows the model's elements declared on their outputs (attribute
+    ``summary_rows``: [key, units, description, reduce]) over the steady window ``sel``:
+    {key: {"value", "units", "description", "source"}} (value None on an empty window)."""
+    out = {}
+    n = sel.sizes.get("time", 0)
+    for name, var in sel.data_vars.items():
+        for key, units, description, reduce in json.loads(var.attrs.get("summary_rows", "[]")):
+            if reduce not in _REDUCE:
+                raise ValueError(f"summary row {key!r}: reduce = {reduce!r} is not one of {sorted(_REDUCE)}")
+            value = _REDUCE[reduce](np.asarray(var.values)) if n else None
+            out[key] = {"value": value, "units": units, "description": description, "source": name}
     return out
 
 
@@ -148,7 +180,9 @@ def summary_units(res, summ: dict) -> dict:
     attributes (the model's declared outputs), not parsed from the key names; the steady
     window in the time coordinate's units, ratios dimensionless ("-")."""
     units = {}
-    for key, var in _UNIT_SOURCE.items():
+    sources = dict(_UNIT_SOURCE)
+    sources.update({f"mean_{name}_W": name for name in friction_variables(res.ds)})  # the declared friction outputs
+    for key, var in sources.items():
         if key in summ and var in res.ds:
             units[key] = str(res.ds[var].attrs.get("units", ""))
     units["steady_window_s"] = str(res.ds["time"].attrs.get("units", "s"))
@@ -173,7 +207,7 @@ def power_balance(
     ``tol`` P_in cannot be dissipation — energy is then released from storage the balance
     does not count (elastic energy of the contacts, e.g. while the load still ramps, or a
     window that is not steady) or the integration error shows. ``friction``: the mean
-    friction power of the run [W] (issue 14), if it has friction; the note then splits D
+    friction power of the run [W], if it has friction; the note then splits D
     into friction and the rest (contact damping, elastic storage)."""
     d = p_in - p_out - dke_dt
     scale = max(abs(p_in), abs(p_out), 1e-12)

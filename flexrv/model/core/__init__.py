@@ -1,0 +1,1 @@
+"""The model's core: typed kernel parameters (:mod:`~flexrv.model.core.params`)."""

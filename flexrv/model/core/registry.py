@@ -1,0 +1,194 @@
+"""The registry of compiled force elements and the fused kernel generated from it.
+
+A compiled force element is a :class:`~flexrv.model.base.KernelGroup` subclass with a
+``kind``, a ``kernel`` (a numba function ``kernel(q, v, f, jq, jv, jac, pack)`` that adds
+the element's generalized forces into f and, if ``jac``, its Jacobians into jq, jv over
+the coordinates ``pack.idx``), a typed ``pack`` (:mod:`flexrv.model.core.params`), its
+declared outputs (``outputs``), friction outputs (``friction_outputs``) and summary rows
+(``summary_rows``). ONE line registers it: ``register(MyElement)``. The order of
+registration is the order of the calls in the fused kernel (the order in which the
+elements' forces are summed).
+
+The fused kernel of a model's elements (:func:`fused_functions`) is generated source:
+a module with ``fused_kernel(q, v, f, jq, jv, jac, p0, p1, ...)`` calling each present
+element's kernel once by name, and ``fused_history`` looping it over a time history,
+written to ``flexrv/model/core/_generated/`` and imported, so numba compiles and caches
+it like any other function (``cache=True``: the cache index sits beside the file).
+
+Why generated source and not ``numba.literal_unroll`` over a tuple of (kernel, pack):
+numba lowers a compiled function passed as a VALUE (an element of a tuple, an
+argument) as the address of a Python object in this process and then refuses to cache
+the caller ("Cannot cache compiled function ... as it uses dynamic globals", measured
+on the crank supports' kernel when its Newton took the residual function as an
+argument); an uncached fused kernel recompiles in every process (tens of seconds). A
+generated module calls every kernel as a global (a direct call, cacheable), passes only
+the present elements (no empty packs to unbox), and has ONE call site per kernel (several
+call sites of the large kernels made LLVM's code generation take minutes).
+
+Staleness: numba keys a cached function on its own file only. The generated file's
+name and text carry a hash of the sources its kernels can call (the elements' kernel
+modules, flexrv/model/numerics, flexrv/model/core/params.py, flexrv/contact,
+flexrv/geometry, flexrv/ehl), so an edit of any of them gives a new file that compiles
+afresh instead of reusing old machine code. Compile time of a fresh fused kernel: see ``benchmarks/bench_rigid.py``
+(measured in the module docstring of :mod:`flexrv.model.kernels`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import inspect
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+_PACKAGE = Path(__file__).resolve().parents[2]
+#: where the generated fused kernels are written (beside their numba cache)
+GENERATED = Path(__file__).resolve().parent / "_generated"
+#: the sources a kernel can call into besides its own module (hashed into the generated file's name):
+#: the model's shared numerics and parameter types, the contact laws, geometry and EHL kernels
+_CALLEE_SOURCES = ("model/numerics", "model/core/params.py", "contact", "geometry", "ehl")
+
+
+@dataclass(frozen=True)
+class ElementSpec:
+    """A registered compiled force element: its kind, group class and kernel."""
+
+    kind: str
+    group: type
+    kernel: object
+
+
+#: kind -> spec, in registration (= call) order
+ELEMENTS: dict[str, ElementSpec] = {}
+
+
+def register(group: type) -> type:
+    """Register a compiled force element (a KernelGroup subclass with ``kind`` and a
+    static ``kernel``); usable as a class decorator. Re-registering a kind replaces it
+    in place (module reloads); two classes of one kind are refused."""
+    kind = getattr(group, "kind", "")
+    kernel = inspect.getattr_static(group, "kernel", None)
+    kernel = getattr(kernel, "__func__", kernel)
+    if not kind or kernel is None or not hasattr(kernel, "py_func"):
+        raise TypeError(f"{group.__name__}: a registered element needs a kind and a compiled static kernel")
+    old = ELEMENTS.get(kind)
+    if old is not None and old.group.__qualname__ != group.__qualname__:
+        raise ValueError(f"element kind {kind!r} is registered twice ({old.group.__name__}, {group.__name__})")
+    ELEMENTS[kind] = ElementSpec(kind, group, kernel)
+    return group
+
+
+def spec_of(group_obj) -> ElementSpec | None:
+    """The registered spec of a group object (None: not a registered element)."""
+    spec = ELEMENTS.get(getattr(group_obj, "kind", ""))
+    return spec if spec is not None and isinstance(group_obj, spec.group) else None
+
+
+_HASHES: dict[tuple, str] = {}
+
+
+def _source_hash(specs) -> str:
+    """Hash of the sources the kernels of ``specs`` can call (read once per process)."""
+    key = tuple((s.kind, id(s.kernel)) for s in specs)
+    if key not in _HASHES:
+        _HASHES[key] = _hash_files(specs)
+    return _HASHES[key]
+
+
+def _hash_files(specs) -> str:
+    h = hashlib.sha256()
+    files = set()
+    for name in _CALLEE_SOURCES:
+        path = _PACKAGE / name
+        files |= set(path.rglob("*.py")) if path.is_dir() else {path}
+    files |= {Path(inspect.getsourcefile(s.kernel.py_func)).resolve() for s in specs}
+    for p in sorted(files):
+        h.update(str(p).encode())
+        h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _fused_source(specs, callee_hash: str) -> str:
+    """Text of the generated module for the elements ``specs`` (in call order)."""
+    n = len(specs)
+    packs = ", ".join(f"p{i}" for i in range(n))
+    timed = [(i, s.group.time_field) for i, s in enumerate(specs) if s.group.time_field]
+    lines = [
+        '"""Generated by flexrv.model.core.registry (do not edit): the fused kernel of the elements',
+        f'{", ".join(s.kind for s in specs)}; callee sources {callee_hash}."""',
+        "",
+        "from numba import njit",
+        "",
+    ]
+    for i, s in enumerate(specs):
+        lines.append(f"from {s.kernel.py_func.__module__} import {s.kernel.py_func.__name__} as k{i}")
+    lines += [
+        "",
+        "",
+        "@njit(cache=True)",
+        f"def fused_kernel(q, v, f, jq, jv, jac, {packs}):",
+        "    f[:] = 0.0",
+        "    if jac:",
+        "        jq[:, :] = 0.0",
+        "        jv[:, :] = 0.0",
+    ]
+    lines += [f"    k{i}(q, v, f, jq, jv, jac, p{i})" for i in range(n)]
+    tin = "".join(f"tin{i}, " for i, _ in timed)
+    lines += [
+        "",
+        "",
+        "@njit(cache=True)",
+        f"def fused_history(qs, vs, {tin}f, jq, jv, {packs}, src, dst):",
+        "    for i in range(qs.shape[0]):",
+    ]
+    lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
+    lines += [
+        f"        fused_kernel(qs[i], vs[i], f, jq, jv, False, {packs})",
+        "        for r in range(len(src)):",
+        "            dst[r][i, :] = src[r]",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+_LOADED: dict[str, object] = {}
+
+
+def _write_generated(name: str, source: str, write) -> Path:
+    """The generated file ``name`` with ``source`` (written if missing or different): in
+    :data:`GENERATED`, or where the package is read-only in flexrv's cache folder (keyed by
+    the package's path, so two installations never share a file)."""
+    from flexrv.cache import cache_dir
+
+    for folder in (GENERATED, cache_dir() / "fused" / hashlib.sha256(str(_PACKAGE).encode()).hexdigest()[:12]):
+        path = folder / name
+        try:
+            if not path.exists() or path.read_text() != source:
+                folder.mkdir(parents=True, exist_ok=True)
+                write(path, source)
+            return path
+        except OSError:
+            continue
+    raise OSError(f"cannot write the generated fused kernel {name}")
+
+
+def fused_functions(specs) -> tuple:
+    """(fused_kernel, fused_history) of the elements ``specs`` (call order), generated
+    and imported once per process (module docstring)."""
+    specs = tuple(specs)
+    callee_hash = _source_hash(specs)
+    source = _fused_source(specs, callee_hash)
+    key = hashlib.sha256(source.encode()).hexdigest()[:16]
+    mod = _LOADED.get(key)
+    if mod is None:
+        from flexrv.cache import atomic_write_text
+
+        path = _write_generated(f"fused_{key}.py", source, atomic_write_text)
+        name = f"flexrv.model.core._generated.fused_{key}"
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        spec.loader.exec_module(mod)
+        _LOADED[key] = mod
+    return mod.fused_kernel, mod.fused_history

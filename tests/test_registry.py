@@ -1,0 +1,173 @@
+"""The element registry (flexrv.model.core.registry): a force element defined here, in
+this test module, with ONE registry line, appears in the fused kernel, the outputs,
+the friction sum and the summary without any other file knowing it; and every
+registered element declares what the guide in CONTRIBUTING.md asks for."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+import flexrv.model.kernels  # noqa: F401  (the built-in elements first: the toy is called last)
+from flexrv.model.base import KernelGroup, Output, SummaryRow
+from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.core.registry import ELEMENTS, register
+
+# ------------------------------------------------------------------ the toy element
+#: a torsional spring and viscous damper between the carrier and the (fixed) housing
+ToyLaw = law_type("ToyLaw", k=float, c=float)
+ToyPack = pack_type(
+    "ToyPack", ("idx", (np.int64, 1)), ("law", ToyLaw), ("torque", (np.float64, (1,))), ("power", (np.float64, (1,)))
+)
+
+
+@njit(cache=True)
+def toy_kernel(q, v, f, jq, jv, jac, pack):
+    """Torque M = -k theta - c omega on the carrier's rotation (idx[2]); its damper's
+    power c omega^2 (dissipated, declared as friction)."""
+    i = pack.idx[2]
+    m = -pack.law.k * q[i] - pack.law.c * v[i]
+    f[i] += m
+    pack.torque[0] = m
+    pack.power[0] = pack.law.c * v[i] * v[i]
+    if jac:
+        jq[i, i] -= pack.law.k
+        jv[i, i] -= pack.law.c
+
+
+class ToyTorsion(KernelGroup):
+    """The toy element (members: carrier)."""
+
+    name = "toy_torsion"
+    kind = "toy_torsion"
+    kernel = staticmethod(toy_kernel)
+    members = ("carrier",)
+    friction_outputs = ("toy_damper_power",)
+    summary_rows = (
+        SummaryRow("max_toy_torque_Nm", "N m", "largest |torque| of the toy spring", "toy_torque", "max_abs"),
+    )
+
+    def __init__(self, k, c):
+        self.law = ToyLaw.of(k=k, c=c)
+        self.torque, self.power = np.zeros(1), np.zeros(1)
+
+    def pack(self, idx, history=False):
+        return ToyPack(idx, self.law, self.torque, self.power)
+
+    @staticmethod
+    def empty_pack():
+        return empty_pack(ToyPack)
+
+    def record_sources(self):
+        return {"torque": self.torque, "power": self.power}
+
+    def outputs(self, t, rec):
+        return {
+            "toy_torque": Output(rec["torque"][..., 0], ("time",), "N m", "torque of the toy spring on the carrier"),
+            "toy_damper_power": Output(rec["power"][..., 0], ("time",), "W", "power dissipated by the toy damper"),
+        }
+
+
+register(ToyTorsion)  # the one registry line
+
+K_TOY, C_TOY = 2e5, 30.0
+
+
+def _states(model, n=5, seed=4):
+    """A few loaded states: discs turned into the pins, the carrier turned and turning."""
+    rng = np.random.default_rng(seed)
+    q = np.tile(model.q0, (n, 1))
+    v = np.zeros_like(q)
+    for k in range(model.params.n_discs):
+        q[:, model.slice(f"disc{k}").start + 2] += 1.5e-4
+    for j in range(model.params.n_cranks):
+        q[:, model.slice(f"crank{j}").start + 2] += 5e-5
+    c = model.slice("carrier").start + 2
+    q[:, c] += np.linspace(1e-4, 3e-4, n)
+    v[:, c] = np.linspace(-0.5, 0.5, n)
+    return q + rng.normal(scale=1e-8, size=q.shape), v
+
+
+@pytest.fixture(scope="module")
+def toy_model():
+    from flexrv.design import load
+    from flexrv.model.factory import build_model
+
+    base = build_model(load("rv40e"), exudyn=False)
+    toy = build_model(load("rv40e"), exudyn=False)
+    toy.groups.append(ToyTorsion(K_TOY, C_TOY))
+    return base, toy
+
+
+def test_toy_element_is_in_the_fused_kernel(toy_model):
+    """The fused kernel of the model with the toy element (generated from the registry)
+    gives the model's forces and Jacobians plus exactly the toy's: on the carrier's
+    rotation -k theta - c omega (closed form), Jacobian entries -k, -c; every other
+    entry bit-identical to the model without it."""
+    base, toy = toy_model
+    assert [s.kind for s in ELEMENTS.values()][-1] == "toy_torsion"
+    q, v = _states(base, n=1)
+    f0, dq0, dv0 = base.generalized_forces(0.0, q[0], v[0])
+    f1, dq1, dv1 = toy.generalized_forces(0.0, q[0], v[0])
+    assert "toy_torsion" in [g.kind for g, _ in toy.fused.slots]
+    c = base.slice("carrier").start + 2
+    expected = -K_TOY * q[0, c] - C_TOY * v[0, c]
+    assert f1[c] - f0[c] == pytest.approx(expected, rel=1e-12)
+    other = np.arange(len(f0)) != c
+    np.testing.assert_array_equal(f1[other], f0[other])
+    assert dq1[c, c] - dq0[c, c] == pytest.approx(-K_TOY, rel=1e-9)
+    assert dv1[c, c] - dv0[c, c] == pytest.approx(-C_TOY, rel=1e-12)
+
+
+def test_toy_element_in_outputs_friction_and_summary(toy_model, tmp_path):
+    """Results built from states of the toy model (flexrv.post.results_from_states) carry
+    the toy's declared outputs (its torque equals the closed form at every sample), the
+    friction sum includes its damper power c omega^2, and the run summary (summary.json
+    and summary.md, rendered by flexrv.post) lists its declared summary row with the
+    largest |torque| of the window."""
+    import json
+
+    from flexrv.post.io import save
+    from flexrv.post.results import results_from_states
+
+    base, toy = toy_model
+    q, v = _states(toy)
+    t = np.linspace(0.0, 4e-4, len(q))
+    res = results_from_states(toy, t, q, v, dt=1e-4)
+    ref = results_from_states(base, t, q, v, dt=1e-4)
+    c = toy.slice("carrier").start + 2
+    torque = -K_TOY * q[:, c] - C_TOY * v[:, c]
+    np.testing.assert_allclose(res.ds["toy_torque"].values, torque, rtol=1e-12)
+    assert res.ds["toy_damper_power"].attrs["role"] == "friction"
+    damper = C_TOY * v[:, c] ** 2
+    base_fric = ref.ds["friction_power"].values if "friction_power" in ref.ds else 0.0
+    np.testing.assert_allclose(res.ds["friction_power"].values, base_fric + damper, rtol=1e-12, atol=1e-12)
+    res.attrs.update(steady_start_s=0.0, steady_end_s=float(t[-1]))
+    d = save(res, tmp_path / "run")
+    summ = json.loads((d / "summary.json").read_text())
+    row = summ["elements"]["max_toy_torque_Nm"]
+    assert row["value"] == pytest.approx(np.abs(torque).max(), rel=1e-12) and row["units"] == "N m"
+    assert summ["mean_toy_damper_power_W"] == pytest.approx(damper.mean(), rel=1e-12)
+    md = (d / "summary.md").read_text()
+    assert "max_toy_torque_Nm" in md and "mean_toy_damper_power_W" in md
+
+
+def test_every_registered_element_declares_its_parts():
+    """The guide's "add a force element" list (CONTRIBUTING.md), checked on every
+    registered element: a kind, a compiled kernel, a pack type whose absent-element
+    pack is derived (empty_pack), record sources and outputs, and summary rows only on
+    outputs it declares; an element lacking outputs fails here."""
+    import inspect
+
+    for kind, spec in ELEMENTS.items():
+        cls = spec.group
+        assert cls.kind == kind and hasattr(spec.kernel, "py_func"), kind
+        assert "empty_pack" in vars(cls) or any("empty_pack" in vars(b) for b in cls.__mro__[:-1]), kind
+        assert cls.outputs is not KernelGroup.outputs, f"{kind}: declares no outputs"
+        assert cls.record_sources is not KernelGroup.record_sources, f"{kind}: records nothing"
+        src = inspect.getsource(cls.outputs)
+        for row in cls.summary_rows:
+            assert f'"{row.source}"' in src, f"{kind}: summary row {row.key} reads an undeclared output"
+        for name in cls.friction_outputs:
+            assert f'"{name}"' in src, f"{kind}: friction output {name} is not declared"
