@@ -59,6 +59,6 @@ def test_cli_design_json():
     """`flexrv design rv221 --json` prints the same report (CLI owned by the lead)."""
     res = CliRunner().invoke(app, ["design", "rv221", "--json"])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output)
+    data = json.loads(res.stdout)
     assert data["kinematics"]["ratio"] == 221.0
     assert data["involute_stage"]["contact_ratio"] == pytest.approx(1.439633, rel=1e-5)

@@ -372,7 +372,8 @@ def test_quasi_static_carrier_and_disc_add_their_fe_compliance():
 # ------------------------------------------------------------------ bad input
 def test_self_intersecting_disc_and_bad_switch_name_the_field():
     """A disc whose crank holes would cut the teeth or be cut by the centre hole,
-    planets that would overlap on the crank circle, and an unknown body model: ConfigError naming the field (the carrier's
+    planets that would overlap on the crank circle, and an unknown body model: ConfigError naming the field
+    (the carrier's
     own cases: tests/test_fem_carrier.py::test_carrier_design_errors_name_the_field)."""
     from flexrv.design import override
     from flexrv.errors import ConfigError

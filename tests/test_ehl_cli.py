@@ -24,7 +24,7 @@ def test_ehl_preset_json(tmp_path):
     png = tmp_path / "ehl.png"
     res = CliRunner().invoke(app, ["ehl", "--preset", "rv221", "--grid", "33", "--json", "--png", str(png)])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output)
+    data = json.loads(res.stdout)
     inp, out = data["inputs"], data["outputs"]
     red = load("rv221")
     geom = BallBearingGeometry.from_design(red.main_bearing)
@@ -69,12 +69,12 @@ def test_ehl_grid_refinement_reported():
     args = ["ehl", "--load-n", "100", "--speed-m-s", "1", "--rx-m", "0.01", "--ry-m", "0.04", "--json"]
     res = CliRunner().invoke(app, args + ["--grid-tol", "0.001", "--max-grid", "129"])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output)
+    data = json.loads(res.stdout)
     out = data["outputs"]
     assert out["grid_used"] == 129 and not out["grid_converged"] and out["grid_change"] > 0.001
     assert data["inputs"]["grid_tol"] == 0.001 and "not grid-converged" in data["warnings"][0]
     res = CliRunner().invoke(app, args)
-    out = json.loads(res.output)["outputs"]
+    out = json.loads(res.stdout)["outputs"]
     assert out["grid_converged"] and out["grid_change"] < 0.02 and out["grid_used"] >= 129
 
 

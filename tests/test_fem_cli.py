@@ -20,7 +20,7 @@ def test_mesh_json_counts_match_files():
 
     r = CliRunner().invoke(app, ["mesh", "rv40e", "--part", "crankshaft", "--size", "4", "--json"])
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     back = meshio.read(data["vtu"])
     assert data["nodes"] == back.points.shape[0] and data["elements"] == back.cells[0].data.shape[0]
     assert data["groups"]["eccentric_1"] > 0
@@ -36,7 +36,7 @@ def test_modes_json_ordering_and_bad_part(tmp_path):
         app, ["modes", "rv40e", "--part", "crankshaft", "--size", "5", "--n", "3", "--json", "--vtu", str(tmp_path)]
     )
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     f, fc = np.array(data["free_hz"]), np.array(data["constrained_hz"])
     assert f.size == 3 and np.all(f > 1000) and np.all(np.diff(f) >= 0)
     assert fc.size == 3 and np.all(np.diff(fc) >= 0) and fc[0] > f[0]

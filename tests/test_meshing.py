@@ -106,7 +106,7 @@ def test_carrier_part_groups_and_cli(tmp_path, monkeypatch):
     rv = load("rv40e")
     r = CliRunner().invoke(app, ["mesh", "rv40e", "--part", "carrier", "--size", "8", "--json"])
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     n = rv.first_stage.n_planets
     expected = {f"bore_{p}_{k}" for p in ("in", "out") for k in range(1, n + 1)} | {
         "flange",

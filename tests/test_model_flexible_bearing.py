@@ -456,7 +456,7 @@ def test_two_rows_one_element():
     carrier_v[2] = 0.9
     qn, vn = np.zeros(n), np.zeros(n)
     qn[:6], vn[:6] = carrier_q, carrier_v
-    ref_f, ref_j, states = np.zeros(n), np.zeros((n, n)), []
+    ref_f, ref_j = np.zeros(n), np.zeros((n, n))
     f_q, f_v = 0.5, 2e3
     for r, idx in zip(rows, idxs):
         q, qt = _random_state(r, seed=11)

@@ -72,7 +72,8 @@ def test_ring_deflection_under_ball_loads_matches_full_fe(rings, condense):
     coordinates (a condensed ring's recovered from its contact loads); the reduced ring's
     raceway deflection at every loaded ball (along its contact normal) equals the
     full FE solution of the clamped ring under the same ball loads within 1 % of
-    the largest deflection (measured 0.08 % with 12 eigenmodes in the basis; outer and inner ring, both rows; the second row is the
+    the largest deflection (measured 0.08 % with 12 eigenmodes in the basis; outer and inner ring, both rows;
+    the second row is the
     mirror image z -> -z of the meshed ring, so its loads are mirrored for the
     FE reference)."""
     rv, out = rings
@@ -208,7 +209,8 @@ def test_stiffened_flexible_reducer_matches_rigid_ring_reducer():
 
 def test_condensed_rings_match_the_uncondensed_formulation(rings):
     """Static condensation (issue 15) against the uncondensed formulation (the
-    rings' massless modal coordinates as system coordinates, same kernel): :cite:`seed001`'s 20 kN radial + 15 kN axial case on the standalone bearing, both rings
+    rings' massless modal coordinates as system coordinates, same kernel): :cite:`seed001`'s 20 kN radial + 15
+    kN axial case on the standalone bearing, both rings
     flexible, both rows. Ball loads and raceway deflections at the contacts agree
     within 1e-6 of their maxima (measured 2e-9 and 2e-8: the local solve's
     tolerance 1e-13 m on ~1 um deflections, and the static solver's), the

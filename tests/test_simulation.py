@@ -67,7 +67,8 @@ def test_kinematics_ratio_and_crank_speed(steady_run):
 def test_power_and_torque_balance(steady_run):
     """Steady state: input power = output power + dissipation + dE_kin/dt; beyond the
     friction's own dissipation (output friction_power) the model dissipates only in
-    contact dampers, so |P_in - P_out - P_friction| < 2 % of P_in. Torque balance of the whole reducer about its axis at every
+    contact dampers, so |P_in - P_out - P_friction| < 2 % of P_in. Torque balance of the whole reducer about
+    its axis at every
     window (Euler's law for the carrier, cranks and discs): the change of their
     angular momentum equals the impulse of -load torque + sun reaction - pin
     reactions on the housing, to 1 % of the load-torque impulse."""

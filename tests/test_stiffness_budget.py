@@ -132,7 +132,7 @@ def test_design_cli_prints_the_budget():
 
     res = CliRunner().invoke(app, ["design", "rv40e", "--json"])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output)
+    data = json.loads(res.stdout)
     b = data["stiffness_budget"]
     el = b["elements"]
     assert set(el) == {

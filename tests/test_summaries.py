@@ -194,12 +194,12 @@ def test_first_compile_notice(tmp_path):
         return index, SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace(_index_path=str(index))))
 
     helper_index, helper = dispatcher("cycloid._pin_gap_kernel")
-    entry_index, entry = dispatcher("kernels.fused_kernel")
+    entry_index, entry = dispatcher("fused.fused_kernel")
     modules = {
         "flexrv.geometry.cycloid": SimpleNamespace(_PIN_GAP=helper),
-        "flexrv.model.kernels": SimpleNamespace(fused_kernel=entry),
+        "flexrv.model.core._generated.fused_0123abcd": SimpleNamespace(fused_kernel=entry),
     }
-    assert uncached_kernels(modules) == ["cycloid._PIN_GAP", "kernels.fused_kernel"]
+    assert uncached_kernels(modules) == ["cycloid._PIN_GAP", "fused.fused_kernel"]
     out = io.StringIO()
     assert announce_compile(out, modules) and "compiling numba kernels (once, ~" in out.getvalue()
     entry_index.write_bytes(b"")

@@ -331,7 +331,8 @@ def local_run(tmp_path_factory):
 
 @pytest.mark.slow
 def test_study_outputs_and_rerun_identical(local_run, tmp_path):
-    """(slow: three tiny studies.) The study writes samples.nc / summary / PNGs with finite outputs; a second identical command
+    """(slow: three tiny studies.) The study writes samples.nc / summary / PNGs with finite outputs; a second
+    identical command
     recomputes nothing; a fresh run in another directory gives the identical table."""
     out, data = local_run
     assert data["samples"] == 4 and data["evaluations"] == 4

@@ -92,7 +92,7 @@ def test_te_cli_uncertainty(tmp_path):
     args = ["te", "rv40e", "--crank-revolutions", "0.05", "--points-per-mesh", "4", "--out", str(out)]
     res = CliRunner().invoke(app, [*args, "--uncertainty", "4", "--json"])
     assert res.exit_code == 0, res.output
-    d = json.loads(res.output)
+    d = json.loads(res.stdout)
     u = d["uncertainty"]
     assert set(OUTPUTS) <= set(u["outputs"]) and u["failed"] == []
     for name in OUTPUTS:
@@ -155,7 +155,7 @@ def test_stiffness_test_cli_names_and_uncertainty(tmp_path):
     args = ["stiffness-test", "rv40e", "--quarter-time", "0.01", "--out", str(tmp_path / "st")]
     res = CliRunner().invoke(app, [*args, "--json", "--uncertainty", "4"])
     assert res.exit_code == 0, res.output
-    d = json.loads(res.output)
+    d = json.loads(res.stdout)
     assert set(DEFINITIONS) <= set(d)
     b = d["stiffness_budget"]
     assert {k for k, e in b["elements"].items() if not e["in_model"]} == {

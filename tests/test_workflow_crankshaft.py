@@ -29,7 +29,8 @@ def test_table4_frequencies_follow_from_the_kinematics():
     """:cite:`seed002` Table 4 at 1215 r/min input (RV-40E: z_s 16, z_p 32, z_c 39, 40
     pins, i = 81): input 20.25 Hz; crank spin relative to the carrier
     (f_in - f_out) z_s / z_p = 10 Hz; carrier f_in / 81 = 0.25 Hz; first-stage mesh
-    z_s (f_in - f_out) = 320 Hz; cycloid mesh z_c (f_crank) = 390 Hz (Willis; :cite:`seed002` rounds). The workflow's table of seed numbers agrees to 1 % with these."""
+    z_s (f_in - f_out) = 320 Hz; cycloid mesh z_c (f_crank) = 390 Hz (Willis; :cite:`seed002` rounds). The
+    workflow's table of seed numbers agrees to 1 % with these."""
     from flexrv.workflows.crankshaft_flexibility import SEED_TABLE4
 
     f_in = 1215.0 / 60.0

@@ -98,12 +98,12 @@ def test_report_is_generated_full_and_smoke_kept_apart(tmp_path):
     _compare_json(tmp_path / "rigid_vs_flexible-smoke", 3.0, 3.0)
     r = CliRunner().invoke(app, ["report", "--results", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
-    assert json.loads(r.output)["sections"] == ["demo"]
+    assert json.loads(r.stdout)["sections"] == ["demo"]
     full = (tmp_path / "REPORT.md").read_text()
     assert "SMOKE" not in full and "## Answer" not in full and "Demo workflow" in full
     assert full.count("## References") == 1 and "Simulation rv40e" not in full
     r = CliRunner().invoke(app, ["report", "--results", str(tmp_path), "--smoke", "--json"])
-    assert json.loads(r.output)["sections"] == ["demo-smoke"]  # the compare.json folder has no summary
+    assert json.loads(r.stdout)["sections"] == ["demo-smoke"]  # the compare.json folder has no summary
     smoke = (tmp_path / "REPORT-smoke.md").read_text()
     assert smoke.splitlines()[0].endswith("(SMOKE RUNS)") and "## Answer" in smoke
     assert not (tmp_path / "README.md").exists()

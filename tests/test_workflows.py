@@ -111,7 +111,7 @@ def test_cli_report(kinematic, torsional, gallery, results_root):
     (never README.md); the smoke runs' banner is carried into the report."""
     r = CliRunner().invoke(app, ["report", "--results", str(results_root), "--json"])
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     assert data["sections"] == ["kinematic_validation", "mode_gallery", "torsional_stiffness"]
     assert data["path"].endswith("REPORT.md") and not (results_root / "README.md").exists()
     report = (results_root / "REPORT.md").read_text()
@@ -123,7 +123,7 @@ def test_cli_workflow(tmp_path):
     """``flexrv workflow mode_gallery --smoke --json`` writes summary.md and reports the folder."""
     r = CliRunner().invoke(app, ["workflow", "mode_gallery", "--smoke", "--out", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     assert data["out_dir"] == str(tmp_path) and (tmp_path / "summary.md").exists()
     assert data["numbers"]["frequencies_hz"]["rv40e/crankshaft"][0] > 0
 

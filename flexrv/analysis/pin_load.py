@@ -417,7 +417,8 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     597 N). A linear bending spring in series
     has no exact power-law form: the path's constant is matched to the series
     deflection at the reference load Q_ref (the largest pin force at the rated
-    torque, of the design without its errors, :func:`flexrv.design.manufacturing.nominal_design`): K = Q_ref / (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
+    torque, of the design without its errors, :func:`flexrv.design.manufacturing.nominal_design`): K = Q_ref /
+    (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
     Without a [housing] table the pins are rigidly seated: K = k_disc."""
     from flexrv.contact.hertz import conformal_line_contact, effective_modulus, series_stiffness
 

@@ -282,7 +282,8 @@ class Crankshaft(_Strict):
         default=None,
         ge=-50.0,
         le=50.0,
-        description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end play (-) [um]",
+        description="Axial ring approach of each bearing from the pair's preload (+), or half the pair's end "
+        "play (-) [um]",
     )
     support_bearing_radial_stiffness_N_per_m: float | None = Field(
         default=None, gt=1e6, le=1e12, description="Radial stiffness of one crank support bearing (linear model only)"
@@ -345,7 +346,8 @@ class Crankshaft(_Strict):
             raise _bad(
                 "crankshaft.support_bearing_pitch_diameter_mm",
                 dm,
-                f"must be >= {d_j + 2.0 * wall + dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG):.4g} mm: "
+                f"must be >= "
+                f"{d_j + 2.0 * wall + dw * math.cos(self.support_bearing_contact_angle_deg * RAD_PER_DEG):.4g} mm: "
                 f"the cone raceway (d_m - D cos alpha) must clear the {d_j:g} mm support journal by a "
                 f"ring wall of 0.15 D = {wall:.3g} mm",
                 "the bearing does not fit on the journal",
@@ -469,7 +471,8 @@ class MainBearing(_Strict):
             raise _bad(
                 "main_bearing.ring_width_mm",
                 self.ring_width_mm,
-                f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} mm) lies on the raceway",
+                f"must be >= {2.2 * half_contact:.4g} mm so the contact point (axial offset {half_contact:.3g} "
+                f"mm) lies on the raceway",
             )
         if math.pi * dm / self.ball_count <= d * 1.05:
             raise _bad(
@@ -554,7 +557,8 @@ class Carrier(_Strict):
             raise _bad(
                 "carrier.pillar_circle_radius_mm",
                 rc_p,
-                f"must be <= {r_o - rp - lig:.4g} mm (plate_outer_diameter_mm / 2 = {r_o:g} mm - pillar radius {rp:g} mm "
+                f"must be <= {r_o - rp - lig:.4g} mm (plate_outer_diameter_mm / 2 = {r_o:g} mm - pillar radius "
+                f"{rp:g} mm "
                 f"- ligament {lig:g} mm)",
                 "the pillars would stick out of the plates",
             )
@@ -571,7 +575,8 @@ class Carrier(_Strict):
             raise _bad(
                 "carrier.pillar_diameter_mm",
                 self.pillar_diameter_mm,
-                f"must be <= {spacing - lig:.4g} mm for pillar_count = {self.pillar_count} on pillar_circle_radius_mm = {rc_p:g}",
+                f"must be <= {spacing - lig:.4g} mm for pillar_count = {self.pillar_count} on "
+                f"pillar_circle_radius_mm = {rc_p:g}",
                 "neighbouring pillars would overlap",
             )
         return self
@@ -629,7 +634,8 @@ class Carrier(_Strict):
                     raise _bad(
                         "carrier.pillar_circle_radius_mm",
                         rc_p,
-                        f"a pillar (pillar_diameter_mm = {self.pillar_diameter_mm:g}) at {math.degrees(ang):.4g} deg is {dist:.4g} mm from the "
+                        f"a pillar (pillar_diameter_mm = {self.pillar_diameter_mm:g}) at "
+                        f"{math.degrees(ang):.4g} deg is {dist:.4g} mm from the "
                         f"crank bore at {math.degrees(psi):.4g} deg; need >= {rp + r_b + lig:.4g} mm",
                         "pillar and crank bore would intersect",
                     )

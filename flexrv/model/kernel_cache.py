@@ -36,12 +36,15 @@ KERNEL_MODULES = (
     "flexrv.model.kernels",
     "flexrv.model.bearing_kernel",
 )
+#: prefix of the fused kernels generated from the element registry (:mod:`flexrv.model.core.registry`);
+#: their dispatchers are listed as ``fused.<name>``
+GENERATED_PREFIX = "flexrv.model.core._generated."
 #: the compiled functions a run calls directly, per kind of force element (they compile their callees
 #: into themselves): the fused element of the kernel groups and the ball-bearing rows. A helper a run
 #: never calls (e.g. row_kernel, which the tests and the quasi-static path use) stays uncached and must
 #: not trigger the notice on every run
 RUN_ENTRY_POINTS = {
-    "fused": ("kernels.fused_kernel", "kernels.fused_history", "kernels.copy_records_if_same"),
+    "fused": ("fused.fused_kernel", "fused.fused_history", "kernels.copy_records_if_same"),
     "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history"),
 }
 #: measured first-compile time [s] of the rigid model's kernels (see module docstring), for the message
@@ -49,12 +52,15 @@ COMPILE_ESTIMATE_S = 15
 
 
 def uncached_kernels(modules: dict | None = None) -> list[str]:
-    """Names of the kernels of the already imported modules whose on-disk cache index
-    does not exist yet (they will compile on first call). Modules not imported are
-    not used by the run and are skipped; without numba the list is empty."""
+    """Names of the kernels of the already imported modules (:data:`KERNEL_MODULES` and the
+    generated fused kernels) whose on-disk cache index does not exist yet (they will compile
+    on first call). Modules not imported are not used by the run and are skipped; without
+    numba the list is empty."""
     modules = sys.modules if modules is None else modules
+    names = [(m, m.rsplit(".", 1)[-1]) for m in KERNEL_MODULES]
+    names += [(m, "fused") for m in sorted(modules) if m.startswith(GENERATED_PREFIX)]
     out = []
-    for mod_name in KERNEL_MODULES:
+    for mod_name, label in names:
         mod = modules.get(mod_name)
         if mod is None:
             continue
@@ -62,7 +68,7 @@ def uncached_kernels(modules: dict | None = None) -> list[str]:
             cache = getattr(disp, "_cache", None)
             index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
             if index is not None and not Path(index).exists():
-                out.append(f"{mod_name.rsplit('.', 1)[-1]}.{attr}")
+                out.append(f"{label}.{attr}")
     return out
 
 

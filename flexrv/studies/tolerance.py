@@ -994,7 +994,8 @@ def _markdown(r: dict[str, Any]) -> str:
         for row in w["rows"]:
             f = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
             lines.append(
-                f"| {row['tolerance']} | {row['samples_used']} | {f(row['p95_te_pp_arcsec'])} | {f(row['p95_te_pp_arcsec_halved'])} | "
+                f"| {row['tolerance']} | {row['samples_used']} | {f(row['p95_te_pp_arcsec'])} | "
+                f"{f(row['p95_te_pp_arcsec_halved'])} | "
                 f"{f(row['p95_te_pp_arcsec_doubled'])} | {f(row['yield'])} | {f(row['yield_halved'])} | "
                 f"{f(row['yield_doubled'])} |"
             )
