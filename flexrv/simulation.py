@@ -29,16 +29,8 @@ tolerance (rv40e: TE mean within 1e-4 arcsec, lines up to the cycloid mesh withi
 1.6 %; rv221: mean within 0.04 arcsec and its dominant line within 0.7 %, while
 its 200-300 Hz lines depend on the start-up history at the Newton-tolerance level
 -- two steady responses, see that module), the ball model too (with its Newton
-setting :data:`MODEL_NEWTON`). Cost (benchmarks/bench_rigid.py, CPU, 0.3 s
-simulated, 2026-11-24): 1.3 / 2.0 Newton iterations per step with a fresh Jacobian
-per step (rv40e / rv221), 45-47 / 35-36 us per fused residual call (the condensed
-FE bodies' local Newtons) plus ~1.4 us of Python glue; real-time factor (solve +
-outputs) 1.83-1.84 / 1.84-1.85 (paired against 1.87 / 1.83 before one curve
-evaluation less per pin). Then the step's first residual call made the
-fused element's Jacobians too (FusedForces.jacobian_each_step, set here from the
-Newton settings): kernel 100-103 -> 90 us per step on rv40e, real-time factor 1.88,
-1.94 -> 1.79, 1.81 (paired); rv221 1.88, 1.88 -> 1.90, 1.84, its Newton path changed at
-round-off (kernel calls per step 3.98 -> 3.05 but 1.97 -> 2.05 Newton iterations).
+setting :data:`MODEL_NEWTON`). Cost per step and real-time factors: benchmarks/bench_rigid.py
+(figures on the documentation's benchmark page).
 """
 
 from __future__ import annotations
@@ -70,8 +62,7 @@ DEFAULT_DT = 1e-4
 #: flexible rings slower (rv221 14.2 -> 15.7 s per simulated s) and is not used there. It applies
 #: to balls with inertia (model option ball_inertia = true) only: the default quasi-static balls
 #: leave a 6-coordinate element on the carrier, whose Jacobian is fresh every step (the small
-#: dense system, as the rigid model), and run faster with Exudyn's 0.5 (rv40e 5.45, 5.50 ->
-#: 5.19, 5.17 s per simulated s, rv221 4.63, 4.54 -> 4.52, 4.56; 2026-11-24, paired)
+#: dense system, as the rigid model), and run faster with Exudyn's 0.5 (benchmarks/bench_balls.py)
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
 
@@ -89,7 +80,7 @@ DEFAULT_NEWTON_TOLERANCE = (1e-3, 1e-1)
 #: loop's branches do not depend on it: on rv221 (rated 3000 N m, heavy output side) 0.02 s left
 #: the branches 2043 / 1767 N m/arcmin apart (output ringing after the clearance crossing),
 #: 0.08 s gives 2147 / 2132 against the quasi-static 2113 catalog slope; rv40e moves by < 1 %
-#: (2026-11-24, tests/test_stiffness_budget.py::test_default_loop_is_quasi_static)
+#: (tests/test_stiffness_budget.py::test_default_loop_is_quasi_static)
 DEFAULT_QUARTER_TIME = 0.08
 
 #: default wall-time interval between two checkpoints of a run saved to a directory [s]
@@ -289,7 +280,7 @@ class Simulation:
             ts[:k0], qs[:k0], vs[:k0] = (np.asarray(restart[key], dtype=float) for key in ("t", "q", "v"))
             q_b, v_b, a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
             state["k"] = k0
-        # the recording elements' records at every sample, from the integrator's own calls (issue 15)
+        # the recording elements' records at every sample, from the integrator's own calls
         recorder = None
         if record_outputs:
             from flexrv.model.kernels import HistoryRecorder
@@ -362,7 +353,7 @@ class Simulation:
         # small dense systems (the rigid model): a fresh Jacobian at the start of every step. The
         # contact stiffness changes from step to step, so a reused Jacobian needed 3.7-4.6 Newton
         # iterations per step (rv40e / rv221), a fresh one 1.3-1.9: fewer residual calls, whose Python
-        # round trip is most of a step (issue 15; benchmarks/bench_rigid.py, tests/test_time_step.py)
+        # round trip is most of a step (benchmarks/bench_rigid.py, tests/test_time_step.py)
         ti.newton.modifiedNewtonJacUpdatePerStep = model.n <= SPARSE_ABOVE
         ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
         ti.generalizedAlpha.spectralRadius = spectral_radius
@@ -410,7 +401,7 @@ class Simulation:
 
         j = j0
         try:
-            with single_thread_blas():  # one BLAS thread unless FLEXRV_BLAS_THREADS is set (issue 15)
+            with single_thread_blas():  # one BLAS thread unless FLEXRV_BLAS_THREADS is set
                 while j < n_total and ok:
                     j_next = min((j // seg + 1) * seg, n_total)
                     sd.SetODE2Coordinates(q_b.tolist(), configuration=ic)

@@ -38,31 +38,6 @@ def test_ruff_format():
     assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
 
-#: files that still carry dated history or issue numbers in their comments or docstrings
-#: (being cleaned on other branches); a file that is clean must leave the list
-HISTORY_PENDING = {
-    "flexrv/analysis/pin_load.py",
-    "flexrv/analysis/torsional.py",
-    "flexrv/cli/design.py",
-    "flexrv/design/manufacturing.py",
-    "flexrv/design/model.py",
-    "flexrv/model/base.py",
-    "flexrv/model/bearing_kernel.py",
-    "flexrv/model/cranks_discs.py",
-    "flexrv/model/factory.py",
-    "flexrv/model/flexible_bearing.py",
-    "flexrv/model/kernels.py",
-    "flexrv/model/loads.py",
-    "flexrv/model/outputs.py",
-    "flexrv/model/parameters.py",
-    "flexrv/model/pins.py",
-    "flexrv/model/quasi_static.py",
-    "flexrv/post/stats.py",
-    "flexrv/simulation.py",
-    "flexrv/studies/tolerance.py",
-}
-
-
 def _history_files() -> set[str]:
     import re
 
@@ -76,10 +51,6 @@ def _history_files() -> set[str]:
 
 def test_no_dates_or_issue_numbers_in_code():
     """Code says what and why; when and by how much belongs in CHANGELOG.md. No module of
-    ``flexrv`` carries an ISO date or an issue number, except those still listed in
-    :data:`HISTORY_PENDING`, which may only shrink."""
-    found = _history_files()
-    new = sorted(found - HISTORY_PENDING)
-    assert not new, f"dates or issue numbers in: {new} (move the history to CHANGELOG.md)"
-    gone = sorted(HISTORY_PENDING - found)
-    assert not gone, f"clean now - delete from HISTORY_PENDING: {gone}"
+    ``flexrv`` carries an ISO date or an issue number."""
+    found = sorted(_history_files())
+    assert not found, f"dates or issue numbers in: {found} (move the history to CHANGELOG.md)"

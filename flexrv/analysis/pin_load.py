@@ -24,10 +24,10 @@ approach, here with EXACT clearances of the actual pins to the actual profile):
 4. F_i = K w_i^e for w_i > 0 and beta is iterated (monotone scalar root, Brent)
    until sum F_i l_i = T_disc.
 
-Until issue 17 the clearances were linear in the WHOLE no-load rotation
-(delta_i = gap_i(0) - l_i(0) beta0): exact for the equidistant modification
+Why the clearances are not linearised in the whole no-load rotation
+(delta_i = gap_i(0) - l_i(0) beta0): that is exact for the equidistant modification
 (beta0 ~ 1e-4 rad) but up to 0.7 um wrong at the root pins for rotation-like
-modifications and errors (beta0 of a few arcmin), which changed the maximum pin
+modifications and errors (beta0 of a few arcmin), which changes the maximum pin
 force by several per cent.
 
 Contact law (documented choice): ``"palmgren"`` (default) uses the lead's

@@ -557,7 +557,7 @@ def housing_compliance(reducer, output_torque: float | None = None, crank_angle:
 
 def housing_model_compliance(reducer) -> float:
     """The pin housing's torsional compliance c_h in the models and every budget
-    [rad/(N m)] (issue 14): :func:`housing_compliance` ``total`` (ring bending under
+    [rad/(N m)]: :func:`housing_compliance` ``total`` (ring bending under
     the pin loads + tube torsion, an energy equivalent: the ring's ovalisation enters
     only through its strain energy) at the rated torque and crank angle 0 of the design without its errors
     (:func:`flexrv.design.manufacturing.nominal_design`), if the
@@ -724,7 +724,7 @@ def stiffness_budget(
     * housing: the pin housing ring and tube, c_h of the models
       (:func:`housing_model_compliance`, rated torque; ``housing.body_model =
       "rigid"``: left out, its estimate in ``notes``);
-    * carrier and cycloid_disc (issue 14): the elastic bodies' torsional compliances
+    * carrier and cycloid_disc: the elastic bodies' torsional compliances
       at the output, passed in ``bodies`` ({"carrier": c, "cycloid_disc": c} [rad/(N m)],
       e.g. from :func:`flexrv.fem.disc.body_compliances`: the FE lives in a layer above
       this module, so the caller computes it); an element absent from ``bodies`` (or

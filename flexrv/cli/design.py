@@ -163,7 +163,7 @@ def analytic_budget(reducer, torque: float | None = None) -> dict:
 
 def elastic_body_compliances(reducer) -> dict:
     """Torsional compliances [rad/(N m)] at the output of the design's elastic bodies
-    (issue 14), per its switches (``carrier.body_model``, ``second_stage.disc_body_model``
+    per its switches (``carrier.body_model``, ``second_stage.disc_body_model``
     = "condensed_fe"): the FE condensations of :func:`flexrv.fem.disc.body_compliances`
     (cached); a rigid body is left out."""
     from flexrv.fem.disc import body_compliances

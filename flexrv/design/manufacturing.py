@@ -392,6 +392,6 @@ def nominal_design(reducer):
     contacts. (Evaluated on the analytic as-built pin loads instead, a grade-5 error set
     that preloads a few pins concentrated the pattern into unphysical constants: 79 of
     1,380 rv40e tolerance samples fell to 6-50 N m/arcmin and 35 found no pin-load pose
-    at all, 2026-11-24. Stripping the modifications too would load half the pins and
+    at all. Stripping the modifications too would load half the pins and
     halve the housing estimate: the modifications belong to the design.)"""
     return reducer.model_copy(update={"errors": ManufacturingErrors()})

@@ -844,7 +844,7 @@ class ContactSettings(_Strict):
         description="Needle-bearing penetration beyond which a run is stopped as failed [um] "
         "(at least 20 x the impact law's damping depth)",
     )
-    # friction (issue 14): regularised Coulomb friction, flexrv.contact.laws.friction_force
+    # friction: regularised Coulomb friction, flexrv.contact.laws.friction_force
     friction: bool = Field(
         description="Friction at the pin-disc/pin-seat and needle contacts on (true) or off "
         "(false: exactly the frictionless model)"

@@ -227,7 +227,7 @@ def _member_jacobian(m, exu):
     damping): it returns zero and Exudyn adds the object's constant matrices. Without
     one, Exudyn differentiates the object numerically at every Jacobian (2n + 1
     evaluations of a force that is zero or linear; measured 55-75 us per Jacobian
-    for a 114-coordinate ball member, issue 15). Sparse (no entries) for a pure
+    for a 114-coordinate ball member). Sparse (no entries) for a pure
     mass, dense when the member has stiffness or damping matrices (Exudyn requires
     the format of those)."""
     if m.stiffness_matrix is None and m.damping_matrix is None:
@@ -280,7 +280,7 @@ def assemble(model: AssembledModel) -> AssembledModel:
     from flexrv.model.kernels import FusedForces
 
     kernel_groups = [g for g in model.groups if isinstance(g, KernelGroup)]
-    if kernel_groups:  # ONE element for every compiled group (issue 15)
+    if kernel_groups:  # ONE element for every compiled group
         model.fused = FusedForces(model, kernel_groups)
         for g in kernel_groups:
             g._stats = model.fused.stats  # the groups report the fused element's call counts

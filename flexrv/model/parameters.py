@@ -138,7 +138,7 @@ class RigidParameters:
     #: (:func:`flexrv.analysis.torsional.housing_model_compliance`, design ``housing.body_model``); 0: rigid
     housing_compliance: float = 0.0
     extra: dict = field(default_factory=dict)
-    # friction (issue 14, design [contact] friction fields; 0 = off)
+    # friction (design [contact] friction fields; 0 = off)
     pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
     needle_friction: float = 0.0  #: constant friction coefficient of the needle bearings [-]
     needle_friction_radius: float = 0.0  #: d/2 of the needle friction moment, the eccentric journal radius [m]
@@ -150,7 +150,7 @@ def _cyl_mass(rho, d, length):
 
 
 def body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
-    """The elastic bodies' matrices of the models (issue 14), per the design's switches:
+    """The elastic bodies' matrices of the models, per the design's switches:
     the carrier's (2N, 2N) support-point compliance if ``carrier.body_model =
     "condensed_fe"`` (and the design has a ``[carrier]`` table), else (0, 0); the
     discs' (n_discs, 3, 3) rim compliance if ``second_stage.disc_body_model =

@@ -40,7 +40,7 @@ rated torque):
   kinematic TE by t / R_p (1 - 1/i) while it is the first contact, and the
   no-load curve shows 65 % and 96.7 % of that at fractions 1e-2 and 1e-3
   (tests/test_quasi_static.py; 76 %, 97.5 % and 99.7 % at 1e-2, 1e-3 and 1e-4
-  with the stiffer pin law before the pin seats, issue 14). Smaller fractions are more exact but
+  with the stiffer pin law without the pin seats). Smaller fractions are more exact but
   converge poorly (many contacts sit at the onset kink of their laws, and the
   cranks' load sharing inside their clearances becomes indeterminate: an
   extrapolation to T -> 0 from two such paths amplified that indeterminacy into
@@ -352,7 +352,7 @@ class StaticModel:
         C = e_theta . u = u . K u and group g's share is its strain energy
         u . K_g u / C. The shares sum to 1; for elements in series each share is the
         element's part of the total compliance (Castigliano). An elastic carrier or
-        disc body condensed into the crank supports or the pins (issue 14) gets its
+        disc body condensed into the crank supports or the pins gets its
         own share ``carrier`` / ``cycloid_disc``: df . C df / C with df the group's
         force increment on the body's interface (the support points, the rim) and C
         the body's compliance; the group keeps the rest. The elastic housing condensed
@@ -379,7 +379,7 @@ class StaticModel:
         u = np.linalg.solve(k_total, e)
         c = float(u[self.i_theta])
         out = {name: float(u @ k @ u) / c for name, k in parts.items()}
-        # elastic bodies condensed into a group (issue 14): their strain energy split out of it. With the
+        # elastic bodies condensed into a group: their strain energy split out of it. With the
         # group's condensed force increment df = -K_g u on the body's interface, the body stores df.C.df
         # (series element: its part of u.K_g.u), the contact/bearing the rest.
         for g in m.groups:

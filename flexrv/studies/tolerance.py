@@ -30,8 +30,7 @@ Pipeline
 Resolution of one evaluation: :data:`DEFAULT_RESOLUTION`, one crank revolution
 at 2 points per pin-mesh period (78 loaded + 78 no-load positions on rv40e).
 Measured on one sample (rv40e with the example error set ``iso_grade5_rv40e``,
-rated torque, :func:`te_task`, compiled kernels, CPU time in a warm process;
-2026-11-24, after the pins' and gear meshes' Jacobians were completed):
+rated torque, :func:`te_task`, compiled kernels, CPU time in a warm process):
 
 =====================  ==========  ==========  ===========  ===========
 quantity               crank, K=2  crank, K=8  output, K=2  output, K=8
@@ -55,20 +54,9 @@ output-revolution value on this sample, lost motion and backlash are the
 largest over catalog positions spread over a different range. One output
 revolution costs 24x more per sample (2.6 s against 0.11 s); give
 ``output_revolutions=1`` (``--output-revolutions 1``) when the budget allows.
-Before the Jacobians were completed the same sample took 1.0 s at crank K=2
-(45,500 residual calls, 1,030 finite-difference Jacobians; now 2,250-2,700
-calls and none); TE, lost motion and backlash are unchanged to the digits
-shown, the tangent rigidity rose by 0.04-0.07 % (it is read from the Jacobian,
-which now includes the contacts' curvature terms).
 
-Throughput (benchmarks/bench_tolerance.py, 2026-11-24, 16 and 128 samples, on
-the 2 cores shared with other jobs at a load average of about 5): 0.19 CPU s
-per sample in a study (dask included; 0.14-0.16 s in a warm process), fixed
-start-up 12-20 s (LocalCluster, worker imports and numba cache loads), steady
-3.85 samples/s with one worker and 6.61 with two (x1.72), projected 1,000
-samples in 2.9 min on two workers (4.5 min on one). At a load average of 8-10
-the same benchmark gave 1.25 / 2.21 samples/s (7.8 min). Before the Jacobians
-were completed: 0.44 / 0.54 samples/s on 8 samples.
+Throughput of a study (samples per second on one and two workers, start-up):
+benchmarks/bench_tolerance.py; figures on the documentation's benchmark page.
 
 Sensitivities
 -------------
