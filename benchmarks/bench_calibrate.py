@@ -14,9 +14,7 @@ included) it prints the wall time, the CPU time (this process + reaped workers),
 evaluations, and each identified value with its 95 % interval beside the truth (one draw; the
 coverage over 20 draws is counted by ``flexrv workflow calibration``).
 
-Measured (load average 2 on the 2 shared cores): 38 evaluations; workers=0 5.1 s wall (4.1 s
-CPU); workers=2 14.4 s wall (11.6 s CPU, LocalCluster start-up included); at a load average of 7,
-7.4 s and 21.2 s. Goal <= 2 min: met.
+Figures: docs/benchmarks.md.
 """
 
 from __future__ import annotations

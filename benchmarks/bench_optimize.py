@@ -10,11 +10,7 @@ Two parts, paired in one run:
 * the search: ``--budget`` candidates x ``--samples`` draws on ``--workers`` dask workers
   (goal: 200 x 32 on 2 cores in <= 15 min), wall time and candidates per minute.
 
-Measured (2 cores shared with other jobs, load average 9-20): --compare over 54 builds: CPU
-0.27 s per cheap build, 0.42 s per full one (ratio 1.54), largest |cheap - full| lost motion
-0.251 arcmin, rigidity 1.72 N m/arcmin, pin contact pressure 172 MPa (docs/optimize.md);
---budget 10 --samples 32: 973 s (0.37 builds/s under that load; 200 x 33 builds at 0.27 CPU s
-on 2 free cores: 15 min).
+Figures: docs/benchmarks.md.
 
 Usage::
 

@@ -229,27 +229,20 @@ def test_ehl_maps_equal_aspect_and_micrometres(tmp_path):
     _not_blank(plot_ehl_solution(result, tmp_path / "ehl.png"))
 
 
+def _tet10_surface():
+    """One quadratic tetrahedron: its 10 nodes (VTK order) and its 4 six-node surface triangles."""
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.5, 0, 0], [0.5, 0.5, 0], [0, 0.5, 0],
+                      [0, 0, 0.5], [0.5, 0, 0.5], [0, 0.5, 0.5]], float)  # fmt: skip
+    tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
+    return nodes, tris
+
+
 def test_mode_png_offscreen(tmp_path):
     """pyvista off-screen render of a warped tetrahedron surface is not blank."""
     pytest.importorskip("pyvista")
     from flexrv.viz.modes import render_mode_png
 
-    nodes = np.array(
-        [
-            [0, 0, 0],
-            [1, 0, 0],
-            [0, 1, 0],
-            [0, 0, 1],
-            [0.5, 0, 0],
-            [0.5, 0.5, 0],
-            [0, 0.5, 0],
-            [0, 0, 0.5],
-            [0.5, 0, 0.5],
-            [0, 0.5, 0.5],
-        ],
-        float,
-    )
-    tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
+    nodes, tris = _tet10_surface()
     disp = np.zeros_like(nodes)
     disp[3] = [0.1, 0.1, 0.2]
     _not_blank(render_mode_png(tmp_path / "mode.png", nodes, tris, disp, title="test mode"), min_var=1e-4)
@@ -358,22 +351,7 @@ def test_part_modes_render_free_and_constrained(tmp_path):
     pytest.importorskip("pyvista")
     from flexrv.viz.modes import render_part_modes
 
-    nodes = np.array(
-        [
-            [0, 0, 0],
-            [1, 0, 0],
-            [0, 1, 0],
-            [0, 0, 1],
-            [0.5, 0, 0],
-            [0.5, 0.5, 0],
-            [0, 0.5, 0],
-            [0, 0, 0.5],
-            [0.5, 0, 0.5],
-            [0, 0.5, 0.5],
-        ],
-        float,
-    )
-    tris = np.array([[0, 1, 2, 4, 5, 6], [0, 1, 3, 4, 8, 7], [0, 2, 3, 6, 9, 7], [1, 2, 3, 5, 9, 8]])
+    nodes, tris = _tet10_surface()
     modes = np.zeros((30, 2))
     modes[9:12, 0] = [0.1, 0.1, 0.2]
     modes[3:6, 1] = [0.2, 0.0, 0.1]
