@@ -25,16 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
-TRUTH = {
-    "second_stage.modification_equidistant_mm": 0.0062,
-    "crankshaft.support_bearing_axial_preload_um": 2.8,
-    "needle_bearing.roller_length_mm": 9.2,
-}
-FREE = {
-    "second_stage.modification_equidistant_mm": (0.0025, 0.0075),
-    "crankshaft.support_bearing_axial_preload_um": (0.0, 6.0),
-    "needle_bearing.roller_length_mm": (7.0, 12.0),
-}
+from flexrv.workflows.calibration import EXAMPLE_TRUTH as TRUTH
+from flexrv.workflows.calibration import FREE
 
 
 def _cpu() -> float:

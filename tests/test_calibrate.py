@@ -18,18 +18,10 @@ from flexrv.design import load, override
 from flexrv.measured import read_measured
 from flexrv.measured.writer import write_loop
 from flexrv.studies.calibrate import calibrate, screen, synthetic_loop
+from flexrv.workflows.calibration import EXAMPLE_TRUTH as TRUTH
+from flexrv.workflows.calibration import FREE
 
 SIGMA = 0.005  # arcmin
-TRUTH = {
-    "second_stage.modification_equidistant_mm": 0.0062,
-    "crankshaft.support_bearing_axial_preload_um": 2.8,
-    "needle_bearing.roller_length_mm": 9.2,
-}
-FREE = {
-    "second_stage.modification_equidistant_mm": (0.0025, 0.0075),
-    "crankshaft.support_bearing_axial_preload_um": (0.0, 6.0),
-    "needle_bearing.roller_length_mm": (7.0, 12.0),
-}
 
 
 def _measured(tmp_path, truth: dict, seed: int, name: str = "loop.csv"):

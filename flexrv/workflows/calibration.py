@@ -39,6 +39,12 @@ FREE = {
     "crankshaft.support_bearing_axial_preload_um": (0.0, 6.0),
     "needle_bearing.roller_length_mm": (7.0, 12.0),
 }
+#: one fixed "true" design inside FREE (the benchmark's and the default test's round trip)
+EXAMPLE_TRUTH = {
+    "second_stage.modification_equidistant_mm": 0.0062,
+    "crankshaft.support_bearing_axial_preload_um": 2.8,
+    "needle_bearing.roller_length_mm": 9.2,
+}
 SERIES_PAIR = {"crankshaft.eccentric_journal_length_mm": (9.0, 15.0), "housing.ring_outer_diameter_mm": (170.0, 220.0)}
 #: seed004's loop rigidity [N mm/rad] at +-412 N m
 SEED004_RIGIDITY_NMM_PER_RAD = 3.06e8
