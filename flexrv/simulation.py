@@ -730,8 +730,8 @@ def stiffness_test_budget(reducer, torque: float, theta_in: float = 0.0, referen
     compliance_budget`, the same force groups and laws as the dynamic rigid model) at the
     test's pose, the input locked at ``theta_in`` and the output at +``torque`` (static
     equilibrium reached by torque continuation from the kinematic pose), through
-    :func:`flexrv.analysis.budget.stiffness_budget` (the elements no model contains added in
-    series); ``reference``: named rigidities [N m/rad] stored with it (the loop's)."""
+    :func:`flexrv.analysis.budget.stiffness_budget` (every element in the model);
+    ``reference``: named rigidities [N m/rad] stored with it (the loop's)."""
     from flexrv.analysis.budget import ModelShares, stiffness_budget
     from flexrv.model.outputs import model_outputs
     from flexrv.model.quasi_static import StaticModel, ramp_to

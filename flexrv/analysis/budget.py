@@ -2,12 +2,15 @@
 the torque path, in series. One function, :func:`stiffness_budget`, for every route:
 
 * ``flexrv design`` (analytic): the element laws of :mod:`flexrv.analysis.torsional`
-  (:func:`flexrv.analysis.torsional.stiffness_budget`) and the compliances no model contains
-  yet (:mod:`flexrv.analysis.path_compliances`: carrier joints, support-bearing rings, crank torsion,
-  planet spline);
+  (:func:`flexrv.analysis.torsional.stiffness_budget`) and the closed forms of
+  :mod:`flexrv.analysis.path_compliances` (carrier joints, support-bearing rings, crank
+  torsion, planet spline);
 * ``flexrv te`` and ``flexrv stiffness-test`` (model routes): a model's strain-energy shares
-  times its tangent compliance (:class:`ModelShares`), with the elements the model does not
-  contain added in series from the analytic estimates;
+  times its tangent compliance (:class:`ModelShares`). The models carry every element: the
+  carrier's share splits into the carrier body, the support-bearing rings and the carrier
+  joints by their strain energies (:meth:`flexrv.model.quasi_static.StaticModel.
+  compliance_budget`), the gear stage's into the mesh, the crank torsion and the planet spline
+  in proportion to their compliances along the line of action (:func:`split_gear_stage`);
 * the measured-data path: the analytic budget with a measured rigidity beside it
   (``reference``), the difference being what the budget does not explain.
 
@@ -19,6 +22,8 @@ The budget is pure (the caller passes FE compliances and model shares); it is st
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
@@ -53,8 +58,6 @@ GROUP_ELEMENT = {
     "crankshaft_elasticity": "crank_elasticity",
 }
 
-#: elements no dynamic or quasi-static model contains yet: the analytic estimates are added in series
-NOT_IN_MODELS = ("carrier_joints", "support_bearing_rings", "crank_torsion", "planet_spline")
 
 
 @dataclass(frozen=True)
@@ -72,72 +75,57 @@ class ModelShares:
 @dataclass(frozen=True)
 class Budget:
     """A stiffness budget (SI). ``compliances``: element -> torsional compliance at the
-    output [rad/(N m)] of the route's model; ``added``: elements the route's model does not
-    contain, their analytic estimates, in series; ``reference``: named rigidities beside the
-    budget [N m/rad] (e.g. the loop's measured ``rigidity_slope_50_100``)."""
+    output [rad/(N m)] of the route's model (:data:`ELEMENTS`); ``reference``: named
+    rigidities beside the budget [N m/rad] (e.g. the loop's measured ``rigidity_slope_50_100``)."""
 
     route: str
     torque: float
     compliances: dict
-    added: dict = field(default_factory=dict)
     notes: tuple = ()
     reference: dict = field(default_factory=dict)
 
     @property
     def elements(self) -> dict:
-        return {**self.compliances, **self.added}
-
-    @property
-    def model_total(self) -> float:
-        return float(sum(self.compliances.values()))
+        return dict(self.compliances)
 
     @property
     def total(self) -> float:
-        return float(sum(self.elements.values()))
+        return float(sum(self.compliances.values()))
 
     @property
     def rigidity(self) -> float:
-        """1 / total [N m/rad], the added elements included."""
+        """1 / total [N m/rad]."""
         return 1.0 / self.total
 
     def to_dict(self) -> dict:
         """Engineering units (what the commands print and ``--json`` carries): per element
-        its compliance [arcsec/(N m)], share [%] and whether the route's model contains it;
-        the totals and rigidities [N m/arcmin] with and without the added elements."""
+        its compliance [arcsec/(N m)] and share [%]; the total and the rigidity [N m/arcmin]."""
         total = self.total
         out = {
             "route": self.route,
             "torque_Nm": self.torque,
             "elements": {
-                k: {
-                    "compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD,
-                    "share_percent": 100.0 * v / total,
-                    "in_model": k in self.compliances,
-                }
-                for k, v in self.elements.items()
+                k: {"compliance_arcsec_per_Nm": v * ARCSEC_PER_RAD, "share_percent": 100.0 * v / total}
+                for k, v in self.compliances.items()
             },
             "total_compliance_arcsec_per_Nm": total * ARCSEC_PER_RAD,
             "rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / total,
-            "model_rigidity_Nm_per_arcmin": RAD_PER_ARCMIN / self.model_total,
         }
         for name, k in self.reference.items():
             out[f"{name}_Nm_per_arcmin"] = k * RAD_PER_ARCMIN
-            if self.added:
-                out[f"{name}_with_added_Nm_per_arcmin"] = RAD_PER_ARCMIN / (1.0 / k + sum(self.added.values()))
         if self.notes:
             out["notes"] = list(self.notes)
         return out
 
     def to_dataset(self):
         """The budget as an :class:`xarray.Dataset` over ``budget_element``: ``budget_compliance``
-        [arcsec/(N m)], ``budget_share`` [%], ``budget_in_model`` (1/0); the references as
+        [arcsec/(N m)], ``budget_share`` [%]; the references as
         scalars ``budget_reference_<name>`` [N m/arcmin]; route, torque and notes as attributes."""
-        import numpy as np
         import xarray as xr
 
-        names = list(self.elements)
+        names = list(self.compliances)
         total = self.total
-        c = np.array([self.elements[k] for k in names])
+        c = np.array([self.compliances[k] for k in names])
         ds = xr.Dataset(
             {
                 "budget_compliance": (
@@ -146,11 +134,6 @@ class Budget:
                     {"units": "arcsec/(N m)", "long_name": "torsional compliance at the output"},
                 ),
                 "budget_share": (("budget_element",), 100.0 * c / total, {"units": "%", "long_name": "share"}),
-                "budget_in_model": (
-                    ("budget_element",),
-                    np.array([int(k in self.compliances) for k in names], dtype="int8"),
-                    {"units": "1", "long_name": "1: in the route's model, 0: analytic estimate added in series"},
-                ),
             },
             coords={"budget_element": ("budget_element", names)},
         )
@@ -173,7 +156,6 @@ def budget_from_dataset(ds) -> Budget:
     """The :class:`Budget` stored by :meth:`Budget.to_dataset` (in a results dataset)."""
     names = [str(x) for x in ds["budget_element"].values]
     c = ds["budget_compliance"].values / ARCSEC_PER_RAD
-    inside = ds["budget_in_model"].values
     ref = {
         k[len("budget_reference_") :]: float(ds[k]) / RAD_PER_ARCMIN
         for k in ds.data_vars
@@ -183,8 +165,7 @@ def budget_from_dataset(ds) -> Budget:
     return Budget(
         route=str(ds.attrs["budget_route"]),
         torque=float(ds.attrs["budget_torque_Nm"]),
-        compliances={n: float(v) for n, v, i in zip(names, c, inside) if i},
-        added={n: float(v) for n, v, i in zip(names, c, inside) if not i},
+        compliances={n: float(v) for n, v in zip(names, c)},
         notes=tuple(notes.split("\n")) if notes else (),
         reference=ref,
     )
@@ -192,6 +173,36 @@ def budget_from_dataset(ds) -> Budget:
 
 def _named(compliances: dict) -> dict:
     return {GROUP_ELEMENT.get(k, k): v for k, v in compliances.items()}
+
+
+def split_gear_stage(shares: dict, reducer) -> dict:
+    """``shares`` with the gear stage's (``gear_stage``) split into the mesh, the crank torsion
+    and the planet spline in proportion to their compliances in series along the line of
+    action (:mod:`flexrv.model.gear_stage`): the mean mesh compliance 1 / k12
+    (:func:`flexrv.analysis.mesh_stiffness.involute_stage`) and c r_bp^2 of each torsion
+    (:func:`flexrv.analysis.path_compliances.model_compliances`). Proportional is exact for a
+    constant mesh stiffness; the time-varying mesh moves only the mesh's own small part. With
+    flexible cranks (a ``crankshaft_elasticity`` share) the crank's torsion is that group's and
+    the gear stage keeps the spline only."""
+    from flexrv.analysis.mesh_stiffness import involute_stage
+    from flexrv.analysis.path_compliances import model_compliances
+
+    frac = shares.get("gear_stage", 0.0)
+    n = reducer.first_stage.n_planets
+    mc = model_compliances(reducer, np.zeros((n, 2)))
+    crank = 0.0 if "crankshaft_elasticity" in shares else mc.crank_torsion
+    if frac <= 0.0 or crank + mc.planet_spline == 0.0:
+        return dict(shares)
+    stage = involute_stage(reducer)
+    parts = {
+        "gear_stage": 1.0 / stage.k12,
+        "crank_torsion": crank * stage.rb_planet**2,
+        "planet_spline": mc.planet_spline * stage.rb_planet**2,
+    }
+    total = sum(parts.values())
+    out = dict(shares)
+    out.update({k: frac * v / total for k, v in parts.items() if v > 0.0})
+    return out
 
 
 def stiffness_budget(
@@ -206,24 +217,22 @@ def stiffness_budget(
     """The stiffness budget of ``reducer`` at the output ``torque`` [N m] (default rated).
 
     Without ``model``: the analytic budget (:func:`flexrv.analysis.torsional.stiffness_budget`
-    with the elastic bodies' compliances ``bodies`` {"carrier", "cycloid_disc"} [rad/(N m)]),
-    the elements of :data:`NOT_IN_MODELS` included as elements of it. With ``model``
-    (:class:`ModelShares`): the model's shares mapped to the elements
-    (:func:`flexrv.analysis.torsional.budget_from_group_shares`), the elements of
-    :data:`NOT_IN_MODELS` added in series from their analytic estimates. ``reference``: named
-    rigidities [N m/rad] stored beside the budget (a measured or simulated loop's)."""
+    with the elastic bodies' compliances ``bodies`` {"carrier", "cycloid_disc"} [rad/(N m)])
+    and the closed forms of :func:`flexrv.analysis.path_compliances.output_compliances`. With
+    ``model`` (:class:`ModelShares`): the model's shares mapped to the elements
+    (:func:`split_gear_stage`, :func:`flexrv.analysis.torsional.budget_from_group_shares`).
+    ``reference``: named rigidities [N m/rad] stored beside the budget (a measured or
+    simulated loop's)."""
     from flexrv.analysis import path_compliances
     from flexrv.analysis import torsional as tor
 
     t = reducer.operating.rated_torque_Nm if torque is None else float(torque)
-    missing = path_compliances.missing_compliances(reducer)
     if model is None:
         b = tor.stiffness_budget(reducer, t, bodies=bodies)
         comp = _named(b.compliances)
-        comp.update(missing)
-        return Budget(route or "analytic", t, comp, {}, tuple(b.notes), dict(reference or {}))
+        comp.update(path_compliances.output_compliances(reducer))
+        return Budget(route or "analytic", t, comp, tuple(b.notes), dict(reference or {}))
     comp, notes = tor.budget_from_group_shares(
-        model.shares, model.tangent_compliance, model.bending_fraction, reducer, t
+        split_gear_stage(model.shares, reducer), model.tangent_compliance, model.bending_fraction, reducer, t
     )
-    notes = tuple(notes) + ("added in series (analytic estimates, not in the model): " + ", ".join(sorted(missing)),)
-    return Budget(route or "model", t, _named(comp), missing, notes, dict(reference or {}))
+    return Budget(route or "model", t, _named(comp), tuple(notes), dict(reference or {}))

@@ -1,22 +1,46 @@
-"""Compliances of the torque path that no dynamic or quasi-static model contains yet, each a
-closed form referred to the output [rad/(N m)]; the analytic budget lists them as elements,
-the model routes add them in series (:func:`flexrv.analysis.budget.stiffness_budget`).
+"""Compliances of the torque path between the planet gears and the output that the element
+laws of the models do not contain by themselves, each a closed form referred to the output
+[rad/(N m)]. One formula, one executor: the analytic budget lists them as elements
+(:func:`output_compliances`) and the models carry them at their physical places
+(:func:`model_compliances`, called by :func:`flexrv.model.parameters.rigid_parameters`):
+
+* the crank torsion and the planet spline, a torsional compliance c_t per crank between the
+  planet gear and the crank's eccentrics, sit in series with each planet's mesh
+  (:mod:`flexrv.model.gear_stage`): the spline and the crank turn the planet by c_t F r_bp
+  relative to the eccentrics under the mesh force F on the base radius r_bp, which moves the
+  mesh point by c_t r_bp^2 F along the line of action, so the mesh stiffness k becomes
+  k_eff = 1 / (1/k + c_t r_bp^2);
+* the support-bearing rings, a radial compliance c_r / 2 per crank (two bearings in
+  parallel), and the carrier joints, an output torsion c_T, enter the (2N, 2N) compliance of
+  the cranks' support points in the carrier (:mod:`flexrv.model.cranks_discs`, "Carrier"): the
+  rings on its diagonal (a linear series spring; the condensed equilibrium of the supports
+  solves it exactly), the joints as the rank-one term c_T g g^T with g_j = (-y_j, x_j) the map
+  from the support forces to the torque about the axis (T = g . f). Under any support forces
+  the rank-one term moves the support points by c_T T g, a rigid turn of c_T T: a pure output
+  torque sees exactly c_T. With a rigid carrier the same matrix is the support points'
+  compliance.
+
+Referred to the output, a compliance c of each crank's rotation relative to its planet is
+c / (N i_c^2) with i_c = z_rp + z_s / z_p the crank's turn relative to its planet per output
+turn (input held: the planet turns by (1 + z_s / z_p) and the crank by -z_c per output turn,
+:mod:`flexrv.geometry.kinematics`); a mesh compliance s along the line of action gives
+s r_bp^2 / (N (i r_bs)^2) = s / (N i_c^2 r_bp^2) the same, i = 1 + z_p z_rp / z_s.
 
 * ``crank_torsion``: St. Venant torsion of each crank between its planet spline and its
   eccentrics. The crank torque is M_c = T / (N z_rp) (virtual work: with the planets held by
   the mesh, an eccentric turned by Delta relative to its planet turns the output by
   Delta / z_rp, the second stage's ratio of crank rotation relative to the carrier to
-  carrier rotation, :mod:`flexrv.geometry.kinematics`). Energy-equivalent length of the
+  carrier rotation; exactly Delta / i_c, below). Energy-equivalent length of the
   stepped shaft, torque profile m(x) = M(x)/M_c: the spline feeds it in uniformly over the
   gear seat (int (x/L)^2 = L/3), the support journal carries it whole, the two eccentrics
   take half each, uniformly (7 L_e / 12 and L_e / 12):
   c_crank = (1/G) [L_s / (3 J_s) + L_a / J_a + 2 L_e / (3 J_e)], J = pi d^4 / 32
   :cite:`timoshenko1970`; each eccentric journal twists about its own centroid (the offset
-  adds bending, not twist). At the output: c = c_crank / (N z_rp^2).
+  adds bending, not twist). At the output: c = c_crank / (N i_c^2).
 * ``planet_spline``: the N splines with z_sp teeth, a fraction f engaged, each engaged tooth
   pair of stiffness c' per unit face width (ISO 6336's single-pair stiffness used as the
   spline tooth's, an estimate) on the mean radius r_m = seat diameter / 2 over the seat length
-  b: k = f z_sp c' b r_m^2 per crank :cite:`iso6336`; at the output 1 / (k N z_rp^2).
+  b: k = f z_sp c' b r_m^2 per crank :cite:`iso6336`; at the output 1 / (k N i_c^2).
 * ``support_bearing_rings``: the cup and the cone of each support bearing bend as rings on
   the elastic foundation of their seats (carrier bore, crank journal). A roller load Q on a
   ring of bending stiffness E I (I = b h^3 / 12, b the roller length, h the wall) on a Winkler
@@ -45,6 +69,9 @@ the model routes add them in series (:func:`flexrv.analysis.budget.stiffness_bud
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+
+import numpy as np
 
 from flexrv.units import M_PER_MM
 
@@ -72,11 +99,17 @@ def crank_torsion_compliance(reducer) -> float:
     return (ls / (3.0 * polar_moment(ds)) + la / polar_moment(da) + 2.0 * le / (3.0 * polar_moment(de))) / g
 
 
+def crank_ratio(reducer) -> float:
+    """i_c = z_rp + z_s / z_p: the crank's turn relative to its planet per output turn, input held
+    (module docstring)."""
+    fs = reducer.first_stage
+    return reducer.second_stage.pin_count + fs.sun_teeth / fs.planet_teeth
+
+
 def _at_output(c_crank: float, reducer) -> float:
-    """A compliance in each crank's rotation referred to the output: c / (N z_rp^2)."""
-    n = reducer.first_stage.n_planets
-    z_rp = reducer.second_stage.pin_count
-    return c_crank / (n * z_rp**2)
+    """A compliance in each crank's rotation relative to its planet referred to the output:
+    c / (N i_c^2)."""
+    return c_crank / (reducer.first_stage.n_planets * crank_ratio(reducer) ** 2)
 
 
 def crank_torsion(reducer) -> float:
@@ -86,6 +119,11 @@ def crank_torsion(reducer) -> float:
 
 def planet_spline(reducer) -> float:
     """The planet splines at the output [rad/(N m)]."""
+    return _at_output(planet_spline_compliance(reducer), reducer)
+
+
+def planet_spline_compliance(reducer) -> float:
+    """1 / k [rad/(N m)] of one planet spline (module docstring)."""
     pe, cs = reducer.path_estimates, reducer.crankshaft
     c_prime = pe.spline_tooth_stiffness_N_per_mm_um * 1e9  # N/(mm um) -> N/m^2
     r_m = 0.5 * cs.gear_seat_diameter_mm * M_PER_MM
@@ -97,7 +135,7 @@ def planet_spline(reducer) -> float:
         * M_PER_MM
         * r_m**2
     )
-    return _at_output(1.0 / k, reducer)
+    return 1.0 / k
 
 
 def ring_on_foundation(r_in: float, r_out: float, width: float, youngs: float, seat_factor: float) -> float:
@@ -152,17 +190,69 @@ def carrier_joints(reducer) -> float:
     return pe.carrier_joint_torque_fraction**2 * delta / (c.pillar_count * r_p**2)
 
 
-def missing_compliances(reducer) -> dict[str, float]:
-    """The elements of :data:`flexrv.analysis.budget.NOT_IN_MODELS` the design has the data
-    for [rad/(N m)]: crank torsion always; the others with a ``[path_estimates]`` table (and
-    the carrier and tapered-roller supports they need)."""
-    out = {"crank_torsion": crank_torsion(reducer)}
-    if reducer.path_estimates is None:
-        return out
-    out["planet_spline"] = planet_spline(reducer)
-    cs = reducer.crankshaft
-    if reducer.carrier is not None and cs.support_bearing_model == "tapered_rollers":
-        out["support_bearing_rings"] = support_bearing_rings(reducer)
-    if reducer.carrier is not None:
-        out["carrier_joints"] = carrier_joints(reducer)
-    return out
+def _has(reducer) -> dict[str, bool]:
+    """Which of the four elements the design has the data and the switch for: the crank torsion
+    with ``crankshaft.torsion_model = "st_venant"``; the others with a ``[path_estimates]``
+    table (and the carrier and the tapered-roller supports they need)."""
+    pe, c, cs = reducer.path_estimates is not None, reducer.carrier is not None, reducer.crankshaft
+    return {
+        "crank_torsion": cs.torsion_model == "st_venant",
+        "planet_spline": pe,
+        "support_bearing_rings": pe and c and cs.support_bearing_model == "tapered_rollers",
+        "carrier_joints": pe and c,
+    }
+
+
+def output_compliances(reducer) -> dict[str, float]:
+    """The four elements at the output [rad/(N m)] the design has (:func:`_has`): the analytic
+    budget's elements and the closed forms the models reproduce."""
+    laws = {
+        "crank_torsion": crank_torsion,
+        "planet_spline": planet_spline,
+        "support_bearing_rings": support_bearing_rings,
+        "carrier_joints": carrier_joints,
+    }
+    return {k: laws[k](reducer) for k, on in _has(reducer).items() if on}
+
+
+def torque_map(bores: np.ndarray) -> np.ndarray:
+    """g (2N,) with T = g . f the torque about the axis of the support forces f (2N,) at the
+    support points ``bores`` (N, 2) [m]: g_j = (-y_j, x_j)."""
+    b = np.asarray(bores, dtype=float)
+    return np.column_stack([-b[:, 1], b[:, 0]]).ravel()
+
+
+@dataclass(frozen=True)
+class ModelCompliances:
+    """The four elements as the models carry them (module docstring): ``crank_torsion`` and
+    ``planet_spline`` per crank [rad/(N m)], their sum c_t in series with each planet's mesh;
+    ``support_parts`` element -> (2N, 2N) support-point compliance [m/N]
+    (``support_bearing_rings``, ``carrier_joints``), added to the carrier's."""
+
+    crank_torsion: float
+    planet_spline: float
+    support_parts: dict
+
+    def support_compliance(self, carrier_c: np.ndarray) -> np.ndarray:
+        """The carrier's support-point compliance ``carrier_c`` ((0, 0): rigid) with the parts
+        added; (0, 0) if both are empty."""
+        if not self.support_parts:
+            return carrier_c
+        total = sum(self.support_parts.values())
+        return total if carrier_c.size == 0 else carrier_c + total
+
+
+def model_compliances(reducer, bores: np.ndarray) -> ModelCompliances:
+    """The four elements of ``reducer`` at their places in the models (module docstring),
+    ``bores`` (N, 2) the support points in the carrier frame [m]."""
+    has = _has(reducer)
+    c_crank = crank_torsion_compliance(reducer) if has["crank_torsion"] else 0.0
+    c_spline = planet_spline_compliance(reducer) if has["planet_spline"] else 0.0
+    n2 = 2 * len(bores)
+    parts = {}
+    if has["support_bearing_rings"]:
+        parts["support_bearing_rings"] = 0.5 * support_ring_radial_compliance(reducer) * np.eye(n2)
+    if has["carrier_joints"]:
+        g = torque_map(bores)
+        parts["carrier_joints"] = carrier_joints(reducer) * np.outer(g, g)
+    return ModelCompliances(c_crank, c_spline, parts)

@@ -182,19 +182,21 @@ def elastic_body_compliances(reducer) -> dict:
 
 
 def budget_table(title: str, budget: dict) -> Table:
-    """Table element | compliance | share | in the model of a budget dict
+    """Table element | compliance | share | what it is of a budget dict
     (:meth:`flexrv.analysis.budget.Budget.to_dict`), with the totals and the rigidities."""
+    from flexrv.analysis.budget import ELEMENTS
+
     table = Table(title=title, title_justify="left")
     for col, just in (
         ("element", "left"),
         ("compliance [arcsec/(N m)]", "right"),
         ("share [%]", "right"),
-        ("in the model", "left"),
+        ("what it is", "left"),
     ):
         table.add_column(col, justify=just)
     for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
-        where = "yes" if e["in_model"] else "no: estimate added in series"
-        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]), where)
+        what = ELEMENTS.get(name, "")
+        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]), what)
     table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100", "")
     table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "", "")
     for key, value in budget.items():

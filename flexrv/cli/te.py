@@ -75,9 +75,6 @@ def te(
         from flexrv.measured.writer import export_te
 
         data["csv"] = str(export_te(csv, result, reducer.name, f"flexrv te {preset} --torque-nm {result.torque:.17g}"))
-    c_added = sum(budget.added.values()) / RAD_PER_ARCMIN  # arcmin per N m
-    for key in [k for k in summary if k.startswith("rigidity_") and k.endswith("_Nm_per_arcmin")]:
-        data[key[: -len("_Nm_per_arcmin")] + "_with_added_Nm_per_arcmin"] = 1.0 / (1.0 / summary[key] + c_added)
     if uncertainty is not None:
         data["uncertainty"] = uncertainty_report(reducer, uncertainty, out, quiet=json)
     analytic = analytic_budget(reducer, summary["torque_Nm"])
@@ -120,8 +117,7 @@ def quasi_static_budget(summary: dict, outputs: dict, reducer):
     """The stiffness budget of the quasi-static solution (:func:`flexrv.analysis.budget.
     stiffness_budget` with the model's strain-energy shares, :meth:`flexrv.model.quasi_static.
     StaticModel.compliance_budget`, times its tangent compliance; the crank-support group split
-    by the mean of the output ``crank_bending_fraction``); the elements no model contains are
-    added in series."""
+    by the mean of the output ``crank_bending_fraction``)."""
     from flexrv.analysis.budget import ModelShares, stiffness_budget
 
     bend = outputs.get("crank_bending_fraction")

@@ -296,6 +296,10 @@ class Crankshaft(_Strict):
         default="timoshenko",
         description="Crank bending between the support journals and the eccentrics in series with the supports",
     )
+    torsion_model: Literal["st_venant", "rigid"] = Field(
+        default="st_venant",
+        description="Crank torsion between the planet spline and the eccentrics in series with each planet's mesh",
+    )
 
     @model_serializer(mode="wrap")
     def _drop_unused(self, handler):
@@ -907,8 +911,8 @@ class OperatingPoint(_Strict):
 
 
 class PathEstimates(_Strict):
-    """Estimated inputs of the torque-path compliances no model contains yet
-    (:mod:`flexrv.analysis.path_compliances`): carrier pillar joints, support-bearing rings,
+    """Estimated inputs of the torque-path compliances of :mod:`flexrv.analysis.path_compliances`
+    (in every model and the analytic budget): carrier pillar joints, support-bearing rings,
     planet spline (the crank torsion needs only the crank's geometry)."""
 
     carrier_joint_torque_fraction: float = Field(
@@ -1023,8 +1027,8 @@ class Reducer(_Strict):
     )
     path_estimates: PathEstimates | None = Field(
         default=None,
-        description="Estimated inputs of the torque-path compliances no model contains yet (carrier joints, "
-        "support-bearing rings, planet spline); optional: without it the budget leaves them out",
+        description="Estimated inputs of the torque-path compliances (carrier joints, support-bearing rings, "
+        "planet spline) in every model; optional: without it the models and the budget leave them out",
     )
     ranges: dict[str, PlausibleRange] = Field(
         default_factory=dict,

@@ -196,7 +196,10 @@ def build_rigid(
         crankshaft=crankshaft,
         elastic_bodies=[
             b
-            for b, on in (("carrier", p.carrier_compliance.size > 0), ("cycloid_disc", p.disc_compliance.size > 0))
+            for b, on in (
+                ("carrier", reducer.carrier is not None and reducer.carrier.body_model == "condensed_fe"),
+                ("cycloid_disc", p.disc_compliance.size > 0),
+            )
             if on
         ],
     )

@@ -127,6 +127,7 @@ def add_flexible_cranks(
         )
     gear = next(g for g in groups if g.name == "gear_stage")
     gear.members = ("carrier",) + tuple(f"planet{j}" for j in range(p.n_cranks))
+    gear.set_planet_torsion(p.planet_spline_compliance)  # the crank's torsion is the coupling's k_t
     groups.append(CrankElasticity(p.n_cranks, k_t, k_l, c_t, c_l))
     return {
         "crank_torsional_stiffness_Nm_per_rad": k_t,

@@ -10,15 +10,27 @@ angle prescribed by the drive:
 beta_j, a_j the polar angle and radius of the crank (= planet) centre, phi_j the
 absolute planet angle, r_b base radii, alpha_w the working pressure angle. It is
 zero for the ideal rolling motion (r_bs (theta_s - beta) = -r_bp (phi - beta))
-and positive when the drive flanks are compressed. With the normal backlash
+and positive when the drive flanks are compressed. The planet's torsion relative to the
+crank's eccentrics (crank torsion and planet spline, c_t per crank [rad/(N m)],
+:func:`flexrv.analysis.path_compliances.model_compliances`) is in series with the
+mesh: the torque F r_bp turns the planet by c_t F r_bp against the crank, the mesh
+point by c_t r_bp^2 F along the line of action, so the mesh law's stiffness is
+
+    k(xi) = 1 / (1 / k_m(xi) + s),   s = c_t r_bp^2,
+
+k_m the involute mesh's (s = 0: the mesh law itself; a massless series spring, exact
+for the static equilibrium; the planet's own torsional vibration on the crank is the
+flexible-crank model's, :mod:`flexrv.model.flexible_crank`, which keeps only the
+spline here). delta is then the approach of the crank-side mesh point along the line
+of action, the mesh's and the planet's torsion together. With the normal backlash
 b_n = j_t cos(alpha_w) the force is
 
     F = k(xi) delta + c ddelta/dt              for delta > 0   (drive flank, F >= 0)
     F = k(xi) (delta + b_n) + c ddelta/dt      for delta < -b_n (coast flank, F <= 0)
     F = 0                                      otherwise,
 
-with the time-varying stiffness k(xi) of :func:`flexrv.analysis.mesh_stiffness.
-time_varying_mesh_stiffness` at the mesh phase xi_j = z_s (theta_s - beta_j)/2pi
+with the time-varying stiffness k_m(xi) of :func:`flexrv.analysis.mesh_stiffness.
+time_varying_mesh_stiffness` (in series with s) at the mesh phase xi_j = z_s (theta_s - beta_j)/2pi
 - z_s beta_j0/2pi (carrier-frame kinematics: one base pitch per sun tooth passing
 the planet), and the mesh damping c12 of
 :func:`flexrv.analysis.mesh_stiffness.involute_stage`. The generalized forces
@@ -32,8 +44,8 @@ H = d2 delta/dq2 the deflection's curvature (from beta(x, y) = atan2(y, x), the
 radius a(x, y) and the runout terms), delta_e = delta (drive flank) or delta + b_n
 (coast flank), xi the mesh phase (dxi/dq = -z_s/2pi dbeta/dq). The stiffness
 slope dk/dxi is the central difference (+-1e-6 in phase) of the one stiffness law
-:func:`~flexrv.analysis.mesh_stiffness.mesh_stiffness_ramped`, exact for its
-piecewise-linear ramps except within 1e-6 of their corners. Verified against
+(:func:`series_mesh_stiffness` of :func:`~flexrv.analysis.mesh_stiffness.mesh_stiffness_ramped`),
+exact for its piecewise-linear ramps except within 1e-6 of their corners. Verified against
 central differences in tests/test_kernel.py (1e-6 of the largest entry; measured
 7-8e-8).
 
@@ -62,7 +74,8 @@ from flexrv.units import TWO_PI
 
 #: the meshes' scalar law: base radii of sun and planet, sin of the working pressure angle, centre
 #: distance, sun teeth, normal backlash, single-pair stiffness, contact ratio, stiffness ramp
-#: fraction, mesh damping, sun runout amplitude and phase
+#: fraction, mesh damping, sun runout amplitude and phase, the planet torsion's compliance along
+#: the line of action s = c_t r_bp^2 [m/N]
 GearLaw = law_type(
     "GearLaw",
     rbs=float,
@@ -77,6 +90,7 @@ GearLaw = law_type(
     c=float,
     A_sun=float,
     ph_sun=float,
+    s_t=float,
 )
 _F, _I = np.float64, np.int64
 #: :func:`gear_stage_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
@@ -96,6 +110,15 @@ GearPack = pack_type(
 
 
 @njit(cache=True)
+def series_mesh_stiffness(xi, k_single, eps_alpha, ramp, s):
+    """The mesh law's stiffness [N/m] at the mesh phase ``xi``: the involute mesh's
+    (:func:`~flexrv.analysis.mesh_stiffness.mesh_stiffness_ramped`) in series with the
+    planet torsion's compliance ``s`` along the line of action [m/N] (module docstring)."""
+    k = mesh_stiffness_ramped(xi, k_single, eps_alpha, ramp)
+    return k / (1.0 + k * s)
+
+
+@njit(cache=True)
 def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
     """Sun–planet meshes (module docstring) at the sun angle and speed ``pack.drive``:
     adds Q into f[idx] and, if ``jac``, dQ/dq, dQ/dv into jq, jv. Per-mesh force,
@@ -105,6 +128,7 @@ def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
     out_f, out_d, out_k = pack.force, pack.deflection, pack.stiffness
     rbs, rbp, sw, aw, zs, bn = law.rbs, law.rbp, law.sin_alpha_w, law.a_w, law.z_s, law.b_n
     ks, eps, ramp, c, a_s, ph_s = law.k_single, law.eps_alpha, law.ramp, law.c, law.A_sun, law.ph_sun
+    s_t = law.s_t
     r = rbs + rbp
     th_c = q[idx[2]]
     for j in range(beta0.shape[0]):
@@ -132,7 +156,7 @@ def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
         gy = -rb * x / a2 - sw * y / a
         gp = rbp + cos_p
         ddelta = (rbs + cos_s) * ws + gx * v[ix] + gy * v[iy] + gp * v[ip]
-        k = mesh_stiffness_ramped((zs / TWO_PI) * (ts - beta - beta0[j]), ks, eps, ramp)
+        k = series_mesh_stiffness((zs / TWO_PI) * (ts - beta - beta0[j]), ks, eps, ramp, s_t)
         force = 0.0
         active = False
         if delta > 0.0:
@@ -163,7 +187,10 @@ def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
             bx, by = -y / a2, x / a2
             xi = (zs / TWO_PI) * (ts - beta - beta0[j])
             dk = (
-                (mesh_stiffness_ramped(xi + 1e-6, ks, eps, ramp) - mesh_stiffness_ramped(xi - 1e-6, ks, eps, ramp))
+                (
+                    series_mesh_stiffness(xi + 1e-6, ks, eps, ramp, s_t)
+                    - series_mesh_stiffness(xi - 1e-6, ks, eps, ramp, s_t)
+                )
                 / 2e-6
                 * (-zs / TWO_PI)
             )
@@ -211,6 +238,10 @@ class GearMeshes(KernelGroup):
             c=stage.c12,
             A_sun=sun[0],
             ph_sun=sun[1],
+            s_t=0.0,
+        )
+        self.set_planet_torsion(
+            getattr(p, "crank_torsion_compliance", 0.0) + getattr(p, "planet_spline_compliance", 0.0)
         )
         #: (N, 3): planet runout amplitude [m], phase [rad], assembly phase error [rad]
         self.planet = np.ascontiguousarray(
@@ -226,6 +257,15 @@ class GearMeshes(KernelGroup):
         self.force, self.deflection, self.stiffness = np.zeros(self.n), np.zeros(self.n), np.zeros(self.n)
         #: the drive at the time of the last call: sun angle [rad], sun speed [rad/s]
         self.drive = np.zeros(2)
+
+    def set_planet_torsion(self, c_t: float) -> None:
+        """The planet's torsional compliance relative to the crank's eccentrics ``c_t`` per crank
+        [rad/(N m)] in series with each mesh (module docstring): s = c_t r_bp^2."""
+        if not (np.isfinite(c_t) and c_t >= 0.0):
+            raise ValueError(f"planet torsion compliance {c_t!r} must be a finite value >= 0 [rad/(N m)]")
+        #: the planet's torsional compliance per crank [rad/(N m)]
+        self.planet_torsion = float(c_t)
+        self.law = self.law._replace(s_t=float(c_t) * self.rbp**2)
 
     def pack(self, idx, history=False):
         return GearPack(idx, self.law, self.drive, self.beta0, self.planet, self.force, self.deflection, self.stiffness)
@@ -263,9 +303,17 @@ class GearMeshes(KernelGroup):
         return {
             "mesh_force": Output(force, ("time", "planet"), "N", "sun-planet mesh force along the line of action"),
             "mesh_deflection": Output(
-                rec["deflection"], ("time", "planet"), "m", "mesh deflection along the line of action"
+                rec["deflection"],
+                ("time", "planet"),
+                "m",
+                "mesh deflection along the line of action, the planet's torsion on its crank included",
             ),
-            "mesh_stiffness": Output(rec["stiffness"], ("time", "planet"), "N/m", "time-varying mesh stiffness"),
+            "mesh_stiffness": Output(
+                rec["stiffness"],
+                ("time", "planet"),
+                "N/m",
+                "time-varying mesh stiffness, the planet's torsion on its crank in series",
+            ),
             "sun_torque": Output(self.rbs * force.sum(axis=-1), ("time",), "N m", "torque of the meshes on the sun"),
         }
 

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexrv.analysis.path_compliances import model_compliances
 from flexrv.analysis.pin_load import pin_contact_constant
 from flexrv.analysis.torsional import housing_model_compliance, support_constants
 from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
@@ -129,8 +130,16 @@ class RigidParameters:
     planet_runout: np.ndarray  #: (N, 2) amplitude [m], phase [rad]
     planet_phase_errors: np.ndarray  #: (N,) assembly phase error of each planet on its crank [rad]
     #: (2N, 2N) compliance [m/N] of the cranks' support points in the carrier frame (FE carrier,
-    #: :func:`flexrv.fem.carrier.crank_support_compliance`); (0, 0): rigid carrier (``carrier.body_model``)
+    #: :func:`flexrv.fem.carrier.crank_support_compliance`, plus ``carrier_parts``); (0, 0): rigid
+    #: carrier (``carrier.body_model``) without parts
     carrier_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    #: element -> its (2N, 2N) part of ``carrier_compliance`` [m/N]: support-bearing rings, carrier joints
+    #: (:func:`flexrv.analysis.path_compliances.model_compliances`)
+    carrier_parts: dict = field(default_factory=dict)
+    #: torsional compliances per crank between planet gear and eccentrics [rad/(N m)], in series with
+    #: each mesh (:mod:`flexrv.model.gear_stage`): crank torsion, planet spline
+    crank_torsion_compliance: float = 0.0
+    planet_spline_compliance: float = 0.0
     #: (n_discs, 3, 3) compliance of each disc's rim pose (x, y, psi) relative to its hub per unit pin force
     #: (:func:`flexrv.fem.disc.rim_compliance`); (0, 3, 3): rigid discs (``second_stage.disc_body_model``)
     disc_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
@@ -278,6 +287,7 @@ def rigid_parameters(reducer) -> RigidParameters:
         )
     )
     carrier_c, disc_c = body_compliance_matrices(reducer)
+    path = model_compliances(reducer, ab.crank_bores)
     return RigidParameters(
         n_cranks=n,
         n_discs=nd,
@@ -349,7 +359,10 @@ def rigid_parameters(reducer) -> RigidParameters:
         sun_runout=ab.sun_runout,
         planet_runout=ab.planet_runout,
         planet_phase_errors=ab.planet_phase_errors,
-        carrier_compliance=carrier_c,
+        carrier_compliance=path.support_compliance(carrier_c),
+        carrier_parts=path.support_parts,
+        crank_torsion_compliance=path.crank_torsion,
+        planet_spline_compliance=path.planet_spline,
         disc_compliance=disc_c,
         housing_compliance=housing_model_compliance(reducer),
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},

@@ -391,6 +391,9 @@ class StaticModel:
                 e_body = float(df @ (rot @ g.carrier_c @ rot.T) @ df) / c
                 out["carrier"] = e_body
                 out[g.name] -= e_body
+                for part, cm in self.p.carrier_parts.items():  # rings, joints: their own shares of it
+                    out[part] = float(df @ (rot @ cm @ rot.T) @ df) / c
+                    out["carrier"] -= out[part]
             if g.name == "pins" and getattr(g, "elastic_discs", False):
                 e_body = 0.0
                 for k in range(g.nd):

@@ -180,18 +180,15 @@ def stiffness_summary_markdown(
             f"## Stiffness budget at {budget['torque_Nm']:.4g} N m",
             "",
             "Strain-energy budget of the quasi-static model at the test's pose (flexrv.simulation."
-            "stiffness_test_budget, flexrv.analysis.budget), the same elements as `flexrv te` and `flexrv design`; "
-            "elements no model contains are added in series from their analytic estimates.",
+            "stiffness_test_budget, flexrv.analysis.budget), the same elements as `flexrv te` and `flexrv design`, "
+            "every one in the model.",
             "",
-            "| element | compliance [arcsec/(N m)] | share [%] | in the model |",
-            "|---|---|---|---|",
+            "| element | compliance [arcsec/(N m)] | share [%] |",
+            "|---|---|---|",
         ]
         for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
-            lines.append(
-                f"| {name} | {e['compliance_arcsec_per_Nm']:.4g} | {e['share_percent']:.3g} | "
-                f"{'yes' if e['in_model'] else 'no (estimate)'} |"
-            )
-        lines += [f"| total | {budget['total_compliance_arcsec_per_Nm']:.4g} | 100 | |", ""]
+            lines.append(f"| {name} | {e['compliance_arcsec_per_Nm']:.4g} | {e['share_percent']:.3g} |")
+        lines += [f"| total | {budget['total_compliance_arcsec_per_Nm']:.4g} | 100 |", ""]
         lines += [f"- {k}: {v:.4g} N m/arcmin" for k, v in budget.items() if k.endswith("_Nm_per_arcmin")]
         lines += [""] + [f"Note: {n}" for n in budget.get("notes", [])] + [""]
     lines += [

@@ -13,10 +13,9 @@ The evaluation (:func:`te_sample`) is the quasi-static route at a coarse resolut
 revolution's tenth, 4 points per pin mesh, 2 catalog positions) with the design's elastic FE
 bodies rigid and their nominal compliances added in series (the FE condensation of every
 sample would cost a mesh each; their compliances depend on the sampled fields only through the
-crank holes' micrometre changes), and the compliances no model contains
-(:func:`flexrv.analysis.path_compliances.missing_compliances` of the sample) added in series:
-a series compliance c changes a rigidity k to 1 / (1/k + c), the loop span by 2 T_r c and the
-lost motion by 2 (0.03 T_r) c.
+crank holes' micrometre changes): a series compliance c changes a rigidity k to 1 / (1/k + c),
+the loop span by 2 T_r c and the lost motion by 2 (0.03 T_r) c. The compliances of
+:mod:`flexrv.analysis.path_compliances` are in the sampled model (gear stage, support points).
 """
 
 from __future__ import annotations
@@ -145,9 +144,7 @@ def nominal_body_compliance(reducer) -> float:
 
 def te_sample(reducer, bodies: float) -> dict:
     """The named figures of one sampled design by the coarse quasi-static route, the FE bodies'
-    nominal compliance ``bodies`` [rad/(N m)] and the sample's missing compliances in series
-    (module docstring)."""
-    from flexrv.analysis.path_compliances import missing_compliances
+    nominal compliance ``bodies`` [rad/(N m)] in series (module docstring)."""
     from flexrv.model.quasi_static import loaded_te
     from flexrv.post.definitions import LOST_MOTION_FRACTION, PLAY_FRACTIONS
     from flexrv.post.te import te_dataset, te_summary
@@ -160,7 +157,7 @@ def te_sample(reducer, bodies: float) -> dict:
     rigid = override(reducer, upd)
     res = loaded_te(rigid, crank_revolutions=0.1, points_per_mesh=4, catalog_positions=2, play_fractions=PLAY_FRACTIONS)
     s = te_summary(te_dataset(res, rigid))
-    c = (bodies + sum(missing_compliances(reducer).values())) / RAD_PER_ARCMIN  # arcmin per N m
+    c = bodies / RAD_PER_ARCMIN  # arcmin per N m
     rated = reducer.operating.rated_torque_Nm
     out = {k: s[k] for k in ("te_pp_arcsec", "backlash_arcmin")}
     for k in ("rigidity_tangent_Nm_per_arcmin", "rigidity_slope_50_100_Nm_per_arcmin"):
