@@ -13,8 +13,10 @@ from flexrv.model.factory import build_model
 def _variant(name, needle="empirical", ideal=False):
     from flexrv.model.parameters import with_bodies
 
-    r = with_bodies(load(name), [])  # rigid carrier and discs (the elastic bodies: tests/test_bodies.py)
-    upd = {"needle_bearing": r.needle_bearing.model_copy(update={"model": needle})}
+    # rigid carrier and discs, no support-point compliance (the elastic bodies, the rings and joints of
+    # flexrv.analysis.path_compliances: tests/test_bodies.py, tests/test_path_compliances.py)
+    r = with_bodies(load(name), [])
+    upd = {"needle_bearing": r.needle_bearing.model_copy(update={"model": needle}), "path_estimates": None}
     if ideal:
         upd["second_stage"] = r.second_stage.model_copy(update={"modification_equidistant_mm": 0.0})
         upd["needle_bearing"] = upd["needle_bearing"].model_copy(update={"radial_clearance_um": 0.0})

@@ -22,6 +22,7 @@ def test_analytic_and_quasi_static_budgets_agree():
     carrier's share equals its FE g^T C g within 1 % (measured 0.01 %), the disc's
     lies 7 % below the analytic c_d / n_discs (the pins carry 0.964 T / n_discs per
     disc in the model, tests/test_bodies.py), required within 10 %."""
+    from flexrv.analysis.path_compliances import output_compliances
     from flexrv.cli.design import elastic_body_compliances
 
     r = load("rv40e")
@@ -31,7 +32,10 @@ def test_analytic_and_quasi_static_budgets_agree():
     c_qs = 1.0 / sm.tangent_rigidity(0.0, q)
     shares = sm.compliance_budget(0.0, q)
     b = stiffness_budget(r, bodies=elastic_body_compliances(r))
-    assert b.total == pytest.approx(c_qs, rel=0.10)
+    path = output_compliances(r)  # in the model: gear stage and support points (tests/test_path_compliances.py)
+    assert b.total + sum(path.values()) == pytest.approx(c_qs, rel=0.10)
+    for k in ("support_bearing_rings", "carrier_joints"):
+        assert shares[k] * c_qs == pytest.approx(path[k], rel=0.01), k
     # the housing in the model (its pin-ring rotation): c_h (M_h / T)^2, M_h ~ 0.96 T (tests/test_housing.py)
     assert shares["housing"] * c_qs == pytest.approx(b.compliances["housing"], rel=0.10)
     assert shares["carrier"] * c_qs == pytest.approx(b.compliances["carrier"], rel=0.01)
@@ -45,12 +49,12 @@ def test_stiffness_test_budget_matches_design_budget():
     (:func:`flexrv.simulation.stiffness_test_budget`, the quasi-static model at the
     test's pose, no dynamic run) against ``flexrv design``'s analytic budget
     (:func:`flexrv.analysis.budget.stiffness_budget`) on rv40e, both with the FE carrier and
-    disc bodies and the housing: the model's elements are the analytic budget's modelled ones,
-    totals of the modelled elements within 10 % (measured +4.2 % compliance), pin path (contacts +
-    seats) within 10 % (measured -4.4 %), the housing within 10 %; the elements no model contains
-    are added with exactly the analytic values; the model's elements sum to its tangent
-    compliance (rel 1e-6)."""
-    from flexrv.analysis.budget import NOT_IN_MODELS
+    disc bodies and the housing: every analytic element is one of the model's, totals within 10 %
+    (measured +2.6 % compliance), pin path (contacts + seats) within 10 % (measured -4.4 %), the
+    housing within 10 %; the path compliances in the model (support-bearing rings and carrier
+    joints from the support points' strain energy, crank torsion and planet spline split off the
+    gear stage) equal their closed forms within 2 % (measured <= 1.1 %); the model's elements sum
+    to its tangent compliance (rel 1e-6)."""
     from flexrv.analysis.budget import stiffness_budget as budget
     from flexrv.cli.design import elastic_body_compliances
     from flexrv.simulation import stiffness_test_budget
@@ -59,9 +63,10 @@ def test_stiffness_test_budget_matches_design_budget():
     dyn = stiffness_test_budget(r, r.operating.rated_torque_Nm)
     ana = budget(r, bodies=elastic_body_compliances(r))
     comp = dyn.compliances
-    modelled = {k: v for k, v in ana.compliances.items() if k not in NOT_IN_MODELS}
+    modelled = ana.compliances
     assert set(modelled) <= set(comp)
-    assert dyn.added == pytest.approx({k: ana.compliances[k] for k in NOT_IN_MODELS}, rel=1e-12)
+    for k in ("support_bearing_rings", "carrier_joints", "crank_torsion", "planet_spline"):
+        assert comp[k] == pytest.approx(modelled[k], rel=0.02), k
     assert sum(comp.values()) == pytest.approx(sum(modelled.values()), rel=0.10)
     path = ("pin_disc_contacts", "pin_seats")
     assert sum(comp[k] for k in path) == pytest.approx(sum(modelled[k] for k in path), rel=0.10)
@@ -97,7 +102,7 @@ def test_design_te_and_stiffness_test_totals_agree(tmp_path):
     fig, run = stiffness_test("rv40e", save_to=tmp_path)
     b = budget_from_dataset(run.ds)
     dyn_budget = b.rigidity * RAD_PER_ARCMIN
-    dyn_loop = b.to_dict()["loop_rigidity_slope_50_100_with_added_Nm_per_arcmin"]
+    dyn_loop = b.to_dict()["loop_rigidity_slope_50_100_Nm_per_arcmin"]
     for value in (te, dyn_budget, dyn_loop):
         assert value == pytest.approx(design, rel=0.10)
     # the named rigidities of the two routes measure the same thing: within the 4.5 % the routes differ
@@ -181,10 +186,9 @@ def test_quasi_static_budget_splits_the_crank_supports():
     """``flexrv te``'s budget (flexrv.cli.te.quasi_static_budget): each group's share
     times the tangent compliance; the crank-support group split by the mean reported bending
     share into support-bearing rollers and crank bending; the pin path split into contacts and
-    seats by their analytic shares; the elements no model contains added in series (rel 1e-12)."""
+    seats by their analytic shares; the model's total is the budget's (rel 1e-12)."""
     import numpy as np
 
-    from flexrv.analysis.path_compliances import missing_compliances
     from flexrv.cli.te import quasi_static_budget
     from flexrv.model.base import Output
     from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN
@@ -198,13 +202,12 @@ def test_quasi_static_budget_splits_the_crank_supports():
     frac = Output(np.array([[0.5, 0.6, 0.7], [0.5, 0.6, 0.7]]), ("position", "crank"), "1", "")
     b = quasi_static_budget(summary, {"crank_bending_fraction": frac}, r)
     total = RAD_PER_ARCMIN / 250.0
-    assert b.model_total == pytest.approx(total, rel=1e-12)
+    assert b.total == pytest.approx(total, rel=1e-12)
     assert b.compliances["crank_bending"] == pytest.approx(0.36 * total, rel=1e-12)
     assert b.compliances["support_bearing_rollers"] == pytest.approx(0.24 * total, rel=1e-12)
     assert b.compliances["pin_disc_contacts"] + b.compliances["pin_seats"] == pytest.approx(0.1 * total, rel=1e-12)
-    assert b.added == pytest.approx(missing_compliances(r), rel=1e-12)
     d = b.to_dict()
-    assert d["model_rigidity_Nm_per_arcmin"] == pytest.approx(250.0, rel=1e-12)
+    assert d["rigidity_Nm_per_arcmin"] == pytest.approx(250.0, rel=1e-12)
     assert d["total_compliance_arcsec_per_Nm"] == pytest.approx(b.total * ARCSEC_PER_RAD, rel=1e-12)
 
 
@@ -272,8 +275,8 @@ def test_default_loop_is_quasi_static():
 def test_budget_dataset_round_trip_and_measured_reference():
     """The measured-data path: the analytic budget with a measured rigidity beside it
     (``reference``); stored as a dataset over ``budget_element`` and read back equal (rel
-    1e-12), the reference in N m/arcmin under its name; a model-route budget carries its added
-    elements with ``in_model`` 0 and the reference's rigidity with them in series."""
+    1e-12), the reference in N m/arcmin under its name; a model-route budget is its shares times
+    its tangent compliance, nothing added (rel 1e-12)."""
     from flexrv.analysis.budget import ModelShares, budget_from_dataset
     from flexrv.analysis.budget import stiffness_budget as budget
     from flexrv.units import RAD_PER_ARCMIN
@@ -282,13 +285,11 @@ def test_budget_dataset_round_trip_and_measured_reference():
     measured = 89.0 / RAD_PER_ARCMIN  # seed004's rigidity [N m/rad]
     b = budget(r, reference={"measured_loop_secant": measured}, route="measured")
     back = budget_from_dataset(b.to_dataset())
-    assert back.compliances == pytest.approx(b.compliances, rel=1e-12) and back.added == {}
+    assert back.compliances == pytest.approx(b.compliances, rel=1e-12)
     assert back.route == "measured" and back.reference["measured_loop_secant"] == pytest.approx(measured)
     assert b.to_dict()["measured_loop_secant_Nm_per_arcmin"] == pytest.approx(89.0, rel=1e-12)
     m = budget(r, model=ModelShares({"pins": 0.5, "needle_bearings": 0.5}, 1e-6), reference={"loop": 1e6})
-    ds = m.to_dataset()
-    assert set(ds["budget_element"].values[ds["budget_in_model"].values == 0]) == set(m.added)
-    d = m.to_dict()
-    assert d["loop_with_added_Nm_per_arcmin"] == pytest.approx(
-        RAD_PER_ARCMIN / (1e-6 + sum(m.added.values())), rel=1e-12
-    )
+    assert m.total == pytest.approx(1e-6, rel=1e-12)
+    assert m.compliances["needle_bearings"] == pytest.approx(0.5e-6, rel=1e-12)
+    assert m.to_dict()["loop_Nm_per_arcmin"] == pytest.approx(1e6 * RAD_PER_ARCMIN, rel=1e-12)
+    assert budget_from_dataset(m.to_dataset()).compliances == pytest.approx(m.compliances, rel=1e-12)

@@ -76,14 +76,13 @@ def test_torsional_stiffness(torsional):
     +1.3 %); analytic and simulated contact both find more than four pins; the stiffness test
     lies between the measured 89 N m/arcmin and the series model (the bench lacks compliances
     of the real reducer but includes the contact). Under seed004's definition, the loop secant
-    (lost motion included) lies below the 50-100 % slope, lower still with the four path
-    compliances no model contains in series, each with a share between 0 and 100 %."""
+    (lost motion included) lies below the 50-100 % slope; the four path compliances (in the
+    model) each have a share between 0 and 100 % of the budget."""
     n = torsional.numbers
     assert n["zone_seed_4"] == [6, 9]
     assert n["c_w_measured_Nm_per_arcmin"] == pytest.approx(3.06e5 / (180 * 60 / math.pi), rel=1e-9)
     assert n["pins_in_contact_analytic"] >= 4 and n["pins_in_contact_sim"] >= 4
     assert n["c_w_measured_Nm_per_arcmin"] < n["rigidity_test_Nm_per_arcmin"] < n["c_w_series_Nm_per_arcmin"]
-    assert n["rigidity_loop_secant_with_added_Nm_per_arcmin"] < n["rigidity_loop_secant_Nm_per_arcmin"]
     assert n["rigidity_loop_secant_Nm_per_arcmin"] < n["rigidity_test_Nm_per_arcmin"]
     shares = n["path_shares_percent"]
     assert set(shares) == {"crank_torsion", "planet_spline", "support_bearing_rings", "carrier_joints"}

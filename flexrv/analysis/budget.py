@@ -59,7 +59,6 @@ GROUP_ELEMENT = {
 }
 
 
-
 @dataclass(frozen=True)
 class ModelShares:
     """A model's budget: ``shares`` force group -> strain-energy fraction of the tangent

@@ -182,26 +182,18 @@ def elastic_body_compliances(reducer) -> dict:
 
 
 def budget_table(title: str, budget: dict) -> Table:
-    """Table element | compliance | share | what it is of a budget dict
-    (:meth:`flexrv.analysis.budget.Budget.to_dict`), with the totals and the rigidities."""
-    from flexrv.analysis.budget import ELEMENTS
-
+    """Table element | compliance | share of a budget dict (:meth:`flexrv.analysis.budget.
+    Budget.to_dict`, every element in the route's model), with the total and the rigidities."""
     table = Table(title=title, title_justify="left")
-    for col, just in (
-        ("element", "left"),
-        ("compliance [arcsec/(N m)]", "right"),
-        ("share [%]", "right"),
-        ("what it is", "left"),
-    ):
+    for col, just in (("element", "left"), ("compliance [arcsec/(N m)]", "right"), ("share [%]", "right")):
         table.add_column(col, justify=just)
     for name, e in sorted(budget["elements"].items(), key=lambda kv: -kv[1]["share_percent"]):
-        what = ELEMENTS.get(name, "")
-        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]), what)
-    table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100", "")
-    table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "", "")
+        table.add_row(name.replace("_", " "), fmt(e["compliance_arcsec_per_Nm"]), fmt(e["share_percent"]))
+    table.add_row("total", fmt(budget["total_compliance_arcsec_per_Nm"]), "100")
+    table.add_row("rigidity [N m/arcmin]", fmt(budget["rigidity_Nm_per_arcmin"]), "")
     for key, value in budget.items():
         if key.endswith("_Nm_per_arcmin") and key not in ("rigidity_Nm_per_arcmin",):
-            table.add_row(key[: -len("_Nm_per_arcmin")].replace("_", " ") + " [N m/arcmin]", fmt(value), "", "")
+            table.add_row(key[: -len("_Nm_per_arcmin")].replace("_", " ") + " [N m/arcmin]", fmt(value), "")
     if budget.get("notes"):
         table.caption = "; ".join(budget["notes"])
     return table

@@ -36,11 +36,14 @@ def legacy_supports(r, name: str):
     """Design ``r`` with the crank-support law of the references (linear, rigid crank)
     and, like them, rigidly seated pins (no [housing] table: issue 14 put the pin seats
     in series with the pin-disc contact; the references keep the pin law they were
-    written with), and no friction."""
+    written with), no friction, and none of the torque-path compliances of
+    flexrv.analysis.path_compliances (rigid crank torsion, no [path_estimates])."""
     from flexrv.design import from_dict
 
     data = r.model_dump()
     data.pop("housing", None)
+    data.pop("path_estimates", None)
+    data["ranges"] = {k: v for k, v in data.get("ranges", {}).items() if not k.startswith("path_estimates.")}
     cs = {
         k: v
         for k, v in data["crankshaft"].items()
@@ -49,6 +52,7 @@ def legacy_supports(r, name: str):
     cs.update(
         support_bearing_model="linear",
         bending_model="rigid",
+        torsion_model="rigid",
         support_bearing_radial_stiffness_N_per_m=LEGACY_SUPPORT_N_PER_M[name],
     )
     # frictionless, as when the references were written (issue 14 added friction, default on in the presets)
