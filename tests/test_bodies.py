@@ -308,14 +308,23 @@ def test_stiff_disc_reproduces_rigid_pins(params):
 # ------------------------------------------------------------------ switches and the parameter route
 def test_with_bodies_sets_the_design_switches():
     """--parts names the elastic bodies: with_bodies turns the design's switches,
-    and rigid_parameters carries the matrices only for the named bodies."""
+    and rigid_parameters carries the FE matrices only for the named bodies; a rigid carrier's
+    support points keep the rings' and joints' parts (flexrv.analysis.path_compliances), and
+    without [path_estimates] they are rigid."""
+    from flexrv.fem.carrier import crank_support_compliance
+
     r = load("rv40e")
     p = rigid_parameters(with_bodies(r, ["carrier"]))
-    assert p.carrier_compliance.shape == (6, 6) and p.disc_compliance.shape == (0, 3, 3)
+    parts = sum(p.carrier_parts.values())
+    assert set(p.carrier_parts) == {"support_bearing_rings", "carrier_joints"}
+    np.testing.assert_allclose(p.carrier_compliance - parts, crank_support_compliance(r), rtol=1e-12, atol=0)
+    assert p.disc_compliance.shape == (0, 3, 3)
     p = rigid_parameters(with_bodies(r, ["cycloid_disc"]))
-    assert p.carrier_compliance.shape == (0, 0) and p.disc_compliance.shape == (2, 3, 3)
+    assert np.array_equal(p.carrier_compliance, parts) and p.disc_compliance.shape == (2, 3, 3)
     p = rigid_parameters(with_bodies(r, []))
-    assert p.carrier_compliance.size == 0 and p.disc_compliance.size == 0
+    assert np.array_equal(p.carrier_compliance, parts) and p.disc_compliance.size == 0
+    p = rigid_parameters(with_bodies(r, []).model_copy(update={"path_estimates": None}))
+    assert p.carrier_compliance.size == 0 and p.carrier_parts == {}
 
 
 # ------------------------------------------------------------------ quasi-static torsional compliance
