@@ -253,13 +253,12 @@ def test_default_loop_is_quasi_static():
     """The stiffness test's default quarter time (flexrv.simulation.DEFAULT_QUARTER_TIME
     = 0.08 s) makes the loop quasi-static: on rv221 the +T_r and -T_r branch slopes agree
     within 3 % and their mean lies within 5 % of the quasi-static catalog slope of
-    ``flexrv te``; the lost motion within 15 % of te's. Measured 2026-11-24 (rigid model,
-    the preset's FE bodies and housing): rv221 0.08 s branches 1539.0 / 1538.9, te catalog
-    1535.1 N m/arcmin, lost motion 0.889 against te's 0.844 arcmin; at the former default
-    0.02 s the lost motion read 0.408 arcmin (the output still moving through the clearance
-    when the +-3 % band is read) and, before the housing entered the model, the branches
-    2043 / 1767. rv40e: 199.6 at both; lost motion 0.853 (0.02 s) -> 1.275 (0.08 s) against
-    te's 1.415 arcmin (te reads it at its catalog positions, the loop at one pose)."""
+    ``flexrv te``; the lost motion within 15 % of te's. Measured (rigid model, the preset's FE
+    bodies, housing and path compliances): rv221 0.08 s branches 1411.0 / 1410.9, te catalog
+    1407.9 N m/arcmin, lost motion 1.181 against te's 1.204 arcmin; a 0.02 s quarter reads the
+    lost motion low (the output still moving through the clearance when the +-3 % band is
+    read). rv40e: 175.1 (50-100 %), lost motion 1.80 against te's 2.03 arcmin (te reads it at
+    its catalog positions, the loop at one pose)."""
     from flexrv.model.quasi_static import loaded_te
     from flexrv.simulation import stiffness_test
     from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
