@@ -30,14 +30,17 @@ TE_PATH = Path(__file__).with_name("te_reference.json")
 #: per support bearing, rigid crank (issue 14 replaced them by tapered-roller pairs in
 #: series with the crank's bending; the references keep the law they were written with)
 LEGACY_SUPPORT_N_PER_M = {"rv40e": 2.0e8, "rv221": 5.0e8}
+#: needle bearings' radial internal clearance (total play) of the presets when the references were written
+LEGACY_NEEDLE_CLEARANCE_UM = {"rv40e": 6.0, "rv221": 10.0}
 
 
 def legacy_supports(r, name: str):
     """Design ``r`` with the crank-support law of the references (linear, rigid crank)
     and, like them, rigidly seated pins (no [housing] table: issue 14 put the pin seats
     in series with the pin-disc contact; the references keep the pin law they were
-    written with), no friction, and none of the torque-path compliances of
-    flexrv.analysis.path_compliances (rigid crank torsion, no [path_estimates])."""
+    written with), no friction, none of the torque-path compliances of
+    flexrv.analysis.path_compliances (rigid crank torsion, no [path_estimates]) and the needle
+    clearance they were written with (:data:`LEGACY_NEEDLE_CLEARANCE_UM`)."""
     from flexrv.design import from_dict
 
     data = r.model_dump()
@@ -57,8 +60,10 @@ def legacy_supports(r, name: str):
     )
     # frictionless, as when the references were written (issue 14 added friction, default on in the presets)
     contact = dict(data["contact"], friction=False)
+    needle = dict(data["needle_bearing"], radial_clearance_um=LEGACY_NEEDLE_CLEARANCE_UM[name])
     return from_dict(
-        {**data, "crankshaft": cs, "contact": contact}, source=f"{name} with the legacy crank supports, frictionless"
+        {**data, "crankshaft": cs, "contact": contact, "needle_bearing": needle},
+        source=f"{name} with the legacy crank supports, frictionless",
     )
 
 
