@@ -23,14 +23,15 @@ laws of the models do not contain by themselves, each a closed form referred to 
 Referred to the output, a compliance c of each crank's rotation relative to its planet is
 c / (N i_c^2) with i_c = z_rp + z_s / z_p the crank's turn relative to its planet per output
 turn (input held: the planet turns by (1 + z_s / z_p) and the crank by -z_c per output turn,
-:mod:`flexrv.geometry.kinematics`); a mesh compliance s along the line of action gives
-s r_bp^2 / (N (i r_bs)^2) = s / (N i_c^2 r_bp^2) the same, i = 1 + z_p z_rp / z_s.
+:mod:`flexrv.geometry.kinematics`). A mesh compliance s along the line of action carries the
+mesh force F = T / (N i r_bs) (i = 1 + z_p z_rp / z_s the reducer's ratio, i r_bs = i_c r_bp)
+and gives s / (N i_c^2 r_bp^2) at the output: s = c_t r_bp^2 gives c_t / (N i_c^2), the same.
 
 * ``crank_torsion``: St. Venant torsion of each crank between its planet spline and its
-  eccentrics. The crank torque is M_c = T / (N z_rp) (virtual work: with the planets held by
-  the mesh, an eccentric turned by Delta relative to its planet turns the output by
-  Delta / z_rp, the second stage's ratio of crank rotation relative to the carrier to
-  carrier rotation; exactly Delta / i_c, below). Energy-equivalent length of the
+  eccentrics. The crank torque is M_c = T / (N i_c) (virtual work: with the input held, an
+  eccentric turned by Delta relative to its planet turns the output by Delta / i_c, above;
+  i_c is z_rp, the second stage's ratio of crank rotation relative to the carrier to carrier
+  rotation, plus the first stage's z_s / z_p). Energy-equivalent length of the
   stepped shaft, torque profile m(x) = M(x)/M_c: the spline feeds it in uniformly over the
   gear seat (int (x/L)^2 = L/3), the support journal carries it whole, the two eccentrics
   take half each, uniformly (7 L_e / 12 and L_e / 12):
