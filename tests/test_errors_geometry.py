@@ -361,7 +361,7 @@ BAD = [
         "-60..60",
     ),
     (
-        {"clearances": {"needle_extra_clearance_um": [[0.0, 0.0], [-3.5, 0.0], [0.0, 0.0]]}},
+        {"clearances": {"needle_extra_clearance_um": [[0.0, 0.0], [-7.0, 0.0], [0.0, 0.0]]}},
         "errors.clearances.needle_extra_clearance_um[1][0]",
         "total needle clearance",
     ),

@@ -28,8 +28,9 @@ from flexrv.meshing.mesh import generate_mesh
 from flexrv.meshing.parts import CarrierSpec, spec_for
 from flexrv.units import RAD_PER_ARCMIN
 
-#: coarse mesh of the rv40e carrier for the fast tests [m]
-COARSE = 0.008
+#: coarse mesh of the rv40e carrier for the fast tests [m]: at most the 6.5 mm ligament between the
+#: 27 mm centre bore and the crank bores
+COARSE = 0.006
 
 
 @pytest.fixture(autouse=True)
