@@ -231,3 +231,41 @@ def test_quasi_static_model_responds_with_the_closed_forms():
     assert 0.0 < mesh * ARCSEC_PER_RAD < 1e-3
     for k in ("needle_bearings", "pins", "crank_supports"):
         assert b1[k] == pytest.approx(b0[k], rel=0.005), k
+
+
+def test_gear_stage_jacobian_with_the_planet_torsion():
+    """The gear element's dF/dq with the planet torsion in series (rv40e, s = c_t r_bp^2 > 0):
+    central differences (h = 1e-10 m on the crank circle) of its own forces within 1e-6 of the
+    largest entry at the quasi-static equilibrium at the rated torque, at rest and with random
+    speeds (the damper's dependence on q); the stiffness slope of the series law enters through
+    its central difference."""
+    from flexrv.model.assembled import group_index
+    from flexrv.model.parameters import with_bodies
+    from flexrv.model.quasi_static import StaticModel, ramp_to
+
+    r = with_bodies(load("rv40e"), [])
+    sm = StaticModel(r)
+    th = 0.37
+    sm.torque = 0.0
+    q = ramp_to(sm, th, sm.kinematic_pose(th), r.operating.rated_torque_Nm, steps=8)
+    m = sm.model
+    g = next(x for x in m.groups if x.name == "gear_stage")
+    assert g.law.s_t > 0.0
+    ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])]
+    rng = np.random.default_rng(5)
+    for v_scale in (0.0, 1e-3):
+        v = rng.normal(scale=v_scale, size=m.n) / sm.arm
+        g.new_step()
+        jq, _ = g.jacobian(th, q[ix], v[ix])
+        nq = np.zeros_like(jq)
+        for i in range(len(ix)):
+            e = np.zeros(len(ix))
+            e[i] = 1e-10 / sm.arm[ix[i]]
+            g.new_step()
+            fp, _ = g.evaluate(th, q[ix] + e, v[ix])
+            g.new_step()
+            fm, _ = g.evaluate(th, q[ix] - e, v[ix])
+            nq[:, i] = (fp - fm) / (2 * e[i])
+        scale = np.abs(nq).max()
+        assert scale > 1e6
+        assert np.abs(jq - nq).max() <= 1e-6 * scale
