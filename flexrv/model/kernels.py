@@ -173,7 +173,7 @@ class FusedForces:
             for g in (by_kind[k] for k in ELEMENTS if k in by_kind)
         ]
         #: the generated compiled functions of these elements (flexrv.model.core.registry)
-        self.kernel, self.history_kernel = fused_functions([spec_of(g) for g, _ in self.slots])
+        self.kernel, self.history_kernel, self.integrate_kernel = fused_functions([spec_of(g) for g, _ in self.slots])
         self.packs = self._packs(history=False)
         #: (group, its pack's live time-input array) of the elements with time inputs
         self.timed = [(g, getattr(p, g.time_field)) for (g, _), p in zip(self.slots, self.packs) if g.time_field]
