@@ -253,6 +253,11 @@ class Simulation:
         s CPU per simulated s).
         """
         plan = _RunPlan.of(self.reducer, t_end, dt, output_every, segment_steps, restart)
+        import exudyn as exu
+
+        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        if integrator is not None and integrator not in INTEGRATORS:
+            raise InputError(f"integrator = {integrator!r} is not allowed: choose from {', '.join(INTEGRATORS)}")
         model = self.model if self.model is not None else self.build()
         plan.check_size(model.n)
         kind = choose_integrator(model, integrator)
@@ -840,9 +845,12 @@ class _CompiledSegments:
         from flexrv.model.integrator import CompiledIntegrator, compiled_newton_options
 
         self.model = model
-        self.integ = CompiledIntegrator(
-            model, spectral_radius, newton_tolerance, compiled_newton_options(newton_options)
+        options = dict(newton_options or {})
+        tolerance = (
+            options.pop("relativeTolerance", newton_tolerance[0]),
+            options.pop("absoluteTolerance", newton_tolerance[1]),
         )
+        self.integ = CompiledIntegrator(model, spectral_radius, tolerance, compiled_newton_options(options))
         self.integ.nominal = plan.dt
         self.checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
         self._segments = 0
@@ -865,18 +873,22 @@ class _CompiledSegments:
         if j_next >= plan.n_total:
             times[-1] = plan.t_end
         rows = np.full(len(steps), -1, np.int64)
+        k = records.k
         for n, s in enumerate(steps):  # the segment's end is the next one's start (recorded there), unless the last
-            if (s < j_next or s >= plan.n_total) and records.due(s, plan):
-                rows[n] = records.k
-                records.k += 1
+            if (s < j_next or s >= plan.n_total) and (k == 0 or s % plan.output_every == 0 or s >= plan.n_total):
+                if k < records.n_out:
+                    rows[n] = k
+                    k += 1
         tables = integ.tables(times)
         for a in range(0, len(steps), CHECK_EVERY):
             b = min(a + CHECK_EVERY, len(steps))
             done, status = integ.advance(times[a:b], plan.t_of(j + a), rows[a:b], buffers, [tb[a:b] for tb in tables])
             out.steps += done
             stop.step = out.steps
-            if status != 0:  # the rows from the failed step on were not written
-                records.k -= int(np.count_nonzero(rows[a + done :] >= 0))
+            written = rows[: a + done][rows[: a + done] >= 0]
+            if len(written):
+                records.k = int(written[-1]) + 1
+            if status != 0:
                 self._t = float(times[a + done])
                 out.fail = (plan.t_of(j + a + done), integ.failure(status))
                 return False

@@ -71,7 +71,7 @@ def compiled_newton_options(options: dict | None) -> dict:
         if key not in NEWTON_OPTIONS:
             raise InputError(
                 f"newton_options {key!r} is not allowed with the compiled integrator: choose from "
-                f"{', '.join(NEWTON_OPTIONS)} (or --integrator exudyn)"
+                f"{', '.join(NEWTON_OPTIONS)}, relativeTolerance, absoluteTolerance (or --integrator exudyn)"
             )
         out[NEWTON_OPTIONS[key]] = value
     return out

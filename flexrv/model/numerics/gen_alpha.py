@@ -355,6 +355,8 @@ def after_eval(st, f, jq, jv):
         r0 = res if math.isfinite(res) else np.inf
         if r0 <= st.par[P_ATOL]:
             r0 = 2.0 * st.par[P_ATOL]
+        if r0 == 0.0:  # (an absolute tolerance of 0 and an exact predictor)
+            r0 = 1e-300
         st.par[P_R0] = r0
         st.par[P_RES] = r0
         st.par[P_LAST] = r0
