@@ -261,12 +261,7 @@ class Simulation:
         model = self.model if self.model is not None else self.build()
         plan.check_size(model.n)
         kind = choose_integrator(model, integrator)
-        from flexrv.model.kernel_cache import announce_compile
-
-        kinds = (["fused"] if model.fused is not None else []) + (
-            ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
-        )
-        announce_compile(kinds=kinds)  # one line on stderr if the numba kernels compile now (first run)
+        _announce_compile(model)
         if kind == "compiled":
             segments = _CompiledSegments(model, spectral_radius, newton_tolerance, newton_options, plan)
         else:
@@ -278,7 +273,7 @@ class Simulation:
             checkpoint.meta.update(
                 newton_tolerance=list(newton_tolerance),
                 spectral_radius=spectral_radius,
-                newton_options=dict(newton_options or {}),
+                newton_options=newton_options,
                 integrator=kind,
             )
             checkpoint.recorder = records.recorder
@@ -522,6 +517,16 @@ def choose_integrator(model, integrator: str | None) -> str:
     if integrator is None:
         return "compiled" if reason is None else "exudyn"
     return integrator
+
+
+def _announce_compile(model) -> None:
+    """One line on stderr if the model's numba kernels compile now (first run)."""
+    from flexrv.model.kernel_cache import announce_compile
+
+    kinds = (["fused"] if model.fused is not None else []) + (
+        ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
+    )
+    announce_compile(kinds=kinds)
 
 
 class _RunPlan:

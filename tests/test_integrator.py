@@ -157,10 +157,9 @@ def test_cli_refuses_compiled_for_python_groups(tmp_path, capfd):
 def te_of(reducer, integrator, t_end):
     """(mean, p-p, frequencies, amplitudes, results) of the TE over the steady window on
     tests/test_time_step.py's grid."""
-    from test_time_step import GRID
-
     from flexrv.post.spectra import amplitude_spectrum
     from flexrv.simulation import Simulation
+    from tests.test_time_step import GRID
 
     res = Simulation(reducer).run(t_end=t_end, integrator=integrator)
     assert res.attrs["status"] == "completed" and res.attrs["integrator"] == integrator
@@ -176,7 +175,7 @@ def cross_check(reducer, t_end, unique=True):
     lines up to the cycloid mesh within 2 % (tests/test_time_step.py's criterion); for
     a response that is not unique (rv221 at its light preset load, see that module):
     mean within 0.1 arcsec and the dominant line within 2 %."""
-    from test_time_step import lines
+    from tests.test_time_step import lines
 
     m0, pp0, f0, a0, _ = te_of(reducer, "exudyn", t_end)
     m1, pp1, f1, a1, res = te_of(reducer, "compiled", t_end)
@@ -201,7 +200,7 @@ def test_cross_check_against_exudyn_every_preset(name):
     0.012 arcsec, the 13.6 Hz line 0.3 % (its 270-285 Hz lines are one of its two steady
     responses); rv221 at its rated 3000 N m identical to 4e-12 arcsec. The first 100
     steps of a run agree to 1e-15 rad (the same algorithm to round-off). ~10 s each."""
-    from test_time_step import fast
+    from tests.test_time_step import fast
 
     r = fast(name)
     light = r.operating.load_torque_Nm < 0.1 * r.operating.rated_torque_Nm
