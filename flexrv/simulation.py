@@ -856,7 +856,7 @@ class _CompiledSegments:
             options.pop("absoluteTolerance", newton_tolerance[1]),
         )
         self.integ = CompiledIntegrator(model, spectral_radius, tolerance, compiled_newton_options(options))
-        self.integ.nominal = plan.dt
+        self.integ.check_every = CHECK_EVERY
         self.checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
         self._segments = 0
         self._t = plan.t_start
@@ -864,51 +864,40 @@ class _CompiledSegments:
     def segment(self, j, j_next, q_b, v_b, a_b, plan, records, stop, report, out) -> bool:
         """Integrate steps j .. j_next from the boundary state; False on failure."""
         integ = self.integ
-        integ.start(plan.t_of(j), q_b, v_b, a_b)
+        t0, t1 = plan.t_of(j), plan.t_of(j_next)
+        integ.start(t0, q_b, v_b, a_b)
         self._segments += 1
-        self._t = plan.t_of(j)
-        if not np.all(np.isfinite(q_b)) or not np.all(np.isfinite(v_b)):
-            out.fail = (self._t, "the state became NaN/inf")
-            return False
-        if records.due(j, plan) and (records.k == 0 or records.ts[records.k - 1] < plan.t_of(j)):
-            records.append(plan.t_of(j), q_b, v_b)  # a boundary: its records are left to the history pass
-        buffers = integ.outputs(records.ts, records.qs, records.vs, records.recorder)
-        steps = np.arange(j + 1, j_next + 1)
-        times = steps * plan.dt
-        if j_next >= plan.n_total:
-            times[-1] = plan.t_end
-        rows = np.full(len(steps), -1, np.int64)
+        self._t = t0
+        interval = plan.output_every * plan.dt * (1 - 1e-9)
         k = records.k
-        for n, s in enumerate(steps):  # the segment's end is the next one's start (recorded there), unless the last
-            if (s < j_next or s >= plan.n_total) and (k == 0 or s % plan.output_every == 0 or s >= plan.n_total):
-                if k < records.n_out:
-                    rows[n] = k
-                    k += 1
-        tables = integ.tables(times)
-        for a in range(0, len(steps), CHECK_EVERY):
-            b = min(a + CHECK_EVERY, len(steps))
-            done, status = integ.advance(times[a:b], plan.t_of(j + a), rows[a:b], buffers, [tb[a:b] for tb in tables])
-            out.steps += done
-            stop.step = out.steps
-            written = rows[: a + done][rows[: a + done] >= 0]
-            if len(written):
-                records.k = int(written[-1]) + 1
-            if status != 0:
-                self._t = float(times[a + done])
-                out.fail = (plan.t_of(j + a + done), integ.failure(status))
-                return False
-            self._t = float(times[b - 1])
+        if k < records.n_out and (k == 0 or t0 >= records.ts[k - 1] + interval):  # as the pre-step hook at t0
+            records.append(t0, q_b, v_b)  # its per-contact records are left to the history pass
+        buffers = integ.outputs(records.ts, records.qs, records.vs, records.recorder, interval)
+        if records.k:
+            buffers[-1][0] = records.ts[records.k - 1]
+        # the segment's end is recorded as the next segment's start, unless it is the run's end
+        rec = np.array([records.k, records.n_out, int(j_next < plan.n_total)], np.int64)
+
+        def after_call(t, steps):
+            records.k = int(rec[0])
+            reported = out.steps // 200
+            out.steps = stop.step = out.steps + steps
+            self._t = t
             for g in self.checkers:
                 msg = g.check()
                 if msg:
-                    out.fail = (self._t, msg)
-                    return False
-            if stop.stop:
-                return False
-            if report is not None and (b % 200 < CHECK_EVERY or b == len(steps)):
-                report(self._t)
+                    out.fail = (t, msg)
+                    return True
+            if report is not None and out.steps // 200 > reported:
+                report(t)
+            return stop.stop
+
+        status, self._t = integ.segment(t0, t1, plan.dt, rec, buffers, after_call)
+        records.k = int(rec[0])
         self._sync_stats()
-        return True
+        if status > 0:
+            out.fail = (self._t, integ.failure(status))
+        return status == 0
 
     def _sync_stats(self) -> None:
         c = self.integ.counts()
@@ -919,7 +908,17 @@ class _CompiledSegments:
         return i.q.copy(), i.v.copy(), i.a.copy()
 
     def final(self, plan: _RunPlan, records: _Records) -> None:
-        """Nothing: the compiled loop records the end state."""
+        """The end state if the compiled loop's output interval skipped it (as the Exudyn
+        path's), with the per-contact records of its last call (the converged end state)."""
+        k = records.k
+        if k < records.n_out and (k == 0 or plan.t_end > records.ts[k - 1]):
+            records.append(plan.t_end, self.integ.q, self.integ.v)
+            if records.recorder is not None:
+                for i, (element, _, _, src, dst) in enumerate(records.recorder.sources):
+                    if element is self.integ.fused:
+                        for a, d in zip(src, dst):
+                            d[k] = a
+                        records.recorder.valid[i, k] = True
 
     def time_reached(self) -> float:
         return self._t

@@ -11,11 +11,13 @@ The compiled loop returns to Python every ``check_every`` steps, where the group
 per-step checks run on the last accepted state (a skipped pin, a penetration beyond
 the physical limit) as in the Exudyn path's pre-step hook.
 
-A step whose Newton iteration fails is repeated from its start in two halves (each
-half again halved on failure, down to 1e-3 of the step): Exudyn's adaptive step
-reduction, except that the nominal step is taken again right after the failed
-interval (Exudyn keeps the reduced step for ten steps), so every output stays on the
-grid j dt.
+Time stepping as Exudyn's adaptive step (its settings of flexrv.simulation): t += h,
+the last step of a segment clipped to its end; a step whose Newton iteration fails is
+retried from its start at half the step (down to :data:`MIN_SUBSTEP` of it), and the
+step doubles again, up to the nominal one, after :data:`RECOVERY_STEPS` accepted steps
+of at most :data:`RECOVERY_ITERATIONS` Newton iterations (Exudyn's defaults); a state is
+recorded when its time is at least ``output_every`` dt after the last record, as the
+Exudyn path's pre-step hook does. So both integrators take the same steps.
 """
 
 from __future__ import annotations
@@ -33,12 +35,18 @@ NEWTON_OPTIONS = {
     "adaptInitialResidual": "adapt_initial_residual",
 }
 
-#: smallest sub-step of a failed step, as a fraction of the step (Exudyn's minimumStepSize = 1e-3 dt)
+#: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's
+#: minimumStepSize to 1e-3 dt)
 MIN_SUBSTEP = 1e-3
+#: accepted steps before a reduced step doubles, and the most Newton iterations (+1, Exudyn counts
+#: its one discontinuous iteration) of the last of them (Exudyn's adaptiveStepRecoverySteps and
+#: adaptiveStepRecoveryIterations defaults)
+RECOVERY_STEPS = 10
+RECOVERY_ITERATIONS = 7
 
 #: status codes of fused_integrate -> failure text
 _STATUS = {
-    1: "Newton iteration failed (step reduced to its minimum)",
+    1: "Newton iteration failed at the minimum step",
     3: "the state became NaN/inf",
 }
 
@@ -110,11 +118,15 @@ class CompiledIntegrator:
         #: typing of the ~60 arguments, ~100 us per call; valid while the types stay: every array passed
         #: is float64/int64/bool C-contiguous, checked in :meth:`_call`'s callers)
         self._entry = None
+        #: steps of the nominal size per compiled call (the caller's checks run in between)
+        self.check_every = 10
 
     # ------------------------------------------------------------------ state
     def start(self, t: float, q, v, a=None) -> None:
         """Start (or restart at a segment boundary) from (q, v, a); a None: the initial
         accelerations M^-1 f(t, q, v) (zero for a model with massless coordinates)."""
+        for g in self.model.groups:
+            g.reset()
         if a is None:
             a = np.zeros(self.model.n)
             if not self.massless:
@@ -123,8 +135,6 @@ class CompiledIntegrator:
                 )
                 a = np.linalg.solve(self.state.mass, f - self.state.stiff @ q - self.state.damp @ v)
         gen_alpha.set_state(self.state, q, v, a)
-        for g in self.model.groups:
-            g.reset()
 
     @property
     def q(self) -> np.ndarray:
@@ -148,31 +158,40 @@ class CompiledIntegrator:
         }
 
     # ------------------------------------------------------------------ stepping
-    def advance(self, times: np.ndarray, t_prev: float, rows: np.ndarray, out, tables=None) -> tuple[int, int]:
-        """Integrate over the steps ending at ``times`` from the current state at
-        ``t_prev``; ``rows``: output row per step (-1: none), ``out``: (ts, qs, vs, src,
-        dst, valid) (:meth:`outputs`), ``tables``: :meth:`tables` of ``times`` (computed if
-        None). Returns (steps done, status) as ``fused_integrate``, after repeating failed
-        steps in halves (module docstring)."""
-        if tables is None:
-            tables = self.tables(times)
-        done = 0
-        while done < len(times):
-            n, status = self._call(
-                times[done:],
-                t_prev if done == 0 else times[done - 1],
-                rows[done:],
-                out,
-                [tb[done:] for tb in tables],
-            )
-            done += n
-            if status != 1:
-                return done, status
-            t0 = t_prev if done == 0 else times[done - 1]
-            if not self._substeps(t0, times[done], rows[done], out, 2):
-                return done, 1
-            done += 1
-        return done, 0
+    def segment(self, t0: float, t1: float, h: float, rec, out, after_call) -> tuple[int, float]:
+        """Integrate from the current state at ``t0`` to ``t1`` with nominal step ``h`` (module
+        docstring). Steps of the nominal size run :attr:`check_every` at a time in compiled
+        code, reduced ones one by one. ``rec`` (int64: next row, rows, segment end not
+        recorded), ``rec_t`` inside ``out``: the recording state of ``fused_integrate``;
+        ``after_call(t, steps)`` runs after every compiled call (checks, signals, progress) and
+        returns True to stop. Returns (status, time reached): 0 done, -1 stopped by
+        ``after_call``, else the failure status of ``fused_integrate``."""
+        t, step, since = t0, h, 0
+        end_recorded = rec[2]
+        while t < t1 - 1e-10:
+            count = 1 if step < h else self.check_every
+            times = t + step * np.arange(1, count + 1)
+            last = np.nonzero(times >= t1 - 1e-10)[0]
+            if len(last):
+                times = times[: last[0] + 1]
+                times[-1] = min(times[-1], t1)
+                rec[2] = end_recorded
+            else:
+                rec[2] = 0
+            done, status = self._call(times, t, out, rec)
+            if done:
+                t = float(times[done - 1])
+                since += done
+            if status == 1 and step > MIN_SUBSTEP * h * (1 + 1e-9):  # the failed step again at half the step
+                self._restore()
+                step, since = max(0.5 * step, MIN_SUBSTEP * h), 0
+            elif status != 0:
+                return status, t
+            elif step < h and since >= RECOVERY_STEPS and self.state.ip[gen_alpha.I_IT] + 1 <= RECOVERY_ITERATIONS:
+                step, since = min(2.0 * step, h), 0
+            if after_call(t, done):
+                return -1, t
+        return 0, t
 
     def tables(self, times: np.ndarray) -> list:
         """The time inputs of the timed elements at ``times`` (one row per time)."""
@@ -182,44 +201,22 @@ class CompiledIntegrator:
             out.append(np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(times), (len(times), size))))
         return out
 
-    def _substeps(self, t0: float, t1: float, row: int, out, parts: int) -> bool:
-        """The failed step (t0, t1] in ``parts`` equal sub-steps from its start state
-        (each failing one halved again); the end state into output ``row``."""
-        if (t1 - t0) / parts < MIN_SUBSTEP * self.nominal:
-            return False
-        self._restore()
-        sub = t0 + (t1 - t0) * np.arange(1, parts + 1) / parts
-        sub[-1] = t1
-        rows = np.full(parts, -1, np.int64)
-        rows[-1] = row
-        done = 0
-        while done < parts:
-            n, status = self._call(
-                sub[done:], t0 if done == 0 else sub[done - 1], rows[done:], out, self.tables(sub[done:])
-            )
-            done += n
-            if status == 0:
-                return True
-            if status != 1:
-                return False
-            start = t0 if done == 0 else sub[done - 1]
-            if not self._substeps(start, sub[done], rows[done], out, 2):
-                return False
-            done += 1
-        return True
-
     def _restore(self) -> None:
+        """The state at the start of a failed step, for its retry at a smaller step. As
+        Exudyn's step reduction: q, v, a restored, the algorithmic accelerations left at the
+        failed attempt's predictor value a* (Exudyn restores them in its Newton restart,
+        not for a step retry; with alpha_m = 0, a* = alpha_f a_n)."""
         st = self.state
-        st.q[:], st.v[:], st.a[:], st.aa[:] = st.q0, st.v0, st.a0, st.aa0
+        st.q[:], st.v[:], st.a[:] = st.q0, st.v0, st.a0
 
-    def _call(self, times, t_prev, rows, out, tables) -> tuple[int, int]:
+    def _call(self, times, t_prev, out, rec) -> tuple[int, int]:
         fused = self.fused
-        ts, qs, vs, src, dst, valid = out
+        ts, qs, vs, src, dst, valid, rec_t = out
         args = (
             self.state,
             times,
             float(t_prev),
-            *tables,
+            *self.tables(times),
             fused.f,
             fused.jq,
             fused.jv,
@@ -227,7 +224,8 @@ class CompiledIntegrator:
             self.ctrs,
             src,
             dst,
-            rows,
+            rec,
+            rec_t,
             ts,
             qs,
             vs,
@@ -245,18 +243,16 @@ class CompiledIntegrator:
         fused.memo, fused._jac_ready = None, False
         return int(n), int(status)
 
-    #: nominal step of the run (for the smallest sub-step), set by the caller
-    nominal: float = 1.0
-
-    def outputs(self, ts, qs, vs, recorder) -> tuple:
-        """The output buffers of :meth:`advance`: the run's (ts, qs, vs) and the fused
+    def outputs(self, ts, qs, vs, recorder, interval: float) -> tuple:
+        """The output buffers of :meth:`segment`: the run's (ts, qs, vs), the fused
         element's record buffers in ``recorder`` (:class:`flexrv.model.kernels.HistoryRecorder`,
-        or None: dummies)."""
+        or None: dummies) and ``rec_t`` = (time of the last record, recording interval)."""
+        rec_t = np.array([-np.inf, interval])
         if recorder is not None:
             for i, (element, _, _, src, dst) in enumerate(recorder.sources):
                 if element is self.fused:
-                    return ts, qs, vs, src, dst, recorder.valid[i]
-        return ts, qs, vs, (np.zeros(0),), (np.zeros((len(ts), 0)),), np.zeros(len(ts), bool)
+                    return ts, qs, vs, src, dst, recorder.valid[i], rec_t
+        return ts, qs, vs, (np.zeros(0),), (np.zeros((len(ts), 0)),), np.zeros(len(ts), bool), rec_t
 
     def failure(self, status: int) -> str:
         """The failure text of a status of :meth:`advance`."""

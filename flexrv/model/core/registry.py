@@ -160,14 +160,19 @@ def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
     (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the steps ending
     at ``times``, with ONE call site of ``fused_kernel``; returns (steps done, status:
     0 done, 1 Newton failed, 2 an element's inner solve failed, 3 non-finite state).
-    Step i writes the elements' time inputs of row i of their tables, and, if ``rows[i]
-    >= 0``, the accepted state and the elements' records into that output row."""
+    Step i writes the elements' time inputs of row i of their tables; an accepted step
+    is recorded (state into ``ts``, ``qs``, ``vs`` row ``rec[0]``, the elements' records
+    into ``dst``) if its end time is at least ``rec_t[1]`` after the last record
+    ``rec_t[0]`` (or no row is recorded yet), while rows remain (``rec[1]``), except the
+    last step of the call when ``rec[2]`` (a segment's end, recorded as the next one's start)."""
     lines = [
         "",
         "",
         "@njit(cache=True)",
-        f"def fused_integrate(st, times, t_prev, {tin}f, jq, jv, {packs}, ctrs, src, dst, rows, ts, qs, vs, valid):",
-        "    for i in range(times.shape[0]):",
+        f"def fused_integrate(st, times, t_prev, {tin}f, jq, jv, {packs}, ctrs, src, dst, rec, rec_t, "
+        "ts, qs, vs, valid):",
+        "    n = times.shape[0]",
+        "    for i in range(n):",
         "        h = times[i] - (t_prev if i == 0 else times[i - 1])",
     ]
     lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
@@ -189,15 +194,17 @@ def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
         "            return i, 1",
         "        if not finish_step(st):",
         "            return i, 3",
-        "        k = rows[i]",
-        "        if k >= 0:",
+        "        k = rec[0]",
+        "        if (i < n - 1 or rec[2] == 0) and k < rec[1] and (k == 0 or times[i] >= rec_t[0] + rec_t[1]):",
         "            ts[k] = times[i]",
         "            qs[k, :] = st.q",
         "            vs[k, :] = st.v",
         "            for r in range(len(src)):",
         "                dst[r][k, :] = src[r]",
         "            valid[k] = True",
-        "    return times.shape[0], 0",
+        "            rec[0] = k + 1",
+        "            rec_t[0] = times[i]",
+        "    return n, 0",
         "",
     ]
     return lines
