@@ -15,16 +15,14 @@ FAST = {"operating.speed_ramp_time_s": 0.02, "operating.load_ramp_start_s": 0.0,
 NEWTON_TOLERANCE = (1e-5, 1e-3)
 
 
-def _dynamic(preset: str, model: str, t_end: float, integrator: str = "exudyn") -> dict:
+def _dynamic(preset: str, model: str, t_end: float) -> dict:
     from flexrv.design import override
     from flexrv.simulation import Simulation
 
     # a converged Newton tolerance: the pinned numbers are the model's answer, not the path a default-tolerance
     # (1e-3) Newton took to it (which a faster but equivalent residual changes: balls_rv40e's TE p-p was 0.4026
     # and 0.3759 arcsec at the default tolerance before and after the row-kernel rewrite, 0.3616 converged)
-    res = Simulation(override(preset, FAST), model=model).run(
-        t_end=t_end, dt=1e-4, newton_tolerance=NEWTON_TOLERANCE, integrator=integrator
-    )
+    res = Simulation(override(preset, FAST), model=model).run(t_end=t_end, dt=1e-4, newton_tolerance=NEWTON_TOLERANCE)
     sel = res.ds.sel(time=slice(0.5 * t_end, None))
     out = {
         "te_mean_arcsec": float(sel["te"].mean()),
@@ -37,13 +35,8 @@ def _dynamic(preset: str, model: str, t_end: float, integrator: str = "exudyn") 
 
 
 def rigid_rv40e() -> dict:
-    """Rigid model, rv40e, 0.06 s from rest (20 ms ramps), second half; Exudyn's integrator."""
+    """Rigid model, rv40e, 0.06 s from rest (20 ms ramps), second half."""
     return _dynamic("rv40e", "rigid", 0.06)
-
-
-def rigid_rv40e_compiled() -> dict:
-    """:func:`rigid_rv40e` on the compiled integrator (flexrv.model.integrator)."""
-    return _dynamic("rv40e", "rigid", 0.06, integrator="compiled")
 
 
 def balls_rv40e() -> dict:
