@@ -4,15 +4,20 @@
 >>> res = Simulation("rv40e").run(t_end=0.3, dt=1e-4)     # doctest: +SKIP
 >>> res["TE [arcsec]"]                                    # doctest: +SKIP
 
-Integration: Exudyn's implicit generalized-alpha (spectral radius 0.5 to damp
-the stiff contact modes numerically) with modified Newton and analytic group
-Jacobians (for the small dense systems of the rigid model a fresh Jacobian at
-every step); adaptive step reduction on Newton failure. A run is integrated in
+Integration: the implicit generalized-alpha (spectral radius 0.5 to damp the stiff
+contact modes numerically) with modified Newton, a fresh analytic Jacobian at every step
+for the small dense systems, and adaptive step reduction on Newton failure, run by one of
+two integrators (``Simulation.run(integrator=...)``, docs/integrator.md): ``"compiled"``
+(:mod:`flexrv.model.integrator`: the step loop compiled around the fused force kernel,
+the default for models whose forces are all compiled kernels, e.g. the rigid model) or
+``"exudyn"`` (Exudyn's solver with the forces as Python user functions: the reference,
+and the default for models with Python force groups). Both take the same steps with the
+same Newton iterations (tests/test_integrator.py). A run is integrated in
 segments of :data:`SEGMENT_STEPS` steps, the integrator restarted at every
 boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
 cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
-mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
+mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded every
 ``output_every`` steps (with the per-contact results of the integrator's last call
 at that state: the compiled force groups' and the bearing rows',
 :class:`flexrv.model.kernels.HistoryRecorder`),

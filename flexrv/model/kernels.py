@@ -8,7 +8,9 @@ kernels (the physics stays in the elements' modules: one formula, one executor) 
 the model's coordinate vector. It backs both the single
 Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 :meth:`FusedForces.add_to`) and :meth:`flexrv.model.assembled.AssembledModel.generalized_forces`.
-Groups of other kinds (ball bearing, flexible crank) keep their own elements.
+Groups of other kinds (ball bearing, flexible crank) keep their own elements. The
+generated ``fused_integrate`` (:mod:`flexrv.model.core.registry`) runs the compiled
+generalized-alpha around the same kernel (:mod:`flexrv.model.integrator`).
 
 Python work per call: Exudyn's argument lists to arrays (``np.asarray``), the
 drive angle and load vector at t (cached per time), one call of the compiled entry
