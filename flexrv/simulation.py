@@ -104,8 +104,9 @@ STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
 #: steps of the compiled integrator between two returns to Python, where the groups' per-step
 #: checks (a skipped pin, a penetration beyond the physical limit), the signals and the progress
-#: report run (the checks then see every CHECK_EVERY-th accepted state)
-CHECK_EVERY = 10
+#: report run: the checks then see every CHECK_EVERY-th accepted state. 25: one pin-mesh period
+#: of the presets at the default step; a return costs ~90 us (mostly the drive and load tables)
+CHECK_EVERY = 25
 
 
 def check_time_options(reducer, t_end: float | None, dt: float = DEFAULT_DT) -> float:

@@ -114,10 +114,11 @@ class CompiledIntegrator:
         self.timed = [(i, g) for i, (g, _) in enumerate(fused.slots) if g.time_field]
         ctrs = [c for _, c in fused.counters]
         self.ctrs = tuple(ctrs) if ctrs else (np.zeros(1, np.int64),)
-        #: the compiled entry point of fused_integrate for this model's argument types (skips numba's
-        #: typing of the ~60 arguments, ~100 us per call; valid while the types stay: every array passed
-        #: is float64/int64/bool C-contiguous, checked in :meth:`_call`'s callers)
-        self._entry = None
+        #: the compiled entry points of fused_integrate for this model's argument types, by the number
+        #: of record arrays (skips numba's typing of the ~60 arguments on every call; valid while the
+        #: types stay: every array :meth:`_call` passes is a fresh or fixed float64/int64/bool
+        #: C-contiguous array of fixed dimension)
+        self._entry = {}
         #: steps of the nominal size per compiled call (the caller's checks run in between)
         self.check_every = 10
 
@@ -231,13 +232,14 @@ class CompiledIntegrator:
             vs,
             valid,
         )
-        if self._entry is None:  # the compiled function for these types, called directly from then on
+        entry = self._entry.get(len(src))  # (the argument types differ only in the number of records)
+        if entry is None:  # the compiled function for these types, called directly from then on
             n, status = fused.integrate_kernel(*args)
             from flexrv.model.kernels import _entry_point
 
-            self._entry = _entry_point(fused.integrate_kernel, args)
+            self._entry[len(src)] = _entry_point(fused.integrate_kernel, args)
         else:
-            n, status = self._entry(*args)
+            n, status = entry(*args)
         for _, g in self.timed:
             g._time_last = None  # the live time inputs now hold the tables' rows
         fused.memo, fused._jac_ready = None, False
