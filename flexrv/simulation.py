@@ -871,6 +871,9 @@ class _CompiledSegments:
         """Integrate steps j .. j_next from the boundary state; False on failure."""
         integ = self.integ
         t0, t1 = plan.t_of(j), plan.t_of(j_next)
+        if not (np.all(np.isfinite(q_b)) and np.all(np.isfinite(v_b))):  # (a restart's state; steps check their own)
+            out.fail = (t0, "the state became NaN/inf")
+            return False
         integ.start(t0, q_b, v_b, a_b)
         self._segments += 1
         self._t = t0
