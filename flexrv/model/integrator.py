@@ -169,17 +169,23 @@ class CompiledIntegrator:
         ``after_call``, else the failure status of ``fused_integrate``."""
         t, step, since = t0, h, 0
         end_recorded = rec[2]
+        grid = self._grid(t0, t1, h)  # the nominal steps' end times and time inputs, while on that grid
+        at = 0  # the next grid step
         while t < t1 - 1e-10:
-            count = 1 if step < h else self.check_every
-            times = t + step * np.arange(1, count + 1)
-            last = np.nonzero(times >= t1 - 1e-10)[0]
-            if len(last):
-                times = times[: last[0] + 1]
-                times[-1] = min(times[-1], t1)
-                rec[2] = end_recorded
+            if step == h and grid is not None:
+                stop = min(at + self.check_every, len(grid[0]))
+                times, tables = grid[0][at:stop], [tb[at:stop] for tb in grid[1]]
             else:
-                rec[2] = 0
-            done, status = self._call(times, t, out, rec)
+                grid = None
+                times = t + step * np.arange(1, (self.check_every if step == h else 1) + 1)
+                last = np.nonzero(times >= t1 - 1e-10)[0]
+                if len(last):
+                    times = times[: last[0] + 1]
+                    times[-1] = min(times[-1], t1)
+                tables = self.tables(times)
+            rec[2] = end_recorded if times[-1] >= t1 - 1e-10 else 0
+            done, status = self._call(times, t, out, rec, tables)
+            at += done
             if done:
                 t = float(times[done - 1])
                 since += done
@@ -193,6 +199,16 @@ class CompiledIntegrator:
             if after_call(t, done):
                 return -1, t
         return 0, t
+
+    def _grid(self, t0: float, t1: float, h: float) -> tuple | None:
+        """(end times t0 + k h of a segment's nominal steps, the last clipped to t1, their time
+        inputs): one vectorised evaluation per segment instead of one per compiled call."""
+        n = int(np.ceil((t1 - t0) / h - 1e-9))
+        if n < 1:
+            return None
+        times = t0 + h * np.arange(1, n + 1)
+        times[-1] = min(times[-1], t1)
+        return times, self.tables(times)
 
     def tables(self, times: np.ndarray) -> list:
         """The time inputs of the timed elements at ``times`` (one row per time)."""
@@ -210,14 +226,14 @@ class CompiledIntegrator:
         st = self.state
         st.q[:], st.v[:], st.a[:] = st.q0, st.v0, st.a0
 
-    def _call(self, times, t_prev, out, rec) -> tuple[int, int]:
+    def _call(self, times, t_prev, out, rec, tables) -> tuple[int, int]:
         fused = self.fused
         ts, qs, vs, src, dst, valid, rec_t = out
         args = (
             self.state,
             times,
             float(t_prev),
-            *self.tables(times),
+            *tables,
             fused.f,
             fused.jq,
             fused.jv,
