@@ -45,6 +45,8 @@ SECTIONS: dict[str, dict[str, str]] = {
         "(0 to +-412 N m) and identification of the pins in mesh from it. Authors not given.",
     },
     "Books and papers": {
+        "arnold2007": "Arnold, M., Brüls, O. (2007). Convergence of the generalized-alpha scheme for "
+        "constrained mechanical systems. *Multibody System Dynamics* 18(2), 185-202.",
         "bates1988nonlinear": "Bates, D. M., Watts, D. G. (1988). *Nonlinear Regression Analysis and Its "
         "Applications*. Wiley, New York.",
         "blagojevic2011": "Blagojevic, M. et al. (2011). Two-stage cycloidal (RV-type) speed reducer. Cited in "
@@ -57,6 +59,9 @@ SECTIONS: dict[str, dict[str, str]] = {
         "Van Nostrand Reinhold, New York.",
         "chen2008": "Chen et al. (2008). Cycloid-drive force analysis with initial clearances. As cited in the "
         "code; authors, title and venue not verified.",
+        "chung1993": "Chung, J., Hulbert, G. M. (1993). A time integration algorithm for structural dynamics "
+        "with improved numerical dissipation: the generalized-alpha method. *Journal of Applied Mechanics* "
+        "60(2), 371-375.",
         "craig1968": "Craig, R. R., Bampton, M. C. C. (1968). Coupling of substructures for dynamic analyses. "
         "*AIAA Journal* 6(7), 1313-1319.",
         "deb2002nsga2": "Deb, K., Pratap, A., Agarwal, S., Meyarivan, T. (2002). A fast and elitist "

@@ -4,15 +4,20 @@
 >>> res = Simulation("rv40e").run(t_end=0.3, dt=1e-4)     # doctest: +SKIP
 >>> res["TE [arcsec]"]                                    # doctest: +SKIP
 
-Integration: Exudyn's implicit generalized-alpha (spectral radius 0.5 to damp
-the stiff contact modes numerically) with modified Newton and analytic group
-Jacobians (for the small dense systems of the rigid model a fresh Jacobian at
-every step); adaptive step reduction on Newton failure. A run is integrated in
+Integration: the implicit generalized-alpha (spectral radius 0.5 to damp the stiff
+contact modes numerically) with modified Newton, a fresh analytic Jacobian at every step
+for the small dense systems, and adaptive step reduction on Newton failure, run by one of
+two integrators (``Simulation.run(integrator=...)``, docs/integrator.md): ``"compiled"``
+(:mod:`flexrv.model.integrator`: the step loop compiled around the fused force kernel,
+the default for models whose forces are all compiled kernels, e.g. the rigid model) or
+``"exudyn"`` (Exudyn's solver with the forces as Python user functions: the reference,
+and the default for models with Python force groups). Both take the same steps with the
+same Newton iterations (tests/test_integrator.py). A run is integrated in
 segments of :data:`SEGMENT_STEPS` steps, the integrator restarted at every
 boundary from the reached state with every group's history reset, so a
 checkpoint (always at a boundary) resumes bit-identically (:meth:`Simulation.run`;
 cost within the timing noise: rv40e 0.72 s CPU segmented vs 0.72-1.07 s not, TE
-mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded by a pre-step hook every
+mean unchanged to 1e-5 arcsec, p-p to 0.01 %). States are recorded every
 ``output_every`` steps (with the per-contact results of the integrator's last call
 at that state: the compiled force groups' and the bearing rows',
 :class:`flexrv.model.kernels.HistoryRecorder`),
@@ -96,6 +101,12 @@ SEGMENT_STEPS = 1000
 
 #: signal numbers that stop a run gracefully (partial results kept): Ctrl-C, kill
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
+
+#: steps of the compiled integrator between two returns to Python, where the groups' per-step
+#: checks (a skipped pin, a penetration beyond the physical limit), the signals and the progress
+#: report run: the checks then see every CHECK_EVERY-th accepted state. 25: one pin-mesh period
+#: of the presets at the default step; a return costs ~90 us (mostly the drive and load tables)
+CHECK_EVERY = 25
 
 
 def check_time_options(reducer, t_end: float | None, dt: float = DEFAULT_DT) -> float:
@@ -193,11 +204,19 @@ class Simulation:
         segment_steps: int = SEGMENT_STEPS,
         restart: dict | None = None,
         record_outputs: bool = True,
+        integrator: str | None = None,
     ):
         """Integrate to ``t_end`` [s] with step ``dt`` [s]; return :class:`flexrv.post.Results`.
 
         ``progress``: True for a rich progress bar, or a callable ``f(t, t_end)``.
         Default ``t_end``: load ramp end + 0.2 s (steady window after the ramps).
+
+        ``integrator``: ``"compiled"`` (the compiled generalized-alpha around the fused
+        kernel, :mod:`flexrv.model.integrator`; the default for models whose forces all
+        live in compiled kernels, e.g. the rigid model), ``"exudyn"`` (Exudyn's solver, the
+        reference; the default for models with Python groups: balls, flexible rings,
+        flexible crank) or None (that default). Both run the same algorithm and Newton
+        control (docs/integrator.md); the choice is recorded as ``attrs["integrator"]``.
 
         Segments: the run is integrated in segments of ``segment_steps`` steps (step
         index j = 0, S, 2S, ... at t = j dt); at every boundary the integrator is
@@ -207,9 +226,9 @@ class Simulation:
         (:meth:`~flexrv.model.base.ForceGroup.reset`: warm starts, caches). The state
         at a boundary is therefore everything the rest of the run depends on, and a
         run resumed from a boundary (:meth:`resume`) repeats exactly, bit for bit,
-        what the uninterrupted run did. The restart's one approximation: Exudyn
-        restarts the generalized-alpha's algorithmic accelerations from the given
-        accelerations (it has no setter for them), i.e. a_alg := a at the boundary;
+        what the uninterrupted run did. The restart's one approximation: the
+        generalized-alpha's algorithmic accelerations restart from the given
+        accelerations (Exudyn has no setter for them), i.e. a_alg := a at the boundary;
         with spectral radius 0.5 (alpha_m = 0, alpha_f = 1/3, gamma = 5/6) that
         changes the first step's velocity by (1 - gamma) h (a_alg - a) =
         h (a_n-1 - a_n) / 18, of the order of the scheme's own local error (rv40e:
@@ -221,7 +240,8 @@ class Simulation:
         every ``checkpoint_s`` seconds of wall time (``checkpoint.npz``: the records
         and the boundary state; a partial ``results.nc`` with status "running"; both
         atomic), so a killed run loses at most the last interval. SIGINT (Ctrl-C) and
-        SIGTERM stop the run after the current step: the results up to then are
+        SIGTERM stop the run after the current step (the compiled integrator: after
+        the current check interval): the results up to then are
         returned with status "interrupted" (and saved with ``save_to``, where the
         checkpoint is the last segment boundary reached); ``results.attrs["signal"]``
         names the signal.
@@ -238,216 +258,51 @@ class Simulation:
         evaluated again from the recorded states, every pin gap exact (rv40e: +0.2-0.3
         s CPU per simulated s).
         """
-
-        t_end = check_time_options(self.reducer, t_end, dt)
-        seg = int(segment_steps)
-        if seg < 1:
-            raise InputError(f"segment_steps = {segment_steps!r} is not allowed: must be an integer >= 1")
-        n_total = max(int(round(t_end / dt)), 1)  # step j ends at t = j dt, the last one at t_end
-
-        def t_of(j: int) -> float:
-            return float(t_end) if j >= n_total else j * dt
-
-        j0 = 0 if restart is None else int(restart["step"])
-        t_start = t_of(j0)
-        if restart is not None and not j0 < n_total:
-            raise InputError(f"t_end = {t_end:g} s is not allowed: must be > the checkpoint time {t_start:g} s")
-        check_step_count(t_end, dt, output_every, t_start=t_start)
+        plan = _RunPlan.of(self.reducer, t_end, dt, output_every, segment_steps, restart)
         import exudyn as exu
 
         newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        if integrator is not None and integrator not in INTEGRATORS:
+            raise InputError(f"integrator = {integrator!r} is not allowed: choose from {', '.join(INTEGRATORS)}")
         model = self.model if self.model is not None else self.build()
-        if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
-            newton_options = MODEL_NEWTON.get(self.model_name, {}) | newton_options  # the user's settings win
-
-        from flexrv.model.kernel_cache import announce_compile, stop_now
-
-        kinds = (["fused"] if model.fused is not None else []) + (
-            ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
-        )
-        announce_compile(kinds=kinds)  # one line on stderr if the numba kernels compile now (first run)
-        mbs = model.mbs
-        n_steps = check_step_count(t_end, dt, output_every, model.n, t_start=t_start)
-        k0 = 0 if restart is None else len(restart["t"])
-        n_out = k0 + n_steps // output_every + 2
-        ts = np.empty(n_out)
-        qs = np.empty((n_out, model.n))
-        vs = np.empty((n_out, model.n))
-        state = {"k": 0, "step": 0, "fail": None, "stop": False, "signal": None}
-        if restart is None:
-            q_b, v_b, a_b = model.q0.copy(), np.concatenate([m.v0 for m in model.members.values()]), None
+        plan.check_size(model.n)
+        kind = choose_integrator(model, integrator)
+        _announce_compile(model)
+        if kind == "compiled":
+            segments = _CompiledSegments(model, spectral_radius, newton_tolerance, newton_options, plan)
         else:
-            ts[:k0], qs[:k0], vs[:k0] = (np.asarray(restart[key], dtype=float) for key in ("t", "q", "v"))
-            q_b, v_b, a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
-            state["k"] = k0
-        # the recording elements' records at every sample, from the integrator's own calls
-        recorder = None
-        if record_outputs:
-            from flexrv.model.kernels import HistoryRecorder
-
-            recorder = HistoryRecorder(model, n_out)
-            if not recorder.sources:
-                recorder = None
-            elif restart is not None and restart.get("records") is not None:
-                recorder.fill(k0, *restart["records"])
+            segments = _ExudynSegments(model, self.model_name, spectral_radius, newton_tolerance, newton_options)
+        records = _Records(model, plan, restart, record_outputs)
         checkpoint = None
         if save_to is not None and checkpoint_s is not None and checkpoint_s > 0:
-            checkpoint = _Checkpointer(self, Path(save_to), t_end, dt, output_every, seg, float(checkpoint_s))
+            checkpoint = _Checkpointer(self, Path(save_to), plan.t_end, dt, output_every, plan.seg, float(checkpoint_s))
             checkpoint.meta.update(
                 newton_tolerance=list(newton_tolerance),
                 spectral_radius=spectral_radius,
-                newton_options=dict(newton_options or {}),
+                newton_options=newton_options,
+                integrator=kind,
             )
-            checkpoint.recorder = recorder
-        report = _progress_callback(progress, t_end)
-        sd = mbs.systemData
-
-        start_of_step = exu.ConfigurationType.StartOfStep
-
-        from flexrv.model.base import ForceGroup, exudyn_vector
-
-        # only the groups that override the per-step hooks (the others' are no-ops), in group order
-        steppers = [g for g in model.groups if type(g).new_step is not ForceGroup.new_step]
-        checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
-
-        def prestep(mbs_, t_target):
-            # Exudyn calls this with the step's END time; the state is the start-of-step state
-            t = sd.GetTime(start_of_step)
-            values = sd.GetODE2Coordinates()
-            k = state["k"]
-            while k > 0 and ts[k - 1] >= t - 1e-12 * dt:  # a step was repeated (adaptive step reduction)
-                k -= 1
-            state["k"] = k
-            # before recording: a failed run's results hold finite states only (the sum of the Python
-            # floats: 0.3 us, numpy's 2.5 us per step)
-            if not math.isfinite(sum(values)):
-                state["fail"] = (t, "the state became NaN/inf")
-                return False
-            q = exudyn_vector(values)
-            if (k == 0 or t >= ts[k - 1] + output_every * dt * (1 - 1e-9)) and k < n_out:
-                ts[k] = t
-                qs[k] = q
-                vs[k] = exudyn_vector(sd.GetODE2Coordinates_t())
-                if recorder is not None:
-                    recorder.store(k, t, q, vs[k])
-                state["k"] = k + 1
-            state["step"] += 1
-            for g in steppers:
-                g.new_step()
-            for g in checkers:
-                msg = g.check()
-                if msg:
-                    state["fail"] = (t, msg)
-                    return False
-            if state["stop"]:
-                return False
-            if report is not None and state["step"] % 200 == 0:
-                report(t)
-            return True
-
-        mbs.SetPreStepUserFunction(prestep)
-        ss = exu.SimulationSettings()
-        ti = ss.timeIntegration
-        ti.verboseMode = 0
-        ti.newton.useModifiedNewton = True
-        # small dense systems (the rigid model): a fresh Jacobian at the start of every step. The
-        # contact stiffness changes from step to step, so a reused Jacobian needed 3.7-4.6 Newton
-        # iterations per step (rv40e / rv221), a fresh one 1.3-1.9: fewer residual calls, whose Python
-        # round trip is most of a step (benchmarks/bench_rigid.py, tests/test_time_step.py)
-        ti.newton.modifiedNewtonJacUpdatePerStep = model.n <= SPARSE_ABOVE
-        ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
-        ti.generalizedAlpha.spectralRadius = spectral_radius
-        for key, value in newton_options.items():
-            setattr(ti.newton, key, value)
-        if model.fused is not None:  # its Jacobians then come with the step's first residual
-            model.fused.jacobian_each_step = bool(
-                ti.newton.useModifiedNewton and ti.newton.modifiedNewtonJacUpdatePerStep
-            )
-        # massless (quasi-static) coordinates make M singular: start from rest with
-        # zero accelerations instead (every run starts at rest in equilibrium)
-        massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
-        ti.adaptiveStep = True
-        ti.minimumStepSize = dt * 1e-3
-        ss.solution.file.write = False
-        # dense LU for the small rigid models; sparse for the ball/ring models, whose
-        # dense path costs 2-4x more in Exudyn (rv40e flexible: 10.2 -> 4.1 s per 10 ms)
-        ss.linearSolver.solverType = (
-            exu.LinearSolverType.EXUdense if model.n <= SPARSE_ABOVE else exu.LinearSolverType.EigenSparse
-        )
-
-        def on_stop(signum, frame):
-            state["stop"] = True
-            state["signal"] = signal.Signals(signum).name
-            if state["step"] == 0:  # nothing integrated yet (numba may compile for minutes): nothing to keep
-                stop_now(signum)
-
-        old = {}
-        for name in STOP_SIGNALS:
-            try:
-                sig = getattr(signal, name)
-                old[sig] = signal.signal(sig, on_stop)
-            except ValueError:  # not in the main thread
-                break
+            checkpoint.recorder = records.recorder
+        report = _progress_callback(progress, plan.t_end)
         for g in model.groups:
             g.stats[0] = g.stats[1] = 0
-        ic = exu.ConfigurationType.Initial
-        #: the last segment boundary reached: (step index, records before it, q, v, a)
-        boundary = (j0, state["k"], q_b, v_b, a_b)
         t0, c0 = _time.perf_counter(), _time.process_time()
-        error = None
-        ok = True
-        counts = {"newton": 0, "jacobians": 0, "segments": 0}
-        from flexrv.model.kernels import single_thread_blas
-
-        j = j0
-        try:
-            with single_thread_blas():  # one BLAS thread unless FLEXRV_BLAS_THREADS is set
-                while j < n_total and ok:
-                    j_next = min((j // seg + 1) * seg, n_total)
-                    sd.SetODE2Coordinates(q_b.tolist(), configuration=ic)
-                    sd.SetODE2Coordinates_t(v_b.tolist(), configuration=ic)
-                    sd.SetODE2Coordinates_tt([0.0] * model.n if a_b is None else a_b.tolist(), configuration=ic)
-                    ti.generalizedAlpha.computeInitialAccelerations = a_b is None and not massless
-                    ti.startTime, ti.endTime, ti.numberOfSteps = t_of(j), t_of(j_next), j_next - j
-                    for g in model.groups:
-                        g.reset()
-                    if recorder is not None:  # the groups' records were reset: not those of the last call
-                        recorder.forget()
-                    solver = exu.MainSolverImplicitSecondOrder()
-                    try:
-                        ok = solver.SolveSystem(mbs, ss)
-                    except Exception as exc:  # exudyn raises on Newton failure / user-function errors
-                        ok, error = False, exc
-                    counts["newton"] += int(solver.it.newtonStepsCount)
-                    counts["jacobians"] += int(solver.it.newtonJacobiCount)
-                    counts["segments"] += 1
-                    if not ok or state["fail"] is not None or state["stop"]:
-                        ok = False
-                        break
-                    q_b = np.array(sd.GetODE2Coordinates())
-                    v_b = np.array(sd.GetODE2Coordinates_t())
-                    a_b = np.array(sd.GetODE2Coordinates_tt())
-                    j = j_next
-                    boundary = (j, state["k"], q_b, v_b, a_b)
-                    if checkpoint is not None and j < n_total:
-                        checkpoint.maybe_write(model, ts, qs, vs, boundary)
-        finally:
-            for sig, handler in old.items():
-                signal.signal(sig, handler)
+        with _StopSignals() as stop:
+            outcome = _segment_loop(plan, segments, records, checkpoint, stop, report)
         wall, cpu = _time.perf_counter() - t0, _time.process_time() - c0
         if report is not None:
             report(None)
-        k = state["k"]
-        if ok and j >= n_total and k < n_out and (k == 0 or t_end > ts[k - 1]):  # final state
-            ts[k], qs[k], vs[k] = t_end, q_b, v_b
-            if recorder is not None:
-                recorder.store(k, t_end, q_b, v_b)
-            k += 1
+        self.timing.update(solve_s=wall, solve_cpu_s=cpu, integrator=kind)
+        return self._finish(model, plan, segments, records, checkpoint, stop, outcome, save_to)
+
+    def _finish(self, model, plan, segments, records, checkpoint, stop, outcome, save_to):
+        """Timing, status and results of a run (raising SimulationError with the partial
+        results if it failed)."""
+        k = records.k
+        counts = segments.counts()
         self.timing.update(
-            solve_s=wall,
-            solve_cpu_s=cpu,
-            steps=state["step"],
-            simulated_s=float(ts[k - 1]) if k else 0.0,
+            steps=outcome.steps,
+            simulated_s=float(records.ts[k - 1]) if k else 0.0,
             newton_iterations=counts["newton"],
             jacobians=counts["jacobians"],
             segments=counts["segments"],
@@ -456,54 +311,30 @@ class Simulation:
             jacobian_calls={g.name: g.stats[1] for g in model.groups},
         )
         status = "completed"
-        if state["fail"] is not None or (not ok and not state["stop"]):
+        if outcome.fail is not None or (not outcome.ok and not stop.stop):
             status = "failed"
-        elif state["stop"]:
+        elif stop.stop:
             status = "interrupted"
         from flexrv.post.results import results_from_states
 
         res = results_from_states(
             model,
-            ts[:k],
-            qs[:k],
-            vs[:k],
-            dt=dt,
+            records.ts[:k],
+            records.qs[:k],
+            records.vs[:k],
+            dt=plan.dt,
             status=status,
             timing=self.timing,
             cls=Results,
-            records=recorder.records(k) if recorder is not None else None,
+            records=records.recorder.records(k) if records.recorder is not None else None,
         )
-        if state["signal"] is not None:
-            res.attrs["signal"] = state["signal"]
+        res.attrs["integrator"] = self.timing["integrator"]
+        if stop.signal is not None:
+            res.attrs["signal"] = stop.signal
         if checkpoint is not None:  # the last boundary (the complete run: a resume of it is refused as complete)
-            checkpoint.write_states(ts, qs, vs, boundary)
+            checkpoint.write_states(records.ts, records.qs, records.vs, outcome.boundary)
         if status == "failed":
-            detail = " ".join(str(error).split())[:200] if error is not None else ""
-            t_fin = float(sd.GetTime())
-            t_fail, cause = (
-                state["fail"] if state["fail"] is not None else (t_fin, f"Newton iteration failed ({detail})")
-            )
-            res.attrs["failure"] = f"t = {t_fail:.6g} s: {cause}"
-            path = None
-            if save_to is not None and k > 1:
-                path = res.save(save_to)
-            if t_fail <= t_start + 2 * dt:  # at the very start: the assembled design, not the step
-                advice = (
-                    "the design cannot start from rest: check the profile modifications and clearances "
-                    "(second_stage.modification_*, needle_bearing.radial_clearance_um, first_stage.backlash_um) "
-                    "for interference at assembly"
-                )
-            else:
-                advice = (
-                    f"reduce the step (dt = {dt:g} s -> {dt / 2:g} s) or increase contact damping "
-                    "(contact.pin_max_damping_Ns_per_m)"
-                )
-            msg = f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: {advice}" + (
-                f"; partial results saved to {path}" if path else "; partial results in exc.results"
-            )
-            err = SimulationError(msg)
-            err.results = res
-            raise err
+            raise _failure(res, plan, outcome, segments, save_to, k)
         if status == "interrupted" and save_to is not None and k > 1:
             res.save(save_to)
         return res
@@ -545,6 +376,7 @@ class Simulation:
         run_options.setdefault("newton_tolerance", tuple(meta.get("newton_tolerance", DEFAULT_NEWTON_TOLERANCE)))
         run_options.setdefault("spectral_radius", meta.get("spectral_radius", 0.5))
         run_options.setdefault("newton_options", meta.get("newton_options") or None)
+        run_options.setdefault("integrator", meta.get("integrator"))  # (older checkpoints: the model's default)
         t, q, v = ck["t"], ck["q"], ck["v"]
         restart = {
             "t": t[:-1],
@@ -669,6 +501,441 @@ class _Checkpointer:
             records=self.recorder.arrays(k) if self.recorder is not None else None,
         )
         self.spent += _time.perf_counter() - t0
+
+
+#: the integrators of :meth:`Simulation.run` (``integrator``)
+INTEGRATORS = ("compiled", "exudyn")
+
+
+def choose_integrator(model, integrator: str | None) -> str:
+    """The integrator of a run: ``integrator`` checked (InputError naming the value and the
+    allowed ones; "compiled" for a model with Python groups: InputError with the reason), or
+    the default: "compiled" where :func:`flexrv.model.integrator.compiled_eligible`, else "exudyn"."""
+    from flexrv.model.integrator import compiled_eligible
+
+    if integrator is not None and integrator not in INTEGRATORS:
+        raise InputError(f"integrator = {integrator!r} is not allowed: choose from {', '.join(INTEGRATORS)}")
+    reason = compiled_eligible(model)
+    if integrator == "compiled" and reason is not None:
+        raise InputError(
+            f"integrator = 'compiled' is not allowed for the {model.name} model: {reason}; use --integrator exudyn"
+        )
+    if integrator is None:
+        return "compiled" if reason is None else "exudyn"
+    return integrator
+
+
+def _announce_compile(model) -> None:
+    """One line on stderr if the model's numba kernels compile now (first run)."""
+    from flexrv.model.kernel_cache import announce_compile
+
+    kinds = (["fused"] if model.fused is not None else []) + (
+        ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
+    )
+    announce_compile(kinds=kinds)
+
+
+class _RunPlan:
+    """The time grid of a run: step j ends at t = j dt (the last at t_end), segments of
+    ``seg`` steps, the first step index ``j0`` (a restart's boundary)."""
+
+    def __init__(self, t_end, dt, output_every, seg, j0):
+        self.t_end, self.dt, self.output_every, self.seg, self.j0 = float(t_end), dt, int(output_every), seg, j0
+        self.n_total = max(int(round(t_end / dt)), 1)  # step j ends at t = j dt, the last one at t_end
+        self.t_start = self.t_of(j0)
+
+    @classmethod
+    def of(cls, reducer, t_end, dt, output_every, segment_steps, restart) -> "_RunPlan":
+        """Checked options (InputError naming the value)."""
+        t_end = check_time_options(reducer, t_end, dt)
+        seg = int(segment_steps)
+        if seg < 1:
+            raise InputError(f"segment_steps = {segment_steps!r} is not allowed: must be an integer >= 1")
+        j0 = 0 if restart is None else int(restart["step"])
+        plan = cls(t_end, dt, output_every, seg, j0)
+        if restart is not None and not j0 < plan.n_total:
+            raise InputError(f"t_end = {t_end:g} s is not allowed: must be > the checkpoint time {plan.t_start:g} s")
+        check_step_count(t_end, dt, output_every, t_start=plan.t_start)
+        return plan
+
+    def t_of(self, j: int) -> float:
+        return self.t_end if j >= self.n_total else j * self.dt
+
+    def check_size(self, n: int) -> int:
+        self.n_steps = check_step_count(self.t_end, self.dt, self.output_every, n, t_start=self.t_start)
+        return self.n_steps
+
+
+class _Records:
+    """The recorded states (t, q, v) of a run, the row count ``k`` and the per-contact
+    records (:class:`flexrv.model.kernels.HistoryRecorder`, or None); the boundary state
+    to start from (a restart's, or the model's initial state)."""
+
+    def __init__(self, model, plan: _RunPlan, restart: dict | None, record_outputs: bool):
+        k0 = 0 if restart is None else len(restart["t"])
+        self.n_out = n_out = k0 + plan.n_steps // plan.output_every + 2
+        self.ts, self.qs, self.vs = np.empty(n_out), np.empty((n_out, model.n)), np.empty((n_out, model.n))
+        self.k = k0
+        if restart is None:
+            self.q_b, self.v_b, self.a_b = model.q0.copy(), np.concatenate([m.v0 for m in model.members.values()]), None
+        else:
+            self.ts[:k0], self.qs[:k0], self.vs[:k0] = (
+                np.asarray(restart[key], dtype=float) for key in ("t", "q", "v")
+            )
+            self.q_b, self.v_b, self.a_b = (np.array(restart[key], dtype=float) for key in ("q_b", "v_b", "a_b"))
+        self.recorder = None
+        if record_outputs:
+            from flexrv.model.kernels import HistoryRecorder
+
+            recorder = HistoryRecorder(model, n_out)
+            if recorder.sources:
+                self.recorder = recorder
+                if restart is not None and restart.get("records") is not None:
+                    recorder.fill(k0, *restart["records"])
+
+    def due(self, j: int, plan: _RunPlan) -> bool:
+        """Whether the state at the end of step j is recorded (every output_every steps, and the end)."""
+        return (self.k == 0 or j % plan.output_every == 0 or j >= plan.n_total) and self.k < self.n_out
+
+    def append(self, t: float, q, v) -> None:
+        """Record a state whose per-contact records are left to the outputs' history pass."""
+        k = self.k
+        self.ts[k], self.qs[k], self.vs[k] = t, q, v
+        self.k = k + 1
+
+
+class _StopSignals:
+    """SIGINT/SIGTERM stop a run gracefully while inside: ``stop`` set, ``signal`` named;
+    before the first step (numba may compile for minutes) the process exits at once
+    (130 / 143, :func:`flexrv.model.kernel_cache.stop_now`)."""
+
+    def __init__(self):
+        self.stop, self.signal, self.step, self._old = False, None, 0, {}
+
+    def _on_stop(self, signum, frame):
+        from flexrv.model.kernel_cache import stop_now
+
+        self.stop = True
+        self.signal = signal.Signals(signum).name
+        if self.step == 0:  # nothing integrated yet: nothing to keep
+            stop_now(signum)
+
+    def __enter__(self):
+        for name in STOP_SIGNALS:
+            try:
+                sig = getattr(signal, name)
+                self._old[sig] = signal.signal(sig, self._on_stop)
+            except ValueError:  # not in the main thread
+                break
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self._old.items():
+            signal.signal(sig, handler)
+        return False
+
+
+class _Outcome:
+    """How a segment loop ended: ``ok``, the failure (t, cause) or error, the steps taken
+    and the last boundary reached: (step index, records before it, q, v, a)."""
+
+    def __init__(self, boundary):
+        self.ok, self.fail, self.error, self.steps, self.boundary = True, None, None, 0, boundary
+
+
+def _segment_loop(plan: _RunPlan, segments, records: _Records, checkpoint, stop: _StopSignals, report) -> _Outcome:
+    """Integrate segment by segment (:meth:`Simulation.run`) with ``segments`` (Exudyn's or
+    the compiled integrator): restart at every boundary, checkpoint there, stop on a
+    failure or a signal."""
+    from flexrv.model.kernels import single_thread_blas
+
+    out = _Outcome((plan.j0, records.k, records.q_b, records.v_b, records.a_b))
+    j = plan.j0
+    q_b, v_b, a_b = records.q_b, records.v_b, records.a_b
+    with single_thread_blas():  # one BLAS thread unless FLEXRV_BLAS_THREADS is set
+        while j < plan.n_total:
+            j_next = min((j // plan.seg + 1) * plan.seg, plan.n_total)
+            ok = segments.segment(j, j_next, q_b, v_b, a_b, plan, records, stop, report, out)
+            if not ok or out.fail is not None or stop.stop:
+                out.ok = False
+                break
+            q_b, v_b, a_b = segments.boundary_state()
+            j = j_next
+            out.boundary = (j, records.k, q_b, v_b, a_b)
+            if checkpoint is not None and j < plan.n_total:
+                checkpoint.maybe_write(segments.model, records.ts, records.qs, records.vs, out.boundary)
+    records.q_b, records.v_b = q_b, v_b
+    if out.ok and j >= plan.n_total:
+        segments.final(plan, records)
+    return out
+
+
+def _failure(res, plan: _RunPlan, outcome: _Outcome, segments, save_to, k: int) -> SimulationError:
+    """The SimulationError of a failed run (its partial results attached, saved with ``save_to``)."""
+    error = outcome.error
+    detail = " ".join(str(error).split())[:200] if error is not None else ""
+    t_fail, cause = (
+        outcome.fail if outcome.fail is not None else (segments.time_reached(), f"Newton iteration failed ({detail})")
+    )
+    res.attrs["failure"] = f"t = {t_fail:.6g} s: {cause}"
+    path = None
+    if save_to is not None and k > 1:
+        path = res.save(save_to)
+    dt = plan.dt
+    if t_fail <= plan.t_start + 2 * dt:  # at the very start: the assembled design, not the step
+        advice = (
+            "the design cannot start from rest: check the profile modifications and clearances "
+            "(second_stage.modification_*, needle_bearing.radial_clearance_um, first_stage.backlash_um) "
+            "for interference at assembly"
+        )
+    else:
+        advice = (
+            f"reduce the step (dt = {dt:g} s -> {dt / 2:g} s) or increase contact damping "
+            "(contact.pin_max_damping_Ns_per_m)"
+        )
+    msg = f"simulation failed at t = {t_fail:.6g} s: {cause}. Suggestion: {advice}" + (
+        f"; partial results saved to {path}" if path else "; partial results in exc.results"
+    )
+    err = SimulationError(msg)
+    err.results = res
+    return err
+
+
+class _ExudynSegments:
+    """Segments on Exudyn's implicit generalized-alpha (modified Newton, adaptive step);
+    a pre-step hook records the states, runs the groups' per-step checks and stops on a signal."""
+
+    def __init__(self, model, model_name: str, spectral_radius, newton_tolerance, newton_options):
+        import exudyn as exu
+
+        self.exu, self.model = exu, model
+        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
+            newton_options = MODEL_NEWTON.get(model_name, {}) | newton_options  # the user's settings win
+        self.ss = ss = exu.SimulationSettings()
+        ti = self.ti = ss.timeIntegration
+        ti.verboseMode = 0
+        ti.newton.useModifiedNewton = True
+        # small dense systems (the rigid model): a fresh Jacobian at the start of every step. The
+        # contact stiffness changes from step to step, so a reused Jacobian needed 3.7-4.6 Newton
+        # iterations per step (rv40e / rv221), a fresh one 1.3-1.9: fewer residual calls, whose Python
+        # round trip is most of a step (benchmarks/bench_rigid.py, tests/test_time_step.py)
+        ti.newton.modifiedNewtonJacUpdatePerStep = model.n <= SPARSE_ABOVE
+        ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton_tolerance
+        ti.generalizedAlpha.spectralRadius = spectral_radius
+        for key, value in newton_options.items():
+            setattr(ti.newton, key, value)
+        if model.fused is not None:  # its Jacobians then come with the step's first residual
+            model.fused.jacobian_each_step = bool(
+                ti.newton.useModifiedNewton and ti.newton.modifiedNewtonJacUpdatePerStep
+            )
+        # massless (quasi-static) coordinates make M singular: start from rest with
+        # zero accelerations instead (every run starts at rest in equilibrium)
+        self.massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
+        ti.adaptiveStep = True
+        ss.solution.file.write = False
+        # dense LU for the small rigid models; sparse for the ball/ring models, whose
+        # dense path costs 2-4x more in Exudyn (rv40e flexible: 10.2 -> 4.1 s per 10 ms)
+        ss.linearSolver.solverType = (
+            exu.LinearSolverType.EXUdense if model.n <= SPARSE_ABOVE else exu.LinearSolverType.EigenSparse
+        )
+        self._counts = {"newton": 0, "jacobians": 0, "segments": 0}
+        self._hooked = False
+
+    def _install_prestep(self, plan, records, stop, report, out) -> None:
+        """The pre-step hook (once per run): record, check, stop."""
+        from flexrv.model.base import ForceGroup, exudyn_vector
+
+        model, exu = self.model, self.exu
+        sd = model.mbs.systemData
+        start_of_step = exu.ConfigurationType.StartOfStep
+        # only the groups that override the per-step hooks (the others' are no-ops), in group order
+        steppers = [g for g in model.groups if type(g).new_step is not ForceGroup.new_step]
+        checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
+        ts, qs, vs, recorder = records.ts, records.qs, records.vs, records.recorder
+        dt, output_every, n_out = plan.dt, plan.output_every, records.n_out
+
+        def prestep(mbs_, t_target):
+            # Exudyn calls this with the step's END time; the state is the start-of-step state
+            t = sd.GetTime(start_of_step)
+            values = sd.GetODE2Coordinates()
+            k = records.k
+            while k > 0 and ts[k - 1] >= t - 1e-12 * dt:  # a step was repeated (adaptive step reduction)
+                k -= 1
+            records.k = k
+            # before recording: a failed run's results hold finite states only (the sum of the Python
+            # floats: 0.3 us, numpy's 2.5 us per step)
+            if not math.isfinite(sum(values)):
+                out.fail = (t, "the state became NaN/inf")
+                return False
+            q = exudyn_vector(values)
+            if (k == 0 or t >= ts[k - 1] + output_every * dt * (1 - 1e-9)) and k < n_out:
+                ts[k] = t
+                qs[k] = q
+                vs[k] = exudyn_vector(sd.GetODE2Coordinates_t())
+                if recorder is not None:
+                    recorder.store(k, t, q, vs[k])
+                records.k = k + 1
+            out.steps += 1
+            stop.step = out.steps
+            for g in steppers:
+                g.new_step()
+            for g in checkers:
+                msg = g.check()
+                if msg:
+                    out.fail = (t, msg)
+                    return False
+            if stop.stop:
+                return False
+            if report is not None and out.steps % 200 == 0:
+                report(t)
+            return True
+
+        model.mbs.SetPreStepUserFunction(prestep)
+        self._hooked = True
+
+    def segment(self, j, j_next, q_b, v_b, a_b, plan, records, stop, report, out) -> bool:
+        """Integrate steps j .. j_next from the boundary state; False on failure."""
+        if not self._hooked:
+            self._install_prestep(plan, records, stop, report, out)
+        exu, model, ti = self.exu, self.model, self.ti
+        sd = model.mbs.systemData
+        ic = exu.ConfigurationType.Initial
+        ti.minimumStepSize = plan.dt * 1e-3
+        sd.SetODE2Coordinates(q_b.tolist(), configuration=ic)
+        sd.SetODE2Coordinates_t(v_b.tolist(), configuration=ic)
+        sd.SetODE2Coordinates_tt([0.0] * model.n if a_b is None else a_b.tolist(), configuration=ic)
+        ti.generalizedAlpha.computeInitialAccelerations = a_b is None and not self.massless
+        ti.startTime, ti.endTime, ti.numberOfSteps = plan.t_of(j), plan.t_of(j_next), j_next - j
+        for g in model.groups:
+            g.reset()
+        if records.recorder is not None:  # the groups' records were reset: not those of the last call
+            records.recorder.forget()
+        solver = exu.MainSolverImplicitSecondOrder()
+        ok = True
+        try:
+            ok = solver.SolveSystem(model.mbs, self.ss)
+        except Exception as exc:  # exudyn raises on Newton failure / user-function errors
+            ok, out.error = False, exc
+        self._counts["newton"] += int(solver.it.newtonStepsCount)
+        self._counts["jacobians"] += int(solver.it.newtonJacobiCount)
+        self._counts["segments"] += 1
+        return bool(ok)
+
+    def boundary_state(self):
+        sd = self.model.mbs.systemData
+        return (
+            np.array(sd.GetODE2Coordinates()),
+            np.array(sd.GetODE2Coordinates_t()),
+            np.array(sd.GetODE2Coordinates_tt()),
+        )
+
+    def final(self, plan: _RunPlan, records: _Records) -> None:
+        """The end state (the pre-step hook records start-of-step states only)."""
+        k = records.k
+        if k < records.n_out and (k == 0 or plan.t_end > records.ts[k - 1]):
+            records.ts[k], records.qs[k], records.vs[k] = plan.t_end, records.q_b, records.v_b
+            if records.recorder is not None:
+                records.recorder.store(k, plan.t_end, records.q_b, records.v_b)
+            records.k = k + 1
+
+    def time_reached(self) -> float:
+        return float(self.model.mbs.systemData.GetTime())
+
+    def counts(self) -> dict:
+        return dict(self._counts)
+
+
+class _CompiledSegments:
+    """Segments on the compiled generalized-alpha (:mod:`flexrv.model.integrator`): the
+    steps of a segment in compiled code, back in Python every :data:`CHECK_EVERY` steps
+    for the groups' per-step checks, the signals and the progress report."""
+
+    def __init__(self, model, spectral_radius, newton_tolerance, newton_options, plan: _RunPlan):
+        from flexrv.model.base import ForceGroup
+        from flexrv.model.integrator import CompiledIntegrator, compiled_newton_options
+
+        self.model = model
+        options = dict(newton_options or {})
+        tolerance = (
+            options.pop("relativeTolerance", newton_tolerance[0]),
+            options.pop("absoluteTolerance", newton_tolerance[1]),
+        )
+        self.integ = CompiledIntegrator(model, spectral_radius, tolerance, compiled_newton_options(options))
+        self.integ.check_every = CHECK_EVERY
+        self.checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
+        self._segments = 0
+        self._t = plan.t_start
+
+    def segment(self, j, j_next, q_b, v_b, a_b, plan, records, stop, report, out) -> bool:
+        """Integrate steps j .. j_next from the boundary state; False on failure."""
+        integ = self.integ
+        t0, t1 = plan.t_of(j), plan.t_of(j_next)
+        if not (np.all(np.isfinite(q_b)) and np.all(np.isfinite(v_b))):  # (a restart's state; steps check their own)
+            out.fail = (t0, "the state became NaN/inf")
+            return False
+        integ.start(t0, q_b, v_b, a_b)
+        self._segments += 1
+        self._t = t0
+        interval = plan.output_every * plan.dt * (1 - 1e-9)
+        k = records.k
+        if k < records.n_out and (k == 0 or t0 >= records.ts[k - 1] + interval):  # as the pre-step hook at t0
+            records.append(t0, q_b, v_b)  # its per-contact records are left to the history pass
+        buffers = integ.outputs(records.ts, records.qs, records.vs, records.recorder, interval)
+        if records.k:
+            buffers[-1][0] = records.ts[records.k - 1]
+        # the segment's end is recorded as the next segment's start, unless it is the run's end
+        rec = np.array([records.k, records.n_out, int(j_next < plan.n_total)], np.int64)
+
+        def after_call(t, steps):
+            records.k = int(rec[0])
+            reported = out.steps // 200
+            out.steps = stop.step = out.steps + steps
+            self._t = t
+            for g in self.checkers:
+                msg = g.check()
+                if msg:
+                    out.fail = (t, msg)
+                    return True
+            if report is not None and out.steps // 200 > reported:
+                report(t)
+            return stop.stop
+
+        status, self._t = integ.segment(t0, t1, plan.dt, rec, buffers, after_call)
+        records.k = int(rec[0])
+        self._sync_stats()
+        if status > 0:
+            out.fail = (self._t, integ.failure(status))
+        return status == 0
+
+    def _sync_stats(self) -> None:
+        c = self.integ.counts()
+        self.integ.fused.stats[0], self.integ.fused.stats[1] = c["calls"], c["jacobian_calls"]
+
+    def boundary_state(self):
+        i = self.integ
+        return i.q.copy(), i.v.copy(), i.a.copy()
+
+    def final(self, plan: _RunPlan, records: _Records) -> None:
+        """The end state if the compiled loop's output interval skipped it (as the Exudyn
+        path's), with the per-contact records of its last call (the converged end state)."""
+        k = records.k
+        if k < records.n_out and (k == 0 or plan.t_end > records.ts[k - 1]):
+            records.append(plan.t_end, self.integ.q, self.integ.v)
+            if records.recorder is not None:
+                for i, (element, _, _, src, dst) in enumerate(records.recorder.sources):
+                    if element is self.integ.fused:
+                        for a, d in zip(src, dst):
+                            d[k] = a
+                        records.recorder.valid[i, k] = True
+
+    def time_reached(self) -> float:
+        return self._t
+
+    def counts(self) -> dict:
+        self._sync_stats()
+        c = self.integ.counts()
+        return {"newton": c["newton"], "jacobians": c["jacobians"], "segments": self._segments}
 
 
 def _newton_settings(exu) -> dict[str, object]:

@@ -82,6 +82,12 @@ DT_HELP = (
     "2 % of a 2.5e-5 s reference on rv40e, rigid and ball models, tests/test_time_step.py)."
 )
 CHECKPOINT_HELP = "Wall time between two checkpoints of the results into --out [s] (0: none)."
+INTEGRATOR_HELP = (
+    "Time integrator: 'compiled' (the compiled generalized-alpha around the fused force kernel; the "
+    "default for models whose forces are all compiled, e.g. --model rigid) or 'exudyn' (Exudyn's "
+    "solver, the reference; the default for models with Python force groups: balls, flexible). "
+    "Same algorithm and Newton control, docs/integrator.md."
+)
 
 
 def _exit_code(res) -> int:
@@ -107,6 +113,7 @@ def simulate(
         None, "--resume", help="Continue a killed run from the last checkpoint in this output directory."
     ),
     checkpoint: float = typer.Option(10.0, "--checkpoint-s", help=CHECKPOINT_HELP),
+    integrator: str = typer.Option(None, "--integrator", help=INTEGRATOR_HELP),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
     """Run the multibody model; write NetCDF, config, summary.md and PNGs.
@@ -131,7 +138,8 @@ def simulate(
         check_output_dir(resume, "--resume", allow_existing=True)
         out = resume
         try:
-            sim, res = Simulation.resume(resume, progress=bar, checkpoint_s=checkpoint or None)
+            extra = {} if integrator is None else {"integrator": integrator}
+            sim, res = Simulation.resume(resume, progress=bar, checkpoint_s=checkpoint or None, **extra)
         finally:
             if bar:
                 bar.stop()
@@ -145,7 +153,9 @@ def simulate(
         out = check_output_dir(out or _default_out(preset, model, "sim"), "--out", overwrite=overwrite)
         sim = Simulation(preset, model=model, model_options=options)
         try:
-            res = sim.run(t_end=t_end, dt=dt, progress=bar, save_to=out, checkpoint_s=checkpoint or None)
+            res = sim.run(
+                t_end=t_end, dt=dt, progress=bar, save_to=out, checkpoint_s=checkpoint or None, integrator=integrator
+            )
         finally:
             if bar:
                 bar.stop()
@@ -168,6 +178,7 @@ def simulate(
         "pins_in_contact_mean": s["pins_in_contact_mean"],
         "pins_in_contact_max": s["pins_in_contact_max"],
         "wall_time_s": sim.timing.get("solve_s"),
+        "integrator": res.attrs.get("integrator"),
     }
     for key in (
         "max_ball_load_N",

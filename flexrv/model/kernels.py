@@ -8,7 +8,9 @@ kernels (the physics stays in the elements' modules: one formula, one executor) 
 the model's coordinate vector. It backs both the single
 Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 :meth:`FusedForces.add_to`) and :meth:`flexrv.model.assembled.AssembledModel.generalized_forces`.
-Groups of other kinds (ball bearing, flexible crank) keep their own elements.
+Groups of other kinds (ball bearing, flexible crank) keep their own elements. The
+generated ``fused_integrate`` (:mod:`flexrv.model.core.registry`) runs the compiled
+generalized-alpha around the same kernel (:mod:`flexrv.model.integrator`).
 
 Python work per call: Exudyn's argument lists to arrays (``np.asarray``), the
 drive angle and load vector at t (cached per time), one call of the compiled entry
@@ -173,7 +175,7 @@ class FusedForces:
             for g in (by_kind[k] for k in ELEMENTS if k in by_kind)
         ]
         #: the generated compiled functions of these elements (flexrv.model.core.registry)
-        self.kernel, self.history_kernel = fused_functions([spec_of(g) for g, _ in self.slots])
+        self.kernel, self.history_kernel, self.integrate_kernel = fused_functions([spec_of(g) for g, _ in self.slots])
         self.packs = self._packs(history=False)
         #: (group, its pack's live time-input array) of the elements with time inputs
         self.timed = [(g, getattr(p, g.time_field)) for (g, _), p in zip(self.slots, self.packs) if g.time_field]

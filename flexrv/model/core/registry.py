@@ -11,7 +11,9 @@ elements' forces are summed).
 
 The fused kernel of a model's elements (:func:`fused_functions`) is generated source:
 a module with ``fused_kernel(q, v, f, jq, jv, jac, p0, p1, ...)`` calling each present
-element's kernel once by name, and ``fused_history`` looping it over a time history,
+element's kernel once by name, ``fused_history`` looping it over a time history and
+``fused_integrate``, the compiled generalized-alpha integrator around it
+(:mod:`flexrv.model.numerics.gen_alpha`, one call site of ``fused_kernel``),
 written to ``flexrv/model/core/_generated/`` and imported, so numba compiles and caches
 it like any other function (``cache=True``: the cache index sits beside the file).
 
@@ -120,6 +122,7 @@ def _fused_source(specs, callee_hash: str) -> str:
         "",
         "from numba import njit",
         "",
+        "from flexrv.model.numerics.gen_alpha import EVALUATE, FAILED, I_JAC, after_eval, begin_step, finish_step",
     ]
     for i, s in enumerate(specs):
         lines.append(f"from {s.kernel.py_func.__module__} import {s.kernel.py_func.__name__} as k{i}")
@@ -147,9 +150,64 @@ def _fused_source(specs, callee_hash: str) -> str:
         f"        fused_kernel(qs[i], vs[i], f, jq, jv, False, {packs})",
         "        for r in range(len(src)):",
         "            dst[r][i, :] = src[r]",
+    ]
+    lines += _integrate_source(n, timed, packs, tin)
+    return "\n".join(lines)
+
+
+def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
+    """Lines of the generated ``fused_integrate``: the compiled generalized-alpha
+    (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the steps ending
+    at ``times``, with ONE call site of ``fused_kernel``; returns (steps done, status:
+    0 done, 1 Newton failed, 2 an element's inner solve failed, 3 non-finite state).
+    Step i writes the elements' time inputs of row i of their tables; an accepted step
+    is recorded (state into ``ts``, ``qs``, ``vs`` row ``rec[0]``, the elements' records
+    into ``dst``) if its end time is at least ``rec_t[1]`` after the last record
+    ``rec_t[0]`` (or no row is recorded yet), while rows remain (``rec[1]``), except the
+    last step of the call when ``rec[2]`` (a segment's end, recorded as the next one's start)."""
+    lines = [
+        "",
+        "",
+        "@njit(cache=True)",
+        f"def fused_integrate(st, times, t_prev, {tin}f, jq, jv, {packs}, ctrs, src, dst, rec, rec_t, "
+        "ts, qs, vs, valid):",
+        "    n = times.shape[0]",
+        "    for i in range(n):",
+        "        h = times[i] - (t_prev if i == 0 else times[i - 1])",
+    ]
+    lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
+    lines += [
+        "        begin_step(st, h)",
+        "        status = EVALUATE",
+        "        while status == EVALUATE:",
+        "            before = 0",
+        "            for c in ctrs:",
+        "                before += c[0]",
+        f"            fused_kernel(st.q, st.v, f, jq, jv, st.ip[I_JAC] != 0, {packs})",
+        "            after = 0",
+        "            for c in ctrs:",
+        "                after += c[0]",
+        "            if after != before:",
+        "                return i, 2",
+        "            status = after_eval(st, f, jq, jv)",
+        "        if status == FAILED:",
+        "            return i, 1",
+        "        if not finish_step(st):",
+        "            return i, 3",
+        "        k = rec[0]",
+        "        if (i < n - 1 or rec[2] == 0) and k < rec[1] and (k == 0 or times[i] >= rec_t[0] + rec_t[1]):",
+        "            ts[k] = times[i]",
+        "            qs[k, :] = st.q",
+        "            vs[k, :] = st.v",
+        "            for r in range(len(src)):",
+        "                dst[r][k, :] = src[r]",
+        "            valid[k] = True",
+        "            rec[0] = k + 1",
+        "            rec_t[0] = times[i]",
+        "    return n, 0",
         "",
     ]
-    return "\n".join(lines)
+    return lines
 
 
 _LOADED: dict[str, object] = {}
@@ -174,8 +232,8 @@ def _write_generated(name: str, source: str, write) -> Path:
 
 
 def fused_functions(specs) -> tuple:
-    """(fused_kernel, fused_history) of the elements ``specs`` (call order), generated
-    and imported once per process (module docstring)."""
+    """(fused_kernel, fused_history, fused_integrate) of the elements ``specs`` (call
+    order), generated and imported once per process (module docstring)."""
     specs = tuple(specs)
     callee_hash = _source_hash(specs)
     source = _fused_source(specs, callee_hash)
@@ -191,4 +249,4 @@ def fused_functions(specs) -> tuple:
         sys.modules[name] = mod
         spec.loader.exec_module(mod)
         _LOADED[key] = mod
-    return mod.fused_kernel, mod.fused_history
+    return mod.fused_kernel, mod.fused_history, mod.fused_integrate

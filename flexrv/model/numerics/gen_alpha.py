@@ -1,0 +1,383 @@
+"""Generalized-alpha time integration of M a + K q + D v = f(t, q, v), compiled.
+
+The scheme is the Arnold–Brüls form :cite:`arnold2007` of the Chung–Hulbert
+generalized-alpha method :cite:`chung1993`, as Exudyn's implicit second-order solver
+runs it (its documented settings and its published solver source were read; nothing
+is copied): from the spectral radius rho_inf
+
+    alpha_m = (2 rho - 1) / (rho + 1),  alpha_f = rho / (rho + 1),
+    gamma = 1/2 + alpha_f - alpha_m,    beta = (gamma + 1/2)^2 / 4
+
+(rho = 0.5: alpha_m = 0, alpha_f = 1/3, gamma = 5/6, beta = 4/9). A step h from
+(q_n, v_n, a_n, a_alg_n) (a_alg: the algorithmic accelerations) predicts
+
+    q = q_n + h v_n + h^2 (1/2 - beta) a_alg_n + h^2 beta a*,
+    v = v_n + h (1 - gamma) a_alg_n + h gamma a*,   a* = (alpha_f a_n - alpha_m a_alg_n) / (1 - alpha_m),
+    a = 0,
+
+and corrects with Newton on the residual r = M a + K q + D v - f(t_n+1, q, v): with
+beta' = (1 - alpha_m) / (h^2 beta (1 - alpha_f)) and gamma' = gamma / (h beta), the
+iteration matrix S = beta' M + K + gamma' D - df/dq - gamma' df/dv and the update
+S dx = r, q -= dx, v -= gamma' dx, a -= beta' dx. After convergence
+a_alg_n+1 = a* + (1 - alpha_f) / (1 - alpha_m) a_n+1.
+
+Newton control (Exudyn's defaults of the modified Newton with a Jacobian at the start
+of every step): converged when ||r||_2 / r_0 <= relative tolerance or ||r||_2 <=
+absolute tolerance, r_0 the residual at the predictor (at least 2 x the absolute
+tolerance; raised to the first iteration's residual if that is larger); the Jacobian
+is reused while the residual contracts by at most ``contractivity`` per iteration
+(checked from the third iteration), else a new one is computed at the current state;
+a contraction worse than 2 (or a diverged state) restarts the step from the predictor
+with one extra iteration, a second failure switches to full Newton; after
+``max_modified`` iterations full Newton; at most ``max_iterations`` iterations.
+
+Reverse communication: the functions here never call the force; the caller (the
+generated ``fused_integrate`` of :mod:`flexrv.model.core.registry`, or the test's
+driver) evaluates f (and, when :data:`I_JAC` asks, df/dq, df/dv) at the state the
+state machine holds and hands it back to :func:`after_eval`. So the force kernel has
+ONE call site, inside a small loop, whatever the Newton does.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from flexrv.model.core.params import pack_type
+
+# -- indices into the state's float parameters ``par``
+P_ALPHA_M, P_ALPHA_F, P_GAMMA, P_BETA, P_RTOL, P_ATOL, P_CONTRACT, P_MAXNORM = range(8)
+P_H, P_R0, P_RES, P_LAST = 8, 9, 10, 11
+N_PAR = 12
+# -- indices into the state's integer registers ``ip``
+I_PHASE, I_IT, I_JACREQ, I_FULL, I_RESTARTED, I_EXTRA, I_JAC, I_MAXIT, I_MAXMOD = range(9)
+I_NEWTON, I_JACOBIANS, I_CALLS, I_JACCALLS, I_ADAPT = 9, 10, 11, 12, 13
+N_IP = 14
+# -- phases: what the evaluation the state machine asked for is
+PH_PREDICTOR, PH_ITERATE, PH_JACOBIAN = 0, 1, 2
+# -- results of after_eval
+EVALUATE, CONVERGED, FAILED = 1, 0, -1
+
+#: the integrator state: parameters, registers, current and start-of-step vectors,
+#: residual, Newton correction, the constant matrices and the factorised iteration matrix
+GaState = pack_type(
+    "GaState",
+    ("par", (np.float64, 1)),
+    ("ip", (np.int64, 1)),
+    ("q", (np.float64, 1)),
+    ("v", (np.float64, 1)),
+    ("a", (np.float64, 1)),
+    ("aa", (np.float64, 1)),
+    ("q0", (np.float64, 1)),
+    ("v0", (np.float64, 1)),
+    ("a0", (np.float64, 1)),
+    ("aa0", (np.float64, 1)),
+    ("r", (np.float64, 1)),
+    ("dx", (np.float64, 1)),
+    ("mass", (np.float64, 2)),
+    ("stiff", (np.float64, 2)),
+    ("damp", (np.float64, 2)),
+    ("lu", (np.float64, 2)),
+    ("piv", (np.int64, 1)),
+)
+
+
+def coefficients(spectral_radius: float) -> tuple[float, float, float, float]:
+    """(alpha_m, alpha_f, gamma, beta) of the spectral radius rho_inf in [0, 1] (module docstring).
+
+    >>> coefficients(0.5)
+    (0.0, 0.3333333333333333, 0.8333333333333333, 0.4444444444444444)
+    """
+    rho = float(spectral_radius)
+    am = (2.0 * rho - 1.0) / (rho + 1.0)
+    af = rho / (rho + 1.0)
+    gamma = 0.5 + af - am
+    return am, af, gamma, 0.25 * (gamma + 0.5) ** 2
+
+
+def new_state(
+    mass,
+    stiffness=None,
+    damping=None,
+    spectral_radius: float = 0.5,
+    tolerance: tuple[float, float] = (1e-3, 1e-1),
+    contractivity: float = 0.5,
+    max_iterations: int = 25,
+    max_modified: int = 8,
+    adapt_initial_residual: bool = True,
+) -> GaState:
+    """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0)."""
+    m = np.ascontiguousarray(mass, dtype=float)
+    n = m.shape[0]
+    z = np.zeros((n, n))
+    par = np.zeros(N_PAR)
+    par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA] = coefficients(spectral_radius)
+    par[P_RTOL], par[P_ATOL] = tolerance
+    par[P_CONTRACT], par[P_MAXNORM] = contractivity, 1e38
+    ip = np.zeros(N_IP, np.int64)
+    ip[I_MAXIT], ip[I_MAXMOD], ip[I_ADAPT] = max_iterations, max_modified, int(adapt_initial_residual)
+    vec = [np.zeros(n) for _ in range(10)]
+    return GaState(
+        par,
+        ip,
+        *vec,
+        m,
+        z.copy() if stiffness is None else np.ascontiguousarray(stiffness, dtype=float),
+        z.copy() if damping is None else np.ascontiguousarray(damping, dtype=float),
+        z.copy(),
+        np.zeros(n, np.int64),
+    )
+
+
+def set_state(st: GaState, q, v, a, a_alg=None) -> None:
+    """Start from (q, v, a); the algorithmic accelerations a_alg default to a (a restart)."""
+    st.q[:], st.v[:], st.a[:] = q, v, a
+    st.aa[:] = a if a_alg is None else a_alg
+
+
+@njit(cache=True)
+def lu_factor(a, lu, piv):
+    """LU factorisation with partial pivoting of a (n x n) into lu, piv; False if singular."""
+    n = a.shape[0]
+    lu[:, :] = a
+    for k in range(n):
+        p, big = k, abs(lu[k, k])
+        for i in range(k + 1, n):
+            if abs(lu[i, k]) > big:
+                p, big = i, abs(lu[i, k])
+        piv[k] = p
+        if big == 0.0 or not math.isfinite(big):
+            return False
+        if p != k:
+            for j in range(n):
+                lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
+        inv = 1.0 / lu[k, k]
+        for i in range(k + 1, n):
+            lu[i, k] *= inv
+            lik = lu[i, k]
+            if lik != 0.0:
+                for j in range(k + 1, n):
+                    lu[i, j] -= lik * lu[k, j]
+    return True
+
+
+@njit(cache=True)
+def lu_solve(lu, piv, b, x):
+    """x = A^-1 b from :func:`lu_factor`'s lu, piv."""
+    n = lu.shape[0]
+    x[:] = b
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+    for i in range(n):
+        s = x[i]
+        for j in range(i):
+            s -= lu[i, j] * x[j]
+        x[i] = s
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for j in range(i + 1, n):
+            s -= lu[i, j] * x[j]
+        x[i] = s / lu[i, i]
+
+
+@njit(cache=True)
+def _predict(st):
+    """The predictor from the start-of-step state (module docstring); a := 0."""
+    par = st.par
+    h, am, af, gamma, beta = par[P_H], par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA]
+    c_q, c_v = h * h * (0.5 - beta), h * (1.0 - gamma)
+    for i in range(st.q.shape[0]):
+        aa = (af * st.a0[i] - am * st.aa0[i]) / (1.0 - am)
+        st.aa[i] = aa
+        st.q[i] = st.q0[i] + h * st.v0[i] + c_q * st.aa0[i] + h * h * beta * aa
+        st.v[i] = st.v0[i] + c_v * st.aa0[i] + h * gamma * aa
+        st.a[i] = 0.0
+
+
+@njit(cache=True)
+def begin_step(st, h):
+    """Start a step of size h from the current state: store it as the start of the step,
+    predict, and ask for an evaluation with the Jacobian (the Jacobian of every step)."""
+    st.q0[:] = st.q
+    st.v0[:] = st.v
+    st.a0[:] = st.a
+    st.aa0[:] = st.aa
+    st.par[P_H] = h
+    ip = st.ip
+    ip[I_IT] = 0
+    ip[I_FULL] = 0
+    ip[I_RESTARTED] = 0
+    ip[I_EXTRA] = 0
+    ip[I_JACREQ] = 0
+    ip[I_PHASE] = PH_PREDICTOR
+    ip[I_JAC] = 1
+    _predict(st)
+
+
+@njit(cache=True)
+def _residual(st, f):
+    """r = M a + K q + D v - f; returns ||r||_2 (NaN if not finite)."""
+    n = st.q.shape[0]
+    s = 0.0
+    for i in range(n):
+        ri = -f[i]
+        for j in range(n):
+            ri += st.mass[i, j] * st.a[j] + st.stiff[i, j] * st.q[j] + st.damp[i, j] * st.v[j]
+        st.r[i] = ri
+        s += ri * ri
+    return math.sqrt(s)
+
+
+@njit(cache=True)
+def _factor(st, jq, jv):
+    """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; False if singular."""
+    par = st.par
+    h = par[P_H]
+    bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
+    gp = par[P_GAMMA] / (h * par[P_BETA])
+    n = st.q.shape[0]
+    s = st.lu
+    for i in range(n):
+        for j in range(n):
+            s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
+    st.ip[I_JACOBIANS] += 1
+    return lu_factor(s.copy(), s, st.piv)
+
+
+@njit(cache=True)
+def _correct(st):
+    """One Newton correction with the factorised S; the next evaluation without Jacobian."""
+    par = st.par
+    h = par[P_H]
+    bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
+    gp = par[P_GAMMA] / (h * par[P_BETA])
+    lu_solve(st.lu, st.piv, st.r, st.dx)
+    for i in range(st.q.shape[0]):
+        st.q[i] -= st.dx[i]
+        st.v[i] -= gp * st.dx[i]
+        st.a[i] -= bp * st.dx[i]
+    st.ip[I_IT] += 1
+    st.ip[I_NEWTON] += 1
+    st.ip[I_PHASE] = PH_ITERATE
+    st.ip[I_JAC] = 0
+    return EVALUATE
+
+
+@njit(cache=True)
+def _restart(st):
+    """Back to the predictor of this step, one extra iteration after convergence; the
+    evaluation brings the Jacobian."""
+    ip = st.ip
+    st.par[P_RES] = st.par[P_R0]
+    st.par[P_LAST] = st.par[P_R0]
+    ip[I_RESTARTED] = 1
+    ip[I_EXTRA] = 1
+    st.q[:] = st.q0
+    st.v[:] = st.v0
+    st.a[:] = st.a0
+    st.aa[:] = st.aa0
+    _predict(st)
+    ip[I_PHASE] = PH_JACOBIAN
+    ip[I_JAC] = 1
+    return EVALUATE
+
+
+@njit(cache=True)
+def _diverged(st):
+    big = st.par[P_MAXNORM]
+    sq = 0.0
+    sv = 0.0
+    for i in range(st.q.shape[0]):
+        sq += st.q[i] * st.q[i]
+        sv += st.v[i] * st.v[i]
+    return not (sq < big and sv < big)
+
+
+@njit(cache=True)
+def _iterate(st, res):
+    """Convergence test and Newton control after an evaluation at a corrected state."""
+    par, ip = st.par, st.ip
+    it = ip[I_IT]
+    if ip[I_ADAPT] and res > par[P_R0] and it <= 1:
+        par[P_R0] = res
+        par[P_LAST] = res
+    par[P_RES] = res
+    converged = res / par[P_R0] <= par[P_RTOL] or res <= par[P_ATOL]
+    if converged and ip[I_EXTRA]:
+        ip[I_EXTRA] = 0
+        converged = False
+    elif converged:
+        return CONVERGED
+    else:
+        ip[I_EXTRA] = 0
+        diverged = _diverged(st) or not math.isfinite(res)
+        if diverged and ip[I_FULL]:
+            return FAILED
+        if not ip[I_FULL] and it > ip[I_MAXMOD]:
+            ip[I_JACREQ] = 1
+            ip[I_FULL] = 1
+        contraction = res / par[P_LAST]
+        par[P_LAST] = res
+        if not ip[I_FULL] and (diverged or (contraction > par[P_CONTRACT] and it > 2)):
+            ip[I_JACREQ] = 1
+            if ip[I_RESTARTED]:
+                ip[I_FULL] = 1
+            if diverged or contraction > 2.0 or ip[I_FULL]:
+                ip[I_JACREQ] = 0
+                if it >= ip[I_MAXIT]:
+                    return FAILED
+                return _restart(st)
+    if it >= ip[I_MAXIT]:
+        return FAILED
+    if ip[I_JACREQ] or ip[I_FULL]:  # a new Jacobian at this state first
+        ip[I_JACREQ] = 0
+        ip[I_PHASE] = PH_JACOBIAN
+        ip[I_JAC] = 1
+        return EVALUATE
+    return _correct(st)
+
+
+@njit(cache=True)
+def after_eval(st, f, jq, jv):
+    """Take the evaluation f (and df/dq, df/dv if ``ip[I_JAC]``) at the current state;
+    return :data:`EVALUATE` (evaluate again at the new current state, with the Jacobian if
+    ``ip[I_JAC]``), :data:`CONVERGED` or :data:`FAILED`."""
+    ip = st.ip
+    ip[I_CALLS] += 1
+    ip[I_JACCALLS] += ip[I_JAC]
+    res = _residual(st, f)
+    phase = ip[I_PHASE]
+    if phase == PH_PREDICTOR:
+        r0 = res if math.isfinite(res) else np.inf
+        if r0 <= st.par[P_ATOL]:
+            r0 = 2.0 * st.par[P_ATOL]
+        if r0 == 0.0:  # (an absolute tolerance of 0 and an exact predictor)
+            r0 = 1e-300
+        st.par[P_R0] = r0
+        st.par[P_RES] = r0
+        st.par[P_LAST] = r0
+    elif phase == PH_ITERATE:
+        return _iterate(st, res)
+    if not math.isfinite(res):
+        return FAILED
+    if not _factor(st, jq, jv):
+        return FAILED
+    return _correct(st)
+
+
+@njit(cache=True)
+def finish_step(st):
+    """After convergence: a_alg_n+1 = a* + (1 - alpha_f) / (1 - alpha_m) a_n+1; True if
+    the state is finite."""
+    par = st.par
+    c = (1.0 - par[P_ALPHA_F]) / (1.0 - par[P_ALPHA_M])
+    ok = True
+    for i in range(st.q.shape[0]):
+        st.aa[i] += c * st.a[i]
+        if not (math.isfinite(st.q[i]) and math.isfinite(st.v[i])):
+            ok = False
+    return ok

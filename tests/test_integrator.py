@@ -1,0 +1,243 @@
+"""The compiled generalized-alpha integrator (flexrv.model.numerics.gen_alpha,
+flexrv.model.integrator) alone on linear oscillators against closed forms, and on every
+preset's rigid model against Exudyn's integrator (the reference) by the criteria of
+tests/test_time_step.py."""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+import pytest
+
+from flexrv.design import list_presets, load
+from flexrv.errors import InputError
+from flexrv.model.numerics import gen_alpha
+from flexrv.simulation import choose_integrator
+
+# -------------------------------------------------------------- the algorithm alone
+
+
+def integrate_linear(mass, stiffness, damping, q0, v0, h, n_steps, rho=0.5, tol=(1e-12, 1e-14)):
+    """Integrate M a + D v + K q = 0 with the state machine, the linear force handed
+    back as f = -K q - D v with its Jacobians (-K, -D); returns (q, v) per step."""
+    st = gen_alpha.new_state(mass, spectral_radius=rho, tolerance=tol)
+    a0 = np.linalg.solve(mass, -stiffness @ q0 - damping @ v0)
+    gen_alpha.set_state(st, q0, v0, a0)
+    jq, jv = -np.asarray(stiffness, float), -np.asarray(damping, float)
+    qs, vs = [np.array(q0, float)], [np.array(v0, float)]
+    for _ in range(n_steps):
+        gen_alpha.begin_step(st, h)
+        status = gen_alpha.EVALUATE
+        while status == gen_alpha.EVALUATE:
+            status = gen_alpha.after_eval(st, jq @ st.q + jv @ st.v, jq, jv)
+        assert status == gen_alpha.CONVERGED
+        assert gen_alpha.finish_step(st)
+        qs.append(st.q.copy())
+        vs.append(st.v.copy())
+    return np.array(qs), np.array(vs)
+
+
+M2 = np.diag([1.0, 2.0])
+K2 = np.array([[3.0, -1.0], [-1.0, 1.0]])
+
+
+def exact_2dof(t, q0):
+    """Closed form of M q'' + K q = 0 from rest at q0: the modes of K phi = w^2 M phi."""
+    from scipy.linalg import eigh
+
+    w2, phi = eigh(K2, M2)  # phi^T M phi = I
+    eta0 = phi.T @ M2 @ q0
+    return (phi @ (eta0[:, None] * np.cos(np.sqrt(w2)[:, None] * t[None, :]))).T
+
+
+def test_second_order_convergence_on_a_linear_2dof_oscillator():
+    """Undamped 2-DOF oscillator (M = diag(1, 2), K = [[3, -1], [-1, 1]]) from rest at
+    q0 = (1, 0) over 2 s against its modal closed form: halving the step divides the
+    error by 4 (second order, :cite:`chung1993`, for any rho_inf). Measured orders
+    2.00-2.01 for rho_inf = 0.5 and 0.8; required 2 +- 0.1."""
+    q0 = np.array([1.0, 0.0])
+    for rho in (0.5, 0.8):
+        errors = []
+        for h in (1e-2, 5e-3, 2.5e-3):
+            n = int(round(2.0 / h))
+            qs, _ = integrate_linear(M2, K2, np.zeros((2, 2)), q0, np.zeros(2), h, n, rho=rho)
+            errors.append(np.abs(qs - exact_2dof(h * np.arange(n + 1), q0)).max())
+        orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+        assert np.all(np.abs(orders - 2.0) < 0.1), (rho, orders)
+
+
+def amplification(omega_h: float, rho: float) -> np.ndarray:
+    """The one-step map of (q, h v, h^2 a, h^2 a_alg) for q'' + omega^2 q = 0 (h = 1),
+    built column by column from the integrator (the scheme is linear)."""
+    cols = []
+    for e in np.eye(4):
+        st = gen_alpha.new_state(np.eye(1), stiffness=[[omega_h**2]], spectral_radius=rho, tolerance=(1e-14, 0.0))
+        gen_alpha.set_state(st, e[:1], e[1:2], e[2:3], e[3:4])
+        gen_alpha.begin_step(st, 1.0)
+        status = gen_alpha.EVALUATE
+        z = np.zeros((1, 1))
+        while status == gen_alpha.EVALUATE:
+            status = gen_alpha.after_eval(st, np.zeros(1), z, z)
+        assert status == gen_alpha.CONVERGED
+        gen_alpha.finish_step(st)
+        cols.append([st.q[0], st.v[0], st.a[0], st.aa[0]])
+    return np.array(cols).T
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.5, 0.8, 1.0])
+def test_spectral_radius_of_the_amplification(rho):
+    """Closed form of the generalized-alpha (:cite:`chung1993`): the spectral radius of
+    the one-step amplification tends to rho_inf for omega h -> infinity (the parameter's
+    definition) and to 1 for omega h -> 0 (no dissipation of the resolved modes);
+    rho_inf = 1 dissipates nothing at any omega h. At omega h = 1e6 the radius is within
+    1e-4 of rho_inf (measured 8e-5 for rho_inf = 0.5 and 0.8, 1e-4 for 0: its double root
+    at 0 splits as the square root of the perturbation); at omega h = 1e-3 within 1e-12
+    of 1; required 2e-4 and 1e-9."""
+    r_inf = max(abs(np.linalg.eigvals(amplification(1e6, rho))))
+    r_0 = max(abs(np.linalg.eigvals(amplification(1e-3, rho))))
+    assert r_inf == pytest.approx(rho, abs=2e-4)
+    assert r_0 == pytest.approx(1.0, abs=1e-9)
+    if rho == 1.0:
+        assert max(abs(np.linalg.eigvals(amplification(3.0, rho)))) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_coefficients_match_exudyns_documented_values():
+    """rho_inf = 0.5: alpha_m = 0, alpha_f = 1/3, gamma = 5/6, beta = 4/9 (the values
+    flexrv.simulation's docstring derives its restart error from)."""
+    am, af, g, b = gen_alpha.coefficients(0.5)
+    assert (am, af, g, b) == pytest.approx((0.0, 1 / 3, 5 / 6, 4 / 9), abs=1e-15)
+
+
+def test_linear_solve():
+    """lu_factor / lu_solve against numpy on a random, pivoting-needing matrix; a singular
+    matrix is reported."""
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(9, 9))
+    a[0, 0] = 0.0
+    lu, piv, x = np.zeros((9, 9)), np.zeros(9, np.int64), np.zeros(9)
+    b = rng.normal(size=9)
+    assert gen_alpha.lu_factor(a, lu, piv)
+    gen_alpha.lu_solve(lu, piv, b, x)
+    assert np.allclose(x, np.linalg.solve(a, b), rtol=1e-12, atol=1e-12)
+    assert not gen_alpha.lu_factor(np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3, np.int64))
+
+
+# -------------------------------------------------------------- choice of the integrator
+
+
+def test_choice_of_the_integrator():
+    """Default: compiled where every force is a compiled kernel, else Exudyn; "compiled"
+    for a model with a Python group is one InputError naming the group; unknown names rejected."""
+    python_group = types.SimpleNamespace(name="ball_bearing")
+    balls = types.SimpleNamespace(name="balls", fused=types.SimpleNamespace(others=[python_group]), n=3, groups=[])
+    assert choose_integrator(balls, None) == "exudyn"
+    assert choose_integrator(balls, "exudyn") == "exudyn"
+    with pytest.raises(InputError, match="ball_bearing"):
+        choose_integrator(balls, "compiled")
+    with pytest.raises(InputError, match="choose from compiled, exudyn"):
+        choose_integrator(balls, "rk4")
+
+
+def test_cli_refuses_compiled_for_python_groups(tmp_path, capfd):
+    """flexrv simulate --model balls --integrator compiled: one clear message, exit 2."""
+    from flexrv.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "rv40e", "--model", "balls", "--integrator", "compiled", "--t-end", "0.001",
+              "--out", str(tmp_path / "o")])  # fmt: skip
+    err = capfd.readouterr().err
+    assert info.value.code == 2
+    assert "integrator = 'compiled' is not allowed" in err and "--integrator exudyn" in err
+
+
+# -------------------------------------------------------------- cross-check against Exudyn
+
+
+def te_of(reducer, integrator, t_end):
+    """(mean, p-p, frequencies, amplitudes, results) of the TE over the steady window on
+    tests/test_time_step.py's grid."""
+    from flexrv.post.spectra import amplitude_spectrum
+    from flexrv.simulation import Simulation
+    from tests.test_time_step import GRID
+
+    res = Simulation(reducer).run(t_end=t_end, integrator=integrator)
+    assert res.attrs["status"] == "completed" and res.attrs["integrator"] == integrator
+    t0, t1 = res.steady_window()
+    tg = np.arange(int(round(t0 / GRID)), int(round(t1 / GRID)) + 1) * GRID
+    te = np.interp(tg, res.time, res["te"].values)
+    f, a = amplitude_spectrum(te, tg)
+    return float(te.mean()), float(np.ptp(te)), f, a, res
+
+
+def cross_check(reducer, t_end, unique=True):
+    """Compiled vs Exudyn: TE mean within 0.05 arcsec, p-p within 0.05 arcsec and the
+    lines up to the cycloid mesh within 2 % (tests/test_time_step.py's criterion); for
+    a response that is not unique (rv221 at its light preset load, see that module):
+    mean within 0.1 arcsec and the dominant line within 2 %."""
+    from tests.test_time_step import lines
+
+    m0, pp0, f0, a0, _ = te_of(reducer, "exudyn", t_end)
+    m1, pp1, f1, a1, res = te_of(reducer, "compiled", t_end)
+    assert np.array_equal(f0, f1)
+    if unique:
+        pk = lines(reducer, f0, a0)
+        assert abs(m1 - m0) < 0.05
+        assert abs(pp1 - pp0) < 0.05
+        assert np.max(np.abs(a1[pk] - a0[pk]) / a0[pk]) < 0.02
+    else:
+        assert abs(m1 - m0) < 0.1
+        i = int(np.argmax(a0 * (f0 > 0)))
+        assert abs(a1[i] - a0[i]) < 0.02 * a0[i]
+    return res
+
+
+@pytest.mark.parametrize("name", list_presets())
+def test_cross_check_against_exudyn_every_preset(name):
+    """Every preset, rigid model, shortened ramps (rated speed at 0.01 s, load 0.01-0.03
+    s), t_end 0.3 s, both integrators. Measured: rv40e mean 6e-12 arcsec apart, p-p
+    2e-11 arcsec, lines (60, 330, 340, 390 Hz) identical to 1e-8; rv221 at its rated 3000 N
+    m mean 3e-12 arcsec, p-p 1e-10 arcsec; rv221 at its preset 20 N m mean 0.003 arcsec,
+    the 13.6 Hz line 0.16 % (its 270-285 Hz lines 15-16 %: its two steady responses pick
+    up round-off-level differences). ~10 s each."""
+    from tests.test_time_step import fast
+
+    r = fast(name)
+    light = r.operating.load_torque_Nm < 0.1 * r.operating.rated_torque_Nm
+    cross_check(r, 0.3, unique=not light)
+    if light:  # loaded, the response is unique: the full criterion
+        op = r.operating.model_copy(update={"load_torque_Nm": r.operating.rated_torque_Nm})
+        cross_check(r.model_copy(update={"operating": op}), 0.3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list_presets())
+def test_cross_check_full_default_run(name):
+    """The full default run (default ramps and t_end) of every preset, both integrators,
+    the criterion of :func:`cross_check`. ~30 s each."""
+    r = load(name)
+    light = r.operating.load_torque_Nm < 0.1 * r.operating.rated_torque_Nm
+    cross_check(r, None, unique=not light)
+
+
+def test_same_steps_as_exudyn_through_step_reductions():
+    """From rest with 20 ms ramps and a tight Newton tolerance (1e-5 / 1e-3 N, the
+    regression cases' setting), rv40e's start-up has Newton failures and step reductions
+    (eight in the first 4 ms): both integrators take the same steps at the same times with
+    the same Newton iterations and Jacobians, and their TE agrees to round-off growth
+    (measured over 0.06 s: 2055 iterations and 917 Jacobians each, TE within 1e-9 arcsec;
+    required here over 0.02 s: equal counts and times, TE within 1e-6 arcsec)."""
+    from flexrv.design import override
+    from flexrv.simulation import Simulation
+    from tests.regression_cases import FAST, NEWTON_TOLERANCE
+
+    out = {}
+    for integrator in ("exudyn", "compiled"):
+        sim = Simulation(override("rv40e", FAST))
+        res = sim.run(t_end=0.02, dt=1e-4, newton_tolerance=NEWTON_TOLERANCE, integrator=integrator)
+        out[integrator] = (res, sim.timing)
+    (ra, ta), (rb, tb) = out["exudyn"], out["compiled"]
+    assert ta["newton_iterations"] == tb["newton_iterations"] and ta["jacobians"] == tb["jacobians"]
+    assert len(ra.time) == len(rb.time) and np.allclose(ra.time, rb.time, rtol=0, atol=1e-12)
+    assert np.any(np.abs(np.diff(ra.time) - 1e-4) > 1e-6)  # the reductions moved the output times off the grid
+    assert np.abs(ra["te"].values - rb["te"].values).max() < 1e-6
