@@ -868,90 +868,11 @@ def _zero_written(jac, nx, nz):
 
 
 @njit(cache=True)
-def row_eval(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    jq,
-    jv,
-):
-    """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
-    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
-    rigid and modal rings only the entries it writes, :func:`_zero_written`: the
-    other entries must be zero, as in a zero-allocated work array);
-    coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
-
-    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
-    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
-    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
-    contact deflections and last tangent; every ring: the contacts' films, the film
-    iteration's warm start, :func:`film_workspace`; updated);
-    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
-    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
-    sum of the local iterations, local solves, then the same four of the
-    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
-    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
-
-    ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
-    CONDENSED_BALLS (the quasi-static balls' modes, see there).
-
-    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
-    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
-    and K the contact stiffness — block diagonal for rigid and modal rings
-    (added ball by ball, :func:`_add_block_jacobian`), the dense condensed
-    (I - K C)^-1 K for condensed rings (:func:`_condensed_contact_matrix`; geometric-stiffness
-    terms of the frame rotation are dropped; the modified Newton iteration
-    converges on the residual, which is exact). The azimuths' cosines and sines
-    are the normalised in-plane coordinates (no sin/cos of the atan2)."""
-    z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
-    co_r, co_z, off_i, off_o = (
-        geometry.outer_center_radius,
-        geometry.outer_center_z,
-        geometry.inner_offset,
-        geometry.outer_offset,
-    )
-    rb, speed_factor, cage_ratio = geometry.ball_radius_pitch, geometry.speed_factor, geometry.cage_ratio
-    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
-    m_i = tab_i.shape[2]
-    m_o = tab_o.shape[2]
-    cond_i = comp_i.shape[0] > 0
-    cond_o = comp_o.shape[0] > 0
-    state[1] = 0
-    nz = ball_ref.shape[0]
-    b0 = 6 + m_i + m_o
-    nx_i = 6 + m_i
-    f[:] = 0.0
-    if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
-        jq[:, :] = 0.0
-        if jacobian == CONDENSED_BALLS:
-            jv[:, :] = 0.0
-    elif jacobian:
-        if cond_i or cond_o:
-            jq[:, :] = 0.0
-            jv[:, :] = 0.0
-        else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
-            _zero_written(jq, b0, nz)
-            _zero_written(jv, b0, nz)
+def _frame_kinematics(q, qt):
+    """The frame's rotation A = Rx(ax) Ry(ay) Rz(az), the map G of omega = G phi_t
+    (Exudyn RotXYZ2RotationMatrix / RotXYZ2G) and omega's components."""
     ax, ay, az = q[3], q[4], q[5]
     sa, ca, sb, cb, sc, cc = math.sin(ax), math.cos(ax), math.sin(ay), math.cos(ay), math.sin(az), math.cos(az)
-    # A = Rx(ax) Ry(ay) Rz(az); omega = G phi_t (Exudyn RotXYZ2RotationMatrix / RotXYZ2G)
     a = np.empty((3, 3))
     a[0, 0], a[0, 1], a[0, 2] = cb * cc, -cb * sc, sb
     a[1, 0], a[1, 1], a[1, 2] = ca * sc + sa * sb * cc, ca * cc - sa * sb * sc, -sa * cb
@@ -963,13 +884,26 @@ def row_eval(
     om0 = g[0, 0] * qt[3] + g[0, 1] * qt[4] + g[0, 2] * qt[5]
     om1 = g[1, 0] * qt[3] + g[1, 1] * qt[4] + g[1, 2] * qt[5]
     om2 = g[2, 0] * qt[3] + g[2, 1] * qt[4] + g[2, 2] * qt[5]
-    speed = speed_factor * abs(qt[5])
+    return a, g, om0, om1, om2
+
+
+@njit(cache=True)
+def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, om):
+    """Pass 1 of :func:`row_eval`: the geometry of every ball with the rings undeflected
+    (modal rings: with their coordinates), ball minus groove centre e0 and relative
+    velocity w0 of both contacts. Returns (ball centres, inner and outer azimuths, the
+    outer azimuths' cos and sin, arms A p of the inner groove centres, e0_i, w0_i, e0_o,
+    w0_o, raceway displacements du_i, du_o (global; modal rings), the condensed rings'
+    rotations to their cylindrical frames, the modal rings' bases at every ball)."""
+    om0, om1, om2 = om
+    z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
+    co_r, co_z = geometry.outer_center_radius, geometry.outer_center_z
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = ball_ref.shape[0]
+    b0 = 6 + m_i + m_o
     bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
-    two_pi = 2.0 * math.pi
-    # ---------------- pass 1: geometry of every ball with the rings undeflected
-    # (modal rings: with their coordinates), ball minus groove centre e0 and
-    # relative velocity w0 of both contacts
     bpos = np.empty((nz, 3))
     psi_i = np.empty(nz)
     psi_o = np.empty(nz)
@@ -1046,7 +980,20 @@ def row_eval(
             r_o[2, 0], r_o[2, 1], r_o[2, 2] = 0.0, 0.0, 1.0
         e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
         w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
-    # ---------------- condensed rings: contact deflections
+    return bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+
+
+@njit(cache=True)
+def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state):
+    """The contacts of both rings at every ball (:func:`_ring_contacts`; condensed rings:
+    their local solves, the inner one's deflection added to the arms ``pre[4]``). Returns
+    (loads, normals, dQ/d delta, damping, approach lengths and films of the inner and
+    outer contacts, the condensed rings' global compliance factors)."""
+    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre[1], pre[2], pre[4], pre[5], pre[6], pre[7], pre[8]
+    du_i, du_o, rot_i, rot_o = pre[9], pre[10], pre[11], pre[12]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    nz = psi_i.shape[0]
     load_i = np.empty(nz)
     load_o = np.empty(nz)
     nrm_i = np.empty((nz, 3))
@@ -1063,6 +1010,7 @@ def row_eval(
     nco = 3 * nz if (cond_o and jacobian) else 0
     wg_i = np.empty((nci, comp_i.shape[2]))  # condensed rings' global compliance factors (Jacobian only)
     wg_o = np.empty((nco, comp_o.shape[2]))
+    off_i, off_o = geometry.inner_offset, geometry.outer_offset
     _ring_contacts(
         cond_i,
         psi_i,
@@ -1111,14 +1059,208 @@ def row_eval(
         wg_o,
         state,
     )
-    # ---------------- pass 2: generalized forces (and Jacobian blocks)
+    return load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o
+
+
+@njit(cache=True)
+def _ball_force(j, q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, bas_i, bas_o, f, rec, record):
+    """Ball j's contact reactions on the frame and the rings' modes, its cage and pocket
+    forces, into ``f`` (and its row of ``rec``); returns the cage direction (etx, ety)
+    and the ball's radius in the housing."""
+    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre[0], pre[1], pre[2], pre[3], pre[4], pre[9], pre[10]
+    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con[0], con[1], con[2], con[3], con[10], con[11]
+    z_row, rb, cage_ratio = geometry.z, geometry.ball_radius_pitch, geometry.cage_ratio
+    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = bpos.shape[0]
+    bj = 6 + m_i + m_o + 3 * j
+    two_pi = 2.0 * math.pi
+    bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
+    vx, vy = qt[bj], qt[bj + 1]
+    qi, qo = load_i[j], load_o[j]
+    fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
+    fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
+    # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
+    f[0] -= fix
+    f[1] -= fiy
+    f[2] -= fiz
+    ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+    mx = ap1 * fiz - ap2 * fiy
+    my = ap2 * fix - ap0 * fiz
+    mz = ap0 * fiy - ap1 * fix
+    for r in range(3):
+        f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
+    flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
+    fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
+    flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
+    if m_i > 0:
+        _basis(tab_i, zs_i, psi_i[j], bas_i)
+        for k in range(m_i):
+            f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
+    if m_o > 0:
+        _basis(tab_o, zs_o, psi_o[j], bas_o)
+        for k in range(m_o):
+            f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
+    # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
+    psi = psi_o[j]
+    cos_p, sin_p = cs_o[j, 0], cs_o[j, 1]
+    pocket = two_pi * j / nz + cage_ratio * q[5]
+    dev = psi - pocket
+    dev -= two_pi * math.floor(dev / two_pi + 0.5)  # wrapped to [-pi, pi)
+    radius = math.sqrt(bx * bx + by * by)
+    etx, ety = -sin_p, cos_p
+    s_t = vx * etx + vy * ety - radius * cage_ratio * qt[5]
+    fc = -(cage_k * radius * dev + cage_c * s_t)
+    pr = radius - rb
+    f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
+    f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
+    f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
+    if record:
+        rec[j, 0], rec[j, 1] = qi, qo
+        for c in range(3):
+            rec[j, 2 + c] = nrm_i[j, c]
+            rec[j, 5 + c] = nrm_o[j, c]
+            rec[j, 16 + c] = du_i[j, c]
+            rec[j, 19 + c] = du_o[j, c]
+            rec[j, 22 + c] = bpos[j, c]
+        rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
+        rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
+        rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
+        rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
+    return etx, ety, radius
+
+
+@njit(cache=True)
+def _ball_local_blocks(j, b0, qt, geometry, pre, con, etx, ety, radius, k_i, d_i, k_o, d_o, jq):
+    """Ball j's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
+    and, in column 3, the rate of its force from the frame's and rings' motion."""
+    w0_i, w0_o = pre[6], pre[8]
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o = con[:10]
+    cage_ratio, cage_k, pocket_k = geometry.cage_ratio, geometry.cage_stiffness, geometry.pocket_stiffness
+    bj = b0 + 3 * j
+    vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+    _contact_blocks(load_i[j], dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+    _contact_blocks(load_o[j], dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
+    et = (etx, ety, 0.0)
+    # groove centres' velocities (ball velocity minus the contacts' relative velocities)
+    gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
+    go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
+    for c1 in range(3):
+        rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
+        for c2 in range(3):
+            ee = et[c1] * et[c2]
+            eye = 1.0 if c1 == c2 else 0.0
+            jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
+            rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
+        jq[3 * j + c1, 3] = rate
+
+
+@njit(cache=True)
+def _ball_jacobian(
+    j, jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, etx, ety, radius, jq, jv
+):
+    """Ball j's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
+    (b0..b0+2)] into the work blocks jl, vl (the helpers at ball index b0), then scattered
+    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS); the
+    condensed rings' contacts keep their T rows and contact factors for
+    :func:`_condensed_row_jacobian`. ``wk``: :func:`row_eval`'s pass-2 work arrays."""
+    arm, bas_i_all, bas_o_all = pre[4], pre[13], pre[14]
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o = con[:12]
+    k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o = wk
+    cage_ratio, cage_k, cage_c = geometry.cage_ratio, geometry.cage_stiffness, geometry.cage_damping
+    pocket_k = geometry.pocket_stiffness
+    cond_i = ti_all.shape[0] > 0
+    cond_o = vf_o.shape[0] > 0
+    b0 = 6 + m_i + m_o
+    nx_i = 6 + m_i
+    bj = b0 + 3 * j
+    qi, qo = load_i[j], load_o[j]
+    jl[:, :] = 0.0
+    vl[:, :] = 0.0
+    if not cond_i:  # (condensed rings: the blocks' factors below)
+        _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+    if not cond_o:
+        _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
+    et = (etx, ety, 0.0)
+    for c1 in range(3):
+        for c2 in range(3):
+            ee = et[c1] * et[c2]
+            eye = 1.0 if c1 == c2 else 0.0
+            jl[b0 + c1, b0 + c2] += -cage_k * ee - pocket_k * (eye - ee)
+            vl[b0 + c1, b0 + c2] += -cage_c * ee
+        jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
+        vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
+    # T_i = [I | -[Ap]x G | A basis_i]
+    ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+    for c in range(3):  # -(skew(Ap) G)[:, c]
+        g0, g1, g2 = g[0, c], g[1, c], g[2, c]
+        t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
+        t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
+        t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
+    if m_i > 0:
+        for r in range(3):
+            for k in range(m_i):
+                t_i[r, 6 + k] = (
+                    a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] + a[r, 2] * bas_i_all[j, 2, k]
+                )
+    if cond_i:
+        for r in range(3):
+            for c in range(nx_i):
+                ti_all[3 * j + r, c] = t_i[r, c]
+        _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
+    else:
+        _add_block_jacobian(jl, k_i, t_i, b0, 0, nx_i)
+        _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
+        gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
+        if gain != 0.0:
+            _add_speed_column(vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1], gain * nrm_i[j, 2])
+    if cond_o:
+        _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
+    else:
+        bo = bas_o_all[j] if m_o > 0 else bas_o
+        _add_block_jacobian(jl, k_o, bo, b0, 6 + m_i, m_o)
+        _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
+        gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
+        if gain != 0.0:
+            _add_speed_column(
+                vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1], gain * nrm_o[j, 2]
+            )
+    if jacobian == CONDENSED_BALLS:
+        _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j : 3 * j + 3], inv3, tm3)
+    else:
+        for r in range(b0 + 3):
+            rr = r if r < b0 else bj + r - b0
+            for c in range(b0 + 3):
+                cc = c if c < b0 else bj + c - b0
+                jq[rr, cc] += jl[r, c]
+                jv[rr, cc] += vl[r, c]
+
+
+@njit(cache=True)
+def _row_pass2(
+    q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+):
+    """Pass 2 of :func:`row_eval`: every ball's generalized forces (:func:`_ball_force`)
+    and Jacobian blocks (:func:`_ball_local_blocks`, :func:`_ball_jacobian`). Returns the
+    condensed rings' T rows and contact factors of every ball and the entrainment speed's
+    rate d u / d q_t[5] (for :func:`_condensed_row_jacobian`)."""
+    cond_i = pre[11].shape[0] > 0
+    cond_o = pre[12].shape[0] > 0
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = pre[0].shape[0]
+    b0 = 6 + m_i + m_o
+    nx_i = 6 + m_i
+    bas_i = np.empty((3, m_i))
+    bas_o = np.empty((3, m_o))
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
     k_o = np.empty((3, 3))
     d_o = np.empty((3, 3))
     t_i = np.zeros((3, nx_i))
     nl = b0 + 3 if (jacobian and jacobian != BALL_BLOCKS) else 0
-    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see below)
+    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see _ball_jacobian)
     vl = np.empty((nl, nl))
     inv3 = np.empty((3, 3))  # (work of _condense_ball)
     tm3 = np.empty((3, b0))
@@ -1129,167 +1271,159 @@ def row_eval(
     )
     for r in range(3):
         t_i[r, r] = 1.0
+    nci = 3 * nz if (cond_i and jacobian) else 0
+    nco = 3 * nz if (cond_o and jacobian) else 0
     ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
     vf_i = np.empty((nci // 3, 2, 3))
     vf_o = np.empty((nco // 3, 2, 3))
+    wk = (k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o)
     record = rec.shape[0] == nz
     # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
     # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
-    dudw = speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
+    dudw = geometry.speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
     for j in range(nz):
-        bj = b0 + 3 * j
-        bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
-        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
-        qi, qo = load_i[j], load_o[j]
-        fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
-        fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
-        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
-        f[0] -= fix
-        f[1] -= fiy
-        f[2] -= fiz
-        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
-        mx = ap1 * fiz - ap2 * fiy
-        my = ap2 * fix - ap0 * fiz
-        mz = ap0 * fiy - ap1 * fix
-        for r in range(3):
-            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
-        flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
-        fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
-        flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
-        if m_i > 0:
-            _basis(tab_i, zs_i, psi_i[j], bas_i)
-            for k in range(m_i):
-                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
-        if m_o > 0:
-            _basis(tab_o, zs_o, psi_o[j], bas_o)
-            for k in range(m_o):
-                f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
-        # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
-        psi = psi_o[j]
-        cos_p, sin_p = cs_o[j, 0], cs_o[j, 1]
-        pocket = two_pi * j / nz + cage_ratio * az
-        dev = psi - pocket
-        dev -= two_pi * math.floor(dev / two_pi + 0.5)  # wrapped to [-pi, pi)
-        radius = math.sqrt(bx * bx + by * by)
-        etx, ety = -sin_p, cos_p
-        s_t = vx * etx + vy * ety - radius * cage_ratio * qt[5]
-        fc = -(cage_k * radius * dev + cage_c * s_t)
-        pr = radius - rb
-        f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
-        f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
-        f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
-        if record:
-            rec[j, 0], rec[j, 1] = qi, qo
-            for c in range(3):
-                rec[j, 2 + c] = nrm_i[j, c]
-                rec[j, 5 + c] = nrm_o[j, c]
-                rec[j, 16 + c] = du_i[j, c]
-                rec[j, 19 + c] = du_o[j, c]
-                rec[j, 22 + c] = bpos[j, c]
-            rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
-            rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
-            rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
-            rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
+        etx, ety, radius = _ball_force(
+            j, q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, bas_i, bas_o, f, rec, record
+        )
         if not jacobian:
             continue
         if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
-            _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-            _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
-            et = (etx, ety, 0.0)
-            # groove centres' velocities (ball velocity minus the contacts' relative velocities)
-            gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
-            go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
-            for c1 in range(3):
-                rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
-                for c2 in range(3):
-                    ee = et[c1] * et[c2]
-                    eye = 1.0 if c1 == c2 else 0.0
-                    jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
-                    rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
-                jq[3 * j + c1, 3] = rate
+            _ball_local_blocks(j, b0, qt, geometry, pre, con, etx, ety, radius, k_i, d_i, k_o, d_o, jq)
             continue
-        # ---- Jacobian blocks of this ball: its (b0 + 3)^2 square [x (0..b0-1), the ball
-        # (b0..b0+2)] into jl, vl (the helpers at ball index b0), then scattered into jq, jv
-        # -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS)
-        jl[:, :] = 0.0
-        vl[:, :] = 0.0
-        if not cond_i:  # (condensed rings: the blocks' factors below)
-            _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-        if not cond_o:
-            _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
-        et = (etx, ety, 0.0)
-        for c1 in range(3):
-            for c2 in range(3):
-                ee = et[c1] * et[c2]
-                eye = 1.0 if c1 == c2 else 0.0
-                jl[b0 + c1, b0 + c2] += -cage_k * ee - pocket_k * (eye - ee)
-                vl[b0 + c1, b0 + c2] += -cage_c * ee
-            jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
-            vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
-        # T_i = [I | -[Ap]x G | A basis_i]
-        for c in range(3):  # -(skew(Ap) G)[:, c]
-            g0, g1, g2 = g[0, c], g[1, c], g[2, c]
-            t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
-            t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
-            t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
-        if m_i > 0:
-            for r in range(3):
-                for k in range(m_i):
-                    t_i[r, 6 + k] = (
-                        a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] + a[r, 2] * bas_i_all[j, 2, k]
-                    )
-        if cond_i:
-            for r in range(3):
-                for c in range(nx_i):
-                    ti_all[3 * j + r, c] = t_i[r, c]
-            _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
-        else:
-            _add_block_jacobian(jl, k_i, t_i, b0, 0, nx_i)
-            _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
-            gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
-            if gain != 0.0:
-                _add_speed_column(
-                    vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1], gain * nrm_i[j, 2]
-                )
-        if cond_o:
-            _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
-        else:
-            bo = bas_o_all[j] if m_o > 0 else bas_o
-            _add_block_jacobian(jl, k_o, bo, b0, 6 + m_i, m_o)
-            _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
-            gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
-            if gain != 0.0:
-                _add_speed_column(
-                    vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1], gain * nrm_o[j, 2]
-                )
+        _ball_jacobian(
+            j, jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, etx, ety, radius, jq, jv
+        )
+    return ti_all, vf_i, vf_o, dudw
+
+
+@njit(cache=True)
+def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
+    """The dense Jacobian blocks of the condensed rings' contacts (:func:`row_eval`):
+    the contacts in series with the ring, (I - K C)^-1 K and D, through the inner ring's
+    T rows onto the frame and, for both rings, onto the balls; ``p2``: :func:`_row_pass2`'s
+    result."""
+    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o, wg_i, wg_o = (
+        con[2],
+        con[3],
+        con[6],
+        con[7],
+        con[10],
+        con[11],
+        con[12],
+        con[13],
+    )
+    ti_all, vf_i, vf_o, dudw = p2
+    nz = nrm_i.shape[0]
+    ball = slice(b0, b0 + 3 * nz)
+    if ti_all.shape[0] > 0:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
+        kim = _condensed_contact_matrix(vf_i, nrm_i, cd_i, wg_i)
+        for jac, km in ((jq, kim[0]), (jv, kim[1])):
+            jac[ball, ball] += km
+            kt = km @ ti_all
+            jac[ball, 0:nx_i] -= kt
+            tk = ti_all.T @ km
+            jac[0:nx_i, ball] -= tk
+            jac[0:nx_i, 0:nx_i] += tk @ ti_all
+        kd = kim[0] @ _film_displacements(law_i, speed, film_i, nrm_i, dudw)
+        jv[ball, 5] += kd
+        jv[0:nx_i, 5] -= ti_all.T @ kd
+    if vf_o.shape[0] > 0:  # outer ring in the housing: ball-ball only (m_o = 0)
+        kom = _condensed_contact_matrix(vf_o, nrm_o, cd_o, wg_o)
+        jq[ball, ball] += kom[0]
+        jv[ball, ball] += kom[1]
+        jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
+
+
+@njit(cache=True)
+def row_eval(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    jacobian,
+    rec,
+    f,
+    jq,
+    jv,
+):
+    """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
+    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
+    rigid and modal rings only the entries it writes, :func:`_zero_written`: the
+    other entries must be zero, as in a zero-allocated work array);
+    coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
+
+    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
+    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
+    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
+    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
+    contact deflections and last tangent; every ring: the contacts' films, the film
+    iteration's warm start, :func:`film_workspace`; updated);
+    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
+    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
+    sum of the local iterations, local solves, then the same four of the
+    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
+    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
+
+    ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
+    CONDENSED_BALLS (the quasi-static balls' modes, see there).
+
+    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
+    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
+    and K the contact stiffness — block diagonal for rigid and modal rings
+    (added ball by ball, :func:`_add_block_jacobian`), the dense condensed
+    (I - K C)^-1 K for condensed rings (:func:`_condensed_contact_matrix`; geometric-stiffness
+    terms of the frame rotation are dropped; the modified Newton iteration
+    converges on the residual, which is exact). The azimuths' cosines and sines
+    are the normalised in-plane coordinates (no sin/cos of the atan2).
+
+    Phases (each its own compiled function): the frame's kinematics
+    (:func:`_frame_kinematics`), pass 1 with the rings undeflected
+    (:func:`_row_geometry`), the contacts and the condensed rings' local solves
+    (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
+    ball (:func:`_row_pass2`), the condensed rings' dense blocks
+    (:func:`_condensed_row_jacobian`)."""
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    state[1] = 0
+    nz = ball_ref.shape[0]
+    b0 = 6 + m_i + m_o
+    f[:] = 0.0
+    if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
+        jq[:, :] = 0.0
         if jacobian == CONDENSED_BALLS:
-            _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j : 3 * j + 3], inv3, tm3)
-        else:
-            for r in range(b0 + 3):
-                rr = r if r < b0 else bj + r - b0
-                for c in range(b0 + 3):
-                    cc = c if c < b0 else bj + c - b0
-                    jq[rr, cc] += jl[r, c]
-                    jv[rr, cc] += vl[r, c]
+            jv[:, :] = 0.0
+    elif jacobian:
+        if cond_i or cond_o:
+            jq[:, :] = 0.0
+            jv[:, :] = 0.0
+        else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
+            _zero_written(jq, b0, nz)
+            _zero_written(jv, b0, nz)
+    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
+    speed = geometry.speed_factor * abs(qt[5])
+    pre = _row_geometry(
+        q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, (om0, om1, om2)
+    )
+    con = _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state)
+    p2 = _row_pass2(
+        q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+    )
     if jacobian and (cond_i or cond_o):
-        ball = slice(b0, b0 + 3 * nz)
-        if cond_i:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
-            kim = _condensed_contact_matrix(vf_i, nrm_i, cd_i, wg_i)
-            for jac, km in ((jq, kim[0]), (jv, kim[1])):
-                jac[ball, ball] += km
-                kt = km @ ti_all
-                jac[ball, 0:nx_i] -= kt
-                tk = ti_all.T @ km
-                jac[0:nx_i, ball] -= tk
-                jac[0:nx_i, 0:nx_i] += tk @ ti_all
-            kd = kim[0] @ _film_displacements(law_i, speed, film_i, nrm_i, dudw)
-            jv[ball, 5] += kd
-            jv[0:nx_i, 5] -= ti_all.T @ kd
-        if cond_o:  # outer ring in the housing: ball-ball only (m_o = 0)
-            kom = _condensed_contact_matrix(vf_o, nrm_o, cd_o, wg_o)
-            jq[ball, ball] += kom[0]
-            jv[ball, ball] += kom[1]
-            jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
+        _condensed_row_jacobian(law_i, law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
 
 
 @njit(cache=True)
@@ -1552,6 +1686,33 @@ def _split_balls(ws, nb, nx):
 
 
 @njit(cache=True)
+def _predict_balls(q, qt, ball_ref, cage_ratio, b, bt, sm, xl, xtl):
+    """The quasi-static balls' start from the last solution (:func:`quasi_static_balls`):
+    turned about the axis with their cage by cage_ratio (phi_z - phi_z,last), then
+    b += S (x - x_last) over the other coordinates and b_t = b_t,last + S (x_t - x_t,last),
+    into q[nx:], qt[nx:]."""
+    nz = ball_ref.shape[0]
+    nb = 3 * nz
+    nx = q.shape[0] - nb
+    turn = cage_ratio * (q[5] - xl[5])
+    ct, st = math.cos(turn), math.sin(turn)
+    for j in range(nz):
+        px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
+        q[nx + 3 * j] = ct * px - st * py - ball_ref[j, 0]
+        q[nx + 3 * j + 1] = st * px + ct * py - ball_ref[j, 1]
+        q[nx + 3 * j + 2] = b[3 * j + 2]
+    for e in range(nb):
+        acc = 0.0
+        acc_t = bt[e]
+        for c in range(nx):
+            if c != 5:
+                acc += sm[e, c] * (q[c] - xl[c])
+            acc_t += sm[e, c] * (qt[c] - xtl[c])
+        q[nx + e] += acc
+        qt[nx + e] = acc_t
+
+
+@njit(cache=True)
 def quasi_static_balls(
     q,
     qt,
@@ -1608,49 +1769,13 @@ def quasi_static_balls(
             q[nx + e] = b[e]
             qt[nx + e] = bt[e]
     else:
-        turn = geometry.cage_ratio * (q[5] - xl[5])
-        ct, st = math.cos(turn), math.sin(turn)
-        for j in range(nz):
-            px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
-            q[nx + 3 * j] = ct * px - st * py - ball_ref[j, 0]
-            q[nx + 3 * j + 1] = st * px + ct * py - ball_ref[j, 1]
-            q[nx + 3 * j + 2] = b[3 * j + 2]
-        for e in range(nb):
-            acc = 0.0
-            acc_t = bt[e]
-            for c in range(nx):
-                if c != 5:
-                    acc += sm[e, c] * (q[c] - xl[c])
-                acc_t += sm[e, c] * (qt[c] - xtl[c])
-            q[nx + e] += acc
-            qt[nx + e] = acc_t
-        its = ball_equilibrium(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            geometry.ball_force_tol,
-            BALL_MAXIT,
-            f,
-            kbb,
-            rec,
-        )
-        if its < 0:  # once more from the last solution
-            for e in range(nb):
-                q[nx + e] = b[e]
-                qt[nx + e] = bt[e]
+        _predict_balls(q, qt, ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        its = -1
+        for attempt in range(2):
+            if attempt == 1:  # once more from the last solution
+                for e in range(nb):
+                    q[nx + e] = b[e]
+                    qt[nx + e] = bt[e]
             its = ball_equilibrium(
                 q,
                 qt,
@@ -1674,6 +1799,8 @@ def quasi_static_balls(
                 kbb,
                 rec,
             )
+            if its >= 0:
+                break
         state[5] = 0
         _count_solve(state, 4, its)
         if its >= 0:

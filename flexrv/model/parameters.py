@@ -37,7 +37,7 @@ from flexrv.analysis.torsional import housing_model_compliance, support_constant
 from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
 from flexrv.contact.laws import effective_pin_friction
 from flexrv.geometry.as_built import as_built
-from flexrv.geometry.kinematics import member_speeds, total_ratio
+from flexrv.geometry.kinematics import total_ratio
 from flexrv.units import M_PER_MM
 
 
@@ -98,7 +98,6 @@ class RigidParameters:
     contact_depth: float
     pin_penetration_limit: float  #: [m] a run stops as failed beyond it
     needle_penetration_limit: float  #: [m]
-    needle_clearance: float
     needle_roller_count: int
     needle_roller_k: float  #: roller constant (inner + outer line contacts in series) [N/m^(10/9)]
     needle_pitch_ratio: float  #: gamma = D / d_m of the needle bearing
@@ -137,7 +136,6 @@ class RigidParameters:
     #: torsional compliance of the pin housing about the axis [rad/(N m)]
     #: (:func:`flexrv.analysis.torsional.housing_model_compliance`, design ``housing.body_model``); 0: rigid
     housing_compliance: float = 0.0
-    extra: dict = field(default_factory=dict)
     # friction (design [contact] friction fields; 0 = off)
     pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
     needle_friction: float = 0.0  #: constant friction coefficient of the needle bearings [-]
@@ -191,38 +189,42 @@ def with_bodies(reducer, bodies) -> object:
     return reducer.model_copy(update=update)
 
 
-def rigid_parameters(reducer) -> RigidParameters:
-    """Derive :class:`RigidParameters` from a design.
-
-    Mass estimates (homogeneous cylinders, density of the part's material):
-    crank = planet gear (pitch-circle disc, face width b) + gear seat + two support
-    journals + two eccentric journals; disc = annulus between the centre hole and
-    the root circle R_p - r_rp - a minus the crank holes (J = m (R^2 + r^2)/2 of
-    the annulus, hole correction by parallel axes). Rigid main bearing: the
-    design's radial and axial stiffness (``main_bearing.rigid_*``, estimates with
-    provenance in the presets), tilting k_r (s/2)^2 with the row spacing s, and
-    carrier-mode damping 2 zeta sqrt(k m) (the ball-resolved and flexible
-    main-bearing models replace it).
-    """
-    fs, ss, cs, nb = reducer.first_stage, reducer.second_stage, reducer.crankshaft, reducer.needle_bearing
-    op, ct = reducer.operating, reducer.contact
+def _first_stage(reducer) -> dict:
+    """Counts, ratio and the first stage's base radii, working pressure angle and crank positions."""
+    fs, ss = reducer.first_stage, reducer.second_stage
     n = fs.n_planets
-    nd = ss.n_discs
     z_s, z_p, z_c, z_rp = fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count
-    ratio = float(total_ratio(z_s, z_p, z_c, z_rp))
     alpha = fs.pressure_angle
     rb_s = 0.5 * fs.module * z_s * math.cos(alpha)
     rb_p = 0.5 * fs.module * z_p * math.cos(alpha)
     a_w = fs.center_distance
     alpha_w = math.acos((rb_s + rb_p) / a_w)
-    beta = 2.0 * math.pi * np.arange(n) / n
-    # pins, discs, cranks: the as-built geometry (nominal + the design's [errors]), one place
-    ab = as_built(reducer)
-    # masses
+    return dict(
+        n_cranks=n,
+        n_discs=ss.n_discs,
+        z_s=z_s,
+        z_p=z_p,
+        z_c=z_c,
+        z_rp=z_rp,
+        ratio=float(total_ratio(z_s, z_p, z_c, z_rp)),
+        base_radius_sun=rb_s,
+        base_radius_planet=rb_p,
+        center_distance=a_w,
+        working_pressure_angle=alpha_w,
+        normal_backlash=fs.backlash * math.cos(alpha_w),
+        crank_angles=2.0 * math.pi * np.arange(n) / n,
+    )
+
+
+def _masses(reducer) -> dict:
+    """Crank (planet gear + shaft), planet, disc and carrier masses and inertias
+    (homogeneous cylinders, see :func:`rigid_parameters`)."""
+    fs, ss, cs = reducer.first_stage, reducer.second_stage, reducer.crankshaft
+    n, nd = fs.n_planets, ss.n_discs
     rho_g = reducer.material("gears").density_kg_m3
     rho_c = reducer.material("crankshaft").density_kg_m3
     rho_d = reducer.material("cycloid_disc").density_kg_m3
-    r_pitch_p = 0.5 * fs.module * z_p
+    r_pitch_p = 0.5 * fs.module * fs.planet_teeth
     m_planet = rho_g * math.pi * r_pitch_p**2 * fs.face_width
     parts = [
         (cs.gear_seat_diameter_mm, cs.gear_seat_length_mm, 1),
@@ -230,24 +232,36 @@ def rigid_parameters(reducer) -> RigidParameters:
         (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm, nd),
     ]
     m_shaft = sum(k * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) for d, l, k in parts)
-    crank_mass = m_planet + m_shaft
     crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(
         k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2 for d, l, k in parts
     )
     d_seat, l_seat = cs.gear_seat_diameter_mm * 1e-3, cs.gear_seat_length_mm * 1e-3
     m_seat = _cyl_mass(rho_c, d_seat, l_seat)
-    planet_mass = m_planet + m_seat
-    planet_inertia = 0.5 * m_planet * r_pitch_p**2 + 0.5 * m_seat * (0.5 * d_seat) ** 2
     r_out = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
     r_in = ss.center_hole_radius
     r_h = reducer.crank_hole_radius
     b = ss.disc_width
+    a_w = fs.center_distance
     m_ann = rho_d * math.pi * (r_out**2 - r_in**2) * b
     m_hole = rho_d * math.pi * r_h**2 * b
-    disc_mass = m_ann - n * m_hole
-    disc_inertia = 0.5 * m_ann * (r_out**2 + r_in**2) - n * m_hole * (0.5 * r_h**2 + a_w**2)
-    # contact constants: the pin path = pin-disc contact, pin seat and pin bending in series
-    # (flexrv.analysis.pin_load.pin_contact_constant, the one constant of every model)
+    return dict(
+        crank_mass=m_planet + m_shaft,
+        crank_inertia=crank_inertia,
+        planet_mass=m_planet + m_seat,
+        planet_inertia=0.5 * m_planet * r_pitch_p**2 + 0.5 * m_seat * (0.5 * d_seat) ** 2,
+        disc_mass=m_ann - n * m_hole,
+        disc_inertia=0.5 * m_ann * (r_out**2 + r_in**2) - n * m_hole * (0.5 * r_h**2 + a_w**2),
+        carrier_mass=reducer.inertia.carrier_mass_kg,
+        carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
+        input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
+    )
+
+
+def _contacts(reducer) -> dict:
+    """Pin, needle and crank-support contact constants, limits and friction. The pin path
+    is the pin-disc contact, pin seat and pin bending in series
+    (:func:`flexrv.analysis.pin_load.pin_contact_constant`, the one constant of every model)."""
+    cs, nb, ct = reducer.crankshaft, reducer.needle_bearing, reducer.contact
     k_line = pin_contact_constant(reducer).k
     depth = ct.impact_damping_depth_mm * 1e-3
     if ct.pin_law == "hertz_line":
@@ -262,10 +276,36 @@ def rigid_parameters(reducer) -> RigidParameters:
         reducer.material("rolling_elements").poisson_ratio,
     )
     k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
-    roller_k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
     d_roll = nb.roller_diameter_mm * 1e-3
     dm = cs.eccentric_journal_diameter_mm * 1e-3 + d_roll
     support_law, support_angles, support_linear = support_constants(reducer)
+    return dict(
+        support_stiffness=(2.0 * cs.support_bearing_radial_stiffness_N_per_m if support_linear else float("nan")),
+        support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
+        support_law=support_law,
+        support_roller_angles=support_angles,
+        support_linear=support_linear,
+        pin_k=pin_k,
+        pin_exponent=pin_e,
+        pin_c_max=ct.pin_max_damping_Ns_per_m,
+        contact_depth=depth,
+        pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
+        needle_penetration_limit=ct.needle_penetration_limit_um * 1e-6,
+        needle_roller_count=nb.roller_count,
+        needle_roller_k=float(series_stiffness(k_roll, k_roll, LINE_EXPONENT)),
+        needle_pitch_ratio=d_roll / dm,
+        needle_c_max=ct.pin_max_damping_Ns_per_m,
+        pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
+        if ct.friction
+        else 0.0,
+        needle_friction=ct.needle_friction_coefficient if ct.friction else 0.0,
+        needle_friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
+        friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,
+    )
+
+
+def _main_bearing(reducer) -> dict:
+    """The rigid main bearing's stiffness (x, y, z, rx, ry) and carrier-mode damping."""
     mb = reducer.main_bearing
     k_r = mb.rigid_radial_stiffness_N_per_m
     s = mb.row_spacing_mm * 1e-3
@@ -277,59 +317,13 @@ def rigid_parameters(reducer) -> RigidParameters:
             kmb * np.array([reducer.inertia.carrier_mass_kg] * 3 + [reducer.inertia.carrier_inertia_kg_m2 / 2] * 2)
         )
     )
-    carrier_c, disc_c = body_compliance_matrices(reducer)
-    return RigidParameters(
-        n_cranks=n,
-        n_discs=nd,
-        z_s=z_s,
-        z_p=z_p,
-        z_c=z_c,
-        z_rp=z_rp,
-        ratio=ratio,
-        base_radius_sun=rb_s,
-        base_radius_planet=rb_p,
-        center_distance=a_w,
-        working_pressure_angle=alpha_w,
-        normal_backlash=fs.backlash * math.cos(alpha_w),
-        crank_angles=beta,
-        eccentricity=ss.eccentricity,
-        pin_circle_radius=ss.pin_circle_radius,
-        pin_radius=ss.pin_radius,
-        d_radius=ss.modification_shift,
-        d_pin_radius=ss.modification_equidistant,
-        d_rotation=ss.modification_rotation,
-        disc_width=b,
-        pins=ab.pins,
-        chi0=ab.chi0,
-        disc_rot0=ab.disc_rot0,
-        holes=ab.holes,
-        crank_mass=crank_mass,
-        crank_inertia=crank_inertia,
-        planet_mass=planet_mass,
-        planet_inertia=planet_inertia,
-        disc_mass=disc_mass,
-        disc_inertia=disc_inertia,
-        carrier_mass=reducer.inertia.carrier_mass_kg,
-        carrier_inertia=reducer.inertia.carrier_inertia_kg_m2,
-        input_inertia=reducer.inertia.input_shaft_inertia_kg_m2,
-        support_stiffness=(2.0 * cs.support_bearing_radial_stiffness_N_per_m if support_linear else float("nan")),
-        support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
-        support_law=support_law,
-        support_roller_angles=support_angles,
-        support_linear=support_linear,
-        main_bearing_stiffness=kmb,
-        main_bearing_damping=cmb,
-        pin_k=pin_k,
-        pin_exponent=pin_e,
-        pin_c_max=ct.pin_max_damping_Ns_per_m,
-        contact_depth=depth,
-        pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
-        needle_penetration_limit=ct.needle_penetration_limit_um * 1e-6,
-        needle_clearance=nb.radial_clearance_um * 1e-6,
-        needle_roller_count=nb.roller_count,
-        needle_roller_k=roller_k,
-        needle_pitch_ratio=d_roll / dm,
-        needle_c_max=ct.pin_max_damping_Ns_per_m,
+    return dict(main_bearing_stiffness=kmb, main_bearing_damping=cmb)
+
+
+def _operating(reducer) -> dict:
+    """Drive and load of the run (design ``[operating]``)."""
+    op = reducer.operating
+    return dict(
         input_speed=op.input_speed,
         speed_ramp_time=op.speed_ramp_time_s,
         load_torque=op.load_torque_Nm,
@@ -338,6 +332,26 @@ def rigid_parameters(reducer) -> RigidParameters:
         external_axial_force=op.external_axial_force_N,
         external_radial_force=op.external_radial_force_N,
         tilting_moment=op.tilting_moment_Nm,
+    )
+
+
+def _second_stage(reducer) -> dict:
+    """The second stage's nominal geometry and the as-built geometry of every element
+    (nominal + the design's [errors], :func:`flexrv.geometry.as_built.as_built`, one place)."""
+    ss = reducer.second_stage
+    ab = as_built(reducer)
+    return dict(
+        eccentricity=ss.eccentricity,
+        pin_circle_radius=ss.pin_circle_radius,
+        pin_radius=ss.pin_radius,
+        d_radius=ss.modification_shift,
+        d_pin_radius=ss.modification_equidistant,
+        d_rotation=ss.modification_rotation,
+        disc_width=ss.disc_width,
+        pins=ab.pins,
+        chi0=ab.chi0,
+        disc_rot0=ab.disc_rot0,
+        holes=ab.holes,
         pin_radii=ab.pin_radii,
         disc_profile=ab.disc_profile,
         profile_harmonics=ab.profile_harmonics,
@@ -349,14 +363,31 @@ def rigid_parameters(reducer) -> RigidParameters:
         sun_runout=ab.sun_runout,
         planet_runout=ab.planet_runout,
         planet_phase_errors=ab.planet_phase_errors,
+    )
+
+
+def rigid_parameters(reducer) -> RigidParameters:
+    """Derive :class:`RigidParameters` from a design.
+
+    Mass estimates (homogeneous cylinders, density of the part's material):
+    crank = planet gear (pitch-circle disc, face width b) + gear seat + two support
+    journals + two eccentric journals; disc = annulus between the centre hole and
+    the root circle R_p - r_rp - a minus the crank holes (J = m (R^2 + r^2)/2 of
+    the annulus, hole correction by parallel axes). Rigid main bearing: the
+    design's radial and axial stiffness (``main_bearing.rigid_*``, estimates with
+    provenance in the presets), tilting k_r (s/2)^2 with the row spacing s, and
+    carrier-mode damping 2 zeta sqrt(k m) (the ball-resolved and flexible
+    main-bearing models replace it).
+    """
+    carrier_c, disc_c = body_compliance_matrices(reducer)
+    return RigidParameters(
+        **_first_stage(reducer),
+        **_second_stage(reducer),
+        **_masses(reducer),
+        **_contacts(reducer),
+        **_main_bearing(reducer),
+        **_operating(reducer),
         carrier_compliance=carrier_c,
         disc_compliance=disc_c,
         housing_compliance=housing_model_compliance(reducer),
-        extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
-        pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
-        if ct.friction
-        else 0.0,
-        needle_friction=ct.needle_friction_coefficient if ct.friction else 0.0,
-        needle_friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
-        friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,
     )

@@ -131,6 +131,7 @@ time histories (outputs) evaluate every gap exactly.
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
@@ -446,6 +447,170 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, PinPack(pack.idx_rim, *pins[1:]), cd, pack.dstate, hs, pack.work)
 
 
+#: views of the rim condensation's work array (:func:`_rim_views`, layout of :func:`pin_work_size`):
+#: st, the Newton state, 15 vectors (the last call's hub q, v, condensed force and rim offsets, the
+#: hub state, the local rim coordinates and forces, delta, the Newton's base, step and residual,
+#: a_k stacked, the condensed force, the norms' weights), 11 matrices (S_q, S_v, the condensed
+#: Jacobians, J, J_v, C, N, scratch, D, scratch)
+RimWork = namedtuple(
+    "RimWork",
+    "st nw qp vp qfc dlast qh vh ql fl delta base step res av qf weight sq sv jc jvc jl jvl cm nm tmp dd t2",
+)
+
+
+@njit(cache=True)
+def _rim_views(wk, m):
+    """The named views of the rim condensation's work array for m local coordinates."""
+    mm = m * m
+    st = wk[0:4]
+    nw = wk[4 : 4 + NEWTON_STATE]
+    o = 4 + NEWTON_STATE
+    vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
+    mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
+    return RimWork(
+        st, nw, vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7], vec[8], vec[9], vec[10], vec[11],
+        vec[12], vec[13], vec[14], mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7], mat[8], mat[9],
+        mat[10],
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _add_condensed(f, jq, jv, jac, idx, qf, jc, jvc):
+    """Add a condensed force qf and, with ``jac``, the condensed Jacobians at idx."""
+    m = qf.shape[0]
+    for r in range(m):
+        f[idx[r]] += qf[r]
+    if jac:
+        for r in range(m):
+            for c in range(m):
+                jq[idx[r], idx[c]] += jc[r, c]
+                jv[idx[r], idx[c]] += jvc[r, c]
+
+
+@njit(cache=True)
+def _rim_reuse(dstate, w):
+    """(valid, same): whether the previous call's predictor may be used (st[0] set and the
+    rim offsets not set from outside since) and whether this call is at its hub state."""
+    m = w.qh.shape[0]
+    valid = w.st[0] > 0.0
+    if valid:
+        for r in range(m):
+            if dstate[r // 3, r % 3] != w.dlast[r]:  # rim offsets set from outside: a fresh start from them
+                valid = False
+    same = valid
+    if valid:
+        for r in range(m):
+            if w.qh[r] != w.qp[r] or w.vh[r] != w.vp[r]:
+                same = False
+                break
+    return valid, same
+
+
+@njit(cache=True)
+def _rim_start(dstate, cd, ch, r_p, w):
+    """The rim compliance C = blockdiag(C_d,k) + c_h A A^T at the hub centres, the
+    Newton's start delta (the stored rim offsets) and its norms' weights."""
+    m = w.qh.shape[0]
+    nd = m // 3
+    qh, av, cm, delta = w.qh, w.av, w.cm, w.delta
+    for kd in range(nd):
+        av[3 * kd], av[3 * kd + 1], av[3 * kd + 2] = -qh[3 * kd + 1], qh[3 * kd], 1.0
+    for r in range(m):
+        for c in range(m):
+            cm[r, c] = ch * av[r] * av[c]
+    if cd.shape[0] > 0:
+        for kd in range(nd):
+            for r in range(3):
+                for c in range(3):
+                    cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
+    for r in range(m):
+        delta[r] = dstate[r // 3, r % 3]
+        w.weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
+
+
+@njit(cache=True)
+def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
+    """The rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) =
+    I - C J, from the first-order predictor of the previous call (``valid``); the last
+    correction applied linearised (condensed force into w.qf, offsets into dstate) and the
+    housing's rotation and rim offsets into hs. Returns the pins' torque on the discs."""
+    m = w.qh.shape[0]
+    nd = m // 3
+    delta, step, qf, av = w.delta, w.step, w.qf, w.av
+    if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
+        for r in range(m):
+            acc = 0.0
+            for c in range(m):
+                acc += w.sq[r, c] * (w.qh[c] - w.qp[c]) + w.sv[r, c] * (w.vh[c] - w.vp[c])
+            step[r] = acc
+        apply_predictor(delta, step, w.weight)
+    newton_start(w.nw)
+    while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
+        r1, scale = _rim_residual(w.qh, w.vh, w.ql, w.fl, w.jl, w.jvl, pins_loc, w.cm, w.weight, delta, w.res)
+        if newton_update(w.nw, r1, scale, delta, w.base, step, w.res, w.cm, w.jl, -1.0, w.tmp, w.nm, *RIM_NEWTON):
+            break
+    # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
+    # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
+    s = 0.0
+    for r in range(m):
+        acc = w.fl[r]
+        for c in range(m):
+            acc -= w.jl[r, c] * step[c]
+        qf[r] = acc
+        s += av[r] * acc  # torque of the pins on the discs about the axis = -(their torque on the housing)
+    if ch > 0.0:
+        phi = -ch * s  # housing rotation phi_h = c_h M_h, M_h = -s
+        hs[1] = phi
+        for kd in range(nd):
+            hs[2 + 2 * kd] = -phi * av[3 * kd]
+            hs[3 + 2 * kd] = -phi * av[3 * kd + 1]
+    for r in range(m):
+        delta[r] -= step[r]
+        dstate[r // 3, r % 3] = delta[r]
+        w.dlast[r] = delta[r]
+        w.qfc[r] = qf[r]
+    return s
+
+
+@njit(cache=True)
+def _rim_tangent(ch, s, w):
+    """The condensed Jacobians J N (I + D) and (I + J N C) J_v into w.jc, w.jvc, and the
+    predictor's sensitivities S_q = C dQ_eff/dq + D, S_v = C dQ_eff/dv with the hub
+    state they belong to (also the repeated state's result)."""
+    m = w.qh.shape[0]
+    nd = m // 3
+    dd, tmp, t2, av, qf = w.dd, w.tmp, w.t2, w.av, w.qf
+    for r in range(m):
+        for c in range(m):
+            dd[r, c] = 0.0
+    if ch > 0.0:  # a_k moves with the hub centre: D = d(C Q)/dq at fixed Q
+        for kd in range(nd):
+            cx, cy = 3 * kd, 3 * kd + 1
+            dd[cy, cx] += ch * s
+            dd[cx, cy] -= ch * s
+            for r in range(m):
+                dd[r, cx] += ch * av[r] * qf[cy]
+                dd[r, cy] -= ch * av[r] * qf[cx]
+    for r in range(m):
+        for c in range(m):
+            tmp[r, c] = dd[r, c] + (1.0 if r == c else 0.0)
+    matmul_small(w.nm, tmp, t2)
+    matmul_small(w.jl, t2, w.jc)  # J N (I + D)
+    matmul_small(w.cm, w.jvl, tmp)
+    matmul_small(w.nm, tmp, t2)
+    matmul_small(w.jl, t2, w.jvc)
+    for r in range(m):
+        for c in range(m):
+            w.jvc[r, c] += w.jvl[r, c]  # (I + J N C) J_v
+    matmul_small(w.cm, w.jc, w.sq)
+    matmul_small(w.cm, w.jvc, w.sv)
+    for r in range(m):
+        w.qp[r], w.vp[r] = w.qh[r], w.vh[r]
+        for c in range(m):
+            w.sq[r, c] += dd[r, c]
+    w.st[0] = 1.0
+
+
 @njit(cache=True)
 def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, wk):
     """The rim condensation (module docstring, "Disc body", "Housing"): the pins act
@@ -479,125 +644,25 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
     holds st = (valid, -, -, -), the last call's hub q and v, its condensed force, its
     rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[0] = 0
-    (reset, history pass) starts from dstate without the predictor."""
+    (reset, history pass) starts from dstate without the predictor.
+
+    Phases (each its own compiled function): the work array's views (:func:`_rim_views`),
+    the reuse test (:func:`_rim_reuse`), the compliance and start (:func:`_rim_start`),
+    the Newton (:func:`_rim_solve`), the condensed Jacobians (:func:`_rim_tangent`)."""
     idx = pins.idx
-    r_p = pins.law.pin_circle_radius
-    nd = pins.profile.shape[0]
-    m = 3 * nd
-    mm = m * m
+    m = 3 * pins.profile.shape[0]
     ch = hs[0] if hs.shape[0] > 0 else 0.0
-    st = wk[0:4]
-    nw = wk[4 : 4 + NEWTON_STATE]
-    o = 4 + NEWTON_STATE
-    vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
-    qp, vp, qfc, dlast, qh, vh, ql = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6]
-    fl, delta, base, step, res, av, qf, weight = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13], vec[14]
-    mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
-    sq, sv, jc, jvc, jl, jvl = mat[0], mat[1], mat[2], mat[3], mat[4], mat[5]
-    cm, nm, tmp, dd, t2 = mat[6], mat[7], mat[8], mat[9], mat[10]
+    w = _rim_views(wk, m)
     for r in range(m):
-        qh[r], vh[r] = q[idx[r]], v[idx[r]]
-    valid = st[0] > 0.0
-    if valid:
-        for r in range(m):
-            if dstate[r // 3, r % 3] != dlast[r]:  # rim offsets set from outside: a fresh start from them
-                valid = False
-    if valid:
-        same = True
-        for r in range(m):
-            if qh[r] != qp[r] or vh[r] != vp[r]:
-                same = False
-                break
-        if same:  # the previous call's state: its result
-            for r in range(m):
-                f[idx[r]] += qfc[r]
-            if jac:
-                for r in range(m):
-                    for c in range(m):
-                        jq[idx[r], idx[c]] += jc[r, c]
-                        jv[idx[r], idx[c]] += jvc[r, c]
-            return
-    for kd in range(nd):
-        av[3 * kd], av[3 * kd + 1], av[3 * kd + 2] = -qh[3 * kd + 1], qh[3 * kd], 1.0
-    for r in range(m):
-        for c in range(m):
-            cm[r, c] = ch * av[r] * av[c]
-    if cd.shape[0] > 0:
-        for kd in range(nd):
-            for r in range(3):
-                for c in range(3):
-                    cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
-    for r in range(m):
-        delta[r] = dstate[r // 3, r % 3]
-        weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
-    if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
-        for r in range(m):
-            acc = 0.0
-            for c in range(m):
-                acc += sq[r, c] * (qh[c] - qp[c]) + sv[r, c] * (vh[c] - vp[c])
-            step[r] = acc
-        apply_predictor(delta, step, weight)
-    newton_start(nw)
-    while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
-        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
-        if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
-            break
-    # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
-    # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
-    s = 0.0
-    for r in range(m):
-        acc = fl[r]
-        for c in range(m):
-            acc -= jl[r, c] * step[c]
-        qf[r] = acc
-        s += av[r] * acc  # torque of the pins on the discs about the axis = -(their torque on the housing)
-    if ch > 0.0:
-        phi = -ch * s  # housing rotation phi_h = c_h M_h, M_h = -s
-        hs[1] = phi
-        for kd in range(nd):
-            hs[2 + 2 * kd] = -phi * av[3 * kd]
-            hs[3 + 2 * kd] = -phi * av[3 * kd + 1]
-    for r in range(m):
-        delta[r] -= step[r]
-        f[idx[r]] += qf[r]
-        dstate[r // 3, r % 3] = delta[r]
-        dlast[r] = delta[r]
-        qfc[r] = qf[r]
-    # condensed Jacobians (also the predictor's sensitivities and the repeated state's result)
-    for r in range(m):
-        for c in range(m):
-            dd[r, c] = 0.0
-    if ch > 0.0:  # a_k moves with the hub centre: D = d(C Q)/dq at fixed Q
-        for kd in range(nd):
-            cx, cy = 3 * kd, 3 * kd + 1
-            dd[cy, cx] += ch * s
-            dd[cx, cy] -= ch * s
-            for r in range(m):
-                dd[r, cx] += ch * av[r] * qf[cy]
-                dd[r, cy] -= ch * av[r] * qf[cx]
-    for r in range(m):
-        for c in range(m):
-            tmp[r, c] = dd[r, c] + (1.0 if r == c else 0.0)
-    matmul_small(nm, tmp, t2)
-    matmul_small(jl, t2, jc)  # J N (I + D)
-    matmul_small(cm, jvl, tmp)
-    matmul_small(nm, tmp, t2)
-    matmul_small(jl, t2, jvc)
-    for r in range(m):
-        for c in range(m):
-            jvc[r, c] += jvl[r, c]  # (I + J N C) J_v
-    matmul_small(cm, jc, sq)
-    matmul_small(cm, jvc, sv)
-    for r in range(m):
-        qp[r], vp[r] = qh[r], vh[r]
-        for c in range(m):
-            sq[r, c] += dd[r, c]
-    st[0] = 1.0
-    if jac:
-        for r in range(m):
-            for c in range(m):
-                jq[idx[r], idx[c]] += jc[r, c]
-                jv[idx[r], idx[c]] += jvc[r, c]
+        w.qh[r], w.vh[r] = q[idx[r]], v[idx[r]]
+    valid, same = _rim_reuse(dstate, w)
+    if same:  # the previous call's state: its result
+        _add_condensed(f, jq, jv, jac, idx, w.qfc, w.jc, w.jvc)
+        return
+    _rim_start(dstate, cd, ch, pins.law.pin_circle_radius, w)
+    s = _rim_solve(valid, pins_loc, ch, dstate, hs, w)
+    _rim_tangent(ch, s, w)
+    _add_condensed(f, jq, jv, jac, idx, w.qf, w.jc, w.jvc)
 
 
 @functools.lru_cache(maxsize=64)
