@@ -110,10 +110,12 @@ from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_s
 from flexrv.units import DEG_PER_RAD
 
 _F, _I = np.float64, np.int64
-#: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law
-SupportLaw = law_type("SupportLaw", damping=float, linear=bool)
+#: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law, the
+#: crank's bending stiffness k_bend [N/m] (0: rigid crank) and the cage's pitch ratio g = D cos(alpha) / d_m
+#: (the roller law's entries that the kernel itself reads)
+SupportLaw = law_type("SupportLaw", damping=float, linear=bool, k_bend=float, g=float)
 #: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
-#: the tapered-roller pair's law vector (:mod:`flexrv.contact.tapered_roller`, read by its SC_ names),
+#: the tapered-roller pair's law vector (passed on to :func:`flexrv.contact.tapered_roller.crank_support_force`),
 #: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
 #: crank, bearing displacement = Newton start, bending share), the elastic carrier's support-point
 #: compliance (2N, 2N) (empty: rigid), its deflections (N, 4) and the work array (:func:`support_work_size`)
@@ -533,8 +535,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     (:func:`_support_loads`), the tangent (:func:`_support_tangent`) and the Jacobian rows
     (:func:`_support_jacobian`)."""
     idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
-    linear = pack.law.linear
-    g = sc[SC_G]
+    linear, g = pack.law.linear, pack.law.g
     th = q[idx[2]]
     c, s = np.cos(th), np.sin(th)
     n = bores.shape[0]
@@ -545,7 +546,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
         _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, pack.bstate, pack.ustate, w)
     else:
         _support_forces(w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, pack.bstate, w.fs, w.kk, w.hh, w.qs)
-    _support_loads(f, idx, pack.law.damping, sc[SC_K_BEND], pack.fx, pack.fy, pack.bend, w)
+    _support_loads(f, idx, pack.law.damping, pack.law.k_bend, pack.fx, pack.fy, pack.bend, w)
     if not (jac or elastic):
         return
     arm_term = _support_tangent(q, idx, g, elastic, w)
@@ -574,7 +575,7 @@ class CrankSupports(KernelGroup):
         self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
         self.linear = bool(p.support_linear)
         self.c = p.support_damping
-        self.law = SupportLaw.of(damping=self.c, linear=self.linear)
+        self.law = SupportLaw.of(damping=self.c, linear=self.linear, k_bend=self.sc[SC_K_BEND], g=self.sc[SC_G])
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
@@ -631,7 +632,7 @@ class CrankSupports(KernelGroup):
                 "radial force of the carrier on each crank (both support bearings)",
             )
         }
-        if self.sc[SC_K_BEND] > 0.0:  # elastic crank
+        if self.law.k_bend > 0.0:  # elastic crank
             out["crank_bending_fraction"] = Output(
                 rec["bend"],
                 ("time", "crank"),

@@ -187,14 +187,17 @@ PinPack = pack_type(
     ("pw", (_F, 2)),
     ("ctr", (_I, (4,))),
 )
+#: the pin housing's torsional compliance c_h [rad/(N m)] (0: rigid housing)
+HousingLaw = law_type("HousingLaw", compliance=float)
 #: :func:`pin_body_kernel`'s pack: the pins' pack, rim compliance (n_discs, 3, 3) (empty: rigid
-#: discs), rim offsets (n_discs, 3), housing state (c_h, phi_h, per disc -phi_h a_k), the local
-#: rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
+#: discs), rim offsets (n_discs, 3), the housing's law and state (c_h, phi_h, per disc -phi_h a_k;
+#: written), the local rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
 PinBodyPack = pack_type(
     "PinBodyPack",
     ("pins", PinPack),
     ("disc_c", (_F, 3)),
     ("dstate", (_F, 2)),
+    ("housing_law", HousingLaw),
     ("housing", (_F, 1)),
     ("idx_rim", (_I, 1)),
     ("work", (_F, 1)),
@@ -433,18 +436,19 @@ def pin_work_size(m: int) -> int:
 @njit(cache=True)
 def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     """The pins' kernel with elastic disc bodies and/or the elastic housing (module
-    docstring, "Disc body", "Housing"). ``pack`` = (pin_kernel's pack, cd, dstate, hs,
-    idx_rim = 0..3 n_discs - 1, wk): cd (n_discs, 3, 3) the rim
-    compliance of each disc (empty: rigid discs), dstate (n_discs, 3) the rim
-    offsets delta (x, y, psi) of the last call (output), hs the housing's (c_h,
-    phi_h, ...), wk the condensation's work array (:func:`_pin_condensed_kernel`).
+    docstring, "Disc body", "Housing"). ``pack`` (:data:`PinBodyPack`): the pin kernel's
+    pack, ``disc_c`` (n_discs, 3, 3) the rim compliance of each disc (empty: rigid discs),
+    ``dstate`` (n_discs, 3) the rim offsets delta (x, y, psi) of the last call (output),
+    ``housing_law.compliance`` c_h, ``housing`` the housing's state (c_h, phi_h, ...;
+    written), ``work`` the condensation's work array (:func:`_pin_condensed_kernel`).
     Rigid discs and a rigid housing (c_h = 0): a plain :func:`pin_kernel` call."""
-    pins, cd, hs = pack.pins, pack.disc_c, pack.housing
-    if cd.shape[0] == 0 and not (hs.shape[0] > 0 and hs[0] > 0.0):
+    pins, cd, ch = pack.pins, pack.disc_c, pack.housing_law.compliance
+    if cd.shape[0] == 0 and not ch > 0.0:
         pin_kernel(q, v, f, jq, jv, jac, pins)
         return
     # the pin kernel's pack on the local rim coordinates (built here: one array to unbox, not sixteen)
-    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, PinPack(pack.idx_rim, *pins[1:]), cd, pack.dstate, hs, pack.work)
+    pins_loc = PinPack(pack.idx_rim, *pins[1:])
+    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, pack.dstate, pack.housing, pack.work)
 
 
 #: views of the rim condensation's work array (:func:`_rim_views`, layout of :func:`pin_work_size`):
@@ -612,7 +616,7 @@ def _rim_tangent(ch, s, w):
 
 
 @njit(cache=True)
-def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, wk):
+def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, hs, wk):
     """The rim condensation (module docstring, "Disc body", "Housing"): the pins act
     on the rim poses q_r = q_hub + delta of all discs, delta = C(q) Q(q_r, v), C =
     blockdiag(C_d,k) + c_h A A^T (cd empty: rigid disc bodies; c_h = 0: the discs
@@ -651,7 +655,6 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     the Newton (:func:`_rim_solve`), the condensed Jacobians (:func:`_rim_tangent`)."""
     idx = pins.idx
     m = 3 * pins.profile.shape[0]
-    ch = hs[0] if hs.shape[0] > 0 else 0.0
     w = _rim_views(wk, m)
     for r in range(m):
         w.qh[r], w.vh[r] = q[idx[r]], v[idx[r]]
@@ -764,6 +767,7 @@ class PinContacts(KernelGroup):
         c_h = float(getattr(p, "housing_compliance", 0.0))
         if not (np.isfinite(c_h) and c_h >= 0.0):
             raise ValueError(f"housing_compliance = {c_h!r} must be a finite compliance >= 0 [rad/(N m)]")
+        self.housing_law = HousingLaw.of(compliance=c_h)
         self.hstate = np.zeros(2 + 2 * self.nd)
         self.hstate[0] = c_h
         #: the rim condensation's work array (_pin_condensed_kernel: predictor state, last result, scratch)
@@ -772,7 +776,7 @@ class PinContacts(KernelGroup):
 
     @property
     def elastic_housing(self) -> bool:
-        return self.hstate[0] > 0.0
+        return self.housing_law.compliance > 0.0
 
     @property
     def elastic_discs(self) -> bool:
@@ -809,7 +813,13 @@ class PinContacts(KernelGroup):
             ctr=ctr,
         )
         return PinBodyPack(
-            pins=pins, disc_c=self.disc_c, dstate=self.dstate, housing=self.hstate, idx_rim=self.idx_rim, work=work
+            pins=pins,
+            disc_c=self.disc_c,
+            dstate=self.dstate,
+            housing_law=self.housing_law,
+            housing=self.hstate,
+            idx_rim=self.idx_rim,
+            work=work,
         )
 
     @staticmethod
