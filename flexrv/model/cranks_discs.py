@@ -103,7 +103,7 @@ from numba import njit
 from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import inv_small, matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
@@ -563,6 +563,9 @@ class CrankSupports(KernelGroup):
 
     name = "crank_supports"
     kind = "supports"
+    summary_rows = (
+        SummaryRow("max_crank_support_force_N", "N", "largest crank-support force", "crank_support_force", "max"),
+    )
     kernel = staticmethod(crank_support_kernel)
 
     def __init__(self, params):
@@ -872,6 +875,7 @@ class NeedleBearings(KernelGroup):
 
     name = "needle_bearings"
     kind = "needles"
+    summary_rows = (SummaryRow("max_needle_force_N", "N", "largest needle-bearing force", "needle_force", "max"),)
     kernel = staticmethod(needle_kernel)
     friction_outputs = ("needle_friction_power",)
 

@@ -56,7 +56,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.analysis.mesh_stiffness import mesh_stiffness_ramped
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.units import TWO_PI
 
@@ -184,6 +184,7 @@ class GearMeshes(KernelGroup):
 
     name = "gear_stage"
     kind = "gear"
+    summary_rows = (SummaryRow("max_mesh_force_N", "N", "largest sun-planet mesh force", "mesh_force", "max"),)
     kernel = staticmethod(gear_stage_kernel)
     time_field = "drive"
 

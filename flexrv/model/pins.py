@@ -138,7 +138,7 @@ from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.geometry.cycloid import _FOOT, closest_point_settings
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
@@ -709,6 +709,9 @@ class PinContacts(KernelGroup):
 
     name = "pins"
     kind = "pins"
+    summary_rows = (
+        SummaryRow("min_pin_gap_m", "m", "smallest pin-profile gap (negative: penetration)", "pin_gap", "min"),
+    )
     kernel = staticmethod(pin_body_kernel)
     friction_outputs = ("pin_friction_power",)
     failure_message = "pin gap: closest-point iteration did not converge"
