@@ -583,7 +583,7 @@ class CrankSupports(KernelGroup):
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
         #: (2N, 2N) support-point compliance of the elastic carrier, carrier frame [m/N]; (0, 0): rigid
-        self.carrier_c = np.ascontiguousarray(getattr(p, "carrier_compliance", np.zeros((0, 0))), dtype=float)
+        self.carrier_c = np.ascontiguousarray(p.carrier_compliance, dtype=float)
         if self.carrier_c.size and self.carrier_c.shape != (2 * self.n, 2 * self.n):
             raise ValueError(f"carrier_compliance has shape {self.carrier_c.shape}, expected {(2 * self.n,) * 2}")
         self.ustate = np.zeros((self.n, 4))

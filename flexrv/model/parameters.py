@@ -41,6 +41,20 @@ from flexrv.geometry.kinematics import total_ratio
 from flexrv.units import M_PER_MM
 
 
+class _Lazy:
+    """The value of a :class:`RigidParameters` field that is built on first access."""
+
+    def __repr__(self) -> str:
+        return "LAZY"
+
+    def __reduce__(self):
+        return "LAZY"  # pickled by reference: the one sentinel in every process
+
+
+#: a field's default: built on first access from the design (:data:`_LAZY_BUILDERS`)
+LAZY = _Lazy()
+
+
 @dataclass(frozen=True)
 class RigidParameters:
     """All numbers of the rigid model (SI). Built by :func:`rigid_parameters`."""
@@ -92,8 +106,6 @@ class RigidParameters:
     support_linear: bool  #: the linear support law (crankshaft.support_bearing_model = "linear")
     main_bearing_stiffness: np.ndarray  #: (5,) x, y, z, rx, ry [N/m, N m/rad]
     main_bearing_damping: np.ndarray
-    pin_k: float  #: pin-contact constant [N/m^e]
-    pin_exponent: float
     pin_c_max: float
     contact_depth: float
     pin_penetration_limit: float  #: [m] a run stops as failed beyond it
@@ -127,20 +139,35 @@ class RigidParameters:
     sun_runout: np.ndarray  #: (2,) amplitude [m] along the lines of action, phase [rad]
     planet_runout: np.ndarray  #: (N, 2) amplitude [m], phase [rad]
     planet_phase_errors: np.ndarray  #: (N,) assembly phase error of each planet on its crank [rad]
+    # ---- built on first access (:data:`LAZY`): only the element that reads one pays for it
     #: (2N, 2N) compliance [m/N] of the cranks' support points in the carrier frame (FE carrier,
     #: :func:`flexrv.fem.carrier.crank_support_compliance`); (0, 0): rigid carrier (``carrier.body_model``)
-    carrier_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    carrier_compliance: np.ndarray = field(default=LAZY, repr=False)
     #: (n_discs, 3, 3) compliance of each disc's rim pose (x, y, psi) relative to its hub per unit pin force
     #: (:func:`flexrv.fem.disc.rim_compliance`); (0, 3, 3): rigid discs (``second_stage.disc_body_model``)
-    disc_compliance: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
+    disc_compliance: np.ndarray = field(default=LAZY, repr=False)
     #: torsional compliance of the pin housing about the axis [rad/(N m)]
     #: (:func:`flexrv.analysis.torsional.housing_model_compliance`, design ``housing.body_model``); 0: rigid
-    housing_compliance: float = 0.0
+    housing_compliance: float = field(default=LAZY, repr=False)
+    #: pin-contact constant [N/m^e] and exponent (:func:`_pin_law`: the analytic pin-load distribution)
+    pin_k: float = field(default=LAZY, repr=False)
+    pin_exponent: float = field(default=LAZY, repr=False)
     # friction (design [contact] friction fields; 0 = off)
     pin_friction: float = 0.0  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-]
     needle_friction: float = 0.0  #: constant friction coefficient of the needle bearings [-]
     needle_friction_radius: float = 0.0  #: d/2 of the needle friction moment, the eccentric journal radius [m]
     friction_velocity: float = 0.0  #: regularisation speed v_reg [m/s] (0 = friction off)
+    #: the design the :data:`LAZY` fields are built from
+    reducer: object = field(default=None, repr=False, compare=False)
+
+    def __getattribute__(self, name):
+        value = object.__getattribute__(self, name)
+        if value is LAZY:  # built once, on first access (frozen: set through object.__setattr__)
+            for key, built in _LAZY_BUILDERS[name](object.__getattribute__(self, "reducer")).items():
+                if object.__getattribute__(self, key) is LAZY:
+                    object.__setattr__(self, key, built)
+            value = object.__getattribute__(self, name)
+        return value
 
 
 def _cyl_mass(rho, d, length):
@@ -262,13 +289,7 @@ def _contacts(reducer) -> dict:
     is the pin-disc contact, pin seat and pin bending in series
     (:func:`flexrv.analysis.pin_load.pin_contact_constant`, the one constant of every model)."""
     cs, nb, ct = reducer.crankshaft, reducer.needle_bearing, reducer.contact
-    k_line = pin_contact_constant(reducer).k
     depth = ct.impact_damping_depth_mm * 1e-3
-    if ct.pin_law == "hertz_line":
-        pin_k, pin_e = k_line, LINE_EXPONENT
-    else:  # impact law with the seeds' exponent, matched to the Hertz line law at penetration d
-        pin_e = ct.impact_exponent
-        pin_k = k_line * depth ** (LINE_EXPONENT - pin_e)
     e_nb = effective_modulus(
         reducer.material("crankshaft").youngs_modulus,
         reducer.material("crankshaft").poisson_ratio,
@@ -285,8 +306,6 @@ def _contacts(reducer) -> dict:
         support_law=support_law,
         support_roller_angles=support_angles,
         support_linear=support_linear,
-        pin_k=pin_k,
-        pin_exponent=pin_e,
         pin_c_max=ct.pin_max_damping_Ns_per_m,
         contact_depth=depth,
         pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
@@ -302,6 +321,35 @@ def _contacts(reducer) -> dict:
         needle_friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
         friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,
     )
+
+
+def _pin_law(reducer) -> dict:
+    """The pin law's constant and exponent: the pin path = pin-disc contact, pin seat and pin
+    bending in series (:func:`flexrv.analysis.pin_load.pin_contact_constant`, the one constant
+    of every model, matched at the largest pin load of the analytic distribution); the impact
+    law takes the seeds' exponent, matched to the Hertz line law at the damping depth."""
+    ct = reducer.contact
+    k_line = pin_contact_constant(reducer).k
+    depth = ct.impact_damping_depth_mm * 1e-3
+    if ct.pin_law == "hertz_line":
+        return {"pin_k": k_line, "pin_exponent": LINE_EXPONENT}
+    return {"pin_k": k_line * depth ** (LINE_EXPONENT - ct.impact_exponent), "pin_exponent": ct.impact_exponent}
+
+
+def _bodies(reducer) -> dict:
+    """The elastic bodies' compliance matrices (:func:`body_compliance_matrices`)."""
+    carrier_c, disc_c = body_compliance_matrices(reducer)
+    return {"carrier_compliance": carrier_c, "disc_compliance": disc_c}
+
+
+#: field -> builder(reducer) -> {field: value} of the :data:`LAZY` fields (one builder may fill several)
+_LAZY_BUILDERS = {
+    "carrier_compliance": _bodies,
+    "disc_compliance": _bodies,
+    "housing_compliance": lambda reducer: {"housing_compliance": housing_model_compliance(reducer)},
+    "pin_k": _pin_law,
+    "pin_exponent": _pin_law,
+}
 
 
 def _main_bearing(reducer) -> dict:
@@ -378,8 +426,12 @@ def rigid_parameters(reducer) -> RigidParameters:
     provenance in the presets), tilting k_r (s/2)^2 with the row spacing s, and
     carrier-mode damping 2 zeta sqrt(k m) (the ball-resolved and flexible
     main-bearing models replace it).
+
+    The expensive parameters are built on first access (:data:`LAZY`): the elastic bodies'
+    FE condensations when the crank supports or the pins are built, the analytic pin-load
+    distribution behind the pin law and the housing's compliance when the pins are built; a
+    caller that reads masses or geometry only (e.g. a workflow's moment balance) builds none.
     """
-    carrier_c, disc_c = body_compliance_matrices(reducer)
     return RigidParameters(
         **_first_stage(reducer),
         **_second_stage(reducer),
@@ -387,7 +439,5 @@ def rigid_parameters(reducer) -> RigidParameters:
         **_contacts(reducer),
         **_main_bearing(reducer),
         **_operating(reducer),
-        carrier_compliance=carrier_c,
-        disc_compliance=disc_c,
-        housing_compliance=housing_model_compliance(reducer),
+        reducer=reducer,
     )

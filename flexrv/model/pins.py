@@ -759,7 +759,7 @@ class PinContacts(KernelGroup):
         #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
         self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
         #: (n_discs, 3, 3) rim compliance of the elastic discs (pin_body_kernel); (0, 3, 3): rigid discs
-        self.disc_c = np.ascontiguousarray(getattr(p, "disc_compliance", np.zeros((0, 3, 3))), dtype=float)
+        self.disc_c = np.ascontiguousarray(p.disc_compliance, dtype=float)
         if self.disc_c.size and self.disc_c.shape != (self.nd, 3, 3):
             raise ValueError(f"disc_compliance has shape {self.disc_c.shape}, expected {(self.nd, 3, 3)}")
         if not self.disc_c.size:
@@ -767,7 +767,7 @@ class PinContacts(KernelGroup):
         self.dstate = np.zeros((self.nd, 3))
         #: housing (module docstring, "Housing"): (c_h [rad/(N m)], phi_h [rad], per disc the housing's part
         #: -phi_h a_k of the rim offset (x, y) [m]); c_h = 0: rigid housing
-        c_h = float(getattr(p, "housing_compliance", 0.0))
+        c_h = float(p.housing_compliance)
         if not (np.isfinite(c_h) and c_h >= 0.0):
             raise ValueError(f"housing_compliance = {c_h!r} must be a finite compliance >= 0 [rad/(N m)]")
         self.housing_law = HousingLaw.of(compliance=c_h)
