@@ -524,7 +524,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
     arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
-    tenth of max|u|), and stops on the residual rule as before; the small systems are solved without
+    tenth of max|u|), and stops on the residual rule above; the small systems are solved without
     LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
     (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
     called from Python); with ``carrier.body_model = "rigid"`` 2.6 us.

@@ -638,7 +638,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     sensitivities S_q = d(delta)/dq = C dQ_eff/dq + D, S_v = C dQ_eff/dv (used where
     the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
     restarting elsewhere, start from delta_prev), so the start's residual is second
-    order in the state change; it stops when max|R| <= tol (as before: 1e-10 of
+    order in the state change; it stops when max|R| <= tol (1e-10 of
     max|delta|, at least 1e-15 m), so the records of the last evaluation (pin
     forces, gaps) stay exact to that tolerance. Measured in a rv40e run: after a
     Newton correction of the solver (|dq| ~ 1e-7) the predicted start is within ~3e-12
