@@ -85,3 +85,15 @@ def test_summary_keys_are_spelled_in_one_place():
         text = (post / name).read_text()
         hits += [f"{name}: {row.key}" for row in SUMMARY_KEYS if f'"{row.key}"' in text]
     assert not hits, hits
+
+
+def test_every_summary_number_is_in_the_table(run_dir):
+    """No number of summary.json escapes the table: each numeric top-level key is a
+    SUMMARY_KEYS row, a declared friction output's mean (friction_keys) or run metadata
+    (the steady window and the ratios)."""
+    summ = json.loads((run_dir / "summary.json").read_text())
+    meta = {"steady_revolutions", "ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical"}
+    known = {row.key for row in SUMMARY_KEYS} | meta | set(summ.get("friction_keys", ()))
+    numbers = [k for k, v in summ.items() if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    assert "te_pp_arcsec" in numbers and "mean_dissipation_W" in numbers
+    assert [k for k in numbers if k not in known] == []

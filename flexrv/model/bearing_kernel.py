@@ -867,7 +867,7 @@ def _zero_written(jac, nx, nz):
                 jac[b + r, b + c] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _frame_kinematics(q, qt):
     """The frame's rotation A = Rx(ax) Ry(ay) Rz(az), the map G of omega = G phi_t
     (Exudyn RotXYZ2RotationMatrix / RotXYZ2G) and omega's components."""
@@ -887,7 +887,7 @@ def _frame_kinematics(q, qt):
     return a, g, om0, om1, om2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, om):
     """Pass 1 of :func:`row_eval`: the geometry of every ball with the rings undeflected
     (modal rings: with their coordinates), ball minus groove centre e0 and relative
@@ -983,7 +983,7 @@ def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, c
     return bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state):
     """The contacts of both rings at every ball (:func:`_ring_contacts`; condensed rings:
     their local solves, the inner one's deflection added to the arms ``pre[4]``). Returns
@@ -1062,11 +1062,11 @@ def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o
     return load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o
 
 
-@njit(cache=True)
-def _ball_force(j, q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, bas_i, bas_o, f, rec, record):
-    """Ball j's contact reactions on the frame and the rings' modes, its cage and pocket
-    forces, into ``f`` (and its row of ``rec``); returns the cage direction (etx, ety)
-    and the ball's radius in the housing."""
+@njit(cache=True, inline="always")
+def _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, rec):
+    """Every ball's contact reactions on the frame and the rings' modes, its cage and pocket
+    forces, into ``f`` (and ``rec`` when it has a row per ball); returns (Z, 3): each ball's
+    cage direction (etx, ety) and radius in the housing (for the Jacobian blocks)."""
     bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre[0], pre[1], pre[2], pre[3], pre[4], pre[9], pre[10]
     load_i, load_o, nrm_i, nrm_o, film_i, film_o = con[0], con[1], con[2], con[3], con[10], con[11]
     z_row, rb, cage_ratio = geometry.z, geometry.ball_radius_pitch, geometry.cage_ratio
@@ -1074,97 +1074,113 @@ def _ball_force(j, q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, ba
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
     nz = bpos.shape[0]
-    bj = 6 + m_i + m_o + 3 * j
     two_pi = 2.0 * math.pi
-    bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
-    vx, vy = qt[bj], qt[bj + 1]
-    qi, qo = load_i[j], load_o[j]
-    fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
-    fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
-    # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
-    f[0] -= fix
-    f[1] -= fiy
-    f[2] -= fiz
-    ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
-    mx = ap1 * fiz - ap2 * fiy
-    my = ap2 * fix - ap0 * fiz
-    mz = ap0 * fiy - ap1 * fix
-    for r in range(3):
-        f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
-    flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
-    fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
-    flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
-    if m_i > 0:
-        _basis(tab_i, zs_i, psi_i[j], bas_i)
-        for k in range(m_i):
-            f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
-    if m_o > 0:
-        _basis(tab_o, zs_o, psi_o[j], bas_o)
-        for k in range(m_o):
-            f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
-    # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
-    psi = psi_o[j]
-    cos_p, sin_p = cs_o[j, 0], cs_o[j, 1]
-    pocket = two_pi * j / nz + cage_ratio * q[5]
-    dev = psi - pocket
-    dev -= two_pi * math.floor(dev / two_pi + 0.5)  # wrapped to [-pi, pi)
-    radius = math.sqrt(bx * bx + by * by)
-    etx, ety = -sin_p, cos_p
-    s_t = vx * etx + vy * ety - radius * cage_ratio * qt[5]
-    fc = -(cage_k * radius * dev + cage_c * s_t)
-    pr = radius - rb
-    f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
-    f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
-    f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
-    if record:
-        rec[j, 0], rec[j, 1] = qi, qo
-        for c in range(3):
-            rec[j, 2 + c] = nrm_i[j, c]
-            rec[j, 5 + c] = nrm_o[j, c]
-            rec[j, 16 + c] = du_i[j, c]
-            rec[j, 19 + c] = du_o[j, c]
-            rec[j, 22 + c] = bpos[j, c]
-        rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
-        rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
-        rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
-        rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
-    return etx, ety, radius
+    bas_i = np.empty((3, m_i))
+    bas_o = np.empty((3, m_o))
+    record = rec.shape[0] == nz
+    ebr = np.empty((nz, 3))
+    for j in range(nz):
+        bj = 6 + m_i + m_o + 3 * j
+        bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
+        vx, vy = qt[bj], qt[bj + 1]
+        qi, qo = load_i[j], load_o[j]
+        fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
+        fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
+        # reaction on the frame: -f at c_i; moment -(Ap x f) mapped by G^T; modes -basis^T A^T f
+        f[0] -= fix
+        f[1] -= fiy
+        f[2] -= fiz
+        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+        mx = ap1 * fiz - ap2 * fiy
+        my = ap2 * fix - ap0 * fiz
+        mz = ap0 * fiy - ap1 * fix
+        for r in range(3):
+            f[3 + r] -= g[0, r] * mx + g[1, r] * my + g[2, r] * mz
+        flx = a[0, 0] * fix + a[1, 0] * fiy + a[2, 0] * fiz
+        fly = a[0, 1] * fix + a[1, 1] * fiy + a[2, 1] * fiz
+        flz = a[0, 2] * fix + a[1, 2] * fiy + a[2, 2] * fiz
+        if m_i > 0:
+            _basis(tab_i, zs_i, psi_i[j], bas_i)
+            for k in range(m_i):
+                f[6 + k] -= bas_i[0, k] * flx + bas_i[1, k] * fly + bas_i[2, k] * flz
+        if m_o > 0:
+            _basis(tab_o, zs_o, psi_o[j], bas_o)
+            for k in range(m_o):
+                f[6 + m_i + k] -= bas_o[0, k] * fox + bas_o[1, k] * foy + bas_o[2, k] * foz
+        # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
+        psi = psi_o[j]
+        cos_p, sin_p = cs_o[j, 0], cs_o[j, 1]
+        pocket = two_pi * j / nz + cage_ratio * q[5]
+        dev = psi - pocket
+        dev -= two_pi * math.floor(dev / two_pi + 0.5)  # wrapped to [-pi, pi)
+        radius = math.sqrt(bx * bx + by * by)
+        etx, ety = -sin_p, cos_p
+        s_t = vx * etx + vy * ety - radius * cage_ratio * qt[5]
+        fc = -(cage_k * radius * dev + cage_c * s_t)
+        pr = radius - rb
+        f[bj] = fix + fox + fc * etx - pocket_k * pr * cos_p
+        f[bj + 1] = fiy + foy + fc * ety - pocket_k * pr * sin_p
+        f[bj + 2] = fiz + foz - pocket_k * (bz - z_row)
+        if record:
+            rec[j, 0], rec[j, 1] = qi, qo
+            for c in range(3):
+                rec[j, 2 + c] = nrm_i[j, c]
+                rec[j, 5 + c] = nrm_o[j, c]
+                rec[j, 16 + c] = du_i[j, c]
+                rec[j, 19 + c] = du_o[j, c]
+                rec[j, 22 + c] = bpos[j, c]
+            rec[j, 8], rec[j, 9] = psi_i[j], psi_o[j]
+            rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
+            rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
+            rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
+        ebr[j, 0], ebr[j, 1], ebr[j, 2] = etx, ety, radius
+    return ebr
 
 
-@njit(cache=True)
-def _ball_local_blocks(j, b0, qt, geometry, pre, con, etx, ety, radius, k_i, d_i, k_o, d_o, jq):
-    """Ball j's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
-    and, in column 3, the rate of its force from the frame's and rings' motion."""
+@njit(cache=True, inline="always")
+def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
+    """Every ball's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
+    and, in column 3, the rate of its force from the frame's and rings' motion; ``ebr``:
+    :func:`_row_forces`' cage directions and radii."""
     w0_i, w0_o = pre[6], pre[8]
     load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o = con[:10]
     cage_ratio, cage_k, pocket_k = geometry.cage_ratio, geometry.cage_stiffness, geometry.pocket_stiffness
-    bj = b0 + 3 * j
-    vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
-    _contact_blocks(load_i[j], dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-    _contact_blocks(load_o[j], dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
-    et = (etx, ety, 0.0)
-    # groove centres' velocities (ball velocity minus the contacts' relative velocities)
-    gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
-    go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
-    for c1 in range(3):
-        rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
-        for c2 in range(3):
-            ee = et[c1] * et[c2]
-            eye = 1.0 if c1 == c2 else 0.0
-            jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
-            rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
-        jq[3 * j + c1, 3] = rate
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
+    for j in range(load_i.shape[0]):
+        etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
+        bj = b0 + 3 * j
+        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+        _contact_blocks(
+            load_i[j], dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i
+        )
+        _contact_blocks(
+            load_o[j], dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o
+        )
+        et = (etx, ety, 0.0)
+        # groove centres' velocities (ball velocity minus the contacts' relative velocities)
+        gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
+        go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
+        for c1 in range(3):
+            rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
+            for c2 in range(3):
+                ee = et[c1] * et[c2]
+                eye = 1.0 if c1 == c2 else 0.0
+                jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
+                rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
+            jq[3 * j + c1, 3] = rate
 
 
-@njit(cache=True)
-def _ball_jacobian(
-    j, jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, etx, ety, radius, jq, jv
-):
-    """Ball j's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
+@njit(cache=True, inline="always")
+def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv):
+    """Every ball's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
     (b0..b0+2)] into the work blocks jl, vl (the helpers at ball index b0), then scattered
     into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS); the
     condensed rings' contacts keep their T rows and contact factors for
-    :func:`_condensed_row_jacobian`. ``wk``: :func:`row_eval`'s pass-2 work arrays."""
+    :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
+    :func:`_row_forces`' cage directions and radii."""
     arm, bas_i_all, bas_o_all = pre[4], pre[13], pre[14]
     load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o = con[:12]
     k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o = wk
@@ -1174,75 +1190,79 @@ def _ball_jacobian(
     cond_o = vf_o.shape[0] > 0
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
-    bj = b0 + 3 * j
-    qi, qo = load_i[j], load_o[j]
-    jl[:, :] = 0.0
-    vl[:, :] = 0.0
-    if not cond_i:  # (condensed rings: the blocks' factors below)
-        _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-    if not cond_o:
-        _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
-    et = (etx, ety, 0.0)
-    for c1 in range(3):
-        for c2 in range(3):
-            ee = et[c1] * et[c2]
-            eye = 1.0 if c1 == c2 else 0.0
-            jl[b0 + c1, b0 + c2] += -cage_k * ee - pocket_k * (eye - ee)
-            vl[b0 + c1, b0 + c2] += -cage_c * ee
-        jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
-        vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
-    # T_i = [I | -[Ap]x G | A basis_i]
-    ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
-    for c in range(3):  # -(skew(Ap) G)[:, c]
-        g0, g1, g2 = g[0, c], g[1, c], g[2, c]
-        t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
-        t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
-        t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
-    if m_i > 0:
-        for r in range(3):
-            for k in range(m_i):
-                t_i[r, 6 + k] = (
-                    a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] + a[r, 2] * bas_i_all[j, 2, k]
+    for j in range(load_i.shape[0]):
+        etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
+        bj = b0 + 3 * j
+        qi, qo = load_i[j], load_o[j]
+        jl[:, :] = 0.0
+        vl[:, :] = 0.0
+        if not cond_i:  # (condensed rings: the blocks' factors below)
+            _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
+        if not cond_o:
+            _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
+        et = (etx, ety, 0.0)
+        for c1 in range(3):
+            for c2 in range(3):
+                ee = et[c1] * et[c2]
+                eye = 1.0 if c1 == c2 else 0.0
+                jl[b0 + c1, b0 + c2] += -cage_k * ee - pocket_k * (eye - ee)
+                vl[b0 + c1, b0 + c2] += -cage_c * ee
+            jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
+            vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
+        # T_i = [I | -[Ap]x G | A basis_i]
+        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+        for c in range(3):  # -(skew(Ap) G)[:, c]
+            g0, g1, g2 = g[0, c], g[1, c], g[2, c]
+            t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
+            t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
+            t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
+        if m_i > 0:
+            for r in range(3):
+                for k in range(m_i):
+                    t_i[r, 6 + k] = (
+                        a[r, 0] * bas_i_all[j, 0, k] + a[r, 1] * bas_i_all[j, 1, k] + a[r, 2] * bas_i_all[j, 2, k]
+                    )
+        if cond_i:
+            for r in range(3):
+                for c in range(nx_i):
+                    ti_all[3 * j + r, c] = t_i[r, c]
+            _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
+        else:
+            _add_block_jacobian(jl, k_i, t_i, b0, 0, nx_i)
+            _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
+            gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
+            if gain != 0.0:
+                _add_speed_column(
+                    vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1], gain * nrm_i[j, 2]
                 )
-    if cond_i:
-        for r in range(3):
-            for c in range(nx_i):
-                ti_all[3 * j + r, c] = t_i[r, c]
-        _contact_factors(qi, dq_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, vf_i[j])
-    else:
-        _add_block_jacobian(jl, k_i, t_i, b0, 0, nx_i)
-        _add_block_jacobian(vl, d_i, t_i, b0, 0, nx_i)
-        gain = _film_speed_gain(law_i, speed, film_i[j]) * dudw
-        if gain != 0.0:
-            _add_speed_column(vl, k_i, t_i, b0, 0, nx_i, 5, gain * nrm_i[j, 0], gain * nrm_i[j, 1], gain * nrm_i[j, 2])
-    if cond_o:
-        _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
-    else:
-        bo = bas_o_all[j] if m_o > 0 else bas_o
-        _add_block_jacobian(jl, k_o, bo, b0, 6 + m_i, m_o)
-        _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
-        gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
-        if gain != 0.0:
-            _add_speed_column(
-                vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1], gain * nrm_o[j, 2]
-            )
-    if jacobian == CONDENSED_BALLS:
-        _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j : 3 * j + 3], inv3, tm3)
-    else:
-        for r in range(b0 + 3):
-            rr = r if r < b0 else bj + r - b0
-            for c in range(b0 + 3):
-                cc = c if c < b0 else bj + c - b0
-                jq[rr, cc] += jl[r, c]
-                jv[rr, cc] += vl[r, c]
+        if cond_o:
+            _contact_factors(qo, dq_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, vf_o[j])
+        else:
+            bo = bas_o_all[j] if m_o > 0 else bas_o
+            _add_block_jacobian(jl, k_o, bo, b0, 6 + m_i, m_o)
+            _add_block_jacobian(vl, d_o, bo, b0, 6 + m_i, m_o)
+            gain = _film_speed_gain(law_o, speed, film_o[j]) * dudw
+            if gain != 0.0:
+                _add_speed_column(
+                    vl, k_o, bo, b0, 6 + m_i, m_o, 5, gain * nrm_o[j, 0], gain * nrm_o[j, 1], gain * nrm_o[j, 2]
+                )
+        if jacobian == CONDENSED_BALLS:
+            _condense_ball(jl, vl, b0, jq, jv, s_balls[3 * j : 3 * j + 3], inv3, tm3)
+        else:
+            for r in range(b0 + 3):
+                rr = r if r < b0 else bj + r - b0
+                for c in range(b0 + 3):
+                    cc = c if c < b0 else bj + c - b0
+                    jq[rr, cc] += jl[r, c]
+                    jv[rr, cc] += vl[r, c]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _row_pass2(
     q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
 ):
-    """Pass 2 of :func:`row_eval`: every ball's generalized forces (:func:`_ball_force`)
-    and Jacobian blocks (:func:`_ball_local_blocks`, :func:`_ball_jacobian`). Returns the
+    """Pass 2 of :func:`row_eval`: every ball's generalized forces (:func:`_row_forces`)
+    and Jacobian blocks (:func:`_row_local_blocks`, :func:`_row_ball_jacobians`). Returns the
     condensed rings' T rows and contact factors of every ball and the entrainment speed's
     rate d u / d q_t[5] (for :func:`_condensed_row_jacobian`)."""
     cond_i = pre[11].shape[0] > 0
@@ -1252,7 +1272,6 @@ def _row_pass2(
     nz = pre[0].shape[0]
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
-    bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
@@ -1260,7 +1279,7 @@ def _row_pass2(
     d_o = np.empty((3, 3))
     t_i = np.zeros((3, nx_i))
     nl = b0 + 3 if (jacobian and jacobian != BALL_BLOCKS) else 0
-    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see _ball_jacobian)
+    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see _row_ball_jacobians)
     vl = np.empty((nl, nl))
     inv3 = np.empty((3, 3))  # (work of _condense_ball)
     tm3 = np.empty((3, b0))
@@ -1277,26 +1296,18 @@ def _row_pass2(
     vf_i = np.empty((nci // 3, 2, 3))
     vf_o = np.empty((nco // 3, 2, 3))
     wk = (k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o)
-    record = rec.shape[0] == nz
     # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
     # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
     dudw = geometry.speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
-    for j in range(nz):
-        etx, ety, radius = _ball_force(
-            j, q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, bas_i, bas_o, f, rec, record
-        )
-        if not jacobian:
-            continue
-        if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
-            _ball_local_blocks(j, b0, qt, geometry, pre, con, etx, ety, radius, k_i, d_i, k_o, d_o, jq)
-            continue
-        _ball_jacobian(
-            j, jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, etx, ety, radius, jq, jv
-        )
+    ebr = _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, rec)
+    if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
+        _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq)
+    elif jacobian:
+        _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv)
     return ti_all, vf_i, vf_o, dudw
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
     """The dense Jacobian blocks of the condensed rings' contacts (:func:`row_eval`):
     the contacts in series with the ring, (I - K C)^-1 K and D, through the inner ring's
@@ -1685,7 +1696,7 @@ def _split_balls(ws, nb, nx):
     return ws[:nb], ws[nb : 2 * nb], sm, ws[o : o + nx], ws[o + nx : o + 2 * nx], ws[o + 2 * nx : o + 2 * nx + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _predict_balls(q, qt, ball_ref, cage_ratio, b, bt, sm, xl, xtl):
     """The quasi-static balls' start from the last solution (:func:`quasi_static_balls`):
     turned about the axis with their cage by cage_ratio (phi_z - phi_z,last), then

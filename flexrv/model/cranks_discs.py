@@ -251,7 +251,7 @@ SupportWork = namedtuple(
 )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _support_views(wk, n):
     """The named views of the work array (:func:`support_work_size`) for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
@@ -296,13 +296,14 @@ def _support_views(wk, n):
     )  # fmt: skip
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _support_approach(q, v, idx, bores, g, c, s, w):
     """Per crank: the bore's arm (rx, ry) in the housing frame, the rigid approach d0 of
     the crank centre to its bore and its rate, the cage angle gamma; fs, u, K and H zeroed."""
+    rx, ry, d0x, d0y, dvx, dvy, gam, fs = w.rx, w.ry, w.d0x, w.d0y, w.dvx, w.dvy, w.gam, w.fs
+    u, kk, hh = w.u, w.kk, w.hh
     th, om = q[idx[2]], v[idx[2]]
     n = bores.shape[0]
-    rx, ry, d0x, d0y, dvx, dvy, gam = w.rx, w.ry, w.d0x, w.d0y, w.dvx, w.dvy, w.gam
     for j in range(n):
         lx, ly = bores[j, 0], bores[j, 1]
         rx[j], ry[j] = c * lx - s * ly, s * lx + c * ly
@@ -313,21 +314,23 @@ def _support_approach(q, v, idx, bores, g, c, s, w):
         dvy[j] = v[jy] - v[idx[1]] - om * rx[j]
         gam[j] = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
     for r in range(2 * n):
-        w.fs[r], w.u[r] = 0.0, 0.0
+        fs[r], u[r] = 0.0, 0.0
         for k in range(2 * n):
-            w.kk[r, k] = 0.0
+            kk[r, k] = 0.0
         for k in range(n):
-            w.hh[r, k] = 0.0
+            hh[r, k] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, w):
     """The elastic carrier's support-point deflection u = -C_h f_s(d0 - u) by the carrier
     Newton (numerics.newton), started from the first-order predictor of the previous
     call; the last correction applied linearised; u stored in ``ustate``."""
+    ch, u, ulast, step, st, fs, kk, res = w.ch, w.u, w.ulast, w.step, w.st, w.fs, w.kk, w.res
+    ones, su, qp, nw, d0x, d0y, gam, hh = w.ones, w.su, w.qp, w.nw, w.d0x, w.d0y, w.gam, w.hh
+    qs, u0, tmp, mm = w.qs, w.u0, w.tmp, w.mm
     n = ustate.shape[0]
     n2, m = 2 * n, 3 + 3 * n
-    ch, u, ulast, step, fs, kk, res = w.ch, w.u, w.ulast, w.step, w.fs, w.kk, w.res
     for a in range(n):  # C_h = R C R^T, blockwise
         for b in range(n):
             c00, c01 = cc[2 * a, 2 * b], cc[2 * a, 2 * b + 1]
@@ -336,9 +339,9 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
             t10, t11 = s * c00 + c * c10, s * c01 + c * c11
             ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
             ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
-    valid = w.st[0] > 0.0
+    valid = st[0] > 0.0
     for r in range(n2):
-        w.ones[r] = 1.0
+        ones[r] = 1.0
     for j in range(n):
         u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
         if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
@@ -348,15 +351,13 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
             acc = 0.0
             for col in range(m):
                 qc = q[idx[col]] if col < 3 else q[idx[col + 3]]
-                acc += w.su[r, col] * (qc - w.qp[col])
+                acc += su[r, col] * (qc - qp[col])
             step[r] = acc
-        apply_predictor(u, step, w.ones)
-    newton_start(w.nw)
+        apply_predictor(u, step, ones)
+    newton_start(nw)
     while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
-        r1, scale = _carrier_evaluate(
-            w.d0x, w.d0y, w.gam, clear, sc, angles, linear, bstate, fs, kk, w.hh, w.qs, ch, u, res
-        )
-        if newton_update(w.nw, r1, scale, u, w.u0, step, res, ch, kk, 1.0, w.tmp, w.mm, *CARRIER_NEWTON):
+        r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
+        if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
             break
     # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
     # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
@@ -374,19 +375,20 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
         ustate[j, 2], ustate[j, 3] = c * u[2 * j] + s * u[2 * j + 1], -s * u[2 * j] + c * u[2 * j + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _support_loads(f, idx, cd, kb, out_fx, out_fy, out_bend, w):
     """The support forces (spring and damper) on cranks and carrier into ``f`` and the
     outputs: the force on each crank and the bending share of each support's tangential
     compliance, |K_s t|^2 / (k_bend t.K_s t) (module docstring of
     flexrv.contact.tapered_roller: the shaft deflection is K_s dd / k_bend)."""
-    rx, ry, kk, fs, u, damp, qs = w.rx, w.ry, w.kk, w.fs, w.u, w.damp, w.qs
+    rx, ry, kk, fs, u, damp, qs, dvx = w.rx, w.ry, w.kk, w.fs, w.u, w.damp, w.qs, w.dvx
+    dvy = w.dvy
     for j in range(rx.shape[0]):
         jx, jy = idx[6 + 3 * j], idx[7 + 3 * j]
         kxx, kxy, kyy = kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j + 1]
         damp[j] = cd if (qs[j] > 0.0 or kxx + kyy > 0.0) else 0.0
-        fx = fs[2 * j] - damp[j] * w.dvx[j]  # on the crank
-        fy = fs[2 * j + 1] - damp[j] * w.dvy[j]
+        fx = fs[2 * j] - damp[j] * dvx[j]  # on the crank
+        fy = fs[2 * j + 1] - damp[j] * dvy[j]
         ax, ay = rx[j] + u[2 * j], ry[j] + u[2 * j + 1]  # the bore's arm (elastic carrier: deflected)
         f[idx[0]] -= fx
         f[idx[1]] -= fy
@@ -401,15 +403,16 @@ def _support_loads(f, idx, cd, kb, out_fx, out_fy, out_bend, w):
         out_bend[j] = (ktx * ktx + kty * kty) / (kb * ktt) if (kb > 0.0 and ktt > 0.0) else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _support_tangent(q, idx, g, elastic, w):
     """dfs/dq over the local coordinates into ``w.df`` (elastic carrier: condensed,
     M (-K dd0 + H dgamma) - M K a dtheta) and, elastic, the predictor's S = du/dq and q
     for the next call; returns the moment's arm term d(arm)/dtheta x fs."""
-    n = w.rx.shape[0]
-    n2, m = 2 * n, 3 + 3 * n
     rx, ry, fs, u, d0, df, t2, gg = w.rx, w.ry, w.fs, w.u, w.d0, w.df, w.t2, w.gg
-    kk, ch, mm, tmp, zf, wc, av = w.kk, w.ch, w.mm, w.tmp, w.zf, w.wc, w.av
+    kk, ch, mm, tmp, zf, wc, av, hh = w.kk, w.ch, w.mm, w.tmp, w.zf, w.wc, w.av, w.hh
+    su, qp, st = w.su, w.qp, w.st
+    n = rx.shape[0]
+    n2, m = 2 * n, 3 + 3 * n
     # d(d0)/dq and d(gamma)/dq over the local coordinates
     for r in range(n2):
         for col in range(m):
@@ -421,7 +424,7 @@ def _support_tangent(q, idx, g, elastic, w):
         d0[2 * j + 1, 1], d0[2 * j + 1, 2], d0[2 * j + 1, 4 + 3 * j] = -1.0, -rx[j], 1.0
         gg[j, 2], gg[j, 5 + 3 * j] = 0.5 * (1.0 + g), 0.5 * (1.0 - g)
     matmul_small(kk, d0, df)
-    matmul_small(w.hh, gg, t2)
+    matmul_small(hh, gg, t2)
     for r in range(n2):
         for col in range(m):
             df[r, col] = t2[r, col] - df[r, col]  # dfs/dq (rigid carrier)
@@ -459,18 +462,18 @@ def _support_tangent(q, idx, g, elastic, w):
     for r in range(n2):
         arm_term -= zf[r] * av[r]
     # the predictor's sensitivity S = du/dq = -C_h df - a e_theta^T (u = -C_h f_s, C_h turning with theta)
-    matmul_small(ch, df, w.su)
+    matmul_small(ch, df, su)
     for r in range(n2):
         for col in range(m):
-            w.su[r, col] = -w.su[r, col]
-        w.su[r, 2] -= av[r]
+            su[r, col] = -su[r, col]
+        su[r, 2] -= av[r]
     for col in range(m):
-        w.qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
-    w.st[0] = 1.0
+        qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
+    st[0] = 1.0
     return arm_term
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _support_jacobian(jq, jv, idx, with_arm, arm_term, w):
     """The Jacobian rows: crank j (x, y) += df; carrier (x, y) -= sum df; carrier theta
     -= (Z (r + u) + C_h Z fs) . df (+ the arm term, ``with_arm``); the dampers' d f / d v."""
@@ -662,7 +665,7 @@ class CrankSupports(KernelGroup):
         return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _needle_contact(dx, dy, dvx, dvy, clear, law, roller_angles, phc, psd, arms, out_roll, out_angle):
     """One needle bearing at the relative displacement (dx, dy) and velocity (dvx, dvy) of
     the eccentric to the disc hole: the force on the disc (fx, fy), the moments on crank
@@ -725,7 +728,7 @@ def _needle_contact(dx, dy, dvx, dvy, clear, law, roller_angles, phc, psd, arms,
     return fx, fy, mc, md, min_gap, (kxx, kxy, kyx, kyy, dxx, dxy, dyy, cgx, cgy)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _needle_jacobian(jq, jv, ii, v, law, arms, ecc_arm, rh, force, tangent, friction, b, gmat):
     """One needle bearing's Jacobian rows (``ii``: crank x, y, phi; disc x, y, psi): B =
     d(d)/dq, G = dF/dq = K B + D W + cg g, dQ/dq = -B^T G - (dB^T/dq) F, the damper's

@@ -462,7 +462,7 @@ RimWork = namedtuple(
 )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rim_views(wk, m):
     """The named views of the rim condensation's work array for m local coordinates."""
     mm = m * m
@@ -478,7 +478,7 @@ def _rim_views(wk, m):
     )  # fmt: skip
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _add_condensed(f, jq, jv, jac, idx, qf, jc, jvc):
     """Add a condensed force qf and, with ``jac``, the condensed Jacobians at idx."""
     m = qf.shape[0]
@@ -491,32 +491,33 @@ def _add_condensed(f, jq, jv, jac, idx, qf, jc, jvc):
                 jv[idx[r], idx[c]] += jvc[r, c]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rim_reuse(dstate, w):
     """(valid, same): whether the previous call's predictor may be used (st[0] set and the
     rim offsets not set from outside since) and whether this call is at its hub state."""
-    m = w.qh.shape[0]
-    valid = w.st[0] > 0.0
+    qh, st, dlast, qp, vh, vp = w.qh, w.st, w.dlast, w.qp, w.vh, w.vp
+    m = qh.shape[0]
+    valid = st[0] > 0.0
     if valid:
         for r in range(m):
-            if dstate[r // 3, r % 3] != w.dlast[r]:  # rim offsets set from outside: a fresh start from them
+            if dstate[r // 3, r % 3] != dlast[r]:  # rim offsets set from outside: a fresh start from them
                 valid = False
     same = valid
     if valid:
         for r in range(m):
-            if w.qh[r] != w.qp[r] or w.vh[r] != w.vp[r]:
+            if qh[r] != qp[r] or vh[r] != vp[r]:
                 same = False
                 break
     return valid, same
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rim_start(dstate, cd, ch, r_p, w):
     """The rim compliance C = blockdiag(C_d,k) + c_h A A^T at the hub centres, the
     Newton's start delta (the stored rim offsets) and its norms' weights."""
-    m = w.qh.shape[0]
+    qh, av, cm, delta, weight = w.qh, w.av, w.cm, w.delta, w.weight
+    m = qh.shape[0]
     nd = m // 3
-    qh, av, cm, delta = w.qh, w.av, w.cm, w.delta
     for kd in range(nd):
         av[3 * kd], av[3 * kd + 1], av[3 * kd + 2] = -qh[3 * kd + 1], qh[3 * kd], 1.0
     for r in range(m):
@@ -529,37 +530,39 @@ def _rim_start(dstate, cd, ch, r_p, w):
                     cm[3 * kd + r, 3 * kd + c] += cd[kd, r, c]
     for r in range(m):
         delta[r] = dstate[r // 3, r % 3]
-        w.weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
+        weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     """The rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) =
     I - C J, from the first-order predictor of the previous call (``valid``); the last
     correction applied linearised (condensed force into w.qf, offsets into dstate) and the
     housing's rotation and rim offsets into hs. Returns the pins' torque on the discs."""
-    m = w.qh.shape[0]
+    qh, delta, step, qf, av, sq, qp, sv = w.qh, w.delta, w.step, w.qf, w.av, w.sq, w.qp, w.sv
+    vh, vp, weight, nw, ql, fl, jl, jvl = w.vh, w.vp, w.weight, w.nw, w.ql, w.fl, w.jl, w.jvl
+    cm, res, base, tmp, nm, dlast, qfc = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc
+    m = qh.shape[0]
     nd = m // 3
-    delta, step, qf, av = w.delta, w.step, w.qf, w.av
     if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
         for r in range(m):
             acc = 0.0
             for c in range(m):
-                acc += w.sq[r, c] * (w.qh[c] - w.qp[c]) + w.sv[r, c] * (w.vh[c] - w.vp[c])
+                acc += sq[r, c] * (qh[c] - qp[c]) + sv[r, c] * (vh[c] - vp[c])
             step[r] = acc
-        apply_predictor(delta, step, w.weight)
-    newton_start(w.nw)
+        apply_predictor(delta, step, weight)
+    newton_start(nw)
     while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
-        r1, scale = _rim_residual(w.qh, w.vh, w.ql, w.fl, w.jl, w.jvl, pins_loc, w.cm, w.weight, delta, w.res)
-        if newton_update(w.nw, r1, scale, delta, w.base, step, w.res, w.cm, w.jl, -1.0, w.tmp, w.nm, *RIM_NEWTON):
+        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
+        if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
             break
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
     for r in range(m):
-        acc = w.fl[r]
+        acc = fl[r]
         for c in range(m):
-            acc -= w.jl[r, c] * step[c]
+            acc -= jl[r, c] * step[c]
         qf[r] = acc
         s += av[r] * acc  # torque of the pins on the discs about the axis = -(their torque on the housing)
     if ch > 0.0:
@@ -571,19 +574,21 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     for r in range(m):
         delta[r] -= step[r]
         dstate[r // 3, r % 3] = delta[r]
-        w.dlast[r] = delta[r]
-        w.qfc[r] = qf[r]
+        dlast[r] = delta[r]
+        qfc[r] = qf[r]
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rim_tangent(ch, s, w):
     """The condensed Jacobians J N (I + D) and (I + J N C) J_v into w.jc, w.jvc, and the
     predictor's sensitivities S_q = C dQ_eff/dq + D, S_v = C dQ_eff/dv with the hub
     state they belong to (also the repeated state's result)."""
-    m = w.qh.shape[0]
+    qh, dd, tmp, t2, av, qf, nm, jl = w.qh, w.dd, w.tmp, w.t2, w.av, w.qf, w.nm, w.jl
+    jc, cm, jvl, jvc, sq, sv, qp, vp = w.jc, w.cm, w.jvl, w.jvc, w.sq, w.sv, w.qp, w.vp
+    vh, st = w.vh, w.st
+    m = qh.shape[0]
     nd = m // 3
-    dd, tmp, t2, av, qf = w.dd, w.tmp, w.t2, w.av, w.qf
     for r in range(m):
         for c in range(m):
             dd[r, c] = 0.0
@@ -598,21 +603,21 @@ def _rim_tangent(ch, s, w):
     for r in range(m):
         for c in range(m):
             tmp[r, c] = dd[r, c] + (1.0 if r == c else 0.0)
-    matmul_small(w.nm, tmp, t2)
-    matmul_small(w.jl, t2, w.jc)  # J N (I + D)
-    matmul_small(w.cm, w.jvl, tmp)
-    matmul_small(w.nm, tmp, t2)
-    matmul_small(w.jl, t2, w.jvc)
+    matmul_small(nm, tmp, t2)
+    matmul_small(jl, t2, jc)  # J N (I + D)
+    matmul_small(cm, jvl, tmp)
+    matmul_small(nm, tmp, t2)
+    matmul_small(jl, t2, jvc)
     for r in range(m):
         for c in range(m):
-            w.jvc[r, c] += w.jvl[r, c]  # (I + J N C) J_v
-    matmul_small(w.cm, w.jc, w.sq)
-    matmul_small(w.cm, w.jvc, w.sv)
+            jvc[r, c] += jvl[r, c]  # (I + J N C) J_v
+    matmul_small(cm, jc, sq)
+    matmul_small(cm, jvc, sv)
     for r in range(m):
-        w.qp[r], w.vp[r] = w.qh[r], w.vh[r]
+        qp[r], vp[r] = qh[r], vh[r]
         for c in range(m):
-            w.sq[r, c] += dd[r, c]
-    w.st[0] = 1.0
+            sq[r, c] += dd[r, c]
+    st[0] = 1.0
 
 
 @njit(cache=True)
@@ -656,8 +661,9 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     idx = pins.idx
     m = 3 * pins.profile.shape[0]
     w = _rim_views(wk, m)
+    qh, vh = w.qh, w.vh
     for r in range(m):
-        w.qh[r], w.vh[r] = q[idx[r]], v[idx[r]]
+        qh[r], vh[r] = q[idx[r]], v[idx[r]]
     valid, same = _rim_reuse(dstate, w)
     if same:  # the previous call's state: its result
         _add_condensed(f, jq, jv, jac, idx, w.qfc, w.jc, w.jvc)
