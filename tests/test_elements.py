@@ -13,13 +13,17 @@ import pytest
 MODEL = Path(__file__).resolve().parents[1] / "flexrv" / "model"
 
 #: the positional pack readers the kernels used before their parameters were named: a
-#: scalar vector read by number (``sc[3]``, ``sc[sc.shape[0] - 1]``, ``dc[1]``), a row
-#: geometry or contact law read by number (``geometry[13]``, ``law_i[5]``), a pack read
+#: scalar vector read by number (``sc[3]``, ``sc[sc.shape[0] - 1]``, ``dc[1]``) or by an index
+#: constant in a kernel (``sc[SC_G]``; the group's host code builds the named law from them), a row
+#: geometry or contact law read by number (``geometry[13]``, ``law_i[5]``), the housing's compliance
+#: read from its state vector (``hs[0]``), a pack read
 #: by position (``pack[0][-1]``, ``loads[1]``) or unpacked whole (``a, b, ... = pack``),
 #: a hand-sized empty pack (``np.zeros(13)`` in ``empty_pack``)
 _OLD_READERS = (
     r"\bsc\[\s*(\d|sc\.shape)",
+    r"(?<!self\.)\bsc\[\s*SC_",
     r"\bdc\[\s*\d",
+    r"\bhs\[\s*0\s*\]",
     r"\bgeometry\[\s*\d",
     r"\blaw(_i|_o)?\[\s*(\d|N_LAW)",
     r"\bpack\[\s*-?\d",
@@ -58,7 +62,9 @@ def test_old_reader_patterns_catch_the_old_code():
     samples = (
         "    z_rp, R_p = int(sc[0]), sc[1]",
         "    mu = sc[sc.shape[0] - 2]",
+        "    kb, g = sc[SC_K_BEND], sc[SC_G]",
         "    cd, linear = dc[0], dc[1] > 0.5",
+        "    ch = hs[0] if hs.shape[0] > 0 else 0.0",
         "    if geometry[13] > 0.0:",
         "    damping = max(law_i[5], law_o[5])",
         "        ctr = pack[0][-1]",

@@ -156,10 +156,15 @@ def test_toy_element_in_outputs_friction_and_summary(toy_model, tmp_path):
 def test_every_registered_element_declares_its_parts():
     """The guide's "add a force element" list (CONTRIBUTING.md), checked on every
     registered element: a kind, a compiled kernel, a pack type whose absent-element
-    pack is derived (empty_pack), record sources and outputs, and summary rows only on
-    outputs it declares; an element lacking outputs fails here."""
+    pack is derived (empty_pack), record sources and outputs, and at least one summary
+    row, each on an output it declares, with a known reduction and a key of its own (no
+    other element's, none of the run summary's table flexrv.post.stats.SUMMARY_KEYS); an
+    element lacking outputs or summary rows fails here."""
     import inspect
 
+    from flexrv.post.stats import _REDUCE, SUMMARY_KEYS
+
+    keys = {row.key for row in SUMMARY_KEYS}
     for kind, spec in ELEMENTS.items():
         cls = spec.group
         assert cls.kind == kind and hasattr(spec.kernel, "py_func"), kind
@@ -167,7 +172,38 @@ def test_every_registered_element_declares_its_parts():
         assert cls.outputs is not KernelGroup.outputs, f"{kind}: declares no outputs"
         assert cls.record_sources is not KernelGroup.record_sources, f"{kind}: records nothing"
         src = inspect.getsource(cls.outputs)
+        assert cls.summary_rows, f"{kind}: declares no summary rows"
         for row in cls.summary_rows:
             assert f'"{row.source}"' in src, f"{kind}: summary row {row.key} reads an undeclared output"
+            assert row.reduce in _REDUCE and row.units, f"{kind}: summary row {row.key}"
+            assert row.key not in keys, f"{kind}: summary key {row.key} is taken"
+            keys.add(row.key)
         for name in cls.friction_outputs:
             assert f'"{name}"' in src, f"{kind}: friction output {name} is not declared"
+
+
+def test_toy_element_in_the_stiffness_budget():
+    """The model route of the stiffness budget (flexrv.analysis.budget.stiffness_budget with
+    the quasi-static model's strain-energy shares, as ``flexrv te``) lists the toy element by
+    its group name with nothing else changed. Closed form (Castigliano): the toy spring
+    holds the output against the housing in parallel with the reducer, so under a unit
+    output torque it turns by the total compliance C and stores k C^2 / 2: its share is
+    k C and its budget compliance k C^2 (to 1e-9: the shares come from the same tangent);
+    the shares of all groups sum to 1."""
+    from flexrv.analysis.budget import ModelShares, stiffness_budget
+    from flexrv.design import load
+    from flexrv.model.quasi_static import StaticModel, ramp_to
+
+    red = load("rv40e")
+    sm = StaticModel(red)
+    sm.model.groups.append(ToyTorsion(K_TOY, 0.0))
+    sm.model.fused = None  # the fused kernel of the groups with the toy
+    theta = 0.1
+    q = ramp_to(sm, theta, sm.kinematic_pose(theta), red.operating.rated_torque_Nm)
+    shares = sm.compliance_budget(theta, q)
+    c = 1.0 / sm.tangent_rigidity(theta, q)
+    assert sum(shares.values()) == pytest.approx(1.0, rel=1e-9)
+    assert shares["toy_torsion"] == pytest.approx(K_TOY * c, rel=1e-9)
+    budget = stiffness_budget(red, model=ModelShares(shares, c), route="quasi_static")
+    assert budget.compliances["toy_torsion"] == pytest.approx(K_TOY * c * c, rel=1e-9)
+    assert "toy_torsion" in budget.to_dict()["elements"]

@@ -243,12 +243,21 @@ class ModelCompliances:
         return total if carrier_c.size == 0 else carrier_c + total
 
 
+def planet_torsion_compliances(reducer) -> tuple[float, float]:
+    """Per-crank torsional compliances [rad/(N m)] between planet gear and eccentrics that the
+    gear stage puts in series with each mesh: (crank torsion, planet spline), 0 where the design
+    leaves an element out."""
+    has = _has(reducer)
+    c_crank = crank_torsion_compliance(reducer) if has["crank_torsion"] else 0.0
+    c_spline = planet_spline_compliance(reducer) if has["planet_spline"] else 0.0
+    return c_crank, c_spline
+
+
 def model_compliances(reducer, bores: np.ndarray) -> ModelCompliances:
     """The four elements of ``reducer`` at their places in the models (module docstring),
     ``bores`` (N, 2) the support points in the carrier frame [m]."""
     has = _has(reducer)
-    c_crank = crank_torsion_compliance(reducer) if has["crank_torsion"] else 0.0
-    c_spline = planet_spline_compliance(reducer) if has["planet_spline"] else 0.0
+    c_crank, c_spline = planet_torsion_compliances(reducer)
     n2 = 2 * len(bores)
     parts = {}
     if has["support_bearing_rings"]:

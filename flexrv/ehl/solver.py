@@ -733,7 +733,212 @@ def _interpolate(P, X0, Y0, X1, Y1):
 _TRACE = False
 
 
+def _check_solver_inputs(
+    load,
+    speed,
+    rx,
+    ry,
+    e_eff,
+    lubricant,
+    grid,
+    x_inlet,
+    x_outlet,
+    y_half,
+    stencil,
+    wedge_order,
+    extrapolate,
+    grid_tol,
+    max_grid,
+):
+    """Validate :func:`solve_point_contact`'s inputs (InputError naming the bad one) and resolve
+    its defaults; returns (wedge_order, extrapolate, refine_asked, max_grid)."""
+    for name, value in (("load", load), ("speed", speed), ("rx", rx), ("ry", ry), ("e_eff", e_eff)):
+        if value is None or not np.isfinite(value) or value <= 0:
+            raise InputError(f"{name} must be finite and > 0, got {value!r}")
+    lubricant.check()
+    if grid < 9 or ((grid - 1) & (grid - 2)) != 0:
+        raise InputError(f"grid must be 2^k + 1 >= 9 nodes (e.g. 65, 129, 257), got {grid}")
+    if wedge_order is None:
+        wedge_order = 2 if grid >= 129 else 1
+    if extrapolate is None:
+        extrapolate = wedge_order == 2 and grid >= 129
+    refine_asked = max_grid is not None or extrapolate  # warn if the grid change then misses grid_tol
+    if max_grid is None:
+        max_grid = 513 if extrapolate else grid
+    if max_grid < grid or ((max_grid - 1) & (max_grid - 2)) != 0:
+        raise InputError(f"max_grid must be 2^k + 1 >= grid = {grid}, got {max_grid}")
+    if grid_tol is not None and not (0 < grid_tol < 1):
+        raise InputError(f"grid_tol must be in (0, 1) or None, got {grid_tol!r}")
+    if wedge_order not in (1, 2):
+        raise InputError(f"wedge_order must be 1 or 2, got {wedge_order!r}")
+    if stencil not in (0, 1, 2, 3):
+        raise InputError(f"stencil must be 0..3, got {stencil!r}")
+    if not (x_inlet < 0 < x_outlet) or y_half <= 0:
+        raise InputError(
+            f"domain must contain the contact centre: x_inlet={x_inlet} < 0 < x_outlet={x_outlet}, y_half={y_half} > 0"
+        )
+    return wedge_order, extrapolate, refine_asked, max_grid
+
+
+def _continuation_levels(grid, coarsest, extrapolate, grid_tol):
+    """The grid continuation's levels (coarsest to ``grid``) and the first level solved to the
+    full tolerance (:func:`solve_point_contact`)."""
+    levels = []
+    n = grid
+    while n >= coarsest:
+        levels.append(n)
+        n = (n - 1) // 2 + 1
+    levels = levels[::-1] or [grid]
+    if extrapolate and len(levels) < 2:
+        raise InputError(
+            f"extrapolate=True needs a coarser level: grid={grid} must be >= 2 * coarsest - 1 = {2 * coarsest - 1}"
+        )
+    # levels whose central film enters the reported value or the grid-change estimate are solved to
+    # ``tol``; the others only to ``coarse_tol``
+    exact_from = grid
+    for _ in range(int(extrapolate) + int(grid_tol is not None)):  # the reported value and the one below
+        exact_from = (exact_from - 1) // 2 + 1
+
+    return levels, exact_from
+
+
+def _reported_film(values, k, extrapolate):
+    """Reported film of level k [m] from a level's films ``values`` (central or minimum):
+    extrapolated from levels k-1, k when enabled."""
+    if extrapolate:
+        return (4.0 * values[k] - values[k - 1]) / 3.0 if k >= 1 else float("nan")
+    return values[k]
+
+
+def _film_change(values, k, extrapolate):
+    """|reported(k) / reported(k - 1) - 1| (nan without a coarser reported value)."""
+    if k < (2 if extrapolate else 1):
+        return float("nan")
+    return abs(_reported_film(values, k, extrapolate) / _reported_film(values, k - 1, extrapolate) - 1.0)
+
+
 # ----------------------------------------------------------------- public API
+def _reported_films(h_levels, hmin_levels, k, n, extrapolate):
+    """(h_c of level k, h_c of the level below, reported h_c, reported h_min) [m]; a
+    non-positive or non-finite reported film (a failed extrapolation) raises ConvergenceError."""
+    h_grid = h_levels[k]
+    h_coarse = h_levels[k - 1] if k >= 1 else float("nan")
+    h_central = _reported_film(h_levels, k, extrapolate)
+    if not np.isfinite(h_central) or h_central <= 0:
+        raise ConvergenceError(
+            f"Richardson extrapolation of h_c failed: h_c({n}) = {h_grid:.4e} m, "
+            f"h_c({(n - 1) // 2 + 1}) = {h_coarse:.4e} m"
+        )
+    h_min = _reported_film(hmin_levels, k, extrapolate)
+    if not np.isfinite(h_min) or h_min <= 0:
+        raise ConvergenceError(
+            f"Richardson extrapolation of h_min failed: h_min({n}) = {hmin_levels[k]:.4e} m, "
+            f"h_min({(n - 1) // 2 + 1}) = "
+            f"{hmin_levels[k - 1] if k >= 1 else float('nan'):.4e} m"
+        )
+    return h_grid, h_coarse, h_central, h_min
+
+
+def _grid_converged(grid_tol, change, change_c, change_min, refine_asked, n, where):
+    """Whether the reported films met ``grid_tol``; a RuntimeWarning (naming the load case
+    ``where``) when refinement was asked for and did not reach it."""
+    grid_converged = bool(grid_tol is None or (np.isfinite(change) and change <= grid_tol))
+    if not grid_converged and refine_asked:  # refinement was asked for and did not reach grid_tol
+        warnings.warn(
+            f"EHL film not grid-converged at the {n}x{n} grid (max_grid): h_c changed by "
+            f"{100 * change_c:.2f} % and h_min by {100 * change_min:.2f} % from the next-coarser grid "
+            f"(grid_tol {100 * grid_tol:.1f} %); "
+            f"{where}",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    return grid_converged
+
+
+def _hertz_start(prob, n, load, speed, rx, ry, e_eff, lubricant, hscale):
+    """A level's start: the Hertz pressure scaled to the load, the rigid approach from the
+    Hamrock-Dowson central film."""
+    r2 = prob.X[:, None] ** 2 + prob.Y[None, :] ** 2
+    P = np.sqrt(np.clip(1.0 - r2, 0.0, None))
+    P *= prob.load_target / (prob.dX * prob.dY * P.sum())
+    hc_hd, _ = hamrock_dowson(load, speed, rx, ry, e_eff, lubricant.viscosity, lubricant.pressure_viscosity)
+    ic, jc = np.argmin(np.abs(prob.X)), n // 2
+    return P, float(hc_hd) / hscale - float(prob.gap[ic, jc] + prob.elastic(P)[ic, jc])
+
+
+def _run_continuation(
+    make,
+    hertz_start,
+    levels,
+    grid,
+    exact_from,
+    max_grid,
+    grid_tol,
+    extrapolate,
+    tol,
+    coarse_tol,
+    max_iter,
+    hscale,
+    where,
+):
+    """The grid continuation of :func:`solve_point_contact`: each level's Newton from the
+    previous level's pressure (the first, or after an unusable coarse level, from
+    ``hertz_start``), refined beyond ``grid`` up to ``max_grid`` until the reported films
+    change by less than ``grid_tol``. Returns (problem, P, H0, H, n, k, steps, residual,
+    total steps, residual history, central and minimum films of every level, closed film,
+    grid change, of h_c, of h_min)."""
+    P = H0 = None
+    prev = None
+    history: list = []
+    h_levels: list = []
+    hmin_levels: list = []  # sub-grid minimum film of each level [m] (:func:`_subgrid_min`)
+    total = 0
+    k = 0
+    change = float("nan")
+    while True:
+        n = levels[k]
+        prob = make(n)
+        if P is None:
+            P, H0 = hertz_start(prob, n)
+        else:
+            P = np.maximum(_interpolate(P, prev.X, prev.Y, prob.X, prob.Y), 0.0)
+        history = []
+        final = n >= grid
+        # a coarse level that only provides the starting point may stop short of its tolerance
+        level_tol = tol if n >= exact_from else max(tol, coarse_tol)
+        prob.trace = _TRACE
+        P, H0, steps, res = prob.newton(P, H0, level_tol, max_iter if final else 2 * max_iter, history)
+        total += steps
+        if (not np.isfinite(res) or res >= level_tol) and n >= exact_from:
+            raise ConvergenceError(
+                f"EHL solver did not converge on the {n}x{n} grid: residual reached {res:.3e} "
+                f"(target {level_tol:.1e}) after {steps} Newton steps {where}"
+            )
+        if not (np.all(np.isfinite(P)) and np.isfinite(H0)):  # only possible below exact_from
+            P = H0 = None  # unusable coarse start: the next level starts again from the Hertz pressure
+            h_levels.append(float("nan"))
+            hmin_levels.append(float("nan"))
+            k += 1
+            continue
+        ic = int(np.argmin(np.abs(prob.X)))
+        H = prob.film(P, H0)
+        h_levels.append(float(H[ic, n // 2] * hscale))
+        hmin_levels.append(_subgrid_min(H) * hscale)
+        prev = prob
+        if not final:
+            k += 1
+            continue
+        closed = bool(np.any(H[1:-1, 1:-1] <= 0))
+        change_c, change_min = _film_change(h_levels, k, extrapolate), _film_change(hmin_levels, k, extrapolate)
+        change = max(change_c, change_min)  # nan if either is nan
+        converged = True if grid_tol is None else bool((not closed) and np.isfinite(change) and change <= grid_tol)
+        if converged or n >= max_grid:
+            break
+        levels.append(2 * n - 1)  # refine: one more level of the continuation
+        k += 1
+    return prob, P, H0, H, n, k, steps, res, total, history, h_levels, hmin_levels, closed, change, change_c, change_min
+
+
 def solve_point_contact(
     load,
     speed,
@@ -808,31 +1013,10 @@ def solve_point_contact(
     ConvergenceError
         Newton did not reach ``tol`` (message: residual reached and iterations).
     """
-    for name, value in (("load", load), ("speed", speed), ("rx", rx), ("ry", ry), ("e_eff", e_eff)):
-        if value is None or not np.isfinite(value) or value <= 0:
-            raise InputError(f"{name} must be finite and > 0, got {value!r}")
-    lubricant.check()
-    if grid < 9 or ((grid - 1) & (grid - 2)) != 0:
-        raise InputError(f"grid must be 2^k + 1 >= 9 nodes (e.g. 65, 129, 257), got {grid}")
-    if wedge_order is None:
-        wedge_order = 2 if grid >= 129 else 1
-    if extrapolate is None:
-        extrapolate = wedge_order == 2 and grid >= 129
-    refine_asked = max_grid is not None or extrapolate  # warn if the grid change then misses grid_tol
-    if max_grid is None:
-        max_grid = 513 if extrapolate else grid
-    if max_grid < grid or ((max_grid - 1) & (max_grid - 2)) != 0:
-        raise InputError(f"max_grid must be 2^k + 1 >= grid = {grid}, got {max_grid}")
-    if grid_tol is not None and not (0 < grid_tol < 1):
-        raise InputError(f"grid_tol must be in (0, 1) or None, got {grid_tol!r}")
-    if wedge_order not in (1, 2):
-        raise InputError(f"wedge_order must be 1 or 2, got {wedge_order!r}")
-    if stencil not in (0, 1, 2, 3):
-        raise InputError(f"stencil must be 0..3, got {stencil!r}")
-    if not (x_inlet < 0 < x_outlet) or y_half <= 0:
-        raise InputError(
-            f"domain must contain the contact centre: x_inlet={x_inlet} < 0 < x_outlet={x_outlet}, y_half={y_half} > 0"
-        )
+    wedge_order, extrapolate, refine_asked, max_grid = _check_solver_inputs(
+        load, speed, rx, ry, e_eff, lubricant, grid, x_inlet, x_outlet, y_half, stencil, wedge_order, extrapolate,
+        grid_tol, max_grid,
+    )  # fmt: skip
     load, speed, rx, ry, e_eff = map(float, (load, speed, rx, ry, e_eff))
     hz = point_contact(load, rx, ry, e_eff)
     a, b, p_h = float(hz.a), float(hz.b), float(hz.p_max)
@@ -845,125 +1029,33 @@ def solve_point_contact(
     def kernel_scale(n, dX, dY):
         return influence_kernel(n, n, dX * b, dY * a) / e_eff * p_h / hscale
 
-    # grid continuation
-    levels = []
-    n = grid
-    while n >= coarsest:
-        levels.append(n)
-        n = (n - 1) // 2 + 1
-    levels = levels[::-1] or [grid]
-    if extrapolate and len(levels) < 2:
-        raise InputError(
-            f"extrapolate=True needs a coarser level: grid={grid} must be >= 2 * coarsest - 1 = {2 * coarsest - 1}"
-        )
-    # levels whose central film enters the reported value or the grid-change estimate are solved to
-    # ``tol``; the others only to ``coarse_tol``
-    exact_from = grid
-    for _ in range(int(extrapolate) + int(grid_tol is not None)):  # the reported value and the one below
-        exact_from = (exact_from - 1) // 2 + 1
+    levels, exact_from = _continuation_levels(grid, coarsest, extrapolate, grid_tol)
 
-    def reported(k, values=None):
-        """Reported film of level k (extrapolated from levels k-1, k when enabled) [m]: the
-        central film, or h_min with ``values=hmin_levels``."""
-        values = h_levels if values is None else values
-        if extrapolate:
-            return (4.0 * values[k] - values[k - 1]) / 3.0 if k >= 1 else float("nan")
-        return values[k]
-
-    def change_of(k, values=None):
-        """|reported(k) / reported(k - 1) - 1| (nan without a coarser reported value)."""
-        if k < (2 if extrapolate else 1):
-            return float("nan")
-        return abs(reported(k, values) / reported(k - 1, values) - 1.0)
-
-    P = H0 = None
-    prev = None
-    history: list = []
-    h_levels: list = []
-    hmin_levels: list = []  # sub-grid minimum film of each level [m] (:func:`_subgrid_min`)
-    total = 0
-    k = 0
-    change = float("nan")
-    while True:
-        n = levels[k]
-        prob = _GridProblem(
+    def make(n):
+        return _GridProblem(
             n, x_inlet, x_outlet, y_half, b / a, ky, lam, kernel_scale, p_h, lubricant, stencil, wedge_order, symmetric
         )
-        if P is None:
-            r2 = prob.X[:, None] ** 2 + prob.Y[None, :] ** 2
-            P = np.sqrt(np.clip(1.0 - r2, 0.0, None))
-            P *= prob.load_target / (prob.dX * prob.dY * P.sum())
-            hc_hd, _ = hamrock_dowson(load, speed, rx, ry, e_eff, lubricant.viscosity, lubricant.pressure_viscosity)
-            ic, jc = np.argmin(np.abs(prob.X)), n // 2
-            H0 = float(hc_hd) / hscale - float(prob.gap[ic, jc] + prob.elastic(P)[ic, jc])
-        else:
-            P = np.maximum(_interpolate(P, prev.X, prev.Y, prob.X, prob.Y), 0.0)
-        history = []
-        final = n >= grid
-        # a coarse level that only provides the starting point may stop short of its tolerance
-        level_tol = tol if n >= exact_from else max(tol, coarse_tol)
-        prob.trace = _TRACE
-        P, H0, steps, res = prob.newton(P, H0, level_tol, max_iter if final else 2 * max_iter, history)
-        total += steps
-        if (not np.isfinite(res) or res >= level_tol) and n >= exact_from:
-            raise ConvergenceError(
-                f"EHL solver did not converge on the {n}x{n} grid: residual reached {res:.3e} "
-                f"(target {level_tol:.1e}) after {steps} Newton steps "
-                f"(load {load:g} N, speed {speed:g} m/s)"
-            )
-        if not (np.all(np.isfinite(P)) and np.isfinite(H0)):  # only possible below exact_from
-            P = H0 = None  # unusable coarse start: the next level starts again from the Hertz pressure
-            h_levels.append(float("nan"))
-            hmin_levels.append(float("nan"))
-            k += 1
-            continue
-        ic = int(np.argmin(np.abs(prob.X)))
-        H = prob.film(P, H0)
-        h_levels.append(float(H[ic, n // 2] * hscale))
-        hmin_levels.append(_subgrid_min(H) * hscale)
-        prev = prob
-        if not final:
-            k += 1
-            continue
-        closed = bool(np.any(H[1:-1, 1:-1] <= 0))
-        change_c, change_min = change_of(k), change_of(k, hmin_levels)
-        change = max(change_c, change_min)  # nan if either is nan
-        converged = True if grid_tol is None else bool((not closed) and np.isfinite(change) and change <= grid_tol)
-        if converged or n >= max_grid:
-            break
-        levels.append(2 * n - 1)  # refine: one more level of the continuation
-        k += 1
+
+    where = f"(load {load:g} N, speed {speed:g} m/s)"
+
+    def start(prob, n):
+        return _hertz_start(prob, n, load, speed, rx, ry, e_eff, lubricant, hscale)
+
+    run = _run_continuation(
+        make, start, levels, grid, exact_from, max_grid, grid_tol, extrapolate, tol, coarse_tol, max_iter, hscale,
+        where,
+    )  # fmt: skip
+    prob, P, H0, H, n, k, steps, res, total, history, h_levels, hmin_levels, closed, change, change_c, change_min = run
     if closed:
         raise ConvergenceError(
             f"EHL solution on the {n}x{n} grid has a closed film (min h = {H[1:-1, 1:-1].min() * hscale:.3e} m < 0) "
             f"after {steps} Newton steps, residual {res:.3e}: the grid does not resolve the film at this load "
             f"(Moes M = {moes_m:.3g}); use a finer grid (max_grid) or the Hamrock-Dowson formula"
         )
-    h_grid = h_levels[k]
-    h_coarse = h_levels[k - 1] if k >= 1 else float("nan")
-    h_central = reported(k)
-    if not np.isfinite(h_central) or h_central <= 0:
-        raise ConvergenceError(
-            f"Richardson extrapolation of h_c failed: h_c({n}) = {h_grid:.4e} m, "
-            f"h_c({(n - 1) // 2 + 1}) = {h_coarse:.4e} m"
-        )
-    h_min = reported(k, hmin_levels)
-    if not np.isfinite(h_min) or h_min <= 0:
-        raise ConvergenceError(
-            f"Richardson extrapolation of h_min failed: h_min({n}) = {hmin_levels[k]:.4e} m, "
-            f"h_min({(n - 1) // 2 + 1}) = "
-            f"{hmin_levels[k - 1] if k >= 1 else float('nan'):.4e} m"
-        )
-    grid_converged = bool(grid_tol is None or (np.isfinite(change) and change <= grid_tol))
-    if not grid_converged and refine_asked:  # refinement was asked for and did not reach grid_tol
-        warnings.warn(
-            f"EHL film not grid-converged at the {n}x{n} grid (max_grid): h_c changed by "
-            f"{100 * change_c:.2f} % and h_min by {100 * change_min:.2f} % from the next-coarser grid "
-            f"(grid_tol {100 * grid_tol:.1f} %); "
-            f"load {load:g} N, speed {speed:g} m/s, Moes M = {moes_m:.3g}",
-            RuntimeWarning,
-            stacklevel=2,
-        )
+    h_grid, h_coarse, h_central, h_min = _reported_films(h_levels, hmin_levels, k, n, extrapolate)
+    grid_converged = _grid_converged(
+        grid_tol, change, change_c, change_min, refine_asked, n, f"{where[1:-1]}, Moes M = {moes_m:.3g}"
+    )
     return EHLResult(
         x=prob.X * b,
         y=prob.Y * a,

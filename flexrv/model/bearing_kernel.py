@@ -867,91 +867,12 @@ def _zero_written(jac, nx, nz):
                 jac[b + r, b + c] = 0.0
 
 
-@njit(cache=True)
-def row_eval(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    jq,
-    jv,
-):
-    """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
-    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
-    rigid and modal rings only the entries it writes, :func:`_zero_written`: the
-    other entries must be zero, as in a zero-allocated work array);
-    coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
-
-    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
-    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
-    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
-    contact deflections and last tangent; every ring: the contacts' films, the film
-    iteration's warm start, :func:`film_workspace`; updated);
-    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
-    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
-    sum of the local iterations, local solves, then the same four of the
-    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
-    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
-
-    ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
-    CONDENSED_BALLS (the quasi-static balls' modes, see there).
-
-    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
-    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
-    and K the contact stiffness — block diagonal for rigid and modal rings
-    (added ball by ball, :func:`_add_block_jacobian`), the dense condensed
-    (I - K C)^-1 K for condensed rings (:func:`_condensed_contact_matrix`; geometric-stiffness
-    terms of the frame rotation are dropped; the modified Newton iteration
-    converges on the residual, which is exact). The azimuths' cosines and sines
-    are the normalised in-plane coordinates (no sin/cos of the atan2)."""
-    z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
-    co_r, co_z, off_i, off_o = (
-        geometry.outer_center_radius,
-        geometry.outer_center_z,
-        geometry.inner_offset,
-        geometry.outer_offset,
-    )
-    rb, speed_factor, cage_ratio = geometry.ball_radius_pitch, geometry.speed_factor, geometry.cage_ratio
-    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
-    m_i = tab_i.shape[2]
-    m_o = tab_o.shape[2]
-    cond_i = comp_i.shape[0] > 0
-    cond_o = comp_o.shape[0] > 0
-    state[1] = 0
-    nz = ball_ref.shape[0]
-    b0 = 6 + m_i + m_o
-    nx_i = 6 + m_i
-    f[:] = 0.0
-    if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
-        jq[:, :] = 0.0
-        if jacobian == CONDENSED_BALLS:
-            jv[:, :] = 0.0
-    elif jacobian:
-        if cond_i or cond_o:
-            jq[:, :] = 0.0
-            jv[:, :] = 0.0
-        else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
-            _zero_written(jq, b0, nz)
-            _zero_written(jv, b0, nz)
+@njit(cache=True, inline="always")
+def _frame_kinematics(q, qt):
+    """The frame's rotation A = Rx(ax) Ry(ay) Rz(az), the map G of omega = G phi_t
+    (Exudyn RotXYZ2RotationMatrix / RotXYZ2G) and omega's components."""
     ax, ay, az = q[3], q[4], q[5]
     sa, ca, sb, cb, sc, cc = math.sin(ax), math.cos(ax), math.sin(ay), math.cos(ay), math.sin(az), math.cos(az)
-    # A = Rx(ax) Ry(ay) Rz(az); omega = G phi_t (Exudyn RotXYZ2RotationMatrix / RotXYZ2G)
     a = np.empty((3, 3))
     a[0, 0], a[0, 1], a[0, 2] = cb * cc, -cb * sc, sb
     a[1, 0], a[1, 1], a[1, 2] = ca * sc + sa * sb * cc, ca * cc - sa * sb * sc, -sa * cb
@@ -963,13 +884,26 @@ def row_eval(
     om0 = g[0, 0] * qt[3] + g[0, 1] * qt[4] + g[0, 2] * qt[5]
     om1 = g[1, 0] * qt[3] + g[1, 1] * qt[4] + g[1, 2] * qt[5]
     om2 = g[2, 0] * qt[3] + g[2, 1] * qt[4] + g[2, 2] * qt[5]
-    speed = speed_factor * abs(qt[5])
+    return a, g, om0, om1, om2
+
+
+@njit(cache=True, inline="always")
+def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, om):
+    """Pass 1 of :func:`row_eval`: the geometry of every ball with the rings undeflected
+    (modal rings: with their coordinates), ball minus groove centre e0 and relative
+    velocity w0 of both contacts. Returns (ball centres, inner and outer azimuths, the
+    outer azimuths' cos and sin, arms A p of the inner groove centres, e0_i, w0_i, e0_o,
+    w0_o, raceway displacements du_i, du_o (global; modal rings), the condensed rings'
+    rotations to their cylindrical frames, the modal rings' bases at every ball)."""
+    om0, om1, om2 = om
+    z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
+    co_r, co_z = geometry.outer_center_radius, geometry.outer_center_z
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = ball_ref.shape[0]
+    b0 = 6 + m_i + m_o
     bas_i = np.empty((3, m_i))
     bas_o = np.empty((3, m_o))
-    two_pi = 2.0 * math.pi
-    # ---------------- pass 1: geometry of every ball with the rings undeflected
-    # (modal rings: with their coordinates), ball minus groove centre e0 and
-    # relative velocity w0 of both contacts
     bpos = np.empty((nz, 3))
     psi_i = np.empty(nz)
     psi_o = np.empty(nz)
@@ -1046,7 +980,20 @@ def row_eval(
             r_o[2, 0], r_o[2, 1], r_o[2, 2] = 0.0, 0.0, 1.0
         e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
         w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
-    # ---------------- condensed rings: contact deflections
+    return bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+
+
+@njit(cache=True, inline="always")
+def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state):
+    """The contacts of both rings at every ball (:func:`_ring_contacts`; condensed rings:
+    their local solves, the inner one's deflection added to the arms ``pre[4]``). Returns
+    (loads, normals, dQ/d delta, damping, approach lengths and films of the inner and
+    outer contacts, the condensed rings' global compliance factors)."""
+    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre[1], pre[2], pre[4], pre[5], pre[6], pre[7], pre[8]
+    du_i, du_o, rot_i, rot_o = pre[9], pre[10], pre[11], pre[12]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    nz = psi_i.shape[0]
     load_i = np.empty(nz)
     load_o = np.empty(nz)
     nrm_i = np.empty((nz, 3))
@@ -1063,6 +1010,7 @@ def row_eval(
     nco = 3 * nz if (cond_o and jacobian) else 0
     wg_i = np.empty((nci, comp_i.shape[2]))  # condensed rings' global compliance factors (Jacobian only)
     wg_o = np.empty((nco, comp_o.shape[2]))
+    off_i, off_o = geometry.inner_offset, geometry.outer_offset
     _ring_contacts(
         cond_i,
         psi_i,
@@ -1111,35 +1059,30 @@ def row_eval(
         wg_o,
         state,
     )
-    # ---------------- pass 2: generalized forces (and Jacobian blocks)
-    k_i = np.empty((3, 3))
-    d_i = np.empty((3, 3))
-    k_o = np.empty((3, 3))
-    d_o = np.empty((3, 3))
-    t_i = np.zeros((3, nx_i))
-    nl = b0 + 3 if (jacobian and jacobian != BALL_BLOCKS) else 0
-    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see below)
-    vl = np.empty((nl, nl))
-    inv3 = np.empty((3, 3))  # (work of _condense_ball)
-    tm3 = np.empty((3, b0))
-    s_balls = (
-        balls[2 * 3 * nz : 2 * 3 * nz + 3 * nz * b0].reshape((3 * nz, b0))
-        if jacobian == CONDENSED_BALLS
-        else np.empty((0, b0))
-    )
-    for r in range(3):
-        t_i[r, r] = 1.0
-    ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
-    vf_i = np.empty((nci // 3, 2, 3))
-    vf_o = np.empty((nco // 3, 2, 3))
+    return load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o
+
+
+@njit(cache=True, inline="always")
+def _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, rec):
+    """Every ball's contact reactions on the frame and the rings' modes, its cage and pocket
+    forces, into ``f`` (and ``rec`` when it has a row per ball); returns (Z, 3): each ball's
+    cage direction (etx, ety) and radius in the housing (for the Jacobian blocks)."""
+    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre[0], pre[1], pre[2], pre[3], pre[4], pre[9], pre[10]
+    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con[0], con[1], con[2], con[3], con[10], con[11]
+    z_row, rb, cage_ratio = geometry.z, geometry.ball_radius_pitch, geometry.cage_ratio
+    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = bpos.shape[0]
+    two_pi = 2.0 * math.pi
+    bas_i = np.empty((3, m_i))
+    bas_o = np.empty((3, m_o))
     record = rec.shape[0] == nz
-    # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
-    # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
-    dudw = speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
+    ebr = np.empty((nz, 3))
     for j in range(nz):
-        bj = b0 + 3 * j
+        bj = 6 + m_i + m_o + 3 * j
         bx, by, bz = bpos[j, 0], bpos[j, 1], bpos[j, 2]
-        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+        vx, vy = qt[bj], qt[bj + 1]
         qi, qo = load_i[j], load_o[j]
         fix, fiy, fiz = -qi * nrm_i[j, 0], -qi * nrm_i[j, 1], -qi * nrm_i[j, 2]
         fox, foy, foz = -qo * nrm_o[j, 0], -qo * nrm_o[j, 1], -qo * nrm_o[j, 2]
@@ -1167,7 +1110,7 @@ def row_eval(
         # ---- cage (tangential spring-damper to the kinematic pocket) + pocket spring
         psi = psi_o[j]
         cos_p, sin_p = cs_o[j, 0], cs_o[j, 1]
-        pocket = two_pi * j / nz + cage_ratio * az
+        pocket = two_pi * j / nz + cage_ratio * q[5]
         dev = psi - pocket
         dev -= two_pi * math.floor(dev / two_pi + 0.5)  # wrapped to [-pi, pi)
         radius = math.sqrt(bx * bx + by * by)
@@ -1190,27 +1133,67 @@ def row_eval(
             rec[j, 25], rec[j, 26] = film_i[j], film_o[j]
             rec[j, 10], rec[j, 11], rec[j, 12] = -flx, -fly, -flz
             rec[j, 13], rec[j, 14], rec[j, 15] = -fox, -foy, -foz
-        if not jacobian:
-            continue
-        if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
-            _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
-            _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
-            et = (etx, ety, 0.0)
-            # groove centres' velocities (ball velocity minus the contacts' relative velocities)
-            gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
-            go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
-            for c1 in range(3):
-                rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
-                for c2 in range(3):
-                    ee = et[c1] * et[c2]
-                    eye = 1.0 if c1 == c2 else 0.0
-                    jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
-                    rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
-                jq[3 * j + c1, 3] = rate
-            continue
-        # ---- Jacobian blocks of this ball: its (b0 + 3)^2 square [x (0..b0-1), the ball
-        # (b0..b0+2)] into jl, vl (the helpers at ball index b0), then scattered into jq, jv
-        # -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS)
+        ebr[j, 0], ebr[j, 1], ebr[j, 2] = etx, ety, radius
+    return ebr
+
+
+@njit(cache=True, inline="always")
+def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
+    """Every ball's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
+    and, in column 3, the rate of its force from the frame's and rings' motion; ``ebr``:
+    :func:`_row_forces`' cage directions and radii."""
+    w0_i, w0_o = pre[6], pre[8]
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o = con[:10]
+    cage_ratio, cage_k, pocket_k = geometry.cage_ratio, geometry.cage_stiffness, geometry.pocket_stiffness
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
+    for j in range(load_i.shape[0]):
+        etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
+        bj = b0 + 3 * j
+        vx, vy, vz = qt[bj], qt[bj + 1], qt[bj + 2]
+        _contact_blocks(
+            load_i[j], dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i
+        )
+        _contact_blocks(
+            load_o[j], dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o
+        )
+        et = (etx, ety, 0.0)
+        # groove centres' velocities (ball velocity minus the contacts' relative velocities)
+        gi = (vx - w0_i[j, 0], vy - w0_i[j, 1], vz - w0_i[j, 2])
+        go = (vx - w0_o[j, 0], vy - w0_o[j, 1], vz - w0_o[j, 2])
+        for c1 in range(3):
+            rate = cage_k * radius * cage_ratio * et[c1] * qt[5]
+            for c2 in range(3):
+                ee = et[c1] * et[c2]
+                eye = 1.0 if c1 == c2 else 0.0
+                jq[3 * j + c1, c2] = k_i[c1, c2] + k_o[c1, c2] - cage_k * ee - pocket_k * (eye - ee)
+                rate -= k_i[c1, c2] * gi[c2] + k_o[c1, c2] * go[c2]
+            jq[3 * j + c1, 3] = rate
+
+
+@njit(cache=True, inline="always")
+def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv):
+    """Every ball's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
+    (b0..b0+2)] into the work blocks jl, vl (the helpers at ball index b0), then scattered
+    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS); the
+    condensed rings' contacts keep their T rows and contact factors for
+    :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
+    :func:`_row_forces`' cage directions and radii."""
+    arm, bas_i_all, bas_o_all = pre[4], pre[13], pre[14]
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o = con[:12]
+    k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o = wk
+    cage_ratio, cage_k, cage_c = geometry.cage_ratio, geometry.cage_stiffness, geometry.cage_damping
+    pocket_k = geometry.pocket_stiffness
+    cond_i = ti_all.shape[0] > 0
+    cond_o = vf_o.shape[0] > 0
+    b0 = 6 + m_i + m_o
+    nx_i = 6 + m_i
+    for j in range(load_i.shape[0]):
+        etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
+        bj = b0 + 3 * j
+        qi, qo = load_i[j], load_o[j]
         jl[:, :] = 0.0
         vl[:, :] = 0.0
         if not cond_i:  # (condensed rings: the blocks' factors below)
@@ -1227,6 +1210,7 @@ def row_eval(
             jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
             vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
         # T_i = [I | -[Ap]x G | A basis_i]
+        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
         for c in range(3):  # -(skew(Ap) G)[:, c]
             g0, g1, g2 = g[0, c], g[1, c], g[2, c]
             t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
@@ -1271,25 +1255,186 @@ def row_eval(
                     cc = c if c < b0 else bj + c - b0
                     jq[rr, cc] += jl[r, c]
                     jv[rr, cc] += vl[r, c]
+
+
+@njit(cache=True, inline="always")
+def _row_pass2(
+    q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+):
+    """Pass 2 of :func:`row_eval`: every ball's generalized forces (:func:`_row_forces`)
+    and Jacobian blocks (:func:`_row_local_blocks`, :func:`_row_ball_jacobians`). Returns the
+    condensed rings' T rows and contact factors of every ball and the entrainment speed's
+    rate d u / d q_t[5] (for :func:`_condensed_row_jacobian`)."""
+    cond_i = pre[11].shape[0] > 0
+    cond_o = pre[12].shape[0] > 0
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    nz = pre[0].shape[0]
+    b0 = 6 + m_i + m_o
+    nx_i = 6 + m_i
+    bas_o = np.empty((3, m_o))
+    k_i = np.empty((3, 3))
+    d_i = np.empty((3, 3))
+    k_o = np.empty((3, 3))
+    d_o = np.empty((3, 3))
+    t_i = np.zeros((3, nx_i))
+    nl = b0 + 3 if (jacobian and jacobian != BALL_BLOCKS) else 0
+    jl = np.empty((nl, nl))  # one ball's Jacobian blocks (see _row_ball_jacobians)
+    vl = np.empty((nl, nl))
+    inv3 = np.empty((3, 3))  # (work of _condense_ball)
+    tm3 = np.empty((3, b0))
+    s_balls = (
+        balls[2 * 3 * nz : 2 * 3 * nz + 3 * nz * b0].reshape((3 * nz, b0))
+        if jacobian == CONDENSED_BALLS
+        else np.empty((0, b0))
+    )
+    for r in range(3):
+        t_i[r, r] = 1.0
+    nci = 3 * nz if (cond_i and jacobian) else 0
+    nco = 3 * nz if (cond_o and jacobian) else 0
+    ti_all = np.empty((nci, nx_i))  # condensed rings: T and the contact stiffness factors of every ball
+    vf_i = np.empty((nci // 3, 2, 3))
+    vf_o = np.empty((nco // 3, 2, 3))
+    wk = (k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o)
+    # entrainment speed u = speed_factor |omega_z|: the films' speed dependence enters
+    # d f / d q_t[5] as if each ball moved by n dh/du du/dq_t[5] (dQ/du = dQ/ddelta dh/du)
+    dudw = geometry.speed_factor * (1.0 if qt[5] > 0.0 else -1.0)
+    ebr = _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, rec)
+    if jacobian == BALL_BLOCKS:  # the local ball solve: see BALL_BLOCKS
+        _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq)
+    elif jacobian:
+        _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv)
+    return ti_all, vf_i, vf_o, dudw
+
+
+@njit(cache=True, inline="always")
+def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
+    """The dense Jacobian blocks of the condensed rings' contacts (:func:`row_eval`):
+    the contacts in series with the ring, (I - K C)^-1 K and D, through the inner ring's
+    T rows onto the frame and, for both rings, onto the balls; ``p2``: :func:`_row_pass2`'s
+    result."""
+    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o, wg_i, wg_o = (
+        con[2],
+        con[3],
+        con[6],
+        con[7],
+        con[10],
+        con[11],
+        con[12],
+        con[13],
+    )
+    ti_all, vf_i, vf_o, dudw = p2
+    nz = nrm_i.shape[0]
+    ball = slice(b0, b0 + 3 * nz)
+    if ti_all.shape[0] > 0:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
+        kim = _condensed_contact_matrix(vf_i, nrm_i, cd_i, wg_i)
+        for jac, km in ((jq, kim[0]), (jv, kim[1])):
+            jac[ball, ball] += km
+            kt = km @ ti_all
+            jac[ball, 0:nx_i] -= kt
+            tk = ti_all.T @ km
+            jac[0:nx_i, ball] -= tk
+            jac[0:nx_i, 0:nx_i] += tk @ ti_all
+        kd = kim[0] @ _film_displacements(law_i, speed, film_i, nrm_i, dudw)
+        jv[ball, 5] += kd
+        jv[0:nx_i, 5] -= ti_all.T @ kd
+    if vf_o.shape[0] > 0:  # outer ring in the housing: ball-ball only (m_o = 0)
+        kom = _condensed_contact_matrix(vf_o, nrm_o, cd_o, wg_o)
+        jq[ball, ball] += kom[0]
+        jv[ball, ball] += kom[1]
+        jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
+
+
+@njit(cache=True)
+def row_eval(
+    q,
+    qt,
+    ball_ref,
+    geometry,
+    tab_i,
+    zs_i,
+    tab_o,
+    zs_o,
+    law_i,
+    law_o,
+    comp_i,
+    comp_o,
+    ws_i,
+    ws_o,
+    balls,
+    state,
+    jacobian,
+    rec,
+    f,
+    jq,
+    jv,
+):
+    """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
+    derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
+    rigid and modal rings only the entries it writes, :func:`_zero_written`: the
+    other entries must be zero, as in a zero-allocated work array);
+    coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
+
+    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
+    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
+    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
+    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
+    contact deflections and last tangent; every ring: the contacts' films, the film
+    iteration's warm start, :func:`film_workspace`; updated);
+    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
+    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
+    sum of the local iterations, local solves, then the same four of the
+    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
+    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
+
+    ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
+    CONDENSED_BALLS (the quasi-static balls' modes, see there).
+
+    Jacobian blocks: d f_ball/d b = K, d f_ball/d x = -K T, d g_x/d b = -T^T K,
+    d g_x/d x = T^T K T with T_j = d c_j / d x (x: frame and modal coordinates)
+    and K the contact stiffness — block diagonal for rigid and modal rings
+    (added ball by ball, :func:`_add_block_jacobian`), the dense condensed
+    (I - K C)^-1 K for condensed rings (:func:`_condensed_contact_matrix`; geometric-stiffness
+    terms of the frame rotation are dropped; the modified Newton iteration
+    converges on the residual, which is exact). The azimuths' cosines and sines
+    are the normalised in-plane coordinates (no sin/cos of the atan2).
+
+    Phases (each its own compiled function): the frame's kinematics
+    (:func:`_frame_kinematics`), pass 1 with the rings undeflected
+    (:func:`_row_geometry`), the contacts and the condensed rings' local solves
+    (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
+    ball (:func:`_row_pass2`), the condensed rings' dense blocks
+    (:func:`_condensed_row_jacobian`)."""
+    m_i = tab_i.shape[2]
+    m_o = tab_o.shape[2]
+    cond_i = comp_i.shape[0] > 0
+    cond_o = comp_o.shape[0] > 0
+    state[1] = 0
+    nz = ball_ref.shape[0]
+    b0 = 6 + m_i + m_o
+    f[:] = 0.0
+    if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
+        jq[:, :] = 0.0
+        if jacobian == CONDENSED_BALLS:
+            jv[:, :] = 0.0
+    elif jacobian:
+        if cond_i or cond_o:
+            jq[:, :] = 0.0
+            jv[:, :] = 0.0
+        else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
+            _zero_written(jq, b0, nz)
+            _zero_written(jv, b0, nz)
+    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
+    speed = geometry.speed_factor * abs(qt[5])
+    pre = _row_geometry(
+        q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, (om0, om1, om2)
+    )
+    con = _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state)
+    p2 = _row_pass2(
+        q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+    )
     if jacobian and (cond_i or cond_o):
-        ball = slice(b0, b0 + 3 * nz)
-        if cond_i:  # the dense condensed contacts of the inner ring (frame coordinates only: m_i = 0)
-            kim = _condensed_contact_matrix(vf_i, nrm_i, cd_i, wg_i)
-            for jac, km in ((jq, kim[0]), (jv, kim[1])):
-                jac[ball, ball] += km
-                kt = km @ ti_all
-                jac[ball, 0:nx_i] -= kt
-                tk = ti_all.T @ km
-                jac[0:nx_i, ball] -= tk
-                jac[0:nx_i, 0:nx_i] += tk @ ti_all
-            kd = kim[0] @ _film_displacements(law_i, speed, film_i, nrm_i, dudw)
-            jv[ball, 5] += kd
-            jv[0:nx_i, 5] -= ti_all.T @ kd
-        if cond_o:  # outer ring in the housing: ball-ball only (m_o = 0)
-            kom = _condensed_contact_matrix(vf_o, nrm_o, cd_o, wg_o)
-            jq[ball, ball] += kom[0]
-            jv[ball, ball] += kom[1]
-            jv[ball, 5] += kom[0] @ _film_displacements(law_o, speed, film_o, nrm_o, dudw)
+        _condensed_row_jacobian(law_i, law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
 
 
 @njit(cache=True)
@@ -1551,6 +1696,33 @@ def _split_balls(ws, nb, nx):
     return ws[:nb], ws[nb : 2 * nb], sm, ws[o : o + nx], ws[o + nx : o + 2 * nx], ws[o + 2 * nx : o + 2 * nx + 1]
 
 
+@njit(cache=True, inline="always")
+def _predict_balls(q, qt, ball_ref, cage_ratio, b, bt, sm, xl, xtl):
+    """The quasi-static balls' start from the last solution (:func:`quasi_static_balls`):
+    turned about the axis with their cage by cage_ratio (phi_z - phi_z,last), then
+    b += S (x - x_last) over the other coordinates and b_t = b_t,last + S (x_t - x_t,last),
+    into q[nx:], qt[nx:]."""
+    nz = ball_ref.shape[0]
+    nb = 3 * nz
+    nx = q.shape[0] - nb
+    turn = cage_ratio * (q[5] - xl[5])
+    ct, st = math.cos(turn), math.sin(turn)
+    for j in range(nz):
+        px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
+        q[nx + 3 * j] = ct * px - st * py - ball_ref[j, 0]
+        q[nx + 3 * j + 1] = st * px + ct * py - ball_ref[j, 1]
+        q[nx + 3 * j + 2] = b[3 * j + 2]
+    for e in range(nb):
+        acc = 0.0
+        acc_t = bt[e]
+        for c in range(nx):
+            if c != 5:
+                acc += sm[e, c] * (q[c] - xl[c])
+            acc_t += sm[e, c] * (qt[c] - xtl[c])
+        q[nx + e] += acc
+        qt[nx + e] = acc_t
+
+
 @njit(cache=True)
 def quasi_static_balls(
     q,
@@ -1608,49 +1780,13 @@ def quasi_static_balls(
             q[nx + e] = b[e]
             qt[nx + e] = bt[e]
     else:
-        turn = geometry.cage_ratio * (q[5] - xl[5])
-        ct, st = math.cos(turn), math.sin(turn)
-        for j in range(nz):
-            px, py = ball_ref[j, 0] + b[3 * j], ball_ref[j, 1] + b[3 * j + 1]
-            q[nx + 3 * j] = ct * px - st * py - ball_ref[j, 0]
-            q[nx + 3 * j + 1] = st * px + ct * py - ball_ref[j, 1]
-            q[nx + 3 * j + 2] = b[3 * j + 2]
-        for e in range(nb):
-            acc = 0.0
-            acc_t = bt[e]
-            for c in range(nx):
-                if c != 5:
-                    acc += sm[e, c] * (q[c] - xl[c])
-                acc_t += sm[e, c] * (qt[c] - xtl[c])
-            q[nx + e] += acc
-            qt[nx + e] = acc_t
-        its = ball_equilibrium(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            geometry.ball_force_tol,
-            BALL_MAXIT,
-            f,
-            kbb,
-            rec,
-        )
-        if its < 0:  # once more from the last solution
-            for e in range(nb):
-                q[nx + e] = b[e]
-                qt[nx + e] = bt[e]
+        _predict_balls(q, qt, ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        its = -1
+        for attempt in range(2):
+            if attempt == 1:  # once more from the last solution
+                for e in range(nb):
+                    q[nx + e] = b[e]
+                    qt[nx + e] = bt[e]
             its = ball_equilibrium(
                 q,
                 qt,
@@ -1674,6 +1810,8 @@ def quasi_static_balls(
                 kbb,
                 rec,
             )
+            if its >= 0:
+                break
         state[5] = 0
         _count_solve(state, 4, its)
         if its >= 0:

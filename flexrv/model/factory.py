@@ -69,6 +69,61 @@ def empirical_needle_constant(reducer) -> float:
     return (0.9 * c) ** (10.0 / 9.0)
 
 
+def _drive(p, drive: str):
+    """The input's angle and speed functions of a drive: ``ramp`` (to the design's speed),
+    ``locked`` or ``position`` (quasi-static: the 'time' argument is the input angle itself)."""
+    from flexrv.model.loads import locked_drive, position_drive, ramp_drive
+
+    if drive == "ramp":
+        return ramp_drive(p.input_speed, p.speed_ramp_time)
+    if drive == "locked":
+        return locked_drive()
+    if drive == "position":
+        return position_drive()
+    raise ConfigError(f"drive = {drive!r} is not allowed: choose 'ramp', 'locked' or 'position'")
+
+
+def _add_main_bearing(reducer, p, main_bearing, ring_options, ball_inertia, members, groups, info) -> None:
+    """Insert the main bearing's group (and the balls' members) before the loads: the
+    rigid 5-DOF element, or the ball-resolved bearing with rigid (``balls``) or reduced
+    flexible rings (``flexible``; see :func:`build_rigid`)."""
+    if main_bearing == "rigid":
+        from flexrv.model.main_bearing_rigid import RigidMainBearing
+
+        if ball_inertia is not None:
+            raise ConfigError(
+                f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
+                f"applies to the ball-resolved bearing (model 'balls' or 'flexible')"
+            )
+        groups.insert(4, RigidMainBearing(p))
+    elif main_bearing in ("balls", "flexible"):
+        from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
+
+        rings = {}
+        if main_bearing == "flexible":
+            from flexrv.model.flexible_bearing import flexible_rings
+
+            rings = flexible_rings(
+                reducer, **check_options("ring_options", ring_options, signature_options(flexible_rings, skip=1))
+            )
+            info["flexible_bodies"] = rings["bodies"]
+            info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
+        if ball_inertia is None:  # quasi-static balls unless a condensed ring couples them (see the docstring)
+            ball_inertia = any(
+                r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or []
+            )
+        group = BallBearingGroup(
+            rows_from_design(
+                reducer, inner=rings.get("inner"), outer=rings.get("outer"), ball_inertia=bool(ball_inertia)
+            )
+        )
+        info["ball_inertia"] = bool(ball_inertia)
+        members.update(group.new_members())
+        groups.insert(4, group)
+    else:
+        raise ConfigError(f"main_bearing = {main_bearing!r} is not allowed: choose 'rigid', 'balls' or 'flexible'")
+
+
 def build_rigid(
     reducer,
     drive: str = "ramp",
@@ -106,8 +161,7 @@ def build_rigid(
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
     from flexrv.model.gear_stage import GearMeshes
-    from flexrv.model.loads import OutputLoads, locked_drive, position_drive, ramp_drive, step_torque
-    from flexrv.model.main_bearing_rigid import RigidMainBearing
+    from flexrv.model.loads import OutputLoads, step_torque
     from flexrv.model.parameters import rigid_parameters, with_bodies
     from flexrv.model.pins import PinContacts
 
@@ -117,14 +171,7 @@ def build_rigid(
             raise ConfigError(f"bodies = {','.join(bad)} is not allowed: choose from {', '.join(BODY_PARTS)}")
         reducer = with_bodies(reducer, bodies)
     p = rigid_parameters(reducer)
-    if drive == "ramp":
-        theta, omega = ramp_drive(p.input_speed, p.speed_ramp_time)
-    elif drive == "locked":
-        theta, omega = locked_drive()
-    elif drive == "position":  # quasi-static: the 'time' argument is the input angle itself
-        theta, omega = position_drive()
-    else:
-        raise ConfigError(f"drive = {drive!r} is not allowed: choose 'ramp', 'locked' or 'position'")
+    theta, omega = _drive(p, drive)
     if torque is None:
         torque = step_torque(p.load_torque, *p.load_ramp)
     nb_model = reducer.needle_bearing.model
@@ -144,39 +191,7 @@ def build_rigid(
     ]
     members = _members(p)
     info: dict = {}
-    if main_bearing == "rigid":
-        if ball_inertia is not None:
-            raise ConfigError(
-                f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
-                f"applies to the ball-resolved bearing (model 'balls' or 'flexible')"
-            )
-        groups.insert(4, RigidMainBearing(p))
-    elif main_bearing in ("balls", "flexible"):
-        from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
-
-        rings = {}
-        if main_bearing == "flexible":
-            from flexrv.model.flexible_bearing import flexible_rings
-
-            rings = flexible_rings(
-                reducer, **check_options("ring_options", ring_options, signature_options(flexible_rings, skip=1))
-            )
-            info["flexible_bodies"] = rings["bodies"]
-            info["ring_lowest_mode_hz"] = rings["lowest_mode_hz"]
-        if ball_inertia is None:  # quasi-static balls unless a condensed ring couples them (see the docstring)
-            ball_inertia = any(
-                r is not None and r.condensed for side in ("inner", "outer") for r in rings.get(side) or []
-            )
-        group = BallBearingGroup(
-            rows_from_design(
-                reducer, inner=rings.get("inner"), outer=rings.get("outer"), ball_inertia=bool(ball_inertia)
-            )
-        )
-        info["ball_inertia"] = bool(ball_inertia)
-        members.update(group.new_members())
-        groups.insert(4, group)
-    else:
-        raise ConfigError(f"main_bearing = {main_bearing!r} is not allowed: choose 'rigid', 'balls' or 'flexible'")
+    _add_main_bearing(reducer, p, main_bearing, ring_options, ball_inertia, members, groups, info)
     if crankshaft == "flexible":
         from flexrv.model.flexible_crank import add_flexible_cranks
 

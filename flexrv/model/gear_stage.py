@@ -68,7 +68,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.analysis.mesh_stiffness import mesh_stiffness_ramped
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.units import TWO_PI
 
@@ -211,6 +211,7 @@ class GearMeshes(KernelGroup):
 
     name = "gear_stage"
     kind = "gear"
+    summary_rows = (SummaryRow("max_mesh_force_N", "N", "largest sun-planet mesh force", "mesh_force", "max"),)
     kernel = staticmethod(gear_stage_kernel)
     time_field = "drive"
 
@@ -240,9 +241,7 @@ class GearMeshes(KernelGroup):
             ph_sun=sun[1],
             s_t=0.0,
         )
-        self.set_planet_torsion(
-            getattr(p, "crank_torsion_compliance", 0.0) + getattr(p, "planet_spline_compliance", 0.0)
-        )
+        self.set_planet_torsion(p.crank_torsion_compliance + p.planet_spline_compliance)
         #: (N, 3): planet runout amplitude [m], phase [rad], assembly phase error [rad]
         self.planet = np.ascontiguousarray(
             np.column_stack(

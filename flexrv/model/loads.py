@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _step_and_slope, adams_step
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, pack_type
 
 #: :func:`loads_kernel`'s pack: the carrier's 6 indices and the generalized load vector at t
@@ -117,6 +117,7 @@ class OutputLoads(KernelGroup):
 
     name = "loads"
     kind = "loads"
+    summary_rows = (SummaryRow("mean_load_torque_Nm", "N m", "mean load torque on the output", "load_torque", "mean"),)
     kernel = staticmethod(loads_kernel)
     time_field = "load"
     members = ("carrier",)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, pack_type
 
 #: :func:`main_bearing_kernel`'s pack: the carrier's 6 indices, diagonal stiffness and damping, reaction
@@ -46,6 +46,15 @@ class RigidMainBearing(KernelGroup):
 
     name = "main_bearing"
     kind = "main_bearing"
+    summary_rows = (
+        SummaryRow(
+            "max_main_bearing_radial_force_N",
+            "N",
+            "largest radial main-bearing reaction",
+            "main_bearing_radial_force",
+            "max",
+        ),
+    )
     kernel = staticmethod(main_bearing_kernel)
     members = ("carrier",)
 

@@ -131,13 +131,14 @@ time histories (outputs) evaluate every gap exactly.
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.geometry.cycloid import _FOOT, closest_point_settings
-from flexrv.model.base import KernelGroup, Output
+from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
@@ -186,14 +187,17 @@ PinPack = pack_type(
     ("pw", (_F, 2)),
     ("ctr", (_I, (4,))),
 )
+#: the pin housing's torsional compliance c_h [rad/(N m)] (0: rigid housing)
+HousingLaw = law_type("HousingLaw", compliance=float)
 #: :func:`pin_body_kernel`'s pack: the pins' pack, rim compliance (n_discs, 3, 3) (empty: rigid
-#: discs), rim offsets (n_discs, 3), housing state (c_h, phi_h, per disc -phi_h a_k), the local
-#: rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
+#: discs), rim offsets (n_discs, 3), the housing's law and state (c_h, phi_h, per disc -phi_h a_k;
+#: written), the local rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
 PinBodyPack = pack_type(
     "PinBodyPack",
     ("pins", PinPack),
     ("disc_c", (_F, 3)),
     ("dstate", (_F, 2)),
+    ("housing_law", HousingLaw),
     ("housing", (_F, 1)),
     ("idx_rim", (_I, 1)),
     ("work", (_F, 1)),
@@ -432,91 +436,88 @@ def pin_work_size(m: int) -> int:
 @njit(cache=True)
 def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     """The pins' kernel with elastic disc bodies and/or the elastic housing (module
-    docstring, "Disc body", "Housing"). ``pack`` = (pin_kernel's pack, cd, dstate, hs,
-    idx_rim = 0..3 n_discs - 1, wk): cd (n_discs, 3, 3) the rim
-    compliance of each disc (empty: rigid discs), dstate (n_discs, 3) the rim
-    offsets delta (x, y, psi) of the last call (output), hs the housing's (c_h,
-    phi_h, ...), wk the condensation's work array (:func:`_pin_condensed_kernel`).
+    docstring, "Disc body", "Housing"). ``pack`` (:data:`PinBodyPack`): the pin kernel's
+    pack, ``disc_c`` (n_discs, 3, 3) the rim compliance of each disc (empty: rigid discs),
+    ``dstate`` (n_discs, 3) the rim offsets delta (x, y, psi) of the last call (output),
+    ``housing_law.compliance`` c_h, ``housing`` the housing's state (c_h, phi_h, ...;
+    written), ``work`` the condensation's work array (:func:`_pin_condensed_kernel`).
     Rigid discs and a rigid housing (c_h = 0): a plain :func:`pin_kernel` call."""
-    pins, cd, hs = pack.pins, pack.disc_c, pack.housing
-    if cd.shape[0] == 0 and not (hs.shape[0] > 0 and hs[0] > 0.0):
+    pins, cd, ch = pack.pins, pack.disc_c, pack.housing_law.compliance
+    if cd.shape[0] == 0 and not ch > 0.0:
         pin_kernel(q, v, f, jq, jv, jac, pins)
         return
     # the pin kernel's pack on the local rim coordinates (built here: one array to unbox, not sixteen)
-    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, PinPack(pack.idx_rim, *pins[1:]), cd, pack.dstate, hs, pack.work)
+    pins_loc = PinPack(pack.idx_rim, *pins[1:])
+    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, pack.dstate, pack.housing, pack.work)
 
 
-@njit(cache=True)
-def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, wk):
-    """The rim condensation (module docstring, "Disc body", "Housing"): the pins act
-    on the rim poses q_r = q_hub + delta of all discs, delta = C(q) Q(q_r, v), C =
-    blockdiag(C_d,k) + c_h A A^T (cd empty: rigid disc bodies; c_h = 0: the discs
-    decouple), A stacking a_k = (-y_k, x_k, 1) at the hub centres. Local Newton on
-    the 3 n_discs offsets, R = delta - C Q, dR/d(delta) = I - C J (J = dQ/dq from
-    :func:`pin_kernel`, evaluated on the local rim coordinates: no n x n arrays),
-    step halving on max|R| (x, y [m]; psi times R_p), the last correction applied
-    linearised (Q + J d(delta), exact to O(|R|^2)). Condensed Jacobians, with N =
-    (I - C J)^-1: dQ_eff/dq = J N (I + D) (= (I - J C)^-1 J (I + D)), D = d(C Q)/dq
-    at fixed Q = c_h (dA/dq (A^T Q) + A (dA/dq)^T Q) (a_k follows the hub centre),
-    and dQ_eff/dv = (I + J N C) J_v (= (I - J C)^-1 J_v; the rim's velocity is the
-    hub's: the rate of delta is left out of the contact damping). phi_h = c_h M_h,
-    M_h = -A^T Q into hs[1], the housing's part -phi_h a_k of each rim offset into
-    hs[2 + 2 k], hs[3 + 2 k].
+#: views of the rim condensation's work array (:func:`_rim_views`, layout of :func:`pin_work_size`):
+#: st, the Newton state, 15 vectors (the last call's hub q, v, condensed force and rim offsets, the
+#: hub state, the local rim coordinates and forces, delta, the Newton's base, step and residual,
+#: a_k stacked, the condensed force, the norms' weights), 11 matrices (S_q, S_v, the condensed
+#: Jacobians, J, J_v, C, N, scratch, D, scratch)
+RimWork = namedtuple(
+    "RimWork",
+    "st nw qp vp qfc dlast qh vh ql fl delta base step res av qf weight sq sv jc jvc jl jvl cm nm tmp dd t2",
+)
 
-    Cost per call (in a run the pin-kernel evaluations are the
-    condensation's cost): the Newton starts from the first-order predictor delta_0 =
-    delta_prev + S_q dq_hub + S_v dv_hub with the previous call's condensed
-    sensitivities S_q = d(delta)/dq = C dQ_eff/dq + D, S_v = C dQ_eff/dv (used where
-    the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
-    restarting elsewhere, start from delta_prev), so the start's residual is second
-    order in the state change; it stops when max|R| <= tol (as before: 1e-10 of
-    max|delta|, at least 1e-15 m), so the records of the last evaluation (pin
-    forces, gaps) stay exact to that tolerance. Measured in a rv40e run: after a
-    Newton correction of the solver (|dq| ~ 1e-7) the predicted start is within ~3e-12
-    m of the solution (from delta_prev: ~5e-8), after a time step's rigid motion
-    (|dq| ~ 1.6e-4) within ~4e-9 m. A call at exactly the previous call's hub state (q,
-    v) and rim offsets (the solver's Jacobian after its residual) adds the stored
-    result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
-    holds st = (valid, -, -, -), the last call's hub q and v, its condensed force, its
-    rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[0] = 0
-    (reset, history pass) starts from dstate without the predictor."""
-    idx = pins.idx
-    r_p = pins.law.pin_circle_radius
-    nd = pins.profile.shape[0]
-    m = 3 * nd
+
+@njit(cache=True, inline="always")
+def _rim_views(wk, m):
+    """The named views of the rim condensation's work array for m local coordinates."""
     mm = m * m
-    ch = hs[0] if hs.shape[0] > 0 else 0.0
     st = wk[0:4]
     nw = wk[4 : 4 + NEWTON_STATE]
     o = 4 + NEWTON_STATE
     vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
-    qp, vp, qfc, dlast, qh, vh, ql = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6]
-    fl, delta, base, step, res, av, qf, weight = vec[7], vec[8], vec[9], vec[10], vec[11], vec[12], vec[13], vec[14]
     mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
-    sq, sv, jc, jvc, jl, jvl = mat[0], mat[1], mat[2], mat[3], mat[4], mat[5]
-    cm, nm, tmp, dd, t2 = mat[6], mat[7], mat[8], mat[9], mat[10]
+    return RimWork(
+        st, nw, vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7], vec[8], vec[9], vec[10], vec[11],
+        vec[12], vec[13], vec[14], mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7], mat[8], mat[9],
+        mat[10],
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _add_condensed(f, jq, jv, jac, idx, qf, jc, jvc):
+    """Add a condensed force qf and, with ``jac``, the condensed Jacobians at idx."""
+    m = qf.shape[0]
     for r in range(m):
-        qh[r], vh[r] = q[idx[r]], v[idx[r]]
+        f[idx[r]] += qf[r]
+    if jac:
+        for r in range(m):
+            for c in range(m):
+                jq[idx[r], idx[c]] += jc[r, c]
+                jv[idx[r], idx[c]] += jvc[r, c]
+
+
+@njit(cache=True, inline="always")
+def _rim_reuse(dstate, w):
+    """(valid, same): whether the previous call's predictor may be used (st[0] set and the
+    rim offsets not set from outside since) and whether this call is at its hub state."""
+    qh, st, dlast, qp, vh, vp = w.qh, w.st, w.dlast, w.qp, w.vh, w.vp
+    m = qh.shape[0]
     valid = st[0] > 0.0
     if valid:
         for r in range(m):
             if dstate[r // 3, r % 3] != dlast[r]:  # rim offsets set from outside: a fresh start from them
                 valid = False
+    same = valid
     if valid:
-        same = True
         for r in range(m):
             if qh[r] != qp[r] or vh[r] != vp[r]:
                 same = False
                 break
-        if same:  # the previous call's state: its result
-            for r in range(m):
-                f[idx[r]] += qfc[r]
-            if jac:
-                for r in range(m):
-                    for c in range(m):
-                        jq[idx[r], idx[c]] += jc[r, c]
-                        jv[idx[r], idx[c]] += jvc[r, c]
-            return
+    return valid, same
+
+
+@njit(cache=True, inline="always")
+def _rim_start(dstate, cd, ch, r_p, w):
+    """The rim compliance C = blockdiag(C_d,k) + c_h A A^T at the hub centres, the
+    Newton's start delta (the stored rim offsets) and its norms' weights."""
+    qh, av, cm, delta, weight = w.qh, w.av, w.cm, w.delta, w.weight
+    m = qh.shape[0]
+    nd = m // 3
     for kd in range(nd):
         av[3 * kd], av[3 * kd + 1], av[3 * kd + 2] = -qh[3 * kd + 1], qh[3 * kd], 1.0
     for r in range(m):
@@ -530,6 +531,19 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
     for r in range(m):
         delta[r] = dstate[r // 3, r % 3]
         weight[r] = r_p if r % 3 == 2 else 1.0  # max|R|, max|delta| over x, y [m] and psi times R_p
+
+
+@njit(cache=True, inline="always")
+def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
+    """The rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) =
+    I - C J, from the first-order predictor of the previous call (``valid``); the last
+    correction applied linearised (condensed force into w.qf, offsets into dstate) and the
+    housing's rotation and rim offsets into hs. Returns the pins' torque on the discs."""
+    qh, delta, step, qf, av, sq, qp, sv = w.qh, w.delta, w.step, w.qf, w.av, w.sq, w.qp, w.sv
+    vh, vp, weight, nw, ql, fl, jl, jvl = w.vh, w.vp, w.weight, w.nw, w.ql, w.fl, w.jl, w.jvl
+    cm, res, base, tmp, nm, dlast, qfc = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc
+    m = qh.shape[0]
+    nd = m // 3
     if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
         for r in range(m):
             acc = 0.0
@@ -559,11 +573,22 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
             hs[3 + 2 * kd] = -phi * av[3 * kd + 1]
     for r in range(m):
         delta[r] -= step[r]
-        f[idx[r]] += qf[r]
         dstate[r // 3, r % 3] = delta[r]
         dlast[r] = delta[r]
         qfc[r] = qf[r]
-    # condensed Jacobians (also the predictor's sensitivities and the repeated state's result)
+    return s
+
+
+@njit(cache=True, inline="always")
+def _rim_tangent(ch, s, w):
+    """The condensed Jacobians J N (I + D) and (I + J N C) J_v into w.jc, w.jvc, and the
+    predictor's sensitivities S_q = C dQ_eff/dq + D, S_v = C dQ_eff/dv with the hub
+    state they belong to (also the repeated state's result)."""
+    qh, dd, tmp, t2, av, qf, nm, jl = w.qh, w.dd, w.tmp, w.t2, w.av, w.qf, w.nm, w.jl
+    jc, cm, jvl, jvc, sq, sv, qp, vp = w.jc, w.cm, w.jvl, w.jvc, w.sq, w.sv, w.qp, w.vp
+    vh, st = w.vh, w.st
+    m = qh.shape[0]
+    nd = m // 3
     for r in range(m):
         for c in range(m):
             dd[r, c] = 0.0
@@ -593,11 +618,60 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, dstate, hs, 
         for c in range(m):
             sq[r, c] += dd[r, c]
     st[0] = 1.0
-    if jac:
-        for r in range(m):
-            for c in range(m):
-                jq[idx[r], idx[c]] += jc[r, c]
-                jv[idx[r], idx[c]] += jvc[r, c]
+
+
+@njit(cache=True)
+def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, hs, wk):
+    """The rim condensation (module docstring, "Disc body", "Housing"): the pins act
+    on the rim poses q_r = q_hub + delta of all discs, delta = C(q) Q(q_r, v), C =
+    blockdiag(C_d,k) + c_h A A^T (cd empty: rigid disc bodies; c_h = 0: the discs
+    decouple), A stacking a_k = (-y_k, x_k, 1) at the hub centres. Local Newton on
+    the 3 n_discs offsets, R = delta - C Q, dR/d(delta) = I - C J (J = dQ/dq from
+    :func:`pin_kernel`, evaluated on the local rim coordinates: no n x n arrays),
+    step halving on max|R| (x, y [m]; psi times R_p), the last correction applied
+    linearised (Q + J d(delta), exact to O(|R|^2)). Condensed Jacobians, with N =
+    (I - C J)^-1: dQ_eff/dq = J N (I + D) (= (I - J C)^-1 J (I + D)), D = d(C Q)/dq
+    at fixed Q = c_h (dA/dq (A^T Q) + A (dA/dq)^T Q) (a_k follows the hub centre),
+    and dQ_eff/dv = (I + J N C) J_v (= (I - J C)^-1 J_v; the rim's velocity is the
+    hub's: the rate of delta is left out of the contact damping). phi_h = c_h M_h,
+    M_h = -A^T Q into hs[1], the housing's part -phi_h a_k of each rim offset into
+    hs[2 + 2 k], hs[3 + 2 k].
+
+    Cost per call (in a run the pin-kernel evaluations are the
+    condensation's cost): the Newton starts from the first-order predictor delta_0 =
+    delta_prev + S_q dq_hub + S_v dv_hub with the previous call's condensed
+    sensitivities S_q = d(delta)/dq = C dQ_eff/dq + D, S_v = C dQ_eff/dv (used where
+    the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
+    restarting elsewhere, start from delta_prev), so the start's residual is second
+    order in the state change; it stops when max|R| <= tol (1e-10 of
+    max|delta|, at least 1e-15 m), so the records of the last evaluation (pin
+    forces, gaps) stay exact to that tolerance. Measured in a rv40e run: after a
+    Newton correction of the solver (|dq| ~ 1e-7) the predicted start is within ~3e-12
+    m of the solution (from delta_prev: ~5e-8), after a time step's rigid motion
+    (|dq| ~ 1.6e-4) within ~4e-9 m. A call at exactly the previous call's hub state (q,
+    v) and rim offsets (the solver's Jacobian after its residual) adds the stored
+    result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
+    holds st = (valid, -, -, -), the last call's hub q and v, its condensed force, its
+    rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[0] = 0
+    (reset, history pass) starts from dstate without the predictor.
+
+    Phases (each its own compiled function): the work array's views (:func:`_rim_views`),
+    the reuse test (:func:`_rim_reuse`), the compliance and start (:func:`_rim_start`),
+    the Newton (:func:`_rim_solve`), the condensed Jacobians (:func:`_rim_tangent`)."""
+    idx = pins.idx
+    m = 3 * pins.profile.shape[0]
+    w = _rim_views(wk, m)
+    qh, vh = w.qh, w.vh
+    for r in range(m):
+        qh[r], vh[r] = q[idx[r]], v[idx[r]]
+    valid, same = _rim_reuse(dstate, w)
+    if same:  # the previous call's state: its result
+        _add_condensed(f, jq, jv, jac, idx, w.qfc, w.jc, w.jvc)
+        return
+    _rim_start(dstate, cd, ch, pins.law.pin_circle_radius, w)
+    s = _rim_solve(valid, pins_loc, ch, dstate, hs, w)
+    _rim_tangent(ch, s, w)
+    _add_condensed(f, jq, jv, jac, idx, w.qf, w.jc, w.jvc)
 
 
 @functools.lru_cache(maxsize=64)
@@ -641,6 +715,9 @@ class PinContacts(KernelGroup):
 
     name = "pins"
     kind = "pins"
+    summary_rows = (
+        SummaryRow("min_pin_gap_m", "m", "smallest pin-profile gap (negative: penetration)", "pin_gap", "min"),
+    )
     kernel = staticmethod(pin_body_kernel)
     friction_outputs = ("pin_friction_power",)
     failure_message = "pin gap: closest-point iteration did not converge"
@@ -688,7 +765,7 @@ class PinContacts(KernelGroup):
         #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
         self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
         #: (n_discs, 3, 3) rim compliance of the elastic discs (pin_body_kernel); (0, 3, 3): rigid discs
-        self.disc_c = np.ascontiguousarray(getattr(p, "disc_compliance", np.zeros((0, 3, 3))), dtype=float)
+        self.disc_c = np.ascontiguousarray(p.disc_compliance, dtype=float)
         if self.disc_c.size and self.disc_c.shape != (self.nd, 3, 3):
             raise ValueError(f"disc_compliance has shape {self.disc_c.shape}, expected {(self.nd, 3, 3)}")
         if not self.disc_c.size:
@@ -696,9 +773,10 @@ class PinContacts(KernelGroup):
         self.dstate = np.zeros((self.nd, 3))
         #: housing (module docstring, "Housing"): (c_h [rad/(N m)], phi_h [rad], per disc the housing's part
         #: -phi_h a_k of the rim offset (x, y) [m]); c_h = 0: rigid housing
-        c_h = float(getattr(p, "housing_compliance", 0.0))
+        c_h = float(p.housing_compliance)
         if not (np.isfinite(c_h) and c_h >= 0.0):
             raise ValueError(f"housing_compliance = {c_h!r} must be a finite compliance >= 0 [rad/(N m)]")
+        self.housing_law = HousingLaw.of(compliance=c_h)
         self.hstate = np.zeros(2 + 2 * self.nd)
         self.hstate[0] = c_h
         #: the rim condensation's work array (_pin_condensed_kernel: predictor state, last result, scratch)
@@ -707,7 +785,7 @@ class PinContacts(KernelGroup):
 
     @property
     def elastic_housing(self) -> bool:
-        return self.hstate[0] > 0.0
+        return self.housing_law.compliance > 0.0
 
     @property
     def elastic_discs(self) -> bool:
@@ -744,7 +822,13 @@ class PinContacts(KernelGroup):
             ctr=ctr,
         )
         return PinBodyPack(
-            pins=pins, disc_c=self.disc_c, dstate=self.dstate, housing=self.hstate, idx_rim=self.idx_rim, work=work
+            pins=pins,
+            disc_c=self.disc_c,
+            dstate=self.dstate,
+            housing_law=self.housing_law,
+            housing=self.hstate,
+            idx_rim=self.idx_rim,
+            work=work,
         )
 
     @staticmethod

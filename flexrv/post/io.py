@@ -15,10 +15,13 @@ import numpy as np
 
 from flexrv.cache import atomic_path, atomic_write_text
 from flexrv.post.format import fmt as _fmt
+from flexrv.post.stats import summary_table
 
 
 def summary_markdown(res, summ: dict) -> str:
-    """summary.md: run info, kinematic validation table, TE statistics."""
+    """summary.md: run info, kinematic validation table, the run's summary keys
+    (:data:`flexrv.post.stats.SUMMARY_KEYS`, units from the declared outputs) and the force
+    elements' declared summary rows."""
     lines = [
         f"# Simulation {summ['preset']} ({summ['model']} model)",
         "",
@@ -46,25 +49,8 @@ def summary_markdown(res, summ: dict) -> str:
         "| quantity | value | unit |",
         "|---|---|---|",
     ]
-    for key, unit in (
-        ("te_min_arcsec", "arcsec"),
-        ("te_max_arcsec", "arcsec"),
-        ("te_pp_arcsec", "arcsec"),
-        ("te_mean_arcsec", "arcsec"),
-        ("te_rms_fluctuation_arcsec", "arcsec"),
-        ("max_pin_force_N", "N"),
-        ("pins_in_contact_mean", "-"),
-        ("pins_in_contact_max", "-"),
-        ("mean_input_power_W", "W"),
-        ("mean_output_power_W", "W"),
-        ("mean_dissipation_W", "W"),
-        ("efficiency", "-"),
-        ("mean_friction_power_W", "W"),
-        *((key, "W") for key in summ.get("friction_keys", ())),  # per group: the declared friction outputs
-    ):
-        if key not in summ:
-            continue
-        lines.append(f"| {key} | {_fmt(summ.get(key))} | {unit} |")
+    for key, value, unit in summary_table(summ):  # the listed keys of flexrv.post.stats.SUMMARY_KEYS
+        lines.append(f"| {key} | {_fmt(value)} | {unit} |")
     rows = summ.get("elements") or {}
     if rows:
         lines += ["", "## Force elements (steady window)", "", "| quantity | value | unit | description |"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -59,10 +60,9 @@ def summary(res) -> dict:
     te = sel["te"].values
     table = kinematic_table(res)
     ratio_sim = table[-1]["simulated"]
-    pin = sel["pin_force"].values if "pin_force" in sel else np.zeros((len(te), 1, 1))
-    in_contact = sel["pins_in_contact"].values if "pins_in_contact" in sel else np.zeros((len(te), 1))
-    p_in = float(np.mean(sel["power_in"].values)) if len(te) else float("nan")
-    p_out = float(np.mean(sel["power_out"].values)) if len(te) else float("nan")
+    window = _window_rows(sel, "window")
+    power = _window_rows(sel, "power")
+    p_in, p_out = power["mean_input_power_W"], power["mean_output_power_W"]
     ke = sel["kinetic_energy"].values
     tw = sel["time"].values
     dke = float((ke[-1] - ke[0]) / (tw[-1] - tw[0])) if len(te) > 1 and tw[-1] > tw[0] else 0.0
@@ -81,16 +81,8 @@ def summary(res) -> dict:
         "ratio_theoretical": float(res.attrs["ratio"]),
         "ratio_simulated": ratio_sim,
         "ratio_simulated_over_theoretical": ratio_sim / float(res.attrs["ratio"]),
-        "te_min_arcsec": float(te.min()) if finite else None,
-        "te_max_arcsec": float(te.max()) if finite else None,
-        "te_pp_arcsec": float(te.max() - te.min()) if finite else None,
-        "te_mean_arcsec": float(te.mean()) if finite else None,
-        "te_rms_fluctuation_arcsec": float(np.std(te)) if finite else None,
-        "max_pin_force_N": float(pin.max()) if finite else None,
-        "pins_in_contact_mean": float(np.mean(in_contact)) if finite else None,
-        "pins_in_contact_max": int(np.max(in_contact)) if finite else None,
-        "mean_input_power_W": p_in,
-        "mean_output_power_W": p_out,
+        **window,
+        **power,
         "mean_kinetic_energy_rate_W": dke,
         "mean_dissipation_W": balance["dissipation_W"],
         **efficiency_summary(sel, p_in, p_out),
@@ -98,34 +90,95 @@ def summary(res) -> dict:
         "notes": ([] if steady else [str(res.attrs.get("steady_note", "NOT STEADY"))]) + [balance["note"]],
         "kinematics": table,
         "failure": res.attrs.get("failure"),
-        **_bearing_summary(sel, finite),
+        **_window_rows(sel, "bearing"),
+        **_film_summary(sel, finite),
         "elements": element_summary(sel),
     }
     out["units"] = summary_units(res, out)
     return out
 
 
-#: summary key -> the result variable whose ``units`` attribute it carries
-_UNIT_SOURCE = {
-    "te_min_arcsec": "te",
-    "te_max_arcsec": "te",
-    "te_pp_arcsec": "te",
-    "te_mean_arcsec": "te",
-    "te_rms_fluctuation_arcsec": "te",
-    "max_pin_force_N": "pin_force",
-    "mean_input_power_W": "power_in",
-    "mean_output_power_W": "power_out",
-    "mean_dissipation_W": "power_in",
-    "mean_friction_power_W": "friction_power",
-    "mean_kinetic_energy_rate_W": "power_in",
-    "max_ball_load_N": "ball_load_inner",
-    "max_ring_deformation_m": "ring_deformation_outer",
-    "max_inner_ring_deformation_m": "ring_deformation_inner",
-    "max_ball_pressure_Pa": "ball_max_pressure",
-    "min_film_thickness_m": "ball_film_thickness",
-    "pins_in_contact_mean": "pins_in_contact",
-    "pins_in_contact_max": "pins_in_contact",
-}
+class SummaryKey(NamedTuple):
+    """One number of the run summary: its ``key`` (with the unit in the name where it has
+    one), the declared output it reads and whose ``units`` it carries (``source``; None:
+    dimensionless, "-"), the reduction over the steady window (``reduce``, a name of
+    :data:`_REDUCE`; "": computed by :func:`summary` from several outputs), a
+    ``description``, its ``group`` ("window": None on an empty window; "power": NaN on an
+    empty window; "bearing": only when its output exists and the window is not empty;
+    "derived": computed in :func:`summary`) and whether the run tables (summary.md, the
+    CLI) list it (``listed``)."""
+
+    key: str
+    source: str | None
+    reduce: str
+    description: str
+    group: str = "window"
+    listed: bool = True
+
+
+#: ONE table of the run summary's keys: :func:`summary` computes the rows with a reduction
+#: from it, :func:`summary_units` takes their units from it, summary.md
+#: (:func:`flexrv.post.io.summary_markdown`) and the CLI tables (:func:`summary_table`) list
+#: them from it. The force elements' own rows come from their declared ``summary_rows``
+#: (:func:`element_summary`, the summary's "elements").
+SUMMARY_KEYS = (
+    SummaryKey("te_min_arcsec", "te", "min", "smallest transmission error"),
+    SummaryKey("te_max_arcsec", "te", "max", "largest transmission error"),
+    SummaryKey("te_pp_arcsec", "te", "p2p", "transmission error peak-to-peak"),
+    SummaryKey("te_mean_arcsec", "te", "mean", "mean transmission error"),
+    SummaryKey("te_rms_fluctuation_arcsec", "te", "std", "RMS of the transmission error about its mean"),
+    SummaryKey("max_pin_force_N", "pin_force", "max", "largest pin-disc contact force"),
+    SummaryKey("pins_in_contact_mean", "pins_in_contact", "mean", "mean number of pins in contact per disc"),
+    SummaryKey("pins_in_contact_max", "pins_in_contact", "max_int", "largest number of pins in contact per disc"),
+    SummaryKey("mean_input_power_W", "power_in", "mean", "mean input power", "power"),
+    SummaryKey("mean_output_power_W", "power_out", "mean", "mean output power", "power"),
+    SummaryKey(
+        "mean_kinetic_energy_rate_W", "power_in", "", "mean rate of the kinetic energy", "derived", listed=False
+    ),
+    SummaryKey("mean_dissipation_W", "power_in", "", "P_in - P_out - dE_kin/dt", "derived"),
+    SummaryKey("efficiency", None, "", "mean output power / mean input power", "derived"),
+    SummaryKey("mean_friction_power_W", "friction_power", "", "mean dissipated friction power", "derived"),
+    SummaryKey("max_ball_load_N", "ball_load_inner", "max", "largest ball load", "bearing", listed=False),
+    SummaryKey(
+        "max_ring_deformation_m", "ring_deformation_outer", "max", "largest outer-ring deformation", "bearing", False
+    ),
+    SummaryKey(
+        "max_inner_ring_deformation_m",
+        "ring_deformation_inner",
+        "max",
+        "largest inner-ring deformation",
+        "bearing",
+        False,
+    ),
+    SummaryKey("max_ball_pressure_Pa", "ball_max_pressure", "max", "largest ball contact pressure", "bearing", False),
+    SummaryKey(
+        "min_film_thickness_m", "ball_film_thickness", "", "smallest film of the loaded balls", "derived", False
+    ),
+)
+
+
+def _window_rows(sel, group: str) -> dict:
+    """The values of the table's rows of ``group`` with a reduction over the window ``sel``."""
+    n = sel.sizes.get("time", 0)
+    out = {}
+    for row in SUMMARY_KEYS:
+        if row.group != group:
+            continue
+        if group == "bearing" and not (row.source in sel and n):
+            continue
+        if not n:
+            out[row.key] = float("nan") if group == "power" else None
+        elif row.source in sel:
+            out[row.key] = _REDUCE[row.reduce](np.asarray(sel[row.source].values))
+    return out
+
+
+def summary_table(summ: dict) -> list[tuple[str, object, str]]:
+    """(key, value, units) of the listed rows of :data:`SUMMARY_KEYS` present in a summary,
+    then its per-group friction keys: the rows of summary.md's table and the CLI tables."""
+    units = summ.get("units", {})
+    keys = [row.key for row in SUMMARY_KEYS if row.listed] + list(summ.get("friction_keys", ()))
+    return [(key, summ.get(key), units.get(key, "-")) for key in keys if key in summ]
 
 
 def efficiency_summary(sel, p_in: float, p_out: float) -> dict:
@@ -157,6 +210,8 @@ _REDUCE = {
     "max_abs": lambda a: float(np.max(np.abs(a))),
     "p2p": lambda a: float(np.max(a) - np.min(a)),
     "mean_sum": lambda a: float(np.mean(a.reshape(a.shape[0], -1).sum(axis=1))),
+    "std": lambda a: float(np.std(a)),
+    "max_int": lambda a: int(np.max(a)),
 }
 
 
@@ -180,14 +235,15 @@ def summary_units(res, summ: dict) -> dict:
     attributes (the model's declared outputs), not parsed from the key names; the steady
     window in the time coordinate's units, ratios dimensionless ("-")."""
     units = {}
-    sources = dict(_UNIT_SOURCE)
+    sources = {row.key: row.source for row in SUMMARY_KEYS}
     sources.update({f"mean_{name}_W": name for name in friction_variables(res.ds)})  # the declared friction outputs
     for key, var in sources.items():
         if key in summ and var in res.ds:
             units[key] = str(res.ds[var].attrs.get("units", ""))
     units["steady_window_s"] = str(res.ds["time"].attrs.get("units", "s"))
-    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical", "efficiency"):
+    for key in ("ratio_theoretical", "ratio_simulated", "ratio_simulated_over_theoretical"):
         units[key] = "-"
+    units.update({row.key: "-" for row in SUMMARY_KEYS if row.source is None and row.key in summ})
     return units
 
 
@@ -242,19 +298,10 @@ def power_balance(
     return {"dissipation_W": float(d), "note": note}
 
 
-def _bearing_summary(sel, finite: bool) -> dict:
-    """Steady-window extremes of the ball-resolved / flexible bearing outputs."""
-    out = {}
-    for key, var, fn in (
-        ("max_ball_load_N", "ball_load_inner", np.max),
-        ("max_ring_deformation_m", "ring_deformation_outer", np.max),
-        ("max_inner_ring_deformation_m", "ring_deformation_inner", np.max),
-        ("max_ball_pressure_Pa", "ball_max_pressure", np.max),
-    ):
-        if var in sel and finite:
-            out[key] = float(fn(sel[var].values))
-    if "ball_film_thickness" in sel and finite:
-        h = sel["ball_film_thickness"].values
-        loaded = sel["ball_load_inner"].values > 0
-        out["min_film_thickness_m"] = float(h[loaded].min()) if loaded.any() else None
-    return out
+def _film_summary(sel, finite: bool) -> dict:
+    """The smallest film thickness of the loaded balls over the window (ball-resolved bearing)."""
+    if "ball_film_thickness" not in sel or not finite:
+        return {}
+    h = sel["ball_film_thickness"].values
+    loaded = sel["ball_load_inner"].values > 0
+    return {"min_film_thickness_m": float(h[loaded].min()) if loaded.any() else None}

@@ -151,6 +151,102 @@ def hertz_and_life(reducer, res, max_force: float) -> dict:
     }
 
 
+#: the notes on the seed's stress and eccentricity results (text of the workflow's report)
+NOTES = (
+    (
+        "Stress: the seed applies each roller force as a point load through beam elements on a 1 mm hex mesh; a "
+        "point load's FE stress is singular (it grows with mesh refinement), and its six listed forces all act on "
+        "one side. flexrv spreads each roller's force over the eccentric's raceway nodes of that roller's angular "
+        "pitch (2 pi / Z) and its whole length, so its von Mises maximum is the structural (bending + shear) "
+        "stress of the shaft, found at the sharp, unfilleted shoulder next to a clamped support journal (a real "
+        "fillet lowers it); the local contact stress is the Hertz pressure reported separately (about 2 GPa, "
+        "normal for needle bearings and below the ~4 GPa static limit of bearing steel, ISO 76)."
+    ),
+    (
+        "Eccentricity: the tangential part of the crank-bearing load is T / (N n r_c), independent of the "
+        "eccentricity, so flexrv's max roller force changes by only ~10 % (and falls slightly) over the valid "
+        "range; the seed's +40 % from 1.0 to 2.0 mm is not supported by a torque balance. TE: flexrv's rigid "
+        "model has ideal profiles (no pitch errors), so its TE is the sub-arcsecond ripple of the mesh and "
+        "bearing compliances; the seed's 4.5-5.8 arcsec come from its ADAMS impact contacts (parameters not "
+        "given) and cannot be reproduced from the stated data."
+    ),
+)
+
+
+def _eccentricity_sweep(base, red, res, instant, stress, smoke, sweep, t_end, size) -> list[dict]:
+    """The eccentricity sweep's rows (the study's own eccentricity reuses its run ``res``, its
+    largest-load ``instant`` and ``stress``; an eccentricity without a valid disc is a row with its reason)."""
+    from flexrv.errors import ConfigError
+    from flexrv.simulation import Simulation
+
+    i, k, j = instant
+    sweep_rows = []
+    for ecc in SMOKE["sweep"] if smoke else (sweep or SWEEP):
+        seed_f, seed_s, seed_te = SEED_SWEEP.get(ecc, (None, None, None))
+        try:
+            red_e = _design(base, ecc)
+        except ConfigError as exc:
+            sweep_rows.append(
+                {
+                    "eccentricity [mm]": ecc,
+                    "valid": False,
+                    "max roller force [N]": None,
+                    "von Mises max [MPa]": None,
+                    "TE p-p [arcsec]": None,
+                    "seed force [N]": seed_f,
+                    "seed stress [MPa]": seed_s,
+                    "seed TE [arcsec]": seed_te,
+                    "note": str(exc).split("\n")[-1].strip(),
+                }
+            )
+            continue
+        if abs(ecc - red.second_stage.eccentricity_mm) < 1e-12:  # the study's own case: reuse run and FE solve
+            res_e, (ie, ke, _), st = res, (i, k, j), stress
+        else:
+            res_e = Simulation(red_e, model="rigid").run(t_end=t_end)
+            ie, ke, _ = max_load_instant(res_e)
+            st = crank_stress(red_e, res_e, ie, size=size)
+        te = res_e.steady("te").values
+        sweep_rows.append(
+            {
+                "eccentricity [mm]": ecc,
+                "valid": True,
+                "max roller force [N]": float(res_e["roller_force"].values[ie, 0, ke].max()),
+                "von Mises max [MPa]": 1e-6 * st["von_mises_max_Pa"],
+                "TE p-p [arcsec]": float(np.ptp(te)) if te.size else None,
+                "seed force [N]": seed_f,
+                "seed stress [MPa]": seed_s,
+                "seed TE [arcsec]": seed_te,
+                "note": "",
+            }
+        )
+    return sweep_rows
+
+
+def _figure(res, f, ang, i, k):
+    """Roller forces of crank 0 over time, at the largest-load instant, and vs contact direction."""
+    from matplotlib.ticker import MaxNLocator
+
+    fig, ax = new_figure(1, 3, figsize=(15, 4))
+    tt = res["roller_force"]["time"].values
+    for n in range(f.size):
+        ax[0].plot(tt, res["roller_force"].values[:, 0, k, n], lw=0.6)
+    ax[0].axvline(res.time[i], color="k", ls=":", label=f"instant of the middle and right panels, {res.time[i]:.4f} s")
+    ax[0].xaxis.set_major_locator(MaxNLocator(5))
+    ax[0].set_xlabel("time [s]")
+    ax[0].legend(loc="upper left", fontsize=7)
+    ax[0].set_ylabel(f"roller forces, crank 0 bearing {k} [N]")
+    ax[1].bar(np.arange(1, f.size + 1), f)
+    ax[1].set_xlabel("roller number")
+    ax[1].set_ylabel(f"force at t = {res.time[i]:.4f} s [N]")
+    ax[2].remove()
+    axp = fig.add_subplot(1, 3, 3, projection="polar")  # roller forces at their contact directions (housing frame)
+    axp.bar(ang, f, width=2.0 * np.pi / f.size * 0.8, bottom=0.0, alpha=0.8)
+    axp.set_title("roller force [N] vs contact direction", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
 def run(
     out_dir=None, smoke: bool = False, preset: str = PRESET, t_end: float | None = None, sweep=None
 ) -> WorkflowResult:
@@ -158,7 +254,6 @@ def run(
     import xarray as xr
 
     from flexrv.design import load
-    from flexrv.errors import ConfigError
     from flexrv.geometry.kinematics import reducer_kinematics
     from flexrv.simulation import Simulation
 
@@ -266,47 +361,7 @@ def run(
         "component of the pin-force resultant. The seed's table sums to ~39 kN of roller force on one bearing "
         "(all 15 rollers at 2.5-3.5 kN), which no torque balance of a 600 N m reducer supports",
     )
-    # ---- eccentricity sweep
-    sweep_rows = []
-    for ecc in SMOKE["sweep"] if smoke else (sweep or SWEEP):
-        seed_f, seed_s, seed_te = SEED_SWEEP.get(ecc, (None, None, None))
-        try:
-            red_e = _design(base, ecc)
-        except ConfigError as exc:
-            sweep_rows.append(
-                {
-                    "eccentricity [mm]": ecc,
-                    "valid": False,
-                    "max roller force [N]": None,
-                    "von Mises max [MPa]": None,
-                    "TE p-p [arcsec]": None,
-                    "seed force [N]": seed_f,
-                    "seed stress [MPa]": seed_s,
-                    "seed TE [arcsec]": seed_te,
-                    "note": str(exc).split("\n")[-1].strip(),
-                }
-            )
-            continue
-        if abs(ecc - red.second_stage.eccentricity_mm) < 1e-12:  # the study's own case: reuse run and FE solve
-            res_e, (ie, ke, _), st = res, (i, k, j), stress
-        else:
-            res_e = Simulation(red_e, model="rigid").run(t_end=t_end)
-            ie, ke, _ = max_load_instant(res_e)
-            st = crank_stress(red_e, res_e, ie, size=size)
-        te = res_e.steady("te").values
-        sweep_rows.append(
-            {
-                "eccentricity [mm]": ecc,
-                "valid": True,
-                "max roller force [N]": float(res_e["roller_force"].values[ie, 0, ke].max()),
-                "von Mises max [MPa]": 1e-6 * st["von_mises_max_Pa"],
-                "TE p-p [arcsec]": float(np.ptp(te)) if te.size else None,
-                "seed force [N]": seed_f,
-                "seed stress [MPa]": seed_s,
-                "seed TE [arcsec]": seed_te,
-                "note": "",
-            }
-        )
+    sweep_rows = _eccentricity_sweep(base, red, res, (i, k, j), stress, smoke, sweep, t_end, size)
     r.tables["eccentricity sweep (seed003: 1.0 / 1.5 / 2.0 mm; 1.2-1.4 mm added)"] = sweep_rows
     invalid = [row for row in sweep_rows if not row["valid"]]
     if invalid:
@@ -316,23 +371,7 @@ def run(
             + "; ".join(f"{row['eccentricity [mm]']} mm: {row['note']}" for row in invalid)
             + ". flexrv reports them instead of simulating an undercut or looping profile."
         )
-    r.text.append(
-        "Stress: the seed applies each roller force as a point load through beam elements on a 1 mm hex mesh; a "
-        "point load's FE stress is singular (it grows with mesh refinement), and its six listed forces all act on "
-        "one side. flexrv spreads each roller's force over the eccentric's raceway nodes of that roller's angular "
-        "pitch (2 pi / Z) and its whole length, so its von Mises maximum is the structural (bending + shear) "
-        "stress of the shaft, found at the sharp, unfilleted shoulder next to a clamped support journal (a real "
-        "fillet lowers it); the local contact stress is the Hertz pressure reported separately (about 2 GPa, "
-        "normal for needle bearings and below the ~4 GPa static limit of bearing steel, ISO 76)."
-    )
-    r.text.append(
-        "Eccentricity: the tangential part of the crank-bearing load is T / (N n r_c), independent of the "
-        "eccentricity, so flexrv's max roller force changes by only ~10 % (and falls slightly) over the valid "
-        "range; the seed's +40 % from 1.0 to 2.0 mm is not supported by a torque balance. TE: flexrv's rigid "
-        "model has ideal profiles (no pitch errors), so its TE is the sub-arcsecond ripple of the mesh and "
-        "bearing compliances; the seed's 4.5-5.8 arcsec come from its ADAMS impact contacts (parameters not "
-        "given) and cannot be reproduced from the stated data."
-    )
+    r.text.extend(NOTES)
     r.text.append(
         f"Preset eccentricity for this study: {red.second_stage.eccentricity_mm} mm (seed002's RV-40E data); "
         f"the FE crankshaft has {stress['n_nodes']} nodes (Tet10); the roller loads of both bearings of crank 0 "
@@ -349,26 +388,7 @@ def run(
     r.datasets["roller_forces"] = xr.Dataset(
         {"roller_force": res["roller_force"].isel(crank=0), "roller_angle": res["roller_angle"].isel(crank=0)}
     )
-    from matplotlib.ticker import MaxNLocator
-
-    fig, ax = new_figure(1, 3, figsize=(15, 4))
-    tt = res["roller_force"]["time"].values
-    for n in range(f.size):
-        ax[0].plot(tt, res["roller_force"].values[:, 0, k, n], lw=0.6)
-    ax[0].axvline(res.time[i], color="k", ls=":", label=f"instant of the middle and right panels, {res.time[i]:.4f} s")
-    ax[0].xaxis.set_major_locator(MaxNLocator(5))
-    ax[0].set_xlabel("time [s]")
-    ax[0].legend(loc="upper left", fontsize=7)
-    ax[0].set_ylabel(f"roller forces, crank 0 bearing {k} [N]")
-    ax[1].bar(np.arange(1, f.size + 1), f)
-    ax[1].set_xlabel("roller number")
-    ax[1].set_ylabel(f"force at t = {res.time[i]:.4f} s [N]")
-    ax[2].remove()
-    axp = fig.add_subplot(1, 3, 3, projection="polar")  # roller forces at their contact directions (housing frame)
-    axp.bar(ang, f, width=2.0 * np.pi / f.size * 0.8, bottom=0.0, alpha=0.8)
-    axp.set_title("roller force [N] vs contact direction", fontsize=9)
-    fig.tight_layout()
-    r.figures["roller_forces"] = fig
+    r.figures["roller_forces"] = _figure(res, f, ang, i, k)
     r.save(out_dir)
     return r
 

@@ -55,6 +55,130 @@ SMOKE = {"samples": 20, "what_if_samples": 4}
 TOP = 3
 
 
+def _figure(ds, rows, n):
+    """The two distributions with the published values, and the what-if bars."""
+    fig, axes = new_figure(1, 3, figsize=(15, 4.2))
+    for ax, key, ref, unit in (
+        (axes[0], "te_pp_arcsec", PUBLISHED_TE_PP_ARCSEC, "arcsec"),
+        (axes[1], "lost_motion_arcmin", CATALOG_LOST_MOTION_ARCMIN, "arcmin"),
+    ):
+        v = ds[key].values
+        v = v[np.isfinite(v)]
+        if v.size:
+            ax.hist(v, bins=max(5, min(50, 2 * int(np.sqrt(v.size)))), color="0.6")
+            for q, style in ((50.0, "-"), (95.0, "--"), (99.7, ":")):
+                ax.axvline(np.percentile(v, q), color="C0", ls=style, label=f"P{q:g}")
+        ax.axvline(ref, color="C3", lw=2, label="published" if key == "te_pp_arcsec" else "catalog limit")
+        ax.set_xlabel(f"{key} [{unit}]")
+        ax.set_ylabel("reducers")
+        ax.legend(fontsize=8)
+    ax = axes[2]
+    if rows:
+        names = [w["tolerance"] for w in rows][::-1]
+        pos = np.arange(len(names))
+        for off, key, color, label in (
+            (0.27, "p95_te_pp_arcsec_doubled", "C3", "doubled"),
+            (0.0, "p95_te_pp_arcsec", "0.5", "as drawn"),
+            (-0.27, "p95_te_pp_arcsec_halved", "C0", "halved"),
+        ):
+            ax.barh(pos + off, [w[key] or 0.0 for w in rows][::-1], height=0.25, color=color, label=label)
+        ax.set_yticks(pos, names)
+        ax.set_xlabel("P95 TE p-p [arcsec]")
+        ax.legend(fontsize=8)
+    ax.set_title("what if one tolerance is halved / doubled")
+    fig.suptitle(f"rv40e batch of {n} (ISO grade-5 tolerances)")
+    fig.tight_layout()
+    return fig
+
+
+def _ranking_text(top, ranking, src, fit, best, rows) -> str:
+    """The paragraph on the tolerances that matter most for TE p-p and what halving one does."""
+    strong = [row["tolerance"] for row in ranking[:TOP] if (row.get("src2") or 0.0) >= 0.01]
+    para = (
+        f"The tolerances that matter most for TE p-p: {', '.join(top)}"
+        + (
+            f" (SRC on the {src.get('best')} basis, R^2 {fit.get('r2', float('nan')):.2f}: the linear fit "
+            "explains that share of the variance)"
+            if fit
+            else ""
+        )
+        + f"; {len(strong)} of them reach{'es' if len(strong) == 1 else ''} an SRC^2 of 0.01"
+        + (f" ({', '.join(strong)})." if strong else ".")
+    )
+    if best is not None and best["p95_te_pp_arcsec"] is not None and best["p95_te_pp_arcsec_halved"] is not None:
+        para += (
+            f" Halving {best['tolerance']} alone moves P95 TE p-p from {best['p95_te_pp_arcsec']:.3g} to "
+            f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec (doubling: {best['p95_te_pp_arcsec_doubled']:.3g}) "
+            f"on the first {best['samples_used']} samples."
+        )
+    for w in rows:
+        lm3 = (
+            w.get("p50_lost_motion_arcmin_halved"),
+            w.get("p50_lost_motion_arcmin"),
+            w.get("p50_lost_motion_arcmin_doubled"),
+        )
+        if None in (w["yield"], w["yield_halved"], w["yield_doubled"], *lm3):
+            continue
+        if w["yield_halved"] < w["yield"] < w["yield_doubled"]:
+            para += (
+                f" Tightening {w['tolerance']} LOWERS the yield ({w['yield']:.2f} -> {w['yield_halved']:.2f}; "
+                f"doubled {w['yield_doubled']:.2f})"
+            )
+            if lm3[0] >= lm3[1] >= lm3[2]:
+                para += (
+                    f": the median lost motion goes {lm3[1]:.3g} -> {lm3[0]:.3g} arcmin (doubled {lm3[2]:.3g}), "
+                    "i.e. in this model larger errors of this kind take up clearance and lower the lost "
+                    "motion, which limits the yield."
+                )
+            else:
+                para += "."
+    return para
+
+
+def _add_tables(r, first, rows, pct) -> None:
+    """The tables: the tolerances that matter most (per output), the what-if rows, the distribution."""
+    for out_key, label in (("te_pp_arcsec", "TE p-p"), ("lost_motion_arcmin", "lost motion")):
+        r.tables[f"the tolerances that matter most for {label}"] = [
+            {
+                "rank": i + 1,
+                "tolerance": row["tolerance"],
+                "SRC^2": row.get("src2"),
+                "R^2 of the fit": row.get("r2"),
+                "method": row["method"],
+                "source": first["tolerances"].get(row["tolerance"], {}).get("source", ""),
+            }
+            for i, row in enumerate(first["ranked_sensitivities"].get(out_key, [])[:TOP])
+        ]
+    r.tables["what if (first M samples re-evaluated)"] = [
+        {
+            "tolerance": w["tolerance"],
+            "samples": w["samples_used"],
+            "P95 TE p-p [arcsec]": w["p95_te_pp_arcsec"],
+            "halved": w["p95_te_pp_arcsec_halved"],
+            "doubled": w["p95_te_pp_arcsec_doubled"],
+            "P50 lost motion [arcmin]": w.get("p50_lost_motion_arcmin"),
+            "LM halved": w.get("p50_lost_motion_arcmin_halved"),
+            "LM doubled": w.get("p50_lost_motion_arcmin_doubled"),
+            "yield": w["yield"],
+            "yield halved": w["yield_halved"],
+            "yield doubled": w["yield_doubled"],
+        }
+        for w in rows
+    ]
+    r.tables["distribution"] = [
+        {
+            "output": k,
+            "P50": p.get("P50"),
+            "P95": p.get("P95"),
+            "P99.7": p.get("P99.7"),
+            "mean": p.get("mean"),
+            "std": p.get("std"),
+            "samples": p.get("n"),
+        }
+        for k, p in pct.items()
+    ]
+
+
 def run(
     out_dir=None,
     smoke: bool = False,
@@ -134,49 +258,10 @@ def run(
         )
     src = first["sensitivity_src"].get("te_pp_arcsec", {})
     fit = src.get(src.get("best") or "", None) or {}
-    for out_key, label in (("te_pp_arcsec", "TE p-p"), ("lost_motion_arcmin", "lost motion")):
-        r.tables[f"the tolerances that matter most for {label}"] = [
-            {
-                "rank": i + 1,
-                "tolerance": row["tolerance"],
-                "SRC^2": row.get("src2"),
-                "R^2 of the fit": row.get("r2"),
-                "method": row["method"],
-                "source": first["tolerances"].get(row["tolerance"], {}).get("source", ""),
-            }
-            for i, row in enumerate(first["ranked_sensitivities"].get(out_key, [])[:TOP])
-        ]
     rows = [w for w in res["what_if"]["rows"] if w["tolerance"] in top]
-    r.tables["what if (first M samples re-evaluated)"] = [
-        {
-            "tolerance": w["tolerance"],
-            "samples": w["samples_used"],
-            "P95 TE p-p [arcsec]": w["p95_te_pp_arcsec"],
-            "halved": w["p95_te_pp_arcsec_halved"],
-            "doubled": w["p95_te_pp_arcsec_doubled"],
-            "P50 lost motion [arcmin]": w.get("p50_lost_motion_arcmin"),
-            "LM halved": w.get("p50_lost_motion_arcmin_halved"),
-            "LM doubled": w.get("p50_lost_motion_arcmin_doubled"),
-            "yield": w["yield"],
-            "yield halved": w["yield_halved"],
-            "yield doubled": w["yield_doubled"],
-        }
-        for w in rows
-    ]
+    _add_tables(r, first, rows, pct)
     # the nominal reducer (no errors) at the same resolution, for the lost-motion context
     nominal = te_task(load(PRESET), **DEFAULT_RESOLUTION)
-    r.tables["distribution"] = [
-        {
-            "output": k,
-            "P50": p.get("P50"),
-            "P95": p.get("P95"),
-            "P99.7": p.get("P99.7"),
-            "mean": p.get("mean"),
-            "std": p.get("std"),
-            "samples": p.get("n"),
-        }
-        for k, p in pct.items()
-    ]
     best = max(rows, key=lambda w: (w["p95_te_pp_arcsec"] or 0.0) - (w["p95_te_pp_arcsec_halved"] or 0.0), default=None)
     text = (
         f"{n} rv40e reducers drawn (scrambled Sobol', seed {seed}) from the ISO grade-5 tolerance set "
@@ -202,46 +287,7 @@ def run(
     )
     r.text.append(text)
     if top:
-        strong = [row["tolerance"] for row in ranking[:TOP] if (row.get("src2") or 0.0) >= 0.01]
-        para = (
-            f"The tolerances that matter most for TE p-p: {', '.join(top)}"
-            + (
-                f" (SRC on the {src.get('best')} basis, R^2 {fit.get('r2', float('nan')):.2f}: the linear fit "
-                "explains that share of the variance)"
-                if fit
-                else ""
-            )
-            + f"; {len(strong)} of them reach{'es' if len(strong) == 1 else ''} an SRC^2 of 0.01"
-            + (f" ({', '.join(strong)})." if strong else ".")
-        )
-        if best is not None and best["p95_te_pp_arcsec"] is not None and best["p95_te_pp_arcsec_halved"] is not None:
-            para += (
-                f" Halving {best['tolerance']} alone moves P95 TE p-p from {best['p95_te_pp_arcsec']:.3g} to "
-                f"{best['p95_te_pp_arcsec_halved']:.3g} arcsec (doubling: {best['p95_te_pp_arcsec_doubled']:.3g}) "
-                f"on the first {best['samples_used']} samples."
-            )
-        for w in rows:
-            lm3 = (
-                w.get("p50_lost_motion_arcmin_halved"),
-                w.get("p50_lost_motion_arcmin"),
-                w.get("p50_lost_motion_arcmin_doubled"),
-            )
-            if None in (w["yield"], w["yield_halved"], w["yield_doubled"], *lm3):
-                continue
-            if w["yield_halved"] < w["yield"] < w["yield_doubled"]:
-                para += (
-                    f" Tightening {w['tolerance']} LOWERS the yield ({w['yield']:.2f} -> {w['yield_halved']:.2f}; "
-                    f"doubled {w['yield_doubled']:.2f})"
-                )
-                if lm3[0] >= lm3[1] >= lm3[2]:
-                    para += (
-                        f": the median lost motion goes {lm3[1]:.3g} -> {lm3[0]:.3g} arcmin (doubled {lm3[2]:.3g}), "
-                        "i.e. in this model larger errors of this kind take up clearance and lower the lost "
-                        "motion, which limits the yield."
-                    )
-                else:
-                    para += "."
-        r.text.append(para)
+        r.text.append(_ranking_text(top, ranking, src, fit, best, rows))
     r.text.append(
         "Why the numbers can differ from a measurement: the range is one crank revolution (cost: the "
         "output revolution is 24x dearer per sample), the elastic bodies (carrier, discs, housing) enter as "
@@ -250,38 +296,7 @@ def run(
         "the tolerance set is a stated ISO grade (not a measured process), and a bench measures under its "
         "own load and speed. Nothing is tuned to the published values."
     )
-    # figures: the two distributions with the published values, the what-if bars
-    fig, axes = new_figure(1, 3, figsize=(15, 4.2))
-    for ax, key, ref, unit in (
-        (axes[0], "te_pp_arcsec", PUBLISHED_TE_PP_ARCSEC, "arcsec"),
-        (axes[1], "lost_motion_arcmin", CATALOG_LOST_MOTION_ARCMIN, "arcmin"),
-    ):
-        v = ds[key].values
-        v = v[np.isfinite(v)]
-        if v.size:
-            ax.hist(v, bins=max(5, min(50, 2 * int(np.sqrt(v.size)))), color="0.6")
-            for q, style in ((50.0, "-"), (95.0, "--"), (99.7, ":")):
-                ax.axvline(np.percentile(v, q), color="C0", ls=style, label=f"P{q:g}")
-        ax.axvline(ref, color="C3", lw=2, label="published" if key == "te_pp_arcsec" else "catalog limit")
-        ax.set_xlabel(f"{key} [{unit}]")
-        ax.set_ylabel("reducers")
-        ax.legend(fontsize=8)
-    ax = axes[2]
-    if rows:
-        names = [w["tolerance"] for w in rows][::-1]
-        pos = np.arange(len(names))
-        for off, key, color, label in (
-            (0.27, "p95_te_pp_arcsec_doubled", "C3", "doubled"),
-            (0.0, "p95_te_pp_arcsec", "0.5", "as drawn"),
-            (-0.27, "p95_te_pp_arcsec_halved", "C0", "halved"),
-        ):
-            ax.barh(pos + off, [w[key] or 0.0 for w in rows][::-1], height=0.25, color=color, label=label)
-        ax.set_yticks(pos, names)
-        ax.set_xlabel("P95 TE p-p [arcsec]")
-        ax.legend(fontsize=8)
-    ax.set_title("what if one tolerance is halved / doubled")
-    fig.suptitle(f"rv40e batch of {n} (ISO grade-5 tolerances)")
-    fig.tight_layout()
+    fig = _figure(ds, rows, n)
     r.figures["tolerance_study"] = fig
     r.datasets["samples"] = ds[[k for k in OUTPUTS] + ["x"]]
     r.numbers = {

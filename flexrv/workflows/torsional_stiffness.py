@@ -45,49 +45,18 @@ def _path_shares(res) -> dict:
     return {"elements": {k: d[k] for k in PATH_ELEMENTS if k in d}}
 
 
-def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=None, settle=None) -> WorkflowResult:
-    """:cite:`seed004` torsional-stiffness study for ``preset``; saves to ``results/torsional_stiffness``."""
-    import xarray as xr
-
-    from flexrv.analysis.pin_load import reducer_pin_loads
+def _meshing_zone(r, red, th, ktc, seed_ktc, factor):
+    """The meshing zone identified from the measured C_W (through the seed's derived C_c), into the
+    comparisons of ``r``; returns (second-stage stiffness, C_W, zones: seed 4 pins, seed free, flexrv)."""
     from flexrv.analysis.torsional import (
         SEED004_CC_NMM,
         SEED004_CW_NMM,
-        SEED004_KTC_NMM,
         identify_meshing_zone,
         required_mesh_stiffness,
         second_stage_stiffness,
-        seed004_pin_contributions,
     )
-    from flexrv.design import load
-    from flexrv.simulation import stiffness_test
-    from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
 
-    red = load(preset)
-    ss = red.second_stage
     t_rated = red.operating.rated_torque_Nm
-    r = WorkflowResult(
-        NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke
-    )
-
-    # ---- per-pin contributions
-    th, ktc = seed004_pin_contributions(red)
-    seed_ktc = SEED004_KTC_NMM * NMM
-    n = min(len(th), len(seed_ktc))
-    r.tables["per-pin equivalent torsional stiffness KTC_j [N m/rad]"] = [
-        {
-            "pin": j + 1,
-            "phase [deg]": float(np.degrees(th[j])),
-            "seed004": float(seed_ktc[j]),
-            "flexrv": float(ktc[j]),
-            "flexrv/seed": float(ktc[j] / seed_ktc[j]) if seed_ktc[j] > 0 else None,
-        }
-        for j in range(n)
-    ]
-    pos = seed_ktc[:n] > 0
-    factor = float(np.median(ktc[:n][pos] / seed_ktc[:n][pos]))
-
-    # ---- meshing zone from the measured C_W (through the seed's derived C_c)
     ss_st = second_stage_stiffness(red, t_rated)
     c_w = SEED004_CW_NMM * NMM
     c_c_seed = SEED004_CC_NMM * NMM
@@ -125,8 +94,14 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
         c_c_flexrv,
         f"flexrv's needle-bearing C_Hc = {ss_st.c_bearings:.4g} N m/rad at rated torque",
     )
+    return ss_st, c_w, z_seed4, z_seed, z_fx
 
-    # ---- pins in contact: analytic distribution
+
+def _pins_in_contact(r, red):
+    """The pins in contact at rated torque (analytic distribution, one disc): table and comparison."""
+    from flexrv.analysis.pin_load import reducer_pin_loads
+
+    ss, t_rated = red.second_stage, red.operating.rated_torque_Nm
     pl = reducer_pin_loads(red, t_rated)
     psi = 2 * np.pi * np.arange(ss.pin_count) / ss.pin_count
     idx = np.flatnonzero(pl.in_contact)
@@ -142,6 +117,89 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
         f"{pl.n_contact} ({seed_no.min()}-{seed_no.max()})",
         "analytic pin-load distribution with the design's clearance modification (Palmgren line contact)",
     )
+    return pl
+
+
+def _figure(th_n, seed_n, ktc_n, z_seed4, th, ang, tq, st):
+    """Per-pin stiffness (seed and flexrv, the seed table's zone) and the stiffness loop."""
+    fig, (a1, a2) = new_figure(1, 2, figsize=(11, 4))
+    a1.semilogy(np.degrees(th_n), seed_n, "o-", label="seed004")
+    a1.semilogy(np.degrees(th_n), ktc_n, "s-", label="flexrv")
+    a1.axvspan(
+        np.degrees(th[z_seed4.first - 1]),
+        np.degrees(th[z_seed4.last - 1]),
+        color="C0",
+        alpha=0.2,
+        label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}",
+    )
+    k_top = float(max(np.max(seed_n), np.max(ktc_n)))
+    a1.set_ylim(k_top * 1e-4, k_top * 3)  # 4 decades: the loaded pins, not the numerically unloaded ones
+    a1.set_xlabel("meshing phase [deg]"), a1.set_ylabel("pin stiffness KTC_j [N m/rad]"), a1.legend(fontsize=7)
+    a2.plot(ang, tq, lw=0.8)
+    a2.set_xlabel("twist [arcmin]"), a2.set_ylabel("output torque [N m]")
+    a2.set_title(
+        f"stiffness test: rigidity {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin,\n"
+        f"lost motion {st.lost_motion_arcmin:.3g} arcmin, hysteresis {st.hysteresis_arcmin:.3g} arcmin",
+        fontsize=9,
+    )
+    a2.grid(True, lw=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def _add_datasets(r, th_n, ktc_n, seed_n, time, tq, ang) -> None:
+    """The per-pin stiffness and the stiffness loop as datasets of ``r``."""
+    import xarray as xr
+
+    r.datasets["per_pin"] = xr.Dataset(
+        {
+            "ktc_flexrv": ("phase", ktc_n, {"units": "N m/rad"}),
+            "ktc_seed": ("phase", seed_n, {"units": "N m/rad"}),
+        },
+        coords={"phase": ("phase", np.degrees(th_n), {"units": "deg"})},
+    )
+    r.datasets["stiffness_loop"] = xr.Dataset(
+        {"torque": ("time", tq, {"units": "N m"}), "twist": ("time", ang, {"units": "arcmin"})},
+        coords={"time": ("time", time, {"units": "s"})},
+    )
+
+
+def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=None, settle=None) -> WorkflowResult:
+    """:cite:`seed004` torsional-stiffness study for ``preset``; saves to ``results/torsional_stiffness``."""
+
+    from flexrv.analysis.torsional import (
+        SEED004_KTC_NMM,
+        seed004_pin_contributions,
+    )
+    from flexrv.design import load
+    from flexrv.simulation import stiffness_test
+    from flexrv.units import ARCMIN_PER_RAD, RAD_PER_ARCMIN
+
+    red = load(preset)
+    r = WorkflowResult(
+        NAME, f"Torsional stiffness of the {red.name} second stage", ["004 (RV-40E torsional stiffness)"], smoke=smoke
+    )
+
+    # ---- per-pin contributions
+    th, ktc = seed004_pin_contributions(red)
+    seed_ktc = SEED004_KTC_NMM * NMM
+    n = min(len(th), len(seed_ktc))
+    r.tables["per-pin equivalent torsional stiffness KTC_j [N m/rad]"] = [
+        {
+            "pin": j + 1,
+            "phase [deg]": float(np.degrees(th[j])),
+            "seed004": float(seed_ktc[j]),
+            "flexrv": float(ktc[j]),
+            "flexrv/seed": float(ktc[j] / seed_ktc[j]) if seed_ktc[j] > 0 else None,
+        }
+        for j in range(n)
+    ]
+    pos = seed_ktc[:n] > 0
+    factor = float(np.median(ktc[:n][pos] / seed_ktc[:n][pos]))
+
+    ss_st, c_w, z_seed4, z_seed, z_fx = _meshing_zone(r, red, th, ktc, seed_ktc, factor)
+
+    pl = _pins_in_contact(r, red)
 
     # ---- stiffness test (contact simulation)
     test = dict(SMOKE_TEST if smoke else FULL_TEST)
@@ -229,40 +287,8 @@ def run(out_dir=None, smoke: bool = False, preset: str = PRESET, quarter_time=No
     )
 
     ang = -res["theta_out"].values * ARCMIN_PER_RAD
-    r.datasets["per_pin"] = xr.Dataset(
-        {
-            "ktc_flexrv": ("phase", ktc[:n], {"units": "N m/rad"}),
-            "ktc_seed": ("phase", seed_ktc[:n], {"units": "N m/rad"}),
-        },
-        coords={"phase": ("phase", np.degrees(th[:n]), {"units": "deg"})},
-    )
-    r.datasets["stiffness_loop"] = xr.Dataset(
-        {"torque": ("time", tq, {"units": "N m"}), "twist": ("time", ang, {"units": "arcmin"})},
-        coords={"time": ("time", res.time, {"units": "s"})},
-    )
-
-    fig, (a1, a2) = new_figure(1, 2, figsize=(11, 4))
-    a1.semilogy(np.degrees(th[:n]), seed_ktc[:n], "o-", label="seed004")
-    a1.semilogy(np.degrees(th[:n]), ktc[:n], "s-", label="flexrv")
-    a1.axvspan(
-        np.degrees(th[z_seed4.first - 1]),
-        np.degrees(th[z_seed4.last - 1]),
-        color="C0",
-        alpha=0.2,
-        label=f"zone (seed table) pins {z_seed4.first}-{z_seed4.last}",
-    )
-    k_top = float(max(np.max(seed_ktc[:n]), np.max(ktc[:n])))
-    a1.set_ylim(k_top * 1e-4, k_top * 3)  # 4 decades: the loaded pins, not the numerically unloaded ones
-    a1.set_xlabel("meshing phase [deg]"), a1.set_ylabel("pin stiffness KTC_j [N m/rad]"), a1.legend(fontsize=7)
-    a2.plot(ang, tq, lw=0.8)
-    a2.set_xlabel("twist [arcmin]"), a2.set_ylabel("output torque [N m]")
-    a2.set_title(
-        f"stiffness test: rigidity {st.rigidity_Nm_per_arcmin:.4g} N m/arcmin,\n"
-        f"lost motion {st.lost_motion_arcmin:.3g} arcmin, hysteresis {st.hysteresis_arcmin:.3g} arcmin",
-        fontsize=9,
-    )
-    a2.grid(True, lw=0.3)
-    fig.tight_layout()
+    _add_datasets(r, th[:n], ktc[:n], seed_ktc[:n], res.time, tq, ang)
+    fig = _figure(th[:n], seed_ktc[:n], ktc[:n], z_seed4, th, ang, tq, st)
     r.figures["stiffness"] = fig
     r.save(out_dir)
     return r
