@@ -174,11 +174,40 @@ def ball_load_distribution(
         u = np.where(free, 2.0 * d0 * np.sign(f_dir) * scale_u * (np.abs(f_dir) > 0), 0.0)
         if not np.any(u):
             u[2] = d0
+    u, kn, norm, it = _damped_newton(state, k_of, u, kn, free, (scale_u, scale_r), tol * load_scale, max_iter, big_a)
+    if not norm < tol * load_scale:
+        raise ConvergenceError(
+            f"ball_load_distribution: equilibrium residual {norm:.3g} N after {it} Newton "
+            f"iterations (load scale {load_scale:.3g} N); the load may not be supportable "
+            "by the selected rows/free directions"
+        )
+    res, jac, q, alpha, delta, row_f = state(u, kn)
+    idx = np.unravel_index(int(np.argmax(q)), q.shape)
+    return BallLoadResult(
+        displacement=u,
+        loads=q,
+        contact_angle=alpha,
+        approach=delta,
+        azimuth=psi,
+        stiffness_constant=kn,
+        max_load=float(q[idx]),
+        max_index=(int(idx[0]), int(idx[1])),
+        row_forces=row_f,
+        residual=float(np.max(np.abs(res[free]))),
+        iterations=it,
+    )
+
+
+def _damped_newton(state, k_of, u, kn, free, scales, tolerance: float, max_iter: int, big_a: float):
+    """Newton on the free displacements of :func:`ball_load_distribution` with steps
+    limited to 5 % of A and backtracking on the scaled residual, the contact stiffness
+    lagged by one iteration; returns (u, kn, residual norm, iterations)."""
+    scale_u, scale_r = scales
     res, jac, *_ = state(u, kn)
     norm = np.linalg.norm((res * scale_r)[free])
     it = 0
     for it in range(1, max_iter + 1):
-        if norm < tol * load_scale:
+        if norm < tolerance:
             break
         jf = (jac * scale_r[:, None])[np.ix_(free, free)]
         rf = (res * scale_r)[free]
@@ -206,27 +235,7 @@ def ball_load_distribution(
         kn = np.where(q_new > 0, k_of(alpha_new), kn)  # lag K_n(alpha)
         res, jac, *_ = state(u, kn)
         norm = np.linalg.norm((res * scale_r)[free])
-    if not norm < tol * load_scale:
-        raise ConvergenceError(
-            f"ball_load_distribution: equilibrium residual {norm:.3g} N after {it} Newton "
-            f"iterations (load scale {load_scale:.3g} N); the load may not be supportable "
-            "by the selected rows/free directions"
-        )
-    res, jac, q, alpha, delta, row_f = state(u, kn)
-    idx = np.unravel_index(int(np.argmax(q)), q.shape)
-    return BallLoadResult(
-        displacement=u,
-        loads=q,
-        contact_angle=alpha,
-        approach=delta,
-        azimuth=psi,
-        stiffness_constant=kn,
-        max_load=float(q[idx]),
-        max_index=(int(idx[0]), int(idx[1])),
-        row_forces=row_f,
-        residual=float(np.max(np.abs(res[free]))),
-        iterations=it,
-    )
+    return u, kn, norm, it
 
 
 def stribeck_max_load(radial_force, ball_count, contact_angle):

@@ -163,25 +163,9 @@ def pin_load_distribution(
     balances the torque.
     """
     torque = float(torque)
-    if not np.isfinite(torque):
-        raise InputError(f"torque = {torque!r} must be finite")
-    if width <= 0 or e_eff <= 0:
-        raise InputError(f"width = {width!r} and e_eff = {e_eff!r} must be > 0")
-    k, e = _law(law, width, e_eff)
-    if stiffness_constant is not None:
-        if law != "palmgren" or not (np.isfinite(stiffness_constant) and stiffness_constant > 0):
-            raise InputError(f"stiffness_constant = {stiffness_constant!r} needs law 'palmgren' and a value > 0")
-        k = float(stiffness_constant)
-    pins_h = pin_positions(z_rp, pin_circle_radius) if pins is None else np.asarray(pins, dtype=float)
-    radii = np.full(z_rp, float(pin_radius)) if pin_radii is None else np.asarray(pin_radii, dtype=float)
-    if pins_h.shape != (z_rp, 2) or radii.shape != (z_rp,):
-        raise InputError(
-            f"pins must have shape ({z_rp}, 2) and pin_radii ({z_rp},), got {pins_h.shape} and {radii.shape}"
-        )
-    if not (np.all(np.isfinite(pins_h)) and np.all(np.isfinite(radii)) and np.all(radii > 0)):
-        raise InputError("pins and pin_radii must be finite, pin_radii > 0")
-    if harmonics is not None:
-        harmonics = np.asarray(harmonics, dtype=float).reshape(-1, 3)
+    k, e, pins_h, radii, harmonics = _checked_inputs(
+        torque, z_rp, pin_circle_radius, pin_radius, width, e_eff, law, pins, pin_radii, harmonics, stiffness_constant
+    )
     profile = (d_radius, d_pin_radius, d_rotation)
     center, rot = nominal_disc_pose(z_rp, eccentricity, crank_angle)
     sign = 1.0 if torque >= 0 else -1.0
@@ -195,63 +179,10 @@ def pin_load_distribution(
         )
         return gap, normal, phi, p[:, 0] * normal[:, 1] - p[:, 1] * normal[:, 0]
 
-    # no-load pose: first contact, Newton steps on the exact gaps
-    gap, normal, phi, arms = state(0.0)
-    overlap = -float(np.min(gap))  # at the nominal pose
-    tiny = 1e-9 * pin_circle_radius
-    beta0 = 0.0
-    for _ in range(40):
-        sarm = sign * arms
-        # pins that the rotation moves towards the profile; a pin near the line of centres
-        # (arm -> 0) defines no rotation: its gap over its arm is round-off (or, under an
-        # interference fit, a step of radians), so the pose comes from the pins with a real arm
-        pos = sarm > max(tiny, FIRST_CONTACT_ARM_FRACTION * float(np.max(sarm)))
-        if not np.any(pos):
-            raise ConvergenceError("pin_load_distribution: no pin has a positive moment arm")
-        step = float(np.min(gap[pos] / sarm[pos]))
-        if abs(step) * pin_circle_radius <= GAP_RESOLUTION or abs(step) <= 1e-15 + 1e-12 * abs(beta0):
-            # the step moves no pin by more than the gaps are resolved: first contact found. In the
-            # degenerate pose of an unmodified profile every pin touches at once and the gaps are
-            # round-off of either sign, so the steps never fall below an absolute 1e-15 rad
-            break
-        beta0 += step
-        if abs(beta0) > 0.25 * 2.0 * np.pi / z_rp:
-            raise InputError(
-                f"pin_load_distribution: no no-load pose within a quarter pin pitch ({np.degrees(beta0):.3g} deg "
-                f"reached at crank angle {crank_angle:g} rad): the modifications or errors make the disc overlap "
-                "the pins on both sides (interference fit, largest overlap at the nominal pose "
-                f"{1e6 * overlap:.3g} um); "
-                "the initial-clearance method needs a clearance somewhere"
-            )
-        gap, normal, phi, arms = state(beta0, phi0=phi if abs(step) < 1e-3 else None)
-    else:
-        raise ConvergenceError(f"pin_load_distribution: no-load pose not found (last step {step:.3g} rad)")
+    beta0, (gap, normal, phi, arms) = _no_load_pose(state, sign, z_rp, pin_circle_radius, crank_angle)
     sarm = sign * arms
-
-    def approach(beta):
-        return sarm * (beta - beta0) - gap
-
-    def residual(beta):
-        w = np.maximum(approach(beta), 0.0)
-        return float(np.sum(k * w**e * sarm)) - abs(torque)
-
-    lo = beta0 - 1e-12 - abs(beta0) * 1e-12
-    if residual(lo) > 0:  # interference: pins already preloaded at beta0; search below
-        step = max(abs(beta0), 1e-6)
-        while residual(lo) > 0:
-            lo -= step
-            step *= 2
-            if step > 1.0:
-                raise ConvergenceError("pin_load_distribution: cannot bracket the disc rotation (preload too large)")
-    hi = max(beta0, lo) + 1e-6
-    step = 1e-6
-    while residual(hi) < 0:
-        hi += step
-        step *= 2
-        if step > 1.0:
-            raise ConvergenceError(f"pin_load_distribution: torque {torque:g} N m not reachable")
-    beta = brentq(residual, lo, hi, xtol=1e-18, rtol=4 * np.finfo(float).eps, maxiter=200)
-    w = approach(beta)
+    beta = _balancing_rotation(k, e, sarm, gap, beta0, torque)
+    w = sarm * (beta - beta0) - gap
     contact = w > 0
     wp = np.where(contact, w, 0.0)
     forces = k * wp**e
@@ -288,6 +219,91 @@ def pin_load_distribution(
         exponent=e,
         stiffness_constant=k,
     )
+
+
+def _checked_inputs(torque, z_rp, pin_circle_radius, pin_radius, width, e_eff, law, pins, pin_radii, harmonics, k_path):
+    """The law's constant and exponent and the actual pins, radii and harmonics of
+    :func:`pin_load_distribution`, checked (InputError naming what is wrong)."""
+    if not np.isfinite(torque):
+        raise InputError(f"torque = {torque!r} must be finite")
+    if width <= 0 or e_eff <= 0:
+        raise InputError(f"width = {width!r} and e_eff = {e_eff!r} must be > 0")
+    k, e = _law(law, width, e_eff)
+    if k_path is not None:
+        if law != "palmgren" or not (np.isfinite(k_path) and k_path > 0):
+            raise InputError(f"stiffness_constant = {k_path!r} needs law 'palmgren' and a value > 0")
+        k = float(k_path)
+    pins_h = pin_positions(z_rp, pin_circle_radius) if pins is None else np.asarray(pins, dtype=float)
+    radii = np.full(z_rp, float(pin_radius)) if pin_radii is None else np.asarray(pin_radii, dtype=float)
+    if pins_h.shape != (z_rp, 2) or radii.shape != (z_rp,):
+        raise InputError(
+            f"pins must have shape ({z_rp}, 2) and pin_radii ({z_rp},), got {pins_h.shape} and {radii.shape}"
+        )
+    if not (np.all(np.isfinite(pins_h)) and np.all(np.isfinite(radii)) and np.all(radii > 0)):
+        raise InputError("pins and pin_radii must be finite, pin_radii > 0")
+    if harmonics is not None:
+        harmonics = np.asarray(harmonics, dtype=float).reshape(-1, 3)
+    return k, e, pins_h, radii, harmonics
+
+
+def _no_load_pose(state, sign: float, z_rp: int, pin_circle_radius: float, crank_angle: float):
+    """The no-load rotation beta0 of first contact (Newton steps on the exact gaps of
+    ``state(beta, phi0)``) and the state there."""
+    gap, normal, phi, arms = state(0.0)
+    overlap = -float(np.min(gap))  # at the nominal pose
+    tiny = 1e-9 * pin_circle_radius
+    beta0 = 0.0
+    for _ in range(40):
+        sarm = sign * arms
+        # pins that the rotation moves towards the profile; a pin near the line of centres
+        # (arm -> 0) defines no rotation: its gap over its arm is round-off (or, under an
+        # interference fit, a step of radians), so the pose comes from the pins with a real arm
+        pos = sarm > max(tiny, FIRST_CONTACT_ARM_FRACTION * float(np.max(sarm)))
+        if not np.any(pos):
+            raise ConvergenceError("pin_load_distribution: no pin has a positive moment arm")
+        step = float(np.min(gap[pos] / sarm[pos]))
+        if abs(step) * pin_circle_radius <= GAP_RESOLUTION or abs(step) <= 1e-15 + 1e-12 * abs(beta0):
+            # the step moves no pin by more than the gaps are resolved: first contact found. In the
+            # degenerate pose of an unmodified profile every pin touches at once and the gaps are
+            # round-off of either sign, so the steps never fall below an absolute 1e-15 rad
+            return beta0, (gap, normal, phi, arms)
+        beta0 += step
+        if abs(beta0) > 0.25 * 2.0 * np.pi / z_rp:
+            raise InputError(
+                f"pin_load_distribution: no no-load pose within a quarter pin pitch ({np.degrees(beta0):.3g} deg "
+                f"reached at crank angle {crank_angle:g} rad): the modifications or errors make the disc overlap "
+                "the pins on both sides (interference fit, largest overlap at the nominal pose "
+                f"{1e6 * overlap:.3g} um); "
+                "the initial-clearance method needs a clearance somewhere"
+            )
+        gap, normal, phi, arms = state(beta0, phi0=phi if abs(step) < 1e-3 else None)
+    raise ConvergenceError(f"pin_load_distribution: no-load pose not found (last step {step:.3g} rad)")
+
+
+def _balancing_rotation(k: float, e: float, sarm, gap, beta0: float, torque: float) -> float:
+    """The rotation beta at which the pins' moments sum to ``|torque|`` (bracketed from the
+    no-load pose beta0, Brent's method to round-off)."""
+
+    def residual(beta):
+        w = np.maximum(sarm * (beta - beta0) - gap, 0.0)
+        return float(np.sum(k * w**e * sarm)) - abs(torque)
+
+    lo = beta0 - 1e-12 - abs(beta0) * 1e-12
+    if residual(lo) > 0:  # interference: pins already preloaded at beta0; search below
+        step = max(abs(beta0), 1e-6)
+        while residual(lo) > 0:
+            lo -= step
+            step *= 2
+            if step > 1.0:
+                raise ConvergenceError("pin_load_distribution: cannot bracket the disc rotation (preload too large)")
+    hi = max(beta0, lo) + 1e-6
+    step = 1e-6
+    while residual(hi) < 0:
+        hi += step
+        step *= 2
+        if step > 1.0:
+            raise ConvergenceError(f"pin_load_distribution: torque {torque:g} N m not reachable")
+    return brentq(residual, lo, hi, xtol=1e-18, rtol=4 * np.finfo(float).eps, maxiter=200)
 
 
 def disc_effective_modulus(reducer) -> float:
