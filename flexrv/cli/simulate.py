@@ -164,6 +164,9 @@ def simulate(
         "te_max_arcsec": s["te_max_arcsec"],
         "te_pp_arcsec": s["te_pp_arcsec"],
         "steady_window_s": s["steady_window_s"],
+        "steady": s["steady_state"],  # what summary.md says in words: its window is (NOT) STEADY, and why
+        "steady_reason": s["steady_note"],
+        "notes": s["notes"],
         "max_pin_force_N": s["max_pin_force_N"],
         "pins_in_contact_mean": s["pins_in_contact_mean"],
         "pins_in_contact_max": s["pins_in_contact_max"],
@@ -180,8 +183,13 @@ def simulate(
             data[key] = s[key]
 
     def render(d):
-        rows = [(*_label_unit(k), v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}") for k, v in d.items()]
+        shown = {k: v for k, v in d.items() if k not in ("steady_reason", "notes")}
+        rows = [
+            (*_label_unit(k), v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}") for k, v in shown.items()
+        ]
         console.print(kv_table(f"simulate {preset} ({model})", [(k, v, u) for k, u, v in rows]))
+        for note in d["notes"]:
+            console.print(f"note: {note}", style=None if d["steady"] else "yellow")
 
     emit(data, json, render)
     code = _exit_code(res)
