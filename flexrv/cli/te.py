@@ -57,6 +57,7 @@ def te(
         "--out",
         overwrite=overwrite,
     )
+    announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh)
     result = loaded_te(
         reducer,
         torque=torque_nm,
@@ -114,6 +115,28 @@ def te(
             console.print(uncertainty_table(d["uncertainty"]))
 
     emit(data, json, render)
+
+
+#: measured cost of the static solution per position [s] (loaded and no-load curves, outputs) and the
+#: fixed cost of a run (model, catalog points, files, figures) on one core (benchmarks/bench_te.py)
+SECONDS_PER_POSITION = 6e-4
+SECONDS_FIXED = 5.0
+
+
+def announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh: int) -> str:
+    """One line on stderr before the static solution: how many positions, what is solved,
+    how long it usually takes (:data:`SECONDS_PER_POSITION`)."""
+    import sys
+
+    from flexrv.model.quasi_static import positions_for
+
+    n = len(positions_for(reducer, output_revolutions, crank_revolutions, points_per_mesh))
+    line = (
+        f"flexrv te {reducer.name}: static equilibrium at {n} positions (loaded and no-load curves), "
+        f"catalog points, files and figures; usually ~{SECONDS_FIXED + SECONDS_PER_POSITION * n:.0f} s"
+    )
+    print(line, file=sys.stderr, flush=True)
+    return line
 
 
 def quasi_static_budget(summary: dict, outputs: dict, reducer):
