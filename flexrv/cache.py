@@ -426,11 +426,15 @@ def cached_entry(paths, key: str, load, build, enabled: bool = True):
 #: what a cache entry's build does, by the suffix of its first file (the notice of a first build)
 _BUILD_KINDS = {
     ".compliance.json": "condensing the {part} FE body (stiffness matrix and static condensation)",
+    ".patches.json": "condensing the {part} FE body at its pin contacts (one load case per contact patch)",
+    ".sweep.json": "condensing the {part} FE body for a sweep of load positions",
+    ".cms.npz": "reducing the {part} FE body to its modes (Craig-Bampton)",
     ".msh": "meshing the {part} (gmsh, second-order tetrahedra)",
 }
-#: typical first-build time [s] of an entry, by kind, on a 2-core machine (benchmarks/bench_first_run.py);
-#: the notice quotes the time this cache's own earlier builds of the kind took when it has them
-TYPICAL_BUILD_S = {".compliance.json": 30.0, ".msh": 10.0}
+#: typical first-build time [s] of an entry, by kind, on one core of a quiet 2-core machine (benchmarks/
+#: bench_bodies.py: a preset's carrier 12-13 s, disc 11-26 s with their meshes); the notice quotes the
+#: time this cache's own earlier builds of the kind took when it has them
+TYPICAL_BUILD_S = {".compliance.json": 10.0, ".patches.json": 15.0, ".sweep.json": 15.0, ".cms.npz": 15.0, ".msh": 4.0}
 #: file in the cache folder with the measured build time of each kind of entry
 BUILD_TIMES = "build_times.json"
 
