@@ -77,3 +77,31 @@ def test_te_summary_md_states_unconverged_positions(te_run):
     assert "did not converge" not in (out / "summary.md").read_text()
     text = te_summary_markdown({**saved, "unconverged_positions": 3}, load("rv40e"))
     assert "3 positions did not converge" in text
+
+
+def test_stiffness_test_json_carries_the_reading_summary_md_states():
+    """A synthetic linear loop with play (k = 100 N m/arcmin, +-0.5 arcmin of play, T_r = 400 N m):
+    the figures summary.md states beside the named ones (rated torque, fit range, lost-motion band
+    and its angles, hysteresis angles at T = 0) are in ``reading()``, the dict `flexrv stiffness-test
+    --json` prints, with the values summary.md writes (same attributes, 1e-12), and the lost-motion
+    angles at +-3 % T_r read -0.5 - 0.12 and 0.5 + 0.12 arcmin (closed form, 1e-9)."""
+    import numpy as np
+
+    from flexrv.post.stiffness import evaluate_stiffness_test, stiffness_summary_markdown
+    from flexrv.units import RAD_PER_ARCMIN
+
+    rated, k, play = 400.0, 100.0, 0.5
+    t = np.linspace(0.0, 4.0, 4001)
+    torque = rated * np.interp(t, [0.0, 1.0, 3.0, 4.0], [0.0, 1.0, -1.0, 0.0])
+    angle = (torque / k + play * np.sign(torque)) * RAD_PER_ARCMIN
+    fig = evaluate_stiffness_test(t, torque, angle, (0.0, 1.0, 3.0, 4.0))
+    reading = fig.reading()
+    assert not set(reading) & set(fig.named())
+    for key in ("rated_torque_Nm", "fit_range_low_Nm", "lost_motion_torque_Nm", "hysteresis_ascending_angle_arcmin"):
+        assert key in reading
+    assert reading["rated_torque_Nm"] == pytest.approx(rated, rel=1e-12)
+    assert reading["lost_motion_torque_Nm"] == pytest.approx(0.03 * rated, rel=1e-12)
+    assert reading["lost_motion_negative_angle_arcmin"] == pytest.approx(-(play + 0.03 * rated / k), rel=1e-9)
+    assert reading["lost_motion_positive_angle_arcmin"] == pytest.approx(play + 0.03 * rated / k, rel=1e-9)
+    md = stiffness_summary_markdown(fig, "synthetic", "rigid", 1.0, 1e-4, plot=None)
+    assert f"{reading['fit_range_low_Nm']:.4g}" in md and f"{reading['lost_motion_torque_Nm']:.3g}" in md

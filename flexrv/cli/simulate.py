@@ -236,7 +236,7 @@ def stiffness_test_cmd(
     finally:
         if bar:
             bar.stop()
-    data = {"output_dir": str(out), **fig.named(), "stiffness_budget": _budget(res)}
+    data = {"output_dir": str(out), **fig.named(), "reading": fig.reading(), "stiffness_budget": _budget(res)}
     if csv is not None:  # the loop in the measured-data format (flexrv.measured.writer)
         from flexrv.measured.writer import export_stiffness_test
 
@@ -252,7 +252,8 @@ def stiffness_test_cmd(
     def render(d):
         from flexrv.cli.design import budget_table
 
-        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in ("stiffness_budget", "uncertainty")]
+        skip = ("stiffness_budget", "uncertainty", "reading")
+        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in skip]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
         if "uncertainty" in d:
             from flexrv.cli.te import uncertainty_table
