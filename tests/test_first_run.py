@@ -133,3 +133,19 @@ def test_first_line_within_seconds_and_signal_while_building_bodies(tmp_path, si
     assert elapsed < 5.0, elapsed
     assert "Traceback" not in stderr
     assert not out.exists()
+
+
+def test_sigterm_inside_a_gmsh_session_reaches_python():
+    """gmsh's initialisation installs its own C handler of SIGTERM (the process then dies with
+    -15, no cleanup); inside flexrv's gmsh session Python's handler runs (exit 143 here)."""
+    code = (
+        "import os, signal, sys\n"
+        "signal.signal(signal.SIGTERM, lambda s, f: sys.exit(143))\n"
+        "from flexrv.meshing.session import gmsh_session\n"
+        "with gmsh_session():\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    signal.pause() if hasattr(signal, 'pause') else None\n"
+    )
+    env = {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 143, r.stderr[-2000:]
