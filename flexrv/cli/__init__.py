@@ -7,7 +7,7 @@ table by default. Any :class:`flexrv.errors.FlexrvError` and every usage error
 (unknown option or command, a value of the wrong type, a missing argument)
 becomes one clear message on stderr and exit code 2 — never a traceback. A bare
 ``flexrv`` (or a command that needs arguments, given none) prints the help on
-stderr and exits 2, like any other usage error. Ctrl-C / SIGTERM exit 130.
+stderr and exits 2, like any other usage error. Ctrl-C exits 130 and SIGTERM 143 in every phase.
 """
 
 from __future__ import annotations
