@@ -149,3 +149,28 @@ def test_sigterm_inside_a_gmsh_session_reaches_python():
     env = {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
     r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
     assert r.returncode == 143, r.stderr[-2000:]
+
+
+def test_te_reports_progress_of_both_curves():
+    """loaded_te's ``progress(stage, done, total)``: both curves report, counts rise to the number
+    of positions (every 256 positions and at the end), and the CLI's bar accepts them."""
+    from flexrv.cli.te import progress_bar
+    from flexrv.design import load
+    from flexrv.model.quasi_static import loaded_te
+
+    calls = []
+    r = loaded_te(
+        load("rv40e"),
+        crank_revolutions=1.0,
+        points_per_mesh=8,
+        catalog_positions=1,
+        progress=lambda stage, done, total: calls.append((stage, done, total)),
+    )
+    n = len(r.input_angle)
+    assert n == 312
+    assert calls == [(stage, done, n) for stage in ("loaded curve", "no-load curve") for done in (256, n)]
+    bar = progress_bar(True)
+    for call in calls:
+        bar(*call)
+    bar.stop()
+    assert progress_bar(False) is None

@@ -58,14 +58,20 @@ def te(
         overwrite=overwrite,
     )
     announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh)
-    result = loaded_te(
-        reducer,
-        torque=torque_nm,
-        output_revolutions=output_revolutions,
-        crank_revolutions=crank_revolutions,
-        points_per_mesh=points_per_mesh,
-        play_fractions=PLAY_FRACTIONS,
-    )
+    bar = progress_bar(not json)
+    try:
+        result = loaded_te(
+            reducer,
+            torque=torque_nm,
+            output_revolutions=output_revolutions,
+            crank_revolutions=crank_revolutions,
+            points_per_mesh=points_per_mesh,
+            play_fractions=PLAY_FRACTIONS,
+            progress=bar,
+        )
+    finally:
+        if bar is not None:
+            bar.stop()
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)
     budget = quasi_static_budget(summary, result.outputs, reducer)
@@ -137,6 +143,36 @@ def announce_positions(reducer, output_revolutions, crank_revolutions, points_pe
     )
     print(line, file=sys.stderr, flush=True)
     return line
+
+
+def progress_bar(enabled: bool):
+    """A rich progress bar on stderr of the curves' positions (``progress(stage, done, total)`` of
+    :func:`flexrv.model.quasi_static.loaded_te`), one task per curve; None if not ``enabled``
+    (``--json``). Rich draws it only on a terminal; ``.stop()`` ends it."""
+    if not enabled:
+        return None
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    tasks = {}
+
+    def report(stage: str, done: int, total: int) -> None:
+        if not tasks:
+            bar.start()
+        if stage not in tasks:
+            tasks[stage] = bar.add_task(stage, total=total)
+        bar.update(tasks[stage], completed=done)
+
+    report.stop = bar.stop
+    return report
 
 
 def quasi_static_budget(summary: dict, outputs: dict, reducer):

@@ -499,7 +499,12 @@ def positions_for(
 
 
 def equilibrium_path(
-    sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, max_failed_fraction: float = 0.01, periodic: bool = False
+    sm: StaticModel,
+    angles: np.ndarray,
+    q_start: np.ndarray,
+    max_failed_fraction: float = 0.01,
+    periodic: bool = False,
+    progress=None,
 ):
     """Solve every position; each is warm-started from the previous solution
     advanced by the nominal kinematic increment (measured: 2 Newton iterations
@@ -509,7 +514,7 @@ def equilibrium_path(
     the solution one crank revolution earlier (:func:`_periodic_image`) while such starts are
     equilibria already (zero iterations: one residual call per position); the first that is
     not ends them (as-built errors that break the symmetry). Every position is still solved
-    to the same tolerance.
+    to the same tolerance. ``progress(done, total)`` is called every 256 positions and at the end.
     A position that neither its warm start nor a restart from the kinematic pose
     (:func:`_restart`) converges is returned as NaN with iterations -1; more than
     ``max_failed_fraction`` of such positions raise ConvergenceError.
@@ -537,6 +542,8 @@ def equilibrium_path(
         if imaged and its[k] > 0:
             image = None
         last = k
+        if progress is not None and (k % 256 == 255 or k == len(angles) - 1):
+            progress(k + 1, len(angles))
     failed = int(np.sum(its < 0))
     if failed > max_failed_fraction * len(angles):
         raise ConvergenceError(
@@ -675,6 +682,8 @@ def loaded_te(
     is read too (catalog ``play_positions_rad``; the geometric backlash's extrapolation,
     :mod:`flexrv.post.definitions`). ``torque`` [N m] defaults to the design's rated torque; it must be positive and
     at most 3x the rated torque (beyond that the Hertz laws leave their range).
+    ``progress(stage, done, total)``: called while the curves are solved (stage "loaded curve" /
+    "no-load curve", positions done of total).
     """
     from flexrv.model.base import Output
 
@@ -702,12 +711,13 @@ def loaded_te(
     except ConvergenceError:
         pass  # nothing touches (clearances everywhere): the load ramp closes them
     q_load = ramp_to(sm, angles[0], q0, torque, steps=8)
-    qs, its = equilibrium_path(sm, angles, q_load)
+    stage = (lambda name: lambda done, total: progress(name, done, total)) if progress is not None else None
+    qs, its = equilibrium_path(sm, angles, q_load, progress=stage and stage("loaded curve"))
     # no-load curve
     t_small = no_load_fraction * rated
     sm.torque = torque
     q_small = ramp_to(sm, angles[0], qs[0], t_small)
-    qs_nl, its_nl = equilibrium_path(sm, angles, q_small, periodic=True)
+    qs_nl, its_nl = equilibrium_path(sm, angles, q_small, periodic=True, progress=stage and stage("no-load curve"))
     ratio = sm.p.ratio
     th_out = qs[:, sm.i_theta]
     te = th_out - angles / ratio
