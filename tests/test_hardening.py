@@ -348,6 +348,7 @@ def test_failed_evaluations_exit_nonzero_with_the_count(monkeypatch, capsys):
             "skipped_existing": 0,
             "failed": 3,
             "wall_time_s": 0.1,
+            "resolution": {},
             "percentiles": {},
             "yield": None,
             "ranked_sensitivities": {},
