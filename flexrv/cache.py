@@ -17,6 +17,7 @@ import math
 import os
 import re
 import tempfile
+import time
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -412,9 +413,77 @@ def cached_entry(paths, key: str, load, build, enabled: bool = True):
             return value, True
         if problem != "missing":
             cache_notice(paths[0], problem)
+        elif _entry_kind(paths[0])[1]:  # a known kind of slow build (an FE body, a mesh)
+            build_notice(paths[0])
+        t0 = time.perf_counter()
         value = build()
         stamp_entry(paths, key)
+        if _entry_kind(paths[0])[1]:
+            record_build_time(paths[0], time.perf_counter() - t0)
     return value, False
+
+
+#: what a cache entry's build does, by the suffix of its first file (the notice of a first build)
+_BUILD_KINDS = {
+    ".compliance.json": "condensing the {part} FE body (stiffness matrix and static condensation)",
+    ".patches.json": "condensing the {part} FE body at its pin contacts (one load case per contact patch)",
+    ".sweep.json": "condensing the {part} FE body for a sweep of load positions",
+    ".cms.npz": "reducing the {part} FE body to its modes (Craig-Bampton)",
+    ".msh": "meshing the {part} (gmsh, second-order tetrahedra)",
+}
+#: typical first-build time [s] of an entry, by kind, on one core of a quiet 2-core machine (benchmarks/
+#: bench_bodies.py: a preset's carrier 12-13 s, disc 11-26 s with their meshes); the notice quotes the
+#: time this cache's own earlier builds of the kind took when it has them
+TYPICAL_BUILD_S = {".compliance.json": 10.0, ".patches.json": 15.0, ".sweep.json": 15.0, ".cms.npz": 15.0, ".msh": 4.0}
+#: file in the cache folder with the measured build time of each kind of entry
+BUILD_TIMES = "build_times.json"
+
+
+def _entry_kind(path) -> tuple[str, str]:
+    """(part, kind) of a cache entry's file name ``<part>-<hash><kind>``: ``carrier-3f..e1.msh``
+    -> (``"carrier"``, ``".msh"``); the kind is "" for an unknown suffix."""
+    name = Path(path).name
+    part, _, rest = name.partition("-")
+    for kind in _BUILD_KINDS:
+        if rest.endswith(kind):
+            return part.replace("_", " "), kind
+    return part.replace("_", " "), ""
+
+
+def _build_times() -> dict:
+    try:
+        data = json.loads((cache_dir() / BUILD_TIMES).read_text())
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def build_notice(path, stream=None) -> str:
+    """Print (on stderr) and return the one line announcing the first build of a cache entry:
+    what it does and how long it usually takes (this cache's last build of that kind of
+    entry, else :data:`TYPICAL_BUILD_S`), e.g. ``flexrv: meshing the carrier (gmsh, ...);
+    once, usually ~10 s; cached for later runs``."""
+    import sys
+
+    part, kind = _entry_kind(path)
+    what = _BUILD_KINDS.get(kind, "building the {part}").format(part=part)
+    seconds = _build_times().get(f"{part}{kind}", TYPICAL_BUILD_S.get(kind))
+    usual = f", usually ~{seconds:.0f} s" if seconds else ""
+    line = f"flexrv: {what}; once{usual}; cached for later runs"
+    print(line, file=sys.stderr if stream is None else stream, flush=True)
+    return line
+
+
+def record_build_time(path, seconds: float) -> None:
+    """Remember how long the build of this kind of entry took (the next notice quotes it);
+    a failure to write is ignored (the figure is only a hint)."""
+    part, kind = _entry_kind(path)
+    times = _build_times()
+    times[f"{part}{kind}"] = round(float(seconds), 1)
+    try:
+        atomic_write_text(cache_dir() / BUILD_TIMES, json.dumps(times, indent=1, sort_keys=True))
+    except OSError:
+        pass
 
 
 def cached_dataclass(path, key: str, cls, compute, enabled: bool = True):

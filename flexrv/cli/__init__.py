@@ -7,7 +7,7 @@ table by default. Any :class:`flexrv.errors.FlexrvError` and every usage error
 (unknown option or command, a value of the wrong type, a missing argument)
 becomes one clear message on stderr and exit code 2 — never a traceback. A bare
 ``flexrv`` (or a command that needs arguments, given none) prints the help on
-stderr and exits 2, like any other usage error. Ctrl-C / SIGTERM exit 130.
+stderr and exits 2, like any other usage error. Ctrl-C exits 130 and SIGTERM 143 in every phase.
 """
 
 from __future__ import annotations
@@ -175,8 +175,47 @@ class Terminated(KeyboardInterrupt):
     signum = 15
 
 
+#: SIGTERM received by this process (typer returns a KeyboardInterrupt as exit code 130, whatever raised it)
+_TERMINATED: list[int] = []
+
+
 def _raise_terminated(signum, frame) -> None:
+    _TERMINATED.append(signum)
     raise Terminated()
+
+
+#: commands that may build FE bodies or compile numba kernels (the first-run notice)
+_BUILDING_COMMANDS = frozenset(
+    {"simulate", "stiffness-test", "te", "design", "compare", "tolerance", "sweep", "optimize", "calibrate"}
+    | {"validate", "workflow", "mesh", "modes", "report", "ehl"}
+)
+
+
+def first_run_notice(args: list[str], stream=None) -> str | None:
+    """The one line a command prints at its start when numba's kernel cache is still empty
+    (a first run on this machine or of this flexrv version): what the minutes go to and that
+    it happens once. None (nothing printed) for a warm cache, ``--help`` and commands that
+    build nothing."""
+    from flexrv.cache import numba_cache_dir
+
+    command = next((a for a in args if a in _BUILDING_COMMANDS), None)
+    if command is None or "--help" in args:
+        return None
+    folder = numba_cache_dir()
+    try:
+        warm = folder.is_dir() and any(folder.rglob("*.nbi"))
+    except OSError:
+        warm = False
+    if warm:
+        return None
+    from flexrv.model.kernel_cache import FIRST_RUN_ESTIMATE_S
+
+    line = (
+        f"flexrv {command}: first run: compiling numba kernels and building the design's FE bodies "
+        f"(once, about {FIRST_RUN_ESTIMATE_S / 60:.0f} min on 2 cores; later runs take seconds)"
+    )
+    print(line, file=sys.stderr if stream is None else stream, flush=True)
+    return line
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -195,6 +234,7 @@ def main(argv: list[str] | None = None) -> None:
         signal.signal(signal.SIGTERM, _raise_terminated)
     except ValueError:  # not the main thread (an embedding application): its own handling applies
         pass
+    first_run_notice(args)
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")
     click_exit = _types("Exit")
@@ -214,9 +254,9 @@ def main(argv: list[str] | None = None) -> None:
         print_error(f"{exc.strerror or exc}: {where}" if where else f"{exc.strerror or exc}")
         sys.exit(USAGE_EXIT)
     except (typer.Exit, *click_exit) as exc:
-        sys.exit(exc.exit_code)
+        sys.exit(_signal_code(exc.exit_code))
     except (typer.Abort, *click_abort, KeyboardInterrupt) as exc:
-        sys.exit(128 + getattr(exc, "signum", 2))
+        sys.exit(128 + getattr(exc, "signum", 15 if _TERMINATED else 2))
     except no_args as exc:  # bare `flexrv` / a command given no arguments: help, usage exit code
         print(exc.format_message(), file=sys.stderr)
         sys.exit(USAGE_EXIT)
@@ -238,4 +278,10 @@ def main(argv: list[str] | None = None) -> None:
         print_error(" ".join(str(exc.format_message()).split()))
         sys.exit(exc.exit_code if exc.exit_code else USAGE_EXIT)
     if isinstance(rv, int) and not isinstance(rv, bool):
-        sys.exit(rv)
+        sys.exit(_signal_code(rv))
+
+
+def _signal_code(code: int) -> int:
+    """Exit code 143 for a run that SIGTERM stopped (typer reports any KeyboardInterrupt, and so
+    SIGTERM's :class:`Terminated`, as 130), else ``code``."""
+    return 128 + _TERMINATED[-1] if code == 130 and _TERMINATED else code

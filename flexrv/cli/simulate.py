@@ -174,6 +174,9 @@ def simulate(
         "te_max_arcsec": s["te_max_arcsec"],
         "te_pp_arcsec": s["te_pp_arcsec"],
         "steady_window_s": s["steady_window_s"],
+        "steady": s["steady_state"],  # what summary.md says in words: its window is (NOT) STEADY, and why
+        "steady_reason": s["steady_note"],
+        "notes": s["notes"],
         "max_pin_force_N": s["max_pin_force_N"],
         "pins_in_contact_mean": s["pins_in_contact_mean"],
         "pins_in_contact_max": s["pins_in_contact_max"],
@@ -191,8 +194,13 @@ def simulate(
             data[key] = s[key]
 
     def render(d):
-        rows = [(*_label_unit(k), v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}") for k, v in d.items()]
+        shown = {k: v for k, v in d.items() if k not in ("steady_reason", "notes")}
+        rows = [
+            (*_label_unit(k), v if not isinstance(v, list) else f"{v[0]:.4g} - {v[1]:.4g}") for k, v in shown.items()
+        ]
         console.print(kv_table(f"simulate {preset} ({model})", [(k, v, u) for k, u, v in rows]))
+        for note in d["notes"]:
+            console.print(f"note: {note}", style=None if d["steady"] else "yellow")
 
     emit(data, json, render)
     code = _exit_code(res)
@@ -239,7 +247,7 @@ def stiffness_test_cmd(
     finally:
         if bar:
             bar.stop()
-    data = {"output_dir": str(out), **fig.named(), "stiffness_budget": _budget(res)}
+    data = {"output_dir": str(out), **fig.named(), "reading": fig.reading(), "stiffness_budget": _budget(res)}
     if csv is not None:  # the loop in the measured-data format (flexrv.measured.writer)
         from flexrv.measured.writer import export_stiffness_test
 
@@ -255,7 +263,8 @@ def stiffness_test_cmd(
     def render(d):
         from flexrv.cli.design import budget_table
 
-        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in ("stiffness_budget", "uncertainty")]
+        skip = ("stiffness_budget", "uncertainty", "reading")
+        rows = [(*_label_unit(k), v) for k, v in d.items() if k not in skip]
         console.print(kv_table(f"stiffness test {preset} ({model})", [(k, v, u) for k, u, v in rows]))
         if "uncertainty" in d:
             from flexrv.cli.te import uncertainty_table

@@ -57,14 +57,21 @@ def te(
         "--out",
         overwrite=overwrite,
     )
-    result = loaded_te(
-        reducer,
-        torque=torque_nm,
-        output_revolutions=output_revolutions,
-        crank_revolutions=crank_revolutions,
-        points_per_mesh=points_per_mesh,
-        play_fractions=PLAY_FRACTIONS,
-    )
+    announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh)
+    bar = progress_bar(not json)
+    try:
+        result = loaded_te(
+            reducer,
+            torque=torque_nm,
+            output_revolutions=output_revolutions,
+            crank_revolutions=crank_revolutions,
+            points_per_mesh=points_per_mesh,
+            play_fractions=PLAY_FRACTIONS,
+            progress=bar,
+        )
+    finally:
+        if bar is not None:
+            bar.stop()
     ds = te_dataset(result, reducer)
     summary = te_summary(ds)
     budget = quasi_static_budget(summary, result.outputs, reducer)
@@ -111,6 +118,58 @@ def te(
             console.print(uncertainty_table(d["uncertainty"]))
 
     emit(data, json, render)
+
+
+#: measured cost of the static solution per position [s] (loaded and no-load curves, outputs) and the
+#: fixed cost of a run (model, catalog points, files, figures) on one core (benchmarks/bench_te.py)
+SECONDS_PER_POSITION = 6e-4
+SECONDS_FIXED = 5.0
+
+
+def announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh: int) -> str:
+    """One line on stderr before the static solution: how many positions, what is solved,
+    how long it usually takes (:data:`SECONDS_PER_POSITION`)."""
+    import sys
+
+    from flexrv.model.quasi_static import positions_for
+
+    n = len(positions_for(reducer, output_revolutions, crank_revolutions, points_per_mesh))
+    line = (
+        f"flexrv te {reducer.name}: static equilibrium at {n} positions (loaded and no-load curves), "
+        f"catalog points, files and figures; usually ~{SECONDS_FIXED + SECONDS_PER_POSITION * n:.0f} s"
+    )
+    print(line, file=sys.stderr, flush=True)
+    return line
+
+
+def progress_bar(enabled: bool):
+    """A rich progress bar on stderr of the curves' positions (``progress(stage, done, total)`` of
+    :func:`flexrv.model.quasi_static.loaded_te`), one task per curve; None if not ``enabled``
+    (``--json``). Rich draws it only on a terminal; ``.stop()`` ends it."""
+    if not enabled:
+        return None
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    tasks = {}
+
+    def report(stage: str, done: int, total: int) -> None:
+        if not tasks:
+            bar.start()
+        if stage not in tasks:
+            tasks[stage] = bar.add_task(stage, total=total)
+        bar.update(tasks[stage], completed=done)
+
+    report.stop = bar.stop
+    return report
 
 
 def quasi_static_budget(summary: dict, outputs: dict, reducer):

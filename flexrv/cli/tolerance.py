@@ -86,6 +86,7 @@ def tolerance(
             "skipped_existing",
             "failed",
             "wall_time_s",
+            "resolution",
             "percentiles",
             "yield",
             "ranked_sensitivities",

@@ -26,6 +26,7 @@ def gmsh_session(model_name: str = "flexrv", threads: int = 1) -> Iterator["obje
     if gmsh.isInitialized():  # a crashed caller left a session open: start clean
         gmsh.finalize()
     gmsh.initialize(readConfigFiles=False, run=False, interruptible=False)
+    _restore_signal_handlers()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 0)
@@ -34,3 +35,18 @@ def gmsh_session(model_name: str = "flexrv", threads: int = 1) -> Iterator["obje
         yield gmsh
     finally:
         gmsh.finalize()
+
+
+def _restore_signal_handlers() -> None:
+    """gmsh's initialisation installs its own C handler of SIGTERM, which kills the process
+    (exit -15) instead of letting Python's handler stop the command with 143: give Python's
+    handlers of SIGTERM and SIGINT back (main thread only; elsewhere signals are not ours)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        handler = signal.getsignal(sig)
+        if handler is not None:
+            signal.signal(sig, handler)

@@ -1,20 +1,15 @@
 """First-run notice for the numba kernels.
 
-The hot kernels (closest point of the pin gap, the impact law, the ball-bearing row)
+The hot kernels (the fused kernel of the compiled force elements, the ball-bearing rows)
 are compiled by numba on their first call and cached on disk (``cache=True``) in
 ``NUMBA_CACHE_DIR``, which flexrv sets to ``<user cache>/flexrv/numba/<version>``
 (:func:`flexrv.cache.numba_cache_dir`; a damaged entry is discarded and compiled
 again, :func:`flexrv.cache.guard_numba_cache`). The first run of a fresh install
-therefore spends most of its time compiling, with no progress:
-:func:`announce_compile` prints one short line before that happens. Ctrl-C or
-SIGTERM during the compilation end the run at once (:func:`stop_now`).
-
-Measured (``benchmarks/bench_first_run.py``: ``flexrv simulate rv40e --t-end 0.01``,
-fresh ``NUMBA_CACHE_DIR``, 2 shared cores, numba 0.68, after the force groups became
-one compiled fused kernel): 13.6 s first run against 3.1 s with the cache filled, i.e.
-10.5 s of compilation (before the fused kernel, rv221's first run spent 86 s compiling
-the array kernels of the pin gap and the impact law). The ball-bearing row kernels
-add their own compile time to the first ``balls``/``flexible`` run.
+therefore spends most of its time compiling: :func:`announce_compile` prints one short
+line before that happens (and the command line one line at its start,
+:func:`flexrv.cli.first_run_notice`). Ctrl-C or SIGTERM during the compilation end the
+run at once (:func:`stop_now`). The time estimates quoted come from
+``benchmarks/bench_first_run.py`` (docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -47,8 +42,10 @@ RUN_ENTRY_POINTS = {
     "fused": ("fused.fused_kernel", "fused.fused_history", "kernels.copy_records_if_same"),
     "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history"),
 }
-#: measured first-compile time [s] of the rigid model's kernels (see module docstring), for the message
-COMPILE_ESTIMATE_S = 15
+#: first-compile time [s] of the rigid model's kernels on 2 cores (benchmarks/bench_first_run.py), for the notice
+COMPILE_ESTIMATE_S = 60
+#: a whole first run [s] on 2 cores (kernels and FE bodies of a preset), for the command line's notice
+FIRST_RUN_ESTIMATE_S = 120
 
 
 def uncached_kernels(modules: dict | None = None) -> list[str]:
@@ -93,7 +90,7 @@ def stop_now(signum: int) -> None:
 
 
 def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bool:
-    """Print one short line, ``flexrv: compiling numba kernels (once, ~15 s or more; ...)``, on
+    """Print one short line, ``flexrv: compiling numba kernels (once, ~60 s or more; ...)``, on
     stderr if a kernel the run calls (:data:`RUN_ENTRY_POINTS` of ``kinds``, default all)
     is not cached yet; returns whether it printed."""
     missing = uncached_kernels(modules)

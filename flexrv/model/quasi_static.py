@@ -501,11 +501,23 @@ def positions_for(
     return np.arange(n) * (span / n)
 
 
-def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, max_failed_fraction: float = 0.01):
+def equilibrium_path(
+    sm: StaticModel,
+    angles: np.ndarray,
+    q_start: np.ndarray,
+    max_failed_fraction: float = 0.01,
+    periodic: bool = False,
+    progress=None,
+):
     """Solve every position; each is warm-started from the previous solution
     advanced by the nominal kinematic increment (measured: 2 Newton iterations
     per position against 3 with secant extrapolation, and 2 against 8 at a
     vanishing torque, where the contact set changes between positions).
+    ``periodic``: from the second crank revolution on, a position starts from the image of
+    the solution one crank revolution earlier (:func:`_periodic_image`) while such starts are
+    equilibria already (zero iterations: one residual call per position); the first that is
+    not ends them (as-built errors that break the symmetry). Every position is still solved
+    to the same tolerance. ``progress(done, total)`` is called every 256 positions and at the end.
     A position that neither its warm start nor a restart from the kinematic pose
     (:func:`_restart`) converges is returned as NaN with iterations -1; more than
     ``max_failed_fraction`` of such positions raise ConvergenceError.
@@ -513,11 +525,15 @@ def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, m
     qs = np.empty((len(angles), sm.n))
     its = np.empty(len(angles), dtype=int)
     kin = sm.kinematic_pose(angles)
+    image = _periodic_image(sm, angles) if periodic else None
     guess = q_start
     last = None
     for k, th in enumerate(angles):
+        imaged = False
         if k:
             guess = qs[last] + (kin[k] - kin[last]) if last is not None else kin[k]
+            if image is not None and k >= image.period and its[k - image.period] >= 0:
+                guess, imaged = image(qs[k - image.period], kin[k - image.period], kin[k]), True
         try:
             qs[k], its[k] = sm.solve(th, guess)
         except ConvergenceError:
@@ -526,7 +542,11 @@ def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, m
             except ConvergenceError:
                 qs[k], its[k] = np.nan, -1  # reported: the caller counts the unconverged positions
                 continue
+        if imaged and its[k] > 0:
+            image = None
         last = k
+        if progress is not None and (k % 256 == 255 or k == len(angles) - 1):
+            progress(k + 1, len(angles))
     failed = int(np.sum(its < 0))
     if failed > max_failed_fraction * len(angles):
         raise ConvergenceError(
@@ -534,6 +554,49 @@ def equilibrium_path(sm: StaticModel, angles: np.ndarray, q_start: np.ndarray, m
             f"(torque {sm.torque:.6g} N m): more than {100 * max_failed_fraction:g} %"
         )
     return qs, its
+
+
+def _periodic_image(sm: StaticModel, angles: np.ndarray):
+    """The map of a solution onto the positions one crank revolution (relative to the carrier)
+    later, or None where the positions do not repeat after a whole number of steps.
+
+    After one crank revolution the carrier has turned by dtheta_c (one pin pitch, 2 pi / z_rp),
+    every crank and disc is back in its place relative to the carrier and the pins are
+    relabelled: a design whose as-built geometry has that symmetry has the same equilibrium
+    there, turned by dtheta_c. The image keeps the deviation q - q_kin from the kinematic pose
+    with its in-plane vectors (x, y and tilts rx, ry) turned by dtheta_c. Returns a callable
+    ``image(q_earlier, kin_earlier, kin_now)`` with attribute ``period`` (positions)."""
+    from flexrv.geometry.kinematics import member_speeds
+
+    p = sm.p
+    if len(angles) < 2:
+        return None
+    step = float(angles[1] - angles[0])
+    s = member_speeds(1.0, p.z_s, p.z_p, p.z_c, p.z_rp)
+    rev = 2.0 * math.pi / abs(float(s.crank_relative))  # input angle of one crank revolution
+    period = int(round(rev / step))
+    dth = rev * float(s.carrier)
+    if period < 1 or abs(period * step - rev) > 1e-9 * rev or period >= len(angles):
+        return None
+    if abs(dth * p.z_rp / (2.0 * math.pi) - round(dth * p.z_rp / (2.0 * math.pi))) > 1e-9:
+        return None  # the pins do not repeat
+    ia, ib = [], []
+    for mem in sm.model.members.values():
+        lab = list(mem.labels)
+        for a, b in (("x", "y"), ("rx", "ry")):
+            if a in lab and b in lab:
+                ia.append(mem.offset + lab.index(a))
+                ib.append(mem.offset + lab.index(b))
+    ia, ib = np.array(ia, dtype=int), np.array(ib, dtype=int)
+    c, sn = math.cos(dth), math.sin(dth)
+
+    def image(q_earlier, kin_earlier, kin_now):
+        d = q_earlier - kin_earlier
+        d[ia], d[ib] = c * d[ia] - sn * d[ib], sn * d[ia] + c * d[ib]
+        return kin_now + d
+
+    image.period = period
+    return image
 
 
 def _restart(sm: StaticModel, theta_in: float, q_kin: np.ndarray) -> np.ndarray:
@@ -622,6 +685,8 @@ def loaded_te(
     is read too (catalog ``play_positions_rad``; the geometric backlash's extrapolation,
     :mod:`flexrv.post.definitions`). ``torque`` [N m] defaults to the design's rated torque; it must be positive and
     at most 3x the rated torque (beyond that the Hertz laws leave their range).
+    ``progress(stage, done, total)``: called while the curves are solved (stage "loaded curve" /
+    "no-load curve", positions done of total).
     """
     from flexrv.model.base import Output
 
@@ -649,12 +714,13 @@ def loaded_te(
     except ConvergenceError:
         pass  # nothing touches (clearances everywhere): the load ramp closes them
     q_load = ramp_to(sm, angles[0], q0, torque, steps=8)
-    qs, its = equilibrium_path(sm, angles, q_load)
+    stage = (lambda name: lambda done, total: progress(name, done, total)) if progress is not None else None
+    qs, its = equilibrium_path(sm, angles, q_load, progress=stage and stage("loaded curve"))
     # no-load curve
     t_small = no_load_fraction * rated
     sm.torque = torque
     q_small = ramp_to(sm, angles[0], qs[0], t_small)
-    qs_nl, its_nl = equilibrium_path(sm, angles, q_small)
+    qs_nl, its_nl = equilibrium_path(sm, angles, q_small, periodic=True, progress=stage and stage("no-load curve"))
     ratio = sm.p.ratio
     th_out = qs[:, sm.i_theta]
     te = th_out - angles / ratio

@@ -54,6 +54,13 @@ class StiffnessTest:
         out["friction_energy_J"] = float(self.friction_energy_J)
         return out
 
+    def reading(self) -> dict:
+        """How the named figures were read, the numbers summary.md states beside them (rated
+        torque, fit range, lost-motion band and angles, the branches' slopes, the hysteresis
+        angles at T = 0): every saved figure of :data:`_FIGURES` that :meth:`named` leaves out."""
+        named = self.named()
+        return {name: float(getattr(self, name)) for name, _, _ in _FIGURES if name not in named}
+
 
 def loop_energy(torque_down, angle_down, torque_back, angle_back, rated: float, samples: int = 2001) -> float:
     """The loop's area from its descending and returning branches

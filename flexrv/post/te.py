@@ -279,6 +279,12 @@ def te_summary_markdown(summary: dict, reducer, errors_note: str = "") -> str:
     ]
     if errors_note:
         lines += [errors_note, ""]
+    if s.get("unconverged_positions"):
+        lines += [
+            f"{s['unconverged_positions']} positions did not converge (NaN in the curves; "
+            "`unconverged_positions` in summary.json and `--json`).",
+            "",
+        ]
     lines += ["| quantity | value | unit |", "|---|---|---|"]
     for name, value, unit in rows:
         v = f"{value:.4g}" if isinstance(value, float) else str(value)
