@@ -662,10 +662,11 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
 def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progress: bool) -> dict[str, Any]:
     """The body of :func:`run_study` once the output folder exists."""
     from flexrv.cache import atomic_write_text
-    from flexrv.sweep import SweepSpec, build_cases, run_sweep
-
-    res = {**DEFAULT_RESOLUTION, **cfg.resolution}
     from flexrv.model.quasi_static import positions_for
+    from flexrv.sweep import SweepSpec, build_cases, process_cpu_s, run_sweep
+
+    client_cpu0 = process_cpu_s()
+    res = {**DEFAULT_RESOLUTION, **cfg.resolution}
 
     positions_for(
         reducer,
@@ -727,6 +728,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
         "failed": int(sum(s != "ok" for s in status)),
         "failed_plain": int(sum(s != "ok" for s in status[:n_plain])),
         "wall_time_s": wall,
+        "cpu": summary_sweep.cpu.as_dict(),
         "resolution": res,
         "tolerances": tol.to_dict(),
         "percentiles": {k: percentiles(ys[k]) for k in OUTPUTS},
@@ -759,6 +761,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
     result["what_if"] = _what_if(parts, y, specs)
     result["ranked_sensitivities"] = _ranking(result)
     _write_outputs(out, cfg, plan, parts, y_plain, status[:n_plain], ids[:n_plain], specs, result)
+    result["cpu"]["client_study_cpu_s"] = process_cpu_s() - client_cpu0  # sampling, cluster, outputs included
     result["output_dir"] = str(out)
     atomic_write_text(out / "summary.json", json.dumps(_jsonable(result), indent=1))
     return result
