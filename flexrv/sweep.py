@@ -332,10 +332,16 @@ def run_batch(
 ) -> tuple[list[dict[str, Any]], float]:
     """Run a batch of cases one after the other on a worker: each case's design is
     ``base`` with its overrides (:func:`flexrv.design.apply_overrides`, the design
-    :func:`build_cases` validated). Returns the records of :func:`run_case` in order
-    and the batch's CPU time on the worker [s]."""
+    :func:`build_cases` validated). Cases of one design that differ by their
+    ``[errors]`` only (tolerance draws) share the model constants of the design without
+    errors, computed once (:func:`flexrv.model.parameters.shared_nominal_constants`: the
+    same numbers). Returns the records of :func:`run_case` in order and the batch's CPU
+    time on the worker [s]."""
+    from flexrv.model.parameters import shared_nominal_constants
+
     cpu = time.process_time()
-    records = [run_case(apply_overrides(base, o), task, options) for o in overrides]
+    with shared_nominal_constants():
+        records = [run_case(apply_overrides(base, o), task, options) for o in overrides]
     return records, time.process_time() - cpu
 
 
