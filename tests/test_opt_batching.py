@@ -97,13 +97,13 @@ def test_shared_nominal_constants_same_answers(rv40e_draws, monkeypatch):
     problem = rv40e_draws
     res = {"crank_revolutions": 0.1, "points_per_mesh": 2, "catalog_positions": 1, "force_tol": 1e-6, "max_iter": 200}
     calls = {"n": 0}
-    body = prm.body_compliance_matrices
+    body = prm._body_compliance_matrices
 
     def counted(reducer):
         calls["n"] += 1
         return body(reducer)
 
-    monkeypatch.setattr(prm, "body_compliance_matrices", counted)
+    monkeypatch.setattr(prm, "_body_compliance_matrices", counted)
     me._NOMINAL_MEMO.clear()
     shared = me.modification_task(problem.base, problem.draws, {"resolution": res})
     assert calls["n"] == 1
@@ -131,10 +131,12 @@ def test_nominal_constants_are_those_of_the_error_free_design(rv40e_draws):
     from flexrv.design.manufacturing import nominal_design
 
     red = from_dict({**rv40e_draws.base, "errors": rv40e_draws.draws[0]})
-    plain = prm.nominal_constants(red)
-    with prm.shared_nominal_constants() as _:
-        first = prm.nominal_constants(nominal_design(red))
-        again = prm.nominal_constants(red)
-    assert plain[0] == first[0] == again[0] and plain[3] == first[3] == again[3]
-    for k in (1, 2):
-        assert np.array_equal(plain[k], again[k]) and again[k] is not first[k]
+    plain = prm.body_compliance_matrices(red)
+    with prm.shared_nominal_constants():
+        first = prm.body_compliance_matrices(nominal_design(red))
+        again = prm.body_compliance_matrices(red)
+        k = prm.nominal_shared(red, "pin_law_constant", prm._pin_law_constant)
+    assert k == prm._pin_law_constant(red) > 0.0
+    for i in (0, 1):
+        assert np.array_equal(plain[i], first[i]) and np.array_equal(plain[i], again[i])
+        assert again[i] is not first[i] and again[i].size
