@@ -334,10 +334,10 @@ def run_batch(
     ``base`` with its overrides (:func:`flexrv.design.apply_overrides`, the design
     :func:`build_cases` validated). Cases of one design that differ by their
     ``[errors]`` only (tolerance draws) share the model constants of the design without
-    errors, computed once (:func:`flexrv.model.parameters.shared_nominal_constants`: the
+    errors, computed once (:func:`flexrv.design.manufacturing.shared_nominal_constants`: the
     same numbers). Returns the records of :func:`run_case` in order and the batch's CPU
     time on the worker [s]."""
-    from flexrv.model.parameters import shared_nominal_constants
+    from flexrv.design.manufacturing import shared_nominal_constants
 
     cpu = time.process_time()
     with shared_nominal_constants():

@@ -9,6 +9,7 @@ import contextlib
 import numpy as np
 import pytest
 
+import flexrv.design.manufacturing as mf
 import flexrv.model.parameters as prm
 from flexrv.studies._opt_runner import Runner, Store, chunk_draws, join_chunks
 
@@ -107,17 +108,17 @@ def test_shared_nominal_constants_same_answers(rv40e_draws, monkeypatch):
     me._NOMINAL_MEMO.clear()
     shared = me.modification_task(problem.base, problem.draws, {"resolution": res})
     assert calls["n"] == 1
-    orig = prm.shared_nominal_constants
+    orig = mf.shared_nominal_constants
 
     @contextlib.contextmanager
     def off(memo=None):
         yield
 
-    monkeypatch.setattr(prm, "shared_nominal_constants", off)
+    monkeypatch.setattr(mf, "shared_nominal_constants", off)
     calls["n"] = 0
     each = me.modification_task(problem.base, problem.draws, {"resolution": res})
     assert calls["n"] == 3
-    monkeypatch.setattr(prm, "shared_nominal_constants", orig)
+    monkeypatch.setattr(mf, "shared_nominal_constants", orig)
     assert shared == each
     assert np.all(np.isfinite(shared["draws"]["lost_motion"]))
     assert shared["draws"]["lost_motion"][0] != shared["draws"]["lost_motion"][1]  # different builds
@@ -127,16 +128,17 @@ def test_nominal_constants_are_those_of_the_error_free_design(rv40e_draws):
     """Inside the sharing block a design with errors gets the constants of its error-free
     design, equal to the ones computed without sharing for the design with errors (the
     constants do not read the errors), and each call returns its own arrays."""
+    from flexrv.analysis.pin_load import pin_contact_constant
+    from flexrv.analysis.torsional import housing_model_compliance
     from flexrv.design import from_dict
     from flexrv.design.manufacturing import nominal_design
 
     red = from_dict({**rv40e_draws.base, "errors": rv40e_draws.draws[0]})
-    plain = prm.body_compliance_matrices(red)
-    with prm.shared_nominal_constants():
+    plain = prm.body_compliance_matrices(red), pin_contact_constant(red).k, housing_model_compliance(red)
+    with mf.shared_nominal_constants():
         first = prm.body_compliance_matrices(nominal_design(red))
-        again = prm.body_compliance_matrices(red)
-        k = prm.nominal_shared(red, "pin_law_constant", prm._pin_law_constant)
-    assert k == prm._pin_law_constant(red) > 0.0
+        again = prm.body_compliance_matrices(red), pin_contact_constant(red).k, housing_model_compliance(red)
+    assert plain[1] == again[1] > 0.0 and plain[2] == again[2] > 0.0
     for i in (0, 1):
-        assert np.array_equal(plain[i], first[i]) and np.array_equal(plain[i], again[i])
-        assert again[i] is not first[i] and again[i].size
+        assert np.array_equal(plain[0][i], first[i]) and np.array_equal(plain[0][i], again[0][i])
+        assert again[0][i] is not first[i] and again[0][i].size

@@ -27,8 +27,6 @@ rotation coordinate psi_k, which starts at the conjugate value chi0_k / z_c
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import math
 from dataclasses import dataclass, field
 
@@ -159,48 +157,10 @@ def body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
     "condensed_fe"``, else (0, 3, 3). From the cached FE condensations
     (:mod:`flexrv.fem.carrier`, :mod:`flexrv.fem.disc`; cold: about a minute each).
     Functions of the design without its errors: shared by its error sets inside
-    :func:`shared_nominal_constants`."""
-    return nominal_shared(reducer, "body_compliances", _body_compliance_matrices)
+    :func:`flexrv.design.manufacturing.shared_nominal_constants`."""
+    from flexrv.design.manufacturing import nominal_shared
 
-
-#: memo of :func:`nominal_shared` while :func:`shared_nominal_constants` is active (None: off)
-_NOMINAL_MEMO: contextvars.ContextVar[dict | None] = contextvars.ContextVar("nominal_memo", default=None)
-
-
-@contextlib.contextmanager
-def shared_nominal_constants(memo: dict | None = None):
-    """Within the block, the model constants that depend on the design without its errors
-    only (:func:`nominal_shared`) are computed once per such design and shared by its error
-    sets (a batch of tolerance draws builds its models with the same numbers, computed
-    once). ``memo``: a dict to keep them in (the caller bounds it), a fresh one by default."""
-    token = _NOMINAL_MEMO.set({} if memo is None else memo)
-    try:
-        yield
-    finally:
-        _NOMINAL_MEMO.reset(token)
-
-
-def nominal_shared(reducer, name: str, compute):
-    """``compute(reducer)``, a function of the design without its errors
-    (:func:`flexrv.design.manufacturing.nominal_design`): inside
-    :func:`shared_nominal_constants` taken from the memo of that design if computed
-    before (numpy arrays copied: each model owns its own)."""
-    memo = _NOMINAL_MEMO.get()
-    if memo is None:
-        return compute(reducer)
-    from flexrv.design.manufacturing import nominal_design
-
-    key = (name, nominal_design(reducer).model_dump_json())
-    if key not in memo:
-        memo[key] = compute(reducer)
-    value = memo[key]
-    if isinstance(value, tuple):
-        return tuple(v.copy() if isinstance(v, np.ndarray) else v for v in value)
-    return value.copy() if isinstance(value, np.ndarray) else value
-
-
-def _pin_law_constant(reducer) -> float:
-    return pin_contact_constant(reducer).k
+    return nominal_shared(reducer, "body_compliance_matrices", _body_compliance_matrices)
 
 
 def _body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
@@ -296,7 +256,7 @@ def rigid_parameters(reducer) -> RigidParameters:
     disc_inertia = 0.5 * m_ann * (r_out**2 + r_in**2) - n * m_hole * (0.5 * r_h**2 + a_w**2)
     # contact constants: the pin path = pin-disc contact, pin seat and pin bending in series
     # (flexrv.analysis.pin_load.pin_contact_constant, the one constant of every model)
-    k_line = nominal_shared(reducer, "pin_law_constant", _pin_law_constant)
+    k_line = pin_contact_constant(reducer).k
     depth = ct.impact_damping_depth_mm * 1e-3
     if ct.pin_law == "hertz_line":
         pin_k, pin_e = k_line, LINE_EXPONENT
@@ -399,7 +359,7 @@ def rigid_parameters(reducer) -> RigidParameters:
         planet_phase_errors=ab.planet_phase_errors,
         carrier_compliance=carrier_c,
         disc_compliance=disc_c,
-        housing_compliance=nominal_shared(reducer, "housing_compliance", housing_model_compliance),
+        housing_compliance=housing_model_compliance(reducer),
         extra={"member_speeds_per_input": member_speeds(1.0, z_s, z_p, z_c, z_rp)},
         pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
         if ct.friction

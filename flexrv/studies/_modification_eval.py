@@ -148,7 +148,7 @@ def build_quantities(reducer, resolution: dict) -> dict[str, float]:
 
 
 #: the design-only model constants of the last candidates evaluated in this process
-#: (:func:`flexrv.model.parameters.shared_nominal_constants`): the chunks of one candidate's
+#: (:func:`flexrv.design.manufacturing.shared_nominal_constants`): the chunks of one candidate's
 #: draws that run on the same worker build them once
 _NOMINAL_MEMO: dict = {}
 #: most candidates kept in :data:`_NOMINAL_MEMO`
@@ -162,10 +162,10 @@ def modification_task(design: dict, draws: list, options: dict) -> dict:
     ``{"nominal": {q: v}, "draws": {q: [v per draw]}}`` (``nominal`` empty when skipped);
     a build whose solve fails gives NaN (counted as failed by the statistics). The builds
     share the model constants of the design without its errors, computed once
-    (:func:`flexrv.model.parameters.nominal_constants`: the same numbers)."""
+    (:func:`flexrv.design.manufacturing.shared_nominal_constants`: the same numbers)."""
     from flexrv.design import from_dict
+    from flexrv.design.manufacturing import shared_nominal_constants
     from flexrv.errors import FlexrvError
-    from flexrv.model.parameters import shared_nominal_constants
 
     res = options["resolution"]
     if len(_NOMINAL_MEMO) >= _MEMO_SIZE:
