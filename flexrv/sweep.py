@@ -522,6 +522,7 @@ class SweepSummary:
     table_nc: Path | None
     plots: list[Path]
     cpu: CpuAccount = field(default_factory=CpuAccount)
+    case_ids: list[str] = field(default_factory=list)  #: every case's id, in the spec's order
 
 
 def run_sweep(
@@ -587,6 +588,7 @@ def run_sweep(
         table_nc=nc_path,
         plots=plot_paths,
         cpu=cpu,
+        case_ids=[c.case_id for c in cases],
     )
 
 

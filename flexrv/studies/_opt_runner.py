@@ -136,13 +136,15 @@ class Store:
         keys = [self.key(d, options) for d in designs]
         out: list[dict | None] = [None] * len(designs)
         todo: list[int] = []
+        asked: set[str] = set()
         for i, k in enumerate(keys):
             path = self.dir / f"{k}.json"
             if path.exists():
                 out[i] = json.loads(path.read_text())
                 self.reused += 1
-            elif k not in [keys[j] for j in todo]:  # the same design twice in one batch: once
+            elif k not in asked:  # the same design twice in one batch: computed once
                 todo.append(i)
+                asked.add(k)
         if todo:
             self._compute(todo, keys, designs, options, labels or [{}] * len(designs))
         for i, k in enumerate(keys):

@@ -669,7 +669,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
     """The body of :func:`run_study` once the output folder exists."""
     from flexrv.cache import atomic_write_text
     from flexrv.model.quasi_static import positions_for
-    from flexrv.sweep import SweepSpec, build_cases, process_cpu_s, run_sweep
+    from flexrv.sweep import SweepSpec, process_cpu_s, run_sweep
 
     client_cpu0 = process_cpu_s()
     res = {**DEFAULT_RESOLUTION, **cfg.resolution}
@@ -709,7 +709,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
         batch=cfg.batch,
     )  # the study draws its own figures
     wall = time.perf_counter() - t0
-    ids = [c.case_id for c in build_cases(spec)]
+    ids = summary_sweep.case_ids
     records = []
     for cid in ids:
         path = out / "runs" / "cases" / f"{cid}.json"
