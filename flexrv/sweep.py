@@ -557,6 +557,8 @@ def run_sweep(
     from flexrv.design import load
 
     check_workers(n_workers, force)
+    if batch is not None and (isinstance(batch, bool) or not isinstance(batch, int) or batch < 1):
+        raise ConfigError(f"--batch {batch!r}: must be an integer >= 1 (cases per dask task)")
     out = Path(out_dir) if out_dir else Path("results") / spec.name
     # everything checked before any case runs: every case's design, task, options, outputs
     cases = build_cases(spec, validate=True)

@@ -141,3 +141,15 @@ def test_batched_sweep_stopped_resumes_same_as_unbatched(tmp_path, monkeypatch):
         assert r.get("error") == ref[name].get("error")
     computed = [records[n] for n in records if n not in before]
     assert again.cpu.workers_s >= sum(r["cpu_time_s"] for r in computed) > 0.0
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.5, True])
+def test_bad_batch_refused_before_anything(tmp_path, bad):
+    """--batch must be an integer >= 1: one ConfigError naming it, nothing written."""
+    from flexrv.errors import ConfigError
+
+    spec_path = tmp_path / "spec.toml"
+    spec_path.write_text(SPEC)
+    with pytest.raises(ConfigError, match=r"--batch .*integer >= 1"):
+        run_sweep(load_spec(spec_path), out_dir=tmp_path / "o", n_workers=1, progress=False, batch=bad)
+    assert not (tmp_path / "o").exists()
