@@ -142,3 +142,33 @@ def test_nominal_constants_are_those_of_the_error_free_design(rv40e_draws):
     for i in (0, 1):
         assert np.array_equal(plain[0][i], first[i]) and np.array_equal(plain[0][i], again[0][i])
         assert again[0][i] is not first[i] and again[0][i].size
+
+
+def test_chunked_candidate_interrupted_is_recomputed(tmp_path, monkeypatch):
+    """A candidate split into 5 chunks, interrupted at its third chunk, leaves no record (a
+    record is stored only whole); the rerun computes it and stores the record of one task."""
+    import tests.test_optimize as me
+    from tests.test_optimize import _analytic_problem
+
+    p = _analytic_problem(draws=5)
+    (ref,) = Store(tmp_path / "ref", p.task, p.draws, Runner(mode="inline")).evaluate([p.base], p.options)
+    orig = me.analytic_task
+    calls = {"n": 0}
+
+    def stop_third(design, draws, options):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return orig(design, draws, options)
+
+    runner = Runner(mode="inline")
+    monkeypatch.setattr(runner, "slots", lambda: 2)
+    monkeypatch.setattr(me, "analytic_task", stop_third)
+    store = Store(tmp_path / "run", p.task, p.draws, runner)
+    with pytest.raises(KeyboardInterrupt):
+        store.evaluate([p.base], p.options)
+    assert not list((tmp_path / "run" / "evaluations").glob("*.json"))
+    monkeypatch.setattr(me, "analytic_task", orig)
+    again = Store(tmp_path / "run", p.task, p.draws, runner)
+    (rec,) = again.evaluate([p.base], p.options)
+    assert again.computed == 1 and rec["result"] == ref["result"]
