@@ -125,6 +125,7 @@ class Store:
         self.draws_hash = content_hash(draws, length=16)
         self.computed = 0
         self.reused = 0
+        self.workers_cpu_s = 0.0  #: the computed tasks' CPU time on their workers
 
     def key(self, design: dict, options: dict) -> str:
         from flexrv.cache import content_hash, flexrv_version
@@ -169,6 +170,7 @@ class Store:
         def done(j: int, record: dict) -> None:
             i, c = owner[j]
             parts[i][c] = record
+            self.workers_cpu_s += record.get("cpu_time_s", 0.0)
             if len(parts[i]) < len(chunks):
                 return
             record = join_chunks([parts[i][c] for c in range(len(chunks))])
