@@ -10,24 +10,48 @@ Two parts, paired in one run:
 * the search: ``--budget`` candidates x ``--samples`` draws on ``--workers`` dask workers
   (goal: 200 x 32 on 2 cores in <= 15 min), wall time and candidates per minute.
 
+* ``--paired``: the same search twice in one run, first as the former evaluation (every
+  build computes the constants of the design without errors itself, one task per
+  candidate always), then as today's (the builds of a candidate share those constants;
+  a batch with few candidates split into chunks of draws): wall and CPU of each, their
+  ratio, and whether the two Pareto sets are identical (they must be: the same numbers).
+* ``--builds``: CPU per cheap build in this process, the builds of a candidate sharing the
+  error-free constants or not (paired, alternating; the same figures bit for bit).
+
 Figures: docs/benchmarks.md.
 
 Usage::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py --compare --designs 6 --draws 8
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py --budget 200 --samples 32 --workers 2
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py --paired --budget 20 --samples 32
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py --builds --samples 8
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
+import resource
 import shutil
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+#: this checkout's flexrv and this module, in this process and in the spawned dask workers
+ROOT = str(Path(__file__).resolve().parent.parent)
+sys.path.insert(0, ROOT)
+os.environ["PYTHONPATH"] = os.pathsep.join(
+    [ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+)
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 VARY = ["second_stage.modification_equidistant_mm=0:0.015", "second_stage.modification_shift_mm=-0.015:0.015"]
 
@@ -74,11 +98,121 @@ def compare(designs: int, draws: int, seed: int) -> dict:
     return out
 
 
-def search(budget: int, samples: int, workers: int, seed: int, out: str | None) -> dict:
-    from flexrv.studies.optimize import OptimizeConfig, run_optimize
+@contextlib.contextmanager
+def _unshared():
+    import flexrv.design.manufacturing as mf
 
-    tmp = Path(out) if out else Path(tempfile.mkdtemp(prefix="bench_optimize_"))
-    cfg = OptimizeConfig(
+    @contextlib.contextmanager
+    def off(memo=None):
+        yield
+
+    orig = mf.shared_nominal_constants
+    mf.shared_nominal_constants = off
+    try:
+        yield
+    finally:
+        mf.shared_nominal_constants = orig
+
+
+def unshared_task(design: dict, draws: list, options: dict) -> dict:
+    """The modification task with every build computing the error-free constants itself."""
+    from flexrv.studies._modification_eval import modification_task
+
+    with _unshared():
+        return modification_task(design, draws, options)
+
+
+def builds(samples: int, seed: int) -> dict:
+    """CPU per cheap build of one candidate, shared constants or not (paired, alternating)."""
+    from flexrv.studies._modification_eval import _NOMINAL_MEMO, modification_task
+    from flexrv.studies.optimize import CHEAP_RESOLUTION, OptimizeConfig, build_problem
+
+    cfg = OptimizeConfig("rv40e", vary=VARY, objectives=["lost_motion_p95_arcmin"], tolerances="rv40e")
+    cfg.samples_per_design, cfg.seed = samples, seed
+    problem, _, _ = build_problem(cfg)
+    opts = {"resolution": CHEAP_RESOLUTION}
+    modification_task(problem.base, problem.draws[:1], opts)  # warm
+    t = {"shared": 0.0, "unshared": 0.0}
+    res = {}
+    for _ in range(2):
+        for label in ("unshared", "shared"):
+            _NOMINAL_MEMO.clear()
+            c = time.process_time()
+            with _unshared() if label == "unshared" else contextlib.nullcontext():
+                r = modification_task(problem.base, problem.draws, opts)
+            t[label] += time.process_time() - c
+            res.setdefault(label, r)
+            assert r == res[label]
+    n = 2 * (samples + 1)
+    return {
+        "builds": n,
+        "unshared_cpu_s_per_build": t["unshared"] / n,
+        "shared_cpu_s_per_build": t["shared"] / n,
+        "ratio": t["unshared"] / t["shared"],
+        "identical": res["shared"] == res["unshared"],
+    }
+
+
+def _cpu_children() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def paired(budget: int, samples: int, workers: int, seed: int) -> dict:
+    """The same search as before (unshared constants, one task per candidate) and now."""
+    import flexrv.studies._opt_runner as runner
+    from flexrv.studies.optimize import build_problem, run_optimize
+
+    out = {}
+    chunk = runner.chunk_draws
+    for label in ("before", "now"):
+        with tempfile.TemporaryDirectory() as tmp:
+            cfg = _config(budget, samples, workers, seed, tmp)
+            problem = None
+            if label == "before":
+                problem, _, _ = build_problem(cfg)
+                problem.task = "benchmarks.bench_optimize:unshared_task"
+                runner.chunk_draws = lambda n, c, s: [(0, n)]
+            c0, k0, t0 = _cpu_self(), _cpu_children(), time.perf_counter()
+            try:
+                r = run_optimize(cfg, progress=False, problem=problem)
+            finally:
+                runner.chunk_draws = chunk
+            wall = time.perf_counter() - t0
+            workers_cpu = sum(
+                json.loads(p.read_text()).get("cpu_time_s", 0.0) for p in (Path(tmp) / "evaluations").glob("*.json")
+            )
+            out[label] = {
+                "wall_time_s": wall,
+                "client_cpu_s": _cpu_self() - c0,
+                "children_cpu_s": _cpu_children() - k0,
+                "workers_task_cpu_s": workers_cpu,
+                "computed": r["computed_now"],
+                "pareto": [{k: v for k, v in p.items() if k not in ("full", "full_minus_cheap")} for p in r["pareto"]],
+            }
+        print(label, json.dumps({k: v for k, v in out[label].items() if k != "pareto"}), flush=True)
+    same = out["before"]["pareto"] == out["now"]["pareto"]
+    return {
+        "budget": budget,
+        "samples_per_design": samples,
+        "workers": workers,
+        "before": {k: v for k, v in out["before"].items() if k != "pareto"},
+        "now": {k: v for k, v in out["now"].items() if k != "pareto"},
+        "wall_ratio": out["before"]["wall_time_s"] / out["now"]["wall_time_s"],
+        "identical_pareto": same,
+        "pareto_points": len(out["now"]["pareto"]),
+    }
+
+
+def _cpu_self() -> float:
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+def _config(budget: int, samples: int, workers: int, seed: int, out: str):
+    from flexrv.studies.optimize import OptimizeConfig
+
+    return OptimizeConfig(
         "rv40e",
         vary=VARY,
         objectives=["lost_motion_p95_arcmin:min", "rigidity_median_Nm_per_arcmin:max"],
@@ -88,8 +222,15 @@ def search(budget: int, samples: int, workers: int, seed: int, out: str | None) 
         budget=budget,
         workers=workers,
         seed=seed,
-        out=str(tmp),
+        out=out,
     )
+
+
+def search(budget: int, samples: int, workers: int, seed: int, out: str | None) -> dict:
+    from flexrv.studies.optimize import run_optimize
+
+    tmp = Path(out) if out else Path(tempfile.mkdtemp(prefix="bench_optimize_"))
+    cfg = _config(budget, samples, workers, seed, str(tmp))
     t = time.perf_counter()
     r = run_optimize(cfg, progress=True)
     wall = time.perf_counter() - t
@@ -118,8 +259,14 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="keep the search's output directory here")
+    ap.add_argument("--paired", action="store_true", help="the search before/now, paired in one run")
+    ap.add_argument("--builds", action="store_true", help="CPU per cheap build, shared constants or not")
     a = ap.parse_args()
-    if a.compare:
+    if a.paired:
+        print(json.dumps(paired(a.budget, a.samples, a.workers, a.seed), indent=1))
+    elif a.builds:
+        print(json.dumps(builds(a.samples, a.seed), indent=1))
+    elif a.compare:
         print(json.dumps(compare(a.designs, a.draws, a.seed), indent=1))
     else:
         print(json.dumps(search(a.budget, a.samples, a.workers, a.seed, a.out), indent=1))

@@ -435,7 +435,15 @@ def pin_contact_constant(reducer) -> PinContactConstant:
     deflection at the reference load Q_ref (the largest pin force at the rated
     torque, of the design without its errors, :func:`flexrv.design.manufacturing.nominal_design`): K = Q_ref /
     (delta_contacts(Q_ref) + Q_ref / k_bend)^(10/9).
-    Without a [housing] table the pins are rigidly seated: K = k_disc."""
+    Without a [housing] table the pins are rigidly seated: K = k_disc. A function of the
+    design without its errors: shared by its error sets inside
+    :func:`flexrv.design.manufacturing.shared_nominal_constants`."""
+    from flexrv.design.manufacturing import nominal_shared
+
+    return nominal_shared(reducer, "pin_contact_constant", _pin_contact_constant)
+
+
+def _pin_contact_constant(reducer) -> PinContactConstant:
     from flexrv.contact.hertz import conformal_line_contact, effective_modulus, series_stiffness
 
     ss, h = reducer.second_stage, reducer.housing

@@ -566,12 +566,14 @@ def housing_model_compliance(reducer) -> float:
     pin-load pattern changes it only through the pins in mesh). The dynamic and
     quasi-static models turn the pin ring by phi_h = c_h M_h
     (:func:`flexrv.model.pins.pin_body_kernel`), the analytic budget adds c_h in series."""
-    from flexrv.design.manufacturing import nominal_design
+    from flexrv.design.manufacturing import nominal_design, nominal_shared
 
     h = reducer.housing
     if h is None or h.body_model != "ring_estimate":
         return 0.0
-    return float(housing_compliance(nominal_design(reducer)).total)
+    return nominal_shared(
+        reducer, "housing_model_compliance", lambda r: float(housing_compliance(nominal_design(r)).total)
+    )
 
 
 @dataclass(frozen=True)

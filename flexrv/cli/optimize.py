@@ -82,6 +82,7 @@ def optimize(
         "computed_now",
         "reused",
         "wall_time_s",
+        "cpu",
         "cheap_error",
         "preset",
         "pareto",

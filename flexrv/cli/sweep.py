@@ -22,6 +22,9 @@ def sweep(
         None, "--workers", min=1, help="LocalCluster worker processes, 1 to the CPU count (default: CPU count)."
     ),
     retry_failed: bool = typer.Option(False, "--retry-failed", help="Recompute cases recorded as failed."),
+    batch: Optional[int] = typer.Option(
+        None, "--batch", min=1, help="Cases per dask task (default: 4 tasks per worker, at most 32 cases each)."
+    ),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
     json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ) -> None:
@@ -42,6 +45,7 @@ def sweep(
         retry_failed=retry_failed,
         progress=not json,
         force=force,
+        batch=batch,
     )
     data = {
         "out_dir": str(summary.out_dir),
@@ -52,10 +56,11 @@ def sweep(
         "table_csv": str(summary.table_csv),
         "table_nc": str(summary.table_nc),
         "plots": [str(p) for p in summary.plots],
+        "cpu": summary.cpu.as_dict(),
     }
 
     def render(d):
-        console.print(kv_table("sweep", [(k, v, "") for k, v in d.items() if k != "plots"]))
+        console.print(kv_table("sweep", [(k, v, "") for k, v in d.items() if k not in ("plots", "cpu")]))
 
     emit(data, json, render)
     if summary.failed:

@@ -87,6 +87,7 @@ def tolerance(
             "failed",
             "wall_time_s",
             "resolution",
+            "cpu",
             "percentiles",
             "yield",
             "ranked_sensitivities",
@@ -100,6 +101,11 @@ def tolerance(
             for k in ("samples", "sampler", "variables", "evaluations", "computed_now", "skipped_existing", "failed")
         ]
         rows.append(("wall time", d["wall_time_s"], "s"))
+        c = d["cpu"]
+        if c["workers_cpu_s"] > 0:
+            rows.append(
+                ("CPU: workers / this process", f"{c['workers_cpu_s']:.4g} / {c['client_study_cpu_s']:.4g}", "s")
+            )
         console.print(kv_table(f"tolerance study {d['design']} -> {d['output_dir']}", rows))
         prow = [
             (f"{k} P50 / P95 / P99.7", f"{p['P50']:.4g} / {p['P95']:.4g} / {p['P99.7']:.4g}", "")

@@ -35,6 +35,8 @@ the as-built pins with the discs at assembly beyond
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 from typing import Any
 
@@ -395,3 +397,43 @@ def nominal_design(reducer):
     at all. Stripping the modifications too would load half the pins and
     halve the housing estimate: the modifications belong to the design.)"""
     return reducer.model_copy(update={"errors": ManufacturingErrors()})
+
+
+#: memo of :func:`nominal_shared` while :func:`shared_nominal_constants` is active (None: off)
+_NOMINAL_MEMO: contextvars.ContextVar[dict | None] = contextvars.ContextVar("nominal_memo", default=None)
+
+
+@contextlib.contextmanager
+def shared_nominal_constants(memo: dict | None = None):
+    """Within the block, the constants that depend on the design without its errors only
+    (:func:`nominal_shared`: the body compliances, the pin law's constant, the housing
+    compliance) are computed once per such design and shared by its error sets: a batch of
+    tolerance draws builds its models with the same numbers, computed once. ``memo``: a
+    dict to keep them in (the caller bounds it), a fresh one by default."""
+    token = _NOMINAL_MEMO.set({} if memo is None else memo)
+    try:
+        yield
+    finally:
+        _NOMINAL_MEMO.reset(token)
+
+
+def nominal_shared(reducer, name: str, compute):
+    """``compute(reducer)``, a function of the design without its errors
+    (:func:`nominal_design`; ``name`` tells the functions apart): inside
+    :func:`shared_nominal_constants` taken from the memo of that design when computed
+    before (numpy arrays copied: each caller owns its own)."""
+    memo = _NOMINAL_MEMO.get()
+    if memo is None:
+        return compute(reducer)
+    key = (name, nominal_design(reducer).model_dump_json())
+    if key not in memo:
+        memo[key] = compute(reducer)
+    return _copied(memo[key])
+
+
+def _copied(value):
+    import numpy as np
+
+    if isinstance(value, tuple):
+        return tuple(_copied(v) for v in value)
+    return value.copy() if isinstance(value, np.ndarray) else value

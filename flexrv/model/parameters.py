@@ -189,7 +189,15 @@ def body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
     "condensed_fe"`` (and the design has a ``[carrier]`` table), else (0, 0); the
     discs' (n_discs, 3, 3) rim compliance if ``second_stage.disc_body_model =
     "condensed_fe"``, else (0, 3, 3). From the cached FE condensations
-    (:mod:`flexrv.fem.carrier`, :mod:`flexrv.fem.disc`; cold: about a minute each)."""
+    (:mod:`flexrv.fem.carrier`, :mod:`flexrv.fem.disc`; cold: about a minute each).
+    Functions of the design without its errors: shared by its error sets inside
+    :func:`flexrv.design.manufacturing.shared_nominal_constants`."""
+    from flexrv.design.manufacturing import nominal_shared
+
+    return nominal_shared(reducer, "body_compliance_matrices", _body_compliance_matrices)
+
+
+def _body_compliance_matrices(reducer) -> tuple[np.ndarray, np.ndarray]:
     carrier_c = np.zeros((0, 0))
     cr = reducer.carrier
     if cr is not None and cr.body_model == "condensed_fe":

@@ -147,24 +147,41 @@ def build_quantities(reducer, resolution: dict) -> dict[str, float]:
     }
 
 
+#: the design-only model constants of the last candidates evaluated in this process
+#: (:func:`flexrv.design.manufacturing.shared_nominal_constants`): the chunks of one candidate's
+#: draws that run on the same worker build them once
+_NOMINAL_MEMO: dict = {}
+#: most candidates kept in :data:`_NOMINAL_MEMO`
+_MEMO_SIZE = 8
+
+
 def modification_task(design: dict, draws: list, options: dict) -> dict:
-    """One candidate on a worker: its nominal build (the design's own ``[errors]``) and one
-    build per tolerance draw (``draws``: ``[errors]`` tables), at ``options["resolution"]``.
-    Returns ``{"nominal": {q: v}, "draws": {q: [v per draw]}}``; a build whose solve fails
-    gives NaN (counted as failed by the statistics)."""
+    """One candidate (or a chunk of its draws) on a worker: its nominal build (the design's
+    own ``[errors]``; skipped with ``options["nominal"] = False``) and one build per
+    tolerance draw (``draws``: ``[errors]`` tables), at ``options["resolution"]``. Returns
+    ``{"nominal": {q: v}, "draws": {q: [v per draw]}}`` (``nominal`` empty when skipped);
+    a build whose solve fails gives NaN (counted as failed by the statistics). The builds
+    share the model constants of the design without its errors, computed once
+    (:func:`flexrv.design.manufacturing.shared_nominal_constants`: the same numbers)."""
     from flexrv.design import from_dict
+    from flexrv.design.manufacturing import shared_nominal_constants
     from flexrv.errors import FlexrvError
 
     res = options["resolution"]
-    nominal = build_quantities(from_dict(design, source="optimize candidate"), res)
-    per = {q: [] for q in QUANTITIES}
-    for errors in draws:
-        try:
-            vals = build_quantities(from_dict({**design, "errors": errors}, source="optimize draw"), res)
-        except FlexrvError:
-            vals = {q: float("nan") for q in QUANTITIES}
-        for q in QUANTITIES:
-            per[q].append(vals[q])
+    if len(_NOMINAL_MEMO) >= _MEMO_SIZE:
+        _NOMINAL_MEMO.clear()
+    with shared_nominal_constants(_NOMINAL_MEMO):
+        nominal = {}
+        if options.get("nominal", True):
+            nominal = build_quantities(from_dict(design, source="optimize candidate"), res)
+        per = {q: [] for q in QUANTITIES}
+        for errors in draws:
+            try:
+                vals = build_quantities(from_dict({**design, "errors": errors}, source="optimize draw"), res)
+            except FlexrvError:
+                vals = {q: float("nan") for q in QUANTITIES}
+            for q in QUANTITIES:
+                per[q].append(vals[q])
     return {"nominal": nominal, "draws": per}
 
 

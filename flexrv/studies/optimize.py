@@ -486,9 +486,11 @@ def run_optimize(cfg: OptimizeConfig, progress: bool = True, mode: str = "dask",
         raise InputError(f"--out {out}: exists and is not a directory")
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "config.json", json.dumps(_config_dict(cfg), indent=1))
+    from flexrv.sweep import process_cpu_s
+
     runner = Runner(cfg.scheduler, cfg.workers, mode=mode)
     store = Store(out, problem.task, problem.draws, runner)
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), process_cpu_s()
     try:
         preset = _evaluate_preset(problem, store)
         cands = search(problem, store, cfg.budget, cfg.population, cfg.seed, preset.metrics, _printer(progress))
@@ -518,6 +520,7 @@ def run_optimize(cfg: OptimizeConfig, progress: bool = True, mode: str = "dask",
         "computed_now": store.computed,
         "reused": store.reused,
         "wall_time_s": time.perf_counter() - t0,
+        "cpu": {"client_cpu_s": process_cpu_s() - cpu0, "workers_cpu_s": store.workers_cpu_s},
         "preset": _point(problem, preset, full.get(_key(preset))),
         "pareto": [_point(problem, c) for c in front],
         "recommended": {k: _point(problem, c, full.get(_key(c))) for k, c in rec.items()},

@@ -18,9 +18,11 @@ Pipeline
    (:func:`flexrv.model.quasi_static.loaded_te`) as a task of the sweep machinery
    (:func:`flexrv.sweep.run_sweep`): dask.distributed (a LocalCluster of
    single-threaded worker processes, or ``--scheduler`` for a running cluster),
-   one atomically written JSON per sample under ``<out>/runs/cases`` keyed by a
-   hash of the design, so a killed study resumes without recomputing a finished
-   sample.
+   samples in batches per task (the builds of a batch share the constants of the
+   design without its errors), one atomically written JSON per sample under
+   ``<out>/runs/cases`` keyed by a hash of the design, so a killed study resumes
+   without recomputing a finished sample. ``summary.json`` ``cpu`` gives the CPU
+   time of the client process and of the workers.
 3. **Statistics**: percentiles P50 / P95 / P99.7 of every output, the yield (the
    fraction of samples meeting every ``--spec``) with its exact Clopper-Pearson
    95 % interval (``scipy.stats.binomtest(...).proportion_ci(method="exact")``),
@@ -549,6 +551,8 @@ class StudyConfig:
     resolution: dict[str, Any] = field(default_factory=lambda: dict(DEFAULT_RESOLUTION))
     #: allow more local workers than the machine has cores
     force: bool = False
+    #: samples per dask task (None: :func:`flexrv.sweep.batch_size` of the samples and workers)
+    batch: int | None = None
 
 
 def _validate(cfg: StudyConfig) -> list[Spec]:
@@ -563,6 +567,8 @@ def _validate(cfg: StudyConfig) -> list[Spec]:
     if cfg.sampler not in ("random", "sobol", "lhs"):
         raise InputError(f"--sampler {cfg.sampler!r}: allowed random, sobol, lhs")
     check_workers(cfg.workers, cfg.force)
+    if cfg.batch is not None and (isinstance(cfg.batch, bool) or not isinstance(cfg.batch, int) or cfg.batch < 1):
+        raise InputError(f"batch {cfg.batch!r}: must be an integer >= 1 (samples per dask task)")
     if cfg.what_if_samples < 0:
         raise InputError(f"--what-if-samples {cfg.what_if_samples}: must be >= 0")
     if cfg.what_if_entries is not None and not isinstance(cfg.what_if_entries, (list, tuple)):
@@ -662,10 +668,11 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
 def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progress: bool) -> dict[str, Any]:
     """The body of :func:`run_study` once the output folder exists."""
     from flexrv.cache import atomic_write_text
-    from flexrv.sweep import SweepSpec, build_cases, run_sweep
-
-    res = {**DEFAULT_RESOLUTION, **cfg.resolution}
     from flexrv.model.quasi_static import positions_for
+    from flexrv.sweep import SweepSpec, process_cpu_s, run_sweep
+
+    client_cpu0 = process_cpu_s()
+    res = {**DEFAULT_RESOLUTION, **cfg.resolution}
 
     positions_for(
         reducer,
@@ -699,9 +706,10 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
         progress=progress,
         plots=False,
         force=cfg.force,
+        batch=cfg.batch,
     )  # the study draws its own figures
     wall = time.perf_counter() - t0
-    ids = [c.case_id for c in build_cases(spec)]
+    ids = summary_sweep.case_ids
     records = []
     for cid in ids:
         path = out / "runs" / "cases" / f"{cid}.json"
@@ -727,6 +735,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
         "failed": int(sum(s != "ok" for s in status)),
         "failed_plain": int(sum(s != "ok" for s in status[:n_plain])),
         "wall_time_s": wall,
+        "cpu": summary_sweep.cpu.as_dict(),
         "resolution": res,
         "tolerances": tol.to_dict(),
         "percentiles": {k: percentiles(ys[k]) for k in OUTPUTS},
@@ -759,6 +768,7 @@ def _run_in(out: Path, cfg: StudyConfig, specs, reducer, tol, design_data, progr
     result["what_if"] = _what_if(parts, y, specs)
     result["ranked_sensitivities"] = _ranking(result)
     _write_outputs(out, cfg, plan, parts, y_plain, status[:n_plain], ids[:n_plain], specs, result)
+    result["cpu"]["client_study_cpu_s"] = process_cpu_s() - client_cpu0  # sampling, cluster, outputs included
     result["output_dir"] = str(out)
     atomic_write_text(out / "summary.json", json.dumps(_jsonable(result), indent=1))
     return result
