@@ -349,6 +349,7 @@ def test_failed_evaluations_exit_nonzero_with_the_count(monkeypatch, capsys):
             "failed": 3,
             "wall_time_s": 0.1,
             "resolution": {},
+            "cpu": {},
             "percentiles": {},
             "yield": None,
             "ranked_sensitivities": {},

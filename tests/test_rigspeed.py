@@ -329,12 +329,13 @@ def test_first_residual_of_a_step_supplies_the_jacobian(history):
 
 
 def test_simulation_sets_jacobian_each_step_from_its_newton_settings():
-    """The fused element makes its Jacobians with the step's first residual exactly when
-    the solver updates the Jacobian at every step (the rigid model's default)."""
+    """On Exudyn's integrator the fused element makes its Jacobians with the step's first
+    residual exactly when the solver updates the Jacobian at every step (the rigid model's
+    default)."""
     from flexrv.simulation import Simulation
 
     sim = Simulation(_fast("rv40e"))
-    sim.run(t_end=0.002)
+    sim.run(t_end=0.002, integrator="exudyn")
     assert sim.model.fused.jacobian_each_step is True
-    sim.run(t_end=0.002, newton_options={"modifiedNewtonJacUpdatePerStep": False})
+    sim.run(t_end=0.002, integrator="exudyn", newton_options={"modifiedNewtonJacUpdatePerStep": False})
     assert sim.model.fused.jacobian_each_step is False

@@ -501,6 +501,10 @@ def positions_for(
     return np.arange(n) * (span / n)
 
 
+#: imaged starts in a row that need Newton iterations before the periodic route ends
+IMAGE_MISSES = 3
+
+
 def equilibrium_path(
     sm: StaticModel,
     angles: np.ndarray,
@@ -515,9 +519,11 @@ def equilibrium_path(
     vanishing torque, where the contact set changes between positions).
     ``periodic``: from the second crank revolution on, a position starts from the image of
     the solution one crank revolution earlier (:func:`_periodic_image`) while such starts are
-    equilibria already (zero iterations: one residual call per position); the first that is
-    not ends them (as-built errors that break the symmetry). Every position is still solved
-    to the same tolerance. ``progress(done, total)`` is called every 256 positions and at the end.
+    equilibria already (zero iterations: one residual call per position); :data:`IMAGE_MISSES`
+    imaged starts in a row that are not end them (as-built errors that break the symmetry; a
+    single miss is an equilibrium found at the edge of the tolerance, whose image lies just
+    outside). Every position is still solved to the same tolerance. ``progress(done, total)``
+    is called every 256 positions and at the end.
     A position that neither its warm start nor a restart from the kinematic pose
     (:func:`_restart`) converges is returned as NaN with iterations -1; more than
     ``max_failed_fraction`` of such positions raise ConvergenceError.
@@ -528,6 +534,7 @@ def equilibrium_path(
     image = _periodic_image(sm, angles) if periodic else None
     guess = q_start
     last = None
+    misses = 0
     for k, th in enumerate(angles):
         imaged = False
         if k:
@@ -542,7 +549,8 @@ def equilibrium_path(
             except ConvergenceError:
                 qs[k], its[k] = np.nan, -1  # reported: the caller counts the unconverged positions
                 continue
-        if imaged and its[k] > 0:
+        misses = (misses + 1 if its[k] > 0 else 0) if imaged else misses
+        if misses >= IMAGE_MISSES:
             image = None
         last = k
         if progress is not None and (k % 256 == 255 or k == len(angles) - 1):
