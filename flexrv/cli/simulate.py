@@ -163,6 +163,8 @@ def simulate(
         res.save(out)
         if res.attrs.get("status") == "completed":  # saved in full: the resume data is no longer needed
             (Path(out) / "checkpoint.npz").unlink(missing_ok=True)
+    from flexrv.post.stats import SUMMARY_KEYS, summary_table
+
     s = res.summary()
     data = {
         "output_dir": str(out),
@@ -170,28 +172,16 @@ def simulate(
         "ratio_simulated_over_theoretical": s["ratio_simulated_over_theoretical"],
         "ratio_theoretical": s["ratio_theoretical"],
         "ratio_simulated": s["ratio_simulated"],
-        "te_min_arcsec": s["te_min_arcsec"],
-        "te_max_arcsec": s["te_max_arcsec"],
-        "te_pp_arcsec": s["te_pp_arcsec"],
         "steady_window_s": s["steady_window_s"],
         "steady": s["steady_state"],  # what summary.md says in words: its window is (NOT) STEADY, and why
         "steady_reason": s["steady_note"],
         "notes": s["notes"],
-        "max_pin_force_N": s["max_pin_force_N"],
-        "pins_in_contact_mean": s["pins_in_contact_mean"],
-        "pins_in_contact_max": s["pins_in_contact_max"],
         "wall_time_s": sim.timing.get("solve_s"),
         "integrator": res.attrs.get("integrator"),
     }
-    for key in (
-        "max_ball_load_N",
-        "max_ring_deformation_m",
-        "min_film_thickness_m",
-        "efficiency",
-        "mean_friction_power_W",
-    ):
-        if key in s:
-            data[key] = s[key]
+    # the run's figures: the rows of the one summary table (summary.md's), then its unlisted keys present
+    data.update({key: value for key, value, _ in summary_table(s)})
+    data.update({row.key: s[row.key] for row in SUMMARY_KEYS if not row.listed and row.key in s})
 
     def render(d):
         shown = {k: v for k, v in d.items() if k not in ("steady_reason", "notes")}
