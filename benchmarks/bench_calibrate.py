@@ -20,18 +20,14 @@ Figures: docs/benchmarks.md.
 from __future__ import annotations
 
 import argparse
-import resource
 import tempfile
 import time
 from pathlib import Path
 
+from _shared import cpu_with_children_s
+
 from flexrv.workflows.calibration import EXAMPLE_TRUTH as TRUTH
 from flexrv.workflows.calibration import FREE
-
-
-def _cpu() -> float:
-    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
 
 
 def main() -> None:
@@ -48,9 +44,9 @@ def main() -> None:
     path = write_loop(Path(tempfile.mkdtemp()) / "synthetic.csv", t, a, angle_uncertainty_arcmin=0.005)
     m = read_measured(path)
     for w in args.workers:
-        t0, c0 = time.perf_counter(), _cpu()
+        t0, c0 = time.perf_counter(), cpu_with_children_s()
         cal = calibrate(rv, [m], free=FREE, workers=w)
-        wall, cpu = time.perf_counter() - t0, _cpu() - c0
+        wall, cpu = time.perf_counter() - t0, cpu_with_children_s() - c0
         print(f"workers={w}: wall {wall:.1f} s, CPU {cpu:.1f} s, {cal.evaluations} evaluations, {cal.status}")
         for k, v in cal.identified.items():
             inside = v["ci95_low"] <= TRUTH[k] <= v["ci95_high"]

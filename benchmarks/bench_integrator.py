@@ -29,17 +29,10 @@ import os
 import time
 
 import numpy as np
+from _shared import quick_ramps
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-
-def _fast(name: str):
-    from flexrv.design import load
-
-    r = load(name)
-    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
-    return r.model_copy(update={"operating": op})
 
 
 def _run(sim, integrator: str, t_end: float):
@@ -82,7 +75,7 @@ def bench(name: str, t_end: float, repeat: int) -> dict:
     import flexrv.simulation as S
     from flexrv.simulation import Simulation
 
-    sim = Simulation(_fast(name))
+    sim = Simulation(quick_ramps(name))
     model = sim.build()
     for integ in ("exudyn", "compiled"):  # compile / load the kernels
         sim.run(t_end=0.002, integrator=integ, checkpoint_s=None)

@@ -33,25 +33,15 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import os
-import resource
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from _shared import children_cpu_s, use_this_checkout
 
-#: this checkout's flexrv and this module, in this process and in the spawned dask workers
-ROOT = str(Path(__file__).resolve().parent.parent)
-sys.path.insert(0, ROOT)
-os.environ["PYTHONPATH"] = os.pathsep.join(
-    [ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-)
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("MPLBACKEND", "Agg")
+use_this_checkout()
 
 VARY = ["second_stage.modification_equidistant_mm=0:0.015", "second_stage.modification_shift_mm=-0.015:0.015"]
 
@@ -153,15 +143,11 @@ def builds(samples: int, seed: int) -> dict:
     }
 
 
-def _cpu_children() -> float:
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
 def paired(budget: int, samples: int, workers: int, seed: int) -> dict:
     """The same search as before (unshared constants, one task per candidate) and now."""
     import flexrv.studies._opt_runner as runner
     from flexrv.studies.optimize import build_problem, run_optimize
+    from flexrv.sweep import process_cpu_s
 
     out = {}
     chunk = runner.chunk_draws
@@ -173,7 +159,7 @@ def paired(budget: int, samples: int, workers: int, seed: int) -> dict:
                 problem, _, _ = build_problem(cfg)
                 problem.task = "benchmarks.bench_optimize:unshared_task"
                 runner.chunk_draws = lambda n, c, s: [(0, n)]
-            c0, k0, t0 = _cpu_self(), _cpu_children(), time.perf_counter()
+            c0, k0, t0 = process_cpu_s(), children_cpu_s(), time.perf_counter()
             try:
                 r = run_optimize(cfg, progress=False, problem=problem)
             finally:
@@ -184,8 +170,8 @@ def paired(budget: int, samples: int, workers: int, seed: int) -> dict:
             )
             out[label] = {
                 "wall_time_s": wall,
-                "client_cpu_s": _cpu_self() - c0,
-                "children_cpu_s": _cpu_children() - k0,
+                "client_cpu_s": process_cpu_s() - c0,
+                "children_cpu_s": children_cpu_s() - k0,
                 "workers_task_cpu_s": workers_cpu,
                 "computed": r["computed_now"],
                 "pareto": [{k: v for k, v in p.items() if k not in ("full", "full_minus_cheap")} for p in r["pareto"]],
@@ -202,11 +188,6 @@ def paired(budget: int, samples: int, workers: int, seed: int) -> dict:
         "identical_pareto": same,
         "pareto_points": len(out["now"]["pareto"]),
     }
-
-
-def _cpu_self() -> float:
-    r = resource.getrusage(resource.RUSAGE_SELF)
-    return r.ru_utime + r.ru_stime
 
 
 def _config(budget: int, samples: int, workers: int, seed: int, out: str):

@@ -35,17 +35,10 @@ import os
 import time
 
 import numpy as np
+from _shared import quick_ramps
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-
-def _fast(name: str):
-    from flexrv.design import load
-
-    r = load(name)
-    op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
-    return r.model_copy(update={"operating": op})
 
 
 def _instrument(model):
@@ -106,7 +99,7 @@ def _gf_time(model, reps: int = 300) -> float:
 def bench(name: str, t_end: float, dt: float) -> dict:
     from flexrv.simulation import Simulation
 
-    sim = Simulation(_fast(name))
+    sim = Simulation(quick_ramps(name))
     model = sim.build()
     t0 = time.perf_counter()
     gf_us = _gf_time(model, reps=3)  # loads/compiles the kernels

@@ -31,27 +31,13 @@ the workers').
 from __future__ import annotations
 
 import argparse
-import os
-import resource
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-#: this checkout's flexrv, in this process and in the spawned dask workers
-ROOT = str(Path(__file__).resolve().parent.parent)
-sys.path.insert(0, ROOT)
-os.environ["PYTHONPATH"] = os.pathsep.join(
-    [ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-)
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("MPLBACKEND", "Agg")
+from _shared import cpu_with_children_s, use_this_checkout
 
-
-def _cpu() -> float:
-    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+use_this_checkout()
 
 
 def study(n: int, workers: int, res: dict) -> tuple[float, float, int]:
@@ -70,9 +56,9 @@ def study(n: int, workers: int, res: dict) -> tuple[float, float, int]:
             out=tmp,
             resolution=res,
         )
-        c0, t0 = _cpu(), time.perf_counter()
+        c0, t0 = cpu_with_children_s(), time.perf_counter()
         r = run_study(cfg, progress=False)
-        return time.perf_counter() - t0, _cpu() - c0, r["failed"]
+        return time.perf_counter() - t0, cpu_with_children_s() - c0, r["failed"]
 
 
 def client_share(n: int, workers: int, res: dict) -> None:

@@ -210,8 +210,8 @@ def design_uncertainty(reducer, n: int, seed: int = 0, progress: Callable | None
     out["no_effect"] = inert
     out["reasons"] = {k: r.reason for k, r in reducer.ranges.items()}
     out["method"] = (
-        "quasi-static route at a coarse resolution, FE bodies' nominal compliance and the elements no model "
-        "contains added in series; inputs the route does not read screened out (no_effect); the others "
+        "quasi-static route at a coarse resolution with every path compliance in the model, the FE bodies' "
+        "nominal compliance added in series; inputs the route does not read screened out (no_effect); the others "
         "uniform over their [ranges], scrambled Sobol' samples; median and 5-95 % interval; contributors: "
         "SRC^2 of a linear fit (R^2 given), or each input's own SRC^2 with fewer samples than inputs + 3"
     )

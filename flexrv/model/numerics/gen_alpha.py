@@ -46,6 +46,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.core.params import pack_type
+from flexrv.model.numerics.linalg import lu_factor, lu_solve
 
 # -- indices into the state's float parameters ``par``
 P_ALPHA_M, P_ALPHA_F, P_GAMMA, P_BETA, P_RTOL, P_ATOL, P_CONTRACT, P_MAXNORM = range(8)
@@ -138,53 +139,6 @@ def set_state(st: GaState, q, v, a, a_alg=None) -> None:
 
 
 @njit(cache=True)
-def lu_factor(a, lu, piv):
-    """LU factorisation with partial pivoting of a (n x n) into lu, piv; False if singular."""
-    n = a.shape[0]
-    lu[:, :] = a
-    for k in range(n):
-        p, big = k, abs(lu[k, k])
-        for i in range(k + 1, n):
-            if abs(lu[i, k]) > big:
-                p, big = i, abs(lu[i, k])
-        piv[k] = p
-        if big == 0.0 or not math.isfinite(big):
-            return False
-        if p != k:
-            for j in range(n):
-                lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
-        inv = 1.0 / lu[k, k]
-        for i in range(k + 1, n):
-            lu[i, k] *= inv
-            lik = lu[i, k]
-            if lik != 0.0:
-                for j in range(k + 1, n):
-                    lu[i, j] -= lik * lu[k, j]
-    return True
-
-
-@njit(cache=True)
-def lu_solve(lu, piv, b, x):
-    """x = A^-1 b from :func:`lu_factor`'s lu, piv."""
-    n = lu.shape[0]
-    x[:] = b
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-    for i in range(n):
-        s = x[i]
-        for j in range(i):
-            s -= lu[i, j] * x[j]
-        x[i] = s
-    for i in range(n - 1, -1, -1):
-        s = x[i]
-        for j in range(i + 1, n):
-            s -= lu[i, j] * x[j]
-        x[i] = s / lu[i, i]
-
-
-@njit(cache=True)
 def _predict(st):
     """The predictor from the start-of-step state (module docstring); a := 0."""
     par = st.par
@@ -245,7 +199,7 @@ def _factor(st, jq, jv):
         for j in range(n):
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
-    return lu_factor(s.copy(), s, st.piv)
+    return lu_factor(s, s, st.piv)  # in place
 
 
 @njit(cache=True)

@@ -4,8 +4,8 @@ The local systems of the condensed bodies are m x m with m = 3 n_discs (rims),
 2 n_cranks (carrier support points), the ball count (condensed rings) or 3 (one
 ball): LAPACK's call overhead and work arrays cost more than the arithmetic, so
 these loops are used instead. Each is verified against numpy in
-``tests/test_kernel.py`` (inverse, product) and ``tests/test_elements.py``
-(Cholesky, adjugate, condensed step).
+``tests/test_kernel.py`` (inverse, product), ``tests/test_elements.py``
+(Cholesky, adjugate, condensed step) and ``tests/test_integrator.py`` (LU).
 """
 
 from __future__ import annotations
@@ -122,3 +122,51 @@ def adjugate3(k, adj):
     adj[2, 1] = k[0, 1] * k[2, 0] - k[0, 0] * k[2, 1]
     adj[2, 2] = k[0, 0] * k[1, 1] - k[0, 1] * k[1, 0]
     return k[0, 0] * adj[0, 0] + k[0, 1] * adj[1, 0] + k[0, 2] * adj[2, 0]
+
+
+@njit(cache=True)
+def lu_factor(a, lu, piv):
+    """LU factorisation with partial pivoting of a (n x n) into lu, piv (``lu`` may be ``a``:
+    in place); False if singular."""
+    n = a.shape[0]
+    lu[:, :] = a
+    for k in range(n):
+        p, big = k, abs(lu[k, k])
+        for i in range(k + 1, n):
+            if abs(lu[i, k]) > big:
+                p, big = i, abs(lu[i, k])
+        piv[k] = p
+        if big == 0.0 or not math.isfinite(big):
+            return False
+        if p != k:
+            for j in range(n):
+                lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
+        inv = 1.0 / lu[k, k]
+        for i in range(k + 1, n):
+            lu[i, k] *= inv
+            lik = lu[i, k]
+            if lik != 0.0:
+                for j in range(k + 1, n):
+                    lu[i, j] -= lik * lu[k, j]
+    return True
+
+
+@njit(cache=True)
+def lu_solve(lu, piv, b, x):
+    """x = A^-1 b from :func:`lu_factor`'s lu, piv."""
+    n = lu.shape[0]
+    x[:] = b
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+    for i in range(n):
+        s = x[i]
+        for j in range(i):
+            s -= lu[i, j] * x[j]
+        x[i] = s
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for j in range(i + 1, n):
+            s -= lu[i, j] * x[j]
+        x[i] = s / lu[i, i]
