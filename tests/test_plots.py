@@ -75,7 +75,7 @@ def test_pin_force_map_shows_every_disc_aligned(run, tmp_path, captured):
     _not_blank(plot_pin_forces(run, tmp_path / "pins.png"))
     fig = captured[-1]
     f = run["pin_force"].values
-    maps = [ax for ax in fig.axes if ax.collections and "pin angle" in ax.get_ylabel()]
+    maps = [ax for ax in fig.axes if (ax.collections or ax.images) and "pin angle" in ax.get_ylabel()]
     assert len(maps) == f.shape[1] == 2
     line_ax = [ax for ax in fig.axes if "largest pin force" in ax.get_ylabel()][0]
     widths = {round(ax.get_position().width, 4) for ax in maps + [line_ax]}

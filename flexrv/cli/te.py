@@ -46,9 +46,11 @@ def te(
     from flexrv.design import load
     from flexrv.errors import InputError
     from flexrv.model.quasi_static import loaded_te
+    from flexrv.post.io import xarray_without_dask
     from flexrv.post.te import save_te, te_dataset, te_summary
     from flexrv.viz.te_plots import te_plots
 
+    xarray_without_dask()
     if output_revolutions is not None and crank_revolutions is not None:
         raise InputError("--output-revolutions and --crank-revolutions exclude each other: give one")
     reducer = load(preset)

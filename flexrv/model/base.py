@@ -293,7 +293,10 @@ class KernelGroup(ForceGroup):
                 }
             return f, out
         lead = q.shape[:-1]
-        qf, vf = q.reshape(-1, n), np.broadcast_to(v, q.shape).reshape(-1, n)
+        # writable and C-contiguous like the fused kernel's arguments: a read-only (broadcast) or
+        # strided array would be another type signature of the kernel, compiled a second time
+        qf = np.require(q.reshape(-1, n), requirements=("C", "W"))
+        vf = np.require(np.broadcast_to(v, q.shape).reshape(-1, n), requirements=("C", "W"))
         ts = np.broadcast_to(np.asarray(t, dtype=float), lead).ravel()
         pack = self.pack(idx, history=True)
         f = np.zeros(qf.shape)

@@ -80,6 +80,27 @@ def save(res, directory, figures=None) -> Path:
     return d
 
 
+def xarray_without_dask() -> None:
+    """Let xarray know, once per process, that this process uses no dask arrays: xarray asks
+    on its first variable whether its data is a dask array, importing ``dask.array`` (~0.4 s
+    CPU) to find out, and keeps the answer. For a command that never makes dask arrays (``te``,
+    ``simulate``) dask is hidden from that first question (``sys.modules["dask"] = None`` makes
+    its import fail, which xarray reads as "dask not installed"). Nothing happens where dask is
+    imported already (a study that uses it, a test session)."""
+    import sys
+
+    if "dask" in sys.modules:
+        return
+    import xarray as xr
+
+    sys.modules["dask"] = None
+    try:
+        xr.Variable(("x",), np.zeros(1))
+    finally:
+        if sys.modules.get("dask", 0) is None:
+            del sys.modules["dask"]
+
+
 def write_netcdf(ds, path) -> Path:
     """Write ``ds`` to ``path`` atomically (NetCDF4 via h5netcdf).
 
