@@ -121,11 +121,13 @@ def simulate(
     (exit 130 / 143); --resume DIR continues a killed run."""
     import math
 
+    from flexrv.cli.te import skip_final_collection
     from flexrv.errors import InputError
     from flexrv.post.io import xarray_without_dask
     from flexrv.simulation import DEFAULT_DT, Simulation
 
     xarray_without_dask()
+    skip_final_collection()
     dt = DEFAULT_DT if dt is None else dt
     if not (math.isfinite(checkpoint) and checkpoint >= 0):
         raise InputError(f"--checkpoint-s {checkpoint}: must be a finite number >= 0 s")
