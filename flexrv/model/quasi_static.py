@@ -681,13 +681,14 @@ class _CurveRecords:
             sm.residual(0.0, sm.model.q0, jacobian=False)  # builds the fused element
         self.entries = sm.model.fused.record_entries()
         self.buffers = [np.empty((n,) + a.shape) for _, _, a in self.entries]
+        self.pairs = [(a, b) for (_, _, a), b in zip(self.entries, self.buffers)]
         self.valid = np.zeros(n, dtype=bool)
 
     def __call__(self, k: int, theta: float, q: np.ndarray) -> None:
         last = self.sm.last
-        if last is None or last[0] != theta or not np.array_equal(last[1], q):
+        if last is None or last[0] != theta or not (last[1] == q).all():
             self.sm.residual(theta, q, jacobian=False)
-        for (_, _, live), buffer in zip(self.entries, self.buffers):
+        for live, buffer in self.pairs:
             buffer[k] = live
         self.valid[k] = True
 
