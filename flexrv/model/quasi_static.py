@@ -700,7 +700,7 @@ class _CurveRecords:
 
         ok = self.valid & np.isfinite(qs).all(axis=1)
         data: dict = {}
-        for (group, key, shape), buffer in zip(((g, k, a.shape) for g, k, a in self.entries), self.buffers):
+        for (group, key, _), buffer in zip(self.entries, self.buffers):
             data.setdefault(group, {})[key] = buffer[ok]
         records = {"data": data, "valid": {g: np.ones(int(ok.sum()), dtype=bool) for g in data}}
         z = np.zeros_like(qs[ok])
