@@ -455,7 +455,7 @@ def test_gear_runout_and_phase_errors():
     expect = (
         4e-6 * np.sin(ts - beta + 1.1)
         + runout[:, 0] * np.sin(q[8::3] - beta + runout[:, 1])
-        + p.base_radius_planet * err
+        + pg.base_radius_planet * err
     )
     np.testing.assert_allclose(o1["mesh_deflection"].values - o0["mesh_deflection"].values, expect, rtol=0, atol=1e-15)
 
