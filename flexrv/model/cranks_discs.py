@@ -593,11 +593,10 @@ def crank_support_parameters(reducer, drive: DriveParameters) -> CrankSupportPar
     (:func:`flexrv.analysis.path_compliances.model_compliances`)."""
     from flexrv.analysis.path_compliances import model_compliances
     from flexrv.analysis.torsional import support_constants
-    from flexrv.geometry.as_built import as_built
     from flexrv.model.bodies import body_compliance_matrix
 
     cs = reducer.crankshaft
-    ab = as_built(reducer)
+    ab = drive.as_built
     law, angles, linear = support_constants(reducer)
     path = model_compliances(reducer, ab.crank_bores)
     return CrankSupportParameters(
@@ -654,7 +653,6 @@ def needle_parameters(reducer, drive: DriveParameters) -> NeedleParameters:
     :func:`empirical_needle_constant`), the as-built eccentrics, holes and clearances
     (:func:`flexrv.geometry.as_built.as_built`), damping, limit and friction (design ``[contact]``)."""
     from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness
-    from flexrv.geometry.as_built import as_built
 
     cs, nb, ct = reducer.crankshaft, reducer.needle_bearing, reducer.contact
     if nb.model == "empirical":
@@ -665,7 +663,7 @@ def needle_parameters(reducer, drive: DriveParameters) -> NeedleParameters:
         k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
         k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
     d_roll = nb.roller_diameter_mm * 1e-3
-    ab = as_built(reducer)
+    ab = drive.as_built
     return NeedleParameters(
         drive=drive,
         model=nb.model,

@@ -34,11 +34,11 @@ the groups' typed packs (:mod:`flexrv.model.core.params`), built from them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexrv.geometry.as_built import as_built
+from flexrv.geometry.as_built import AsBuilt, as_built
 from flexrv.geometry.kinematics import total_ratio
 from flexrv.units import M_PER_MM
 
@@ -79,6 +79,9 @@ class DriveParameters:
     # contact settings of the pins and the needle bearings (design [contact])
     contact_depth: float  #: penetration depth of the impact law's full damping [m]
     friction_velocity: float  #: regularisation speed v_reg of the friction laws [m/s] (0 = friction off)
+    #: the as-built geometry (:func:`flexrv.geometry.as_built.as_built`: nominal + the design's [errors]),
+    #: built once and read by every element's builder
+    as_built: AsBuilt = field(repr=False, compare=False)
 
 
 def _cyl_mass(rho, d, length):
@@ -159,4 +162,5 @@ def drive_parameters(reducer) -> DriveParameters:
         load_ramp=(op.load_ramp_start_s, op.load_ramp_end_s),
         contact_depth=ct.impact_damping_depth_mm * M_PER_MM,
         friction_velocity=ct.friction_velocity_mm_per_s * M_PER_MM if ct.friction else 0.0,
+        as_built=ab,
     )

@@ -236,7 +236,6 @@ def gear_stage_parameters(reducer, drive: DriveParameters) -> GearStageParameter
     (:func:`flexrv.geometry.as_built.as_built`) and the planets' torsional compliances."""
     from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.analysis.path_compliances import planet_torsion_compliances
-    from flexrv.geometry.as_built import as_built
 
     fs = reducer.first_stage
     alpha = fs.pressure_angle
@@ -244,7 +243,7 @@ def gear_stage_parameters(reducer, drive: DriveParameters) -> GearStageParameter
     rb_p = 0.5 * fs.module * fs.planet_teeth * math.cos(alpha)
     alpha_w = math.acos((rb_s + rb_p) / fs.center_distance)
     c_crank, c_spline = planet_torsion_compliances(reducer)
-    ab = as_built(reducer)
+    ab = drive.as_built
     return GearStageParameters(
         drive=drive,
         stage=involute_stage(reducer),

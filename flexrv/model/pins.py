@@ -752,7 +752,6 @@ def pin_parameters(reducer, drive: DriveParameters) -> PinParameters:
     from flexrv.analysis.torsional import housing_model_compliance
     from flexrv.contact.hertz import LINE_EXPONENT
     from flexrv.contact.laws import effective_pin_friction
-    from flexrv.geometry.as_built import as_built
     from flexrv.model.bodies import body_compliance_matrix
 
     ss, ct = reducer.second_stage, reducer.contact
@@ -761,7 +760,7 @@ def pin_parameters(reducer, drive: DriveParameters) -> PinParameters:
         k, exponent = k_line, LINE_EXPONENT
     else:
         k, exponent = k_line * drive.contact_depth ** (LINE_EXPONENT - ct.impact_exponent), ct.impact_exponent
-    ab = as_built(reducer)
+    ab = drive.as_built
     return PinParameters(
         drive=drive,
         pin_circle_radius=ss.pin_circle_radius,
