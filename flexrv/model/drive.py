@@ -103,11 +103,11 @@ def _masses(reducer) -> dict:
         (cs.support_journal_diameter_mm, cs.support_journal_length_mm, 2),
         (cs.eccentric_journal_diameter_mm, cs.eccentric_journal_length_mm, nd),
     ]
-    m_shaft = sum(k * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) for d, l, k in parts)
+    m_shaft = sum(k * _cyl_mass(rho_c, d * M_PER_MM, l * M_PER_MM) for d, l, k in parts)
     crank_inertia = 0.5 * m_planet * r_pitch_p**2 + sum(
-        k * 0.5 * _cyl_mass(rho_c, d * 1e-3, l * 1e-3) * (0.5e-3 * d) ** 2 for d, l, k in parts
+        k * 0.5 * _cyl_mass(rho_c, d * M_PER_MM, l * M_PER_MM) * (0.5 * M_PER_MM * d) ** 2 for d, l, k in parts
     )
-    d_seat, l_seat = cs.gear_seat_diameter_mm * 1e-3, cs.gear_seat_length_mm * 1e-3
+    d_seat, l_seat = cs.gear_seat_diameter_mm * M_PER_MM, cs.gear_seat_length_mm * M_PER_MM
     m_seat = _cyl_mass(rho_c, d_seat, l_seat)
     r_out = ss.pin_circle_radius - ss.pin_radius - ss.eccentricity
     r_in = ss.center_hole_radius
