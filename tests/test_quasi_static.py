@@ -466,7 +466,7 @@ def test_solver_jacobian_equals_finite_differences(errors):
     tests/test_bodies.py (their local Newton's round-off, ~5e-8 N, is at this test's
     noise floor with steps of 5e-11 m; with 2e-10 / 4e-10 m they agree to 1e-8)."""
     from flexrv.design import load_error_set, with_errors
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
 
     red = load("rv40e") if errors is None else with_errors("rv40e", load_error_set(errors))
     red = with_bodies(red, [])

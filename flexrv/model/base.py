@@ -212,6 +212,16 @@ class KernelGroup(ForceGroup):
     summary_rows: tuple = ()
     #: message of the ConvergenceError raised when :meth:`failure_counter` grows in a call
     failure_message: str = "an inner solve of a force element did not converge"
+    #: the element's typed parameters from the design, ``staticmethod(builder)``: builder(reducer,
+    #: drive) -> a frozen dataclass (``drive``: the shared :class:`flexrv.model.drive.DriveParameters`),
+    #: the first argument of the constructor (:meth:`from_design`)
+    parameters = None
+
+    @classmethod
+    def from_design(cls, reducer, drive, *args, **kwargs):
+        """The element of a design: ``cls(cls.parameters(reducer, drive), *args, **kwargs)``
+        (only this element's parameters are built)."""
+        return cls(cls.parameters(reducer, drive), *args, **kwargs)
 
     def reset(self) -> None:
         """Forget the state of earlier evaluations; the time inputs are written again."""

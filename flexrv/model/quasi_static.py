@@ -12,8 +12,8 @@ angle prescribed. The groups are the SAME objects as in the dynamic model
 (:func:`flexrv.model.factory.build_rigid` with ``exudyn=False`` and the
 ``position`` drive, in which the model's "time" argument is the input angle): the
 same pin gaps, Hertz/Palmgren laws, needle bearings, crank supports, gear meshes
-and main bearing, read from the same as-built parameters
-(:func:`flexrv.model.parameters.rigid_parameters`). At zero velocity the
+and main bearing, each with its own parameters built from the design (the element's
+``parameters``; the shared ones: :func:`flexrv.model.drive.drive_parameters`). At zero velocity the
 damping terms vanish, so this is the dynamic model's equilibrium manifold.
 
 Solver: Newton's method on R with the groups' analytic Jacobians
@@ -394,7 +394,7 @@ class StaticModel:
                 e_body = float(df @ (rot @ g.carrier_c @ rot.T) @ df) / c
                 out["carrier"] = e_body
                 out[g.name] -= e_body
-                for part, cm in self.p.carrier_parts.items():  # rings, joints: their own shares of it
+                for part, cm in g.params.carrier_parts.items():  # rings, joints: their own shares of it
                     out[part] = float(df @ (rot @ cm @ rot.T) @ df) / c
                     out["carrier"] -= out[part]
             if g.name == "pins" and getattr(g, "elastic_discs", False):
