@@ -123,6 +123,54 @@ def test_linear_solve():
     assert not linalg.lu_factor(np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3, np.int64))
 
 
+def _block_system(rng, n, blocks_in, pivoting=True):
+    """A random n x n matrix with uncoupled dense diagonal blocks (zero block-block entries),
+    with a zero on each block's diagonal (partial pivoting needed) if ``pivoting``."""
+    s = rng.normal(size=(n, n)) + 4.0 * np.eye(n)
+    for i, (a0, am) in enumerate(blocks_in):
+        if pivoting:
+            s[a0, a0] = 0.0
+        for j, (b0, bm) in enumerate(blocks_in):
+            if i != j:
+                s[a0 : a0 + am, b0 : b0 + bm] = 0.0
+    return s
+
+
+def test_block_elimination_solve():
+    """block_lu (the balls' blocks eliminated first, then the Schur complement) against
+    numpy's dense solve on random matrices of the flexible-rings structure (x coordinates
+    before, between and after the blocks), with zero pivots inside the blocks: equal to
+    1e-12 relative; the structure check and a singular block are reported."""
+    from flexrv.model.numerics import block_lu
+
+    rng = np.random.default_rng(5)
+    for n, blocks_in in ((40, [(3, 12), (20, 15)]), (249, [(21, 114), (135, 114)]), (10, [(0, 10)])):
+        blocks, xs = block_lu.block_structure(n, blocks_in)
+        assert sorted([*xs, *[i for b0, m in blocks for i in range(b0, b0 + m)]]) == list(range(n))
+        s = _block_system(rng, n, blocks_in)
+        assert block_lu.has_block_structure(s, blocks)
+        nx, nb = len(xs), int(blocks[:, 1].sum())
+        w, piv, ys = s.copy(), np.zeros(n, np.int64), np.zeros((nb, nx))
+        schur, xpiv = np.zeros((nx, nx)), np.zeros(nx, np.int64)
+        assert block_lu.block_factor(w, blocks, xs, piv, ys, schur, xpiv)
+        for _ in range(2):  # one factorisation, several right-hand sides
+            r = rng.normal(size=n)
+            x = np.zeros(n)
+            block_lu.block_solve(w, blocks, xs, piv, ys, schur, xpiv, r, x, np.zeros(nx), np.zeros(nx))
+            ref = np.linalg.solve(s, r)
+            assert np.max(np.abs(x - ref)) <= 1e-12 * np.max(np.abs(ref))
+    blocks2, _ = block_lu.block_structure(10, [(0, 4), (5, 5)])
+    assert not block_lu.has_block_structure(_block_system(rng, 10, [(0, 3), (5, 5)]), blocks2)
+    with pytest.raises(ValueError, match="overlaps"):
+        block_lu.block_structure(10, [(0, 4), (3, 2)])
+    sing = np.eye(6)
+    sing[2:4, 2:4] = 0.0
+    blocks, xs = block_lu.block_structure(6, [(2, 2)])
+    assert not block_lu.block_factor(
+        sing, blocks, xs, np.zeros(6, np.int64), np.zeros((2, 4)), np.zeros((4, 4)), np.zeros(4, np.int64)
+    )
+
+
 # -------------------------------------------------------------- choice of the integrator
 
 
