@@ -331,11 +331,11 @@ def test_output_pass_equals_per_sample_kernel_calls(rings):
         inputs = kernel_inputs(row)
         ws = [inputs[10].copy(), inputs[11].copy()]
         recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
-        forces = row_history(q, qt, *inputs, recs)
+        forces = row_history(q, qt, inputs, recs)
         inputs[10][:], inputs[11][:] = ws
         for i in range(q.shape[0]):
             rec = np.zeros((row.ball_count, N_RECORD))
-            f, _, _ = row_kernel(q[i], qt[i], *inputs, False, rec)
+            f, _, _ = row_kernel(q[i], qt[i], inputs, False, rec)
             np.testing.assert_array_equal(forces[i], f)
             np.testing.assert_array_equal(recs[i], rec)
         assert recs[:, :, col["load_outer"]].max() > 1000.0

@@ -59,7 +59,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.ehl.maps import packed_log_correction
-from flexrv.model.core.params import law_type
+from flexrv.model.core.params import law_type, pack_type
 from flexrv.model.numerics.linalg import adjugate3, cholesky, cholesky_solve
 
 #: a ball contact's normal law: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m] (0: dry), load and
@@ -153,6 +153,31 @@ RowGeometry = law_type(
     pocket_stiffness=float,
     quasi_static_balls=bool,
     ball_force_tol=float,
+)
+
+#: the kernel inputs of a row (:func:`flexrv.model.flexible_bearing.kernel_inputs`), read by name:
+#: ball reference positions (Z, 3) [m]; the row's geometry and cage (:data:`RowGeometry`); per ring
+#: (``_i`` inner, ``_o`` outer): the contact law (:data:`PointLaw`), the cylindrical raceway table
+#: (n_grid, 3, m) of a MODAL ring ((1, 3, 0): none), the compliance factors T K^-1/2 (n_grid, 3, m)
+#: of a CONDENSED ring ((0, 3, 0): none) and the work array (:func:`condense_workspace`,
+#: :func:`film_workspace`); ``zsign``: the inner and outer raceway tables' z sign (-1: mirrored);
+#: ``balls``: the quasi-static balls' work array (:func:`ball_workspace`; empty with ball inertia);
+#: ``state`` (int64, 8): the local solves' statistics (see :func:`row_eval`)
+RowPack = pack_type(
+    "RowPack",
+    ("ball_ref", (np.float64, 2)),
+    ("geometry", RowGeometry),
+    ("law_i", PointLaw),
+    ("law_o", PointLaw),
+    ("tab_i", (np.float64, 3)),
+    ("tab_o", (np.float64, 3)),
+    ("comp_i", (np.float64, 3)),
+    ("comp_o", (np.float64, 3)),
+    ("ws_i", (np.float64, 1)),
+    ("ws_o", (np.float64, 1)),
+    ("zsign", (np.float64, (2,))),
+    ("balls", (np.float64, 1)),
+    ("state", (np.int64, (8,))),
 )
 
 #: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
@@ -693,35 +718,16 @@ def _rotation_z(a, c, s, out):
 
 
 @njit(cache=True)
-def row_kernel(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-):
+def row_kernel(q, qt, p, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n) (new arrays; :func:`row_eval`
     with its outputs allocated here). Quasi-static balls (``geometry.quasi_static_balls``):
     q, q_t, the force and the Jacobians cover the frame and modal coordinates only
-    (:func:`quasi_static_balls`, warm-started from and updating ``balls``)."""
-    nb = 3 * ball_ref.shape[0]
-    n = 6 + tab_i.shape[2] + tab_o.shape[2] + nb
+    (:func:`quasi_static_balls`, warm-started from and updating ``p.balls``)."""
+    nb = 3 * p.ball_ref.shape[0]
+    n = 6 + p.tab_i.shape[2] + p.tab_o.shape[2] + nb
     f = np.empty(n)
-    if geometry.quasi_static_balls:
+    if p.geometry.quasi_static_balls:
         nx = n - nb
         qf = np.zeros(n)
         vf = np.zeros(n)
@@ -730,57 +736,12 @@ def row_kernel(
         nk = nx if jacobian else 0
         kx = np.empty((nk, nk))
         cx = np.empty((nk, nk))
-        quasi_static_balls(
-            qf,
-            vf,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            jacobian,
-            rec,
-            f,
-            np.empty((nb, 4)),
-            kx,
-            cx,
-        )
+        quasi_static_balls(qf, vf, p, jacobian, rec, f, np.empty((nb, 4)), kx, cx)
         return f[:nx].copy(), kx, cx
     nj = n if jacobian else 0
     jq = np.zeros((nj, nj))  # (zero: row_eval clears only the entries it writes)
     jv = np.zeros((nj, nj))
-    row_eval(
-        q,
-        qt,
-        ball_ref,
-        geometry,
-        tab_i,
-        zs_i,
-        tab_o,
-        zs_o,
-        law_i,
-        law_o,
-        comp_i,
-        comp_o,
-        ws_i,
-        ws_o,
-        balls,
-        state,
-        jacobian,
-        rec,
-        f,
-        jq,
-        jv,
-    )
+    row_eval(q, qt, p, jacobian, rec, f, jq, jv)
     return f, jq, jv
 
 
@@ -1346,46 +1307,22 @@ def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
 
 
 @njit(cache=True)
-def row_eval(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    jq,
-    jv,
-):
+def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
     rigid and modal rings only the entries it writes, :func:`_zero_written`: the
     other entries must be zero, as in a zero-allocated work array);
     coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
 
-    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
-    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
-    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
-    contact deflections and last tangent; every ring: the contacts' films, the film
-    iteration's warm start, :func:`film_workspace`; updated);
-    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
-    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
-    sum of the local iterations, local solves, then the same four of the
-    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
-    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
+    ``p``: the row's :data:`RowPack`: the modal rings' raceway tables ``tab_i`` / ``tab_o``
+    (their m coordinates are element coordinates), the condensed rings' compliance
+    factors ``comp_i`` / ``comp_o``, the rings' work arrays ``ws_i`` / ``ws_o`` (contact
+    deflections and last tangent of a condensed ring; every ring: the contacts' films,
+    the film iteration's warm start; updated), the quasi-static balls' work array
+    ``balls`` (used by :func:`quasi_static_balls` only) and ``state`` (int64, 8):
+    [non-converged condensations, 1 if the last call had one, sum of the local
+    iterations, local solves, then the same four of the quasi-static balls' solve];
+    rec: (Z, N_RECORD) per-ball record, or (0, N_RECORD).
 
     ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
     CONDENSED_BALLS (the quasi-static balls' modes, see there).
@@ -1405,6 +1342,9 @@ def row_eval(
     (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
     ball (:func:`_row_pass2`), the condensed rings' dense blocks
     (:func:`_condensed_row_jacobian`)."""
+    ball_ref, geometry, state, balls = p.ball_ref, p.geometry, p.state, p.balls
+    tab_i, tab_o, zs_i, zs_o = p.tab_i, p.tab_o, p.zsign[0], p.zsign[1]
+    law_i, law_o, comp_i, comp_o, ws_i, ws_o = p.law_i, p.law_o, p.comp_i, p.comp_o, p.ws_i, p.ws_o
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
     cond_i = comp_i.shape[0] > 0
@@ -1504,56 +1444,13 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
 
 
 @njit(cache=True)
-def row_force_kernel(
-    q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state
-):
+def row_force_kernel(q, qt, p):
     """Generalized force of a row element (see :func:`row_kernel`)."""
-    return row_kernel(
-        q,
-        qt,
-        ball_ref,
-        geometry,
-        tab_i,
-        zs_i,
-        tab_o,
-        zs_o,
-        law_i,
-        law_o,
-        comp_i,
-        comp_o,
-        ws_i,
-        ws_o,
-        balls,
-        state,
-        False,
-        np.empty((0, N_RECORD)),
-    )[0]
+    return row_kernel(q, qt, p, False, np.empty((0, N_RECORD)))[0]
 
 
 @njit(cache=True)
-def ball_equilibrium(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    tol,
-    max_iter,
-    f,
-    kbb,
-    rec,
-):
+def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)
@@ -1568,37 +1465,15 @@ def ball_equilibrium(
     and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
     last evaluation (at the returned balls and velocities). Returns the number of
     Newton steps (-1: not converged in ``max_iter``)."""
-    nz = ball_ref.shape[0]
+    nz = p.ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
     recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
     jv = np.empty((0, 0))
-    damping = max(law_i.c_max, law_o.c_max, geometry.cage_damping, 1e-300)
+    damping = max(p.law_i.c_max, p.law_o.c_max, p.geometry.cage_damping, 1e-300)
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        row_eval(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            BALL_BLOCKS,
-            recs,
-            f,
-            kbb,
-            jv,
-        )
+        row_eval(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv)
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1724,30 +1599,7 @@ def _predict_balls(q, qt, ball_ref, cage_ratio, b, bt, sm, xl, xtl):
 
 
 @njit(cache=True)
-def quasi_static_balls(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    kbb,
-    kx,
-    cx,
-):
+def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
     """One evaluation of a row with quasi-static balls: q, q_t (n, the full element
     vectors, work arrays) hold the frame and modal coordinates x in their first
     nx = n - 3Z entries (set by the caller); ``balls`` (:func:`ball_workspace`)
@@ -1765,10 +1617,11 @@ def quasi_static_balls(
     CONDENSED_BALLS mode), whose S is stored. A
     Jacobian call at the state of the last solution (Exudyn's usual order) reuses
     it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
-    nz = ball_ref.shape[0]
+    geometry, state = p.geometry, p.state
+    nz = p.ball_ref.shape[0]
     nb = 3 * nz
     nx = q.shape[0] - nb
-    b, bt, sm, xl, xtl, flag = _split_balls(balls, nb, nx)
+    b, bt, sm, xl, xtl, flag = _split_balls(p.balls, nb, nx)
     same = flag[0] > 0.0
     if same:
         for c in range(nx):
@@ -1780,36 +1633,14 @@ def quasi_static_balls(
             q[nx + e] = b[e]
             qt[nx + e] = bt[e]
     else:
-        _predict_balls(q, qt, ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        _predict_balls(q, qt, p.ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
         its = -1
         for attempt in range(2):
             if attempt == 1:  # once more from the last solution
                 for e in range(nb):
                     q[nx + e] = b[e]
                     qt[nx + e] = bt[e]
-            its = ball_equilibrium(
-                q,
-                qt,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                geometry.ball_force_tol,
-                BALL_MAXIT,
-                f,
-                kbb,
-                rec,
-            )
+            its = ball_equilibrium(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec)
             if its >= 0:
                 break
         state[5] = 0
@@ -1823,41 +1654,19 @@ def quasi_static_balls(
                 xtl[c] = qt[c]
             flag[0] = 1.0
     if jacobian:
-        row_eval(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            CONDENSED_BALLS,
-            np.empty((0, N_RECORD)),
-            f,
-            kx,
-            cx,
-        )
+        row_eval(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
 
 
 @njit(cache=True)
 def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
-    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx,
-    then the row's kernel inputs, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
+    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, the
+    row's :data:`RowPack`, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
     Per row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
     vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
-    reference ``ball_ref`` is subtracted), then :func:`row_eval` -- or, for
-    quasi-static balls (``geometry.quasi_static_balls``; idx covers the frame and modal
+    reference ``p.ball_ref`` is subtracted), then :func:`row_eval` -- or, for
+    quasi-static balls (``p.geometry.quasi_static_balls``; idx covers the frame and modal
     coordinates only, qe / ve are the full work vectors), :func:`quasi_static_balls`;
     the rows' results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
     f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
@@ -1875,92 +1684,23 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             for e in range(n):
                 out_f[idx[e]] = 0.0
     for part in parts:
-        (
-            idx,
-            qe,
-            ve,
-            f,
-            jq,
-            jv,
-            rec,
-            kbb,
-            kx,
-            cx,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-        ) = part
+        idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, p = part
         n = idx.shape[0]
         for e in range(n):
             qe[e] = qn[idx[e]]
             ve[e] = vn[idx[e]]
-        if geometry.quasi_static_balls:
-            quasi_static_balls(
-                qe,
-                ve,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                jacobian,
-                rec,
-                f,
-                kbb,
-                kx,
-                cx,
-            )
+        if p.geometry.quasi_static_balls:
+            quasi_static_balls(qe, ve, p, jacobian, rec, f, kbb, kx, cx)
             jq_, jv_ = kx, cx
         else:
             if absolute:
+                ball_ref = p.ball_ref
                 nz = ball_ref.shape[0]
                 b0 = n - 3 * nz
                 for j in range(nz):
                     for c in range(3):
                         qe[b0 + 3 * j + c] -= ball_ref[j, c]
-            row_eval(
-                qe,
-                ve,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                jacobian,
-                rec,
-                f,
-                jq,
-                jv,
-            )
+            row_eval(qe, ve, p, jacobian, rec, f, jq, jv)
             jq_, jv_ = jq, jv
         if jacobian:
             for r in range(n):
@@ -1973,9 +1713,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
 
 
 @njit(cache=True)
-def row_history(
-    qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state, recs
-):
+def row_history(qs, vts, p, recs):
     """:func:`row_eval` over a recorded history (the outputs pass, one compiled loop):
     element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
     per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
@@ -1985,9 +1723,9 @@ def row_history(
     nt = qs.shape[0]
     out = np.zeros(qs.shape)
     empty = np.empty((0, 0))
-    if geometry.quasi_static_balls:
+    if p.geometry.quasi_static_balls:
         nx = qs.shape[1]
-        nb = 3 * ball_ref.shape[0]
+        nb = 3 * p.ball_ref.shape[0]
         qf = np.zeros(nx + nb)
         vf = np.zeros(nx + nb)
         f = np.empty(nx + nb)
@@ -1995,56 +1733,11 @@ def row_history(
         for i in range(nt):
             qf[:nx] = qs[i]
             vf[:nx] = vts[i]
-            quasi_static_balls(
-                qf,
-                vf,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                False,
-                recs[i],
-                f,
-                kbb,
-                empty,
-                empty,
-            )
+            quasi_static_balls(qf, vf, p, False, recs[i], f, kbb, empty, empty)
             out[i] = f[:nx]
         return out
     for i in range(nt):
-        row_eval(
-            qs[i],
-            vts[i],
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            False,
-            recs[i],
-            out[i],
-            empty,
-            empty,
-        )
+        row_eval(qs[i], vts[i], p, False, recs[i], out[i], empty, empty)
     return out
 
 
