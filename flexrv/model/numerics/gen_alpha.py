@@ -46,6 +46,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.core.params import pack_type
+from flexrv.model.numerics.block_lu import block_factor, block_solve, block_structure, has_block_structure
 from flexrv.model.numerics.linalg import lu_factor, lu_solve
 
 # -- indices into the state's float parameters ``par``
@@ -62,7 +63,10 @@ PH_PREDICTOR, PH_ITERATE, PH_JACOBIAN = 0, 1, 2
 EVALUATE, CONVERGED, FAILED = 1, 0, -1
 
 #: the integrator state: parameters, registers, current and start-of-step vectors,
-#: residual, Newton correction, the constant matrices and the factorised iteration matrix
+#: residual, Newton correction, the constant matrices and the factorised iteration matrix; with
+#: dense diagonal blocks (``blocks`` (K, 2) of (start, size); empty: one dense LU), the block
+#: elimination's other coordinates ``xs``, its Y_k, Schur complement, pivots and work vectors
+#: (:mod:`flexrv.model.numerics.block_lu`)
 GaState = pack_type(
     "GaState",
     ("par", (np.float64, 1)),
@@ -82,6 +86,13 @@ GaState = pack_type(
     ("damp", (np.float64, 2)),
     ("lu", (np.float64, 2)),
     ("piv", (np.int64, 1)),
+    ("blocks", (np.int64, 2)),
+    ("xs", (np.int64, 1)),
+    ("ys", (np.float64, 2)),
+    ("schur", (np.float64, 2)),
+    ("xpiv", (np.int64, 1)),
+    ("tx", (np.float64, 1)),
+    ("zx", (np.float64, 1)),
 )
 
 
@@ -108,11 +119,25 @@ def new_state(
     max_iterations: int = 25,
     max_modified: int = 8,
     adapt_initial_residual: bool = True,
+    blocks=None,
 ) -> GaState:
-    """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0)."""
+    """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0).
+    ``blocks``: [(start, size), ...] dense diagonal blocks of the iteration matrix that couple
+    only through the other coordinates (M, K, D and the force's Jacobians zero between two
+    blocks): the Newton systems are then solved by block elimination
+    (:mod:`flexrv.model.numerics.block_lu`); None: one dense LU."""
     m = np.ascontiguousarray(mass, dtype=float)
     n = m.shape[0]
     z = np.zeros((n, n))
+    stiff = z.copy() if stiffness is None else np.ascontiguousarray(stiffness, dtype=float)
+    damp = z.copy() if damping is None else np.ascontiguousarray(damping, dtype=float)
+    if blocks:
+        bl, xs = block_structure(n, blocks)
+        if not all(has_block_structure(a, bl) for a in (m, stiff, damp)):
+            raise ValueError("the mass, stiffness or damping matrix couples two of the dense blocks")
+    else:
+        bl, xs = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
+    nb, nx = int(bl[:, 1].sum()), len(xs)
     par = np.zeros(N_PAR)
     par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA] = coefficients(spectral_radius)
     par[P_RTOL], par[P_ATOL] = tolerance
@@ -125,10 +150,17 @@ def new_state(
         ip,
         *vec,
         m,
-        z.copy() if stiffness is None else np.ascontiguousarray(stiffness, dtype=float),
-        z.copy() if damping is None else np.ascontiguousarray(damping, dtype=float),
+        stiff,
+        damp,
         z.copy(),
         np.zeros(n, np.int64),
+        bl,
+        xs,
+        np.zeros((nb, nx)),
+        np.zeros((nx, nx)),
+        np.zeros(nx, np.int64),
+        np.zeros(nx),
+        np.zeros(nx),
     )
 
 
@@ -199,6 +231,8 @@ def _factor(st, jq, jv):
         for j in range(n):
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
+    if st.blocks.shape[0] > 0:
+        return block_factor(s, st.blocks, st.xs, st.piv, st.ys, st.schur, st.xpiv)
     return lu_factor(s, s, st.piv)  # in place
 
 
@@ -209,7 +243,10 @@ def _correct(st):
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
-    lu_solve(st.lu, st.piv, st.r, st.dx)
+    if st.blocks.shape[0] > 0:
+        block_solve(st.lu, st.blocks, st.xs, st.piv, st.ys, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
+    else:
+        lu_solve(st.lu, st.piv, st.r, st.dx)
     for i in range(st.q.shape[0]):
         st.q[i] -= st.dx[i]
         st.v[i] -= gp * st.dx[i]
