@@ -10,7 +10,11 @@ so a speed change can be checked for an unchanged answer.
 
     python benchmarks/bench_flexible_model.py [--preset rv221] [--t-end 0.1] [--cold]
         [--models rigid,balls,flexible] [--harmonics K] [--parts main_bearing,crankshaft]
-        [--ring-options '{"condense": false}']
+        [--ring-options '{"condense": false}'] [--split]
+
+``--split``: where a step's CPU goes (the preset with 5 ms ramps, the flexible-rings model):
+the bearing rows' force and Jacobian calls (compiled kernel and its Python glue), the fused
+element of the other contacts, and the rest (Exudyn: assembly, sparse LU, Newton, hooks).
 
 Goal: the flexible-rings model (condensed rings, main bearing flexible) <= 15 CPU s per
 simulated second on rv221 and on rv40e (dt 1e-4, one BLAS thread). Measured figures with date and
@@ -65,6 +69,70 @@ def run(preset: str, model: str, t_end: float, options: dict, window: float | No
     }
 
 
+def _timed_method(owner, attr: str, acc: list) -> None:
+    """Accumulate the CPU time and the calls of ``owner.attr`` (a class: every instance) in ``acc``."""
+    fn = getattr(owner, attr)
+
+    if isinstance(owner, type):
+
+        def timed(self, *args, **kw):
+            c0 = time.process_time()
+            out = fn(self, *args, **kw)
+            acc[0] += time.process_time() - c0
+            acc[1] += 1
+            return out
+
+    else:
+
+        def timed(*args, **kw):
+            c0 = time.process_time()
+            out = fn(*args, **kw)
+            acc[0] += time.process_time() - c0
+            acc[1] += 1
+            return out
+
+    setattr(owner, attr, timed)
+
+
+def split(preset: str, t_end: float, window: float) -> None:
+    """Print the CPU per step of the flexible-rings model by part (module docstring, ``--split``)."""
+    from _shared import quick_ramps
+
+    from flexrv.model.flexible_bearing import RowElement
+    from flexrv.simulation import Simulation
+
+    sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
+    model = sim.build()
+    sim.run(t_end=2e-3, segment_steps=5)  # numba loads, one-time imports
+    acc = {k: [0.0, 0] for k in ("row force", "row Jacobian", "fused force", "fused Jacobian")}
+    saved = RowElement.force, RowElement.jacobian
+    _timed_method(RowElement, "force", acc["row force"])
+    _timed_method(RowElement, "jacobian", acc["row Jacobian"])
+    _timed_method(model.fused, "residual", acc["fused force"])
+    _timed_method(model.fused, "jacobian", acc["fused Jacobian"])
+    try:
+        res = sim.run(t_end=t_end)
+    finally:
+        RowElement.force, RowElement.jacobian = saved
+    tm = sim.timing
+    steps = max(tm["steps"], 1)
+    solve = tm["solve_cpu_s"]
+    te = res["te"].sel(time=slice(t_end - window, None)).values
+    print(
+        f"{preset} flexible rings, 5 ms ramps, {t_end:g} s: {steps} steps, "
+        f"Newton {tm['newton_iterations'] / steps:.2f} and Jacobians {tm['jacobians'] / steps:.3f} per step; "
+        f"solve CPU {1e3 * solve / steps:.3f} ms per step"
+    )
+    for key, (cpu, calls) in acc.items():
+        print(
+            f"  {key:15s} {calls / steps:6.2f} calls per step, {1e6 * cpu / max(calls, 1):7.1f} us each, "
+            f"{1e3 * cpu / steps:6.3f} ms per step ({cpu / solve:5.1%})"
+        )
+    rest = solve - sum(v[0] for v in acc.values())
+    print(f"  {'rest (Exudyn)':15s} {1e3 * rest / steps:48.3f} ms per step ({rest / solve:5.1%})")
+    print(f"  TE over the last {window:g} s: mean {te.mean():.4f}, p-p {np.ptp(te):.4f} arcsec")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--preset", default="rv221")
@@ -81,7 +149,11 @@ def main() -> None:
         "(default: the last half; past the load ramp 0.1-0.2 s use --t-end 0.3 --window 0.1)",
     )
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
+    parser.add_argument("--split", action="store_true", help="CPU per step by part (flexible rings, 5 ms ramps)")
     args = parser.parse_args()
+    if args.split:
+        split(args.preset, args.t_end, 0.5 * args.t_end if args.window is None else args.window)
+        return
     if args.cold:
         os.environ["FLEXRV_CACHE"] = tempfile.mkdtemp(prefix="flexrv-bench-")
     window = 0.5 * args.t_end if args.window is None else args.window
