@@ -14,7 +14,10 @@ so a speed change can be checked for an unchanged answer.
 
 ``--split``: where a step's CPU goes (the preset with 5 ms ramps, the flexible-rings model):
 the bearing rows' force and Jacobian calls (compiled kernel and its Python glue), the fused
-element of the other contacts, and the rest (Exudyn: assembly, sparse LU, Newton, hooks).
+element of the other contacts, and the rest (Exudyn: assembly, sparse LU, Newton, hooks); then
+one factorisation of a matrix of the model's structure (the balls' dense blocks, the other
+coordinates) by block elimination (:mod:`flexrv.model.numerics.block_lu`), by the dense
+compiled LU and by LAPACK (scipy), CPU per factorisation.
 
 Goal: the flexible-rings model (condensed rings, main bearing flexible) <= 15 CPU s per
 simulated second on rv221 and on rv40e (dt 1e-4, one BLAS thread). Measured figures with date and
@@ -131,6 +134,53 @@ def split(preset: str, t_end: float, window: float) -> None:
     rest = solve - sum(v[0] for v in acc.values())
     print(f"  {'rest (Exudyn)':15s} {1e3 * rest / steps:48.3f} ms per step ({rest / solve:5.1%})")
     print(f"  TE over the last {window:g} s: mean {te.mean():.4f}, p-p {np.ptp(te):.4f} arcsec")
+    factorisations(model)
+
+
+def factorisations(model, repeat: int = 30) -> None:
+    """Print the CPU of one factorisation of an n x n matrix with the model's ball blocks
+    (members ``main_bearing_balls*``: dense, uncoupled between rows) by block elimination, by
+    the dense compiled LU and by LAPACK's getrf (scipy), and the block solve's error."""
+    import scipy.linalg
+
+    from flexrv.model.numerics import block_lu, linalg
+
+    n = model.n
+    spans = [(m.offset, m.n) for name, m in model.members.items() if name.startswith("main_bearing_balls")]
+    blocks, xs = block_lu.block_structure(n, spans)
+    rng = np.random.default_rng(0)
+    s = rng.normal(size=(n, n)) + n * np.eye(n)
+    for i, (a0, am) in enumerate(blocks):
+        for j, (b0, bm) in enumerate(blocks):
+            if i != j:
+                s[a0 : a0 + am, b0 : b0 + bm] = 0.0
+    nx, nb = len(xs), int(blocks[:, 1].sum())
+    w, piv, ys = s.copy(), np.zeros(n, np.int64), np.zeros((nb, nx))
+    dk = np.zeros(block_lu.work_sizes(blocks, xs)[1])
+    schur, xpiv, lu = np.zeros((nx, nx)), np.zeros(nx, np.int64), np.zeros((n, n))
+
+    def cpu(fn) -> float:
+        fn()
+        c0 = time.process_time()
+        for _ in range(repeat):
+            fn()
+        return 1e3 * (time.process_time() - c0) / repeat
+
+    def blocked():
+        block_lu.block_factor(w, blocks, xs, piv, ys, dk, schur, xpiv)
+
+    t_block = cpu(blocked)
+    t_dense = cpu(lambda: linalg.lu_factor(s, lu, piv))
+    t_lapack = cpu(lambda: scipy.linalg.lu_factor(s))
+    r, x = rng.normal(size=n), np.zeros(n)
+    blocked()
+    block_lu.block_solve(w, blocks, xs, piv, ys, dk, schur, xpiv, r, x, np.zeros(nx), np.zeros(nx))
+    err = np.max(np.abs(x - np.linalg.solve(s, r))) / np.max(np.abs(x))
+    print(
+        f"  factorisation of {n} coordinates (blocks {[int(b) for b in blocks[:, 1]]}, {nx} others): block "
+        f"elimination {t_block:.3f} ms, dense compiled LU {t_dense:.3f} ms, LAPACK getrf {t_lapack:.3f} ms "
+        f"(block solve within {err:.1e} of numpy's)"
+    )
 
 
 def main() -> None:

@@ -152,12 +152,13 @@ def test_block_elimination_solve():
         assert block_lu.has_block_structure(s, blocks)
         nx, nb = len(xs), int(blocks[:, 1].sum())
         w, piv, ys = s.copy(), np.zeros(n, np.int64), np.zeros((nb, nx))
+        dk = np.zeros(block_lu.work_sizes(blocks, xs)[1])
         schur, xpiv = np.zeros((nx, nx)), np.zeros(nx, np.int64)
-        assert block_lu.block_factor(w, blocks, xs, piv, ys, schur, xpiv)
+        assert block_lu.block_factor(w, blocks, xs, piv, ys, dk, schur, xpiv)
         for _ in range(2):  # one factorisation, several right-hand sides
             r = rng.normal(size=n)
             x = np.zeros(n)
-            block_lu.block_solve(w, blocks, xs, piv, ys, schur, xpiv, r, x, np.zeros(nx), np.zeros(nx))
+            block_lu.block_solve(w, blocks, xs, piv, ys, dk, schur, xpiv, r, x, np.zeros(nx), np.zeros(nx))
             ref = np.linalg.solve(s, r)
             assert np.max(np.abs(x - ref)) <= 1e-12 * np.max(np.abs(ref))
     blocks2, _ = block_lu.block_structure(10, [(0, 4), (5, 5)])
@@ -168,7 +169,7 @@ def test_block_elimination_solve():
     sing[2:4, 2:4] = 0.0
     blocks, xs = block_lu.block_structure(6, [(2, 2)])
     assert not block_lu.block_factor(
-        sing, blocks, xs, np.zeros(6, np.int64), np.zeros((2, 4)), np.zeros((4, 4)), np.zeros(4, np.int64)
+        sing, blocks, xs, np.zeros(6, np.int64), np.zeros((2, 4)), np.zeros(4), np.zeros((4, 4)), np.zeros(4, np.int64)
     )
 
 

@@ -46,7 +46,13 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.core.params import pack_type
-from flexrv.model.numerics.block_lu import block_factor, block_solve, block_structure, has_block_structure
+from flexrv.model.numerics.block_lu import (
+    block_factor,
+    block_solve,
+    block_structure,
+    has_block_structure,
+    work_sizes,
+)
 from flexrv.model.numerics.linalg import lu_factor, lu_solve
 
 # -- indices into the state's float parameters ``par``
@@ -65,7 +71,7 @@ EVALUATE, CONVERGED, FAILED = 1, 0, -1
 #: the integrator state: parameters, registers, current and start-of-step vectors,
 #: residual, Newton correction, the constant matrices and the factorised iteration matrix; with
 #: dense diagonal blocks (``blocks`` (K, 2) of (start, size); empty: one dense LU), the block
-#: elimination's other coordinates ``xs``, its Y_k, Schur complement, pivots and work vectors
+#: elimination's other coordinates ``xs``, its Y_k, blocks' LU, Schur complement, pivots and work vectors
 #: (:mod:`flexrv.model.numerics.block_lu`)
 GaState = pack_type(
     "GaState",
@@ -89,6 +95,7 @@ GaState = pack_type(
     ("blocks", (np.int64, 2)),
     ("xs", (np.int64, 1)),
     ("ys", (np.float64, 2)),
+    ("dk", (np.float64, 1)),
     ("schur", (np.float64, 2)),
     ("xpiv", (np.int64, 1)),
     ("tx", (np.float64, 1)),
@@ -137,7 +144,7 @@ def new_state(
             raise ValueError("the mass, stiffness or damping matrix couples two of the dense blocks")
     else:
         bl, xs = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
-    nb, nx = int(bl[:, 1].sum()), len(xs)
+    (nb, nd), nx = work_sizes(bl, xs), len(xs)
     par = np.zeros(N_PAR)
     par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA] = coefficients(spectral_radius)
     par[P_RTOL], par[P_ATOL] = tolerance
@@ -157,6 +164,7 @@ def new_state(
         bl,
         xs,
         np.zeros((nb, nx)),
+        np.zeros(nd),
         np.zeros((nx, nx)),
         np.zeros(nx, np.int64),
         np.zeros(nx),
@@ -232,7 +240,7 @@ def _factor(st, jq, jv):
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
     if st.blocks.shape[0] > 0:
-        return block_factor(s, st.blocks, st.xs, st.piv, st.ys, st.schur, st.xpiv)
+        return block_factor(s, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv)
     return lu_factor(s, s, st.piv)  # in place
 
 
@@ -244,7 +252,7 @@ def _correct(st):
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
     if st.blocks.shape[0] > 0:
-        block_solve(st.lu, st.blocks, st.xs, st.piv, st.ys, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
+        block_solve(st.lu, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
     else:
         lu_solve(st.lu, st.piv, st.r, st.dx)
     for i in range(st.q.shape[0]):
