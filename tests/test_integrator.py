@@ -197,6 +197,54 @@ def test_block_elimination_inside_the_integrator():
         gen_alpha.new_state(coupled, k, blocks=blocks)
 
 
+def _duffing(st, h, n_steps, k, c):
+    """Integrate M a + k q + c q^3 = 0 (the force and its Jacobian handed back to the state
+    machine); returns the states per step."""
+    qs = []
+    for _ in range(n_steps):
+        gen_alpha.begin_step(st, h)
+        status = gen_alpha.EVALUATE
+        while status == gen_alpha.EVALUATE:
+            f = -k * st.q - c * st.q**3
+            jq = np.diag(-k - 3.0 * c * st.q**2)
+            status = gen_alpha.after_eval(st, f, jq, np.zeros_like(jq))
+        assert status == gen_alpha.CONVERGED
+        assert gen_alpha.finish_step(st)
+        qs.append(st.q.copy())
+    return np.array(qs)
+
+
+def test_jacobian_kept_across_steps():
+    """jacobian_each_step=False (Exudyn's modifiedNewtonJacUpdatePerStep = False): on a
+    linear 2-DOF oscillator (exact Jacobian) the first step's factorisation serves all 100
+    steps with bit-identical states; on a stiffening (Duffing) oscillator, 3 coordinates
+    from q0 = 0.5..1.5 with k = 1, c = 4, 200 steps of 0.01, the states agree with a fresh
+    Jacobian per step within 1e-9 (Newton tolerance 1e-10 relative; measured 7.9e-11) with
+    fewer Jacobians (measured 1 against 200) and more Newton iterations (657 against 400)."""
+    q0, h = np.array([1.0, 0.0]), 0.02
+    each = integrate_linear(M2, K2, np.zeros((2, 2)), q0, np.zeros(2), h, 100)
+    st = gen_alpha.new_state(M2, spectral_radius=0.5, tolerance=(1e-12, 1e-14), jacobian_each_step=False)
+    gen_alpha.set_state(st, q0, np.zeros(2), np.linalg.solve(M2, -K2 @ q0))
+    jq = -K2
+    for i in range(100):
+        gen_alpha.begin_step(st, h)
+        status = gen_alpha.EVALUATE
+        while status == gen_alpha.EVALUATE:
+            status = gen_alpha.after_eval(st, jq @ st.q, jq, np.zeros((2, 2)))
+        assert status == gen_alpha.CONVERGED and gen_alpha.finish_step(st)
+        np.testing.assert_array_equal(st.q, each[0][i + 1])
+    assert st.ip[gen_alpha.I_JACOBIANS] == 1
+    mass, k, c, q0 = np.eye(3), 1.0, 4.0, np.array([0.5, 1.0, 1.5])
+    runs = {}
+    for flag in (True, False):
+        st = gen_alpha.new_state(mass, tolerance=(1e-10, 1e-14), jacobian_each_step=flag)
+        gen_alpha.set_state(st, q0, np.zeros(3), -k * q0 - c * q0**3)
+        runs[flag] = (_duffing(st, 0.01, 200, k, c), st.ip[gen_alpha.I_JACOBIANS], st.ip[gen_alpha.I_NEWTON])
+    assert np.max(np.abs(runs[False][0] - runs[True][0])) < 1e-9
+    assert runs[True][1] == 200 and runs[False][1] <= 5
+    assert runs[False][2] > runs[True][2]
+
+
 # -------------------------------------------------------------- choice of the integrator
 
 
