@@ -19,6 +19,10 @@ one factorisation of a matrix of the model's structure (the balls' dense blocks,
 coordinates) by block elimination (:mod:`flexrv.model.numerics.block_lu`), by the dense
 compiled LU and by LAPACK (scipy), CPU per factorisation.
 
+``--paired-newton JSON``: the flexible-rings model (5 ms ramps) with the simulation's Newton
+settings and with these ``newton_options`` on top, alternating, twice each in one process:
+solve CPU per step and per simulated s, Newton iterations, Jacobians and TE of each run.
+
 Goal: the flexible-rings model (condensed rings, main bearing flexible) <= 15 CPU s per
 simulated second on rv221 and on rv40e (dt 1e-4, one BLAS thread). Measured figures with date and
 machine: docs/benchmarks.md; their history: CHANGELOG.md.
@@ -183,6 +187,32 @@ def factorisations(model, repeat: int = 30) -> None:
     )
 
 
+def paired_newton(preset: str, t_end: float, window: float, options: dict, repeat: int = 2) -> None:
+    """Print the flexible-rings model's solve with the default Newton settings and with
+    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``)."""
+    from _shared import quick_ramps
+
+    from flexrv.simulation import Simulation
+
+    print(f"{preset} flexible rings, 5 ms ramps, {t_end:g} s; TE over the last {window:g} s [arcsec]")
+    for _ in range(repeat):
+        for opts in (None, options):
+            sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
+            sim.build()
+            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts)  # numba loads, one-time imports
+            res = sim.run(t_end=t_end, newton_options=opts)
+            tm = sim.timing
+            steps = max(tm["steps"], 1)
+            te = res["te"].sel(time=slice(t_end - window, None)).values
+            print(
+                f"  {json.dumps(opts or {}):44s} {steps:5d} steps, Newton {tm['newton_iterations'] / steps:.2f}, "
+                f"Jacobians {tm['jacobians'] / steps:.3f} per step; solve {1e3 * tm['solve_cpu_s'] / steps:.3f} ms "
+                f"per step, {tm['solve_cpu_s'] / tm['simulated_s']:.1f} s per simulated s; TE {te.mean():.5f}, "
+                f"p-p {np.ptp(te):.5f}",
+                flush=True,
+            )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--preset", default="rv221")
@@ -200,7 +230,16 @@ def main() -> None:
     )
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
     parser.add_argument("--split", action="store_true", help="CPU per step by part (flexible rings, 5 ms ramps)")
+    parser.add_argument("--paired-newton", default=None, help="newton_options (JSON) against the defaults, paired")
     args = parser.parse_args()
+    if args.paired_newton:
+        paired_newton(
+            args.preset,
+            args.t_end,
+            0.5 * args.t_end if args.window is None else args.window,
+            json.loads(args.paired_newton),
+        )
+        return
     if args.split:
         split(args.preset, args.t_end, 0.5 * args.t_end if args.window is None else args.window)
         return
