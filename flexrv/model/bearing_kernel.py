@@ -54,6 +54,7 @@ prepares them).
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
@@ -178,6 +179,26 @@ RowPack = pack_type(
     ("zsign", (np.float64, (2,))),
     ("balls", (np.float64, 1)),
     ("state", (np.int64, (8,))),
+)
+
+#: what pass 1 of :func:`row_eval` (:func:`_row_geometry`) hands on, read by name: ball centres,
+#: inner and outer azimuths, the outer azimuths' cos and sin, the arms A p of the inner groove
+#: centres, ball minus groove centre e0 and relative velocity w0 of each ring's contacts, the
+#: raceway displacements du at the contacts (global: modal rings here, condensed rings from their
+#: local solves), the condensed rings' rotations to their cylindrical frames (empty: not
+#: condensed) and the modal rings' raceway bases at every ball
+RowPass1 = namedtuple(
+    "RowPass1",
+    "bpos psi_i psi_o cs_o arm e0_i w0_i e0_o w0_o du_i du_o rot_i rot_o bas_i bas_o",
+    module=__name__,
+)
+#: what the contact phase of :func:`row_eval` (:func:`_row_contacts`) hands on, per ring (``_i``,
+#: ``_o``): the contacts' loads, unit normals, dQ/d delta, damping coefficients, lengths |e|, central
+#: films and the condensed rings' global compliance factors (3Z, m; empty: none or no Jacobian)
+RowContacts = namedtuple(
+    "RowContacts",
+    "load_i load_o nrm_i nrm_o dq_i dq_o cd_i cd_o len_i len_o film_i film_o wg_i wg_o",
+    module=__name__,
 )
 
 #: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
@@ -852,10 +873,7 @@ def _frame_kinematics(q, qt):
 def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, om):
     """Pass 1 of :func:`row_eval`: the geometry of every ball with the rings undeflected
     (modal rings: with their coordinates), ball minus groove centre e0 and relative
-    velocity w0 of both contacts. Returns (ball centres, inner and outer azimuths, the
-    outer azimuths' cos and sin, arms A p of the inner groove centres, e0_i, w0_i, e0_o,
-    w0_o, raceway displacements du_i, du_o (global; modal rings), the condensed rings'
-    rotations to their cylindrical frames, the modal rings' bases at every ball)."""
+    velocity w0 of both contacts: a :data:`RowPass1`."""
     om0, om1, om2 = om
     z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
     co_r, co_z = geometry.outer_center_radius, geometry.outer_center_z
@@ -941,17 +959,18 @@ def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, c
             r_o[2, 0], r_o[2, 1], r_o[2, 2] = 0.0, 0.0, 1.0
         e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
         w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
-    return bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+    return RowPass1(
+        bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+    )
 
 
 @njit(cache=True, inline="always")
 def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state):
     """The contacts of both rings at every ball (:func:`_ring_contacts`; condensed rings:
-    their local solves, the inner one's deflection added to the arms ``pre[4]``). Returns
-    (loads, normals, dQ/d delta, damping, approach lengths and films of the inner and
-    outer contacts, the condensed rings' global compliance factors)."""
-    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre[1], pre[2], pre[4], pre[5], pre[6], pre[7], pre[8]
-    du_i, du_o, rot_i, rot_o = pre[9], pre[10], pre[11], pre[12]
+    their local solves, the inner one's deflection added to the arms ``pre.arm``): a
+    :data:`RowContacts`."""
+    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre.psi_i, pre.psi_o, pre.arm, pre.e0_i, pre.w0_i, pre.e0_o, pre.w0_o
+    du_i, du_o, rot_i, rot_o = pre.du_i, pre.du_o, pre.rot_i, pre.rot_o
     cond_i = comp_i.shape[0] > 0
     cond_o = comp_o.shape[0] > 0
     nz = psi_i.shape[0]
@@ -1020,7 +1039,7 @@ def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o
         wg_o,
         state,
     )
-    return load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o
+    return RowContacts(load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o)
 
 
 @njit(cache=True, inline="always")
@@ -1028,8 +1047,8 @@ def _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, re
     """Every ball's contact reactions on the frame and the rings' modes, its cage and pocket
     forces, into ``f`` (and ``rec`` when it has a row per ball); returns (Z, 3): each ball's
     cage direction (etx, ety) and radius in the housing (for the Jacobian blocks)."""
-    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre[0], pre[1], pre[2], pre[3], pre[4], pre[9], pre[10]
-    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con[0], con[1], con[2], con[3], con[10], con[11]
+    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre.bpos, pre.psi_i, pre.psi_o, pre.cs_o, pre.arm, pre.du_i, pre.du_o
+    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.film_i, con.film_o
     z_row, rb, cage_ratio = geometry.z, geometry.ball_radius_pitch, geometry.cage_ratio
     cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
     m_i = tab_i.shape[2]
@@ -1103,8 +1122,9 @@ def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
     """Every ball's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
     and, in column 3, the rate of its force from the frame's and rings' motion; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
-    w0_i, w0_o = pre[6], pre[8]
-    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o = con[:10]
+    w0_i, w0_o = pre.w0_i, pre.w0_o
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.dq_i, con.dq_o
+    cd_i, cd_o, len_i, len_o = con.cd_i, con.cd_o, con.len_i, con.len_o
     cage_ratio, cage_k, pocket_k = geometry.cage_ratio, geometry.cage_stiffness, geometry.pocket_stiffness
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
@@ -1142,8 +1162,9 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
     condensed rings' contacts keep their T rows and contact factors for
     :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
-    arm, bas_i_all, bas_o_all = pre[4], pre[13], pre[14]
-    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o = con[:12]
+    arm, bas_i_all, bas_o_all = pre.arm, pre.bas_i, pre.bas_o
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.dq_i, con.dq_o
+    cd_i, cd_o, len_i, len_o, film_i, film_o = con.cd_i, con.cd_o, con.len_i, con.len_o, con.film_i, con.film_o
     k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o = wk
     cage_ratio, cage_k, cage_c = geometry.cage_ratio, geometry.cage_stiffness, geometry.cage_damping
     pocket_k = geometry.pocket_stiffness
@@ -1226,11 +1247,11 @@ def _row_pass2(
     and Jacobian blocks (:func:`_row_local_blocks`, :func:`_row_ball_jacobians`). Returns the
     condensed rings' T rows and contact factors of every ball and the entrainment speed's
     rate d u / d q_t[5] (for :func:`_condensed_row_jacobian`)."""
-    cond_i = pre[11].shape[0] > 0
-    cond_o = pre[12].shape[0] > 0
+    cond_i = pre.rot_i.shape[0] > 0
+    cond_o = pre.rot_o.shape[0] > 0
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
-    nz = pre[0].shape[0]
+    nz = pre.bpos.shape[0]
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
     bas_o = np.empty((3, m_o))
@@ -1274,16 +1295,8 @@ def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
     the contacts in series with the ring, (I - K C)^-1 K and D, through the inner ring's
     T rows onto the frame and, for both rings, onto the balls; ``p2``: :func:`_row_pass2`'s
     result."""
-    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o, wg_i, wg_o = (
-        con[2],
-        con[3],
-        con[6],
-        con[7],
-        con[10],
-        con[11],
-        con[12],
-        con[13],
-    )
+    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o = con.nrm_i, con.nrm_o, con.cd_i, con.cd_o, con.film_i, con.film_o
+    wg_i, wg_o = con.wg_i, con.wg_o
     ti_all, vf_i, vf_o, dudw = p2
     nz = nrm_i.shape[0]
     ball = slice(b0, b0 + 3 * nz)
