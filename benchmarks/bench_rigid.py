@@ -65,13 +65,14 @@ def _record_calls(sim, t_end: float) -> dict:
 
 
 def _replay_functions():
-    """Compiled replays of a call sequence through the fused kernel or one element's kernel."""
+    """Compiled replays of calls [i0, i1) of a sequence through the fused kernel or one
+    element's kernel (``call`` False: the same loop without the kernel)."""
     from numba import njit
 
     def make(kern):
         @njit
-        def replay(qs, vs, jacs, tables, live, f, jq, jv, call, packs):
-            for i in range(qs.shape[0]):
+        def replay(i0, i1, qs, vs, jacs, tables, live, f, jq, jv, call, packs):
+            for i in range(i0, i1):
                 for j in range(len(tables)):
                     live[j][:] = tables[j][i]
                 if call:
@@ -82,43 +83,72 @@ def _replay_functions():
     return make
 
 
-def _replay_costs(model, seq) -> dict:
+def _arrays(pack) -> list:
+    """The arrays of a pack (nested packs included): the elements' states to snapshot."""
+    out = []
+    for value in pack:
+        if isinstance(value, np.ndarray):
+            out.append(value)
+        elif isinstance(value, tuple) and hasattr(value, "_fields"):
+            out += _arrays(value)
+    return out
+
+
+def _chunked_cpu(replay, args, call, packs, n, chunk, repeats) -> float:
+    """CPU s of the whole sequence, the sum over chunks of ``chunk`` calls of the least of
+    ``repeats`` runs of each chunk, every run from the state before the chunk (the packs'
+    arrays restored): robust to the other jobs of a shared machine."""
+    arrays = [a for p in packs for a in _arrays(p)]
+    total = 0.0
+    for i0 in range(0, n, chunk):
+        i1 = min(n, i0 + chunk)
+        saved = [a.copy() for a in arrays]
+        best = np.inf
+        for _ in range(repeats):
+            for a, b in zip(arrays, saved):
+                np.copyto(a, b)
+            c0 = time.process_time()
+            replay(i0, i1, *args, call, packs)
+            best = min(best, time.process_time() - c0)
+        total += best
+    return total
+
+
+def _replay_costs(model, seq, chunk: int = 100, repeats: int = 5) -> dict:
     """CPU us per call sequence of the fused kernel and of every element alone (module
-    docstring), and the pins' evaluation counts."""
+    docstring), and the pins' evaluation count."""
     from flexrv.model.core.registry import spec_of
 
     fused = model.fused
     make = _replay_functions()
+    n = len(seq["t"])
     live = tuple(a for _, a in fused.timed)
     tables = tuple(
-        np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(seq["t"]), (len(seq["t"]), a.size)), dtype=float)
+        np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(seq["t"]), (n, a.size)), dtype=float)
         for g, a in fused.timed
     )
     if not live:  # (numba needs a typed tuple)
-        live, tables = (np.zeros(0),), (np.zeros((len(seq["t"]), 0)),)
+        live, tables = (np.zeros(0),), (np.zeros((n, 0)),)
     kernels = [("fused", fused.kernel, tuple(fused.packs))]
     for (g, _), p in zip(fused.slots, fused.packs):
         kernels.append((g.name, spec_of(g).kernel, (p,)))
     args = (seq["q"], seq["v"], seq["jac"], tables, live, fused.f, fused.jq, fused.jv)
+    pins = next((g for g in model.groups if g.kind == "pins"), None)
+    counter = None if pins is None else getattr(pins, "calls", getattr(pins, "ctr", None))
     out = {}
     for name, kern, packs in kernels:
         replay = make(kern)
-        spent = {True: [], False: []}
-        for call in (True, False, True, False):
-            for g in model.groups:
-                g.reset()
-            replay(*args[:8], call, packs)  # (compile; warm starts as after a first pass)
-            for g in model.groups:
-                g.reset()
-            pins = next((g for g in model.groups if g.kind == "pins"), None)
-            counter = None if pins is None else getattr(pins, "calls", getattr(pins, "ctr", None))
-            c_before = int(counter[0]) if pins is not None else 0
-            c0 = time.process_time()
-            replay(*args[:8], call, packs)
-            spent[call].append(time.process_time() - c0)
-            if call and name == "fused" and pins is not None:
-                out["pin_evaluations"] = int(counter[0]) - c_before
-        out[name] = (min(spent[True]) - min(spent[False])) * 1e6
+        for g in model.groups:
+            g.reset()
+        replay(0, n, *args, True, packs)  # (compile)
+        for g in model.groups:
+            g.reset()
+        c_before = int(counter[0]) if counter is not None else 0
+        spent = _chunked_cpu(replay, args, True, packs, n, chunk, repeats)
+        if name == "fused" and counter is not None:  # (each chunk's last run carries on)
+            out["pin_evaluations"] = int(counter[0]) - c_before
+        empty = _chunked_cpu(replay, args, False, packs, n, chunk, repeats)
+        out[name] = (spent - empty) * 1e6
     return out
 
 

@@ -106,7 +106,15 @@ from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import inv_small, matmul_small
-from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
+from flexrv.model.numerics.newton import (
+    NEWTON_STATE,
+    QUAD_EST,
+    VALID,
+    apply_predictor,
+    carry_quadratic,
+    newton_start,
+    newton_update,
+)
 from flexrv.units import DEG_PER_RAD
 
 _F, _I = np.float64, np.int64
@@ -188,16 +196,42 @@ def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
             jq[ii[s], ii[r]] -= w * (b[0, s] * kb0 + b[1, s] * kb1)
 
 
+#: the slots of a crank's bearing start (SupportWork field ``bp``, per crank): valid (1), the
+#: displacement d (x, y) of the last evaluation, its series tangent K_s (xx, xy, yy) and the bearing
+#: displacement b (x, y) solved there
+BP_VALID, BP_D, BP_K, BP_B, BP_SIZE = 0, 1, 3, 6, 8
+
+
+@njit(cache=True, inline="always")
+def _bearing_start(j, dx, dy, kb, bstate, bp):
+    """The Newton start of crank j's bearing displacement b at d: the last solution b_prev
+    (``bstate``) plus its first-order change (I - K_s / k_bend)(d - d_prev) (db/dd =
+    (K_b + k I)^-1 k = I - K_s / k, K_s the series tangent of the last evaluation), where
+    ``bp`` holds that evaluation and bstate is still its b (else b_prev: set from outside)."""
+    b0x, b0y = bstate[j, 0], bstate[j, 1]
+    if kb > 0.0 and bp[j, BP_VALID] > 0.0 and bp[j, BP_B] == b0x and bp[j, BP_B + 1] == b0y:
+        ex, ey = dx - bp[j, BP_D], dy - bp[j, BP_D + 1]
+        b0x += ex - (bp[j, BP_K] * ex + bp[j, BP_K + 1] * ey) / kb
+        b0y += ey - (bp[j, BP_K + 1] * ex + bp[j, BP_K + 2] * ey) / kb
+    return b0x, b0y
+
+
 @njit(cache=True)
-def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs):
+def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs):
     """Spring force of every crank support at d = d0 - u (housing frame): fs (2N,)
     on the cranks, the block-diagonal tangent kk = -dfs/dd (2N, 2N), hh (2N, N)
-    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts."""
+    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts (bstate,
+    and bp for the first-order start of the next evaluation, :func:`_bearing_start`;
+    kb the crank's bending stiffness)."""
     for j in range(d0x.shape[0]):
+        dx, dy = d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1]
+        b0x, b0y = _bearing_start(j, dx, dy, kb, bstate, bp)
         fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(
-            d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1], gam[j], clear[j], sc, angles, linear, bstate[j, 0], bstate[j, 1]
+            dx, dy, gam[j], clear[j], sc, angles, linear, b0x, b0y
         )
         bstate[j, 0], bstate[j, 1] = bx, by
+        bp[j, BP_VALID], bp[j, BP_D], bp[j, BP_D + 1] = 1.0, dx, dy
+        bp[j, BP_K], bp[j, BP_K + 1], bp[j, BP_K + 2], bp[j, BP_B], bp[j, BP_B + 1] = kxx, kxy, kyy, bx, by
         fs[2 * j], fs[2 * j + 1] = fx, fy
         kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j], kk[2 * j + 1, 2 * j + 1] = kxx, kxy, kxy, kyy
         hh[2 * j, j], hh[2 * j + 1, j] = hx, hy
@@ -207,7 +241,7 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk,
 def support_work_size(n: int) -> int:
     """Length of :func:`crank_support_kernel`'s work array for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
-    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
+    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m + BP_SIZE * n
 
 
 #: the carrier Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
@@ -230,11 +264,11 @@ def _carrier_residual(u, ch, fs, res):
 
 
 @njit(cache=True)
-def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res):
+def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs, ch, u, res):
     """The elastic carrier's support forces at d = d0 - u and residual R = u + C_h f_s into
     ``res`` (tangent K into kk) for :func:`~flexrv.model.numerics.newton.newton_update`;
     returns (max|R|, max|u|)."""
-    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs)
     r0 = _carrier_residual(u, ch, fs, res)
     umax = 0.0
     for r in range(u.shape[0]):
@@ -245,10 +279,11 @@ def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, 
 #: views of :func:`crank_support_kernel`'s work array (:func:`_support_views`): the predictor's
 #: validity flag and the Newton state, the last call's q and S = du/dq and u, per crank the bore's
 #: arm, rigid approach d0 and its rate, cage angle, roller load and damper, the carrier Newton's
-#: vectors (2N) and matrices (2N x 2N), dfs/dgamma, d(d0)/dq, dfs/dq and d(gamma)/dq
+#: vectors (2N) and matrices (2N x 2N), dfs/dgamma, d(d0)/dq, dfs/dq and d(gamma)/dq, the bearings'
+#: Newton starts (N, BP_SIZE)
 SupportWork = namedtuple(
     "SupportWork",
-    "st nw qp su ulast rx ry d0x d0y dvx dvy gam qs damp fs u res step zf wc av u0 ones kk ch mm tmp hh d0 df t2 gg",
+    "st nw qp su ulast rx ry d0x d0y dvx dvy gam qs damp fs u res step zf wc av u0 ones kk ch mm tmp hh d0 df t2 gg bp",
 )
 
 
@@ -291,9 +326,11 @@ def _support_views(wk, n):
     t2 = wk[o + 2 * n2 * m : o + 3 * n2 * m].reshape((n2, m))
     o += 3 * n2 * m
     gg = wk[o : o + n * m].reshape((n, m))
+    o += n * m
+    bp = wk[o : o + BP_SIZE * n].reshape((n, BP_SIZE))
     return SupportWork(
         st, nw, qp, su, ulast, rx, ry, d0x, d0y, dvx, dvy, gam, qs, damp, fs, u, res, step, zf, wc, av, u0, ones,
-        kk, ch, mm, tmp, hh, d0, df, t2, gg,
+        kk, ch, mm, tmp, hh, d0, df, t2, gg, bp,
     )  # fmt: skip
 
 
@@ -323,7 +360,7 @@ def _support_approach(q, v, idx, bores, g, c, s, w):
 
 
 @njit(cache=True, inline="always")
-def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, w):
+def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, kb, bstate, ustate, w):
     """The elastic carrier's support-point deflection u = -C_h f_s(d0 - u) by the carrier
     Newton (numerics.newton), started from the first-order predictor of the previous
     call; the last correction applied linearised; u stored in ``ustate``."""
@@ -357,9 +394,12 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
         apply_predictor(u, step, ones)
     newton_start(nw)
     while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
-        r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
-        if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
+        r1, scale = _carrier_evaluate(
+            d0x, d0y, gam, clear, sc, angles, linear, kb, bstate, w.bp, fs, kk, hh, qs, ch, u, res
+        )
+        if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, ones, st[QUAD_EST], *CARRIER_NEWTON):
             break
+    carry_quadratic(st, nw)
     # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
     # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
     for r in range(n2):
@@ -528,7 +568,9 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
     arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
-    tenth of max|u|), and stops on the residual rule above; the small systems are solved without
+    tenth of max|u|), and stops on the residual rule above or where the quadratic convergence measured
+    in its earlier calls shows the next evaluation would only confirm it
+    (:mod:`flexrv.model.numerics.newton`, step 4); the small systems are solved without
     LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
     (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
     called from Python); with ``carrier.body_model = "rigid"`` 2.6 us.
@@ -539,7 +581,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     (:func:`_support_loads`), the tangent (:func:`_support_tangent`) and the Jacobian rows
     (:func:`_support_jacobian`)."""
     idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
-    linear, g = pack.law.linear, pack.law.g
+    linear, g, kb = pack.law.linear, pack.law.g, pack.law.k_bend
     th = q[idx[2]]
     c, s = np.cos(th), np.sin(th)
     n = bores.shape[0]
@@ -547,9 +589,11 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     w = _support_views(pack.work, n)
     _support_approach(q, v, idx, bores, g, c, s, w)
     if elastic:
-        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, pack.bstate, pack.ustate, w)
+        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, kb, pack.bstate, pack.ustate, w)
     else:
-        _support_forces(w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, pack.bstate, w.fs, w.kk, w.hh, w.qs)
+        _support_forces(
+            w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, kb, pack.bstate, w.bp, w.fs, w.kk, w.hh, w.qs
+        )
     _support_loads(f, idx, pack.law.damping, pack.law.k_bend, pack.fx, pack.fy, pack.bend, w)
     if not (jac or elastic):
         return
