@@ -695,7 +695,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
     restarting elsewhere, start from delta_prev), so the start's residual is second
     order in the state change; it stops when max|R| <= tol (1e-10 of
-    max|delta|, at least 1e-15 m) or when K_est max|step|^2 <= tol / 10 (the
+    max|delta|, at least 1e-15 m) or when K_est max|step|^2 <= QUAD_SAFETY tol (the
     quadratic convergence measured in the earlier calls, numerics.newton step 4), so
     the records of the last evaluation (pin forces, gaps) stay exact to that
     tolerance. Measured in a rv40e run: after a
@@ -705,8 +705,9 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     v) and rim offsets (the solver's Jacobian after its residual) adds the stored
     result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
     holds st = (valid, K_est, -, -) (numerics.newton.VALID, QUAD_EST), the last call's hub
-    q and v, its condensed force, its rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[VALID] = 0
-    (reset, history pass) starts from dstate without the predictor.
+    q and v, its condensed force, its rim offsets, S_q, S_v, the condensed Jacobians and
+    the scratch arrays; st[VALID] = 0 (reset, history pass) starts from dstate without
+    the predictor.
 
     Phases (each its own compiled function): the work array's views (:func:`_rim_views`),
     the reuse test (:func:`_rim_reuse`), the compliance and start (:func:`_rim_start`),
