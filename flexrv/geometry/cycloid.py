@@ -168,24 +168,6 @@ def _rotate(v, angle):
 
 
 # =========================================================================== signed pin gap
-def _closest_point_step(px, py, cx, cy, d1x, d1y, d2x, d2y, max_step):
-    """One Newton step of :func:`_closest_point_newton` for P = (px, py) from the curve
-    point C, C', C'' (:func:`_center_curve_point`): -g'/g'' on g(phi) = |P - C|^2 / 2,
-    a descent step of ``max_step`` where g'' <= 0, clipped to +-max_step. A caller
-    that kept the curve at its warm start takes the first step without evaluating it."""
-    rx, ry = px - cx, py - cy
-    g1 = -(rx * d1x + ry * d1y)
-    g2 = d1x * d1x + d1y * d1y - (rx * d2x + ry * d2y)
-    if g2 > 0.0:
-        step = -g1 / g2
-    else:
-        step = -np.sign(g1) * max_step
-    return min(max(step, -max_step), max_step)
-
-
-_STEP = _jit(_closest_point_step)
-
-
 def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol, max_iter):
     """Newton iteration of :func:`pin_gap` on g(phi) = |P - C(phi)|^2 / 2 for one
     point P = (px, py) from the start ``phi``; steps clipped to ``max_step``, a
@@ -203,7 +185,13 @@ def _closest_point_newton(px, py, phi, z_rp, radius, eccentricity, max_step, tol
     for _ in range(max_iter):
         cx, cy, d1x, d1y, d2x, d2y = _POINT(phi, z_rp, radius, eccentricity)
         rx, ry = px - cx, py - cy
-        step = _STEP(px, py, cx, cy, d1x, d1y, d2x, d2y, max_step)
+        g1 = -(rx * d1x + ry * d1y)
+        g2 = d1x * d1x + d1y * d1y - (rx * d2x + ry * d2y)
+        if g2 > 0.0:
+            step = -g1 / g2
+        else:
+            step = -np.sign(g1) * max_step
+        step = min(max(step, -max_step), max_step)
         if abs(step) < tol:
             break
         phi = phi + step
@@ -230,8 +218,8 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     can reach another lobe's local minimum) from seven starts across the lobe
     around theta, keeping the nearest converged foot point. A start counts as
     converged when the step fell below ``tol`` or the first-order residual is below
-    1e-12 m. Returns (phi, ok, s, nx, ny, cx, cy, d1x, d1y, d2x, d2y) (see
-    :func:`_closest_point_newton`; C, C' and C'' at phi, NaN when not ok).
+    1e-12 m. Returns (phi, ok, s, nx, ny, d1x, d1y, d2x, d2y) (see
+    :func:`_closest_point_newton`; C' and C'' at phi, NaN when not ok).
 
     The warm start's half-lobe test needs no arctangent: with theta = atan2(px,
     py), |phi - theta| (mod 2 pi) <= lobe/2 is cos(phi - theta) |P| = px sin(phi)
@@ -246,16 +234,16 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
         if conv or res <= 1e-12:
             along = px * (z_rp * cx + d1y) + py * (z_rp * cy - d1x)  # R (z - 1) |P| cos(phi - theta)
             if along >= np.cos(0.5 * lobe) * radius * (z_rp - 1) * np.sqrt(px * px + py * py):
-                return phi, True, sd, nx, ny, cx, cy, d1x, d1y, d2x, d2y
+                return phi, True, sd, nx, ny, d1x, d1y, d2x, d2y
     theta = np.arctan2(px, py)
-    best = (theta, False, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan)
+    best = (theta, False, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan)
     best_d2 = np.inf
     for k in range(_COLD_STARTS.shape[0]):
-        phi, conv, res, sd, nx, ny, d2, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(
+        phi, conv, res, sd, nx, ny, d2, _, _, d1x, d1y, d2x, d2y = _NEWTON(
             px, py, theta + lobe * _COLD_STARTS[k], z_rp, radius, eccentricity, max_step, tol, max_iter
         )
         if (conv or res <= 1e-12) and d2 < best_d2:
-            best, best_d2 = (phi, True, sd, nx, ny, cx, cy, d1x, d1y, d2x, d2y), d2
+            best, best_d2 = (phi, True, sd, nx, ny, d1x, d1y, d2x, d2y), d2
     return best
 
 
@@ -267,7 +255,7 @@ def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max
     arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
     failed = 0
     for i in range(px.shape[0]):
-        phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _, _, _ = _FOOT(
+        phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _ = _FOOT(
             px[i], py[i], phi0[i], z_rp, radius, eccentricity, max_step, tol, max_iter
         )
         failed += not ok

@@ -116,8 +116,7 @@ LAPACK (:func:`inv_small`) and stops where the quadratic convergence measured in
 its earlier calls shows the next evaluation would only confirm the tolerance
 (:mod:`flexrv.model.numerics.newton`, step 4); a call at exactly the previous
 call's state adds that call's result. See :func:`_pin_condensed_kernel`. Per pin
-the closest point starts from the previous one with the Newton's first step taken
-from the curve kept at it (:func:`_pin_foot`), the Jacobian's curvature terms
+the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian's curvature terms
 reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
@@ -138,7 +137,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.geometry.cycloid import _FOOT, _STEP, closest_point_settings
+from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import matmul_small
@@ -175,14 +174,10 @@ _F, _I = np.float64, np.int64
 #: how :func:`pin_kernel` uses its warm starts: a cold restart of every closest point every
 #: ``restart_every`` calls (0: never after the first), pins provably open skipped (``skip_open``)
 PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
-#: per (disc, pin) the curve at the closest-point warm start (:data:`PinPack` field ``foot``): phi,
-#: then C, C', C'' (x, y each) at phi (:func:`flexrv.geometry.cycloid._center_curve_point`)
-FOOT_CACHE = 7
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
 #: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
-#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, the curve at them (n_discs, z,
-#: FOOT_CACHE), last exact gaps, outputs per (disc, pin), the warm starts' control, the counters of
-#: calls and of closest-point failures
+#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact gaps, outputs per (disc,
+#: pin), the warm starts' control, the counters of calls and of closest-point failures
 PinPack = pack_type(
     "PinPack",
     ("idx", (_I, 1)),
@@ -193,7 +188,6 @@ PinPack = pack_type(
     ("profile", (_F, 2)),
     ("harm", (_F, 3)),
     ("phi", (_F, 2)),
-    ("foot", (_F, 3)),
     ("last", (_F, 3)),
     ("gap", (_F, 2)),
     ("force", (_F, 2)),
@@ -274,7 +268,7 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv.
     Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
     the output arrays; phi is the closest-point warm start (updated; NaN: cold
-    start) and foot the curve at it (:func:`_pin_foot`). ``calls`` counts calls (a cold
+    start; :func:`_pin_foot`). ``calls`` counts calls (a cold
     restart every ``control.restart_every`` calls), ``failures`` the closest-point
     failures; ``control.skip_open`` allows skipping pins that are provably open.
 
@@ -411,37 +405,19 @@ def _pin_foot(pack, kd, i, px, py, radius, cold):
     """The closest point of pin i to disc k's pin-centre curve (radius R_p + dR_p) at its
     profile-frame position (px, py): (phi, s, n_x, n_y, C'_x, C'_y, C''_x, C''_y) of
     :func:`flexrv.geometry.cycloid._foot_point`, warm-started from pack.phi[kd, i]
-    (``cold``: from the cold starts); phi and the curve at it into pack.phi, pack.foot; a
-    failure counted in pack.failures.
-
-    Warm start: where pack.foot[kd, i] holds the curve at the warm start (its phi equal to
-    pack.phi[kd, i]), the Newton's first step is taken from it
-    (:func:`flexrv.geometry.cycloid._closest_point_step`) instead of evaluating the curve
-    again: the same iterates and the same numbers bit for bit, one curve evaluation less
-    per pin and call (a step below the tolerance is left to the Newton, which stops there).
-    A warm-started local minimum beyond the curve's reach on its side may not be the
-    nearest point (another flank): it is found again from the cold starts
+    (``cold``: from the cold starts), phi into pack.phi, a failure counted in
+    pack.failures. A warm-started local minimum beyond the curve's reach on its side may
+    not be the nearest point (another flank): it is found again from the cold starts
     (:func:`_curve_reach`)."""
-    law, reach, phi, foot = pack.law, pack.reach, pack.phi, pack.foot
+    law, reach, phi = pack.law, pack.reach, pack.phi
     z_rp, ecc, max_step, tol, max_iter = law.z_rp, law.eccentricity, law.max_step, law.tol, law.max_iter
     start = np.nan if cold else phi[kd, i]
-    if not cold and foot[kd, i, 0] == start:
-        fc = foot[kd, i]
-        step = _STEP(px, py, fc[1], fc[2], fc[3], fc[4], fc[5], fc[6], max_step)
-        if not abs(step) < tol:
-            start = start + step
-    ph, ok, dist, nlx, nly, cx, cy, d1x, d1y, d2x, d2y = _FOOT(
-        px, py, start, z_rp, radius, ecc, max_step, tol, max_iter
-    )
+    ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
     if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
-        ph, ok, dist, nlx, nly, cx, cy, d1x, d1y, d2x, d2y = _FOOT(
-            px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter
-        )
+        ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter)
     if not ok:
         pack.failures[0] += 1
     phi[kd, i] = ph
-    fc = foot[kd, i]
-    fc[0], fc[1], fc[2], fc[3], fc[4], fc[5], fc[6] = ph if ok else np.nan, cx, cy, d1x, d1y, d2x, d2y
     return ph, dist, nlx, nly, d1x, d1y, d2x, d2y
 
 
@@ -815,7 +791,6 @@ class PinContacts(KernelGroup):
         self.gap, self.force = np.zeros((self.nd, z)), np.zeros((self.nd, z))
         self.nx, self.ny, self.rxn = np.zeros((self.nd, z)), np.zeros((self.nd, z)), np.zeros((self.nd, z))
         self.ft, self.pw = np.zeros((self.nd, z)), np.zeros((self.nd, z))  # friction force on the disc, its power
-        self.foot = np.full((self.nd, z, FOOT_CACHE), np.nan)  # the curve at the warm starts (_pin_foot)
         self.last = np.full((self.nd, z, 3), np.nan)
         #: the solver's warm starts: a cold restart every restart_every calls, provably open pins skipped
         self.control = PinControl.of(restart_every=restart_every, skip_open=True)
@@ -849,20 +824,15 @@ class PinContacts(KernelGroup):
         return self.disc_c.shape[0] > 0
 
     def pack(self, idx, history=False):
-        phi, foot, last, control, calls, failures = (
+        phi, last, control, calls, failures = (
             self.phi,
-            self.foot,
             self.last,
             self.control,
             self.calls,
             self.failures,
         )
         if history:  # post-processing: cold start at the first sample, then warm; every gap exact
-            phi, foot, last = (
-                np.full_like(self.phi, np.nan),
-                np.full_like(self.foot, np.nan),
-                np.full_like(self.last, np.nan),
-            )
+            phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
             control = PinControl.of(restart_every=0, skip_open=False)
             calls, failures = np.ones(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
             # the rim Newton too starts cold (delta = 0) at the first sample: the history pass and a group's
@@ -880,7 +850,6 @@ class PinContacts(KernelGroup):
             profile=self.profile,
             harm=self.harmonics,
             phi=phi,
-            foot=foot,
             last=last,
             gap=self.gap,
             force=self.force,
@@ -1014,7 +983,6 @@ class PinContacts(KernelGroup):
     def reset(self):
         """Forget the closest-point warm start and the call counter."""
         self.phi[:] = np.nan
-        self.foot[:] = np.nan
         self.last[:] = np.nan
         self.calls[0] = 0
         self.gap[:] = 0.0
