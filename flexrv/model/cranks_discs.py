@@ -196,42 +196,16 @@ def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
             jq[ii[s], ii[r]] -= w * (b[0, s] * kb0 + b[1, s] * kb1)
 
 
-#: the slots of a crank's bearing start (SupportWork field ``bp``, per crank): valid (1), the
-#: displacement d (x, y) of the last evaluation, its series tangent K_s (xx, xy, yy) and the bearing
-#: displacement b (x, y) solved there
-BP_VALID, BP_D, BP_K, BP_B, BP_SIZE = 0, 1, 3, 6, 8
-
-
-@njit(cache=True, inline="always")
-def _bearing_start(j, dx, dy, kb, bstate, bp):
-    """The Newton start of crank j's bearing displacement b at d: the last solution b_prev
-    (``bstate``) plus its first-order change (I - K_s / k_bend)(d - d_prev) (db/dd =
-    (K_b + k I)^-1 k = I - K_s / k, K_s the series tangent of the last evaluation), where
-    ``bp`` holds that evaluation and bstate is still its b (else b_prev: set from outside)."""
-    b0x, b0y = bstate[j, 0], bstate[j, 1]
-    if kb > 0.0 and bp[j, BP_VALID] > 0.0 and bp[j, BP_B] == b0x and bp[j, BP_B + 1] == b0y:
-        ex, ey = dx - bp[j, BP_D], dy - bp[j, BP_D + 1]
-        b0x += ex - (bp[j, BP_K] * ex + bp[j, BP_K + 1] * ey) / kb
-        b0y += ey - (bp[j, BP_K + 1] * ex + bp[j, BP_K + 2] * ey) / kb
-    return b0x, b0y
-
-
 @njit(cache=True)
-def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs):
+def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs):
     """Spring force of every crank support at d = d0 - u (housing frame): fs (2N,)
     on the cranks, the block-diagonal tangent kk = -dfs/dd (2N, 2N), hh (2N, N)
-    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts (bstate,
-    and bp for the first-order start of the next evaluation, :func:`_bearing_start`;
-    kb the crank's bending stiffness)."""
+    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts."""
     for j in range(d0x.shape[0]):
-        dx, dy = d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1]
-        b0x, b0y = _bearing_start(j, dx, dy, kb, bstate, bp)
         fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(
-            dx, dy, gam[j], clear[j], sc, angles, linear, b0x, b0y
+            d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1], gam[j], clear[j], sc, angles, linear, bstate[j, 0], bstate[j, 1]
         )
         bstate[j, 0], bstate[j, 1] = bx, by
-        bp[j, BP_VALID], bp[j, BP_D], bp[j, BP_D + 1] = 1.0, dx, dy
-        bp[j, BP_K], bp[j, BP_K + 1], bp[j, BP_K + 2], bp[j, BP_B], bp[j, BP_B + 1] = kxx, kxy, kyy, bx, by
         fs[2 * j], fs[2 * j + 1] = fx, fy
         kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j], kk[2 * j + 1, 2 * j + 1] = kxx, kxy, kxy, kyy
         hh[2 * j, j], hh[2 * j + 1, j] = hx, hy
@@ -241,7 +215,7 @@ def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, kb, bstate, bp,
 def support_work_size(n: int) -> int:
     """Length of :func:`crank_support_kernel`'s work array for n cranks."""
     n2, m = 2 * n, 3 + 3 * n
-    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m + BP_SIZE * n
+    return 4 + NEWTON_STATE + m + n2 * m + n2 + 9 * n + 9 * n2 + 4 * n2 * n2 + n2 * n + 3 * n2 * m + n * m
 
 
 #: the carrier Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
@@ -264,11 +238,11 @@ def _carrier_residual(u, ch, fs, res):
 
 
 @njit(cache=True)
-def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs, ch, u, res):
+def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res):
     """The elastic carrier's support forces at d = d0 - u and residual R = u + C_h f_s into
     ``res`` (tangent K into kk) for :func:`~flexrv.model.numerics.newton.newton_update`;
     returns (max|R|, max|u|)."""
-    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, kb, bstate, bp, fs, kk, hh, qs)
+    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
     r0 = _carrier_residual(u, ch, fs, res)
     umax = 0.0
     for r in range(u.shape[0]):
@@ -279,11 +253,10 @@ def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, kb, bstate, bp, 
 #: views of :func:`crank_support_kernel`'s work array (:func:`_support_views`): the predictor's
 #: validity flag and the Newton state, the last call's q and S = du/dq and u, per crank the bore's
 #: arm, rigid approach d0 and its rate, cage angle, roller load and damper, the carrier Newton's
-#: vectors (2N) and matrices (2N x 2N), dfs/dgamma, d(d0)/dq, dfs/dq and d(gamma)/dq, the bearings'
-#: Newton starts (N, BP_SIZE)
+#: vectors (2N) and matrices (2N x 2N), dfs/dgamma, d(d0)/dq, dfs/dq and d(gamma)/dq
 SupportWork = namedtuple(
     "SupportWork",
-    "st nw qp su ulast rx ry d0x d0y dvx dvy gam qs damp fs u res step zf wc av u0 ones kk ch mm tmp hh d0 df t2 gg bp",
+    "st nw qp su ulast rx ry d0x d0y dvx dvy gam qs damp fs u res step zf wc av u0 ones kk ch mm tmp hh d0 df t2 gg",
 )
 
 
@@ -326,11 +299,9 @@ def _support_views(wk, n):
     t2 = wk[o + 2 * n2 * m : o + 3 * n2 * m].reshape((n2, m))
     o += 3 * n2 * m
     gg = wk[o : o + n * m].reshape((n, m))
-    o += n * m
-    bp = wk[o : o + BP_SIZE * n].reshape((n, BP_SIZE))
     return SupportWork(
         st, nw, qp, su, ulast, rx, ry, d0x, d0y, dvx, dvy, gam, qs, damp, fs, u, res, step, zf, wc, av, u0, ones,
-        kk, ch, mm, tmp, hh, d0, df, t2, gg, bp,
+        kk, ch, mm, tmp, hh, d0, df, t2, gg,
     )  # fmt: skip
 
 
@@ -360,7 +331,7 @@ def _support_approach(q, v, idx, bores, g, c, s, w):
 
 
 @njit(cache=True, inline="always")
-def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, kb, bstate, ustate, w):
+def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, w):
     """The elastic carrier's support-point deflection u = -C_h f_s(d0 - u) by the carrier
     Newton (numerics.newton), started from the first-order predictor of the previous
     call; the last correction applied linearised; u stored in ``ustate``."""
@@ -394,9 +365,7 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, kb, bstate, usta
         apply_predictor(u, step, ones)
     newton_start(nw)
     while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
-        r1, scale = _carrier_evaluate(
-            d0x, d0y, gam, clear, sc, angles, linear, kb, bstate, w.bp, fs, kk, hh, qs, ch, u, res
-        )
+        r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
         if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, ones, st[QUAD_EST], *CARRIER_NEWTON):
             break
     carry_quadratic(st, nw)
@@ -581,7 +550,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     (:func:`_support_loads`), the tangent (:func:`_support_tangent`) and the Jacobian rows
     (:func:`_support_jacobian`)."""
     idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
-    linear, g, kb = pack.law.linear, pack.law.g, pack.law.k_bend
+    linear, g = pack.law.linear, pack.law.g
     th = q[idx[2]]
     c, s = np.cos(th), np.sin(th)
     n = bores.shape[0]
@@ -589,11 +558,9 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     w = _support_views(pack.work, n)
     _support_approach(q, v, idx, bores, g, c, s, w)
     if elastic:
-        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, kb, pack.bstate, pack.ustate, w)
+        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, pack.bstate, pack.ustate, w)
     else:
-        _support_forces(
-            w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, kb, pack.bstate, w.bp, w.fs, w.kk, w.hh, w.qs
-        )
+        _support_forces(w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, pack.bstate, w.fs, w.kk, w.hh, w.qs)
     _support_loads(f, idx, pack.law.damping, pack.law.k_bend, pack.fx, pack.fy, pack.bend, w)
     if not (jac or elastic):
         return
