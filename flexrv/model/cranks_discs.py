@@ -106,15 +106,7 @@ from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import inv_small, matmul_small
-from flexrv.model.numerics.newton import (
-    NEWTON_STATE,
-    QUAD_EST,
-    VALID,
-    apply_predictor,
-    carry_quadratic,
-    newton_start,
-    newton_update,
-)
+from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD
 
 _F, _I = np.float64, np.int64
@@ -366,9 +358,8 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
     newton_start(nw)
     while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
         r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
-        if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, ones, st[QUAD_EST], *CARRIER_NEWTON):
+        if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
             break
-    carry_quadratic(st, nw)
     # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
     # round-off, below the Newton tolerance (finite differences of 5e-11 m see the condensation)
     for r in range(n2):
@@ -537,9 +528,7 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
     arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
     S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
-    tenth of max|u|), and stops on the residual rule above or where the quadratic convergence measured
-    in its earlier calls shows the next evaluation would only confirm it
-    (:mod:`flexrv.model.numerics.newton`, step 4); the small systems are solved without
+    tenth of max|u|), and stops on the residual rule above; the small systems are solved without
     LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
     (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
     called from Python); with ``carrier.body_model = "rigid"`` 2.6 us.

@@ -111,11 +111,9 @@ tests/test_housing.py.
 Cost: in a run the condensation's cost is its pin-kernel evaluations.
 Each call starts from a first-order predictor of the offsets (the previous call's
 condensed sensitivities), evaluates the pin kernel on the 3 n_discs local rim
-coordinates (3 x 3 blocks, no n x n arrays), solves the small systems without
-LAPACK (:func:`inv_small`) and stops where the quadratic convergence measured in
-its earlier calls shows the next evaluation would only confirm the tolerance
-(:mod:`flexrv.model.numerics.newton`, step 4); a call at exactly the previous
-call's state adds that call's result. See :func:`_pin_condensed_kernel`. Per pin
+coordinates (3 x 3 blocks, no n x n arrays) and solves the small systems without
+LAPACK (:func:`inv_small`); a call at exactly the previous call's state adds that
+call's result. See :func:`_pin_condensed_kernel`. Per pin
 the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian's curvature terms
 reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
@@ -141,15 +139,7 @@ from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.numerics.linalg import matmul_small
-from flexrv.model.numerics.newton import (
-    NEWTON_STATE,
-    QUAD_EST,
-    VALID,
-    apply_predictor,
-    carry_quadratic,
-    newton_start,
-    newton_update,
-)
+from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
 
 #: the pin contacts' scalar law: pin count, pin circle radius R_p [m], nominal pin radius [m],
 #: eccentricity [m], contact law K, exponent, c_max, depth, the closest-point Newton's settings
@@ -565,7 +555,7 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     housing's rotation and rim offsets into hs. Returns the pins' torque on the discs."""
     qh, delta, step, qf, av, sq, qp, sv = w.qh, w.delta, w.step, w.qf, w.av, w.sq, w.qp, w.sv
     vh, vp, weight, nw, ql, fl, jl, jvl = w.vh, w.vp, w.weight, w.nw, w.ql, w.fl, w.jl, w.jvl
-    cm, res, base, tmp, nm, dlast, qfc, st = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc, w.st
+    cm, res, base, tmp, nm, dlast, qfc = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc
     m = qh.shape[0]
     nd = m // 3
     if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
@@ -578,11 +568,8 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     newton_start(nw)
     while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
         r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
-        if newton_update(
-            nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, weight, st[QUAD_EST], *RIM_NEWTON
-        ):
+        if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
             break
-    carry_quadratic(st, nw)
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
@@ -671,16 +658,14 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
     restarting elsewhere, start from delta_prev), so the start's residual is second
     order in the state change; it stops when max|R| <= tol (1e-10 of
-    max|delta|, at least 1e-15 m) or when K_est max|step|^2 <= QUAD_SAFETY tol (the
-    quadratic convergence measured in the earlier calls, numerics.newton step 4), so
-    the records of the last evaluation (pin forces, gaps) stay exact to that
+    max|delta|, at least 1e-15 m), so the records of the last evaluation (pin forces, gaps) stay exact to that
     tolerance. Measured in a rv40e run: after a
     Newton correction of the solver (|dq| ~ 1e-7) the predicted start is within ~3e-12
     m of the solution (from delta_prev: ~5e-8), after a time step's rigid motion
     (|dq| ~ 1.6e-4) within ~4e-9 m. A call at exactly the previous call's hub state (q,
     v) and rim offsets (the solver's Jacobian after its residual) adds the stored
     result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
-    holds st = (valid, K_est, -, -) (numerics.newton.VALID, QUAD_EST), the last call's hub
+    holds st = (valid, -, -, -) (numerics.newton.VALID), the last call's hub
     q and v, its condensed force, its rim offsets, S_q, S_v, the condensed Jacobians and
     the scratch arrays; st[VALID] = 0 (reset, history pass) starts from dstate without
     the predictor.

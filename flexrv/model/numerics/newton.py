@@ -17,15 +17,7 @@ own tangent, so dR/dx = I + sign C J). Both elements run the same iteration:
    and at the caps (``max_evals`` evaluations, ``max_steps`` Newton steps) the
    iteration stops with the correction of its last evaluation in ``step``; the
    element applies that last correction linearised (F + J dx, exact to O(|R|^2)), so
-   its result is smooth in q down to round-off;
-4. quadratic convergence used: the residual after a full Newton step is K |step|^2
-   (K the local constant of the quadratic convergence, measured in every call that
-   takes a full step and evaluates again: K = max|R_next| / max|step|^2); with the
-   element's estimate K_est carried from its previous calls (:func:`carry_quadratic`),
-   the iteration also stops where K_est max|step|^2 <= QUAD_SAFETY tol: the next
-   evaluation would only confirm a residual below the tolerance, and the linearised
-   correction applied instead leaves an error of that order (N R_next, N =
-   (I + sign C J)^-1 contracting). K_est = 0 (a fresh element) switches the rule off.
+   its result is smooth in q down to round-off.
 
 The element evaluates F and J at x, the residual into ``res`` and (max|R|, max|x|) in
 its weighted norm, and hands them to :func:`newton_update`, which decides the next
@@ -43,12 +35,6 @@ from flexrv.model.numerics.linalg import condensed_step
 
 #: halving stops (and the worse point is accepted) below this step fraction
 MIN_STEP_FRACTION = 1e-6
-#: the quadratic-convergence stop (module docstring, step 4): the predicted next residual at most
-#: this fraction of the tolerance (the rims: forces within ~1e-8 N of the converged ones, J ~ 1e9 N/m
-#: times 1e-17 m, the rounding noise of the rim pose, tests/test_friction.py)
-QUAD_SAFETY = 0.01
-#: a carried K_est halves per measuring call unless measured larger (:func:`carry_quadratic`)
-QUAD_DECAY = 0.5
 
 
 @njit(cache=True)
@@ -72,13 +58,12 @@ def _tolerance(scale):
 
 
 #: the slots of the iteration's state array (:func:`newton_update`): evaluations, accepted max|R|,
-#: its tolerance, step fraction, Newton steps, max|step| of the last full step, the largest K
-#: measured in this call (0: none); its length
-EVALS, BEST_R, TOL, LAM, STEPS, STEP_NORM, QUAD = 0, 1, 2, 3, 4, 5, 6
-NEWTON_STATE = 7
-#: the slots of an element's work flags (``st``): its predictor (the previous call's sensitivities
-#: and state) valid (1; 0 reset: start from the stored unknowns without it), its carried K_est
-VALID, QUAD_EST = 0, 1
+#: its tolerance, step fraction, Newton steps; its length
+EVALS, BEST_R, TOL, LAM, STEPS = 0, 1, 2, 3, 4
+NEWTON_STATE = 5
+#: the slot of an element's work flags (``st``) that marks its predictor (the previous call's
+#: sensitivities and state) valid: 1 valid, 0 reset (start from the stored unknowns without it)
+VALID = 0
 
 
 @njit(cache=True)
@@ -89,40 +74,14 @@ def newton_start(state):
 
 
 @njit(cache=True)
-def carry_quadratic(st, state):
-    """After an element's iteration: its carried K_est (st[QUAD_EST]) follows the K
-    measured in this call (state[QUAD]), max(K, QUAD_DECAY K_est); unchanged if none."""
-    if state[QUAD] > 0.0:
-        st[QUAD_EST] = max(state[QUAD], QUAD_DECAY * st[QUAD_EST])
-
-
-@njit(cache=True)
 def newton_update(
-    state,
-    r1,
-    scale,
-    x,
-    x0,
-    step,
-    res,
-    c,
-    j,
-    sign,
-    tmp,
-    inv,
-    weight,
-    quad,
-    max_evals,
-    max_steps,
-    roundoff_abs,
-    roundoff_rel,
+    state, r1, scale, x, x0, step, res, c, j, sign, tmp, inv, max_evals, max_steps, roundoff_abs, roundoff_rel
 ):
     """One turn of the damped Newton (module docstring) after the element evaluated its
     residual ``res``, its tangent ``j`` (J = dF/dx) and (r1, scale) = (max|R|, max|x|)
-    at x (norms weighted by ``weight``). Either sets x to the next point to evaluate and
-    returns False, or returns True: done, x the last evaluated point, ``step`` its
-    Newton correction (x - step solves the linearised system), ``inv`` = (I + sign C
-    J)^-1 at it. ``quad``: the element's carried K_est (step 4; 0: off). x0, tmp: scratch.
+    at x. Either sets x to the next point to evaluate and returns False, or returns
+    True: done, x the last evaluated point, ``step`` its Newton correction (x - step
+    solves the linearised system), ``inv`` = (I + sign C J)^-1 at it. x0, tmp: scratch.
 
     Reverse communication (the element calls its own residual in a loop around this
     function): one compiled iteration for every condensed body without passing compiled
@@ -143,18 +102,10 @@ def newton_update(
                 x[r] = x0[r] - lam * step[r]
             return False
         # the smallest step was worse too: accept it and go on from there
-    if n_eval > 1.0 and state[LAM] == 1.0 and state[STEP_NORM] > 0.0:  # after a full step: measure K
-        state[QUAD] = max(state[QUAD], r1 / (state[STEP_NORM] * state[STEP_NORM]))
     state[BEST_R], state[TOL] = r1, tol1
     condensed_step(c, j, sign, res, tmp, inv, step)
-    snorm = 0.0
-    for r in range(x.shape[0]):
-        snorm = max(snorm, abs(step[r]) * weight[r])
     if r1 <= tol1 or n_eval >= max_evals or state[STEPS] >= max_steps:
         return True
-    if quad > 0.0 and quad * snorm * snorm <= QUAD_SAFETY * tol1:
-        return True
-    state[STEP_NORM] = snorm
     state[STEPS] += 1.0
     state[LAM] = 1.0
     for r in range(x.shape[0]):
