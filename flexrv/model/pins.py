@@ -118,7 +118,7 @@ the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian
 reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
-in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "Warm starts of the kernel").
+in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "The kernel's inner solves").
 
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
