@@ -1,31 +1,27 @@
-"""Benchmark of the rigid reducer model: force residual and Jacobian cost per call,
-real-time factor and the TE statistics (so speed never buys a different answer).
+"""Benchmark of the rigid reducer model on the compiled integrator: the force kernel's
+cost per time step, split by element, and the share of a step outside it.
 
-Run:  python benchmarks/bench_rigid.py [--t-end 0.05] [--dt 1e-4] [--presets rv40e rv221]
+Run:  python benchmarks/bench_rigid.py [--t-end 0.1] [--presets rv40e rv221]
 
-The run starts at rated speed (speed and load ramps shortened to 5 ms) so the
-timing measures steady operation under the preset's load torque. Printed per preset:
+The run starts at rated speed (speed and load ramps shortened to 5 ms,
+``_shared.quick_ramps``) so the timing measures steady operation under the preset's
+load torque. Per preset:
 
-* ``residual`` / ``jacobian``: wall µs per call of the Python force user
-  function(s) and Jacobian user function(s) during the run (all groups of one
-  residual together);
-* ``compiled kernel``: wall µs per time step inside the compiled entry point of the
-  fused kernel (the physics), and everything else of the solve per step (Exudyn's
-  own work, the Python glue of every call, the pre-step hook): the real-time factor
-  the model would have at zero physics cost;
-* ``generalized_forces``: µs per call of ``AssembledModel.generalized_forces`` with
-  the Jacobian at a loaded state (the quasi-static solver's path);
-* real-time factor = solve wall s per simulated s, and post-processing wall s
-  (outputs of every group recomputed from the recorded states; one-time imports
-  excluded);
-* CPU seconds (time.process_time, robust on a shared machine) of the solve and of
-  the outputs, and the real-time factor of both together (goal: <= 1);
-* TE mean and peak-to-peak over t > 0.02 s [arcsec].
+* the compiled integrator's run (``Simulation.run(integrator="compiled")``): CPU s of the
+  solve per simulated s, steps, Newton iterations, force-kernel calls per step, TE mean
+  and peak-to-peak over t > 0.02 s [arcsec];
+* the solver's call sequence: the same window on Exudyn's integrator (which takes the same
+  steps and Newton iterations, tests/test_integrator.py) with every call of the fused
+  kernel recorded (time, q, v, with or without the Jacobian), then replayed in ONE
+  compiled loop from fresh element states (warm starts carried from call to call as in
+  the run): CPU us per step of the whole kernel and of each element alone (the same
+  sequence through that element's kernel), less the same loop without kernel calls;
+* the pins: pin-kernel evaluations per call (the rim condensation's Newton; 1 with rigid
+  discs and housing) and pins evaluated per evaluation (the others proved open);
+* the share of a compiled step outside the kernel: 1 - (replayed kernel CPU per step x
+  steps) / the compiled run's solve CPU (goal < 15 %).
 
-It runs unchanged on a model of Python force elements and on the fused compiled
-element, so both sides of a comparison come from the same script. One-time numba
-compilation/loading (the kernels and the outputs' paths: a 20-step run in 5-step
-segments) is done before timing.
+One-time numba compilation/loading is done before timing (a 20-step run of each integrator).
 """
 
 from __future__ import annotations
@@ -41,152 +37,178 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
-def _instrument(model):
-    """Accumulate wall time and calls of the Python force/Jacobian user functions:
-    the fused element (``model.fused``) if present, else every group's
-    evaluate/jacobian (one residual = one call of every group)."""
-    acc = {"res": [0.0, 0], "jac": [0.0, 0], "kernel": [0.0, 0]}
+def _record_calls(sim, t_end: float) -> dict:
+    """Run ``t_end`` on Exudyn's integrator and record every call of the fused kernel:
+    {"t", "q", "v", "jac"} (calls,) / (calls, n) on the element's coordinates."""
+    fused = sim.build().fused
+    seq = {"t": [], "q": [], "v": [], "jac": []}
+    orig = fused._call
 
-    def wrap(obj, attr, key, count=True, single_state_only=False):
-        fn = getattr(obj, attr)
+    def rec(t, q, v, jac):
+        seq["t"].append(float(t))
+        seq["q"].append(np.array(q, dtype=float))
+        seq["v"].append(np.array(v, dtype=float))
+        seq["jac"].append(bool(jac))
+        return orig(t, q, v, jac)
 
-        def timed(*args, **kw):
-            if single_state_only and np.ndim(args[1]) != 1:  # post-processing, not solver time
-                return fn(*args, **kw)
-            t0 = time.perf_counter()
-            r = fn(*args, **kw)
-            acc[key][0] += time.perf_counter() - t0
-            acc[key][1] += count
-            return r
-
-        setattr(obj, attr, timed)
-
-    fused = getattr(model, "fused", None)
-    if fused is not None:
-        wrap(fused, "residual", "res")
-        wrap(fused, "jacobian", "jac")
-        if getattr(fused, "_entry", None) is not None:  # the compiled kernel alone (found by the warm-up run)
-            wrap(fused, "_entry", "kernel")
-    else:
-        python_groups = [g for g in model.groups if type(g).__name__ != "RigidMainBearing"]
-        for i, g in enumerate(python_groups):
-            wrap(g, "evaluate", "res", count=(i == 0), single_state_only=True)
-            if g.analytic_jacobian:
-                wrap(g, "jacobian", "jac", count=(i == 0))
-    return acc
+    fused._call = rec
+    try:
+        res = sim.run(t_end=t_end, integrator="exudyn", checkpoint_s=None)
+    finally:
+        del fused._call
+    out = {k: np.array(v) for k, v in seq.items()}
+    if not fused.is_full:
+        out["q"], out["v"] = out["q"][:, fused.index], out["v"][:, fused.index]
+    out["steps"] = sim.timing["steps"]
+    out["te"] = res["te"].values
+    return out
 
 
-def _loaded_state(model):
-    """A state with the discs turned into the pins and the drive flanks loaded."""
-    q = model.q0.copy()
-    for k in range(model.params.n_discs):
-        q[model.slice(f"disc{k}").start + 2] += 1.5e-4
-    for j in range(model.params.n_cranks):
-        q[model.slice(f"crank{j}").start + 2] += 5e-5
-    return q
+def _replay_functions():
+    """Compiled replays of calls [i0, i1) of a sequence through the fused kernel or one
+    element's kernel (``call`` False: the same loop without the kernel)."""
+    from numba import njit
+
+    def make(kern):
+        @njit
+        def replay(i0, i1, qs, vs, jacs, tables, live, f, jq, jv, call, packs):
+            for i in range(i0, i1):
+                for j in range(len(tables)):
+                    live[j][:] = tables[j][i]
+                if call:
+                    kern(qs[i], vs[i], f, jq, jv, jacs[i], *packs)
+
+        return replay
+
+    return make
 
 
-def _gf_time(model, reps: int = 300) -> float:
-    """µs per call of generalized_forces(t, q, v) with the Jacobian."""
-    q, v = _loaded_state(model), np.zeros(model.n)
-    model.generalized_forces(0.0, q, v)
-    t0 = time.perf_counter()
-    for i in range(reps):
-        model.generalized_forces(0.0, q + 1e-9 * (i % 7), v)
-    return (time.perf_counter() - t0) / reps * 1e6
+def _arrays(pack) -> list:
+    """The arrays of a pack (nested packs included): the elements' states to snapshot."""
+    out = []
+    for value in pack:
+        if isinstance(value, np.ndarray):
+            out.append(value)
+        elif isinstance(value, tuple) and hasattr(value, "_fields"):
+            out += _arrays(value)
+    return out
 
 
-def bench(name: str, t_end: float, dt: float) -> dict:
+def _chunked_cpu(replay, args, call, packs, n, chunk, repeats) -> float:
+    """CPU s of the whole sequence, the sum over chunks of ``chunk`` calls of the least of
+    ``repeats`` runs of each chunk, every run from the state before the chunk (the packs'
+    arrays restored): robust to the other jobs of a shared machine."""
+    arrays = [a for p in packs for a in _arrays(p)]
+    total = 0.0
+    for i0 in range(0, n, chunk):
+        i1 = min(n, i0 + chunk)
+        saved = [a.copy() for a in arrays]
+        best = np.inf
+        for _ in range(repeats):
+            for a, b in zip(arrays, saved):
+                np.copyto(a, b)
+            c0 = time.process_time()
+            replay(i0, i1, *args, call, packs)
+            best = min(best, time.process_time() - c0)
+        total += best
+    return total
+
+
+def _replay_costs(model, seq, chunk: int = 100, repeats: int = 5) -> dict:
+    """CPU us per call sequence of the fused kernel and of every element alone (module
+    docstring), and the pins' evaluation count."""
+    from flexrv.model.core.registry import spec_of
+
+    fused = model.fused
+    make = _replay_functions()
+    n = len(seq["t"])
+    live = tuple(a for _, a in fused.timed)
+    tables = tuple(
+        np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(seq["t"]), (n, a.size)), dtype=float)
+        for g, a in fused.timed
+    )
+    if not live:  # (numba needs a typed tuple)
+        live, tables = (np.zeros(0),), (np.zeros((n, 0)),)
+    kernels = [("fused", fused.kernel, tuple(fused.packs))]
+    for (g, _), p in zip(fused.slots, fused.packs):
+        kernels.append((g.name, spec_of(g).kernel, (p,)))
+    args = (seq["q"], seq["v"], seq["jac"], tables, live, fused.f, fused.jq, fused.jv)
+    pins = next((g for g in model.groups if g.kind == "pins"), None)
+    counter = None if pins is None else getattr(pins, "calls", getattr(pins, "ctr", None))
+    out = {}
+    for name, kern, packs in kernels:
+        replay = make(kern)
+        for g in model.groups:
+            g.reset()
+        replay(0, n, *args, True, packs)  # (compile)
+        for g in model.groups:
+            g.reset()
+        c_before = int(counter[0]) if counter is not None else 0
+        spent = _chunked_cpu(replay, args, True, packs, n, chunk, repeats)
+        if name == "fused" and counter is not None:  # (each chunk's last run carries on)
+            out["pin_evaluations"] = int(counter[0]) - c_before
+        empty = _chunked_cpu(replay, args, False, packs, n, chunk, repeats)
+        out[name] = (spent - empty) * 1e6
+    return out
+
+
+def bench(name: str, t_end: float) -> dict:
     from flexrv.simulation import Simulation
 
     sim = Simulation(quick_ramps(name))
     model = sim.build()
-    t0 = time.perf_counter()
-    gf_us = _gf_time(model, reps=3)  # loads/compiles the kernels
-    import xarray as xr
-
-    xr.Variable(("t",), np.zeros(3))  # one-time imports of the results path (~0.4 s), not post-processing cost
-    # loads/compiles the outputs' paths too: the integrator's records and (at the segment starts,
-    # where the integrator's last call is not at the recorded state) the compiled history pass
-    sim.run(t_end=20 * dt, dt=dt, segment_steps=5)
-    t_warm = time.perf_counter() - t0
-    gf_us = _gf_time(model)
-    acc = _instrument(model)
-    t0, c0 = time.perf_counter(), time.process_time()
-    res = sim.run(t_end=t_end, dt=dt)
-    total, total_cpu = time.perf_counter() - t0, time.process_time() - c0
-    tm = sim.timing
-    solve = tm["solve_s"]
-    solve_cpu = tm.get("solve_cpu_s", float("nan"))  # absent before the segmented runs
-    te = res["te"]
-    sel = te.values[te["time"].values > 0.02]
+    for integ in ("compiled", "exudyn"):  # compile / load
+        sim.run(t_end=0.002, integrator=integ, checkpoint_s=None)
+    calls0 = model.fused.stats[0]
+    res = sim.run(t_end=t_end, integrator="compiled", checkpoint_s=None)
+    tm = dict(sim.timing)
+    calls = model.fused.stats[0] - calls0
+    te = res["te"].values[res.time > 0.02]
+    seq = _record_calls(sim, t_end)
+    costs = _replay_costs(model, seq)
+    steps = tm["steps"]
+    n_calls = len(seq["t"])
     return {
         "preset": name,
-        "dt_s": dt,
-        "simulated_s": tm["simulated_s"],
-        "solve_wall_s": solve,
-        "post_wall_s": total - solve,
-        "real_time_factor": solve / tm["simulated_s"],
-        "steps": tm["steps"],
-        "newton_iterations_per_step": tm["newton_iterations"] / max(tm["steps"], 1),
-        "jacobian_updates": tm["jacobians"],
-        "warm_up_s": t_warm,
-        "residual_us": acc["res"][0] / max(acc["res"][1], 1) * 1e6,
-        "residual_calls": acc["res"][1],
-        "jacobian_us": acc["jac"][0] / max(acc["jac"][1], 1) * 1e6,
-        "jacobian_calls": acc["jac"][1],
-        "user_function_share": (acc["res"][0] + acc["jac"][0]) / solve,
-        "generalized_forces_us": gf_us,
-        "kernel_us_per_step": acc["kernel"][0] / max(tm["steps"], 1) * 1e6,
-        "kernel_calls_per_step": acc["kernel"][1] / max(tm["steps"], 1),
-        "rest_us_per_step": (
-            (solve - acc["kernel"][0]) / max(tm["steps"], 1) * 1e6 if acc["kernel"][1] else float("nan")
-        ),
-        "te_mean_arcsec": float(np.mean(sel)),
-        "te_pp_arcsec": float(np.ptp(sel)),
-        "solve_cpu_s": solve_cpu,
-        "post_cpu_s": total_cpu - solve_cpu,
-        "run_cpu_s": total_cpu,
-        "rtf_cpu": total_cpu / tm["simulated_s"],
-        "status": res.attrs.get("status", "?") if hasattr(res, "attrs") else "?",
+        "steps": steps,
+        "solve_cpu_s": tm["solve_cpu_s"],
+        "cpu_per_sim_s": tm["solve_cpu_s"] / tm["simulated_s"],
+        "newton_per_step": tm["newton_iterations"] / steps,
+        "calls_per_step": calls / steps,
+        "replayed_calls_per_step": n_calls / seq["steps"],
+        "replayed_steps": seq["steps"],
+        "kernel_us_per_step": costs["fused"] / seq["steps"],
+        "elements_us_per_step": {
+            k: v / seq["steps"] for k, v in costs.items() if k not in ("fused", "pin_evaluations")
+        },
+        "pin_evaluations_per_call": costs.get("pin_evaluations", 0) / n_calls,
+        "te_mean_arcsec": float(np.mean(te)),
+        "te_pp_arcsec": float(np.ptp(te)),
     }
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--t-end", type=float, default=0.05)
-    ap.add_argument("--dt", type=float, default=1e-4)
+    ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--presets", nargs="*", default=["rv40e", "rv221"])
     a = ap.parse_args()
     import flexrv
 
     print(f"flexrv from {os.path.dirname(flexrv.__file__)}")
     for name in a.presets:
-        r = bench(name, a.t_end, a.dt)
-        print(f"{r['preset']}: dt = {r['dt_s']:g} s, {r['steps']} steps for {r['simulated_s']:.3g} s simulated")
+        r = bench(name, a.t_end)
+        outside = 1.0 - r["kernel_us_per_step"] * 1e-6 * r["steps"] / r["solve_cpu_s"]
         print(
-            f"  residual {r['residual_us']:.1f} us/call ({r['residual_calls']} calls), "
-            f"jacobian {r['jacobian_us']:.1f} us/call ({r['jacobian_calls']} calls), "
-            f"user functions {100 * r['user_function_share']:.0f} % of solve"
-        )
-        if r["kernel_calls_per_step"]:
-            print(
-                f"  compiled kernel {r['kernel_us_per_step']:.0f} us/step ({r['kernel_calls_per_step']:.2f} calls); "
-                f"everything else (Exudyn, Python glue, pre-step hook) {r['rest_us_per_step']:.0f} us/step = "
-                f"real-time factor {r['rest_us_per_step'] * 1e-6 / r['dt_s']:.2f} at zero physics cost"
-            )
-        print(f"  generalized_forces with Jacobian {r['generalized_forces_us']:.1f} us/call")
-        print(
-            f"  solve wall {r['solve_wall_s']:.2f} s -> real-time factor {r['real_time_factor']:.2f}; "
-            f"post-processing {r['post_wall_s']:.2f} s; Newton iterations/step "
-            f"{r['newton_iterations_per_step']:.2f}, Jacobian updates {r['jacobian_updates']}"
+            f"{name}: compiled integrator, {r['steps']} steps, CPU {r['cpu_per_sim_s']:.3f} s per simulated s, "
+            f"Newton {r['newton_per_step']:.2f}/step, kernel calls {r['calls_per_step']:.2f}/step "
+            f"(replayed sequence {r['replayed_calls_per_step']:.2f}/step over {r['replayed_steps']} steps)"
         )
         print(
-            f"  CPU: solve {r['solve_cpu_s']:.3f} s, outputs {r['post_cpu_s']:.3f} s -> real-time factor "
-            f"(solve + outputs, CPU) {r['rtf_cpu']:.2f}"
+            f"  kernel {r['kernel_us_per_step']:.1f} us/step; outside the kernel {100 * outside:.0f} % of a step; "
+            f"elements alone (us/step): " + ", ".join(f"{k} {v:.1f}" for k, v in r["elements_us_per_step"].items())
         )
-        print(f"  TE (t > 0.02 s): mean {r['te_mean_arcsec']:.4f} arcsec, p-p {r['te_pp_arcsec']:.4f} arcsec")
-        print(f"  warm-up (numba load/compile) {r['warm_up_s']:.2f} s")
+        print(f"  pins: {r['pin_evaluations_per_call']:.2f} pin-kernel evaluations per call")
+        print(f"  TE (t > 0.02 s): mean {r['te_mean_arcsec']:.5f} arcsec, p-p {r['te_pp_arcsec']:.5f} arcsec")
 
 
 if __name__ == "__main__":

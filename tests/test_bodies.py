@@ -504,11 +504,11 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     counts = {"warm": 0, "cold": 0}
 
     def count():  # pin-kernel evaluations of this call (the cold group's counter restarts at its reset)
-        counts["warm"] += warm.ctr[0] - counts.setdefault("c0", 0)
-        counts["cold"] += cold.ctr[0]
+        counts["warm"] += warm.calls[0] - counts.setdefault("c0", 0)
+        counts["cold"] += cold.calls[0]
 
     def mark():
-        counts["c0"] = warm.ctr[0]
+        counts["c0"] = warm.calls[0]
 
     err_f, err_j, fc = _warm_against_cold(warm, cold, _moving_sequence(q0, big, 1e-3 * big), v, mark, count)
     n_warm, n_cold = counts["warm"], counts["cold"]

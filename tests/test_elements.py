@@ -63,6 +63,27 @@ def test_no_positional_pack_reader_in_flexrv():
     assert not hits, "\n".join(hits)
 
 
+#: positional reads of the pins' and crank supports' counters and states (their calls, failures,
+#: housing state, Newton state and predictor flag are named fields, slots or views)
+_POSITIONAL_STATE = r"\b(ctr|state|st|nw|hs)\[\s*\d"
+_STATE_KERNELS = ("pins.py", "cranks_discs.py", "numerics/newton.py")
+
+
+def test_no_positional_counter_or_state_in_the_pin_and_crank_kernels():
+    """The pin and crank-support kernels and their shared Newton read no counter or state by
+    position (``ctr[1]``, ``state[0]``, ``st[0]``, ``hs[1]``): each is a named pack field or a
+    named slot; the pattern flags the old lines."""
+    hits = []
+    for name in _STATE_KERNELS:
+        path = MODEL / name
+        for n, line in enumerate(path.read_text().splitlines(), 1):
+            if re.search(_POSITIONAL_STATE, line.split("#", 1)[0]):
+                hits.append(f"{name}:{n}: {line.strip()}")
+    assert not hits, "\n".join(hits)
+    for s in ("    cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0", "    state[0] = min_gap", "        hs[1] = phi"):
+        assert re.search(_POSITIONAL_STATE, s), s
+
+
 def test_old_reader_patterns_catch_the_old_code():
     """The patterns above are not vacuous: each flags a line of the kind it names."""
     samples = (

@@ -476,7 +476,7 @@ def test_skipped_pin_is_a_failure():
     m.generalized_forces(0.0, q, v)
     msg = needles.check()
     assert msg is not None and "skipped a pin" in msg
-    dep = needles.state[1:]
+    dep = needles.departure
     np.testing.assert_allclose(np.abs(dep), 2 * np.pi / m.params.z_c, rtol=1e-3)
 
 

@@ -108,7 +108,7 @@ from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import inv_small, matmul_small
-from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
+from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD, M_PER_MM
 
 _F, _I = np.float64, np.int64
@@ -156,7 +156,7 @@ NeedleLaw = law_type(
 #: :func:`needle_kernel`'s pack: indices (each crank's x, y, phi, then each disc's x, y, psi), law,
 #: disc eccentric phases chi0, as-built eccentricities, phase errors, hole centres x, y (cranks,
 #: discs), clearances, roller angles, outputs per bearing (force x, y, rollers' forces and angles,
-#: friction power) and state (min gap, each disc's departure from its conjugate rotation)
+#: friction power), the smallest gap of the last call and each disc's departure from its conjugate rotation
 NeedlePack = pack_type(
     "NeedlePack",
     ("idx", (_I, 1)),
@@ -173,7 +173,8 @@ NeedlePack = pack_type(
     ("roll", (_F, 3)),
     ("angle", (_F, 3)),
     ("pw", (_F, 2)),
-    ("state", (_F, (1,))),
+    ("min_gap", (_F, (1,))),
+    ("departure", (_F, 1)),
 )
 
 
@@ -341,7 +342,7 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
             t10, t11 = s * c00 + c * c10, s * c01 + c * c11
             ch[2 * a, 2 * b], ch[2 * a, 2 * b + 1] = t00 * c - t01 * s, t00 * s + t01 * c  # (R C) R^T
             ch[2 * a + 1, 2 * b], ch[2 * a + 1, 2 * b + 1] = t10 * c - t11 * s, t10 * s + t11 * c
-    valid = st[0] > 0.0
+    valid = st[VALID] > 0.0
     for r in range(n2):
         ones[r] = 1.0
     for j in range(n):
@@ -471,7 +472,7 @@ def _support_tangent(q, idx, g, elastic, w):
         su[r, 2] -= av[r]
     for col in range(m):
         qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
-    st[0] = 1.0
+    st[VALID] = 1.0
     return arm_term
 
 
@@ -723,19 +724,19 @@ class CrankSupports(KernelGroup):
 
     def pack(self, idx, history=False):
         return SupportPack(
-            idx,
-            self.law,
-            self.sc,
-            self.bores,
-            self.clear,
-            self.angles,
-            self.fx,
-            self.fy,
-            self.bstate,
-            self.bend,
-            self.carrier_c,
-            self.ustate,
-            np.zeros_like(self.work) if history else self.work,
+            idx=idx,
+            law=self.law,
+            roller_law=self.sc,
+            bores=self.bores,
+            clear=self.clear,
+            angles=self.angles,
+            fx=self.fx,
+            fy=self.fy,
+            bstate=self.bstate,
+            bend=self.bend,
+            carrier_c=self.carrier_c,
+            ustate=self.ustate,
+            work=np.zeros_like(self.work) if history else self.work,
         )
 
     @staticmethod
@@ -915,13 +916,14 @@ def _needle_jacobian(jq, jv, ii, v, law, arms, ecc_arm, rh, force, tangent, fric
 def needle_kernel(q, v, f, jq, jv, jac, pack):
     """Needle bearings (module docstring): Q into f[idx], Jacobians into jq, jv;
     per-bearing force on the disc into out_fx, out_fy, roller forces and angles
-    (rollers model) into out_roll, out_angle; state[0] = min gap [m], state[1 + k]
-    = disc k's departure from its conjugate rotation [rad]. Phases: each bearing's
+    (rollers model) into out_roll, out_angle; the smallest gap [m] into min_gap, disc
+    k's departure from its conjugate rotation [rad] into departure[k]. Phases: each bearing's
     contact (:func:`_needle_contact`), its loads and friction moment here, its
     Jacobian rows (:func:`_needle_jacobian`)."""
     idx, chi0, ecc, err, hx, hy = pack.idx, pack.chi0, pack.ecc, pack.err, pack.hx, pack.hy
     clear, roller_angles = pack.clear, pack.roller_angles
-    out_fx, out_fy, out_roll, out_angle, out_pw, state = pack.fx, pack.fy, pack.roll, pack.angle, pack.pw, pack.state
+    out_fx, out_fy, out_roll, out_angle, out_pw = pack.fx, pack.fy, pack.roll, pack.angle, pack.pw
+    departure = pack.departure
     law = pack.law
     z_c = law.z_c
     mu_b, r_b, v_reg = law.mu, law.friction_radius, law.v_reg  # friction moment (module docstring)
@@ -935,7 +937,7 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
         acc = 0.0
         for j in range(nc):
             acc += (chi0[kd] + err[j, kd] - q[idx[3 * j + 2]]) / z_c
-        state[1 + kd] = q[idx[3 * nc + 3 * kd + 2]] - acc / nc
+        departure[kd] = q[idx[3 * nc + 3 * kd + 2]] - acc / nc
     for j in range(nc):
         ixc, iyc, ipc = idx[3 * j], idx[3 * j + 1], idx[3 * j + 2]
         phc = q[ipc]
@@ -994,7 +996,7 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
                     b,
                     gmat,
                 )
-    state[0] = min_gap
+    pack.min_gap[0] = min_gap
 
 
 class NeedleBearings(KernelGroup):
@@ -1048,26 +1050,28 @@ class NeedleBearings(KernelGroup):
         self.fx, self.fy = np.zeros((self.nc, self.nd)), np.zeros((self.nc, self.nd))
         self.roll, self.angle = np.zeros((self.nc, self.nd, z)), np.zeros((self.nc, self.nd, z))
         self.pw = np.zeros((self.nc, self.nd))  # friction power on crank + disc (<= 0)
-        self.state = np.full(1 + self.nd, np.nan)
+        self.gap_min = np.full(1, np.inf)  # smallest gap of the last call [m]
+        self.departure = np.full(self.nd, np.nan)  # each disc's departure from its conjugate rotation [rad]
         self.reset()
 
     def pack(self, idx, history=False):
         return NeedlePack(
-            idx,
-            self.law,
-            self.chi0,
-            self.ecc,
-            self.err,
-            self.hx,
-            self.hy,
-            self.clear,
-            self.roller_angles,
-            self.fx,
-            self.fy,
-            self.roll,
-            self.angle,
-            self.pw,
-            self.state,
+            idx=idx,
+            law=self.law,
+            chi0=self.chi0,
+            ecc=self.ecc,
+            err=self.err,
+            hx=self.hx,
+            hy=self.hy,
+            clear=self.clear,
+            roller_angles=self.roller_angles,
+            fx=self.fx,
+            fy=self.fy,
+            roll=self.roll,
+            angle=self.angle,
+            pw=self.pw,
+            min_gap=self.gap_min,
+            departure=self.departure,
         )
 
     @staticmethod
@@ -1077,7 +1081,7 @@ class NeedleBearings(KernelGroup):
     @property
     def min_gap(self) -> float:
         """Smallest gap [m] of the last evaluation (negative: penetration)."""
-        return float(self.state[0])
+        return float(self.gap_min[0])
 
     def record_sources(self):
         rec = {"fx": self.fx, "fy": self.fy, "pw": self.pw}
@@ -1108,22 +1112,22 @@ class NeedleBearings(KernelGroup):
         return out
 
     def reset(self) -> None:
-        self.state[:] = np.nan
-        self.state[0] = np.inf
+        self.departure[:] = np.nan
+        self.gap_min[0] = np.inf
 
     def check(self) -> str | None:
         # a skipped pin first: it is the cause, and the needle penetration it then produces the symptom
         # (on Python floats: numpy's reductions on these few values cost ~4 us per step)
-        state = self.state.tolist()
+        departure = self.departure.tolist()
         limit = math.pi / self.z_rp
-        if any(abs(d) > limit for d in state[1:]):  # (NaN: not evaluated yet, never a skip)
-            dep = self.state[1:]
+        if any(abs(d) > limit for d in departure):  # (NaN: not evaluated yet, never a skip)
+            dep = self.departure
             k = int(np.nanargmax(np.abs(dep)))
             return (
                 f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
                 f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)"
             )
-        if state[0] < -max(20.0 * self.depth, self.limit):
+        if self.gap_min[0] < -max(20.0 * self.depth, self.limit):
             return (
                 f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
                 f"{max(20.0 * self.depth, self.limit) * 1e6:.3g} um"

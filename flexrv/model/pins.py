@@ -112,15 +112,13 @@ Cost: in a run the condensation's cost is its pin-kernel evaluations.
 Each call starts from a first-order predictor of the offsets (the previous call's
 condensed sensitivities), evaluates the pin kernel on the 3 n_discs local rim
 coordinates (3 x 3 blocks, no n x n arrays) and solves the small systems without
-LAPACK (:func:`inv_small`); a call at exactly the previous call's state (the
-solver's Jacobian after its residual) adds that call's result. Measured on rv40e
-(0.3 s run): 1.65 pin-kernel evaluations per solver call instead of
-2.32. See :func:`_pin_condensed_kernel`. Per pin the Jacobian's curvature terms
+LAPACK (:func:`inv_small`); a call at exactly the previous call's state adds that
+call's result. See :func:`_pin_condensed_kernel`. Per pin
+the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian's curvature terms
 reuse the curve's derivatives at the foot point from its Newton iteration, and
 the foot point's half-lobe test needs no arctangent
-(:func:`flexrv.geometry.cycloid._foot_point`): the same numbers bit for bit, the
-pins' part of a rv40e solver call 42.9 -> 40.0 us (first call of a step) and
-22.6 -> 20.8 us (later calls), replayed calls.
+(:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
+in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "The kernel's inner solves").
 
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
@@ -143,7 +141,7 @@ from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import matmul_small
-from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
+from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
 
 #: the pin contacts' scalar law: pin count, pin circle radius R_p [m], nominal pin radius [m],
 #: eccentricity [m], contact law K, exponent, c_max, depth, the closest-point Newton's settings
@@ -165,10 +163,13 @@ PinLaw = law_type(
     v_reg=float,
 )
 _F, _I = np.float64, np.int64
+#: how :func:`pin_kernel` uses its warm starts: a cold restart of every closest point every
+#: ``restart_every`` calls (0: never after the first), pins provably open skipped (``skip_open``)
+PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
 #: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
 #: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact gaps, outputs per (disc,
-#: pin), counters (calls, cold-restart period, closest-point failures, skip provably open pins)
+#: pin), the warm starts' control, the counters of calls and of closest-point failures
 PinPack = pack_type(
     "PinPack",
     ("idx", (_I, 1)),
@@ -187,10 +188,16 @@ PinPack = pack_type(
     ("rxn", (_F, 2)),
     ("ft", (_F, 2)),
     ("pw", (_F, 2)),
-    ("ctr", (_I, (4,))),
+    ("control", PinControl),
+    ("calls", (_I, (1,))),
+    ("failures", (_I, (1,))),
 )
 #: the pin housing's torsional compliance c_h [rad/(N m)] (0: rigid housing)
 HousingLaw = law_type("HousingLaw", compliance=float)
+#: the housing state's slots (PinBodyPack field ``housing``, the group's record "housing"): c_h, the
+#: rotation phi_h, then per disc k the housing's part -phi_h a_k of the rim offset (x, y) at
+#: HOUSING_RIM + 2 k, + 1
+HOUSING_C, HOUSING_PHI, HOUSING_RIM = 0, 1, 2
 #: :func:`pin_body_kernel`'s pack: the pins' pack, rim compliance (n_discs, 3, 3) (empty: rigid
 #: discs), rim offsets (n_discs, 3), the housing's law and state (c_h, phi_h, per disc -phi_h a_k;
 #: written), the local rim indices 0..3 n_discs - 1 and the rim Newton's work array (:func:`pin_work_size`)
@@ -253,8 +260,9 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv.
     Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
     the output arrays; phi is the closest-point warm start (updated; NaN: cold
-    start). ctr[0] counts calls (a cold restart every ctr[1] calls), ctr[2] counts
-    closest-point failures; ctr[3] = 1 allows skipping pins that are provably open.
+    start; :func:`_pin_foot`). ``calls`` counts calls (a cold
+    restart every ``control.restart_every`` calls), ``failures`` the closest-point
+    failures; ``control.skip_open`` allows skipping pins that are provably open.
 
     Skipping (exact for the forces): the gap is 1-Lipschitz in the pin's position
     relative to the disc (distance to a curve) up to the harmonics' variation, so
@@ -264,18 +272,16 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     P0y) of the last exact evaluation. Friction (module docstring): law.mu,
     law.v_reg; per (disc, pin) the friction force on the disc along t = z x n
     into out_ft and its power f_t v_t (<= 0) into out_pw."""
-    idx, law, reach, pins, radii, profile, harm, phi, last = (
+    idx, law, pins, radii, profile, harm, last = (
         pack.idx,
         pack.law,
-        pack.reach,
         pack.pins,
         pack.radii,
         pack.profile,
         pack.harm,
-        pack.phi,
         pack.last,
     )
-    out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw, ctr = (
+    out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw = (
         pack.gap,
         pack.force,
         pack.nx,
@@ -283,16 +289,15 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         pack.rxn,
         pack.ft,
         pack.pw,
-        pack.ctr,
     )
-    z_rp, R_p, r_nom, ecc = law.z_rp, law.pin_circle_radius, law.pin_radius, law.eccentricity
+    R_p, r_nom = law.pin_circle_radius, law.pin_radius
     k, expo, c_max, depth = law.k, law.exponent, law.c_max, law.depth
     mu, v_reg = law.mu, law.v_reg  # friction: effective coefficient, regularisation speed
     fric = mu > 0.0 and v_reg > 0.0
-    max_step, tol, max_iter = law.max_step, law.tol, law.max_iter
-    cold = ctr[1] > 0 and ctr[0] % ctr[1] == 0
-    skip = ctr[3] > 0
-    ctr[0] += 1
+    every, calls = pack.control.restart_every, pack.calls
+    cold = every > 0 and calls[0] % every == 0
+    skip = pack.control.skip_open
+    calls[0] += 1
     for kd in range(profile.shape[0]):
         ix, iy, ip = idx[3 * kd], idx[3 * kd + 1], idx[3 * kd + 2]
         xd, yd, psi = q[ix], q[iy], q[ip]
@@ -313,19 +318,7 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
                 if bound > 0.0:  # provably open (NaN: never skipped)
                     out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
                     continue
-            start = np.nan if cold else phi[kd, i]
-            ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
-                px, py, start, z_rp, radius, ecc, max_step, tol, max_iter
-            )
-            if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
-                # a warm-started local minimum beyond the curve's reach on its side may not be the
-                # nearest point (another flank): find it from the cold starts (_curve_reach)
-                ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
-                    px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter
-                )
-            if not ok:
-                ctr[2] += 1
-            phi[kd, i] = ph
+            ph, dist, nlx, nly, d1x, d1y, d2x, d2y = _pin_foot(pack, kd, i, px, py, radius, cold)
             gap = dist + r_nom + d_rp - radii[i]
             for h in range(harm.shape[1]):
                 gap -= harm[kd, h, 1] * np.cos(harm[kd, h, 0] * ph + harm[kd, h, 2])
@@ -397,6 +390,27 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
         f[ix] += fx
         f[iy] += fy
         f[ip] += fp
+
+
+@njit(cache=True, inline="always")
+def _pin_foot(pack, kd, i, px, py, radius, cold):
+    """The closest point of pin i to disc k's pin-centre curve (radius R_p + dR_p) at its
+    profile-frame position (px, py): (phi, s, n_x, n_y, C'_x, C'_y, C''_x, C''_y) of
+    :func:`flexrv.geometry.cycloid._foot_point`, warm-started from pack.phi[kd, i]
+    (``cold``: from the cold starts), phi into pack.phi, a failure counted in
+    pack.failures. A warm-started local minimum beyond the curve's reach on its side may
+    not be the nearest point (another flank): it is found again from the cold starts
+    (:func:`_curve_reach`)."""
+    law, reach, phi = pack.law, pack.reach, pack.phi
+    z_rp, ecc, max_step, tol, max_iter = law.z_rp, law.eccentricity, law.max_step, law.tol, law.max_iter
+    start = np.nan if cold else phi[kd, i]
+    ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
+    if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
+        ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter)
+    if not ok:
+        pack.failures[0] += 1
+    phi[kd, i] = ph
+    return ph, dist, nlx, nly, d1x, d1y, d2x, d2y
 
 
 #: the rim Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
@@ -495,11 +509,11 @@ def _add_condensed(f, jq, jv, jac, idx, qf, jc, jvc):
 
 @njit(cache=True, inline="always")
 def _rim_reuse(dstate, w):
-    """(valid, same): whether the previous call's predictor may be used (st[0] set and the
+    """(valid, same): whether the previous call's predictor may be used (st[VALID] set and the
     rim offsets not set from outside since) and whether this call is at its hub state."""
     qh, st, dlast, qp, vh, vp = w.qh, w.st, w.dlast, w.qp, w.vh, w.vp
     m = qh.shape[0]
-    valid = st[0] > 0.0
+    valid = st[VALID] > 0.0
     if valid:
         for r in range(m):
             if dstate[r // 3, r % 3] != dlast[r]:  # rim offsets set from outside: a fresh start from them
@@ -569,10 +583,10 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
         s += av[r] * acc  # torque of the pins on the discs about the axis = -(their torque on the housing)
     if ch > 0.0:
         phi = -ch * s  # housing rotation phi_h = c_h M_h, M_h = -s
-        hs[1] = phi
+        hs[HOUSING_PHI] = phi
         for kd in range(nd):
-            hs[2 + 2 * kd] = -phi * av[3 * kd]
-            hs[3 + 2 * kd] = -phi * av[3 * kd + 1]
+            hs[HOUSING_RIM + 2 * kd] = -phi * av[3 * kd]
+            hs[HOUSING_RIM + 2 * kd + 1] = -phi * av[3 * kd + 1]
     for r in range(m):
         delta[r] -= step[r]
         dstate[r // 3, r % 3] = delta[r]
@@ -619,7 +633,7 @@ def _rim_tangent(ch, s, w):
         qp[r], vp[r] = qh[r], vh[r]
         for c in range(m):
             sq[r, c] += dd[r, c]
-    st[0] = 1.0
+    st[VALID] = 1.0
 
 
 @njit(cache=True)
@@ -636,8 +650,8 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     at fixed Q = c_h (dA/dq (A^T Q) + A (dA/dq)^T Q) (a_k follows the hub centre),
     and dQ_eff/dv = (I + J N C) J_v (= (I - J C)^-1 J_v; the rim's velocity is the
     hub's: the rate of delta is left out of the contact damping). phi_h = c_h M_h,
-    M_h = -A^T Q into hs[1], the housing's part -phi_h a_k of each rim offset into
-    hs[2 + 2 k], hs[3 + 2 k].
+    M_h = -A^T Q into hs[HOUSING_PHI], the housing's part -phi_h a_k of each rim offset into
+    hs[HOUSING_RIM + 2 k], hs[HOUSING_RIM + 2 k + 1].
 
     Cost per call (in a run the pin-kernel evaluations are the
     condensation's cost): the Newton starts from the first-order predictor delta_0 =
@@ -646,16 +660,17 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
     the predicted change is below a tenth of max|delta|; larger jumps, e.g. a solver
     restarting elsewhere, start from delta_prev), so the start's residual is second
     order in the state change; it stops when max|R| <= tol (1e-10 of
-    max|delta|, at least 1e-15 m), so the records of the last evaluation (pin
-    forces, gaps) stay exact to that tolerance. Measured in a rv40e run: after a
+    max|delta|, at least 1e-15 m), so the records of the last evaluation (pin forces, gaps) stay exact to that
+    tolerance. Measured in a rv40e run: after a
     Newton correction of the solver (|dq| ~ 1e-7) the predicted start is within ~3e-12
     m of the solution (from delta_prev: ~5e-8), after a time step's rigid motion
     (|dq| ~ 1.6e-4) within ~4e-9 m. A call at exactly the previous call's hub state (q,
     v) and rim offsets (the solver's Jacobian after its residual) adds the stored
     result of that call without evaluating anything. ``wk`` (:func:`pin_work_size`)
-    holds st = (valid, -, -, -), the last call's hub q and v, its condensed force, its
-    rim offsets, S_q, S_v, the condensed Jacobians and the scratch arrays; st[0] = 0
-    (reset, history pass) starts from dstate without the predictor.
+    holds st = (valid, -, -, -) (numerics.newton.VALID), the last call's hub
+    q and v, its condensed force, its rim offsets, S_q, S_v, the condensed Jacobians and
+    the scratch arrays; st[VALID] = 0 (reset, history pass) starts from dstate without
+    the predictor.
 
     Phases (each its own compiled function): the work array's views (:func:`_rim_views`),
     the reuse test (:func:`_rim_reuse`), the compliance and start (:func:`_rim_start`),
@@ -836,8 +851,10 @@ class PinContacts(KernelGroup):
         self.nx, self.ny, self.rxn = np.zeros((self.nd, z)), np.zeros((self.nd, z)), np.zeros((self.nd, z))
         self.ft, self.pw = np.zeros((self.nd, z)), np.zeros((self.nd, z))  # friction force on the disc, its power
         self.last = np.full((self.nd, z, 3), np.nan)
-        #: calls, cold restart period, closest-point failures, skip provably open pins (solver calls)
-        self.ctr = np.array([0, restart_every, 0, 1], dtype=np.int64)
+        #: the solver's warm starts: a cold restart every restart_every calls, provably open pins skipped
+        self.control = PinControl.of(restart_every=restart_every, skip_open=True)
+        self.calls = np.zeros(1, dtype=np.int64)  # pin-kernel calls
+        self.failures = np.zeros(1, dtype=np.int64)  # closest-point failures
         #: (n_discs, 3, 3) rim compliance of the elastic discs (pin_body_kernel); (0, 3, 3): rigid discs
         self.disc_c = np.ascontiguousarray(p.disc_compliance, dtype=float)
         if self.disc_c.size and self.disc_c.shape != (self.nd, 3, 3):
@@ -866,15 +883,22 @@ class PinContacts(KernelGroup):
         return self.disc_c.shape[0] > 0
 
     def pack(self, idx, history=False):
-        phi, last, ctr = self.phi, self.last, self.ctr
+        phi, last, control, calls, failures = (
+            self.phi,
+            self.last,
+            self.control,
+            self.calls,
+            self.failures,
+        )
         if history:  # post-processing: cold start at the first sample, then warm; every gap exact
             phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
-            ctr = np.array([1, 0, 0, 0], dtype=np.int64)
+            control = PinControl.of(restart_every=0, skip_open=False)
+            calls, failures = np.ones(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
             # the rim Newton too starts cold (delta = 0) at the first sample: the history pass and a group's
             # own evaluate of the same samples are then bit-identical whatever ran before. In place: dstate is
             # also the rim record (record_sources "rim"); the solver's next call merely starts its Newton cold
             self.dstate[:] = 0.0
-            self.work[0] = 0.0  # the solver's predictor state no longer matches dstate
+            self.work[VALID] = 0.0  # the solver's predictor state no longer matches dstate
         work = np.zeros_like(self.work) if history else self.work
         pins = PinPack(
             idx=idx,
@@ -893,7 +917,9 @@ class PinContacts(KernelGroup):
             rxn=self.rxn,
             ft=self.ft,
             pw=self.pw,
-            ctr=ctr,
+            control=control,
+            calls=calls,
+            failures=failures,
         )
         return PinBodyPack(
             pins=pins,
@@ -910,11 +936,11 @@ class PinContacts(KernelGroup):
         return empty_pack(PinBodyPack)
 
     def failure_counter(self, pack):
-        return pack.pins.ctr[2:3]  # closest-point failures
+        return pack.pins.failures
 
     @property
     def min_gap(self) -> float:
-        return float(self.gap.min()) if self.ctr[0] > 0 else np.inf
+        return float(self.gap.min()) if self.calls[0] > 0 else np.inf
 
     def record_sources(self):
         return {
@@ -1017,7 +1043,7 @@ class PinContacts(KernelGroup):
         """Forget the closest-point warm start and the call counter."""
         self.phi[:] = np.nan
         self.last[:] = np.nan
-        self.ctr[0] = 0
+        self.calls[0] = 0
         self.gap[:] = 0.0
         self.dstate[:] = 0.0
         self.hstate[1:] = 0.0

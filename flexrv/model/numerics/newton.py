@@ -57,9 +57,13 @@ def _tolerance(scale):
     return max(1e-15, 1e-10 * scale)
 
 
-#: length of the iteration's state array (:func:`newton_update`): evaluations, accepted max|R|,
-#: its tolerance, step fraction, Newton steps
+#: the slots of the iteration's state array (:func:`newton_update`): evaluations, accepted max|R|,
+#: its tolerance, step fraction, Newton steps; its length
+EVALS, BEST_R, TOL, LAM, STEPS = 0, 1, 2, 3, 4
 NEWTON_STATE = 5
+#: the slot of an element's work flags (``st``) that marks its predictor (the previous call's
+#: sensitivities and state) valid: 1 valid, 0 reset (start from the stored unknowns without it)
+VALID = 0
 
 
 @njit(cache=True)
@@ -83,28 +87,28 @@ def newton_update(
     function): one compiled iteration for every condensed body without passing compiled
     functions as arguments, which numba lowers as process addresses and then refuses to
     cache."""
-    n_eval = state[0] + 1.0
-    state[0] = n_eval
+    n_eval = state[EVALS] + 1.0
+    state[EVALS] = n_eval
     tol1 = _tolerance(scale)
-    if n_eval > 1.0 and not r1 < state[1]:  # a worse (or NaN) residual after a step
-        if state[1] <= max(roundoff_abs, roundoff_rel * tol1) or n_eval >= max_evals:
+    if n_eval > 1.0 and not r1 < state[BEST_R]:  # a worse (or NaN) residual after a step
+        if state[BEST_R] <= max(roundoff_abs, roundoff_rel * tol1) or n_eval >= max_evals:
             # at round-off (or out of evaluations): the correction from this last evaluation
             condensed_step(c, j, sign, res, tmp, inv, step)
             return True
-        if not state[3] < MIN_STEP_FRACTION:
-            lam = 0.5 * state[3]
-            state[3] = lam
+        if not state[LAM] < MIN_STEP_FRACTION:
+            lam = 0.5 * state[LAM]
+            state[LAM] = lam
             for r in range(x.shape[0]):
                 x[r] = x0[r] - lam * step[r]
             return False
         # the smallest step was worse too: accept it and go on from there
-    state[1], state[2] = r1, tol1
+    state[BEST_R], state[TOL] = r1, tol1
     condensed_step(c, j, sign, res, tmp, inv, step)
-    if r1 <= tol1 or n_eval >= max_evals or state[4] >= max_steps:
+    if r1 <= tol1 or n_eval >= max_evals or state[STEPS] >= max_steps:
         return True
-    state[4] += 1.0
-    state[3] = 1.0
+    state[STEPS] += 1.0
+    state[LAM] = 1.0
     for r in range(x.shape[0]):
         x0[r] = x[r]
-        x[r] = x0[r] - state[3] * step[r]
+        x[r] = x0[r] - state[LAM] * step[r]
     return False
