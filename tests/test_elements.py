@@ -75,7 +75,7 @@ def test_no_positional_counter_or_state_in_the_pin_and_crank_kernels():
     named slot; the pattern flags the old lines."""
     hits = []
     for name in _STATE_KERNELS:
-        path = MODEL / name
+        path = PACKAGE / "model" / name
         for n, line in enumerate(path.read_text().splitlines(), 1):
             if re.search(_POSITIONAL_STATE, line.split("#", 1)[0]):
                 hits.append(f"{name}:{n}: {line.strip()}")
