@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from flexrv.units import ARCSEC_PER_RAD, RAD_PER_ARCMIN, RPM_PER_RAD_S
+from flexrv.units import ARCSEC_PER_RAD, M_PER_UM, RAD_PER_ARCMIN, RPM_PER_RAD_S
 
 #: Measured torsional stiffness of the RV-40E (:cite:`seed004`): 3.06e8 N mm/rad.
 SEED004_MEASURED_CW = 3.06e5  # N m/rad
@@ -145,7 +145,7 @@ def _modification_sweep(reducer, torque: float) -> dict:
 
     out = {}
     for dr_um in (0.0, 1.0, 2.0, 5.0, 10.0, 20.0):
-        res = reducer_pin_loads(reducer, torque, d_pin_radius=dr_um * 1e-6)
+        res = reducer_pin_loads(reducer, torque, d_pin_radius=dr_um * M_PER_UM)
         out[f"{dr_um:g}um"] = {
             "pins_in_contact": res.n_contact,
             "max_pin_force_N": res.max_force,

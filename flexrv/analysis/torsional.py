@@ -293,7 +293,7 @@ def second_stage_stiffness(
     a_w = fs.center_distance
     forces = crank_bearing_forces(res.resultant, t_disc, a_w, fs.n_planets, first_hole_angle)
     loads = np.linalg.norm(forces, axis=-1)
-    k_hc = needle_radial_stiffness(loads, nb.roller_count, nb.roller_length_mm * 1e-3)
+    k_hc = needle_radial_stiffness(loads, nb.roller_count, nb.roller_length_mm * M_PER_MM)
     c_hc = float(bearing_torsional_stiffness(k_hc, a_w, ss.n_discs))
     # seed-004 pin stiffness at each loaded pin's phase angle (from its arm: |l| = r'_c sin/S)
     psi = 2.0 * np.pi * np.arange(ss.pin_count) / ss.pin_count

@@ -11,6 +11,7 @@ import typer
 from rich.table import Table
 
 from flexrv.cli._common import JSON_HELP, console, emit, fmt, kv_table
+from flexrv.units import M_PER_MM
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -28,7 +29,7 @@ SIZE_OPT = typer.Option(None, "--size", help="Global mesh size [mm] (default: pa
 
 
 def _size_m(size_mm: Optional[float]) -> Optional[float]:
-    return None if size_mm is None else size_mm * 1e-3
+    return None if size_mm is None else size_mm * M_PER_MM
 
 
 COMPLIANCE_HELP = (

@@ -18,7 +18,7 @@ from typing import Any, Literal
 from pydantic import Field, field_validator, model_serializer, model_validator
 
 from flexrv.design._base import _bad, _Strict, floor
-from flexrv.units import M_PER_UM, RAD_PER_DEG
+from flexrv.units import M_PER_MM, M_PER_UM, RAD_PER_DEG
 
 #: allowed transverse contact ratio of the first stage: below 1 the mesh loses
 #: contact between pairs; above 2.5 a spur pair needs unusually long addenda
@@ -51,7 +51,7 @@ class FirstStage(_Strict):
     @property
     def module(self) -> float:
         """Module [m]."""
-        return self.module_mm * 1e-3
+        return self.module_mm * M_PER_MM
 
     @property
     def pressure_angle(self) -> float:
@@ -61,12 +61,12 @@ class FirstStage(_Strict):
     @property
     def face_width(self) -> float:
         """Face width [m]."""
-        return self.face_width_mm * 1e-3
+        return self.face_width_mm * M_PER_MM
 
     @property
     def backlash(self) -> float:
         """Circumferential backlash [m]."""
-        return self.backlash_um * 1e-6
+        return self.backlash_um * M_PER_UM
 
     @property
     def center_distance(self) -> float:
@@ -167,27 +167,27 @@ class SecondStage(_Strict):
 
     @property
     def pin_circle_radius(self) -> float:
-        return self.pin_circle_radius_mm * 1e-3
+        return self.pin_circle_radius_mm * M_PER_MM
 
     @property
     def pin_radius(self) -> float:
-        return self.pin_radius_mm * 1e-3
+        return self.pin_radius_mm * M_PER_MM
 
     @property
     def eccentricity(self) -> float:
-        return self.eccentricity_mm * 1e-3
+        return self.eccentricity_mm * M_PER_MM
 
     @property
     def disc_width(self) -> float:
-        return self.disc_width_mm * 1e-3
+        return self.disc_width_mm * M_PER_MM
 
     @property
     def modification_equidistant(self) -> float:
-        return self.modification_equidistant_mm * 1e-3
+        return self.modification_equidistant_mm * M_PER_MM
 
     @property
     def modification_shift(self) -> float:
-        return self.modification_shift_mm * 1e-3
+        return self.modification_shift_mm * M_PER_MM
 
     @property
     def modification_rotation(self) -> float:
@@ -195,7 +195,7 @@ class SecondStage(_Strict):
 
     @property
     def center_hole_radius(self) -> float:
-        return self.center_hole_radius_mm * 1e-3
+        return self.center_hole_radius_mm * M_PER_MM
 
     @property
     def shortening_coefficient(self) -> float:
@@ -493,11 +493,11 @@ class MainBearing(_Strict):
 
     @property
     def ball_diameter(self) -> float:
-        return self.ball_diameter_mm * 1e-3
+        return self.ball_diameter_mm * M_PER_MM
 
     @property
     def pitch_diameter(self) -> float:
-        return self.pitch_diameter_mm * 1e-3
+        return self.pitch_diameter_mm * M_PER_MM
 
     @property
     def contact_angle(self) -> float:

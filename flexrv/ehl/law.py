@@ -56,6 +56,7 @@ from flexrv.contact.hertz import line_contact_stiffness, point_contact_stiffness
 from flexrv.contact.laws import adams_step, adams_step_derivative
 from flexrv.ehl.film import HAMROCK_DOWSON_LOAD_EXPONENT, PAN_HAMROCK_LOAD_EXPONENT, hamrock_dowson, pan_hamrock_line
 from flexrv.errors import InputError
+from flexrv.units import M_PER_MM
 
 MODES = ("dry", "hamrock_dowson", "map")
 
@@ -244,7 +245,7 @@ class EHLPointLaw:
             mode=mode,
             film_map=fmap,
             c_max=reducer.main_bearing.ball_damping_Ns_per_m,
-            damping_depth=reducer.contact.impact_damping_depth_mm * 1e-3,
+            damping_depth=reducer.contact.impact_damping_depth_mm * M_PER_MM,
         )
 
     @property

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexrv.units import M_PER_MM, M_PER_UM
+
 #: Radial offset of the ring lands (shoulders) from the pitch circle, as a
 #: fraction of the ball diameter: inner land at d_m/2 - 0.25 D, outer at d_m/2 + 0.25 D.
 LAND_OFFSET = 0.25
@@ -73,17 +75,17 @@ class BallBearingGeometry:
         """Build from a :class:`flexrv.design.model.MainBearing`."""
         mb = main_bearing
         return cls(
-            ball_diameter=mb.ball_diameter_mm * 1e-3,
-            pitch_diameter=mb.pitch_diameter_mm * 1e-3,
+            ball_diameter=mb.ball_diameter_mm * M_PER_MM,
+            pitch_diameter=mb.pitch_diameter_mm * M_PER_MM,
             ball_count=mb.ball_count,
             contact_angle=math.radians(mb.contact_angle_deg),
             inner_conformity=mb.inner_conformity,
             outer_conformity=mb.outer_conformity,
-            bore_diameter=mb.inner_ring_bore_diameter_mm * 1e-3,
-            outer_diameter=mb.outer_ring_outer_diameter_mm * 1e-3,
-            ring_width=mb.ring_width_mm * 1e-3,
-            row_spacing=mb.row_spacing_mm * 1e-3,
-            axial_preload=mb.axial_preload_um * 1e-6,
+            bore_diameter=mb.inner_ring_bore_diameter_mm * M_PER_MM,
+            outer_diameter=mb.outer_ring_outer_diameter_mm * M_PER_MM,
+            ring_width=mb.ring_width_mm * M_PER_MM,
+            row_spacing=mb.row_spacing_mm * M_PER_MM,
+            axial_preload=mb.axial_preload_um * M_PER_UM,
         )
 
     # ------------------------------------------------------------ basic sizes

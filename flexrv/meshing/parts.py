@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from flexrv.errors import InputError
+from flexrv.units import M_PER_MM
 
 PARTS = ("outer_ring", "inner_ring", "crankshaft", "cycloid_disc", "carrier")
 
@@ -257,11 +258,11 @@ def spec_for(reducer, part: str):
         cs = reducer.crankshaft
         e = reducer.second_stage.eccentricity
         segs = (
-            ("gear_seat", 0.5e-3 * cs.gear_seat_diameter_mm, 1e-3 * cs.gear_seat_length_mm, 0.0),
-            ("support_a", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0),
-            ("eccentric_1", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, e),
-            ("eccentric_2", 0.5e-3 * cs.eccentric_journal_diameter_mm, 1e-3 * cs.eccentric_journal_length_mm, -e),
-            ("support_b", 0.5e-3 * cs.support_journal_diameter_mm, 1e-3 * cs.support_journal_length_mm, 0.0),
+            ("gear_seat", 0.5e-3 * cs.gear_seat_diameter_mm, M_PER_MM * cs.gear_seat_length_mm, 0.0),
+            ("support_a", 0.5e-3 * cs.support_journal_diameter_mm, M_PER_MM * cs.support_journal_length_mm, 0.0),
+            ("eccentric_1", 0.5e-3 * cs.eccentric_journal_diameter_mm, M_PER_MM * cs.eccentric_journal_length_mm, e),
+            ("eccentric_2", 0.5e-3 * cs.eccentric_journal_diameter_mm, M_PER_MM * cs.eccentric_journal_length_mm, -e),
+            ("support_b", 0.5e-3 * cs.support_journal_diameter_mm, M_PER_MM * cs.support_journal_length_mm, 0.0),
         )
         return CrankshaftSpec(segments=segs)
     if part == "cycloid_disc":
@@ -289,14 +290,14 @@ def spec_for(reducer, part: str):
             )
         return CarrierSpec(
             plate_radius=0.5e-3 * c.plate_outer_diameter_mm,
-            input_thickness=1e-3 * c.input_plate_thickness_mm,
-            output_thickness=1e-3 * c.output_plate_thickness_mm,
-            gap=1e-3 * c.plate_gap_mm,
+            input_thickness=M_PER_MM * c.input_plate_thickness_mm,
+            output_thickness=M_PER_MM * c.output_plate_thickness_mm,
+            gap=M_PER_MM * c.plate_gap_mm,
             crank_circle_radius=reducer.first_stage.center_distance,
             crank_bore_radius=0.5e-3 * c.crank_bore_diameter_mm,
             n_cranks=reducer.first_stage.n_planets,
             center_bore_radius=0.5e-3 * c.center_bore_diameter_mm,
-            pillar_circle_radius=1e-3 * c.pillar_circle_radius_mm,
+            pillar_circle_radius=M_PER_MM * c.pillar_circle_radius_mm,
             pillar_radius=0.5e-3 * c.pillar_diameter_mm,
             pillar_angles=tuple(c.pillar_angles()),
         )

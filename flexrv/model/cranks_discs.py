@@ -109,7 +109,7 @@ from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import inv_small, matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
-from flexrv.units import DEG_PER_RAD, M_PER_MM
+from flexrv.units import DEG_PER_RAD, M_PER_MM, M_PER_UM
 
 _F, _I = np.float64, np.int64
 #: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law, the
@@ -643,7 +643,7 @@ def empirical_needle_constant(reducer) -> float:
     from flexrv.analysis.torsional import needle_radial_stiffness
 
     nb = reducer.needle_bearing
-    c = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * 1e-3))
+    c = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * M_PER_MM))
     return (0.9 * c) ** (10.0 / 9.0)
 
 
@@ -661,22 +661,22 @@ def needle_parameters(reducer, drive: DriveParameters) -> NeedleParameters:
     else:
         mc, mr = reducer.material("crankshaft"), reducer.material("rolling_elements")
         e_nb = effective_modulus(mc.youngs_modulus, mc.poisson_ratio, mr.youngs_modulus, mr.poisson_ratio)
-        k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
+        k_roll = float(line_contact_stiffness(nb.roller_length_mm * M_PER_MM, e_nb))
         k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
-    d_roll = nb.roller_diameter_mm * 1e-3
+    d_roll = nb.roller_diameter_mm * M_PER_MM
     ab = drive.as_built
     return NeedleParameters(
         drive=drive,
         model=nb.model,
         k=k,
         roller_count=nb.roller_count,
-        pitch_ratio=d_roll / (cs.eccentric_journal_diameter_mm * 1e-3 + d_roll),
+        pitch_ratio=d_roll / (cs.eccentric_journal_diameter_mm * M_PER_MM + d_roll),
         eccentricities=ab.eccentricities,
         eccentric_phase_errors=ab.eccentric_phase_errors,
         holes=ab.holes,
         clearances=ab.needle_clearances,
         c_max=ct.pin_max_damping_Ns_per_m,
-        penetration_limit=ct.needle_penetration_limit_um * 1e-6,
+        penetration_limit=ct.needle_penetration_limit_um * M_PER_UM,
         friction=ct.needle_friction_coefficient if ct.friction else 0.0,
         friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
     )

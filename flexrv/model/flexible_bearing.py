@@ -76,6 +76,7 @@ from flexrv.model.bearing_kernel import (
     row_kernel,
 )
 from flexrv.model.core.params import check_pack
+from flexrv.units import M_PER_MM
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -744,7 +745,7 @@ def rows_from_design(
         )
     )
     c_max = reducer.main_bearing.ball_damping_Ns_per_m if c_max is None else c_max
-    depth = reducer.contact.impact_damping_depth_mm * 1e-3 if depth is None else depth
+    depth = reducer.contact.impact_damping_depth_mm * M_PER_MM if depth is None else depth
     ehl = reducer.contact.ehl if ehl is None else ehl
     rx_i, ry_i, rx_o, ry_o = geom.contact_radii()
     if ehl == "dry":

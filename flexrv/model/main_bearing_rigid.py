@@ -17,6 +17,7 @@ from numba import njit
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, pack_type
 from flexrv.model.drive import DriveParameters
+from flexrv.units import M_PER_MM
 
 #: :func:`main_bearing_kernel`'s pack: the carrier's 6 indices, diagonal stiffness and damping, reaction
 MainBearingPack = pack_type(
@@ -47,7 +48,7 @@ def rigid_main_bearing_parameters(reducer, drive: DriveParameters) -> RigidMainB
     inertia for the tilts; the ball-resolved and flexible main-bearing models replace it)."""
     mb = reducer.main_bearing
     k_r = mb.rigid_radial_stiffness_N_per_m
-    s = mb.row_spacing_mm * 1e-3
+    s = mb.row_spacing_mm * M_PER_MM
     k = np.array([k_r, k_r, mb.rigid_axial_stiffness_N_per_m, k_r * (s / 2) ** 2, k_r * (s / 2) ** 2])
     m = np.array([drive.carrier_mass] * 3 + [drive.carrier_inertia / 2] * 2)
     return RigidMainBearingParameters(stiffness=k, damping=2.0 * mb.rigid_damping_ratio * np.sqrt(k * m))

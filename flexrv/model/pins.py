@@ -142,6 +142,7 @@ from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
+from flexrv.units import M_PER_UM
 
 #: the pin contacts' scalar law: pin count, pin circle radius R_p [m], nominal pin radius [m],
 #: eccentricity [m], contact law K, exponent, c_max, depth, the closest-point Newton's settings
@@ -787,7 +788,7 @@ def pin_parameters(reducer, drive: DriveParameters) -> PinParameters:
         pin_k=k,
         pin_exponent=exponent,
         pin_c_max=ct.pin_max_damping_Ns_per_m,
-        pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
+        pin_penetration_limit=ct.pin_penetration_limit_um * M_PER_UM,
         pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
         if ct.friction
         else 0.0,

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from flexrv.units import M_PER_MM
 from flexrv.workflows._common import WorkflowResult, new_figure
 
 NAME = "crank_bearing_forces"
@@ -128,7 +129,7 @@ def hertz_and_life(reducer, res, max_force: float) -> dict:
     from flexrv.contact.hertz import effective_modulus, line_contact
 
     nb, cs = reducer.needle_bearing, reducer.crankshaft
-    d, length = nb.roller_diameter_mm * 1e-3, nb.roller_length_mm * 1e-3
+    d, length = nb.roller_diameter_mm * M_PER_MM, nb.roller_length_mm * M_PER_MM
     r_j = 0.5e-3 * cs.eccentric_journal_diameter_mm
     r_eff = 1.0 / (2.0 / d + 1.0 / r_j)
     mat = reducer.material("crankshaft")
