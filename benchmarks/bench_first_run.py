@@ -29,6 +29,7 @@ import resource
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -38,6 +39,29 @@ COMMANDS = {
     "te": ["te", "rv40e"],
 }
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def _cpu_of_descendants(root: int, seen: dict) -> None:
+    """Record in ``seen`` (pid -> (role, CPU s)) the CPU time of ``root`` and of its children and
+    grandchildren now (Linux /proc; elsewhere nothing)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    stats = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                text = (entry / "stat").read_text()
+                cmd = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            except OSError:
+                continue
+            fields = text.rsplit(")", 1)[-1].split()
+            stats[int(entry.name)] = (int(fields[1]), (int(fields[11]) + int(fields[12])) / tick, cmd)
+    depth, level = {root: 0}, [root]
+    for k in (1, 2):  # the background process and its helper
+        level = [pid for pid, (ppid, _, _) in stats.items() if ppid in level]
+        depth.update((pid, k) for pid in level)
+    for pid, k in depth.items():
+        if pid in stats:
+            seen[pid] = (("command", "background", "its helper")[k], stats[pid][1])
 
 
 def run(args: list[str], env: dict) -> dict:
@@ -54,7 +78,15 @@ def run(args: list[str], env: dict) -> dict:
         text=True,
         bufsize=1,
     )
-    first, first_line, lines = None, "", []
+    first, first_line, lines, seen = None, "", [], {}
+    stop = threading.Event()
+
+    def sample():  # the CPU of each process, sampled until it ends (the background processes end first)
+        while not stop.wait(0.5):
+            _cpu_of_descendants(proc.pid, seen)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
     for line in proc.stdout:
         now = time.perf_counter() - t0
         if first is None and line.strip():
@@ -62,12 +94,18 @@ def run(args: list[str], env: dict) -> dict:
         lines.append((now, line.rstrip()))
     code = proc.wait()
     wall = time.perf_counter() - t0
+    stop.set()
+    sampler.join()
     after = resource.getrusage(resource.RUSAGE_CHILDREN)  # includes the descendants it reaped
     if code != 0:
         sys.stdout.write("\n".join(text for _, text in lines[-30:]) + "\n")
         raise SystemExit(f"flexrv {' '.join(args)} exited {code}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return {"wall": wall, "cpu": cpu, "first": first, "first_line": first_line[:100], "lines": lines, "load": load}
+    per_process = ", ".join(f"{name} {c:.1f} s" for name, c in sorted(seen.values(), key=lambda x: x[0] != "command"))
+    return {
+        **{"wall": wall, "cpu": cpu, "first": first, "first_line": first_line[:100], "lines": lines},
+        **{"load": load, "per_process": per_process},
+    }
 
 
 def environment(checkout: Path, cache: Path) -> dict:
@@ -110,6 +148,7 @@ def main() -> None:
                         f"load average {r['load']:.2f} at start",
                         flush=True,
                     )
+                    print(f"    CPU by process (sampled every 0.5 s): {r['per_process']}", flush=True)
                     if a.lines:
                         for t, text in r["lines"]:
                             if text.startswith("flexrv"):
