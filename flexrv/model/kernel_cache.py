@@ -62,8 +62,9 @@ RUN_ENTRY_POINTS = {
 }
 #: first-compile time [s] of the rigid model's kernels on 2 cores (benchmarks/bench_first_run.py), for the notice
 COMPILE_ESTIMATE_S = 60
-#: a whole first run [s] on 2 cores (kernels and FE bodies of a preset), for the command line's notice
-FIRST_RUN_ESTIMATE_S = 120
+#: a whole first run [s] on 2 cores (kernels compiled in the background while the FE bodies of a preset
+#: are built; benchmarks/bench_first_run.py, docs/benchmarks.md), for the command line's notice
+FIRST_RUN_ESTIMATE_S = 60
 
 
 def uncached_kernels(modules: dict | None = None) -> list[str]:
