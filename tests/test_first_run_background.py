@@ -222,14 +222,20 @@ def _model_compiles_script(args: list[str]) -> str:
 
 
 @pytest.mark.slow
-def test_cold_simulate_loads_every_model_kernel_from_the_background_process(tmp_path):
-    """Empty caches, ``flexrv simulate rv221 --model rigid --t-end 0.01``: the background process
-    compiles the fused kernel, the compiled integrator and the history pass with the real model's
-    argument types (its bodies rigid), so the command itself compiles no model-layer kernel; the
-    run completes (a few minutes on a loaded 2-core machine)."""
+@pytest.mark.parametrize(
+    "args",
+    [["simulate", "rv221", "--model", "rigid", "--t-end", "0.01"], ["te", "rv40e", "--crank-revolutions", "0.2"]],
+    ids=["simulate", "te"],
+)
+def test_cold_command_loads_every_model_kernel_from_the_background_process(tmp_path, args):
+    """Empty caches, ``flexrv simulate rv221 --model rigid`` (short) or ``flexrv te rv40e`` (short):
+    the background process compiles the kernels (simulate: the fused kernel, the compiled integrator,
+    the history pass; te: the fused kernel and its outputs pass) with the real model's argument types
+    (its bodies rigid), so the command itself compiles no model-layer kernel; the command completes
+    (a few minutes each on a loaded 2-core machine)."""
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "FLEXRV_BACKGROUND_COMPILE")}
     env.update(PYTHONPATH=str(ROOT), FLEXRV_CACHE_DIR=str(tmp_path / "cache"), OMP_NUM_THREADS="1")
-    args = ["simulate", "rv221", "--model", "rigid", "--t-end", "0.01", "--out", str(tmp_path / "run"), "--json"]
+    args = [*args, "--out", str(tmp_path / "run"), "--json"]
     r = subprocess.run(
         [sys.executable, "-c", _model_compiles_script(args)], env=env, capture_output=True, text=True, timeout=1800
     )
