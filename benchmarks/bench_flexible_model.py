@@ -10,7 +10,18 @@ so a speed change can be checked for an unchanged answer.
 
     python benchmarks/bench_flexible_model.py [--preset rv221] [--t-end 0.1] [--cold]
         [--models rigid,balls,flexible] [--harmonics K] [--parts main_bearing,crankshaft]
-        [--ring-options '{"condense": false}']
+        [--ring-options '{"condense": false}'] [--split]
+
+``--split``: where a step's CPU goes (the preset with 5 ms ramps, the flexible-rings model):
+the bearing rows' force and Jacobian calls (compiled kernel and its Python glue), the fused
+element of the other contacts, and the rest (Exudyn: assembly, sparse LU, Newton, hooks); then
+one factorisation of a matrix of the model's structure (the balls' dense blocks, the other
+coordinates) by block elimination (:mod:`flexrv.model.numerics.block_lu`), by the dense
+compiled LU and by LAPACK (scipy), CPU per factorisation.
+
+``--paired-newton JSON``: the flexible-rings model (5 ms ramps) with the simulation's Newton
+settings and with these ``newton_options`` on top, alternating, twice each in one process:
+solve CPU per step and per simulated s, Newton iterations, Jacobians and TE of each run.
 
 Goal: the flexible-rings model (condensed rings, main bearing flexible) <= 15 CPU s per
 simulated second on rv221 and on rv40e (dt 1e-4, one BLAS thread). Measured figures with date and
@@ -65,6 +76,143 @@ def run(preset: str, model: str, t_end: float, options: dict, window: float | No
     }
 
 
+def _timed_method(owner, attr: str, acc: list) -> None:
+    """Accumulate the CPU time and the calls of ``owner.attr`` (a class: every instance) in ``acc``."""
+    fn = getattr(owner, attr)
+
+    if isinstance(owner, type):
+
+        def timed(self, *args, **kw):
+            c0 = time.process_time()
+            out = fn(self, *args, **kw)
+            acc[0] += time.process_time() - c0
+            acc[1] += 1
+            return out
+
+    else:
+
+        def timed(*args, **kw):
+            c0 = time.process_time()
+            out = fn(*args, **kw)
+            acc[0] += time.process_time() - c0
+            acc[1] += 1
+            return out
+
+    setattr(owner, attr, timed)
+
+
+def split(preset: str, t_end: float, window: float) -> None:
+    """Print the CPU per step of the flexible-rings model by part (module docstring, ``--split``)."""
+    from _shared import quick_ramps
+
+    from flexrv.model.flexible_bearing import RowElement
+    from flexrv.simulation import Simulation
+
+    sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
+    model = sim.build()
+    sim.run(t_end=2e-3, segment_steps=5)  # numba loads, one-time imports
+    acc = {k: [0.0, 0] for k in ("row force", "row Jacobian", "fused force", "fused Jacobian")}
+    saved = RowElement.force, RowElement.jacobian
+    _timed_method(RowElement, "force", acc["row force"])
+    _timed_method(RowElement, "jacobian", acc["row Jacobian"])
+    _timed_method(model.fused, "residual", acc["fused force"])
+    _timed_method(model.fused, "jacobian", acc["fused Jacobian"])
+    try:
+        res = sim.run(t_end=t_end)
+    finally:
+        RowElement.force, RowElement.jacobian = saved
+    tm = sim.timing
+    steps = max(tm["steps"], 1)
+    solve = tm["solve_cpu_s"]
+    te = res["te"].sel(time=slice(t_end - window, None)).values
+    print(
+        f"{preset} flexible rings, 5 ms ramps, {t_end:g} s: {steps} steps, "
+        f"Newton {tm['newton_iterations'] / steps:.2f} and Jacobians {tm['jacobians'] / steps:.3f} per step; "
+        f"solve CPU {1e3 * solve / steps:.3f} ms per step"
+    )
+    for key, (cpu, calls) in acc.items():
+        print(
+            f"  {key:15s} {calls / steps:6.2f} calls per step, {1e6 * cpu / max(calls, 1):7.1f} us each, "
+            f"{1e3 * cpu / steps:6.3f} ms per step ({cpu / solve:5.1%})"
+        )
+    rest = solve - sum(v[0] for v in acc.values())
+    print(f"  {'rest (Exudyn)':15s} {1e3 * rest / steps:48.3f} ms per step ({rest / solve:5.1%})")
+    print(f"  TE over the last {window:g} s: mean {te.mean():.4f}, p-p {np.ptp(te):.4f} arcsec")
+    factorisations(model)
+
+
+def factorisations(model, repeat: int = 30) -> None:
+    """Print the CPU of one factorisation of an n x n matrix with the model's ball blocks
+    (members ``main_bearing_balls*``: dense, uncoupled between rows) by block elimination, by
+    the dense compiled LU and by LAPACK's getrf (scipy), and the block solve's error."""
+    import scipy.linalg
+
+    from flexrv.model.numerics import block_lu, linalg
+
+    n = model.n
+    spans = [(m.offset, m.n) for name, m in model.members.items() if name.startswith("main_bearing_balls")]
+    blocks, xs = block_lu.block_structure(n, spans)
+    rng = np.random.default_rng(0)
+    s = rng.normal(size=(n, n)) + n * np.eye(n)
+    for i, (a0, am) in enumerate(blocks):
+        for j, (b0, bm) in enumerate(blocks):
+            if i != j:
+                s[a0 : a0 + am, b0 : b0 + bm] = 0.0
+    nx, nb = len(xs), int(blocks[:, 1].sum())
+    w, piv, ys = s.copy(), np.zeros(n, np.int64), np.zeros((nb, nx))
+    dk = np.zeros(block_lu.work_sizes(blocks, xs)[1])
+    schur, xpiv, lu = np.zeros((nx, nx)), np.zeros(nx, np.int64), np.zeros((n, n))
+
+    def cpu(fn) -> float:
+        fn()
+        c0 = time.process_time()
+        for _ in range(repeat):
+            fn()
+        return 1e3 * (time.process_time() - c0) / repeat
+
+    def blocked():
+        block_lu.block_factor(w, blocks, xs, piv, ys, dk, schur, xpiv)
+
+    t_block = cpu(blocked)
+    t_dense = cpu(lambda: linalg.lu_factor(s, lu, piv))
+    t_lapack = cpu(lambda: scipy.linalg.lu_factor(s))
+    r, x = rng.normal(size=n), np.zeros(n)
+    blocked()
+    block_lu.block_solve(w, blocks, xs, piv, ys, dk, schur, xpiv, r, x, np.zeros(nx), np.zeros(nx))
+    err = np.max(np.abs(x - np.linalg.solve(s, r))) / np.max(np.abs(x))
+    print(
+        f"  factorisation of {n} coordinates (blocks {[int(b) for b in blocks[:, 1]]}, {nx} others): block "
+        f"elimination {t_block:.3f} ms, dense compiled LU {t_dense:.3f} ms, LAPACK getrf {t_lapack:.3f} ms "
+        f"(block solve within {err:.1e} of numpy's)"
+    )
+
+
+def paired_newton(preset: str, t_end: float, window: float, options: dict, repeat: int = 2) -> None:
+    """Print the flexible-rings model's solve with the default Newton settings and with
+    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``)."""
+    from _shared import quick_ramps
+
+    from flexrv.simulation import Simulation
+
+    print(f"{preset} flexible rings, 5 ms ramps, {t_end:g} s; TE over the last {window:g} s [arcsec]")
+    for _ in range(repeat):
+        for opts in (None, options):
+            sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
+            sim.build()
+            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts)  # numba loads, one-time imports
+            res = sim.run(t_end=t_end, newton_options=opts)
+            tm = sim.timing
+            steps = max(tm["steps"], 1)
+            te = res["te"].sel(time=slice(t_end - window, None)).values
+            print(
+                f"  {json.dumps(opts or {}):44s} {steps:5d} steps, Newton {tm['newton_iterations'] / steps:.2f}, "
+                f"Jacobians {tm['jacobians'] / steps:.3f} per step; solve {1e3 * tm['solve_cpu_s'] / steps:.3f} ms "
+                f"per step, {tm['solve_cpu_s'] / tm['simulated_s']:.1f} s per simulated s; TE {te.mean():.5f}, "
+                f"p-p {np.ptp(te):.5f}",
+                flush=True,
+            )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--preset", default="rv221")
@@ -81,7 +229,20 @@ def main() -> None:
         "(default: the last half; past the load ramp 0.1-0.2 s use --t-end 0.3 --window 0.1)",
     )
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
+    parser.add_argument("--split", action="store_true", help="CPU per step by part (flexible rings, 5 ms ramps)")
+    parser.add_argument("--paired-newton", default=None, help="newton_options (JSON) against the defaults, paired")
     args = parser.parse_args()
+    if args.paired_newton:
+        paired_newton(
+            args.preset,
+            args.t_end,
+            0.5 * args.t_end if args.window is None else args.window,
+            json.loads(args.paired_newton),
+        )
+        return
+    if args.split:
+        split(args.preset, args.t_end, 0.5 * args.t_end if args.window is None else args.window)
+        return
     if args.cold:
         os.environ["FLEXRV_CACHE"] = tempfile.mkdtemp(prefix="flexrv-bench-")
     window = 0.5 * args.t_end if args.window is None else args.window

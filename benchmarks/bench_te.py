@@ -11,7 +11,8 @@ Prints, per preset, paired in one process (CPU seconds, BLAS pinned to one threa
 * the whole ``loaded_te`` call (loaded + no-load + outputs + catalog points) and its ratio to
   the loaded curve alone, and the TE statistics, so speed never buys a different answer.
 
-With ``--command`` it also times the whole ``flexrv te`` process (CPU of the child).
+With ``--command`` it also times the whole ``flexrv te`` process (CPU of the child);
+``benchmarks/bench_startup.py`` splits that process into its phases.
 
 Goals: one output revolution of rv40e with 8 points per cycloid-mesh period (12,480
 positions) in <= 2 s per curve on one core; the whole command <= 1.3 x its loaded curve.
@@ -78,6 +79,9 @@ def bench(name: str, crank_revolutions: float, output_revolutions: float | None 
         f"   whole loaded_te (loaded + no-load + outputs + catalog) {total:.2f} s CPU "
         f"= {total / t_l:.2f} x the loaded curve"
     )
+    split = ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in getattr(r, "timing", {}).items())
+    if split:
+        print(f"   its phases (s CPU): {split}")
     print(
         f"   TE p-p {s['te_pp_arcsec']:.4f} arcsec, mean {s['te_mean_arcsec']:.3f} arcsec, no-load p-p "
         f"{s['no_load_te_pp_arcsec']:.4f} arcsec, lost motion {s['lost_motion_arcmin']:.4f} arcmin, "

@@ -18,13 +18,30 @@ import pytest
 from scipy.optimize import root
 
 from flexrv.design import load
-from flexrv.model.parameters import rigid_parameters, with_bodies
+from flexrv.model.bodies import with_bodies
+from flexrv.model.drive import drive_parameters
+
+
+def _element_params(group, reducer):
+    """The element's own typed parameters from the design (its ``parameters`` builder)."""
+    return group.parameters(reducer, drive_parameters(reducer))
 
 
 @pytest.fixture(scope="module")
 def params():
-    # rigid housing: the disc and carrier bodies on their own (the housing: tests/test_housing.py)
-    return dataclasses.replace(rigid_parameters(load("rv40e")), housing_compliance=0.0)
+    """The pins' parameters of rv40e with a rigid housing: the disc body on its own (the
+    housing: tests/test_housing.py)."""
+    from flexrv.model.pins import PinContacts
+
+    return dataclasses.replace(_element_params(PinContacts, load("rv40e")), housing_compliance=0.0)
+
+
+@pytest.fixture(scope="module")
+def supports():
+    """The crank supports' parameters of rv40e (the condensed FE carrier)."""
+    from flexrv.model.cranks_discs import CrankSupports
+
+    return _element_params(CrankSupports, load("rv40e"))
 
 
 def _rigid_carrier(p):
@@ -38,7 +55,7 @@ def _rigid_discs(p):
 def _support_state(p, theta=0.3, seed=1, scale=20e-6):
     """A loaded crank-support state: carrier turned by theta, each crank off its bore."""
     rng = np.random.default_rng(seed)
-    n = p.n_cranks
+    n = p.drive.n_cranks
     q = np.zeros(6 + 3 * n)
     q[0:2] = rng.normal(0.0, 2e-6, 2)
     q[2] = theta
@@ -95,35 +112,35 @@ def test_rim_compliance_reproduces_fe_torsion(params):
     cd = params.disc_compliance
     assert cd.shape == (2, 3, 3)
     assert cd[0, 2, 2] == pytest.approx(d.mean, rel=1e-12)
-    assert cd[1, 2, 2] / params.n_discs == pytest.approx(
+    assert cd[1, 2, 2] / params.drive.n_discs == pytest.approx(
         body_compliances(r)["cycloid_disc"]["compliance_rad_per_Nm"], rel=1e-12
     )
 
 
 # ------------------------------------------------------------------ carrier in the crank supports
-def test_condensed_carrier_equals_explicit_bore_unknowns(params):
+def test_condensed_carrier_equals_explicit_bore_unknowns(supports):
     """The condensed kernel's forces equal the uncondensed problem: the support
     points' displacements u (2N, housing frame) as explicit unknowns of
     u + R C R^T f_s(d0 - u) = 0 (f_s from flexrv.contact.tapered_roller.crank_support_force
     per crank), solved by scipy's hybrid root finder to 1e-15 m; forces on the
     cranks, the carrier and the carrier's moment (arm r + u) agree to 1e-9
     relative. The carrier visibly matters here (forces change by > 10 %)."""
-    from flexrv.contact.tapered_roller import SC_G, crank_support_force
+    from flexrv.contact.tapered_roller import crank_support_force
     from flexrv.model.cranks_discs import CrankSupports
 
-    p = params
+    p = supports
     g = CrankSupports(p)
     q = _support_state(p)
     v = np.zeros_like(q)
     f, _ = g.evaluate(0.0, q, v)
-    n, th = p.n_cranks, q[2]
+    n, th = p.drive.n_cranks, q[2]
     c, s = np.cos(th), np.sin(th)
     rot = np.array([[c, -s], [s, c]])
     R = np.kron(np.eye(n), rot)
     ch = R @ p.carrier_compliance @ R.T
     r = p.crank_bores @ rot.T
     d0 = q[6:].reshape(n, 3)[:, :2] - q[:2] - r
-    gam = 0.5 * (1 - p.support_law[SC_G]) * q[8::3] + 0.5 * (1 + p.support_law[SC_G]) * th
+    gam = 0.5 * (1 - p.support_law.g) * q[8::3] + 0.5 * (1 + p.support_law.g) * th
 
     def spring(u):
         out = np.zeros(2 * n)
@@ -179,14 +196,14 @@ def _warm_against_cold(warm, cold, states, v, before=None, after=None):
 
 
 @pytest.mark.parametrize("theta", [0.3, 2.1])
-def test_condensed_carrier_jacobian_central_differences(params, theta):
+def test_condensed_carrier_jacobian_central_differences(supports, theta):
     """Condensed tangent (I + K C_h)^-1 K with the turn of C_h with the carrier and
     the deflected arm: equals central differences (h = 1e-9) of the group's force
     within 1e-6 of the largest entry (measured ~1e-7); the damper Jacobian likewise."""
     from flexrv.model.cranks_discs import CrankSupports
 
-    g = CrankSupports(params)
-    q = _support_state(params, theta=theta, seed=2)
+    g = CrankSupports(supports)
+    q = _support_state(supports, theta=theta, seed=2)
     v = np.zeros_like(q)
     f, _ = g.evaluate(0.0, q, v)
     assert np.abs(f).max() > 500.0
@@ -201,13 +218,13 @@ def test_condensed_carrier_jacobian_central_differences(params, theta):
     assert np.abs(jv - nv).max() <= 1e-6 * np.abs(nv).max()
 
 
-def test_stiff_carrier_reproduces_rigid_supports(params):
+def test_stiff_carrier_reproduces_rigid_supports(supports):
     """C -> 0 (1e-9 of the FE carrier): forces equal the rigid-carrier kernel's to
     1e-6 relative (the remaining carrier share is ~1e-9 of the supports'), the
     Jacobian to 1e-6 of its largest entry."""
     from flexrv.model.cranks_discs import CrankSupports
 
-    p = params
+    p = supports
     stiff = CrankSupports(dataclasses.replace(p, carrier_compliance=1e-9 * p.carrier_compliance))
     rigid = CrankSupports(_rigid_carrier(p))
     q = _support_state(p, seed=4)
@@ -222,8 +239,8 @@ def test_stiff_carrier_reproduces_rigid_supports(params):
 def _disc_state(p, turn=3e-4):
     from flexrv.model.factory import _members
 
-    mem = _members(p)
-    q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.n_discs)])
+    mem = _members(p.drive)
+    q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.drive.n_discs)])
     q[2::3] -= turn  # the discs turned against their pins: loaded
     return q
 
@@ -246,7 +263,9 @@ def test_condensed_disc_equals_explicit_rim_unknowns(params):
         d = x.reshape(-1, 3) * np.array([1.0, 1.0, 1.0 / p.pin_circle_radius])
         Q = g0.evaluate(0.0, q + d.ravel(), v)[0].reshape(-1, 3)
         return (
-            (d - np.einsum("kab,kb->ka", cd, Q)).ravel() * np.array([1.0, 1.0, p.pin_circle_radius] * p.n_discs) * 1e6
+            (d - np.einsum("kab,kb->ka", cd, Q)).ravel()
+            * np.array([1.0, 1.0, p.pin_circle_radius] * p.drive.n_discs)
+            * 1e6
         )
 
     sol = root(resid, np.zeros_like(q), method="hybr", tol=1e-15)
@@ -308,22 +327,27 @@ def test_stiff_disc_reproduces_rigid_pins(params):
 # ------------------------------------------------------------------ switches and the parameter route
 def test_with_bodies_sets_the_design_switches():
     """--parts names the elastic bodies: with_bodies turns the design's switches,
-    and rigid_parameters carries the FE matrices only for the named bodies; a rigid carrier's
-    support points keep the rings' and joints' parts (flexrv.analysis.path_compliances), and
-    without [path_estimates] they are rigid."""
+    and each element's parameters carry the FE matrix only of its named body (the crank
+    supports the carrier's, the pins the discs'); a rigid carrier's support points keep
+    the rings' and joints' parts (flexrv.analysis.path_compliances), and without
+    [path_estimates] they are rigid."""
     from flexrv.fem.carrier import crank_support_compliance
+    from flexrv.model.cranks_discs import CrankSupports
+    from flexrv.model.pins import PinContacts
 
     r = load("rv40e")
-    p = rigid_parameters(with_bodies(r, ["carrier"]))
+    p = _element_params(CrankSupports, with_bodies(r, ["carrier"]))
     parts = sum(p.carrier_parts.values())
     assert set(p.carrier_parts) == {"support_bearing_rings", "carrier_joints"}
     np.testing.assert_allclose(p.carrier_compliance - parts, crank_support_compliance(r), rtol=1e-12, atol=0)
-    assert p.disc_compliance.shape == (0, 3, 3)
-    p = rigid_parameters(with_bodies(r, ["cycloid_disc"]))
-    assert np.array_equal(p.carrier_compliance, parts) and p.disc_compliance.shape == (2, 3, 3)
-    p = rigid_parameters(with_bodies(r, []))
-    assert np.array_equal(p.carrier_compliance, parts) and p.disc_compliance.size == 0
-    p = rigid_parameters(with_bodies(r, []).model_copy(update={"path_estimates": None}))
+    assert _element_params(PinContacts, with_bodies(r, ["carrier"])).disc_compliance.shape == (0, 3, 3)
+    p = _element_params(CrankSupports, with_bodies(r, ["cycloid_disc"]))
+    assert np.array_equal(p.carrier_compliance, parts)
+    assert _element_params(PinContacts, with_bodies(r, ["cycloid_disc"])).disc_compliance.shape == (2, 3, 3)
+    p = _element_params(CrankSupports, with_bodies(r, []))
+    assert np.array_equal(p.carrier_compliance, parts)
+    assert _element_params(PinContacts, with_bodies(r, [])).disc_compliance.size == 0
+    p = _element_params(CrankSupports, with_bodies(r, []).model_copy(update={"path_estimates": None}))
     assert p.carrier_compliance.size == 0 and p.carrier_parts == {}
 
 
@@ -443,7 +467,7 @@ def test_model_info_names_the_elastic_bodies():
         q[m.slice(f"disc{k}").start + 2] -= 3e-4
     _, out = pins.evaluate(0.0, m.group_state(pins, q), np.zeros(3 * pins.nd), want_outputs=True)
     assert out["disc_rim_rotation"].units == "rad" and np.all(out["disc_rim_rotation"].values != 0.0)
-    _, out = sup.evaluate(0.0, _support_state(m.params), np.zeros(6 + 3 * m.params.n_cranks), want_outputs=True)
+    _, out = sup.evaluate(0.0, _support_state(sup.params), np.zeros(6 + 3 * m.params.n_cranks), want_outputs=True)
     assert out["carrier_bore_deflection"].units == "m" and np.all(out["carrier_bore_deflection"].values > 1e-7)
 
 
@@ -469,7 +493,7 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     from flexrv.model.cranks_discs import CrankSupports
     from flexrv.model.pins import PinContacts
 
-    p = rigid_parameters(load("rv40e"))
+    p = _element_params(PinContacts, load("rv40e"))
     assert p.housing_compliance > 0.0 and p.disc_compliance.size and p.pin_friction > 0.0
     warm, cold = PinContacts(p), PinContacts(p)
     q0 = _disc_state(p)
@@ -492,6 +516,7 @@ def test_predictor_path_equals_cold_starts_on_a_moving_sequence():
     assert err_f <= 1e-9 and err_j <= 1e-6, (err_f, err_j)
     assert n_warm / 30 <= 2.0 and n_cold / 30 >= 3.0, (n_warm / 30, n_cold / 30)
 
+    p = _element_params(CrankSupports, load("rv40e"))
     warm, cold = CrankSupports(p), CrankSupports(p)
     assert warm.elastic_carrier
     q0 = _support_state(p)

@@ -9,25 +9,21 @@ import numpy as np
 import pytest
 from scipy.special import gamma as gamma_fn
 
-from flexrv.contact.tapered_roller import (
-    SC_COS_A,
-    SC_DELTA0,
-    SC_EXPONENT,
-    SC_K_BEND,
-    SC_K_ROLLER,
-    SC_LINEAR,
-    crank_support_force,
-    support_deflection,
-)
+from flexrv.contact.tapered_roller import SupportConstants, crank_support_force, support_deflection
 
 N = 10.0 / 9.0
 
 
 def _sc(k_roller=4.8e8, alpha_deg=13.0, delta0=0.0, k_bend=0.0):
-    sc = np.zeros(7)
-    sc[SC_K_ROLLER], sc[SC_COS_A], sc[SC_DELTA0] = k_roller, math.cos(math.radians(alpha_deg)), delta0
-    sc[SC_K_BEND], sc[SC_EXPONENT] = k_bend, N
-    return sc
+    return SupportConstants.of(
+        linear=0.0,
+        k_roller=k_roller,
+        cos_a=math.cos(math.radians(alpha_deg)),
+        delta0=delta0,
+        k_bend=k_bend,
+        exponent=N,
+        g=0.0,
+    )
 
 
 def _angles(z):
@@ -51,12 +47,12 @@ def test_harris_radial_stiffness_zero_clearance():
     Z = 14 rollers vs the integral: within 0.1 % for the roller on the load line
     and half a pitch off it (measured: +0.023 % and -0.030 % in displacement)."""
     sc, z = _sc(), 14
-    ca = sc[SC_COS_A]
+    ca = sc.cos_a
     j_r = gamma_fn((N + 2) / 2) / (2.0 * math.sqrt(math.pi) * gamma_fn((N + 3) / 2))
     assert j_r == pytest.approx(0.2453, abs=0.002)  # Harris' table value (n = 1.1)
     for load in (500.0, 2000.0, 8000.0):
         # closed form: F = 2 Z K (delta_r ca)^n ca J_r -> delta_r
-        delta_r = (load / (2 * z * sc[SC_K_ROLLER] * ca * j_r)) ** (1 / N) / ca
+        delta_r = (load / (2 * z * sc.k_roller * ca * j_r)) ** (1 / N) / ca
         k_cf = N * load / delta_r
         for gam in (0.0, np.pi / z):
             d, k = _tangent_along([load, 0.0], sc, _angles(z), gam)
@@ -71,7 +67,7 @@ def test_preloaded_stiffness_at_zero_load():
     rollers = Z/2), isotropic, at any cage angle."""
     d0 = 0.5e-6
     sc, z = _sc(delta0=d0), 15
-    expect = z * sc[SC_COS_A] ** 2 * N * sc[SC_K_ROLLER] * d0 ** (N - 1)
+    expect = z * sc.cos_a**2 * N * sc.k_roller * d0 ** (N - 1)
     for gam in (0.0, 0.1, 0.3):
         fx, fy, kxx, kxy, kyy, *_ = crank_support_force(0.0, 0.0, gam, 0.0, sc, _angles(z), False, 0.0, 0.0)
         assert abs(fx) < 1e-9 and abs(fy) < 1e-9
@@ -105,18 +101,17 @@ def test_end_play_is_a_dead_band():
     roller on the load line carries K (cos(alpha) d - |delta_0|)^n."""
     sc = _sc(delta0=-1e-6)
     ang = _angles(12)
-    play = 1e-6 / sc[SC_COS_A]
+    play = 1e-6 / sc.cos_a
     out = crank_support_force(0.99 * play, 0.0, 0.0, 0.0, sc, ang, False, 0.0, 0.0)
     assert out[0] == 0.0 and out[2] == 0.0
     x = play + 0.05e-6  # the neighbours at +-30 deg stay open
     out = crank_support_force(x, 0.0, 0.0, 0.0, sc, ang, False, 0.0, 0.0)
-    q = sc[SC_K_ROLLER] * (sc[SC_COS_A] * x - 1e-6) ** N
-    assert out[0] == pytest.approx(-2.0 * sc[SC_COS_A] * q, rel=1e-12)  # only the roller at psi = 0 touches
+    q = sc.k_roller * (sc.cos_a * x - 1e-6) ** N
+    assert out[0] == pytest.approx(-2.0 * sc.cos_a * q, rel=1e-12)  # only the roller at psi = 0 touches
 
 
 def test_linear_option():
     """support_bearing_model = "linear": F = -k max(|d| - c, 0) d/|d| (the legacy law)."""
-    sc = np.zeros(7)
-    sc[SC_LINEAR] = 4e8
+    sc = SupportConstants.zero()._replace(linear=4e8)
     out = crank_support_force(3e-6, 4e-6, 0.0, 1e-6, sc, np.zeros(0), True, 0.0, 0.0)
     np.testing.assert_allclose(out[:2], -4e8 * 4e-6 * np.array([0.6, 0.8]), rtol=1e-12)

@@ -10,18 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-MODEL = Path(__file__).resolve().parents[1] / "flexrv" / "model"
+PACKAGE = Path(__file__).resolve().parents[1] / "flexrv"
 
 #: the positional pack readers the kernels used before their parameters were named: a
 #: scalar vector read by number (``sc[3]``, ``sc[sc.shape[0] - 1]``, ``dc[1]``) or by an index
-#: constant in a kernel (``sc[SC_G]``; the group's host code builds the named law from them), a row
+#: constant (``sc[SC_G]``, ``rigid[SC_K_BEND] = 0``: the support law's constants are a NamedTuple), a row
 #: geometry or contact law read by number (``geometry[13]``, ``law_i[5]``), the housing's compliance
 #: read from its state vector (``hs[0]``), a pack read
 #: by position (``pack[0][-1]``, ``loads[1]``) or unpacked whole (``a, b, ... = pack``),
 #: a hand-sized empty pack (``np.zeros(13)`` in ``empty_pack``)
 _OLD_READERS = (
     r"\bsc\[\s*(\d|sc\.shape)",
-    r"(?<!self\.)\bsc\[\s*SC_",
+    r"\[\s*SC_[A-Z_]+\s*\]",
     r"\bdc\[\s*\d",
     r"\bhs\[\s*0\s*\]",
     r"\bgeometry\[\s*\d",
@@ -33,27 +33,33 @@ _OLD_READERS = (
 )
 
 
-def _model_sources():
-    return sorted(p for p in MODEL.rglob("*.py") if p.name != "kernel_cache.py")
+def _sources():
+    """Every source of the package but the generated fused kernels and the kernel cache's
+    bookkeeping (numba's own index tuples)."""
+    return sorted(
+        p
+        for p in PACKAGE.rglob("*.py")
+        if p.name != "kernel_cache.py" and "_generated" not in p.relative_to(PACKAGE).parts
+    )
 
 
-def test_no_positional_pack_reader_in_the_model():
-    """No kernel reads its parameters by position: every pattern of _OLD_READERS is
-    absent from flexrv/model (a wrong index would compile and run; a wrong name fails
-    to compile), and every ``empty_pack`` is derived from its pack type
+def test_no_positional_pack_reader_in_flexrv():
+    """No kernel, contact law or analysis reads its parameters by position: every pattern
+    of _OLD_READERS is absent from flexrv/ (a wrong index would compile and run; a wrong
+    name fails to compile), and every ``empty_pack`` is derived from its pack type
     (flexrv.model.core.params.empty_pack), not sized by hand."""
     hits = []
-    for path in _model_sources():
+    for path in _sources():
         text = path.read_text()
         for n, line in enumerate(text.splitlines(), 1):
             code = line.split("#", 1)[0]
             for pat in _OLD_READERS:
                 if re.search(pat, code):
-                    hits.append(f"{path.relative_to(MODEL)}:{n}: {line.strip()}")
+                    hits.append(f"{path.relative_to(PACKAGE)}:{n}: {line.strip()}")
         for m in re.finditer(r"def empty_pack\(\):\n((?:        .*\n|\n)+)", text):
             body = [s.strip() for s in m.group(1).splitlines() if s.strip()]
             if len(body) != 1 or not re.fullmatch(r"return empty_pack\(\w+\)", body[0]):
-                hits.append(f"{path.relative_to(MODEL)}: empty_pack not derived: {body}")
+                hits.append(f"{path.relative_to(PACKAGE)}: empty_pack not derived: {body}")
     assert not hits, "\n".join(hits)
 
 
@@ -63,6 +69,8 @@ def test_old_reader_patterns_catch_the_old_code():
         "    z_rp, R_p = int(sc[0]), sc[1]",
         "    mu = sc[sc.shape[0] - 2]",
         "    kb, g = sc[SC_K_BEND], sc[SC_G]",
+        "    rigid[SC_K_BEND] = 0.0",
+        "    k = self.sc[SC_LINEAR]",
         "    cd, linear = dc[0], dc[1] > 0.5",
         "    ch = hs[0] if hs.shape[0] > 0 else 0.0",
         "    if geometry[13] > 0.0:",

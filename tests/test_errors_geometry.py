@@ -29,7 +29,6 @@ from flexrv.geometry.as_built import (
     profile_deviation,
 )
 from flexrv.geometry.cycloid import nominal_disc_pose, pin_gap, to_disc_frame
-from flexrv.model.parameters import rigid_parameters
 from flexrv.units import M_PER_UM, RAD_PER_ARCMIN, RAD_PER_DEG
 
 Z, N, ND = 40, 3, 2  # rv40e: pins, cranks, discs
@@ -87,24 +86,26 @@ def test_zero_errors_as_built_is_nominal_exactly(name):
         ab.planet_phase_errors,
     ):
         assert not np.any(arr)
-    # the rigid model reads the same arrays
-    p = rigid_parameters(r)
-    for key in (
-        "pins",
-        "pin_radii",
-        "disc_profile",
-        "profile_harmonics",
-        "holes",
-        "eccentricities",
-        "crank_bores",
-        "needle_clearances",
-        "support_clearances",
-        "sun_runout",
-        "planet_runout",
-        "planet_phase_errors",
-        "eccentric_phase_errors",
+    # the rigid model's elements read the same arrays, each in its own parameters
+    from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
+    from flexrv.model.drive import drive_parameters
+    from flexrv.model.gear_stage import GearMeshes
+    from flexrv.model.pins import PinContacts
+
+    drive = drive_parameters(r)
+    own = {cls: cls.parameters(r, drive) for cls in (PinContacts, NeedleBearings, CrankSupports, GearMeshes)}
+    for cls, fields in (
+        (PinContacts, {"pins": "pins", "pin_radii": "pin_radii", "disc_profile": "disc_profile"}),
+        (PinContacts, {"profile_harmonics": "profile_harmonics"}),
+        (NeedleBearings, {"holes": "holes", "eccentricities": "eccentricities", "clearances": "needle_clearances"}),
+        (NeedleBearings, {"eccentric_phase_errors": "eccentric_phase_errors"}),
+        (CrankSupports, {"crank_bores": "crank_bores", "support_clearances": "support_clearances"}),
+        (GearMeshes, {"sun_runout": "sun_runout", "planet_runout": "planet_runout"}),
+        (GearMeshes, {"planet_phase_errors": "planet_phase_errors"}),
     ):
-        np.testing.assert_array_equal(getattr(p, key), getattr(ab, key))
+        for field, key in fields.items():
+            np.testing.assert_array_equal(getattr(own[cls], field), getattr(ab, key))
+    np.testing.assert_array_equal(drive.chi0, ab.chi0)
     # assembly pose of the ideal design = nominal pose (round-off)
     centres, rots = assembly_disc_poses(r, ab)
     for k in range(nd):

@@ -351,19 +351,22 @@ def test_friction_loss_vs_kinematic_sliding_speeds(driven):
     measured 1.8e-5 on the pins, 9e-7 on the needles) and 1e-3 on eta (measured 5.8e-5:
     0.93858 estimated vs 0.93852 simulated, the rest being the contact damping)."""
     from flexrv.geometry.kinematics import member_speeds
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.cranks_discs import NeedleBearings
+    from flexrv.model.drive import drive_parameters
+    from flexrv.model.pins import PinContacts
     from flexrv.post.stats import mean_speed
 
     red, _, ds = driven
-    p = rigid_parameters(red)
+    d = drive_parameters(red)
+    p, pn = PinContacts.parameters(red, d), NeedleBearings.parameters(red, d)
     fs, ss = red.first_stage, red.second_stage
     t = ds.time.values
     sp = member_speeds(mean_speed(ds["theta_in"].values, t), fs.sun_teeth, fs.planet_teeth, ss.disc_teeth, ss.pin_count)
-    ix, iy = p.z_rp * ds["disc_x"].values, p.z_rp * ds["disc_y"].values  # pitch points (T, disc)
+    ix, iy = d.z_rp * ds["disc_x"].values, d.z_rp * ds["disc_y"].values  # pitch points (T, disc)
     arm = np.hypot(p.pins[:, 0] - ix[..., None], p.pins[:, 1] - iy[..., None]) - p.pin_radii
     est_pins = p.pin_friction * abs(sp.disc_rotation) * (ds["pin_force"].values * arm).sum(axis=(1, 2)).mean()
     rel = abs(sp.crank_absolute - sp.disc_rotation)
-    est_needles = p.needle_friction * p.needle_friction_radius * rel * ds["needle_force"].values.sum(axis=(1, 2)).mean()
+    est_needles = pn.friction * pn.friction_radius * rel * ds["needle_force"].values.sum(axis=(1, 2)).mean()
     sim_pins = float(ds["pin_friction_power"].sum("disc").mean())
     sim_needles = float(ds["needle_friction_power"].sum(("crank", "disc")).mean())
     assert est_pins == pytest.approx(sim_pins, rel=0.01)

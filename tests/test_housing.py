@@ -16,21 +16,28 @@ import pytest
 from scipy.optimize import root
 
 from flexrv.design import load
-from flexrv.model.parameters import rigid_parameters, with_bodies
-from tests.test_bodies import _central, _qs_loaded  # one central-difference helper for the condensed groups
+from flexrv.model.bodies import with_bodies
+from tests.test_bodies import _central, _element_params, _qs_loaded  # one central-difference helper
+
+
+def _pin_params(reducer):
+    from flexrv.model.pins import PinContacts
+
+    return _element_params(PinContacts, reducer)
 
 
 @pytest.fixture(scope="module")
 def params():
-    return rigid_parameters(load("rv40e"))
+    """The pins' parameters of rv40e (elastic discs and housing)."""
+    return _pin_params(load("rv40e"))
 
 
 def _disc_state(p, turn=3e-4):
     """Discs at their kinematic pose, turned against their pins (loaded)."""
     from flexrv.model.factory import _members
 
-    mem = _members(p)
-    q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.n_discs)])
+    mem = _members(p.drive)
+    q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.drive.n_discs)])
     q[2::3] -= turn
     return q
 
@@ -50,7 +57,7 @@ def test_housing_estimate_enters_the_parameters(params):
     assert params.housing_compliance == pytest.approx(housing_compliance(r).total, rel=1e-12)
     assert 1e-8 < params.housing_compliance < 1e-6
     rigid = r.model_copy(update={"housing": r.housing.model_copy(update={"body_model": "rigid"})})
-    assert rigid_parameters(rigid).housing_compliance == 0.0
+    assert _pin_params(rigid).housing_compliance == 0.0
 
 
 def test_condensed_housing_equals_explicit_unknowns(params):
@@ -125,7 +132,7 @@ def test_condensed_housing_jacobian_combined(params):
     from flexrv.model.pins import PinContacts
 
     p = params
-    assert p.pin_friction > 0.0 and p.disc_compliance.shape[0] == p.n_discs
+    assert p.pin_friction > 0.0 and p.disc_compliance.shape[0] == p.drive.n_discs
     g = PinContacts(p)
     q = _disc_state(p)
     v = np.zeros_like(q)
@@ -179,7 +186,7 @@ def test_quasi_static_housing_adds_its_compliance():
     r = with_bodies(load("rv40e"), [])
     torque = r.operating.rated_torque_Nm
     rigid = r.model_copy(update={"housing": r.housing.model_copy(update={"body_model": "rigid"})})
-    c_h = rigid_parameters(r).housing_compliance
+    c_h = _pin_params(r).housing_compliance
     c1, b1, m_h, phi = _qs(r)
     c0, b0, _, _ = _qs(rigid)
     assert "housing" not in b0 and "housing" in b1

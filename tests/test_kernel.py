@@ -273,9 +273,17 @@ def test_needle_jacobian_columns_vs_central_differences(needle):
 
 # ----------------------------------------------------------------------------- as-built fields
 def _params(name="rv40e", needle="empirical"):
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
 
-    return rigid_parameters(_variant(name, needle))
+    return drive_parameters(_variant(name, needle))
+
+
+def _element_params(group, name="rv40e", needle="empirical"):
+    """The typed parameters of the element ``group`` (its own builder) for a variant."""
+    from flexrv.model.drive import drive_parameters
+
+    r = _variant(name, needle)
+    return group.parameters(r, drive_parameters(r))
 
 
 def _members(p):
@@ -296,26 +304,27 @@ def test_support_clearance_dead_band():
     from flexrv.model.cranks_discs import CrankSupports
 
     p = _params()
+    ps = _element_params(CrankSupports)
     c = 10e-6
-    g0 = CrankSupports(p)
-    g = CrankSupports(dataclasses.replace(p, support_clearances=np.full(p.n_cranks, c)))
+    g0 = CrankSupports(ps)
+    g = CrankSupports(dataclasses.replace(ps, support_clearances=np.full(p.n_cranks, c)))
     mem = _members(p)
     q = _state(mem, g.members)
     v = np.zeros_like(q)
     v[6] = 0.05  # crank 0 moving: damping acts only in contact
     u = np.array([0.6, 0.8])
-    for dist, expect in ((5e-6, 0.0), (15e-6, p.support_stiffness * 5e-6)):
+    for dist, expect in ((5e-6, 0.0), (15e-6, ps.support_stiffness * 5e-6)):
         qq = q.copy()
         qq[6:8] += dist * u
         _, out = g.evaluate(0.0, qq, np.zeros_like(q), want_outputs=True)
         assert out["crank_support_force"].values[0] == pytest.approx(expect, rel=1e-12, abs=1e-9)
         _, out0 = g0.evaluate(0.0, qq, np.zeros_like(q), want_outputs=True)
-        assert out0["crank_support_force"].values[0] == pytest.approx(p.support_stiffness * dist, rel=1e-12)
+        assert out0["crank_support_force"].values[0] == pytest.approx(ps.support_stiffness * dist, rel=1e-12)
         f, _ = g.evaluate(0.0, qq, v)
         if expect == 0.0:
             assert np.all(f == 0.0)
         else:  # spring along d plus the damper
-            assert f[6] == pytest.approx(-expect * u[0] - p.support_damping * 0.05, rel=1e-12)
+            assert f[6] == pytest.approx(-expect * u[0] - ps.support_damping * 0.05, rel=1e-12)
 
 
 def test_crank_bore_position_error():
@@ -326,12 +335,13 @@ def test_crank_bore_position_error():
     from flexrv.model.cranks_discs import CrankSupports
 
     p = _params()
-    bores = p.crank_bores.copy()
+    ps = _element_params(CrankSupports)
+    bores = ps.crank_bores.copy()
     bores[1] += [3e-6, -4e-6]
-    g = CrankSupports(dataclasses.replace(p, crank_bores=bores))
+    g = CrankSupports(dataclasses.replace(ps, crank_bores=bores))
     q = _state(_members(p), g.members)
     f, _ = g.evaluate(0.0, q, np.zeros_like(q))
-    np.testing.assert_allclose(f[9:11], p.support_stiffness * np.array([3e-6, -4e-6]), rtol=1e-9)
+    np.testing.assert_allclose(f[9:11], ps.support_stiffness * np.array([3e-6, -4e-6]), rtol=1e-9)
     assert np.all(f[6:8] == 0.0) and np.all(f[12:14] == 0.0)
 
 
@@ -341,22 +351,19 @@ def test_needle_eccentricity_phase_and_clearance():
     eccentricity error de gives |d| = de; a clearance above |d| gives no force."""
     import dataclasses
 
-    from flexrv.model.cranks_discs import NeedleBearings
-    from flexrv.model.factory import empirical_needle_constant
+    from flexrv.model.cranks_discs import NeedleBearings, empirical_needle_constant
 
     r = _variant("rv40e", "empirical")
     p = _params()
+    pn = _element_params(NeedleBearings)
     k_emp = empirical_needle_constant(r)
+    assert pn.model == "empirical" and pn.k == k_emp
     zero = np.zeros((p.n_cranks, p.n_discs))
     err, de = 2e-3, 4e-6
     errs, ecc = zero.copy(), np.full_like(zero, p.eccentricity)
     errs[0, 1] = err
     ecc[2, 0] += de
-    g = NeedleBearings(
-        dataclasses.replace(p, needle_clearances=zero, eccentric_phase_errors=errs, eccentricities=ecc),
-        "empirical",
-        k_emp,
-    )
+    g = NeedleBearings(dataclasses.replace(pn, clearances=zero, eccentric_phase_errors=errs, eccentricities=ecc))
     q = _state(_members(p), g.members)
     _, out = g.evaluate(0.0, q, np.zeros_like(q), want_outputs=True)
     force = out["needle_force"].values
@@ -366,7 +373,7 @@ def test_needle_eccentricity_phase_and_clearance():
     np.testing.assert_allclose(force, expect, rtol=1e-6, atol=1e-6 * expect.max())
     clear = zero.copy()
     clear[2, 0] = 1.01 * de
-    g2 = NeedleBearings(dataclasses.replace(p, needle_clearances=clear, eccentricities=ecc), "empirical", k_emp)
+    g2 = NeedleBearings(dataclasses.replace(pn, clearances=clear, eccentricities=ecc))
     _, out2 = g2.evaluate(0.0, q, np.zeros_like(q), want_outputs=True)
     assert out2["needle_force"].values[2, 0] == 0.0
 
@@ -386,11 +393,13 @@ def test_pin_radius_position_profile_harmonics():
     ss = r.second_stage.model_copy(
         update={"modification_equidistant_mm": 0.0, "modification_shift_mm": 0.0, "modification_rotation_deg": 0.0}
     )
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
 
-    p = rigid_parameters(r.model_copy(update={"second_stage": ss}))
+    r = r.model_copy(update={"second_stage": ss})
+    d = drive_parameters(r)
+    p = PinContacts.parameters(r, d)
     g0 = PinContacts(p)
-    q = _state(_members(p), g0.members)
+    q = _state(_members(d), g0.members)
     v = np.zeros_like(q)
     g0.evaluate(0.0, q, v)
     gap0, phi0 = g0.gap.copy(), g0.phi.copy()
@@ -403,7 +412,7 @@ def test_pin_radius_position_profile_harmonics():
     pins[7] *= 1 + s / np.linalg.norm(pins[7])
     profile = p.disc_profile.copy()
     profile[1, 1] += 4e-6
-    harm = np.zeros((p.n_discs, 1, 3))
+    harm = np.zeros((d.n_discs, 1, 3))
     harm[0, 0] = [9.0, 3e-6, 0.3]
     g = PinContacts(dataclasses.replace(p, pin_radii=radii, pins=pins, disc_profile=profile, profile_harmonics=harm))
     g.evaluate(0.0, q, v)
@@ -422,20 +431,17 @@ def test_gear_runout_and_phase_errors():
     - beta_j + ph_s) + A_j sin(phi_j - beta_j + ph_j) + r_bp err_j at the same state."""
     import dataclasses
 
-    from flexrv.analysis.mesh_stiffness import involute_stage
     from flexrv.model.gear_stage import GearMeshes
     from flexrv.model.loads import ramp_drive
 
-    r = _variant("rv40e", "empirical")
     p = _params()
+    pg = _element_params(GearMeshes)
     th, om = ramp_drive(p.input_speed, p.speed_ramp_time)
-    stage = involute_stage(r)
     runout = np.array([[5e-6, 0.4], [0.0, 0.0], [7e-6, -1.0]])
     err = np.array([0.0, 1e-4, 0.0])
-    g0 = GearMeshes(p, stage, th, om)
+    g0 = GearMeshes(pg, th, om)
     g = GearMeshes(
-        dataclasses.replace(p, sun_runout=np.array([4e-6, 1.1]), planet_runout=runout, planet_phase_errors=err),
-        stage,
+        dataclasses.replace(pg, sun_runout=np.array([4e-6, 1.1]), planet_runout=runout, planet_phase_errors=err),
         th,
         om,
     )
@@ -449,7 +455,7 @@ def test_gear_runout_and_phase_errors():
     expect = (
         4e-6 * np.sin(ts - beta + 1.1)
         + runout[:, 0] * np.sin(q[8::3] - beta + runout[:, 1])
-        + p.base_radius_planet * err
+        + pg.base_radius_planet * err
     )
     np.testing.assert_allclose(o1["mesh_deflection"].values - o0["mesh_deflection"].values, expect, rtol=0, atol=1e-15)
 
@@ -546,12 +552,13 @@ def test_curve_reach_and_certified_warm_start():
     finds a ~mm gap) gets the cold-start gap: the same gaps as a fresh group to
     1e-12 m and forces to 1e-9 (without the reach check the gaps are wrong)."""
     from flexrv.geometry.cycloid import center_curve
-    from flexrv.model.pins import _curve_reach
+    from flexrv.model.pins import PinContacts, _curve_reach
 
-    p = _params()
+    p = _element_params(PinContacts)
+    d = p.drive
     radius = p.pin_circle_radius + p.disc_profile[0][0]
-    out, inside = _curve_reach(int(p.z_rp), float(radius), float(p.eccentricity))
-    _, d1, d2 = center_curve(np.array([0.0]), p.z_rp, radius, p.eccentricity)
+    out, inside = _curve_reach(int(d.z_rp), float(radius), float(d.eccentricity))
+    _, d1, d2 = center_curve(np.array([0.0]), d.z_rp, radius, d.eccentricity)
     rho = np.hypot(*d1[0]) ** 3 / abs(d1[0, 0] * d2[0, 1] - d1[0, 1] * d2[0, 0])
     assert out == pytest.approx(0.9 * rho, rel=0.01)
     assert inside > 1e-3

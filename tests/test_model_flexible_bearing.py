@@ -298,7 +298,7 @@ def test_kernel_map_law_equals_ehl_law(map_rows, omega):
     qt[3:5] = 0.0
     qt[5] = omega
     rec = np.zeros((m.ball_count, N_RECORD))
-    row_kernel(q, qt, *kernel_inputs(m), False, rec)
+    row_kernel(q, qt, kernel_inputs(m), False, rec)
     col = {name: i for i, name in enumerate(RECORD_FIELDS)}
     row = m.row
     b0 = n - 3 * m.ball_count
@@ -500,19 +500,19 @@ def test_ball_equilibrium_matches_the_static_ball_solver(preset):
     ref = initial_ball_displacements(row).ravel()
     bare = replace(row, pocket_stiffness=0.0)
     q, qt = np.zeros(n), np.zeros(n)
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(bare), 1e-10, 30, f, kbb, rec) <= 6
+    assert 0 <= ball_equilibrium(q, qt, kernel_inputs(bare), 1e-10, 30, f, kbb, rec) <= 6
     assert np.abs(q[6:] - ref).max() < 1e-15
     q = np.zeros(n)
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
+    assert 0 <= ball_equilibrium(q, qt, kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
     assert np.abs(f[6:]).max() <= 1e-10 * rec[:, :2].max()
     assert 1e-10 < np.abs(q[6:] - ref).max() < 0.01 * np.abs(ref).max()
     q[0], q[2], q[4], qt[5] = 2e-6, 1e-6, 1e-5, 1.3  # frame displaced, tilted, spinning
-    assert 0 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
+    assert 0 <= ball_equilibrium(q, qt, kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 6
     ev = evaluate_row(row, q, qt, False)
     assert np.abs(ev.force[6:]).max() <= 1e-10 * ev.inner.load.max() and ev.inner.load.max() > 40.0
     np.testing.assert_array_equal(rec[:, 0], ev.inner.load)  # the records of the last evaluation
     q[0] += 1e-10
-    assert 1 <= ball_equilibrium(q, qt, *kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 2
+    assert 1 <= ball_equilibrium(q, qt, kernel_inputs(row), 1e-10, 30, f, kbb, rec) <= 2
 
 
 def _quasi_static_row(preset, tol=None):
@@ -549,7 +549,7 @@ def test_quasi_static_row_is_the_dynamic_row_at_ball_equilibrium(preset):
     nz = dyn.ball_count
     assert qs_row.n_coordinates == 6 and dyn.n_coordinates == 6 + 3 * nz
     x, xt = _FRAME[0].copy(), _FRAME[1].copy()
-    ws = kernel_inputs(qs_row)[12]
+    ws = kernel_inputs(qs_row).balls
     for step in range(4):
         ev = evaluate_row(qs_row, x, xt, jacobian=True)
         b, bt = (a.copy() for a in _split_balls(ws, 3 * nz, 6)[:2])
@@ -561,7 +561,7 @@ def test_quasi_static_row_is_the_dynamic_row_at_ball_equilibrium(preset):
         assert ev.inner.load.max() > 40.0 and np.abs(ev.force[:3]).max() > 100.0
         x[0] += 1e-8
         x[5] += 1e-6
-    assert kernel_inputs(qs_row)[-1][4] == 0  # no failed solve
+    assert kernel_inputs(qs_row).state[4] == 0  # no failed solve
 
 
 @pytest.mark.parametrize("preset", ["rv221", "rv40e"])
@@ -601,11 +601,11 @@ def test_quasi_static_ball_failure_is_reported():
     row = _quasi_static_row("rv221", tol=1e-20)
     group = BallBearingGroup([row])
     assert group.members == ("carrier",)
-    ws = kernel_inputs(row)[12].copy()
+    ws = kernel_inputs(row).balls.copy()
     row_force(row, *_FRAME)
-    state = kernel_inputs(row)[-1]
+    state = kernel_inputs(row).state
     assert state[4] == 1 and state[5] == 1
-    np.testing.assert_array_equal(kernel_inputs(row)[12], ws)
+    np.testing.assert_array_equal(kernel_inputs(row).balls, ws)
     assert "quasi-static balls" in group.check()
 
 

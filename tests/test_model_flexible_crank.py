@@ -232,14 +232,15 @@ def test_static_crank_twist_is_torque_over_stiffness(locked_runs):
     TE shift against the rigid-crank model is the mean twist seen at the output,
     mean(twist) / z_c (the disc turns 1/z_c of the crank rotation relative to the
     carrier), within 5 % (measured 1.5 %; the cranks share the torque unequally)."""
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
+    from flexrv.model.gear_stage import GearMeshes
 
     red, runs = locked_runs
-    p = rigid_parameters(red)
+    p = drive_parameters(red)
     flex = runs["flexible"]
     k_t = float(flex.attrs["crank_torsional_stiffness_Nm_per_rad"])
     twist = _late(flex, "crank_twist").mean(axis=0)
-    torque = _late(flex, "mesh_force").mean(axis=0) * p.base_radius_planet
+    torque = _late(flex, "mesh_force").mean(axis=0) * GearMeshes.parameters(red, p).base_radius_planet
     np.testing.assert_allclose(twist, -torque / k_t, rtol=0.01)
     assert np.all(torque > 0)
     d_te = _late(flex, "te").mean() - _late(runs["rigid"], "te").mean()

@@ -329,13 +329,13 @@ def test_output_pass_equals_per_sample_kernel_calls(rings):
     col = {name: i for i, name in enumerate(RECORD_FIELDS)}
     for row, (q, qt) in zip(rows, hist):
         inputs = kernel_inputs(row)
-        ws = [inputs[10].copy(), inputs[11].copy()]
+        ws = [inputs.ws_i.copy(), inputs.ws_o.copy()]
         recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
-        forces = row_history(q, qt, *inputs, recs)
-        inputs[10][:], inputs[11][:] = ws
+        forces = row_history(q, qt, inputs, recs)
+        inputs.ws_i[:], inputs.ws_o[:] = ws
         for i in range(q.shape[0]):
             rec = np.zeros((row.ball_count, N_RECORD))
-            f, _, _ = row_kernel(q[i], qt[i], *inputs, False, rec)
+            f, _, _ = row_kernel(q[i], qt[i], inputs, False, rec)
             np.testing.assert_array_equal(forces[i], f)
             np.testing.assert_array_equal(recs[i], rec)
         assert recs[:, :, col["load_outer"]].max() > 1000.0

@@ -11,7 +11,7 @@ from flexrv.model.factory import build_model
 
 
 def _variant(name, needle="empirical", ideal=False):
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
 
     # rigid carrier and discs, no support-point compliance (the elastic bodies, the rings and joints of
     # flexrv.analysis.path_compliances: tests/test_bodies.py, tests/test_path_compliances.py)
@@ -171,9 +171,18 @@ def test_fused_force_element_matches_the_groups():
 
 
 # ----------------------------------------------------------------------------- crank supports (issue 14)
+def _support_params(reducer):
+    """The crank supports' own parameters (CrankSupports.parameters) of a design."""
+    from flexrv.model.cranks_discs import CrankSupports
+    from flexrv.model.drive import drive_parameters
+
+    return CrankSupports.parameters(reducer, drive_parameters(reducer))
+
+
 def _support_state(p, g, seed=0, scatter=3e-6):
     from flexrv.model.factory import _members
 
+    p = p.drive
     mem = _members(p)
     rng = np.random.default_rng(seed)
     q = np.concatenate([mem[n].q0 for n in g.members])
@@ -195,10 +204,9 @@ def test_crank_support_jacobian_exact(clearance_um):
     import dataclasses
 
     from flexrv.model.cranks_discs import CrankSupports
-    from flexrv.model.parameters import rigid_parameters
 
-    p = rigid_parameters(_variant("rv40e"))
-    p = dataclasses.replace(p, support_clearances=np.full(p.n_cranks, clearance_um * 1e-6))
+    p = _support_params(_variant("rv40e"))
+    p = dataclasses.replace(p, support_clearances=np.full(p.drive.n_cranks, clearance_um * 1e-6))
     g = CrankSupports(p)
     q, v = _support_state(p, g)
     v[2] = 0.0  # no carrier spin: the dropped damper term vanishes
@@ -222,9 +230,8 @@ def test_crank_support_forces_balance_and_bending_share():
     generalized moment; the reported bending share equals |K_s t|^2 / (k_b t.K_s t)
     of the law (flexrv.contact.tapered_roller) and lies in (0, 1)."""
     from flexrv.model.cranks_discs import CrankSupports
-    from flexrv.model.parameters import rigid_parameters
 
-    p = rigid_parameters(_variant("rv40e"))
+    p = _support_params(_variant("rv40e"))
     g = CrankSupports(p)
     q, _ = _support_state(p, g, seed=3)
     f, out = g.evaluate(0.0, q, np.zeros_like(q), want_outputs=True)
@@ -241,10 +248,9 @@ def test_linear_support_option_is_the_legacy_spring():
     """support_bearing_model = "linear" (explicit option): the group applies
     F = -2 k_sb d (two bearings) with a rigid crank, exactly."""
     from flexrv.model.cranks_discs import CrankSupports
-    from flexrv.model.parameters import rigid_parameters
     from tests.data.make_force_reference import legacy_supports
 
-    p = rigid_parameters(legacy_supports(_variant("rv40e"), "rv40e"))
+    p = _support_params(legacy_supports(_variant("rv40e"), "rv40e"))
     assert p.support_linear and p.support_stiffness == 4e8
     g = CrankSupports(p)
     q, _ = _support_state(p, g, seed=5)

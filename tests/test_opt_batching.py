@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import flexrv.design.manufacturing as mf
-import flexrv.model.parameters as prm
+import flexrv.model.bodies as prm
 from flexrv.studies._opt_runner import Runner, Store, chunk_draws, join_chunks
 
 
@@ -98,13 +98,13 @@ def test_shared_nominal_constants_same_answers(rv40e_draws, monkeypatch):
     problem = rv40e_draws
     res = {"crank_revolutions": 0.1, "points_per_mesh": 2, "catalog_positions": 1, "force_tol": 1e-6, "max_iter": 200}
     calls = {"n": 0}
-    body = prm._body_compliance_matrices
+    body = prm._body_compliance_matrix
 
-    def counted(reducer):
-        calls["n"] += 1
-        return body(reducer)
+    def counted(reducer, name):
+        calls["n"] += name == "carrier"  # (the discs' likewise)
+        return body(reducer, name)
 
-    monkeypatch.setattr(prm, "_body_compliance_matrices", counted)
+    monkeypatch.setattr(prm, "_body_compliance_matrix", counted)
     me._NOMINAL_MEMO.clear()
     shared = me.modification_task(problem.base, problem.draws, {"resolution": res})
     assert calls["n"] == 1
@@ -134,10 +134,14 @@ def test_nominal_constants_are_those_of_the_error_free_design(rv40e_draws):
     from flexrv.design.manufacturing import nominal_design
 
     red = from_dict({**rv40e_draws.base, "errors": rv40e_draws.draws[0]})
-    plain = prm.body_compliance_matrices(red), pin_contact_constant(red).k, housing_model_compliance(red)
+
+    def bodies(r):
+        return tuple(prm.body_compliance_matrix(r, b) for b in prm.BODY_PARTS)
+
+    plain = bodies(red), pin_contact_constant(red).k, housing_model_compliance(red)
     with mf.shared_nominal_constants():
-        first = prm.body_compliance_matrices(nominal_design(red))
-        again = prm.body_compliance_matrices(red), pin_contact_constant(red).k, housing_model_compliance(red)
+        first = bodies(nominal_design(red))
+        again = bodies(red), pin_contact_constant(red).k, housing_model_compliance(red)
     assert plain[1] == again[1] > 0.0 and plain[2] == again[2] > 0.0
     for i in (0, 1):
         assert np.array_equal(plain[0][i], first[i]) and np.array_equal(plain[0][i], again[0][i])

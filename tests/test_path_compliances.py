@@ -162,13 +162,13 @@ def test_gear_stage_carries_the_planet_torsion():
     """rv40e's gear element: the law's series compliance is s = (c_crank + c_spline) r_bp^2 with
     the closed forms per crank (rel 1e-12); the flexible-crank model keeps only the spline (its
     coupling is the crank's torsion)."""
-    from flexrv.analysis.mesh_stiffness import involute_stage
+    from flexrv.model.bodies import with_bodies
+    from flexrv.model.drive import drive_parameters
     from flexrv.model.gear_stage import GearMeshes
-    from flexrv.model.parameters import rigid_parameters, with_bodies
 
     r = with_bodies(load("rv40e"), [])
-    p = rigid_parameters(r)
-    g = GearMeshes(p, involute_stage(r), lambda t: 0.0, lambda t: 0.0)
+    g = GearMeshes.from_design(r, drive_parameters(r), lambda t: 0.0, lambda t: 0.0)
+    p = g.params
     c_t = pc.crank_torsion_compliance(r) + pc.planet_spline_compliance(r)
     assert g.law.s_t == pytest.approx(c_t * p.base_radius_planet**2, rel=1e-12)
     g.set_planet_torsion(p.planet_spline_compliance)
@@ -208,7 +208,7 @@ def test_quasi_static_model_responds_with_the_closed_forms():
     their closed forms within 1 % (measured 0.01 %, 1e-5 %), and the gear stage's share exceeds
     crank torsion + planet spline by the mesh's own part only (< 0.001 arcsec/(N m), measured
     0.0005). The stiff remainder (needles, pins, supports) is unchanged within 0.5 %."""
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
     from flexrv.model.quasi_static import StaticModel, ramp_to
     from flexrv.units import ARCSEC_PER_RAD
 
@@ -240,7 +240,7 @@ def test_gear_stage_jacobian_with_the_planet_torsion():
     speeds (the damper's dependence on q); the stiffness slope of the series law enters through
     its central difference."""
     from flexrv.model.assembled import group_index
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
     from flexrv.model.quasi_static import StaticModel, ramp_to
 
     r = with_bodies(load("rv40e"), [])

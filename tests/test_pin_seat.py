@@ -32,14 +32,15 @@ def test_conformal_seat_half_width_is_hertz_with_the_conformal_radius():
 
 
 def test_pin_constant_is_disc_and_seat_contact_in_series():
-    """rv40e: the pin law's constant K of the model (rigid_parameters.pin_k) is the
+    """rv40e: the pin law's constant K of the model (PinContacts.parameters: pin_k) is the
     Palmgren disc contact (disc width 12 mm, E' disc/pin) and the Palmgren seat
     contact (26 mm / 2 discs, E' pin/housing) in series: at any load the approach
     (Q/K)^(9/10) equals the sum of the two approaches of
     :func:`flexrv.contact.hertz.line_contact` (Palmgren's formula, Harris & Kotzalas
     eq. 6.74), rel 1e-10; the seat's share of the path compliance is its share of
     that approach."""
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
+    from flexrv.model.pins import PinContacts
 
     r = load("rv40e")
     pc = pin_contact_constant(r)
@@ -52,7 +53,7 @@ def test_pin_constant_is_disc_and_seat_contact_in_series():
         assert (q / pc.k) ** (1.0 / LINE_EXPONENT) == pytest.approx(d1 + d2, rel=1e-10)
     assert pc.shares["pin_seats"] == pytest.approx(float(d2 / (d1 + d2)), rel=1e-10)
     assert sum(pc.shares.values()) == pytest.approx(1.0, rel=1e-12)
-    assert rigid_parameters(r).pin_k == pytest.approx(pc.k, rel=1e-12)
+    assert PinContacts.parameters(r, drive_parameters(r)).pin_k == pytest.approx(pc.k, rel=1e-12)
     # the seat roughly doubles the pin path's compliance (measured share 0.49)
     assert 0.4 < pc.shares["pin_seats"] < 0.6
     # reported conformity of the seat at the largest pin load: moderate (b/r ~ 0.27)

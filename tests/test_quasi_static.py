@@ -201,15 +201,55 @@ def test_bad_inputs_name_the_field(kwargs, field):
         loaded_te(load("rv40e"), **kwargs)
 
 
+def test_outputs_are_the_solver_evaluations_at_the_converged_states():
+    """The force groups' outputs of a curve are copied from the solver's own residual call at
+    each converged position (``_CurveRecords``), not evaluated in a second pass. Reference: a
+    fresh evaluation of every group at the converged states (``group_outputs`` without
+    records: the fused element's history pass, which solves every closest point and inner
+    problem from fresh starts). Every output agrees to 1e-8 of its largest magnitude (the
+    solver's warm-started inner solves converge to ~1e-10 relative); ``pin_gap`` agrees to
+    1e-12 m except at pins the solver proved open, where it is a positive lower bound of the
+    exact gap (as declared). The kernels of the groups keep the one type signature of their
+    call from the fused kernel (a read-only or strided state would compile each again)."""
+    from flexrv.model.outputs import group_outputs
+    from flexrv.model.quasi_static import _CurveRecords, equilibrium_path
+
+    red = load("rv40e")
+    angles = positions_for(red, crank_revolutions=0.1, points_per_mesh=8)
+    sm = StaticModel(red)
+    q = ramp_to(sm, angles[0], sm.kinematic_pose(angles[0]), red.operating.rated_torque_Nm)
+    records = _CurveRecords(sm, len(angles))
+    qs, its = equilibrium_path(sm, angles, q, record=records)
+    got = records.outputs(angles, qs)
+    ref = group_outputs(sm.model, angles, qs, np.zeros_like(qs))
+    for g in sm.model.groups:  # the group's own Jacobian (catalog budget) and a history: one signature
+        qg = sm.model.group_state(g, qs[:3])
+        g.jacobian(angles[0], qg[0], np.zeros(qg.shape[1]))
+        g.evaluate(angles[:3], qg, np.zeros(qg.shape[1]), want_outputs=True)
+        assert len(type(g).kernel.signatures) == 1, g.name
+    assert set(got) == set(ref) and got["pin_force"].dims[0] == "position"
+    for name, o in ref.items():
+        a, b = got[name].values, o.values
+        if name == "pin_gap":
+            exact = np.abs(a - b) <= 1e-12
+            assert np.all(exact | ((a > 0) & (a < b))), name
+            assert np.all(exact[got["pin_force"].values > 0])
+            continue
+        assert np.allclose(a, b, rtol=0.0, atol=1e-8 * np.abs(b).max() + 1e-18), name
+
+
 def test_cli_te_json_matches_saved_results(tmp_path):
     """`flexrv te ... --json`: the required keys, and the TE numbers equal the
-    statistics recomputed from the saved NetCDF (1e-9)."""
+    statistics recomputed from the saved NetCDF (1e-9); the process imports neither dask
+    arrays nor dask.distributed nor Exudyn (``-X importtime``: what a te run does not use)."""
     import xarray as xr
 
     out = tmp_path / "te"
     cp = subprocess.run(
         [
             sys.executable,
+            "-X",
+            "importtime",
             "-m",
             "flexrv",
             "te",
@@ -226,7 +266,12 @@ def test_cli_te_json_matches_saved_results(tmp_path):
         text=True,
         timeout=600,
     )
-    assert cp.returncode == 0, cp.stderr
+    assert cp.returncode == 0, cp.stderr[-3000:]
+    rows = [line.split("|") for line in cp.stderr.splitlines() if line.startswith("import time:")]
+    # modules loaded (a hidden module's refused import is listed too, at a few microseconds)
+    imported = {r[2].strip() for r in rows[1:] if int(r[1]) > 200}
+    # no dask arrays, no dask.distributed, no Exudyn in a te process (flexrv.post.io.xarray_without_dask)
+    assert "xarray" in imported and not imported & {"dask.array", "distributed", "exudyn"}
     d = json.loads(cp.stdout)
     for key in (
         "te_pp_arcsec",
@@ -421,7 +466,7 @@ def test_solver_jacobian_equals_finite_differences(errors):
     tests/test_bodies.py (their local Newton's round-off, ~5e-8 N, is at this test's
     noise floor with steps of 5e-11 m; with 2e-10 / 4e-10 m they agree to 1e-8)."""
     from flexrv.design import load_error_set, with_errors
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
 
     red = load("rv40e") if errors is None else with_errors("rv40e", load_error_set(errors))
     red = with_bodies(red, [])

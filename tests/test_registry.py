@@ -1,9 +1,14 @@
 """The element registry (flexrv.model.core.registry): a force element defined here, in
 this test module, with ONE registry line, appears in the fused kernel, the outputs,
-the friction sum and the summary without any other file knowing it; and every
-registered element declares what the guide in CONTRIBUTING.md asks for."""
+the friction sum, the summary and the budget without any other file knowing it, and
+builds its own typed parameters from the design; and every registered element declares
+what the guide in CONTRIBUTING.md asks for."""
 
 from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -36,6 +41,21 @@ def toy_kernel(q, v, f, jq, jv, jac, pack):
         jv[i, i] -= pack.law.c
 
 
+@dataclass(frozen=True)
+class ToyParameters:
+    """The toy's typed parameters: spring k [N m/rad], damper c [N m s/rad]."""
+
+    k: float
+    c: float
+
+
+def toy_parameters(reducer, drive) -> ToyParameters:
+    """From the design: a spring that holds the rated torque at a twist of 2 mrad, damped at
+    30 % of critical on the carrier's polar inertia (the shared drive parameters)."""
+    k = reducer.operating.rated_torque_Nm / 2e-3
+    return ToyParameters(k=k, c=2.0 * 0.3 * math.sqrt(k * drive.carrier_inertia))
+
+
 class ToyTorsion(KernelGroup):
     """The toy element (members: carrier)."""
 
@@ -48,8 +68,11 @@ class ToyTorsion(KernelGroup):
         SummaryRow("max_toy_torque_Nm", "N m", "largest |torque| of the toy spring", "toy_torque", "max_abs"),
     )
 
-    def __init__(self, k, c):
-        self.law = ToyLaw.of(k=k, c=c)
+    parameters = staticmethod(toy_parameters)
+
+    def __init__(self, params: ToyParameters):
+        self.params = params
+        self.law = ToyLaw.of(k=params.k, c=params.c)
         self.torque, self.power = np.zeros(1), np.zeros(1)
 
     def pack(self, idx, history=False):
@@ -71,7 +94,17 @@ class ToyTorsion(KernelGroup):
 
 register(ToyTorsion)  # the one registry line
 
-K_TOY, C_TOY = 2e5, 30.0
+
+def _toy_constants():
+    from flexrv.design import load
+    from flexrv.model.drive import drive_parameters
+
+    red = load("rv40e")
+    p = toy_parameters(red, drive_parameters(red))
+    return p.k, p.c
+
+
+K_TOY, C_TOY = _toy_constants()  # rv40e: the closed forms below read the toy's own parameters
 
 
 def _states(model, n=5, seed=4):
@@ -96,7 +129,8 @@ def toy_model():
 
     base = build_model(load("rv40e"), exudyn=False)
     toy = build_model(load("rv40e"), exudyn=False)
-    toy.groups.append(ToyTorsion(K_TOY, C_TOY))
+    toy.groups.append(ToyTorsion.from_design(load("rv40e"), toy.params))  # its own parameters, from the design
+    assert (toy.groups[-1].params.k, toy.groups[-1].params.c) == (K_TOY, C_TOY)
     return base, toy
 
 
@@ -155,8 +189,9 @@ def test_toy_element_in_outputs_friction_and_summary(toy_model, tmp_path):
 
 def test_every_registered_element_declares_its_parts():
     """The guide's "add a force element" list (CONTRIBUTING.md), checked on every
-    registered element: a kind, a compiled kernel, a pack type whose absent-element
-    pack is derived (empty_pack), record sources and outputs, and at least one summary
+    registered element: a kind, a compiled kernel, a typed-parameters builder
+    ``parameters(reducer, drive)`` whose result the constructor takes first, a pack type
+    whose absent-element pack is derived (empty_pack), record sources and outputs, and at least one summary
     row, each on an output it declares, with a known reduction and a key of its own (no
     other element's, none of the run summary's table flexrv.post.stats.SUMMARY_KEYS); an
     element lacking outputs or summary rows fails here."""
@@ -180,6 +215,11 @@ def test_every_registered_element_declares_its_parts():
             keys.add(row.key)
         for name in cls.friction_outputs:
             assert f'"{name}"' in src, f"{kind}: friction output {name} is not declared"
+        build = inspect.getattr_static(cls, "parameters", None)
+        assert isinstance(build, staticmethod), f"{kind}: declares no parameters builder"
+        assert list(inspect.signature(build.__func__).parameters)[:2] == ["reducer", "drive"], kind
+        first = list(inspect.signature(cls.__init__).parameters)[1]
+        assert first == "params", f"{kind}: the constructor takes the typed parameters first"
 
 
 def test_toy_element_in_the_stiffness_budget():
@@ -196,7 +236,7 @@ def test_toy_element_in_the_stiffness_budget():
 
     red = load("rv40e")
     sm = StaticModel(red)
-    sm.model.groups.append(ToyTorsion(K_TOY, 0.0))
+    sm.model.groups.append(ToyTorsion(dataclasses.replace(ToyTorsion.parameters(red, sm.p), c=0.0)))
     sm.model.fused = None  # the fused kernel of the groups with the toy
     theta = 0.1
     q = ramp_to(sm, theta, sm.kinematic_pose(theta), red.operating.rated_torque_Nm)

@@ -81,13 +81,13 @@ def test_support_inner_solve_against_independent_root(name):
     measured up to 6e-13)."""
     from scipy.optimize import root
 
-    from flexrv.contact.tapered_roller import SC_K_BEND, _bearing, _roller_directions, crank_support_force
+    from flexrv.contact.tapered_roller import _bearing, _roller_directions, crank_support_force
     from flexrv.model.factory import build_model
 
     m = build_model(load(name), exudyn=False)
     g = next(g for g in m.groups if g.name == "crank_supports")
     sc, angles = g.sc, g.angles
-    kb = sc[SC_K_BEND]
+    kb = sc.k_bend
     assert kb > 0.0 and not g.linear
     rng = np.random.default_rng(15)
     for i in range(300):

@@ -2,7 +2,7 @@
 laws of the models do not contain by themselves, each a closed form referred to the output
 [rad/(N m)]. One formula, one executor: the analytic budget lists them as elements
 (:func:`output_compliances`) and the models carry them at their physical places
-(:func:`model_compliances`, called by :func:`flexrv.model.parameters.rigid_parameters`):
+(:func:`model_compliances`, called by :func:`flexrv.model.cranks_discs.crank_support_parameters`):
 
 * the crank torsion and the planet spline, a torsional compliance c_t per crank between the
   planet gear and the crank's eccentrics, sit in series with each planet's mesh

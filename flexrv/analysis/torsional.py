@@ -410,33 +410,43 @@ def crank_bending(reducer) -> CrankBending:
     return stepped_shaft_bending(segs, mat.youngs_modulus, mat.poisson_ratio)
 
 
-def support_constants(reducer) -> tuple[np.ndarray, np.ndarray, bool]:
+def support_constants(reducer) -> tuple:
     """(sc, roller angles, is_linear) of a design's crank support for
     :func:`flexrv.contact.tapered_roller.crank_support_force` (the one law of the
-    kernel and the budget): roller constant K = series(K_cone, K_cup) of two
-    Palmgren line contacts of length l (E' of crankshaft/rolling-element steel),
-    cos(alpha), delta_0 = s_a sin(alpha), k_bend (0: rigid crank), g = D cos(alpha)/d_m."""
+    kernel and the budget; ``sc`` a :class:`~flexrv.contact.tapered_roller.SupportConstants`):
+    roller constant K = series(K_cone, K_cup) of two Palmgren line contacts of length l
+    (E' of crankshaft/rolling-element steel), cos(alpha), delta_0 = s_a sin(alpha), k_bend
+    (0: rigid crank), g = D cos(alpha)/d_m."""
     from flexrv.contact.hertz import LINE_EXPONENT, effective_modulus, line_contact_stiffness, series_stiffness
+    from flexrv.contact.tapered_roller import SupportConstants
 
     cs = reducer.crankshaft
     linear = cs.support_bearing_model == "linear"
     k_bend = crank_bending(reducer).k_symmetric if cs.bending_model == "timoshenko" else 0.0
-    from flexrv.contact.tapered_roller import SC_COS_A, SC_DELTA0, SC_EXPONENT, SC_G, SC_K_BEND, SC_K_ROLLER, SC_LINEAR
-
-    sc = np.zeros(7)
-    sc[SC_K_BEND] = k_bend
-    sc[SC_EXPONENT] = LINE_EXPONENT
     if linear:
-        sc[SC_LINEAR] = 2.0 * cs.support_bearing_radial_stiffness_N_per_m
+        sc = SupportConstants.of(
+            linear=2.0 * cs.support_bearing_radial_stiffness_N_per_m,
+            k_roller=0.0,
+            cos_a=0.0,
+            delta0=0.0,
+            k_bend=k_bend,
+            exponent=LINE_EXPONENT,
+            g=0.0,
+        )
         return sc, np.zeros(0), True
     mc, mr = reducer.material("crankshaft"), reducer.material("rolling_elements")
     e_eff = effective_modulus(mc.youngs_modulus, mc.poisson_ratio, mr.youngs_modulus, mr.poisson_ratio)
     k_line = float(line_contact_stiffness(cs.support_bearing_roller_length_mm * M_PER_MM, e_eff))
     a = cs.support_bearing_contact_angle_deg * RAD_PER_DEG
-    sc[SC_K_ROLLER] = float(series_stiffness(k_line, k_line, LINE_EXPONENT))
-    sc[SC_COS_A] = np.cos(a)
-    sc[SC_DELTA0] = cs.support_bearing_axial_preload_um * M_PER_UM * np.sin(a)
-    sc[SC_G] = cs.support_bearing_roller_diameter_mm * np.cos(a) / cs.support_bearing_pitch_diameter_mm
+    sc = SupportConstants.of(
+        linear=0.0,
+        k_roller=series_stiffness(k_line, k_line, LINE_EXPONENT),
+        cos_a=np.cos(a),
+        delta0=cs.support_bearing_axial_preload_um * M_PER_UM * np.sin(a),
+        k_bend=k_bend,
+        exponent=LINE_EXPONENT,
+        g=cs.support_bearing_roller_diameter_mm * np.cos(a) / cs.support_bearing_pitch_diameter_mm,
+    )
     z = cs.support_bearing_roller_count
     return sc, 2.0 * np.pi * np.arange(z) / z, False
 
@@ -742,15 +752,14 @@ def stiffness_budget(
     rigid model either).
     """
     from flexrv.analysis.pin_load import reducer_pin_loads
-    from flexrv.contact.tapered_roller import SC_K_BEND, crank_support_force, support_deflection
+    from flexrv.contact.tapered_roller import crank_support_force, support_deflection
 
     torque = reducer.operating.rated_torque_Nm if output_torque is None else float(output_torque)
     st = second_stage_stiffness(reducer, torque, crank_angle)
     n = reducer.first_stage.n_planets
     a_w = reducer.first_stage.center_distance
     sc, angles, linear = support_constants(reducer)
-    rigid = sc.copy()
-    rigid[SC_K_BEND] = 0.0
+    rigid = sc._replace(k_bend=0.0)
     th = crank_hole_angles(n)
     f_sup = abs(torque) / (n * a_w)
     k_bear = 0.0
@@ -778,7 +787,7 @@ def stiffness_budget(
         "pins": float(1.0 / st.c_mesh_tangent),
         "needle_bearings": float(1.0 / k_needle),
         "support_bearings": float(1.0 / (a_w**2 * k_bear)),
-        "crank_bending": float(1.0 / (n * a_w**2 * sc[SC_K_BEND])) if sc[SC_K_BEND] > 0.0 else 0.0,
+        "crank_bending": float(1.0 / (n * a_w**2 * sc.k_bend)) if sc.k_bend > 0.0 else 0.0,
     }
     for name in ("carrier", "cycloid_disc"):
         value = (bodies or {}).get(name)

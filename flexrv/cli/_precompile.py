@@ -33,7 +33,7 @@ def _simulation(reducer, model: str, model_options: dict):
 
 def _static_model(reducer):
     """The quasi-static model of ``te`` with every elastic body rigid."""
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
     from flexrv.model.quasi_static import StaticModel
 
     return StaticModel(with_bodies(reducer, ()))
@@ -53,7 +53,7 @@ def te_job(reducer) -> None:
     """The loaded TE of ``reducer`` with rigid bodies over its first positions (the kernels of ``te``),
     the pins' kernel compiled meanwhile by a helper process (:func:`elements_job`)."""
     from flexrv.model.kernel_cache import start_background
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
     from flexrv.model.quasi_static import loaded_te
     from flexrv.post.definitions import PLAY_FRACTIONS
 

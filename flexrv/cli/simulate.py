@@ -122,9 +122,13 @@ def simulate(
     import math
 
     from flexrv.cli._precompile import start_simulate
+    from flexrv.cli.te import skip_final_collection
     from flexrv.errors import InputError
+    from flexrv.post.io import xarray_without_dask
     from flexrv.simulation import DEFAULT_DT, Simulation
 
+    xarray_without_dask()
+    skip_final_collection()
     dt = DEFAULT_DT if dt is None else dt
     if not (math.isfinite(checkpoint) and checkpoint >= 0):
         raise InputError(f"--checkpoint-s {checkpoint}: must be a finite number >= 0 s")

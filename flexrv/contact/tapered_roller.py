@@ -52,11 +52,37 @@ relative to the summed roller load, see :func:`crank_support_force`):
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-#: sc vector layout of :func:`crank_support_force`
-SC_LINEAR, SC_K_ROLLER, SC_COS_A, SC_DELTA0, SC_K_BEND, SC_EXPONENT, SC_G = range(7)
+
+class SupportConstants(NamedTuple):
+    """The constants ``sc`` of :func:`crank_support_force`, read by name (numba types a
+    NamedTuple of floats defined at module level, and its cache finds it again by name in
+    the next process). Build it with :meth:`of` (every field converted to float, so that
+    every instance has the same numba type)."""
+
+    linear: float  #: radial stiffness k of the linear law (both bearings) [N/m]; 0: roller law
+    k_roller: float  #: roller constant K of Q = K delta^n (two line contacts in series) [N/m^n]
+    cos_a: float  #: cos(alpha) of the cup half-angle [-]
+    delta0: float  #: normal approach of the axial preload s_a sin(alpha) [m]
+    k_bend: float  #: crank bending stiffness in series [N/m]; 0: rigid crank
+    exponent: float  #: load-deflection exponent n of a roller [-]
+    g: float  #: D cos(alpha) / d_m of the cage's epicyclic rate [-]
+
+    @classmethod
+    def of(cls, **values) -> SupportConstants:
+        """Every field given by name (missing or unknown ones rejected), as float."""
+        missing, extra = set(cls._fields) - set(values), set(values) - set(cls._fields)
+        if missing or extra:
+            raise TypeError(f"SupportConstants: missing {sorted(missing)}, unknown {sorted(extra)}")
+        return cls(**{k: float(values[k]) for k in cls._fields})
+
+    @classmethod
+    def zero(cls) -> SupportConstants:
+        return cls(*([0.0] * len(cls._fields)))
 
 
 @njit(cache=True)
@@ -78,7 +104,7 @@ def _bearing(bx, by, clear, sc, ux, uy, is_linear):
     K_b = -dF/db (kxx, kxy, kyy), dF/dgamma (gx, gy) and the summed roller load;
     (ux, uy): the roller directions (:func:`_roller_directions`)."""
     if is_linear:
-        k = sc[SC_LINEAR]
+        k = sc.linear
         dist = np.sqrt(bx * bx + by * by)
         if clear <= 0.0:
             return -k * bx, -k * by, k, 0.0, k, 0.0, 0.0, k * dist
@@ -88,7 +114,7 @@ def _bearing(bx, by, clear, sc, ux, uy, is_linear):
         ux, uy = bx / dist, by / dist
         w = k * clear / dist
         return -sk * bx, -sk * by, sk + w * ux * ux, w * ux * uy, sk + w * uy * uy, 0.0, 0.0, sk * dist
-    kr, ca, d0, n = sc[SC_K_ROLLER], sc[SC_COS_A], sc[SC_DELTA0], sc[SC_EXPONENT]
+    kr, ca, d0, n = sc.k_roller, sc.cos_a, sc.delta0, sc.exponent
     fx = fy = kxx = kxy = kyy = gx = gy = qsum = 0.0
     for i in range(ux.shape[0]):
         cx, cy = ux[i], uy[i]
@@ -119,7 +145,7 @@ def crank_support_force(dx, dy, gam, clear, sc, angles, is_linear, b0x, b0y):
     start for b (the previous solution; any value converges). The inner equation is
     solved to |R|_1 <= 1e-13 (k_bend |d|_1 + |F|_1 + summed roller load), or to its
     round-off floor (a Newton step that no longer lowers |R|), i.e. b to ~1e-19 m."""
-    kb = sc[SC_K_BEND]
+    kb = sc.k_bend
     if is_linear:
         ux = uy = angles[:0]
     else:

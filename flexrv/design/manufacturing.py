@@ -14,7 +14,7 @@ of N lists of n_discs values. ``[[errors.discs]]`` is absent (no disc errors) or
 list of exactly n_discs tables.
 
 Sign conventions (housing / carrier / disc frames of :mod:`flexrv.geometry.cycloid`
-and :mod:`flexrv.model.parameters`): radial errors positive outward, tangential
+and :mod:`flexrv.model.drive`): radial errors positive outward, tangential
 errors positive counter-clockwise; a positive ``pin_radius_um`` enlarges the pin
 (less clearance); ``equidistant_um`` / ``shift_um`` / ``rotation_arcmin`` add to the
 disc's nominal modifications dr_rp, dR_p and d_delta; a profile harmonic

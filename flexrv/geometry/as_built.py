@@ -5,11 +5,11 @@
 actual pin centres and radii, the per-disc profile (modifications + error
 harmonics), the crank-hole centres in each disc, the eccentrics, the crank bores
 in the carrier, the bearing clearances and the first-stage runouts, all SI. The
-rigid/quasi-static model parameters (:func:`flexrv.model.parameters.rigid_parameters`)
+rigid/quasi-static model parameters (:func:`flexrv.model.drive.drive_parameters` and the elements' ``parameters``)
 and the analytic pin-load distribution (:mod:`flexrv.analysis.pin_load`) read it,
 so every model sees the same reducer.
 
-Frames and signs (as :mod:`flexrv.geometry.cycloid` and :mod:`flexrv.model.parameters`):
+Frames and signs (as :mod:`flexrv.geometry.cycloid` and :mod:`flexrv.model.drive`):
 pin j sits at psi_j = 2 pi j / z_rp clockwise from +y, R_p (sin psi_j, cos psi_j);
 crank j at beta_j = 2 pi j / N counter-clockwise from +x, a_w (cos beta_j, sin beta_j)
 in the carrier; radial errors along the element's outward radius, tangential errors

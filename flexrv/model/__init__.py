@@ -4,9 +4,10 @@
 model with compliant contacts: members (carrier with its 5-DOF main-bearing
 element, cranks = planets, cycloid discs) as ``NodeGenericODE2`` nodes with
 constant mass matrices, and the force elements, the compiled ones registered in
-:mod:`.core.registry` and evaluated in ONE generated fused kernel (:mod:`.kernels`), their
-parameters typed and read by name (:mod:`.core.params`), their shared numerics in
-:mod:`.numerics`:
+:mod:`.core.registry` and evaluated in ONE generated fused kernel (:mod:`.kernels`), each building its own
+typed parameters from the design (the element's ``parameters(reducer, drive)``; the
+shared ones in :mod:`.drive`), their kernel packs typed and read by name
+(:mod:`.core.params`), their shared numerics in :mod:`.numerics`:
 
 * :mod:`.gear_stage` — sun–planet meshes along the line of action (time-varying
   ISO 6336 stiffness, damping, backlash; the sun angle is prescribed by the drive);
@@ -18,5 +19,5 @@ parameters typed and read by name (:mod:`.core.params`), their shared numerics i
 * :mod:`.loads` — seed drive (input speed step) and load torque step.
 
 Why TE appears and how it is built is explained in :mod:`flexrv.post.results`;
-the planar-DOF choice is justified in :mod:`.parameters`.
+the planar-DOF choice is justified in :mod:`.drive`.
 """

@@ -212,6 +212,16 @@ class KernelGroup(ForceGroup):
     summary_rows: tuple = ()
     #: message of the ConvergenceError raised when :meth:`failure_counter` grows in a call
     failure_message: str = "an inner solve of a force element did not converge"
+    #: the element's typed parameters from the design, ``staticmethod(builder)``: builder(reducer,
+    #: drive) -> a frozen dataclass (``drive``: the shared :class:`flexrv.model.drive.DriveParameters`),
+    #: the first argument of the constructor (:meth:`from_design`)
+    parameters = None
+
+    @classmethod
+    def from_design(cls, reducer, drive, *args, **kwargs):
+        """The element of a design: ``cls(cls.parameters(reducer, drive), *args, **kwargs)``
+        (only this element's parameters are built)."""
+        return cls(cls.parameters(reducer, drive), *args, **kwargs)
 
     def reset(self) -> None:
         """Forget the state of earlier evaluations; the time inputs are written again."""
@@ -293,7 +303,10 @@ class KernelGroup(ForceGroup):
                 }
             return f, out
         lead = q.shape[:-1]
-        qf, vf = q.reshape(-1, n), np.broadcast_to(v, q.shape).reshape(-1, n)
+        # writable and C-contiguous like the fused kernel's arguments: a read-only (broadcast) or
+        # strided array would be another type signature of the kernel, compiled a second time
+        qf = np.require(q.reshape(-1, n), requirements=("C", "W"))
+        vf = np.require(np.broadcast_to(v, q.shape).reshape(-1, n), requirements=("C", "W"))
         ts = np.broadcast_to(np.asarray(t, dtype=float), lead).ravel()
         pack = self.pack(idx, history=True)
         f = np.zeros(qf.shape)

@@ -54,12 +54,13 @@ prepares them).
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
 
 from flexrv.ehl.maps import packed_log_correction
-from flexrv.model.core.params import law_type
+from flexrv.model.core.params import law_type, pack_type
 from flexrv.model.numerics.linalg import adjugate3, cholesky, cholesky_solve
 
 #: a ball contact's normal law: k [N/m^1.5], film at Q = 1 N and u = 1 m/s [m] (0: dry), load and
@@ -153,6 +154,51 @@ RowGeometry = law_type(
     pocket_stiffness=float,
     quasi_static_balls=bool,
     ball_force_tol=float,
+)
+
+#: the kernel inputs of a row (:func:`flexrv.model.flexible_bearing.kernel_inputs`), read by name:
+#: ball reference positions (Z, 3) [m]; the row's geometry and cage (:data:`RowGeometry`); per ring
+#: (``_i`` inner, ``_o`` outer): the contact law (:data:`PointLaw`), the cylindrical raceway table
+#: (n_grid, 3, m) of a MODAL ring ((1, 3, 0): none), the compliance factors T K^-1/2 (n_grid, 3, m)
+#: of a CONDENSED ring ((0, 3, 0): none) and the work array (:func:`condense_workspace`,
+#: :func:`film_workspace`); ``zsign``: the inner and outer raceway tables' z sign (-1: mirrored);
+#: ``balls``: the quasi-static balls' work array (:func:`ball_workspace`; empty with ball inertia);
+#: ``state`` (int64, 8): the local solves' statistics (see :func:`row_eval`)
+RowPack = pack_type(
+    "RowPack",
+    ("ball_ref", (np.float64, 2)),
+    ("geometry", RowGeometry),
+    ("law_i", PointLaw),
+    ("law_o", PointLaw),
+    ("tab_i", (np.float64, 3)),
+    ("tab_o", (np.float64, 3)),
+    ("comp_i", (np.float64, 3)),
+    ("comp_o", (np.float64, 3)),
+    ("ws_i", (np.float64, 1)),
+    ("ws_o", (np.float64, 1)),
+    ("zsign", (np.float64, (2,))),
+    ("balls", (np.float64, 1)),
+    ("state", (np.int64, (8,))),
+)
+
+#: what pass 1 of :func:`row_eval` (:func:`_row_geometry`) hands on, read by name: ball centres,
+#: inner and outer azimuths, the outer azimuths' cos and sin, the arms A p of the inner groove
+#: centres, ball minus groove centre e0 and relative velocity w0 of each ring's contacts, the
+#: raceway displacements du at the contacts (global: modal rings here, condensed rings from their
+#: local solves), the condensed rings' rotations to their cylindrical frames (empty: not
+#: condensed) and the modal rings' raceway bases at every ball
+RowPass1 = namedtuple(
+    "RowPass1",
+    "bpos psi_i psi_o cs_o arm e0_i w0_i e0_o w0_o du_i du_o rot_i rot_o bas_i bas_o",
+    module=__name__,
+)
+#: what the contact phase of :func:`row_eval` (:func:`_row_contacts`) hands on, per ring (``_i``,
+#: ``_o``): the contacts' loads, unit normals, dQ/d delta, damping coefficients, lengths |e|, central
+#: films and the condensed rings' global compliance factors (3Z, m; empty: none or no Jacobian)
+RowContacts = namedtuple(
+    "RowContacts",
+    "load_i load_o nrm_i nrm_o dq_i dq_o cd_i cd_o len_i len_o film_i film_o wg_i wg_o",
+    module=__name__,
 )
 
 #: quasi-static balls (:func:`ball_equilibrium`): the load [N] below which the local solve's
@@ -693,35 +739,16 @@ def _rotation_z(a, c, s, out):
 
 
 @njit(cache=True)
-def row_kernel(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-):
+def row_kernel(q, qt, p, jacobian, rec):
     """Generalized force (n,) of a row element and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t (n, n) (new arrays; :func:`row_eval`
     with its outputs allocated here). Quasi-static balls (``geometry.quasi_static_balls``):
     q, q_t, the force and the Jacobians cover the frame and modal coordinates only
-    (:func:`quasi_static_balls`, warm-started from and updating ``balls``)."""
-    nb = 3 * ball_ref.shape[0]
-    n = 6 + tab_i.shape[2] + tab_o.shape[2] + nb
+    (:func:`quasi_static_balls`, warm-started from and updating ``p.balls``)."""
+    nb = 3 * p.ball_ref.shape[0]
+    n = 6 + p.tab_i.shape[2] + p.tab_o.shape[2] + nb
     f = np.empty(n)
-    if geometry.quasi_static_balls:
+    if p.geometry.quasi_static_balls:
         nx = n - nb
         qf = np.zeros(n)
         vf = np.zeros(n)
@@ -730,57 +757,12 @@ def row_kernel(
         nk = nx if jacobian else 0
         kx = np.empty((nk, nk))
         cx = np.empty((nk, nk))
-        quasi_static_balls(
-            qf,
-            vf,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            jacobian,
-            rec,
-            f,
-            np.empty((nb, 4)),
-            kx,
-            cx,
-        )
+        quasi_static_balls(qf, vf, p, jacobian, rec, f, np.empty((nb, 4)), kx, cx)
         return f[:nx].copy(), kx, cx
     nj = n if jacobian else 0
     jq = np.zeros((nj, nj))  # (zero: row_eval clears only the entries it writes)
     jv = np.zeros((nj, nj))
-    row_eval(
-        q,
-        qt,
-        ball_ref,
-        geometry,
-        tab_i,
-        zs_i,
-        tab_o,
-        zs_o,
-        law_i,
-        law_o,
-        comp_i,
-        comp_o,
-        ws_i,
-        ws_o,
-        balls,
-        state,
-        jacobian,
-        rec,
-        f,
-        jq,
-        jv,
-    )
+    row_eval(q, qt, p, jacobian, rec, f, jq, jv)
     return f, jq, jv
 
 
@@ -891,10 +873,7 @@ def _frame_kinematics(q, qt):
 def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, om):
     """Pass 1 of :func:`row_eval`: the geometry of every ball with the rings undeflected
     (modal rings: with their coordinates), ball minus groove centre e0 and relative
-    velocity w0 of both contacts. Returns (ball centres, inner and outer azimuths, the
-    outer azimuths' cos and sin, arms A p of the inner groove centres, e0_i, w0_i, e0_o,
-    w0_o, raceway displacements du_i, du_o (global; modal rings), the condensed rings'
-    rotations to their cylindrical frames, the modal rings' bases at every ball)."""
+    velocity w0 of both contacts: a :data:`RowPass1`."""
     om0, om1, om2 = om
     z_row, ci_r, ci_z = geometry.z, geometry.inner_center_radius, geometry.inner_center_z
     co_r, co_z = geometry.outer_center_radius, geometry.outer_center_z
@@ -980,17 +959,18 @@ def _row_geometry(q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, c
             r_o[2, 0], r_o[2, 1], r_o[2, 2] = 0.0, 0.0, 1.0
         e0_o[j, 0], e0_o[j, 1], e0_o[j, 2] = bx - ox, by - oy, bz - oz
         w0_o[j, 0], w0_o[j, 1], w0_o[j, 2] = vx - ovx, vy - ovy, vz - ovz
-    return bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+    return RowPass1(
+        bpos, psi_i, psi_o, cs_o, arm, e0_i, w0_i, e0_o, w0_o, du_i, du_o, rot_i, rot_o, bas_i_all, bas_o_all
+    )
 
 
 @njit(cache=True, inline="always")
 def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state):
     """The contacts of both rings at every ball (:func:`_ring_contacts`; condensed rings:
-    their local solves, the inner one's deflection added to the arms ``pre[4]``). Returns
-    (loads, normals, dQ/d delta, damping, approach lengths and films of the inner and
-    outer contacts, the condensed rings' global compliance factors)."""
-    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre[1], pre[2], pre[4], pre[5], pre[6], pre[7], pre[8]
-    du_i, du_o, rot_i, rot_o = pre[9], pre[10], pre[11], pre[12]
+    their local solves, the inner one's deflection added to the arms ``pre.arm``): a
+    :data:`RowContacts`."""
+    psi_i, psi_o, arm, e0_i, w0_i, e0_o, w0_o = pre.psi_i, pre.psi_o, pre.arm, pre.e0_i, pre.w0_i, pre.e0_o, pre.w0_o
+    du_i, du_o, rot_i, rot_o = pre.du_i, pre.du_o, pre.rot_i, pre.rot_o
     cond_i = comp_i.shape[0] > 0
     cond_o = comp_o.shape[0] > 0
     nz = psi_i.shape[0]
@@ -1059,7 +1039,7 @@ def _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o
         wg_o,
         state,
     )
-    return load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o
+    return RowContacts(load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o, wg_i, wg_o)
 
 
 @njit(cache=True, inline="always")
@@ -1067,8 +1047,8 @@ def _row_forces(q, qt, geometry, tab_i, zs_i, tab_o, zs_o, a, g, pre, con, f, re
     """Every ball's contact reactions on the frame and the rings' modes, its cage and pocket
     forces, into ``f`` (and ``rec`` when it has a row per ball); returns (Z, 3): each ball's
     cage direction (etx, ety) and radius in the housing (for the Jacobian blocks)."""
-    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre[0], pre[1], pre[2], pre[3], pre[4], pre[9], pre[10]
-    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con[0], con[1], con[2], con[3], con[10], con[11]
+    bpos, psi_i, psi_o, cs_o, arm, du_i, du_o = pre.bpos, pre.psi_i, pre.psi_o, pre.cs_o, pre.arm, pre.du_i, pre.du_o
+    load_i, load_o, nrm_i, nrm_o, film_i, film_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.film_i, con.film_o
     z_row, rb, cage_ratio = geometry.z, geometry.ball_radius_pitch, geometry.cage_ratio
     cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
     m_i = tab_i.shape[2]
@@ -1142,8 +1122,9 @@ def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
     """Every ball's rows of the local ball solve (``jacobian`` BALL_BLOCKS): its own 3x3 block
     and, in column 3, the rate of its force from the frame's and rings' motion; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
-    w0_i, w0_o = pre[6], pre[8]
-    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o = con[:10]
+    w0_i, w0_o = pre.w0_i, pre.w0_o
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.dq_i, con.dq_o
+    cd_i, cd_o, len_i, len_o = con.cd_i, con.cd_o, con.len_i, con.len_o
     cage_ratio, cage_k, pocket_k = geometry.cage_ratio, geometry.cage_stiffness, geometry.pocket_stiffness
     k_i = np.empty((3, 3))
     d_i = np.empty((3, 3))
@@ -1181,8 +1162,9 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
     condensed rings' contacts keep their T rows and contact factors for
     :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
-    arm, bas_i_all, bas_o_all = pre[4], pre[13], pre[14]
-    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o, cd_i, cd_o, len_i, len_o, film_i, film_o = con[:12]
+    arm, bas_i_all, bas_o_all = pre.arm, pre.bas_i, pre.bas_o
+    load_i, load_o, nrm_i, nrm_o, dq_i, dq_o = con.load_i, con.load_o, con.nrm_i, con.nrm_o, con.dq_i, con.dq_o
+    cd_i, cd_o, len_i, len_o, film_i, film_o = con.cd_i, con.cd_o, con.len_i, con.len_o, con.film_i, con.film_o
     k_i, d_i, k_o, d_o, t_i, jl, vl, inv3, tm3, s_balls, ti_all, vf_i, vf_o, bas_o = wk
     cage_ratio, cage_k, cage_c = geometry.cage_ratio, geometry.cage_stiffness, geometry.cage_damping
     pocket_k = geometry.pocket_stiffness
@@ -1265,11 +1247,11 @@ def _row_pass2(
     and Jacobian blocks (:func:`_row_local_blocks`, :func:`_row_ball_jacobians`). Returns the
     condensed rings' T rows and contact factors of every ball and the entrainment speed's
     rate d u / d q_t[5] (for :func:`_condensed_row_jacobian`)."""
-    cond_i = pre[11].shape[0] > 0
-    cond_o = pre[12].shape[0] > 0
+    cond_i = pre.rot_i.shape[0] > 0
+    cond_o = pre.rot_o.shape[0] > 0
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
-    nz = pre[0].shape[0]
+    nz = pre.bpos.shape[0]
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
     bas_o = np.empty((3, m_o))
@@ -1313,16 +1295,8 @@ def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
     the contacts in series with the ring, (I - K C)^-1 K and D, through the inner ring's
     T rows onto the frame and, for both rings, onto the balls; ``p2``: :func:`_row_pass2`'s
     result."""
-    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o, wg_i, wg_o = (
-        con[2],
-        con[3],
-        con[6],
-        con[7],
-        con[10],
-        con[11],
-        con[12],
-        con[13],
-    )
+    nrm_i, nrm_o, cd_i, cd_o, film_i, film_o = con.nrm_i, con.nrm_o, con.cd_i, con.cd_o, con.film_i, con.film_o
+    wg_i, wg_o = con.wg_i, con.wg_o
     ti_all, vf_i, vf_o, dudw = p2
     nz = nrm_i.shape[0]
     ball = slice(b0, b0 + 3 * nz)
@@ -1346,46 +1320,22 @@ def _condensed_row_jacobian(law_i, law_o, speed, b0, nx_i, con, p2, jq, jv):
 
 
 @njit(cache=True)
-def row_eval(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    jq,
-    jv,
-):
+def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
     """Generalized force of a row element into ``f`` (n,) and, with ``jacobian``, its
     derivatives d f / d q and d f / d q_t into ``jq``, ``jv`` (n, n) (overwritten; for
     rigid and modal rings only the entries it writes, :func:`_zero_written`: the
     other entries must be zero, as in a zero-allocated work array);
     coordinates ordered [frame(6), inner modes, outer modes, balls(3Z)].
 
-    tab_i / tab_o: cylindrical raceway tables (n_grid, 3, m) of MODAL rings whose m
-    coordinates are element coordinates ((1, 3, 0): none); comp_i / comp_o:
-    compliance factor tables T K^-1/2 (n_grid, 3, m) of CONDENSED rings
-    ((0, 3, 0): none); ws_i / ws_o: the rings' work arrays (:func:`condense_workspace`:
-    contact deflections and last tangent; every ring: the contacts' films, the film
-    iteration's warm start, :func:`film_workspace`; updated);
-    balls: the quasi-static balls' state (2, 3Z), used by :func:`quasi_static_balls`
-    only; state (int64, 8): [non-converged condensations, 1 if the last call had one,
-    sum of the local iterations, local solves, then the same four of the
-    quasi-static balls' solve]; rec: (Z, N_RECORD) per-ball record, or
-    (0, N_RECORD). geometry: the row's :data:`RowGeometry`.
+    ``p``: the row's :data:`RowPack`: the modal rings' raceway tables ``tab_i`` / ``tab_o``
+    (their m coordinates are element coordinates), the condensed rings' compliance
+    factors ``comp_i`` / ``comp_o``, the rings' work arrays ``ws_i`` / ``ws_o`` (contact
+    deflections and last tangent of a condensed ring; every ring: the contacts' films,
+    the film iteration's warm start; updated), the quasi-static balls' work array
+    ``balls`` (used by :func:`quasi_static_balls` only) and ``state`` (int64, 8):
+    [non-converged condensations, 1 if the last call had one, sum of the local
+    iterations, local solves, then the same four of the quasi-static balls' solve];
+    rec: (Z, N_RECORD) per-ball record, or (0, N_RECORD).
 
     ``jacobian``: False (force only), True (the Jacobians), BALL_BLOCKS or
     CONDENSED_BALLS (the quasi-static balls' modes, see there).
@@ -1405,6 +1355,9 @@ def row_eval(
     (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
     ball (:func:`_row_pass2`), the condensed rings' dense blocks
     (:func:`_condensed_row_jacobian`)."""
+    ball_ref, geometry, state, balls = p.ball_ref, p.geometry, p.state, p.balls
+    tab_i, tab_o, zs_i, zs_o = p.tab_i, p.tab_o, p.zsign[0], p.zsign[1]
+    law_i, law_o, comp_i, comp_o, ws_i, ws_o = p.law_i, p.law_o, p.comp_i, p.comp_o, p.ws_i, p.ws_o
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
     cond_i = comp_i.shape[0] > 0
@@ -1504,56 +1457,13 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
 
 
 @njit(cache=True)
-def row_force_kernel(
-    q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state
-):
+def row_force_kernel(q, qt, p):
     """Generalized force of a row element (see :func:`row_kernel`)."""
-    return row_kernel(
-        q,
-        qt,
-        ball_ref,
-        geometry,
-        tab_i,
-        zs_i,
-        tab_o,
-        zs_o,
-        law_i,
-        law_o,
-        comp_i,
-        comp_o,
-        ws_i,
-        ws_o,
-        balls,
-        state,
-        False,
-        np.empty((0, N_RECORD)),
-    )[0]
+    return row_kernel(q, qt, p, False, np.empty((0, N_RECORD)))[0]
 
 
 @njit(cache=True)
-def ball_equilibrium(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    tol,
-    max_iter,
-    f,
-    kbb,
-    rec,
-):
+def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     """Quasi-static balls of a row (rigid or modal rings): the ball coordinates
     q[b0:] (displacements from ball_ref; in: the warm start, out: the solution) such
     that every ball's force of :func:`row_eval` (contacts, cage and pocket springs)
@@ -1568,37 +1478,15 @@ def ball_equilibrium(
     and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
     last evaluation (at the returned balls and velocities). Returns the number of
     Newton steps (-1: not converged in ``max_iter``)."""
-    nz = ball_ref.shape[0]
+    nz = p.ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
     recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
     jv = np.empty((0, 0))
-    damping = max(law_i.c_max, law_o.c_max, geometry.cage_damping, 1e-300)
+    damping = max(p.law_i.c_max, p.law_o.c_max, p.geometry.cage_damping, 1e-300)
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        row_eval(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            BALL_BLOCKS,
-            recs,
-            f,
-            kbb,
-            jv,
-        )
+        row_eval(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv)
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1724,30 +1612,7 @@ def _predict_balls(q, qt, ball_ref, cage_ratio, b, bt, sm, xl, xtl):
 
 
 @njit(cache=True)
-def quasi_static_balls(
-    q,
-    qt,
-    ball_ref,
-    geometry,
-    tab_i,
-    zs_i,
-    tab_o,
-    zs_o,
-    law_i,
-    law_o,
-    comp_i,
-    comp_o,
-    ws_i,
-    ws_o,
-    balls,
-    state,
-    jacobian,
-    rec,
-    f,
-    kbb,
-    kx,
-    cx,
-):
+def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
     """One evaluation of a row with quasi-static balls: q, q_t (n, the full element
     vectors, work arrays) hold the frame and modal coordinates x in their first
     nx = n - 3Z entries (set by the caller); ``balls`` (:func:`ball_workspace`)
@@ -1765,10 +1630,11 @@ def quasi_static_balls(
     CONDENSED_BALLS mode), whose S is stored. A
     Jacobian call at the state of the last solution (Exudyn's usual order) reuses
     it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
-    nz = ball_ref.shape[0]
+    geometry, state = p.geometry, p.state
+    nz = p.ball_ref.shape[0]
     nb = 3 * nz
     nx = q.shape[0] - nb
-    b, bt, sm, xl, xtl, flag = _split_balls(balls, nb, nx)
+    b, bt, sm, xl, xtl, flag = _split_balls(p.balls, nb, nx)
     same = flag[0] > 0.0
     if same:
         for c in range(nx):
@@ -1780,36 +1646,14 @@ def quasi_static_balls(
             q[nx + e] = b[e]
             qt[nx + e] = bt[e]
     else:
-        _predict_balls(q, qt, ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        _predict_balls(q, qt, p.ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
         its = -1
         for attempt in range(2):
             if attempt == 1:  # once more from the last solution
                 for e in range(nb):
                     q[nx + e] = b[e]
                     qt[nx + e] = bt[e]
-            its = ball_equilibrium(
-                q,
-                qt,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                geometry.ball_force_tol,
-                BALL_MAXIT,
-                f,
-                kbb,
-                rec,
-            )
+            its = ball_equilibrium(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec)
             if its >= 0:
                 break
         state[5] = 0
@@ -1823,41 +1667,19 @@ def quasi_static_balls(
                 xtl[c] = qt[c]
             flag[0] = 1.0
     if jacobian:
-        row_eval(
-            q,
-            qt,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            CONDENSED_BALLS,
-            np.empty((0, N_RECORD)),
-            f,
-            kx,
-            cx,
-        )
+        row_eval(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
 
 
 @njit(cache=True)
 def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
-    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx,
-    then the row's kernel inputs, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
+    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, the
+    row's :data:`RowPack`, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
     Per row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
     vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
-    reference ``ball_ref`` is subtracted), then :func:`row_eval` -- or, for
-    quasi-static balls (``geometry.quasi_static_balls``; idx covers the frame and modal
+    reference ``p.ball_ref`` is subtracted), then :func:`row_eval` -- or, for
+    quasi-static balls (``p.geometry.quasi_static_balls``; idx covers the frame and modal
     coordinates only, qe / ve are the full work vectors), :func:`quasi_static_balls`;
     the rows' results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
     f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
@@ -1875,92 +1697,23 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             for e in range(n):
                 out_f[idx[e]] = 0.0
     for part in parts:
-        (
-            idx,
-            qe,
-            ve,
-            f,
-            jq,
-            jv,
-            rec,
-            kbb,
-            kx,
-            cx,
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-        ) = part
+        idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, p = part
         n = idx.shape[0]
         for e in range(n):
             qe[e] = qn[idx[e]]
             ve[e] = vn[idx[e]]
-        if geometry.quasi_static_balls:
-            quasi_static_balls(
-                qe,
-                ve,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                jacobian,
-                rec,
-                f,
-                kbb,
-                kx,
-                cx,
-            )
+        if p.geometry.quasi_static_balls:
+            quasi_static_balls(qe, ve, p, jacobian, rec, f, kbb, kx, cx)
             jq_, jv_ = kx, cx
         else:
             if absolute:
+                ball_ref = p.ball_ref
                 nz = ball_ref.shape[0]
                 b0 = n - 3 * nz
                 for j in range(nz):
                     for c in range(3):
                         qe[b0 + 3 * j + c] -= ball_ref[j, c]
-            row_eval(
-                qe,
-                ve,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                jacobian,
-                rec,
-                f,
-                jq,
-                jv,
-            )
+            row_eval(qe, ve, p, jacobian, rec, f, jq, jv)
             jq_, jv_ = jq, jv
         if jacobian:
             for r in range(n):
@@ -1973,9 +1726,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
 
 
 @njit(cache=True)
-def row_history(
-    qs, vts, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, balls, state, recs
-):
+def row_history(qs, vts, p, recs):
     """:func:`row_eval` over a recorded history (the outputs pass, one compiled loop):
     element coordinates and velocities qs, vts (T, n) -> generalized forces (T, n),
     per-ball records into ``recs`` (T, Z, N_RECORD). The samples run in order, each
@@ -1985,9 +1736,9 @@ def row_history(
     nt = qs.shape[0]
     out = np.zeros(qs.shape)
     empty = np.empty((0, 0))
-    if geometry.quasi_static_balls:
+    if p.geometry.quasi_static_balls:
         nx = qs.shape[1]
-        nb = 3 * ball_ref.shape[0]
+        nb = 3 * p.ball_ref.shape[0]
         qf = np.zeros(nx + nb)
         vf = np.zeros(nx + nb)
         f = np.empty(nx + nb)
@@ -1995,56 +1746,11 @@ def row_history(
         for i in range(nt):
             qf[:nx] = qs[i]
             vf[:nx] = vts[i]
-            quasi_static_balls(
-                qf,
-                vf,
-                ball_ref,
-                geometry,
-                tab_i,
-                zs_i,
-                tab_o,
-                zs_o,
-                law_i,
-                law_o,
-                comp_i,
-                comp_o,
-                ws_i,
-                ws_o,
-                balls,
-                state,
-                False,
-                recs[i],
-                f,
-                kbb,
-                empty,
-                empty,
-            )
+            quasi_static_balls(qf, vf, p, False, recs[i], f, kbb, empty, empty)
             out[i] = f[:nx]
         return out
     for i in range(nt):
-        row_eval(
-            qs[i],
-            vts[i],
-            ball_ref,
-            geometry,
-            tab_i,
-            zs_i,
-            tab_o,
-            zs_o,
-            law_i,
-            law_o,
-            comp_i,
-            comp_o,
-            ws_i,
-            ws_o,
-            balls,
-            state,
-            False,
-            recs[i],
-            out[i],
-            empty,
-            empty,
-        )
+        row_eval(qs[i], vts[i], p, False, recs[i], out[i], empty, empty)
     return out
 
 

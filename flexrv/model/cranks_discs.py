@@ -96,18 +96,20 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.contact.tapered_roller import SC_G, SC_K_BEND, crank_support_force
+from flexrv.contact.tapered_roller import SupportConstants, crank_support_force
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import inv_small, matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
-from flexrv.units import DEG_PER_RAD
+from flexrv.units import DEG_PER_RAD, M_PER_MM
 
 _F, _I = np.float64, np.int64
 #: the crank supports' damper and law switch: damping c [N s/m] while loaded, the linear support law, the
@@ -115,7 +117,7 @@ _F, _I = np.float64, np.int64
 #: (the roller law's entries that the kernel itself reads)
 SupportLaw = law_type("SupportLaw", damping=float, linear=bool, k_bend=float, g=float)
 #: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
-#: the tapered-roller pair's law vector (passed on to :func:`flexrv.contact.tapered_roller.crank_support_force`),
+#: the tapered-roller pair's constants (passed on to :func:`flexrv.contact.tapered_roller.crank_support_force`),
 #: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
 #: crank, bearing displacement = Newton start, bending share), the elastic carrier's support-point
 #: compliance (2N, 2N) (empty: rigid), its deflections (N, 4) and the work array (:func:`support_work_size`)
@@ -123,7 +125,7 @@ SupportPack = pack_type(
     "SupportPack",
     ("idx", (_I, (6,))),
     ("law", SupportLaw),
-    ("roller_law", (_F, (SC_G + 1,))),
+    ("roller_law", SupportConstants),
     ("bores", (_F, 2)),
     ("clear", (_F, 1)),
     ("angles", (_F, 1)),
@@ -559,6 +561,126 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     _support_jacobian(jq, jv, idx, elastic or not linear, arm_term, w)
 
 
+# ---------------------------------------------------------------- the elements' parameters from the design
+@dataclass(frozen=True)
+class CrankSupportParameters:
+    """The crank supports' parameters (SI). Built by :func:`crank_support_parameters`."""
+
+    drive: DriveParameters
+    crank_bores: np.ndarray  #: (N, 2) as-built crank-bore centres in the carrier frame [m]
+    support_clearances: np.ndarray  #: (N,) as-built radial clearance of each crank's support bearings [m]
+    support_law: SupportConstants  #: constants of flexrv.contact.tapered_roller.crank_support_force
+    support_roller_angles: np.ndarray  #: (Z,) roller spacing of a support bearing [rad] (empty: linear law)
+    support_linear: bool  #: the linear support law (crankshaft.support_bearing_model = "linear")
+    #: linear support law only: radial stiffness of one crank (two bearings) [N/m]; NaN otherwise
+    support_stiffness: float
+    support_damping: float  #: damper of one crank (two bearings) [N s/m]
+    #: (2N, 2N) compliance [m/N] of the cranks' support points in the carrier frame (FE carrier,
+    #: :func:`flexrv.fem.carrier.crank_support_compliance`, plus ``carrier_parts``); (0, 0): rigid
+    #: carrier (``carrier.body_model``) without parts
+    carrier_compliance: np.ndarray
+    #: element -> its (2N, 2N) part of ``carrier_compliance`` [m/N]: support-bearing rings, carrier joints
+    #: (:func:`flexrv.analysis.path_compliances.model_compliances`)
+    carrier_parts: dict
+
+
+def crank_support_parameters(reducer, drive: DriveParameters) -> CrankSupportParameters:
+    """The crank supports' parameters: the support law's constants
+    (:func:`flexrv.analysis.torsional.support_constants`), the as-built bores and clearances
+    (:func:`flexrv.geometry.as_built.as_built`), and the carrier's compliance at the as-built
+    support points: the FE carrier if condensed (:func:`flexrv.model.bodies.body_compliance_matrix`,
+    the only FE build of this element) with the support-bearing rings and the pillar joints
+    (:func:`flexrv.analysis.path_compliances.model_compliances`)."""
+    from flexrv.analysis.path_compliances import model_compliances
+    from flexrv.analysis.torsional import support_constants
+    from flexrv.model.bodies import body_compliance_matrix
+
+    cs = reducer.crankshaft
+    ab = drive.as_built
+    law, angles, linear = support_constants(reducer)
+    path = model_compliances(reducer, ab.crank_bores)
+    return CrankSupportParameters(
+        drive=drive,
+        crank_bores=ab.crank_bores,
+        support_clearances=ab.support_clearances,
+        support_law=law,
+        support_roller_angles=angles,
+        support_linear=linear,
+        support_stiffness=2.0 * cs.support_bearing_radial_stiffness_N_per_m if linear else float("nan"),
+        support_damping=2.0 * cs.support_bearing_damping_Ns_per_m,
+        carrier_compliance=path.support_compliance(body_compliance_matrix(reducer, "carrier")),
+        carrier_parts=path.support_parts,
+    )
+
+
+@dataclass(frozen=True)
+class NeedleParameters:
+    """The needle bearings' parameters (SI). Built by :func:`needle_parameters`."""
+
+    drive: DriveParameters
+    model: str  #: needle_bearing.model: "rollers" or "empirical"
+    #: empirical model: the constant K [N/m^(10/9)] of F = K delta^(10/9) (:func:`empirical_needle_constant`);
+    #: rollers model: the roller constant (inner + outer line contacts in series) [N/m^(10/9)]
+    k: float
+    roller_count: int
+    pitch_ratio: float  #: gamma = D / d_m of the needle bearing
+    eccentricities: np.ndarray  #: (N, n_discs) as-built eccentric radius of crank j under disc k [m]
+    eccentric_phase_errors: np.ndarray  #: (N, n_discs) added to chi0_k: chi = chi0_k + err_jk - phi_j [rad]
+    holes: np.ndarray  #: (n_discs, N, 2) as-built crank-hole centres in each disc's frame [m]
+    clearances: np.ndarray  #: (N, n_discs) as-built radial clearance of each needle bearing [m]
+    c_max: float  #: impact law's full damping [N s/m]
+    penetration_limit: float  #: [m] a run stops as failed beyond it
+    friction: float  #: constant friction coefficient of the needle bearings [-] (0: friction off)
+    friction_radius: float  #: d/2 of the friction moment, the eccentric journal radius [m]
+
+
+def empirical_needle_constant(reducer) -> float:
+    """Constant K [N/m^(10/9)] of the needle-bearing law F = K delta^(10/9) that
+    integrates :cite:`seed004`'s empirical stiffness dF/d(delta) = C F^0.1
+    (:func:`flexrv.analysis.torsional.needle_radial_stiffness`, C = its value at
+    F = 1 N): F^0.9 = 0.9 C delta, so K = (0.9 C)^(10/9)."""
+    from flexrv.analysis.torsional import needle_radial_stiffness
+
+    nb = reducer.needle_bearing
+    c = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * 1e-3))
+    return (0.9 * c) ** (10.0 / 9.0)
+
+
+def needle_parameters(reducer, drive: DriveParameters) -> NeedleParameters:
+    """The needle bearings' parameters: the law of the design's ``needle_bearing.model``
+    (rollers: two Hertz line contacts in series per roller,
+    :func:`flexrv.contact.hertz.line_contact_stiffness`; empirical:
+    :func:`empirical_needle_constant`), the as-built eccentrics, holes and clearances
+    (:func:`flexrv.geometry.as_built.as_built`), damping, limit and friction (design ``[contact]``)."""
+    from flexrv.contact.hertz import effective_modulus, line_contact_stiffness, series_stiffness
+
+    cs, nb, ct = reducer.crankshaft, reducer.needle_bearing, reducer.contact
+    if nb.model == "empirical":
+        k = empirical_needle_constant(reducer)
+    else:
+        mc, mr = reducer.material("crankshaft"), reducer.material("rolling_elements")
+        e_nb = effective_modulus(mc.youngs_modulus, mc.poisson_ratio, mr.youngs_modulus, mr.poisson_ratio)
+        k_roll = float(line_contact_stiffness(nb.roller_length_mm * 1e-3, e_nb))
+        k = float(series_stiffness(k_roll, k_roll, LINE_EXPONENT))
+    d_roll = nb.roller_diameter_mm * 1e-3
+    ab = drive.as_built
+    return NeedleParameters(
+        drive=drive,
+        model=nb.model,
+        k=k,
+        roller_count=nb.roller_count,
+        pitch_ratio=d_roll / (cs.eccentric_journal_diameter_mm * 1e-3 + d_roll),
+        eccentricities=ab.eccentricities,
+        eccentric_phase_errors=ab.eccentric_phase_errors,
+        holes=ab.holes,
+        clearances=ab.needle_clearances,
+        c_max=ct.pin_max_damping_Ns_per_m,
+        penetration_limit=ct.needle_penetration_limit_um * 1e-6,
+        friction=ct.needle_friction_coefficient if ct.friction else 0.0,
+        friction_radius=0.5 * M_PER_MM * cs.eccentric_journal_diameter_mm,
+    )
+
+
 class CrankSupports(KernelGroup):
     """Crank centres in their carrier bores (members: carrier, crank0..N-1); the law
     of :func:`flexrv.contact.tapered_roller.crank_support_force` with the constants of
@@ -571,17 +693,19 @@ class CrankSupports(KernelGroup):
     )
     kernel = staticmethod(crank_support_kernel)
 
-    def __init__(self, params):
-        p = params
-        self.n = p.n_cranks
+    parameters = staticmethod(crank_support_parameters)
+
+    def __init__(self, params: CrankSupportParameters):
+        p = self.params = params
+        self.n = p.drive.n_cranks
         self.members = ("carrier",) + tuple(f"crank{j}" for j in range(self.n))
         self.bores = np.ascontiguousarray(p.crank_bores, dtype=float)
         self.clear = np.ascontiguousarray(p.support_clearances, dtype=float)
-        self.sc = np.ascontiguousarray(p.support_law, dtype=float)
+        self.sc = p.support_law
         self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
         self.linear = bool(p.support_linear)
         self.c = p.support_damping
-        self.law = SupportLaw.of(damping=self.c, linear=self.linear, k_bend=self.sc[SC_K_BEND], g=self.sc[SC_G])
+        self.law = SupportLaw.of(damping=self.c, linear=self.linear, k_bend=self.sc.k_bend, g=self.sc.g)
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
         self.bstate = np.zeros((self.n, 2))
         self.bend = np.zeros(self.n)
@@ -882,43 +1006,44 @@ class NeedleBearings(KernelGroup):
     kernel = staticmethod(needle_kernel)
     friction_outputs = ("needle_friction_power",)
 
-    def __init__(self, params, model: str, k_empirical: float | None = None):
-        p = params
-        self.nc, self.nd = p.n_cranks, p.n_discs
+    parameters = staticmethod(needle_parameters)
+
+    def __init__(self, params: NeedleParameters):
+        p = self.params = params
+        d = p.drive
+        self.nc, self.nd = d.n_cranks, d.n_discs
         self.members = tuple(f"crank{j}" for j in range(self.nc)) + tuple(f"disc{k}" for k in range(self.nd))
-        self.model = model
-        self.chi0 = np.ascontiguousarray(p.chi0, dtype=float)
+        self.model = p.model
+        if p.model not in ("rollers", "empirical"):
+            raise ValueError(f"needle model = {p.model!r}: choose 'rollers' or 'empirical'")
+        self.chi0 = np.ascontiguousarray(d.chi0, dtype=float)
         self.ecc = np.ascontiguousarray(p.eccentricities, dtype=float)  # (nc, nd)
         self.err = np.ascontiguousarray(p.eccentric_phase_errors, dtype=float)
         self.hx = np.ascontiguousarray(p.holes[..., 0].T)  # (nc, nd) hole centres in the disc frames
         self.hy = np.ascontiguousarray(p.holes[..., 1].T)
-        self.clear = np.ascontiguousarray(p.needle_clearances, dtype=float)
-        self.depth = p.contact_depth
-        self.limit = p.needle_penetration_limit  # design contact.needle_penetration_limit_um
-        self.z_c, self.z_rp = p.z_c, p.z_rp
-        if model == "empirical":
-            if k_empirical is None:
-                raise ValueError("k_empirical required for the empirical needle model")
-            self.k = float(k_empirical)
+        self.clear = np.ascontiguousarray(p.clearances, dtype=float)
+        self.depth = d.contact_depth
+        self.limit = p.penetration_limit  # design contact.needle_penetration_limit_um
+        self.z_c, self.z_rp = d.z_c, d.z_rp
+        self.k = float(p.k)
+        if p.model == "empirical":
             self.roller_angles = np.zeros(0)
         else:
-            self.k = p.needle_roller_k
-            z = p.needle_roller_count
+            z = p.roller_count
             self.roller_angles = 2.0 * np.pi * np.arange(z) / z
-        g = p.needle_pitch_ratio
         self.law = NeedleLaw.of(
             k=self.k,
             exponent=LINE_EXPONENT,
-            c_max=p.needle_c_max,
-            depth=p.contact_depth,
-            rollers=model == "rollers",
-            pitch_ratio=g,
-            z_c=p.z_c,
-            mu=p.needle_friction,
-            friction_radius=p.needle_friction_radius,
-            v_reg=p.friction_velocity,
+            c_max=p.c_max,
+            depth=d.contact_depth,
+            rollers=p.model == "rollers",
+            pitch_ratio=p.pitch_ratio,
+            z_c=d.z_c,
+            mu=p.friction,
+            friction_radius=p.friction_radius,
+            v_reg=d.friction_velocity,
         )
-        self.mu = p.needle_friction if p.friction_velocity > 0.0 else 0.0
+        self.mu = p.friction if d.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
         self.fx, self.fy = np.zeros((self.nc, self.nd)), np.zeros((self.nc, self.nd))
         self.roll, self.angle = np.zeros((self.nc, self.nd, z)), np.zeros((self.nc, self.nd, z))

@@ -28,9 +28,11 @@ import numpy as np
 from flexrv.errors import ConfigError, check_options, signature_options
 from flexrv.model.assembled import AssembledModel
 from flexrv.model.base import Member
+from flexrv.model.bodies import BODY_PARTS, with_bodies
 
 
 def _members(p) -> dict[str, Member]:
+    """The members from the drive's parameters ``p`` (:class:`flexrv.model.drive.DriveParameters`)."""
     mem: dict[str, Member] = {}
     mc = np.diag(
         [
@@ -55,18 +57,6 @@ def _members(p) -> dict[str, Member]:
             f"disc{k}", np.diag([p.disc_mass, p.disc_mass, p.disc_inertia]), q0, np.zeros(3), ("x", "y", "psi")
         )
     return mem
-
-
-def empirical_needle_constant(reducer) -> float:
-    """Constant K [N/m^(10/9)] of the needle-bearing law F = K delta^(10/9) that
-    integrates :cite:`seed004`'s empirical stiffness dF/d(delta) = C F^0.1
-    (:func:`flexrv.analysis.torsional.needle_radial_stiffness`, C = its value at
-    F = 1 N): F^0.9 = 0.9 C delta, so K = (0.9 C)^(10/9)."""
-    from flexrv.analysis.torsional import needle_radial_stiffness
-
-    nb = reducer.needle_bearing
-    c = float(needle_radial_stiffness(1.0, nb.roller_count, nb.roller_length_mm * 1e-3))
-    return (0.9 * c) ** (10.0 / 9.0)
 
 
 def _drive(p, drive: str):
@@ -95,7 +85,7 @@ def _add_main_bearing(reducer, p, main_bearing, ring_options, ball_inertia, memb
                 f"ball_inertia = {ball_inertia!r} is not allowed with the rigid main bearing: it "
                 f"applies to the ball-resolved bearing (model 'balls' or 'flexible')"
             )
-        groups.insert(4, RigidMainBearing(p))
+        groups.insert(4, RigidMainBearing.from_design(reducer, p))
     elif main_bearing in ("balls", "flexible"):
         from flexrv.model.flexible_bearing import BallBearingGroup, rows_from_design
 
@@ -157,12 +147,13 @@ def build_rigid(
     body around the pins, :mod:`flexrv.model.cranks_discs`, :mod:`flexrv.model.pins`);
     None takes the design's switches (``carrier.body_model``,
     ``second_stage.disc_body_model``), a list sets them (named: ``condensed_fe``,
-    others ``rigid``; :func:`flexrv.model.parameters.with_bodies`)."""
-    from flexrv.analysis.mesh_stiffness import involute_stage
+    others ``rigid``; :func:`flexrv.model.bodies.with_bodies`). ``params`` of the model: the
+    drive's shared parameters (:class:`flexrv.model.drive.DriveParameters`); each element keeps
+    its own (``group.params``)."""
     from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
+    from flexrv.model.drive import drive_parameters
     from flexrv.model.gear_stage import GearMeshes
     from flexrv.model.loads import OutputLoads, step_torque
-    from flexrv.model.parameters import rigid_parameters, with_bodies
     from flexrv.model.pins import PinContacts
 
     if bodies is not None:
@@ -170,24 +161,18 @@ def build_rigid(
         if bad:
             raise ConfigError(f"bodies = {','.join(bad)} is not allowed: choose from {', '.join(BODY_PARTS)}")
         reducer = with_bodies(reducer, bodies)
-    p = rigid_parameters(reducer)
+    p = drive_parameters(reducer)
     theta, omega = _drive(p, drive)
     if torque is None:
         torque = step_torque(p.load_torque, *p.load_ramp)
-    nb_model = reducer.needle_bearing.model
-    k_emp = empirical_needle_constant(reducer) if nb_model == "empirical" else None
+    # each element builds its own parameters from the design (only what it needs)
+    pins = PinContacts.from_design(reducer, p)
     groups = [
-        GearMeshes(p, involute_stage(reducer), theta, omega),
-        CrankSupports(p),
-        NeedleBearings(p, nb_model, k_emp),
-        PinContacts(p),
-        OutputLoads(
-            torque,
-            p.external_radial_force,
-            p.external_axial_force,
-            p.tilting_moment,
-            ramp=None if drive == "position" else p.load_ramp,
-        ),
+        GearMeshes.from_design(reducer, p, theta, omega),
+        CrankSupports.from_design(reducer, p),
+        NeedleBearings.from_design(reducer, p),
+        pins,
+        OutputLoads.from_design(reducer, p, torque, ramp=None if drive == "position" else p.load_ramp),
     ]
     members = _members(p)
     info: dict = {}
@@ -213,7 +198,7 @@ def build_rigid(
             b
             for b, on in (
                 ("carrier", reducer.carrier is not None and reducer.carrier.body_model == "condensed_fe"),
-                ("cycloid_disc", p.disc_compliance.size > 0),
+                ("cycloid_disc", pins.elastic_discs),
             )
             if on
         ],
@@ -323,8 +308,6 @@ def build_balls(reducer, **kwargs) -> AssembledModel:
     return build_rigid(reducer, main_bearing="balls", model_name="balls", **kwargs)
 
 
-#: elastic bodies condensed into the force elements of every model (rigid, balls, flexible)
-BODY_PARTS = ("carrier", "cycloid_disc")
 #: parts that :func:`build_flexible` can make flexible (the last two: :data:`BODY_PARTS`)
 FLEXIBLE_PARTS = ("main_bearing", "crankshaft") + BODY_PARTS
 DEFAULT_FLEXIBLE_PARTS = ("main_bearing",)

@@ -64,6 +64,7 @@ from flexrv.model.bearing_kernel import (
     N_RECORD,
     RECORD_FIELDS,
     RowGeometry,
+    RowPack,
     ball_workspace,
     condense_workspace,
     film_workspace,
@@ -74,6 +75,7 @@ from flexrv.model.bearing_kernel import (
     row_history,
     row_kernel,
 )
+from flexrv.model.core.params import check_pack
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
 
@@ -290,10 +292,11 @@ def _ring_arrays(ring, ball_count: int) -> tuple:
     return table, zs, _NO_COMPLIANCE, film_workspace(ball_count)
 
 
-def kernel_inputs(model: RowModel) -> tuple:
-    """Arguments of :func:`flexrv.model.bearing_kernel.row_kernel` after (q, q_t) for a
-    row (prepared once per row and kept on it: the condensed rings' deflections
-    are the local solve's warm start). A law the kernel does not cover is refused."""
+def kernel_inputs(model: RowModel) -> RowPack:
+    """The :data:`~flexrv.model.bearing_kernel.RowPack` of a row, the argument of the row
+    kernels (:func:`flexrv.model.bearing_kernel.row_kernel`) after (q, q_t), prepared once
+    per row and kept on it (the condensed rings' deflections are the local solve's warm
+    start). A law the kernel does not cover is refused."""
     inputs = getattr(model, "_kernel_inputs", None)
     if inputs is not None:
         return inputs
@@ -334,22 +337,22 @@ def kernel_inputs(model: RowModel) -> tuple:
     if not model.ball_inertia:
         balls = ball_workspace(model.ball_count, model.n_coordinates)
         balls[: 3 * model.ball_count] = initial_ball_displacements(model).ravel()
-    inputs = (
-        np.ascontiguousarray(model.ball_reference, dtype=float),
-        geometry,
-        tab_i,
-        zs_i,
-        tab_o,
-        zs_o,
-        laws[0],
-        laws[1],
-        comp_i,
-        comp_o,
-        ws_i,
-        ws_o,
-        balls,
-        np.zeros(8, np.int64),
+    inputs = RowPack(
+        ball_ref=np.ascontiguousarray(model.ball_reference, dtype=float),
+        geometry=geometry,
+        law_i=laws[0],
+        law_o=laws[1],
+        tab_i=tab_i,
+        tab_o=tab_o,
+        comp_i=comp_i,
+        comp_o=comp_o,
+        ws_i=ws_i,
+        ws_o=ws_o,
+        zsign=np.array([zs_i, zs_o]),
+        balls=balls,
+        state=np.zeros(8, np.int64),
     )
+    check_pack(inputs)
     model._kernel_inputs = inputs
     return inputs
 
@@ -358,15 +361,15 @@ def set_ball_force_tolerance(model: RowModel, tol: float) -> None:
     """Set the relative force tolerance of a row's quasi-static balls (:data:`BALL_FORCE_TOL`
     by default) in its prepared kernel inputs: for studies of the local solve's tolerance."""
     inputs = kernel_inputs(model)
-    if not inputs[1].quasi_static_balls:
+    if not inputs.geometry.quasi_static_balls:
         raise ValueError("the row's balls are element coordinates (ball inertia): no local solve")
-    model._kernel_inputs = (inputs[0], inputs[1]._replace(ball_force_tol=float(tol)), *inputs[2:])
+    model._kernel_inputs = inputs._replace(geometry=inputs.geometry._replace(ball_force_tol=float(tol)))
 
 
 def row_force(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
     """Generalized force of a row element (compiled row kernel)."""
     return row_force_kernel(
-        np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), *kernel_inputs(model)
+        np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_t, dtype=float), kernel_inputs(model)
     )
 
 
@@ -378,7 +381,7 @@ def row_jacobian(model: RowModel, q: np.ndarray, q_t: np.ndarray) -> tuple[np.nd
     _, jq, jv = row_kernel(
         np.ascontiguousarray(q, dtype=float),
         np.ascontiguousarray(q_t, dtype=float),
-        *kernel_inputs(model),
+        kernel_inputs(model),
         True,
         _NO_RECORD,
     )
@@ -443,7 +446,7 @@ def evaluate_row(model: RowModel, q: np.ndarray, q_t: np.ndarray, jacobian: bool
     f, jq, jv = row_kernel(
         np.ascontiguousarray(q, dtype=float),
         np.ascontiguousarray(q_t, dtype=float),
-        *kernel_inputs(model),
+        kernel_inputs(model),
         bool(jacobian),
         rec,
     )
@@ -604,7 +607,7 @@ class RowElement:
         self.memo = None  # until the call has filled the records
         parts = self._parts
         if parts is None:  # (the rows' kernel inputs are made once and kept on them)
-            parts = self._parts = tuple(w + kernel_inputs(r) for w, r in zip(self._work, self.rows))
+            parts = self._parts = tuple((*w, kernel_inputs(r)) for w, r in zip(self._work, self.rows))
         qn, vn = exudyn_vector(q), exudyn_vector(q_t)
         args = (qn, vn, self.absolute, jacobian, f_q, f_v, self.out_f, self.out_j, parts)
         if self._entry is not None:
@@ -950,7 +953,7 @@ class BallBearingGroup(ForceGroup):
         """Failure message if a condensed ring's local contact solve or the quasi-static
         balls' equilibrium did not converge in the last evaluation (the accepted state
         of the step)."""
-        states = [kernel_inputs(r)[-1] for r in self.rows if hasattr(r, "_kernel_inputs")]
+        states = [kernel_inputs(r).state for r in self.rows if hasattr(r, "_kernel_inputs")]
         if any(int(s[1]) for s in states):  # (rigid and modal rings: no local solve, never set)
             return "main bearing: the condensed rings' contact deflections did not converge"
         if any(int(s[5]) for s in states):
@@ -1019,7 +1022,7 @@ class BallBearingGroup(ForceGroup):
         for k, row in enumerate(self.rows):
             qe, ve, idx = self._element_state(q, v, k)
             recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
-            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), *kernel_inputs(row), recs)
+            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), kernel_inputs(row), recs)
             history.append((recs, qe))
         out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
         return forces, out
@@ -1044,7 +1047,7 @@ class BallBearingGroup(ForceGroup):
             if len(todo):
                 part = np.zeros((len(todo), row.ball_count, N_RECORD))
                 frame[todo] = row_history(
-                    np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]), *kernel_inputs(row), part
+                    np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]), kernel_inputs(row), part
                 )[:, :6]
                 recs[todo] = part
             fc[:, _PERM] += frame

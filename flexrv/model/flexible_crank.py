@@ -16,7 +16,7 @@ isotropic lateral spring k_l on the gear seat's offset from the crank axis, with
 stiffness-proportional damping of ratio ``damping_ratio`` on each (default: the design's
 crankshaft.structural_damping_ratio, an estimate with provenance in the presets).
 Mass split: planet gear + gear seat on ``planet<j>``, the rest of the shaft on
-``crank<j>`` (:func:`flexrv.model.parameters.rigid_parameters`).
+``crank<j>`` (:func:`flexrv.model.drive.drive_parameters`).
 
 Why a two-member Guyan model is enough: the shaft's lowest mode with all its
 interfaces clamped is > 20 kHz for both presets (``lowest_clamped_hz``; rv40e:
@@ -102,6 +102,7 @@ def add_flexible_cranks(
 ) -> dict:
     """Turn the rigid cranks of a model under construction into flexible ones (see
     module doc): split the members, re-target the gear meshes, add the coupling.
+    ``params``: the drive's parameters (:class:`flexrv.model.drive.DriveParameters`).
 
     Returns facts for the model's ``info`` (stiffness, frequencies)."""
     from flexrv.errors import ConfigError
@@ -127,7 +128,7 @@ def add_flexible_cranks(
         )
     gear = next(g for g in groups if g.name == "gear_stage")
     gear.members = ("carrier",) + tuple(f"planet{j}" for j in range(p.n_cranks))
-    gear.set_planet_torsion(p.planet_spline_compliance)  # the crank's torsion is the coupling's k_t
+    gear.set_planet_torsion(gear.params.planet_spline_compliance)  # the crank's torsion is the coupling's k_t
     groups.append(CrankElasticity(p.n_cranks, k_t, k_l, c_t, c_l))
     return {
         "crank_torsional_stiffness_Nm_per_rad": k_t,

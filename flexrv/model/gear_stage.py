@@ -49,7 +49,7 @@ exact for its piecewise-linear ramps except within 1e-6 of their corners. Verifi
 central differences in tests/test_kernel.py (1e-6 of the largest entry; measured
 7-8e-8).
 
-As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): sun runout
+As-built geometry (:class:`GearStageParameters`, from :func:`flexrv.geometry.as_built.as_built`): sun runout
 (A_s, ph_s), planet runout (A_j, ph_j) and planet assembly phase errors err_j
 add to the deflection
 
@@ -64,12 +64,16 @@ group's evaluate/jacobian and the fused element of the model call it.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit
 
 from flexrv.analysis.mesh_stiffness import mesh_stiffness_ramped
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.drive import DriveParameters
 from flexrv.units import TWO_PI
 
 #: the meshes' scalar law: base radii of sun and planet, sin of the working pressure angle, centre
@@ -206,6 +210,55 @@ def gear_stage_kernel(q, v, f, jq, jv, jac, pack):
                     jv[ii[m], ii[n]] -= c * g[m] * g[n]
 
 
+# ---------------------------------------------------------------- the element's parameters from the design
+@dataclass(frozen=True)
+class GearStageParameters:
+    """The first stage's parameters (SI). Built by :func:`gear_stage_parameters`."""
+
+    drive: DriveParameters
+    stage: object  #: the involute stage's mesh stiffness (:func:`flexrv.analysis.mesh_stiffness.involute_stage`)
+    base_radius_sun: float
+    base_radius_planet: float
+    working_pressure_angle: float
+    normal_backlash: float
+    sun_runout: np.ndarray  #: (2,) as-built amplitude [m] along the lines of action, phase [rad]
+    planet_runout: np.ndarray  #: (N, 2) as-built amplitude [m], phase [rad]
+    planet_phase_errors: np.ndarray  #: (N,) as-built assembly phase error of each planet on its crank [rad]
+    #: torsional compliances per crank between planet gear and eccentrics [rad/(N m)], in series with
+    #: each mesh: crank torsion, planet spline (:func:`flexrv.analysis.path_compliances.planet_torsion_compliances`)
+    crank_torsion_compliance: float
+    planet_spline_compliance: float
+
+
+def gear_stage_parameters(reducer, drive: DriveParameters) -> GearStageParameters:
+    """The first stage's parameters: base radii, working pressure angle and normal backlash
+    of the involute pair, its mesh stiffness, the as-built runouts and phase errors
+    (:func:`flexrv.geometry.as_built.as_built`) and the planets' torsional compliances."""
+    from flexrv.analysis.mesh_stiffness import involute_stage
+    from flexrv.analysis.path_compliances import planet_torsion_compliances
+
+    fs = reducer.first_stage
+    alpha = fs.pressure_angle
+    rb_s = 0.5 * fs.module * fs.sun_teeth * math.cos(alpha)
+    rb_p = 0.5 * fs.module * fs.planet_teeth * math.cos(alpha)
+    alpha_w = math.acos((rb_s + rb_p) / fs.center_distance)
+    c_crank, c_spline = planet_torsion_compliances(reducer)
+    ab = drive.as_built
+    return GearStageParameters(
+        drive=drive,
+        stage=involute_stage(reducer),
+        base_radius_sun=rb_s,
+        base_radius_planet=rb_p,
+        working_pressure_angle=alpha_w,
+        normal_backlash=fs.backlash * math.cos(alpha_w),
+        sun_runout=ab.sun_runout,
+        planet_runout=ab.planet_runout,
+        planet_phase_errors=ab.planet_phase_errors,
+        crank_torsion_compliance=c_crank,
+        planet_spline_compliance=c_spline,
+    )
+
+
 class GearMeshes(KernelGroup):
     """All sun–planet meshes in one element (members: carrier, crank0..N-1)."""
 
@@ -215,12 +268,15 @@ class GearMeshes(KernelGroup):
     kernel = staticmethod(gear_stage_kernel)
     time_field = "drive"
 
-    def __init__(self, params, stage, input_angle, input_speed, ramp_fraction: float = 0.2):
-        p = params
-        self.n = p.n_cranks
+    parameters = staticmethod(gear_stage_parameters)
+
+    def __init__(self, params: GearStageParameters, input_angle, input_speed, ramp_fraction: float = 0.2):
+        p = self.params = params
+        d, stage = p.drive, p.stage
+        self.n = d.n_cranks
         self.members = ("carrier",) + tuple(f"crank{j}" for j in range(self.n))
         self.rbs, self.rbp = p.base_radius_sun, p.base_radius_planet
-        self.beta0 = np.ascontiguousarray(p.crank_angles, dtype=float)
+        self.beta0 = np.ascontiguousarray(d.crank_angles, dtype=float)
         self.bn = p.normal_backlash
         self.c = stage.c12
         w1 = stage.eps_alpha - 1.0
@@ -230,8 +286,8 @@ class GearMeshes(KernelGroup):
             rbs=p.base_radius_sun,
             rbp=p.base_radius_planet,
             sin_alpha_w=np.sin(p.working_pressure_angle),
-            a_w=p.center_distance,
-            z_s=p.z_s,
+            a_w=d.center_distance,
+            z_s=d.z_s,
             b_n=p.normal_backlash,
             k_single=stage.k_single,
             eps_alpha=stage.eps_alpha,

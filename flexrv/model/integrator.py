@@ -33,6 +33,7 @@ NEWTON_OPTIONS = {
     "maxIterations": "max_iterations",
     "maxModifiedNewtonIterations": "max_modified",
     "adaptInitialResidual": "adapt_initial_residual",
+    "modifiedNewtonJacUpdatePerStep": "jacobian_each_step",
 }
 
 #: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's

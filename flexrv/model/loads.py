@@ -13,12 +13,32 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _step_and_slope, adams_step
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, pack_type
+
+
+@dataclass(frozen=True)
+class LoadParameters:
+    """The external loads on the output flange besides the torque (design ``[operating]``).
+    Built by :func:`load_parameters`."""
+
+    radial: float  #: external radial force along +x [N]
+    axial: float  #: external axial force along +z [N]
+    tilt: float  #: tilting moment about x [N m]
+
+
+def load_parameters(reducer, drive) -> LoadParameters:
+    """The design's external forces and tilting moment (the load torque and its ramp are
+    the drive's, :class:`flexrv.model.drive.DriveParameters`: ``drive`` is not read)."""
+    op = reducer.operating
+    return LoadParameters(radial=op.external_radial_force_N, axial=op.external_axial_force_N, tilt=op.tilting_moment_Nm)
+
 
 #: :func:`loads_kernel`'s pack: the carrier's 6 indices and the generalized load vector at t
 LoadsPack = pack_type("LoadsPack", ("idx", (np.int64, 1)), ("load", (np.float64, 1)))
@@ -121,17 +141,12 @@ class OutputLoads(KernelGroup):
     kernel = staticmethod(loads_kernel)
     time_field = "load"
     members = ("carrier",)
+    parameters = staticmethod(load_parameters)
 
-    def __init__(
-        self,
-        torque,
-        radial: float = 0.0,
-        axial: float = 0.0,
-        tilt: float = 0.0,
-        ramp: tuple[float, float] | None = None,
-    ):
+    def __init__(self, params: LoadParameters, torque, ramp: tuple[float, float] | None = None):
+        self.params = params
         self.torque = torque
-        self.const = np.array([radial, 0.0, 0.0, axial, tilt, 0.0])
+        self.const = np.array([params.radial, 0.0, 0.0, params.axial, params.tilt, 0.0])
         #: the external forces/moment ramp in with step(t, t1, 0, t2, 1) (None: from t = 0)
         self.ramp = ramp
         self._cache = None

@@ -12,7 +12,7 @@ only where the distance is below the curve's reach on its side
 nearest point, and is otherwise found again from the cold starts (after a long
 solver excursion a warm start could otherwise stay on a neighbouring flank).
 
-As-built geometry (:class:`flexrv.model.parameters.RigidParameters`): actual pin
+As-built geometry (:class:`PinParameters`, from :func:`flexrv.geometry.as_built.as_built`): actual pin
 centres ``pins`` and radii r_i (``pin_radii``), per-disc modifications (dR_p,
 dr_rp, d_rotation) (``disc_profile``) and profile harmonics A cos(order phi +
 phase) (``profile_harmonics``, material added along the normal):
@@ -132,6 +132,7 @@ from __future__ import annotations
 
 import functools
 from collections import namedtuple
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -140,6 +141,7 @@ from flexrv.contact.laws import _friction_one, _impact_one
 from flexrv.geometry.cycloid import _FOOT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
+from flexrv.model.drive import DriveParameters
 from flexrv.model.numerics.linalg import matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, apply_predictor, newton_start, newton_update
 
@@ -710,6 +712,75 @@ def _curve_reach(z_rp: int, radius: float, eccentricity: float, samples: int = 4
     return out[0], out[1]
 
 
+# ---------------------------------------------------------------- the element's parameters from the design
+@dataclass(frozen=True)
+class PinParameters:
+    """The pin contacts' parameters (SI). Built by :func:`pin_parameters`."""
+
+    drive: DriveParameters
+    pin_circle_radius: float
+    pin_radius: float  #: nominal pin radius [m]
+    pins: np.ndarray  #: (z_rp, 2) as-built pin centres in the housing frame [m]
+    pin_radii: np.ndarray  #: (z_rp,) as-built pin radii [m]
+    disc_profile: np.ndarray  #: (n_discs, 3) as-built (d_radius [m], d_pin_radius [m], d_rotation [rad]) per disc
+    #: (n_discs, H, 3) (order [-], amplitude [m], phase [rad]): material added along the profile normal,
+    #: delta(phi) = sum A cos(order phi + phase), phi the curve parameter; it reduces the pin gap by
+    #: delta(phi*) at the contact's foot point
+    profile_harmonics: np.ndarray
+    pin_k: float  #: pin-contact constant [N/m^e] (:func:`pin_parameters`)
+    pin_exponent: float
+    pin_c_max: float  #: impact law's full damping [N s/m]
+    pin_penetration_limit: float  #: [m] a run stops as failed beyond it
+    pin_friction: float  #: effective pin coefficient min(mu_pin_disc, mu_pin_seat) [-] (0: friction off)
+    #: (n_discs, 3, 3) compliance of each disc's rim pose (x, y, psi) relative to its hub per unit pin force
+    #: (:func:`flexrv.fem.disc.rim_compliance`); (0, 3, 3): rigid discs (``second_stage.disc_body_model``)
+    disc_compliance: np.ndarray
+    #: torsional compliance of the pin housing about the axis [rad/(N m)]
+    #: (:func:`flexrv.analysis.torsional.housing_model_compliance`, design ``housing.body_model``); 0: rigid
+    housing_compliance: float
+
+
+def pin_parameters(reducer, drive: DriveParameters) -> PinParameters:
+    """The pin contacts' parameters. The pin law's constant: the pin path = pin-disc contact,
+    pin seat and pin bending in series (:func:`flexrv.analysis.pin_load.pin_contact_constant`,
+    the one constant of every model, matched at the largest pin load of the analytic
+    distribution: the only pin-load analysis of the model); the impact law takes the seeds'
+    exponent, matched to the Hertz line law at the damping depth. The as-built pins and
+    profiles (:func:`flexrv.geometry.as_built.as_built`), the elastic discs (FE build only if
+    condensed, :func:`flexrv.model.bodies.body_compliance_matrix`) and the housing's compliance."""
+    from flexrv.analysis.pin_load import pin_contact_constant
+    from flexrv.analysis.torsional import housing_model_compliance
+    from flexrv.contact.hertz import LINE_EXPONENT
+    from flexrv.contact.laws import effective_pin_friction
+    from flexrv.model.bodies import body_compliance_matrix
+
+    ss, ct = reducer.second_stage, reducer.contact
+    k_line = pin_contact_constant(reducer).k
+    if ct.pin_law == "hertz_line":
+        k, exponent = k_line, LINE_EXPONENT
+    else:
+        k, exponent = k_line * drive.contact_depth ** (LINE_EXPONENT - ct.impact_exponent), ct.impact_exponent
+    ab = drive.as_built
+    return PinParameters(
+        drive=drive,
+        pin_circle_radius=ss.pin_circle_radius,
+        pin_radius=ss.pin_radius,
+        pins=ab.pins,
+        pin_radii=ab.pin_radii,
+        disc_profile=ab.disc_profile,
+        profile_harmonics=ab.profile_harmonics,
+        pin_k=k,
+        pin_exponent=exponent,
+        pin_c_max=ct.pin_max_damping_Ns_per_m,
+        pin_penetration_limit=ct.pin_penetration_limit_um * 1e-6,
+        pin_friction=effective_pin_friction(ct.pin_friction_coefficient, ct.pin_seat_friction_coefficient)
+        if ct.friction
+        else 0.0,
+        disc_compliance=body_compliance_matrix(reducer, "cycloid_disc"),
+        housing_compliance=housing_model_compliance(reducer),
+    )
+
+
 class PinContacts(KernelGroup):
     """Pin–disc contacts (members: disc0..n_discs-1)."""
 
@@ -722,40 +793,43 @@ class PinContacts(KernelGroup):
     friction_outputs = ("pin_friction_power",)
     failure_message = "pin gap: closest-point iteration did not converge"
 
-    def __init__(self, params, restart_every: int = 500):
-        p = params
-        self.nd = p.n_discs
+    parameters = staticmethod(pin_parameters)
+
+    def __init__(self, params: PinParameters, restart_every: int = 500):
+        p = self.params = params
+        d = p.drive
+        self.nd = d.n_discs
         self.members = tuple(f"disc{k}" for k in range(self.nd))
         self.pins = np.ascontiguousarray(p.pins, dtype=float)  # (z, 2) actual centres
         self.radii = np.ascontiguousarray(p.pin_radii, dtype=float)
         self.profile = np.ascontiguousarray(p.disc_profile, dtype=float).reshape(self.nd, 3)
         self.harmonics = np.ascontiguousarray(p.profile_harmonics, dtype=float).reshape(self.nd, -1, 3)
         self.k, self.e = p.pin_k, p.pin_exponent
-        self.c_max, self.depth = p.pin_c_max, p.contact_depth
-        self.limit = params.pin_penetration_limit  # design contact.pin_penetration_limit_um
+        self.c_max, self.depth = p.pin_c_max, d.contact_depth
+        self.limit = p.pin_penetration_limit  # design contact.pin_penetration_limit_um
         reach = [
-            _curve_reach(int(p.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(p.eccentricity))
+            _curve_reach(int(d.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(d.eccentricity))
             for kd in range(self.nd)
         ]
-        max_step, tol, max_iter = closest_point_settings(p.z_rp, p.pin_circle_radius)
+        max_step, tol, max_iter = closest_point_settings(d.z_rp, p.pin_circle_radius)
         self.law = PinLaw.of(
-            z_rp=p.z_rp,
+            z_rp=d.z_rp,
             pin_circle_radius=p.pin_circle_radius,
             pin_radius=p.pin_radius,
-            eccentricity=p.eccentricity,
+            eccentricity=d.eccentricity,
             k=p.pin_k,
             exponent=p.pin_exponent,
             c_max=p.pin_c_max,
-            depth=p.contact_depth,
+            depth=d.contact_depth,
             max_step=max_step,
             tol=tol,
             max_iter=max_iter,
             mu=p.pin_friction,
-            v_reg=p.friction_velocity,
+            v_reg=d.friction_velocity,
         )
         #: per disc the pin-centre curve's reach outside, inside [m] (:func:`_curve_reach`)
         self.reach = np.array(reach, dtype=float).reshape(self.nd, 2)
-        self.mu, self.v_reg = p.pin_friction, p.friction_velocity
+        self.mu, self.v_reg = p.pin_friction, d.friction_velocity
         z = len(self.pins)
         self.phi = np.full((self.nd, z), np.nan)
         self.gap, self.force = np.zeros((self.nd, z)), np.zeros((self.nd, z))

@@ -12,8 +12,8 @@ angle prescribed. The groups are the SAME objects as in the dynamic model
 (:func:`flexrv.model.factory.build_rigid` with ``exudyn=False`` and the
 ``position`` drive, in which the model's "time" argument is the input angle): the
 same pin gaps, Hertz/Palmgren laws, needle bearings, crank supports, gear meshes
-and main bearing, read from the same as-built parameters
-(:func:`flexrv.model.parameters.rigid_parameters`). At zero velocity the
+and main bearing, each with its own parameters built from the design (the element's
+``parameters``; the shared ones: :func:`flexrv.model.drive.drive_parameters`). At zero velocity the
 damping terms vanish, so this is the dynamic model's equilibrium manifold.
 
 Solver: Newton's method on R with the groups' analytic Jacobians
@@ -142,6 +142,8 @@ class StaticModel:
         #: of output rotation on rv40e, 6e-4 arcsec)
         self.position_tol = 1e-10
         self.calls = 0
+        #: (input angle, q) of the last residual call (a reference: the solver never changes its arrays)
+        self.last = None
         #: finite-difference Jacobian in the solver's exact phase (the analytic one is exact; kept
         #: for checks: 20x the residual calls)
         self.fd_fallback = False
@@ -161,6 +163,7 @@ class StaticModel:
         """Generalized force sum R(q) and dR/dq at input angle ``theta_in``."""
         self.calls += 1
         f, dq, _ = self.model.generalized_forces(theta_in, q, np.zeros(self.n), jacobian=jacobian)
+        self.last = (theta_in, q)  # the state the force groups' records belong to (_CurveRecords)
         return f, dq
 
     def kinematic_pose(self, theta_in) -> np.ndarray:
@@ -391,7 +394,7 @@ class StaticModel:
                 e_body = float(df @ (rot @ g.carrier_c @ rot.T) @ df) / c
                 out["carrier"] = e_body
                 out[g.name] -= e_body
-                for part, cm in self.p.carrier_parts.items():  # rings, joints: their own shares of it
+                for part, cm in g.params.carrier_parts.items():  # rings, joints: their own shares of it
                     out[part] = float(df @ (rot @ cm @ rot.T) @ df) / c
                     out["carrier"] -= out[part]
             if g.name == "pins" and getattr(g, "elastic_discs", False):
@@ -431,6 +434,8 @@ class LoadedTE:
     solve_time_s: float
     orders: dict = field(default_factory=dict)  #: characteristic orders per output revolution
     no_load_torque: float = 0.0  #: torque of the no-load curve and the backlash [N m]
+    #: process CPU [s] of each phase: model, load_ramp, loaded_curve, no_load_curve, outputs, catalog
+    timing: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         """Headline numbers in engineering units (keys name their unit)."""
@@ -512,6 +517,7 @@ def equilibrium_path(
     max_failed_fraction: float = 0.01,
     periodic: bool = False,
     progress=None,
+    record=None,
 ):
     """Solve every position; each is warm-started from the previous solution
     advanced by the nominal kinematic increment (measured: 2 Newton iterations
@@ -523,7 +529,8 @@ def equilibrium_path(
     imaged starts in a row that are not end them (as-built errors that break the symmetry; a
     single miss is an equilibrium found at the edge of the tolerance, whose image lies just
     outside). Every position is still solved to the same tolerance. ``progress(done, total)``
-    is called every 256 positions and at the end.
+    is called every 256 positions and at the end; ``record(k, theta, q)`` after each converged
+    position (:class:`_CurveRecords`).
     A position that neither its warm start nor a restart from the kinematic pose
     (:func:`_restart`) converges is returned as NaN with iterations -1; more than
     ``max_failed_fraction`` of such positions raise ConvergenceError.
@@ -549,6 +556,8 @@ def equilibrium_path(
             except ConvergenceError:
                 qs[k], its[k] = np.nan, -1  # reported: the caller counts the unconverged positions
                 continue
+        if record is not None:
+            record(k, th, qs[k])
         misses = (misses + 1 if its[k] > 0 else 0) if imaged else misses
         if misses >= IMAGE_MISSES:
             image = None
@@ -639,6 +648,71 @@ def ramp_to(sm: StaticModel, theta_in: float, q: np.ndarray, torque: float, step
     return q
 
 
+class _PhaseClock:
+    """Process CPU [s] between successive :meth:`lap` calls, by phase name (``laps``)."""
+
+    def __init__(self):
+        self.laps: dict[str, float] = {}
+        self._t = _time.process_time()
+
+    def lap(self, name: str) -> None:
+        t = _time.process_time()
+        self.laps[name] = self.laps.get(name, 0.0) + t - self._t
+        self._t = t
+
+
+class _CurveRecords:
+    """The force groups' outputs over a curve from the solver's own evaluations.
+
+    Called after each converged position (``record`` of :func:`equilibrium_path`), it copies
+    the per-contact records of the fused compiled element
+    (:meth:`flexrv.model.kernels.FusedForces.record_entries`) left by the residual call at
+    exactly that state (one more call, without the Jacobian, where the solver's last call was
+    elsewhere: a best iterate, an exact Newton step below the position tolerance). The same
+    numbers as evaluating the groups again at the converged states, to the solvers' own
+    tolerances (warm-started closest points and crank-support solves), except ``pin_gap`` of a
+    pin the solver proved open: a positive lower bound of its gap, as in a simulation's records
+    (:class:`flexrv.model.kernels.HistoryRecorder`). Groups outside the fused element are
+    evaluated by :func:`flexrv.model.outputs.group_outputs` at the converged states."""
+
+    def __init__(self, sm: StaticModel, n: int):
+        self.sm = sm
+        if sm.model.fused is None:
+            sm.residual(0.0, sm.model.q0, jacobian=False)  # builds the fused element
+        self.entries = sm.model.fused.record_entries()
+        self.buffers = [np.empty((n,) + a.shape) for _, _, a in self.entries]
+        self.pairs = [(a, b) for (_, _, a), b in zip(self.entries, self.buffers)]
+        self.valid = np.zeros(n, dtype=bool)
+
+    def __call__(self, k: int, theta: float, q: np.ndarray) -> None:
+        last = self.sm.last
+        if last is None or last[0] != theta or not (last[1] == q).all():
+            self.sm.residual(theta, q, jacobian=False)
+        for live, buffer in self.pairs:
+            buffer[k] = live
+        self.valid[k] = True
+
+    def outputs(self, angles: np.ndarray, qs: np.ndarray) -> dict:
+        """Every group's declared outputs over the positions (dims start with ``position``;
+        NaN at the positions that did not converge)."""
+        from flexrv.model.base import Output
+        from flexrv.model.outputs import group_outputs
+
+        ok = self.valid & np.isfinite(qs).all(axis=1)
+        data: dict = {}
+        for (group, key, _), buffer in zip(self.entries, self.buffers):
+            data.setdefault(group, {})[key] = buffer[ok]
+        records = {"data": data, "valid": {g: np.ones(int(ok.sum()), dtype=bool) for g in data}}
+        z = np.zeros_like(qs[ok])
+        outs = {}
+        for name, val in group_outputs(self.sm.model, angles[ok], qs[ok], z, records=records).items():
+            v = np.asarray(val.values, dtype=float)
+            full = np.full((len(angles),) + v.shape[1:], np.nan)
+            full[ok] = v
+            outs[name] = Output(full, ("position",) + tuple(val.dims[1:]), val.units, val.long_name)
+        return outs
+
+
 def _catalog_levels(
     sm: StaticModel, th: float, q: np.ndarray, torque: float, rated: float, t_small: float, play=()
 ) -> dict[str, float]:
@@ -696,8 +770,6 @@ def loaded_te(
     ``progress(stage, done, total)``: called while the curves are solved (stage "loaded curve" /
     "no-load curve", positions done of total).
     """
-    from flexrv.model.base import Output
-
     op = reducer.operating
     rated = op.rated_torque_Nm
     if torque is None:
@@ -712,7 +784,9 @@ def loaded_te(
             "3 x rated, beyond which the Hertz laws leave their range"
         )
     angles = positions_for(reducer, output_revolutions, crank_revolutions, points_per_mesh)
+    clock = _PhaseClock()
     sm = StaticModel(reducer, options)
+    clock.lap("model")
     t_start = _time.perf_counter()
     q0 = sm.kinematic_pose(angles[0])
     # first position: torque continuation from the kinematic pose
@@ -723,31 +797,24 @@ def loaded_te(
         pass  # nothing touches (clearances everywhere): the load ramp closes them
     q_load = ramp_to(sm, angles[0], q0, torque, steps=8)
     stage = (lambda name: lambda done, total: progress(name, done, total)) if progress is not None else None
-    qs, its = equilibrium_path(sm, angles, q_load, progress=stage and stage("loaded curve"))
+    records = _CurveRecords(sm, len(angles))
+    clock.lap("load_ramp")
+    qs, its = equilibrium_path(sm, angles, q_load, progress=stage and stage("loaded curve"), record=records)
+    clock.lap("loaded_curve")
     # no-load curve
     t_small = no_load_fraction * rated
     sm.torque = torque
     q_small = ramp_to(sm, angles[0], qs[0], t_small)
     qs_nl, its_nl = equilibrium_path(sm, angles, q_small, periodic=True, progress=stage and stage("no-load curve"))
+    clock.lap("no_load_curve")
     ratio = sm.p.ratio
     th_out = qs[:, sm.i_theta]
     te = th_out - angles / ratio
     te_nl = qs_nl[:, sm.i_theta] - angles / ratio
     # outputs declared by the groups, over the positions (at the loaded curve's torque)
-    sm.torque = torque
-    outs = {}
-    ok = np.isfinite(qs).all(axis=1)  # unconverged positions (NaN) carry NaN outputs
-    z = np.zeros_like(qs[ok])
-    for group in sm.model.groups:
-        qg = sm.model.group_state(group, qs[ok])
-        vg = sm.model.group_state(group, z)
-        group.reset()
-        _, o = group.evaluate(angles[ok], qg, vg, want_outputs=True)
-        for name, val in (o or {}).items():
-            v = np.asarray(val.values, dtype=float)
-            full = np.full((len(angles),) + v.shape[1:], np.nan)
-            full[ok] = v
-            outs[name] = Output(full, ("position",) + tuple(val.dims[1:]), val.units, val.long_name)
+    outs = records.outputs(angles, qs)
+    ok = np.isfinite(qs).all(axis=1)
+    clock.lap("outputs")
     # catalog quantities at a few converged positions spread over the range
     good = np.flatnonzero(ok)
     cat_idx = good[np.unique(np.linspace(0, len(good) - 1, max(1, min(catalog_positions, len(good)))).astype(int))]
@@ -769,6 +836,7 @@ def loaded_te(
     if not lm:
         raise ConvergenceError("no catalog position (lost motion, backlash, rigidity) converged")
     wall = _time.perf_counter() - t_start
+    clock.lap("catalog")
     catalog = {
         "lost_motion_rad": float(np.max(lm)),
         "backlash_rad": float(np.max(bl)),
@@ -796,4 +864,5 @@ def loaded_te(
         solve_time_s=wall,
         orders=characteristic_orders(reducer),
         no_load_torque=t_small,
+        timing=clock.laps,
     )

@@ -76,9 +76,53 @@ def save(res, directory, figures=None) -> Path:
         figures(d)
     atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summ), indent=2))
     atomic_write_text(d / "summary.md", summary_markdown(res, summ))
-    with atomic_path(d / "results.nc") as tmp:
-        res.ds.to_netcdf(tmp, engine="h5netcdf")
+    write_netcdf(res.ds, d / "results.nc")
     return d
+
+
+def xarray_without_dask() -> None:
+    """Let xarray know, once per process, that this process uses no dask arrays: xarray asks
+    on its first variable whether its data is a dask array, importing ``dask.array`` (~0.4 s
+    CPU) to find out, and keeps the answer. For a command that never makes dask arrays (``te``,
+    ``simulate``) dask is hidden from that first question (``sys.modules["dask"] = None`` makes
+    its import fail, which xarray reads as "dask not installed"). Nothing happens where dask is
+    imported already (a study that uses it, a test session)."""
+    import sys
+
+    if "dask" in sys.modules:
+        return
+    import xarray as xr
+
+    sys.modules["dask"] = None
+    try:
+        xr.Variable(("x",), np.zeros(1))
+    finally:
+        if sys.modules.get("dask", 0) is None:
+            del sys.modules["dask"]
+
+
+def write_netcdf(ds, path) -> Path:
+    """Write ``ds`` to ``path`` atomically (NetCDF4 via h5netcdf).
+
+    xarray's writer asks dask for the active scheduler to choose its file lock, importing
+    ``dask.base`` and ``distributed`` (~0.5 s CPU together). A process that has imported
+    neither holds no dask collection and no distributed client, so the answer is xarray's
+    default (the threaded lock) either way: a module not imported yet is hidden from that probe
+    (``sys.modules[name] = None`` makes its import fail, which xarray reads as "no dask")."""
+    import sys
+
+    path = Path(path)
+    hidden = [name for name in ("dask", "dask.base", "distributed") if name not in sys.modules]
+    for name in hidden:
+        sys.modules[name] = None
+    try:
+        with atomic_path(path) as tmp:
+            ds.to_netcdf(tmp, engine="h5netcdf")
+    finally:
+        for name in hidden:
+            if sys.modules.get(name, 0) is None:
+                del sys.modules[name]
+    return path
 
 
 def save_partial(res, directory) -> Path:
@@ -90,8 +134,7 @@ def save_partial(res, directory) -> Path:
     d.mkdir(parents=True, exist_ok=True)
     if res.reducer is not None and not (d / "config.toml").exists():
         atomic_write_text(d / "config.toml", to_toml(res.reducer))
-    with atomic_path(d / "results.nc") as tmp:
-        res.ds.to_netcdf(tmp, engine="h5netcdf")
+    write_netcdf(res.ds, d / "results.nc")
     return d
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from flexrv.cache import atomic_path, atomic_write_text, to_jsonable
+from flexrv.cache import atomic_write_text, to_jsonable
 from flexrv.post import definitions as defs
 from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, RAD_PER_ARCMIN
 
@@ -326,11 +326,11 @@ def save_te(ds: xr.Dataset, summary: dict, reducer, directory, errors_note: str 
     """Write ``results.nc``, ``config.toml``, ``summary.json`` and ``summary.md``
     atomically into ``directory``; returns its path."""
     from flexrv.design import to_toml
+    from flexrv.post.io import write_netcdf
 
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
-    with atomic_path(d / "results.nc") as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+    write_netcdf(ds, d / "results.nc")
     atomic_write_text(d / "config.toml", to_toml(reducer))
     atomic_write_text(d / "summary.json", json.dumps(to_jsonable(summary), indent=2))
     atomic_write_text(d / "summary.md", te_summary_markdown(summary, reducer, errors_note))

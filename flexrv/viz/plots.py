@@ -61,6 +61,19 @@ def plot_speeds(res, path) -> Path:
     return _save(fig, Path(path))
 
 
+def _force_map(ax, x: np.ndarray, y: np.ndarray, c: np.ndarray, vmax: float):
+    """Map of ``c`` (len(y), len(x)) over the grid x, y, each value a cell centred on its grid
+    point (``pcolormesh(..., shading="nearest")``). On uniform grids (recorded time steps, pin
+    angles) drawn as one image, which looks the same and costs a fraction of ~10^5 quadrilaterals."""
+    kw = {"cmap": "viridis", "vmin": 0.0, "vmax": vmax}
+    if len(x) > 2 and len(y) > 1:
+        dx, dy = np.diff(x), np.diff(y)
+        if np.allclose(dx, dx[0], rtol=1e-6, atol=0.0) and np.allclose(dy, dy[0], rtol=1e-6, atol=0.0):
+            extent = (x[0] - dx[0] / 2, x[-1] + dx[0] / 2, y[0] - dy[0] / 2, y[-1] + dy[0] / 2)
+            return ax.imshow(c, origin="lower", aspect="auto", interpolation="nearest", extent=extent, **kw)
+    return ax.pcolormesh(x, y, c, shading="nearest", **kw)
+
+
 def plot_pin_forces(res, path) -> Path:
     """Pin force maps (pin angle vs time) of every disc, one panel each, and the largest
     pin force per disc below; all panels share the time axis and the same width (the
@@ -76,7 +89,7 @@ def plot_pin_forces(res, path) -> Path:
     axes = []
     for k in range(n_disc):
         ax = fig.add_subplot(gs[k, 0], sharex=axes[0] if axes else None)
-        im = ax.pcolormesh(t, angle, f[:, k, :].T, shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
+        im = _force_map(ax, t, angle, f[:, k, :].T, vmax)
         ax.set_ylabel(f"disc {k + 1}\npin angle [deg]")
         ax.set_yticks(np.arange(0, 361, 90))
         ax.tick_params(labelbottom=False)

@@ -119,7 +119,15 @@ def plot_te_spectrum(ds, summary: dict, path) -> Path:
     fig, ax = plt.subplots(figsize=(10, 4.0))
     fig.subplots_adjust(left=0.07, right=0.68, bottom=0.13, top=0.9)
     if len(order):
-        ax.vlines(order[1:], 0.0, amp[1:], lw=0.8)
+        # one line from 0 to each amplitude: drawn as a single path with breaks (as ax.vlines draws
+        # it, without a masked-array segment per order)
+        o, a = order[1:], amp[1:]
+        ax.plot(
+            np.column_stack([o, o, np.full_like(o, np.nan)]).ravel(),
+            np.column_stack([np.zeros_like(a), a, np.full_like(a, np.nan)]).ravel(),
+            lw=0.8,
+            color="C0",
+        )
         lines = sorted(summary["spectrum_lines"], key=lambda x: -x["amplitude_arcsec"])
         top = max(amp[1:].max(), 1e-12)
         key = []

@@ -70,7 +70,7 @@ def crank_stress(reducer, res, i: int, crank: int = 0, size: float | None = None
     from flexrv.fem.body import _assemble, material_dict
     from flexrv.fem.static import sector_loads, solve_static, von_mises_field
     from flexrv.meshing import build_mesh, spec_for
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
 
     mres = build_mesh(reducer, "crankshaft", size)
     mesh = mres.data
@@ -84,7 +84,7 @@ def crank_stress(reducer, res, i: int, crank: int = 0, size: float | None = None
     # crank mesh frame: eccentric_1 centred at (+e, 0), eccentric_2 at (-e, 0). Disc k's eccentric points
     # along (sin chi_k, cos chi_k) in the housing frame, chi_k = chi0_k - phi (flexrv.model.cranks_discs), so
     # the housing angle alpha_0 = pi/2 - chi_0 of disc 0's eccentric maps to the mesh's +x axis.
-    p = rigid_parameters(reducer)
+    p = drive_parameters(reducer)
     phi = float(res["crank_angle"].values[i, crank])
     alpha0 = np.pi / 2 - (p.chi0[0] - phi)
     for k, group in enumerate(("eccentric_1", "eccentric_2")[: p.n_discs]):
@@ -345,9 +345,9 @@ def run(
     )
     # closed-form cross-check of the bearing load: the crank bearings carry the output torque to the carrier,
     # so their mean tangential force is T / (N_cranks n_discs r_c) (moment balance of the carrier about its axis)
-    from flexrv.model.parameters import rigid_parameters
+    from flexrv.model.drive import drive_parameters
 
-    prm = rigid_parameters(red)
+    prm = drive_parameters(red)
     f_t = op.load_torque_Nm / (prm.n_cranks * prm.n_discs * prm.center_distance)
     t0, _ = res.steady_window()
     f_mean = float(res["needle_force"].sel(time=slice(t0, None)).values.mean())

@@ -70,7 +70,7 @@ def legacy_supports(r, name: str):
 def short_run_reducer(name: str = "rv40e"):
     """Preset with speed and load ramps shortened to 5 ms (steady after ~0.02 s)."""
     from flexrv.design import load
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
 
     r = with_bodies(legacy_supports(load(name), name), [])  # rigid carrier and discs (issue 14: tests/test_bodies.py)
     op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
@@ -99,7 +99,7 @@ def variant(name: str, needle: str):
     0..4 ms and external radial/axial force and tilting moment (so the loads group
     is exercised at the sampled times)."""
     from flexrv.design import load
-    from flexrv.model.parameters import with_bodies
+    from flexrv.model.bodies import with_bodies
 
     r = with_bodies(legacy_supports(load(name), name), [])  # rigid carrier and discs (issue 14: tests/test_bodies.py)
     op = r.operating.model_copy(

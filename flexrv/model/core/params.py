@@ -9,7 +9,9 @@ flat vector, so a wrong name fails at compile time instead of reading another
 parameter. Pack sizes are derived: a law's length is its field list, an absent
 element's pack is built by :func:`empty_pack` from the pack type's field kinds.
 
-Field kinds of :func:`pack_type`: a law type (zeros of its fields), ``(dtype,
+Field kinds of :func:`pack_type`: a law type (zeros of its fields; :func:`law_type`, or a
+``typing.NamedTuple`` class of scalars with a ``zero()`` class method, as a contact law below
+the model layer defines its constants, e.g. :class:`flexrv.contact.tapered_roller.SupportConstants`), ``(dtype,
 ndim)`` (an array of that many dimensions, empty in an absent element's pack) or
 ``(dtype, shape)`` (a fixed shape the kernel reads even when it has nothing to do,
 zeros in an absent element's pack).
@@ -67,6 +69,11 @@ def pack_type(name: str, *fields: tuple):
     return cls
 
 
+def _is_law(kind) -> bool:
+    """A law type: a named tuple of scalars with ``zero()`` (not a pack type)."""
+    return isinstance(kind, type) and issubclass(kind, tuple) and hasattr(kind, "zero") and not hasattr(kind, "_kinds")
+
+
 def empty_pack(cls):
     """The pack of an absent element of pack type ``cls``: empty arrays (fixed-shape
     fields zero-filled), zero laws, nested packs empty; same numba types as a live pack."""
@@ -74,7 +81,7 @@ def empty_pack(cls):
     for field, kind in cls._kinds.items():
         if hasattr(kind, "_kinds"):
             values.append(empty_pack(kind))
-        elif hasattr(kind, "_types"):
+        elif _is_law(kind):
             values.append(kind.zero())
         else:
             dtype, shape = kind
@@ -89,7 +96,7 @@ def check_pack(pack) -> None:
         value = getattr(pack, field)
         if hasattr(kind, "_kinds"):
             check_pack(value)
-        elif hasattr(kind, "_types"):
+        elif _is_law(kind):
             if type(value) is not kind:
                 raise TypeError(f"{type(pack).__name__}.{field} must be a {kind.__name__}")
         else:

@@ -29,7 +29,10 @@ is reused while the residual contracts by at most ``contractivity`` per iteratio
 (checked from the third iteration), else a new one is computed at the current state;
 a contraction worse than 2 (or a diverged state) restarts the step from the predictor
 with one extra iteration, a second failure switches to full Newton; after
-``max_modified`` iterations full Newton; at most ``max_iterations`` iterations.
+``max_modified`` iterations full Newton; at most ``max_iterations`` iterations. With
+``jacobian_each_step`` False a step starts from the factorised iteration matrix of an
+earlier step of the same size (within 1e-9 relative) and computes a new one only when
+the contraction test above asks for it or after a restart.
 
 Reverse communication: the functions here never call the force; the caller (the
 generated ``fused_integrate`` of :mod:`flexrv.model.core.registry`, or the test's
@@ -46,23 +49,34 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.core.params import pack_type
+from flexrv.model.numerics.block_lu import (
+    block_factor,
+    block_solve,
+    block_structure,
+    has_block_structure,
+    work_sizes,
+)
 from flexrv.model.numerics.linalg import lu_factor, lu_solve
 
 # -- indices into the state's float parameters ``par``
 P_ALPHA_M, P_ALPHA_F, P_GAMMA, P_BETA, P_RTOL, P_ATOL, P_CONTRACT, P_MAXNORM = range(8)
-P_H, P_R0, P_RES, P_LAST = 8, 9, 10, 11
-N_PAR = 12
+P_H, P_R0, P_RES, P_LAST, P_HJAC = 8, 9, 10, 11, 12
+N_PAR = 13
 # -- indices into the state's integer registers ``ip``
 I_PHASE, I_IT, I_JACREQ, I_FULL, I_RESTARTED, I_EXTRA, I_JAC, I_MAXIT, I_MAXMOD = range(9)
 I_NEWTON, I_JACOBIANS, I_CALLS, I_JACCALLS, I_ADAPT = 9, 10, 11, 12, 13
-N_IP = 14
+I_EACHSTEP, I_FACTORED = 14, 15
+N_IP = 16
 # -- phases: what the evaluation the state machine asked for is
 PH_PREDICTOR, PH_ITERATE, PH_JACOBIAN = 0, 1, 2
 # -- results of after_eval
 EVALUATE, CONVERGED, FAILED = 1, 0, -1
 
 #: the integrator state: parameters, registers, current and start-of-step vectors,
-#: residual, Newton correction, the constant matrices and the factorised iteration matrix
+#: residual, Newton correction, the constant matrices and the factorised iteration matrix; with
+#: dense diagonal blocks (``blocks`` (K, 2) of (start, size); empty: one dense LU), the block
+#: elimination's other coordinates ``xs``, its Y_k, blocks' LU, Schur complement, pivots and work vectors
+#: (:mod:`flexrv.model.numerics.block_lu`)
 GaState = pack_type(
     "GaState",
     ("par", (np.float64, 1)),
@@ -82,6 +96,14 @@ GaState = pack_type(
     ("damp", (np.float64, 2)),
     ("lu", (np.float64, 2)),
     ("piv", (np.int64, 1)),
+    ("blocks", (np.int64, 2)),
+    ("xs", (np.int64, 1)),
+    ("ys", (np.float64, 2)),
+    ("dk", (np.float64, 1)),
+    ("schur", (np.float64, 2)),
+    ("xpiv", (np.int64, 1)),
+    ("tx", (np.float64, 1)),
+    ("zx", (np.float64, 1)),
 )
 
 
@@ -108,32 +130,61 @@ def new_state(
     max_iterations: int = 25,
     max_modified: int = 8,
     adapt_initial_residual: bool = True,
+    blocks=None,
+    jacobian_each_step: bool = True,
 ) -> GaState:
-    """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0)."""
+    """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0).
+    ``blocks``: [(start, size), ...] dense diagonal blocks of the iteration matrix that couple
+    only through the other coordinates (M, K, D and the force's Jacobians zero between two
+    blocks): the Newton systems are then solved by block elimination
+    (:mod:`flexrv.model.numerics.block_lu`); None: one dense LU. ``jacobian_each_step``
+    False: a step starts with the factorised iteration matrix of an earlier step of the
+    same size (a new one only when the contraction test asks for it, Exudyn's
+    ``modifiedNewtonJacUpdatePerStep = False``)."""
     m = np.ascontiguousarray(mass, dtype=float)
     n = m.shape[0]
     z = np.zeros((n, n))
+    stiff = z.copy() if stiffness is None else np.ascontiguousarray(stiffness, dtype=float)
+    damp = z.copy() if damping is None else np.ascontiguousarray(damping, dtype=float)
+    if blocks:
+        bl, xs = block_structure(n, blocks)
+        if not all(has_block_structure(a, bl) for a in (m, stiff, damp)):
+            raise ValueError("the mass, stiffness or damping matrix couples two of the dense blocks")
+    else:
+        bl, xs = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
+    (nb, nd), nx = work_sizes(bl, xs), len(xs)
     par = np.zeros(N_PAR)
     par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA] = coefficients(spectral_radius)
     par[P_RTOL], par[P_ATOL] = tolerance
     par[P_CONTRACT], par[P_MAXNORM] = contractivity, 1e38
     ip = np.zeros(N_IP, np.int64)
     ip[I_MAXIT], ip[I_MAXMOD], ip[I_ADAPT] = max_iterations, max_modified, int(adapt_initial_residual)
+    ip[I_EACHSTEP] = int(jacobian_each_step)
     vec = [np.zeros(n) for _ in range(10)]
     return GaState(
         par,
         ip,
         *vec,
         m,
-        z.copy() if stiffness is None else np.ascontiguousarray(stiffness, dtype=float),
-        z.copy() if damping is None else np.ascontiguousarray(damping, dtype=float),
+        stiff,
+        damp,
         z.copy(),
         np.zeros(n, np.int64),
+        bl,
+        xs,
+        np.zeros((nb, nx)),
+        np.zeros(nd),
+        np.zeros((nx, nx)),
+        np.zeros(nx, np.int64),
+        np.zeros(nx),
+        np.zeros(nx),
     )
 
 
 def set_state(st: GaState, q, v, a, a_alg=None) -> None:
-    """Start from (q, v, a); the algorithmic accelerations a_alg default to a (a restart)."""
+    """Start from (q, v, a); the algorithmic accelerations a_alg default to a (a restart,
+    which also forgets the factorised iteration matrix)."""
+    st.ip[I_FACTORED] = 0
     st.q[:], st.v[:], st.a[:] = q, v, a
     st.aa[:] = a if a_alg is None else a_alg
 
@@ -155,7 +206,9 @@ def _predict(st):
 @njit(cache=True)
 def begin_step(st, h):
     """Start a step of size h from the current state: store it as the start of the step,
-    predict, and ask for an evaluation with the Jacobian (the Jacobian of every step)."""
+    predict, and ask for an evaluation with the Jacobian (the Jacobian of every step), or
+    without it when the iteration matrix of an earlier step of this size is kept
+    (``jacobian_each_step`` False)."""
     st.q0[:] = st.q
     st.v0[:] = st.v
     st.a0[:] = st.a
@@ -168,7 +221,8 @@ def begin_step(st, h):
     ip[I_EXTRA] = 0
     ip[I_JACREQ] = 0
     ip[I_PHASE] = PH_PREDICTOR
-    ip[I_JAC] = 1
+    kept = ip[I_EACHSTEP] == 0 and ip[I_FACTORED] != 0 and abs(st.par[P_HJAC] - h) <= 1e-9 * h
+    ip[I_JAC] = 0 if kept else 1
     _predict(st)
 
 
@@ -199,7 +253,13 @@ def _factor(st, jq, jv):
         for j in range(n):
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
-    return lu_factor(s, s, st.piv)  # in place
+    st.par[P_HJAC] = h
+    if st.blocks.shape[0] > 0:
+        ok = block_factor(s, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv)
+    else:
+        ok = lu_factor(s, s, st.piv)  # in place
+    st.ip[I_FACTORED] = int(ok)
+    return ok
 
 
 @njit(cache=True)
@@ -209,7 +269,10 @@ def _correct(st):
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
-    lu_solve(st.lu, st.piv, st.r, st.dx)
+    if st.blocks.shape[0] > 0:
+        block_solve(st.lu, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
+    else:
+        lu_solve(st.lu, st.piv, st.r, st.dx)
     for i in range(st.q.shape[0]):
         st.q[i] -= st.dx[i]
         st.v[i] -= gp * st.dx[i]
@@ -318,7 +381,7 @@ def after_eval(st, f, jq, jv):
         return _iterate(st, res)
     if not math.isfinite(res):
         return FAILED
-    if not _factor(st, jq, jv):
+    if ip[I_JAC] and not _factor(st, jq, jv):  # (no Jacobian: the kept factorisation)
         return FAILED
     return _correct(st)
 
