@@ -52,8 +52,8 @@ def simulate_job(reducer, model: str, model_options: dict, dt: float, integrator
 def te_job(reducer) -> None:
     """The loaded TE of ``reducer`` with rigid bodies over its first positions (the kernels of ``te``),
     the pins' kernel compiled meanwhile by a helper process (:func:`elements_job`)."""
-    from flexrv.model.kernel_cache import start_background
     from flexrv.model.bodies import with_bodies
+    from flexrv.model.kernel_cache import start_background
     from flexrv.model.quasi_static import loaded_te
     from flexrv.post.definitions import PLAY_FRACTIONS
 
