@@ -567,12 +567,57 @@ class _NumbaCachingHook:
 #: damaged numba cache entries discarded by this process (one warning for all of them)
 _DISCARDED: list[str] = []
 
+#: callables ``waiter(cache) -> bool`` asked when a kernel is not in numba's cache, before numba compiles
+#: it: a waiter that returns True has waited for another process that compiles the kernel into the same
+#: cache (:mod:`flexrv.model.kernel_cache`), and the cache is read again
+COMPILE_WAITERS: list = []
+#: name of the lock file in numba's cache folder (:func:`numba_index_lock`)
+NUMBA_LOCK_NAME = "index.lock"
+_LOCK_DEPTH = [0]
+
+
+@contextlib.contextmanager
+def numba_index_lock() -> Iterator[None]:
+    """Exclusive lock (fcntl, ``<numba cache>/index.lock``) around every read and write of numba's
+    cache by flexrv's processes. Numba writes an entry as its index (signature -> data file
+    number) and then the data file, choosing the number from the index it read: two processes
+    compiling different signatures of one kernel at once could both write data file 1, leaving an
+    index that names one signature's machine code for the other's. Under the lock each save reads
+    the index that the last one wrote, and a read never sees an index whose data file is not
+    written yet. Reentrant within a process; a no-op without fcntl or a writable cache folder."""
+    if _LOCK_DEPTH[0]:
+        _LOCK_DEPTH[0] += 1
+        try:
+            yield
+        finally:
+            _LOCK_DEPTH[0] -= 1
+        return
+    try:
+        import fcntl
+
+        folder = numba_cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / NUMBA_LOCK_NAME, "a+")
+    except (ImportError, OSError):
+        handle = None
+    _LOCK_DEPTH[0] = 1
+    try:
+        if handle is not None:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX)
+        yield
+    finally:
+        _LOCK_DEPTH[0] = 0
+        if handle is not None:
+            handle.close()  # (releases the lock)
+
 
 def guard_numba_cache(caching=None) -> None:
     """Make a damaged numba cache entry heal itself: an entry whose index (``.nbi``) or
     data (``.nbc``) cannot be read back (truncated, corrupted: any exception while
     numba loads or rebuilds it) is deleted and the kernel compiled again, with one
-    warning per process. Numba itself only tolerates a missing file."""
+    warning per process. Numba itself only tolerates a missing file. Every read and
+    write holds :func:`numba_index_lock` (processes sharing the cache), and a kernel
+    not found asks the :data:`COMPILE_WAITERS` before numba compiles it."""
     if caching is None:
         import numba.core.caching as caching
     cls = caching.Cache
@@ -580,20 +625,28 @@ def guard_numba_cache(caching=None) -> None:
         return
     load, save = cls.load_overload, cls.save_overload
 
+    def guarded_load(self, sig, target_context):
+        with numba_index_lock():
+            try:
+                return load(self, sig, target_context)
+            except Exception as exc:
+                _discard_numba_entry(self, exc)
+                return None
+
     def load_overload(self, sig, target_context):
-        try:
-            return load(self, sig, target_context)
-        except Exception as exc:
-            _discard_numba_entry(self, exc)
-            return None
+        value = guarded_load(self, sig, target_context)
+        if value is None and any(waiter(self) for waiter in list(COMPILE_WAITERS)):
+            value = guarded_load(self, sig, target_context)  # compiled meanwhile by another process
+        return value
 
     def save_overload(self, sig, data):
-        try:
-            return save(self, sig, data)
-        except Exception as exc:  # e.g. an unreadable index: discard it, save again
-            _discard_numba_entry(self, exc)
-            with contextlib.suppress(Exception):
-                save(self, sig, data)
+        with numba_index_lock():
+            try:
+                return save(self, sig, data)
+            except Exception as exc:  # e.g. an unreadable index: discard it, save again
+                _discard_numba_entry(self, exc)
+                with contextlib.suppress(Exception):
+                    save(self, sig, data)
 
     load_overload._flexrv_guard = True
     cls.load_overload, cls.save_overload = load_overload, save_overload

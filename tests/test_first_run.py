@@ -93,8 +93,9 @@ def test_te_announces_its_positions(capsys):
 def test_first_line_within_seconds_and_signal_while_building_bodies(tmp_path, sig, code):
     """Empty caches (FE and numba): the first line comes within seconds of the start (goal 2 s on
     a quiet machine, benchmarks/bench_first_run.py; 8 s here for a loaded test machine), and a
-    signal a few seconds later, while the design is checked and its FE bodies are built, ends the
-    run within 5 s with 128 + signum, no traceback and no run folder."""
+    signal a few seconds later, while the design is checked and its FE bodies are built (and its
+    kernels compile in a background process), ends the run within 5 s with 128 + signum, no
+    traceback and no run folder, and no process of the run is left."""
     out = tmp_path / "run"
     env = {
         **os.environ,
@@ -120,6 +121,8 @@ def test_first_line_within_seconds_and_signal_while_building_bodies(tmp_path, si
         assert "first run" in first, first
         time.sleep(4.0)
         assert proc.poll() is None, "the run ended before the signal"
+        if len(os.sched_getaffinity(0)) > 1:  # the command and its background compilation
+            assert len(_processes_with_cache(tmp_path / "cache")) >= 2
         t1 = time.monotonic()
         proc.send_signal(sig)
         _, stderr = proc.communicate(timeout=60)
@@ -133,6 +136,26 @@ def test_first_line_within_seconds_and_signal_while_building_bodies(tmp_path, si
     assert elapsed < 5.0, elapsed
     assert "Traceback" not in stderr
     assert not out.exists()
+    t2 = time.monotonic()  # the background compilation (flexrv.model.kernel_cache) ended with the command
+    while _processes_with_cache(tmp_path / "cache") and time.monotonic() - t2 < 5.0:
+        time.sleep(0.1)
+    assert not _processes_with_cache(tmp_path / "cache")
+
+
+def _processes_with_cache(cache: Path) -> list[int]:
+    """Live processes (not zombies) whose environment names ``cache`` as FLEXRV_CACHE_DIR."""
+    needle = f"FLEXRV_CACHE_DIR={cache}".encode() + b"\0"
+    found = []
+    for proc in Path("/proc").iterdir():
+        if not proc.name.isdigit():
+            continue
+        try:
+            if needle in (proc / "environ").read_bytes() + b"\0":
+                if (proc / "stat").read_text().split(")")[-1].split()[0] != "Z":
+                    found.append(int(proc.name))
+        except OSError:
+            continue
+    return found
 
 
 def test_sigterm_inside_a_gmsh_session_reaches_python():

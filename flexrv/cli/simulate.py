@@ -121,6 +121,7 @@ def simulate(
     (exit 130 / 143); --resume DIR continues a killed run."""
     import math
 
+    from flexrv.cli._precompile import start_simulate
     from flexrv.cli.te import skip_final_collection
     from flexrv.errors import InputError
     from flexrv.post.io import xarray_without_dask
@@ -156,6 +157,7 @@ def simulate(
             options["ball_inertia"] = ball_inertia
         out = check_output_dir(out or _default_out(preset, model, "sim"), "--out", overwrite=overwrite)
         sim = Simulation(preset, model=model, model_options=options)
+        start_simulate(sim, dt, integrator)  # a first run: its kernels compile in a second process
         try:
             res = sim.run(
                 t_end=t_end, dt=dt, progress=bar, save_to=out, checkpoint_s=checkpoint or None, integrator=integrator

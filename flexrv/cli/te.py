@@ -58,6 +58,7 @@ def te(
     """Static equilibrium of discs, cranks and carrier at a sequence of input positions under the
     output torque: loaded and no-load TE, lost motion, backlash, torsional rigidity, contact forces,
     TE spectrum; NetCDF, summary.md and PNGs."""
+    from flexrv.cli._precompile import start_te
     from flexrv.design import load
     from flexrv.errors import InputError
     from flexrv.model.quasi_static import loaded_te
@@ -70,6 +71,7 @@ def te(
     if output_revolutions is not None and crank_revolutions is not None:
         raise InputError("--output-revolutions and --crank-revolutions exclude each other: give one")
     reducer = load(preset)
+    start_te(reducer)  # a first run: its kernels compile in a second process
     out = check_output_dir(
         out or Path("results") / f"{Path(preset).stem}_te_{time.strftime('%Y%m%d-%H%M%S')}",
         "--out",

@@ -143,11 +143,12 @@ def _fused_source(specs, callee_hash: str) -> str:
         "",
         "@njit(cache=True)",
         f"def fused_history(qs, vs, {tin}f, jq, jv, {packs}, src, dst):",
+        "    no_jac = qs.shape[0] < 0  # False, typed bool: the literal False would compile fused_kernel again",
         "    for i in range(qs.shape[0]):",
     ]
     lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
     lines += [
-        f"        fused_kernel(qs[i], vs[i], f, jq, jv, False, {packs})",
+        f"        fused_kernel(qs[i], vs[i], f, jq, jv, no_jac, {packs})",
         "        for r in range(len(src)):",
         "            dst[r][i, :] = src[r]",
     ]
