@@ -159,7 +159,7 @@ def test_child_dies_with_the_parent(src, how):
     waiter = {
         "SIGKILL": "time.sleep(300)",
         "SIGTERM": "signal.signal(signal.SIGTERM, lambda s, f: sys.exit(143)); time.sleep(300)",
-        "stop_now": "time.sleep(1.0); stop_now(15)",
+        "stop_now": "time.sleep(4.0); stop_now(15)",  # after the check that the child runs
     }[how]
     code = (
         "import signal, sys, time, flexrv, tinykernel\n"

@@ -431,7 +431,8 @@ def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
         for c in range(m):
             jl[r, c] = 0.0
             jvl[r, c] = 0.0
-    pin_kernel(ql, vh, fl, jl, jvl, True, pins_loc)
+    jac = m >= 0  # True, typed bool: the literal True would compile pin_kernel a second time
+    pin_kernel(ql, vh, fl, jl, jvl, jac, pins_loc)
     r1 = 0.0
     scale = 0.0
     for r in range(m):
