@@ -7,7 +7,15 @@ from pathlib import Path
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
+from flexrv.cli._common import (
+    JSON_HELP,
+    OVERWRITE_HELP,
+    check_output_dir,
+    console,
+    emit,
+    kv_table,
+    skip_final_collection,
+)
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
@@ -122,7 +130,6 @@ def simulate(
     import math
 
     from flexrv.cli._precompile import start_simulate
-    from flexrv.cli.te import skip_final_collection
     from flexrv.errors import InputError
     from flexrv.post.io import xarray_without_dask
     from flexrv.simulation import DEFAULT_DT, Simulation

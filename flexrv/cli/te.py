@@ -8,28 +8,21 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit, kv_table
+from flexrv.cli._common import (
+    JSON_HELP,
+    OVERWRITE_HELP,
+    check_output_dir,
+    console,
+    emit,
+    kv_table,
+    skip_final_collection,
+)
 from flexrv.cli.design import analytic_budget, budget_table
 from flexrv.post.definitions import DEFINITIONS, PLAY_FRACTIONS
 from flexrv.post.te import TE_ROWS
 from flexrv.units import RAD_PER_ARCMIN
 
 PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
-
-
-def skip_final_collection() -> None:
-    """At exit, skip the interpreter's last garbage collections over the objects of a run
-    (numba's kernels and their LLVM objects, xarray, matplotlib: ~0.6 s CPU of a warm
-    ``simulate`` or ``te`` process): :func:`gc.freeze` moves every tracked object into the
-    permanent generation, which collections ignore. Objects are still released by reference
-    counting and the atexit handlers run; only reference cycles are left to the end of the
-    process. Registered once per process."""
-    import atexit
-    import gc
-
-    if not getattr(skip_final_collection, "registered", False):
-        atexit.register(gc.freeze)
-        skip_final_collection.registered = True
 
 
 def te(

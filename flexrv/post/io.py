@@ -7,8 +7,10 @@ while a run is going, ``checkpoint.npz`` (the recorded states, for
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -80,25 +82,34 @@ def save(res, directory, figures=None) -> Path:
     return d
 
 
+@contextlib.contextmanager
+def _modules_hidden(names):
+    """Inside the block, each module of ``names`` not imported yet cannot be imported
+    (``sys.modules[name] = None`` makes its import fail, which xarray reads as "not
+    installed"); afterwards the names are importable again."""
+    hidden = [name for name in names if name not in sys.modules]
+    for name in hidden:
+        sys.modules[name] = None
+    try:
+        yield
+    finally:
+        for name in hidden:
+            if sys.modules.get(name, 0) is None:
+                del sys.modules[name]
+
+
 def xarray_without_dask() -> None:
     """Let xarray know, once per process, that this process uses no dask arrays: xarray asks
     on its first variable whether its data is a dask array, importing ``dask.array`` (~0.4 s
     CPU) to find out, and keeps the answer. For a command that never makes dask arrays (``te``,
-    ``simulate``) dask is hidden from that first question (``sys.modules["dask"] = None`` makes
-    its import fail, which xarray reads as "dask not installed"). Nothing happens where dask is
-    imported already (a study that uses it, a test session)."""
-    import sys
-
+    ``simulate``) dask is hidden from that first question (:func:`_modules_hidden`). Nothing
+    happens where dask is imported already (a study that uses it, a test session)."""
     if "dask" in sys.modules:
         return
     import xarray as xr
 
-    sys.modules["dask"] = None
-    try:
+    with _modules_hidden(("dask",)):
         xr.Variable(("x",), np.zeros(1))
-    finally:
-        if sys.modules.get("dask", 0) is None:
-            del sys.modules["dask"]
 
 
 def write_netcdf(ds, path) -> Path:
@@ -108,20 +119,10 @@ def write_netcdf(ds, path) -> Path:
     ``dask.base`` and ``distributed`` (~0.5 s CPU together). A process that has imported
     neither holds no dask collection and no distributed client, so the answer is xarray's
     default (the threaded lock) either way: a module not imported yet is hidden from that probe
-    (``sys.modules[name] = None`` makes its import fail, which xarray reads as "no dask")."""
-    import sys
-
+    (:func:`_modules_hidden`)."""
     path = Path(path)
-    hidden = [name for name in ("dask", "dask.base", "distributed") if name not in sys.modules]
-    for name in hidden:
-        sys.modules[name] = None
-    try:
-        with atomic_path(path) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
-    finally:
-        for name in hidden:
-            if sys.modules.get(name, 0) is None:
-                del sys.modules[name]
+    with _modules_hidden(("dask", "dask.base", "distributed")), atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
     return path
 
 
