@@ -267,7 +267,7 @@ class Simulation:
         model = self.model if self.model is not None else self.build()
         plan.check_size(model.n)
         kind = choose_integrator(model, integrator)
-        _announce_compile(model)
+        _announce_compile(model, kind)
         if kind == "compiled":
             segments = _CompiledSegments(model, spectral_radius, newton_tolerance, newton_options, plan)
         else:
@@ -525,11 +525,12 @@ def choose_integrator(model, integrator: str | None) -> str:
     return integrator
 
 
-def _announce_compile(model) -> None:
-    """One line on stderr if the model's numba kernels compile now (first run)."""
+def _announce_compile(model, integrator: str) -> None:
+    """One line on stderr if the model's numba kernels compile now (first run) on ``integrator``."""
     from flexrv.model.kernel_cache import announce_compile
 
-    kinds = (["fused"] if model.fused is not None else []) + (
+    fused = ["integrate" if integrator == "compiled" else "fused"]
+    kinds = (fused if model.fused is not None else []) + (
         ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
     )
     announce_compile(kinds=kinds)

@@ -31,7 +31,7 @@ def integrate_linear(mass, stiffness, damping, q0, v0, h, n_steps, rho=0.5, tol=
         gen_alpha.begin_step(st, h)
         status = gen_alpha.EVALUATE
         while status == gen_alpha.EVALUATE:
-            status = gen_alpha.after_eval(st, jq @ st.q + jv @ st.v, jq, jv)
+            status = gen_alpha.after_eval(st, jq @ st.q + jv @ st.v, jq, jv, st.blocks)
         assert status == gen_alpha.CONVERGED
         assert gen_alpha.finish_step(st)
         qs.append(st.q.copy())
@@ -79,7 +79,7 @@ def amplification(omega_h: float, rho: float) -> np.ndarray:
         status = gen_alpha.EVALUATE
         z = np.zeros((1, 1))
         while status == gen_alpha.EVALUATE:
-            status = gen_alpha.after_eval(st, np.zeros(1), z, z)
+            status = gen_alpha.after_eval(st, np.zeros(1), z, z, None)
         assert status == gen_alpha.CONVERGED
         gen_alpha.finish_step(st)
         cols.append([st.q[0], st.v[0], st.a[0], st.aa[0]])
@@ -207,7 +207,7 @@ def _duffing(st, h, n_steps, k, c):
         while status == gen_alpha.EVALUATE:
             f = -k * st.q - c * st.q**3
             jq = np.diag(-k - 3.0 * c * st.q**2)
-            status = gen_alpha.after_eval(st, f, jq, np.zeros_like(jq))
+            status = gen_alpha.after_eval(st, f, jq, np.zeros_like(jq), st.blocks)
         assert status == gen_alpha.CONVERGED
         assert gen_alpha.finish_step(st)
         qs.append(st.q.copy())
@@ -230,7 +230,7 @@ def test_jacobian_kept_across_steps():
         gen_alpha.begin_step(st, h)
         status = gen_alpha.EVALUATE
         while status == gen_alpha.EVALUATE:
-            status = gen_alpha.after_eval(st, jq @ st.q, jq, np.zeros((2, 2)))
+            status = gen_alpha.after_eval(st, jq @ st.q, jq, np.zeros((2, 2)), None)
         assert status == gen_alpha.CONVERGED and gen_alpha.finish_step(st)
         np.testing.assert_array_equal(st.q, each[0][i + 1])
     assert st.ip[gen_alpha.I_JACOBIANS] == 1

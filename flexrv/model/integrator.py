@@ -4,9 +4,11 @@ compiled kernels (the rigid model; :func:`compiled_eligible`).
 :class:`CompiledIntegrator` drives the generated ``fused_integrate`` of the model's
 fused element (:mod:`flexrv.model.core.registry`, the algorithm in
 :mod:`flexrv.model.numerics.gen_alpha`): the steps of a segment run in compiled code,
-the fused kernel called at one site; the drive and the loads (Python callables of
-time) enter as tables of the elements' time inputs at the step ends, evaluated
-vectorised once per call (:meth:`~flexrv.model.base.KernelGroup.time_inputs_many`).
+the elements' kernels called at one site (which also serves the element's evaluations
+from Python during the run: :meth:`flexrv.model.kernels.FusedForces.drive_with`); the
+drive and the loads (Python callables of time) enter as tables of the elements' time
+inputs at the step ends, evaluated vectorised once per call
+(:meth:`~flexrv.model.base.KernelGroup.time_inputs_many`).
 The compiled loop returns to Python every ``check_every`` steps, where the groups'
 per-step checks run on the last accepted state (a skipped pin, a penetration beyond
 the physical limit) as in the Exudyn path's pre-step hook.
@@ -25,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexrv.errors import InputError
+from flexrv.model.core.registry import INTEGRATE
 from flexrv.model.numerics import gen_alpha
 
 #: Exudyn Newton settings the compiled integrator honours (name -> keyword of gen_alpha.new_state)
@@ -111,6 +114,9 @@ class CompiledIntegrator:
         self.state = gen_alpha.new_state(
             mass, stiff, damp, spectral_radius=spectral_radius, tolerance=tuple(tolerance), **(newton or {})
         )
+        #: the state's dense blocks, or None without (the block elimination is then not compiled in)
+        self.blocks = self.state.blocks if self.state.blocks.shape[0] else None
+        fused.drive_with(self.state, self.blocks)  # the element's evaluations from Python: the same entry point
         self.massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
         self.timed = [(i, g) for i, (g, _) in enumerate(fused.slots) if g.time_field]
         ctrs = [c for _, c in fused.counters]
@@ -213,11 +219,7 @@ class CompiledIntegrator:
 
     def tables(self, times: np.ndarray) -> list:
         """The time inputs of the timed elements at ``times`` (one row per time)."""
-        out = []
-        for i, g in self.timed:
-            size = getattr(self.fused.packs[i], g.time_field).size
-            out.append(np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(times), (len(times), size))))
-        return out
+        return self.fused.time_tables(times)
 
     def _restore(self) -> None:
         """The state at the start of a failed step, for its retry at a smaller step. As
@@ -231,7 +233,9 @@ class CompiledIntegrator:
         fused = self.fused
         ts, qs, vs, src, dst, valid, rec_t = out
         args = (
+            INTEGRATE,
             self.state,
+            self.blocks,
             times,
             float(t_prev),
             *tables,

@@ -52,12 +52,16 @@ KERNEL_MODULES = (
 #: prefix of the fused kernels generated from the element registry (:mod:`flexrv.model.core.registry`);
 #: their dispatchers are listed as ``fused.<name>``
 GENERATED_PREFIX = "flexrv.model.core._generated."
-#: the compiled functions every run calls directly, per kind of force element (they compile their callees
-#: into themselves): the fused element of the kernel groups and the ball-bearing rows. A helper a run
-#: may never call (row_kernel, which the tests and the quasi-static path use; copy_records_if_same, which
-#: only Exudyn's path calls, a second to compile) stays uncached and must not trigger the notice
+#: the compiled functions a run calls directly, per kind of run or force element (they compile their
+#: callees into themselves): the fused element of the kernel groups on Exudyn's integrator or in a static
+#: solver (``fused``), the compiled integrator, which also evaluates that element for the run's Python
+#: calls (``integrate``: :meth:`flexrv.model.kernels.FusedForces.drive_with`), and the ball-bearing rows.
+#: A helper a run may never call (row_kernel, which the tests and the quasi-static path use;
+#: copy_records_if_same, which only Exudyn's path calls, a second to compile) stays uncached and must not
+#: trigger the notice
 RUN_ENTRY_POINTS = {
     "fused": ("fused.fused_kernel", "fused.fused_history"),
+    "integrate": ("fused.fused_integrate",),
     "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history"),
 }
 #: first-compile time [s] of the rigid model's kernels on 2 cores (benchmarks/bench_first_run.py), for the notice

@@ -20,7 +20,8 @@ in a run, where the closest points and the supports' inner solves move). Measure
 in benchmarks/bench_rigid.py.
 
 Outputs: :meth:`FusedForces.history` evaluates the same kernels over a recorded
-time history in ONE compiled loop (the generated ``fused_history``), copying each group's
+time history in ONE compiled loop (the generated ``fused_history``, or on a run of the
+compiled integrator that integrator's ``fused_integrate``: :meth:`FusedForces.drive_with`), copying each group's
 per-contact arrays (:meth:`~flexrv.model.base.KernelGroup.record_sources`) per
 sample: bit for bit the groups' own per-sample evaluate, without its ~50 us of
 Python per sample. What remains (~22-28 us per sample) is the kernels' own work,
@@ -47,7 +48,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.model.base import exudyn_vector
-from flexrv.model.core.registry import ELEMENTS, fused_functions, register, spec_of
+from flexrv.model.core.registry import ELEMENTS, ROWS, ROWS_JAC, fused_functions, register, spec_of
 from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
 from flexrv.model.gear_stage import GearMeshes
 from flexrv.model.loads import OutputLoads
@@ -197,6 +198,20 @@ class FusedForces:
         #: the solver updates its Jacobian at the start of every step (set by the simulation from its
         #: Newton settings): the first residual call of a step fills the Jacobians too (:meth:`residual`)
         self.jacobian_each_step = False
+        #: (integrator state, its blocks or None) of the compiled integrator that drives this element
+        #: (:meth:`drive_with`), or None
+        self._driver = None
+        #: the record buffers of a single evaluation through the driver (:meth:`_call_rows`)
+        self._eval_records = None
+
+    def drive_with(self, state, blocks) -> None:
+        """A compiled integrator with the generalized-alpha state ``state`` (``blocks``: as it
+        passes them to ``fused_integrate``) drives this element: the evaluations from Python
+        (:meth:`full`, :meth:`history`: the run's initial accelerations, the outputs' history
+        pass) then go through that same compiled function (its ``ROWS`` mode, the same
+        argument types), so that the run compiles one entry point instead of three (each
+        entry point generates the machine code of every element's kernel again)."""
+        self._driver = (state, blocks)
 
     def _packs(self, history: bool) -> list:
         """The kernel arguments of every slot (the solver's, or fresh ones for a time history)."""
@@ -211,11 +226,7 @@ class FusedForces:
         t = np.ascontiguousarray(t, dtype=float)
         nt = len(t)
         packs = self._packs(history=True)
-        tables = []  # the time inputs at every sample, per element with time inputs
-        for (g, _), p in zip(self.slots, packs):
-            if g.time_field:
-                size = getattr(p, g.time_field).size
-                tables.append(np.ascontiguousarray(np.broadcast_to(g.time_inputs_many(t), (nt, size)), dtype=float))
+        tables = self.time_tables(t)  # the time inputs at every sample, per element with time inputs
         srcs, dsts, keys = [], [], []
         for g, key, a in self.record_entries():
             srcs.append(a.reshape(-1))
@@ -225,17 +236,12 @@ class FusedForces:
         counters = [(g, g.failure_counter(p)) for (g, _), p in zip(self.slots, packs)]
         before = [None if c is None else int(c[0]) for _, c in counters]
         if nt and srcs:
-            self.history_kernel(
-                np.ascontiguousarray(q, dtype=float),
-                np.ascontiguousarray(v, dtype=float),
-                *tables,
-                f,
-                self.jq,
-                self.jv,
-                *packs,
-                tuple(srcs),
-                tuple(dsts),
-            )
+            q, v = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float)
+            if self._driver is not None:
+                ctrs = tuple(c for _, c in counters if c is not None)
+                self._rows(ROWS, t, q, v, tables, f, packs, ctrs, tuple(srcs), tuple(dsts))
+            else:
+                self.history_kernel(q, v, *tables, f, self.jq, self.jv, *packs, tuple(srcs), tuple(dsts))
         for g, _ in self.timed:
             g._time_last = None  # the history pass overwrote the live time inputs
         for (g, c), b in zip(counters, before):
@@ -247,6 +253,69 @@ class FusedForces:
         for (g, key, shape), d in zip(keys, dsts):
             out[g][key] = d.reshape((nt,) + shape)
         return out
+
+    def time_tables(self, times: np.ndarray) -> list:
+        """The time inputs of the elements with time inputs at ``times`` (T,): per element a
+        (T, size) table, row i at times[i]; writable, C-contiguous float64 (one argument type of
+        the compiled functions: a read-only view would be another type, compiled again)."""
+        out = []
+        for g, array in self.timed:
+            rows = np.broadcast_to(g.time_inputs_many(times), (len(times), array.size))
+            out.append(np.require(rows, dtype=np.float64, requirements=("C", "W")))
+        return out
+
+    def _rows(self, mode, t, qs, vs, tables, f, packs, ctrs, src, dst) -> None:
+        """The generated ``fused_integrate`` in ``mode`` ROWS / ROWS_JAC over the states ``qs``,
+        ``vs`` (T, n) at times ``t`` with the time-input ``tables`` (the argument types of the
+        driving integrator's calls: :meth:`drive_with`)."""
+        state, blocks = self._driver
+        nt = len(qs)
+        self.integrate_kernel(
+            mode,
+            state,
+            blocks,
+            t,
+            0.0,
+            *tables,
+            f,
+            self.jq,
+            self.jv,
+            *packs,
+            ctrs or (np.zeros(1, np.int64),),
+            src,
+            dst,
+            np.zeros(3, np.int64),
+            np.zeros(2),
+            np.zeros(nt),
+            qs,
+            vs,
+            np.zeros(nt, dtype=bool),
+        )
+
+    def _call_rows(self, t, q, v, jac) -> None:
+        """One evaluation at (t, q, v) through the driving integrator's compiled function
+        (:meth:`drive_with`), on the live packs; f, jq, jv and the live records as :meth:`_call`."""
+        for g, array in self.timed:
+            g.set_time(t, array)
+        tables = [array.reshape(1, -1) for _, array in self.timed]  # (row 0: the live time inputs themselves)
+        if self._eval_records is None:
+            srcs = tuple(a.reshape(-1) for _, _, a in self.record_entries()) or (np.zeros(0),)
+            self._eval_records = (srcs, tuple(np.empty((1, a.size)) for a in srcs))
+        before = [c[0] for _, c in self.counters]
+        self._rows(
+            ROWS_JAC if jac else ROWS,
+            np.array([float(t)]),
+            np.ascontiguousarray(q, dtype=float).reshape(1, -1),
+            np.ascontiguousarray(v, dtype=float).reshape(1, -1),
+            tables,
+            self.f,
+            self.packs,
+            tuple(c for _, c in self.counters),
+            *self._eval_records,
+        )
+        for (g, c), b in zip(self.counters, before):
+            if c[0] != b:
+                self._failed(g)
 
     def _call(self, t, q, v, jac):
         for g, array in self.timed:  # (the groups cache their time inputs per time)
@@ -331,11 +400,12 @@ class FusedForces:
         """Force and Jacobians on the MODEL's full vector (copies), for static solvers."""
         n_model = len(q)
         self.memo, self._jac_ready = None, False  # the caller may change its arrays afterwards
+        call = self._call if self._driver is None else self._call_rows
         if self.is_full:
-            self._call(float(t), q, v, bool(jacobian))
+            call(float(t), q, v, bool(jacobian))
             return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
         ix = self.index
-        self._call(float(t), np.ascontiguousarray(q[ix]), np.ascontiguousarray(v[ix]), bool(jacobian))
+        call(float(t), np.ascontiguousarray(q[ix]), np.ascontiguousarray(v[ix]), bool(jacobian))
         f = np.zeros(n_model)
         f[ix] = self.f
         dq = dv = None

@@ -11,9 +11,16 @@ elements' forces are summed).
 
 The fused kernel of a model's elements (:func:`fused_functions`) is generated source:
 a module with ``fused_kernel(q, v, f, jq, jv, jac, p0, p1, ...)`` calling each present
-element's kernel once by name, ``fused_history`` looping it over a time history and
-``fused_integrate``, the compiled generalized-alpha integrator around it
-(:mod:`flexrv.model.numerics.gen_alpha`, one call site of ``fused_kernel``),
+element's kernel once by name (static solvers, Exudyn's integrator), ``fused_history``
+looping it over a time history (the outputs of a run on Exudyn's integrator) and
+``fused_integrate``, the compiled generalized-alpha integrator
+(:mod:`flexrv.model.numerics.gen_alpha`) with the elements' kernels called at one site,
+which also evaluates the elements at given states for a run on it (the outputs' history
+pass, the initial accelerations: :meth:`flexrv.model.kernels.FusedForces.drive_with`), so
+that each kind of run compiles its own entry points only: numba generates the machine
+code of every kernel an entry point calls again for that entry point (each compiled
+function is linked with copies of its callees), so each entry point costs the whole
+kernels' code generation once more (rv221's rigid model: ~4-5 s CPU each). The module is
 written to ``flexrv/model/core/_generated/`` and imported, so numba compiles and caches
 it like any other function (``cache=True``: the cache index sits beside the file).
 
@@ -111,6 +118,18 @@ def _hash_files(specs) -> str:
     return h.hexdigest()[:16]
 
 
+#: modes of the generated ``fused_integrate``: integrate time steps, or evaluate the elements at given
+#: states (rows of ``qs``, ``vs``) without or with their Jacobians (:func:`_integrate_source`)
+INTEGRATE, ROWS, ROWS_JAC = 0, 1, 2
+
+
+def _copy_lines(indent: int, dst: str, src: str, n: str) -> list[str]:
+    """Lines copying ``src[c]`` into ``dst[c]`` for c < ``n``: a loop, not a slice assignment, whose
+    shape check compiles numba's string formatting of its error message into every caller."""
+    pad = " " * indent
+    return [f"{pad}for c in range({n}):", f"{pad}    {dst} = {src}"]
+
+
 def _fused_source(specs, callee_hash: str) -> str:
     """Text of the generated module for the elements ``specs`` (in call order)."""
     n = len(specs)
@@ -122,21 +141,13 @@ def _fused_source(specs, callee_hash: str) -> str:
         "",
         "from numba import njit",
         "",
-        "from flexrv.model.numerics.gen_alpha import EVALUATE, FAILED, I_JAC, after_eval, begin_step, finish_step",
+        "from flexrv.model.numerics.gen_alpha import CONVERGED, EVALUATE, FAILED, I_JAC, after_eval, begin_step, "
+        "finish_step",
     ]
     for i, s in enumerate(specs):
         lines.append(f"from {s.kernel.py_func.__module__} import {s.kernel.py_func.__name__} as k{i}")
-    lines += [
-        "",
-        "",
-        "@njit(cache=True)",
-        f"def fused_kernel(q, v, f, jq, jv, jac, {packs}):",
-        "    f[:] = 0.0",
-        "    if jac:",
-        "        jq[:, :] = 0.0",
-        "        jv[:, :] = 0.0",
-    ]
-    lines += [f"    k{i}(q, v, f, jq, jv, jac, p{i})" for i in range(n)]
+    lines += ["", "", "@njit(cache=True)", f"def fused_kernel(q, v, f, jq, jv, jac, {packs}):"]
+    lines += _evaluate_lines(4, n, "q", "v", "jac")
     tin = "".join(f"tin{i}, " for i, _ in timed)
     lines += [
         "",
@@ -146,68 +157,100 @@ def _fused_source(specs, callee_hash: str) -> str:
         "    no_jac = qs.shape[0] < 0  # False, typed bool: the literal False would compile fused_kernel again",
         "    for i in range(qs.shape[0]):",
     ]
-    lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
+    for i, field in timed:
+        lines += _copy_lines(8, f"p{i}.{field}[c]", f"tin{i}[i, c]", f"tin{i}.shape[1]")
     lines += [
         f"        fused_kernel(qs[i], vs[i], f, jq, jv, no_jac, {packs})",
         "        for r in range(len(src)):",
-        "            dst[r][i, :] = src[r]",
+        "            s, d = src[r], dst[r]",
     ]
+    lines += _copy_lines(12, "d[i, c]", "s[c]", "s.shape[0]")
     lines += _integrate_source(n, timed, packs, tin)
     return "\n".join(lines)
 
 
+def _evaluate_lines(indent: int, n: int, q: str, v: str, jac: str) -> list[str]:
+    """Lines of one evaluation of the elements at (``q``, ``v``): f (and, if ``jac``, the
+    Jacobians) zeroed, then every element's kernel once, in registration order."""
+    pad = " " * indent
+    lines = [f"{pad}f[:] = 0.0", f"{pad}if {jac}:", f"{pad}    jq[:, :] = 0.0", f"{pad}    jv[:, :] = 0.0"]
+    return lines + [f"{pad}k{i}({q}, {v}, f, jq, jv, {jac}, p{i})" for i in range(n)]
+
+
 def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
-    """Lines of the generated ``fused_integrate``: the compiled generalized-alpha
-    (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the steps ending
-    at ``times``, with ONE call site of ``fused_kernel``; returns (steps done, status:
-    0 done, 1 Newton failed, 2 an element's inner solve failed, 3 non-finite state).
-    Step i writes the elements' time inputs of row i of their tables; an accepted step
-    is recorded (state into ``ts``, ``qs``, ``vs`` row ``rec[0]``, the elements' records
-    into ``dst``) if its end time is at least ``rec_t[1]`` after the last record
-    ``rec_t[0]`` (or no row is recorded yet), while rows remain (``rec[1]``), except the
-    last step of the call when ``rec[2]`` (a segment's end, recorded as the next one's start)."""
+    """Lines of the generated ``fused_integrate``: with ``mode`` :data:`INTEGRATE`, the compiled
+    generalized-alpha (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the
+    steps ending at ``times``; returns (steps done, status: 0 done, 1 Newton failed, 2 an
+    element's inner solve failed, 3 non-finite state). Step i writes the elements' time inputs
+    of row i of their tables; an accepted step is recorded (state into ``ts``, ``qs``, ``vs``
+    row ``rec[0]``, the elements' records into ``dst``) if its end time is at least ``rec_t[1]``
+    after the last record ``rec_t[0]`` (or no row is recorded yet), while rows remain
+    (``rec[1]``), except the last step of the call when ``rec[2]`` (a segment's end, recorded
+    as the next one's start). ``blocks``: the state's dense diagonal blocks (``st.blocks``),
+    or None for a state without (the block elimination is then not compiled in).
+
+    With ``mode`` :data:`ROWS` (:data:`ROWS_JAC`: with the Jacobians), the elements evaluated
+    at every row i of ``qs``, ``vs`` with the time inputs of row i, their records copied into
+    row i of ``dst`` (the outputs' history pass and single evaluations of a run on this
+    integrator: :meth:`flexrv.model.kernels.FusedForces.history`), ``st`` left alone; returns
+    (rows done, status 0 or 2). ONE call site of every element's kernel serves both modes, so
+    that a run compiles one entry point (each entry point generates the machine code of all
+    the kernels it calls again)."""
     lines = [
         "",
         "",
         "@njit(cache=True)",
-        f"def fused_integrate(st, times, t_prev, {tin}f, jq, jv, {packs}, ctrs, src, dst, rec, rec_t, "
-        "ts, qs, vs, valid):",
-        "    n = times.shape[0]",
+        f"def fused_integrate(mode, st, blocks, times, t_prev, {tin}f, jq, jv, {packs}, ctrs, src, dst, rec, "
+        "rec_t, ts, qs, vs, valid):",
+        f"    rows = mode != {INTEGRATE}",
+        "    n = qs.shape[0] if rows else times.shape[0]",
         "    for i in range(n):",
-        "        h = times[i] - (t_prev if i == 0 else times[i - 1])",
     ]
-    lines += [f"        p{i}.{field}[:] = tin{i}[i]" for i, field in timed]
+    for i, field in timed:
+        lines += _copy_lines(8, f"p{i}.{field}[c]", f"tin{i}[i, c]", f"tin{i}.shape[1]")
     lines += [
-        "        begin_step(st, h)",
+        "        if not rows:",
+        "            begin_step(st, times[i] - (t_prev if i == 0 else times[i - 1]))",
         "        status = EVALUATE",
         "        while status == EVALUATE:",
+        "            q = qs[i] if rows else st.q",
+        "            v = vs[i] if rows else st.v",
+        f"            jac = mode == {ROWS_JAC} if rows else st.ip[I_JAC] != 0",
         "            before = 0",
         "            for c in ctrs:",
         "                before += c[0]",
-        f"            fused_kernel(st.q, st.v, f, jq, jv, st.ip[I_JAC] != 0, {packs})",
+    ]
+    lines += _evaluate_lines(12, n, "q", "v", "jac")
+    lines += [
         "            after = 0",
         "            for c in ctrs:",
         "                after += c[0]",
         "            if after != before:",
         "                return i, 2",
-        "            status = after_eval(st, f, jq, jv)",
-        "        if status == FAILED:",
-        "            return i, 1",
-        "        if not finish_step(st):",
-        "            return i, 3",
-        "        k = rec[0]",
-        "        if (i < n - 1 or rec[2] == 0) and k < rec[1] and (k == 0 or times[i] >= rec_t[0] + rec_t[1]):",
+        "            status = CONVERGED if rows else after_eval(st, f, jq, jv, blocks)",
+        "        if rows:",
+        "            k = i",
+        "        else:",
+        "            if status == FAILED:",
+        "                return i, 1",
+        "            if not finish_step(st):",
+        "                return i, 3",
+        "            k = rec[0]",
+        "            due = k == 0 or times[i] >= rec_t[0] + rec_t[1]",
+        "            if not ((i < n - 1 or rec[2] == 0) and k < rec[1] and due):",
+        "                continue",
         "            ts[k] = times[i]",
-        "            qs[k, :] = st.q",
-        "            vs[k, :] = st.v",
-        "            for r in range(len(src)):",
-        "                dst[r][k, :] = src[r]",
+        "            for c in range(st.q.shape[0]):",
+        "                qs[k, c] = st.q[c]",
+        "                vs[k, c] = st.v[c]",
         "            valid[k] = True",
         "            rec[0] = k + 1",
         "            rec_t[0] = times[i]",
-        "    return n, 0",
-        "",
+        "        for r in range(len(src)):",
+        "            s, d = src[r], dst[r]",
     ]
+    lines += _copy_lines(12, "d[k, c]", "s[c]", "s.shape[0]")
+    lines += ["    return n, 0", ""]
     return lines
 
 

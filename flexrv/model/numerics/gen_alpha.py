@@ -209,10 +209,11 @@ def begin_step(st, h):
     predict, and ask for an evaluation with the Jacobian (the Jacobian of every step), or
     without it when the iteration matrix of an earlier step of this size is kept
     (``jacobian_each_step`` False)."""
-    st.q0[:] = st.q
-    st.v0[:] = st.v
-    st.a0[:] = st.a
-    st.aa0[:] = st.aa
+    for i in range(st.q.shape[0]):  # (loops: a slice copy compiles its error message's formatting)
+        st.q0[i] = st.q[i]
+        st.v0[i] = st.v[i]
+        st.a0[i] = st.a[i]
+        st.aa0[i] = st.aa[i]
     st.par[P_H] = h
     ip = st.ip
     ip[I_IT] = 0
@@ -241,8 +242,9 @@ def _residual(st, f):
 
 
 @njit(cache=True)
-def _factor(st, jq, jv):
-    """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; False if singular."""
+def _factor(st, jq, jv, blocks):
+    """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; False if singular.
+    ``blocks``: ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
     par = st.par
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
@@ -254,8 +256,8 @@ def _factor(st, jq, jv):
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
     st.par[P_HJAC] = h
-    if st.blocks.shape[0] > 0:
-        ok = block_factor(s, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv)
+    if blocks is not None and blocks.shape[0] > 0:
+        ok = block_factor(s, blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv)
     else:
         ok = lu_factor(s, s, st.piv)  # in place
     st.ip[I_FACTORED] = int(ok)
@@ -263,14 +265,14 @@ def _factor(st, jq, jv):
 
 
 @njit(cache=True)
-def _correct(st):
+def _correct(st, blocks):
     """One Newton correction with the factorised S; the next evaluation without Jacobian."""
     par = st.par
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
-    if st.blocks.shape[0] > 0:
-        block_solve(st.lu, st.blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
+    if blocks is not None and blocks.shape[0] > 0:
+        block_solve(st.lu, blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.r, st.dx, st.tx, st.zx)
     else:
         lu_solve(st.lu, st.piv, st.r, st.dx)
     for i in range(st.q.shape[0]):
@@ -293,10 +295,11 @@ def _restart(st):
     st.par[P_LAST] = st.par[P_R0]
     ip[I_RESTARTED] = 1
     ip[I_EXTRA] = 1
-    st.q[:] = st.q0
-    st.v[:] = st.v0
-    st.a[:] = st.a0
-    st.aa[:] = st.aa0
+    for i in range(st.q.shape[0]):
+        st.q[i] = st.q0[i]
+        st.v[i] = st.v0[i]
+        st.a[i] = st.a0[i]
+        st.aa[i] = st.aa0[i]
     _predict(st)
     ip[I_PHASE] = PH_JACOBIAN
     ip[I_JAC] = 1
@@ -315,7 +318,7 @@ def _diverged(st):
 
 
 @njit(cache=True)
-def _iterate(st, res):
+def _iterate(st, res, blocks):
     """Convergence test and Newton control after an evaluation at a corrected state."""
     par, ip = st.par, st.ip
     it = ip[I_IT]
@@ -355,14 +358,16 @@ def _iterate(st, res):
         ip[I_PHASE] = PH_JACOBIAN
         ip[I_JAC] = 1
         return EVALUATE
-    return _correct(st)
+    return _correct(st, blocks)
 
 
 @njit(cache=True)
-def after_eval(st, f, jq, jv):
+def after_eval(st, f, jq, jv, blocks):
     """Take the evaluation f (and df/dq, df/dv if ``ip[I_JAC]``) at the current state;
     return :data:`EVALUATE` (evaluate again at the new current state, with the Jacobian if
-    ``ip[I_JAC]``), :data:`CONVERGED` or :data:`FAILED`."""
+    ``ip[I_JAC]``), :data:`CONVERGED` or :data:`FAILED`. ``blocks``: ``st.blocks``, or None
+    for a state without dense blocks: the block elimination is then pruned at compile time
+    (not compiled in; the rigid models' integrator)."""
     ip = st.ip
     ip[I_CALLS] += 1
     ip[I_JACCALLS] += ip[I_JAC]
@@ -378,12 +383,12 @@ def after_eval(st, f, jq, jv):
         st.par[P_RES] = r0
         st.par[P_LAST] = r0
     elif phase == PH_ITERATE:
-        return _iterate(st, res)
+        return _iterate(st, res, blocks)
     if not math.isfinite(res):
         return FAILED
-    if ip[I_JAC] and not _factor(st, jq, jv):  # (no Jacobian: the kept factorisation)
+    if ip[I_JAC] and not _factor(st, jq, jv, blocks):  # (no Jacobian: the kept factorisation)
         return FAILED
-    return _correct(st)
+    return _correct(st, blocks)
 
 
 @njit(cache=True)

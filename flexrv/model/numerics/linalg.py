@@ -129,7 +129,9 @@ def lu_factor(a, lu, piv):
     """LU factorisation with partial pivoting of a (n x n) into lu, piv (``lu`` may be ``a``:
     in place); False if singular."""
     n = a.shape[0]
-    lu[:, :] = a
+    for i in range(n):  # (loops: a slice copy compiles its error message's formatting)
+        for j in range(n):
+            lu[i, j] = a[i, j]
     for k in range(n):
         p, big = k, abs(lu[k, k])
         for i in range(k + 1, n):
@@ -155,7 +157,8 @@ def lu_factor(a, lu, piv):
 def lu_solve(lu, piv, b, x):
     """x = A^-1 b from :func:`lu_factor`'s lu, piv."""
     n = lu.shape[0]
-    x[:] = b
+    for i in range(n):
+        x[i] = b[i]
     for k in range(n):
         p = piv[k]
         if p != k:
