@@ -571,8 +571,75 @@ _DISCARDED: list[str] = []
 #: it: a waiter that returns True has waited for another process that compiles the kernel into the same
 #: cache (:mod:`flexrv.model.kernel_cache`), and the cache is read again
 COMPILE_WAITERS: list = []
+#: callables ``handler(signum)`` called for a SIGINT or SIGTERM that arrives while numba compiles or loads a
+#: kernel in the main thread (:func:`numba_signals`); the command line registers one that ends the process at
+#: once (:func:`flexrv.model.kernel_cache.stop_now`). A handler that returns leaves the signal to the handler
+#: installed before
+NUMBA_SIGNAL_HANDLERS: list = []
 #: name of the lock file in numba's cache folder (:func:`numba_index_lock`)
 NUMBA_LOCK_NAME = "index.lock"
+_SIGNAL_DEPTH = [0]
+
+
+@contextlib.contextmanager
+def numba_signals() -> Iterator[None]:
+    """While numba compiles or loads a kernel: SIGINT and SIGTERM go to the
+    :data:`NUMBA_SIGNAL_HANDLERS` first. Numba's code generation calls back into Python
+    from C (llvmlite's object-cache hooks, through ctypes), where an exception a signal
+    handler raises (KeyboardInterrupt) is printed and dropped: the signal would be lost
+    and the command would run on. Reentrant; only in the main thread (elsewhere, and
+    without handlers, nothing changes)."""
+    import signal
+    import threading
+
+    if _SIGNAL_DEPTH[0] or not NUMBA_SIGNAL_HANDLERS or threading.current_thread() is not threading.main_thread():
+        _SIGNAL_DEPTH[0] += 1
+        try:
+            yield
+        finally:
+            _SIGNAL_DEPTH[0] -= 1
+        return
+    old = {}
+
+    def on_signal(signum, frame):
+        for handler in list(NUMBA_SIGNAL_HANDLERS):
+            handler(signum)
+        previous = old.get(signum)
+        if callable(previous):
+            previous(signum, frame)
+
+    _SIGNAL_DEPTH[0] = 1
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            old[sig] = signal.signal(sig, on_signal)
+        yield
+    finally:
+        _SIGNAL_DEPTH[0] = 0
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+
+def _compile_signals_listener():
+    """A listener of numba's ``numba:compile`` events: :func:`numba_signals` around each
+    compilation (the compilations of its callees nested inside)."""
+    from numba.core import event
+
+    class CompileSignals(event.Listener):
+        def __init__(self):
+            self._scopes = []
+
+        def on_start(self, event) -> None:
+            scope = numba_signals()
+            scope.__enter__()
+            self._scopes.append(scope)
+
+        def on_end(self, event) -> None:
+            if self._scopes:
+                self._scopes.pop().__exit__(None, None, None)
+
+    return CompileSignals()
+
+
 _LOCK_DEPTH = [0]
 
 
@@ -616,17 +683,22 @@ def guard_numba_cache(caching=None) -> None:
     data (``.nbc``) cannot be read back (truncated, corrupted: any exception while
     numba loads or rebuilds it) is deleted and the kernel compiled again, with one
     warning per process. Numba itself only tolerates a missing file. Every read and
-    write holds :func:`numba_index_lock` (processes sharing the cache), and a kernel
-    not found asks the :data:`COMPILE_WAITERS` before numba compiles it."""
+    write holds :func:`numba_index_lock` (processes sharing the cache), a kernel
+    not found asks the :data:`COMPILE_WAITERS` before numba compiles it, and a signal
+    during a compilation, load or save goes to the :data:`NUMBA_SIGNAL_HANDLERS`
+    (:func:`numba_signals`)."""
     if caching is None:
         import numba.core.caching as caching
     cls = caching.Cache
     if getattr(cls.load_overload, "_flexrv_guard", False):
         return
     load, save = cls.load_overload, cls.save_overload
+    from numba.core import event
+
+    event.register("numba:compile", _compile_signals_listener())
 
     def guarded_load(self, sig, target_context):
-        with numba_index_lock():
+        with numba_index_lock(), numba_signals():
             try:
                 return load(self, sig, target_context)
             except Exception as exc:
@@ -640,7 +712,7 @@ def guard_numba_cache(caching=None) -> None:
         return value
 
     def save_overload(self, sig, data):
-        with numba_index_lock():
+        with numba_index_lock(), numba_signals():
             try:
                 return save(self, sig, data)
             except Exception as exc:  # e.g. an unreadable index: discard it, save again

@@ -229,8 +229,8 @@ def _model_compiles_script(args: list[str]) -> str:
 )
 def test_cold_command_loads_every_model_kernel_from_the_background_process(tmp_path, args):
     """Empty caches, ``flexrv simulate rv221 --model rigid`` (short) or ``flexrv te rv40e`` (short):
-    the background process compiles the kernels (simulate: the fused kernel, the compiled integrator,
-    the history pass; te: the fused kernel and its outputs pass) with the real model's argument types
+    the background process compiles the kernels (simulate: the compiled integrator, which also serves
+    the outputs' pass; te: the fused kernel and its outputs pass) with the real model's argument types
     (its bodies rigid), so the command itself compiles no model-layer kernel; the command completes
     (a few minutes each on a loaded 2-core machine)."""
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "FLEXRV_BACKGROUND_COMPILE")}
@@ -242,3 +242,32 @@ def test_cold_command_loads_every_model_kernel_from_the_background_process(tmp_p
     assert r.returncode == 0, r.stderr[-3000:]
     assert "model compiles in the command: 0 []" in r.stderr, r.stderr[-3000:]
     assert r.stderr.count("background compilation failed") == 0
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_signal_inside_numbas_native_callbacks_is_not_lost(monkeypatch):
+    """Numba's code generation calls Python back from C (llvmlite's object-cache hooks, ctypes),
+    where the KeyboardInterrupt a signal raises is printed and dropped: a Ctrl-C there was lost
+    and a compiling command ran on. Inside ``numba_signals`` (every numba compilation, load and
+    save) a SIGINT goes to ``NUMBA_SIGNAL_HANDLERS`` first (the command line's ends the process
+    with 130 at once: kernel_cache.stop_now); the handlers are restored afterwards."""
+    import ctypes
+
+    from flexrv import cache
+
+    got = []
+    monkeypatch.setattr(cache, "NUMBA_SIGNAL_HANDLERS", [got.append])
+
+    def callback():
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(10000):  # the Python handler runs between these bytecodes, inside the callback
+            pass
+
+    native = ctypes.CFUNCTYPE(None)(callback)
+    native()  # the KeyboardInterrupt raised inside the callback is dropped by ctypes
+    assert got == []
+    before = signal.getsignal(signal.SIGINT)
+    with cache.numba_signals():
+        native()
+    assert got == [signal.SIGINT]
+    assert signal.getsignal(signal.SIGINT) is before

@@ -234,6 +234,9 @@ def main(argv: list[str] | None = None) -> None:
         signal.signal(signal.SIGTERM, _raise_terminated)
     except ValueError:  # not the main thread (an embedding application): its own handling applies
         pass
+    from flexrv.model.kernel_cache import stop_on_signal_while_compiling
+
+    stop_on_signal_while_compiling()  # (a signal inside numba's compilation would otherwise be lost)
     first_run_notice(args)
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")

@@ -114,6 +114,17 @@ def stop_now(signum: int) -> None:
     os._exit(128 + int(signum))
 
 
+def stop_on_signal_while_compiling() -> None:
+    """Let a SIGINT or SIGTERM that arrives while numba compiles or loads a kernel end the
+    process at once with 130 / 143 (:func:`stop_now`; :func:`flexrv.cache.numba_signals`: numba
+    runs Python callbacks from C there, in which the KeyboardInterrupt a signal raises is
+    dropped). The command line's policy: a compiling command has nothing to keep."""
+    from flexrv.cache import NUMBA_SIGNAL_HANDLERS
+
+    if stop_now not in NUMBA_SIGNAL_HANDLERS:
+        NUMBA_SIGNAL_HANDLERS.append(stop_now)
+
+
 def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bool:
     """Print one short line, ``flexrv: compiling numba kernels (once, ~60 s or more; ...)``, on
     stderr if a kernel the run calls (:data:`RUN_ENTRY_POINTS` of ``kinds``, default all)

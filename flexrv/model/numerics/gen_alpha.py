@@ -189,7 +189,7 @@ def set_state(st: GaState, q, v, a, a_alg=None) -> None:
     st.aa[:] = a if a_alg is None else a_alg
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _predict(st):
     """The predictor from the start-of-step state (module docstring); a := 0."""
     par = st.par
@@ -203,7 +203,7 @@ def _predict(st):
         st.a[i] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def begin_step(st, h):
     """Start a step of size h from the current state: store it as the start of the step,
     predict, and ask for an evaluation with the Jacobian (the Jacobian of every step), or
@@ -227,7 +227,7 @@ def begin_step(st, h):
     _predict(st)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _residual(st, f):
     """r = M a + K q + D v - f; returns ||r||_2 (NaN if not finite)."""
     n = st.q.shape[0]
@@ -241,7 +241,7 @@ def _residual(st, f):
     return math.sqrt(s)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _factor(st, jq, jv, blocks):
     """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; False if singular.
     ``blocks``: ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
@@ -264,7 +264,7 @@ def _factor(st, jq, jv, blocks):
     return ok
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _correct(st, blocks):
     """One Newton correction with the factorised S; the next evaluation without Jacobian."""
     par = st.par
@@ -286,7 +286,7 @@ def _correct(st, blocks):
     return EVALUATE
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _restart(st):
     """Back to the predictor of this step, one extra iteration after convergence; the
     evaluation brings the Jacobian."""
@@ -306,7 +306,7 @@ def _restart(st):
     return EVALUATE
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _diverged(st):
     big = st.par[P_MAXNORM]
     sq = 0.0
@@ -317,7 +317,7 @@ def _diverged(st):
     return not (sq < big and sv < big)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _iterate(st, res, blocks):
     """Convergence test and Newton control after an evaluation at a corrected state."""
     par, ip = st.par, st.ip
@@ -361,7 +361,7 @@ def _iterate(st, res, blocks):
     return _correct(st, blocks)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def after_eval(st, f, jq, jv, blocks):
     """Take the evaluation f (and df/dq, df/dv if ``ip[I_JAC]``) at the current state;
     return :data:`EVALUATE` (evaluate again at the new current state, with the Jacobian if
@@ -391,7 +391,7 @@ def after_eval(st, f, jq, jv, blocks):
     return _correct(st, blocks)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def finish_step(st):
     """After convergence: a_alg_n+1 = a* + (1 - alpha_f) / (1 - alpha_m) a_n+1; True if
     the state is finite."""
