@@ -131,7 +131,9 @@ def main() -> None:
         if args[0] in ("simulate", "te") and "--out" not in args:
             args += ["--out", str(tmp / "out")]
         t0 = time.perf_counter()
-        proc = subprocess.run([sys.executable, "-c", CHILD, *args], env=env, capture_output=True, text=True)
+        proc = subprocess.run(  # (in the checkout: ``python -c`` puts the working folder first on sys.path)
+            [sys.executable, "-c", CHILD, *args], env=env, capture_output=True, text=True, cwd=a.checkout.resolve()
+        )
         wall = time.perf_counter() - t0
         if proc.returncode != 0:
             print(proc.stdout[-3000:], proc.stderr[-3000:])

@@ -64,8 +64,9 @@ def _cpu_of_descendants(root: int, seen: dict) -> None:
             seen[pid] = (("command", "background", "its helper")[k], stats[pid][1])
 
 
-def run(args: list[str], env: dict) -> dict:
-    """Run ``python -m flexrv ARGS``: wall, CPU of it and its descendants, first line, the lines
+def run(args: list[str], env: dict, cwd: Path = ROOT) -> dict:
+    """Run ``python -m flexrv ARGS`` in ``cwd`` (``-m`` puts the working folder first on sys.path:
+    the checkout whose flexrv runs): wall, CPU of it and its descendants, first line, the lines
     with their times."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     load = os.getloadavg()[0]
@@ -73,6 +74,7 @@ def run(args: list[str], env: dict) -> dict:
     proc = subprocess.Popen(
         [sys.executable, "-m", "flexrv", *args],
         env=env,
+        cwd=cwd,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -140,7 +142,7 @@ def main() -> None:
                 for k, checkout in enumerate(checkouts):  # one cache per command and checkout: cold starts empty
                     env = environment(checkout, Path(tmp) / f"cache-{name}-{k}")
                     out = os.path.join(tmp, f"{name}-{label}-{k}")
-                    r = run([*args, "--out", out], env)
+                    r = run([*args, "--out", out], env, checkout)
                     where = f" [{checkout}]" if len(checkouts) > 1 else ""
                     print(
                         f"{label} flexrv {' '.join(args)}{where}: wall {r['wall']:.1f} s, CPU {r['cpu']:.1f} s "

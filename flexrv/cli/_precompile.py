@@ -6,10 +6,10 @@ Each job calls the command's own code path (no copy of its argument building) on
 design with rigid bodies: the kernels' argument types are those of the real model (a
 rigid body is an empty array of the same dimension), so the compiled kernels are the
 ones the command then loads from numba's cache. ``simulate``: a run of two time steps
-(the fused kernel, the compiled integrator, the outputs' history pass); ``te``: the
-loaded TE over the first positions (the fused kernel and the kernels of its outputs
-pass). Models with flexible rings or crankshafts build FE bodies of their own; they are
-not compiled in the background.
+(the compiled integrator, which also evaluates the elements for the initial accelerations
+and the outputs' history pass: one entry point); ``te``: the loaded TE over the first
+positions (the fused kernel and the kernels of its outputs pass). Models with flexible
+rings or crankshafts build FE bodies of their own; they are not compiled in the background.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ BACKGROUND_MODELS = ("rigid", "balls")
 TE_JOB_POINTS = 2
 TE_JOB_CRANK_REVOLUTIONS = 0.05
 #: modules of the element kernels compiled by a second helper process beside the job (the largest:
-#: the pins with the disc bodies, ~20 % of the fused kernel's compilation), which the job waits for
+#: the pins with the disc bodies, ~11 s CPU of the ~40 s (simulate) / ~30 s (te) of the whole
+#: compilation, benchmarks/bench_compile.py), which the job waits for
 SPLIT_MODULES = ("flexrv.model.pins",)
 
 

@@ -64,8 +64,9 @@ RUN_ENTRY_POINTS = {
     "integrate": ("fused.fused_integrate",),
     "rows": ("bearing_kernel.row_element", "bearing_kernel.row_history"),
 }
-#: first-compile time [s] of the rigid model's kernels on 2 cores (benchmarks/bench_first_run.py), for the notice
-COMPILE_ESTIMATE_S = 60
+#: first-compile time [s] of the rigid model's kernels in one process (~40 s CPU for the compiled integrator of
+#: rv221, ~30 s for te's fused kernel: benchmarks/bench_compile.py), for the notice
+COMPILE_ESTIMATE_S = 45
 #: a whole first run [s] on 2 cores (kernels compiled in the background while the FE bodies of a preset
 #: are built; benchmarks/bench_first_run.py, docs/benchmarks.md), for the command line's notice
 FIRST_RUN_ESTIMATE_S = 60
@@ -126,7 +127,7 @@ def stop_on_signal_while_compiling() -> None:
 
 
 def announce_compile(stream=None, modules: dict | None = None, kinds=None) -> bool:
-    """Print one short line, ``flexrv: compiling numba kernels (once, ~60 s or more; ...)``, on
+    """Print one short line, ``flexrv: compiling numba kernels (once, ~45 s or more; ...)``, on
     stderr if a kernel the run calls (:data:`RUN_ENTRY_POINTS` of ``kinds``, default all)
     is not cached yet; returns whether it printed."""
     if any(job.running for job in ACTIVE):  # compiling in the background: the wait announces itself
