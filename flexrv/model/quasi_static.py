@@ -71,6 +71,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexrv.errors import ConvergenceError, InputError
+from flexrv.model.numerics.static_step import scaled_norms, shifted_newton_step, work_arrays
 from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD
 
 
@@ -144,6 +145,9 @@ class StaticModel:
         self.calls = 0
         #: (input angle, q) of the last residual call (a reference: the solver never changes its arrays)
         self.last = None
+        #: work arrays of the compiled Newton step
+        self._work = work_arrays(self.n)
+        self._zero = np.zeros(self.n)
         #: finite-difference Jacobian in the solver's exact phase (the analytic one is exact; kept
         #: for checks: 20x the residual calls)
         self.fd_fallback = False
@@ -162,7 +166,15 @@ class StaticModel:
     def residual(self, theta_in: float, q: np.ndarray, jacobian: bool = True):
         """Generalized force sum R(q) and dR/dq at input angle ``theta_in``."""
         self.calls += 1
-        f, dq, _ = self.model.generalized_forces(theta_in, q, np.zeros(self.n), jacobian=jacobian)
+        fused = self.model.fused
+        if fused is not None and fused.is_full and not fused.others:
+            # the fused element holds every force (the rigid model): its compiled call directly, without
+            # the velocity Jacobian a static solver never reads
+            fused.memo, fused._jac_ready = None, False
+            fused._call(float(theta_in), np.ascontiguousarray(q, dtype=float), self._zero, bool(jacobian))
+            f, dq = fused.f.copy(), (fused.jq.copy() if jacobian else None)
+        else:
+            f, dq, _ = self.model.generalized_forces(theta_in, q, self._zero, jacobian=jacobian)
         self.last = (theta_in, q)  # the state the force groups' records belong to (_CurveRecords)
         return f, dq
 
@@ -235,11 +247,12 @@ class StaticModel:
         q = q_start.copy()
         tol = o.force_tol * self.f_ref
         f, jac = self.residual(theta_in, q)
-        r, merit = np.max(np.abs(f / self.arm)), np.linalg.norm(f / self.arm)
+        r, merit = scaled_norms(f, self.arm)
         s0 = self._initial_shift(jac)
         stalls = 0
         shift = 1e-8 * s0  # floor: keeps the step finite for a coordinate whose contacts are all open
-        diag_m = np.diag(self.mass)
+        a, piv = self._work
+        dq = np.empty(self.n)
         exact = False
         best = (r, q)
         rose = False
@@ -259,20 +272,14 @@ class StaticModel:
                 history = [merit]
             if exact and self.fd_fallback:
                 jac = self.fd_jacobian(theta_in, q)
-            try:
-                dq = np.linalg.solve(shift * diag_m - jac, f)
-            except np.linalg.LinAlgError:
-                dq = None
-            if dq is not None and np.all(np.isfinite(dq)):
-                big = np.max(np.abs(dq) * self.arm) / self.max_step
-                if big > 1.0:
-                    dq = dq / big
-                if rose:  # the last step raised the norm: halve this one (a Newton 2-cycle across a
-                    dq = 0.5 * dq  # contact's onset kink then contracts onto the kink)
+            # the step (s M - J)^-1 R, limited to max_step and, if the last step raised the norm,
+            # halved (a Newton 2-cycle across a contact's onset kink then contracts onto the kink)
+            ok, size, raw = shifted_newton_step(jac, f, shift, self.mass, self.arm, self.max_step, rose, a, piv, dq)
+            if ok:
                 q_new = q + dq
                 f_new, jac_new = self.residual(theta_in, q_new)
-                merit_new = np.linalg.norm(f_new / self.arm)
-                if exact and shift <= 1e-8 * s0 and np.max(np.abs(dq) * self.arm) < self.position_tol:
+                r_new, merit_new = scaled_norms(f_new, self.arm)
+                if exact and shift <= 1e-8 * s0 and size < self.position_tol:
                     # the exact Newton step locates the equilibrium to 0.1 nm: at a kink of the
                     # contact laws (a contact at its onset) the residual norm need not fall further
                     return q, it
@@ -281,16 +288,15 @@ class StaticModel:
                 # acceptance, Grippo, Lampariello & Lucidi 1986 :cite:`grippo1986nonmonotone`):
                 # below twice the largest of the last four
                 newton = exact and shift <= 1e-8 * s0
-                if np.isfinite(merit_new) and (merit_new < merit or newton and merit_new < 2.0 * max(history[-4:])):
+                if math.isfinite(merit_new) and (merit_new < merit or newton and merit_new < 2.0 * max(history[-4:])):
                     rose = merit_new > merit
-                    q, f, jac, merit = q_new, f_new, jac_new, merit_new
+                    q, f, jac, merit, r = q_new, f_new, jac_new, merit_new, r_new
                     history.append(merit)
                     rejected = 0
-                    r = np.max(np.abs(f / self.arm))
                     if r < best[0]:
                         best = (r, q)
                     shift = max(0.1 * shift, 1e-8 * s0)
-                    if np.max(np.abs(dq)) < o.step_tol and r < 1e3 * tol:
+                    if raw < o.step_tol and r < 1e3 * tol:
                         return q, it
                     continue
             rejected += 1
@@ -303,11 +309,12 @@ class StaticModel:
                 if stalls > 5:
                     break
                 for _ in range(20):
-                    dq = np.linalg.solve(s0 * diag_m - jac, f)
+                    dq = np.linalg.solve(s0 * np.diag(self.mass) - jac, f)
                     big = np.max(np.abs(dq) * self.arm) / self.max_step
                     q = q + (dq / big if big > 1.0 else dq)
                     f, jac = self.residual(theta_in, q)
-                merit, r = np.linalg.norm(f / self.arm), np.max(np.abs(f / self.arm))
+                r, merit = scaled_norms(f, self.arm)
+                dq = np.empty(self.n)
                 history.append(merit)
                 shift = 1e-8 * s0
         if best[0] < 10.0 * tol:
