@@ -527,9 +527,14 @@ def test_compiled_newton_step_and_norms_equal_numpy():
     """The solver's compiled step (flexrv.model.numerics.static_step) against numpy on a random
     well-conditioned 21 x 21 system: dq = (s diag(m) - J)^-1 R within 1e-12 relative (LU with
     partial pivoting both), its limit to max_step on the scaled size max_i |dq_i| arm_i and its
-    halving exact; the norms max |R_i / arm_i| and |R / arm|_2 within 1e-14; a singular matrix is
-    reported (ok False) as numpy raises."""
-    from flexrv.model.numerics.static_step import scaled_norms, shifted_newton_step, work_arrays
+    halving exact; the norms max |R_i / arm_i| and |R / arm|_2 within 1e-14, max_i |J_ii| / m_i
+    exact; a singular matrix is reported (ok False) as numpy raises."""
+    from flexrv.model.numerics.static_step import (
+        largest_stiffness_per_mass,
+        scaled_norms,
+        shifted_newton_step,
+        work_arrays,
+    )
 
     rng = np.random.default_rng(3)
     n = 21
@@ -550,6 +555,7 @@ def test_compiled_newton_step_and_norms_equal_numpy():
     big, l2 = scaled_norms(f, arm)
     assert big == pytest.approx(np.max(np.abs(f / arm)), rel=1e-14)
     assert l2 == pytest.approx(np.linalg.norm(f / arm), rel=1e-14)
+    assert largest_stiffness_per_mass(jac, mass) == np.max(np.abs(np.diag(jac)) / mass)
     singular = np.zeros((n, n))
     ok, _, _ = shifted_newton_step(singular, f, 0.0, mass, arm, 1.0, False, a, piv, dq)
     assert not ok

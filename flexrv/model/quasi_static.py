@@ -71,7 +71,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexrv.errors import ConvergenceError, InputError
-from flexrv.model.numerics.static_step import scaled_norms, shifted_newton_step, work_arrays
+from flexrv.model.numerics.static_step import (
+    largest_stiffness_per_mass,
+    scaled_norms,
+    shifted_newton_step,
+    work_arrays,
+)
 from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD
 
 
@@ -343,8 +348,7 @@ class StaticModel:
 
     def _initial_shift(self, jac) -> float:
         """Pseudo-time weight whose mass term is 1e-3 of the largest stiffness per mass."""
-        kmax = np.max(np.abs(np.diag(jac)) / self.mass)
-        return 1e-3 * max(kmax, 1e6)
+        return 1e-3 * max(largest_stiffness_per_mass(jac, self.mass), 1e6)
 
     def tangent_rigidity(self, theta_in: float, q: np.ndarray) -> float:
         """Torsional rigidity dT/d(theta_out) [N m/rad] at an equilibrium, input

@@ -29,6 +29,17 @@ def scaled_norms(f, arm):
 
 
 @njit(cache=True)
+def largest_stiffness_per_mass(jac, mass):
+    """max_i |J_ii| / m_i (NaN if any is NaN, as numpy's max)."""
+    big = 0.0
+    for i in range(mass.shape[0]):
+        x = abs(jac[i, i]) / mass[i]
+        if x > big or x != x:
+            big = x
+    return big
+
+
+@njit(cache=True)
 def shifted_newton_step(jac, f, shift, mass, arm, max_step, halve, a, piv, dq):
     """dq = (shift diag(mass) - jac)^-1 f, scaled down so that max_i |dq_i| arm_i <= max_step,
     then halved if ``halve``; ``a`` (n, n) and ``piv`` (n,) are work arrays. Returns (ok,
