@@ -26,8 +26,12 @@ step solves (s M - J) dq = R with the members' mass matrix M as the metric, so a
 step through a clearance, where J is singular, becomes an over-damped motion
 towards contact, and near the solution the iteration is Newton's (details and
 the fallbacks for contacts at their onset in :meth:`StaticModel.solve`). Successive positions are warm-started from the
-previous solution advanced by the nominal kinematic increment
-(:func:`equilibrium_path`: 2.0 Newton iterations per position on rv40e).
+kinematic pose plus the deviation from it extrapolated from the two previous solutions
+(:func:`equilibrium_path`: 1.7 Newton iterations per position on rv40e, 1.1 on rv221); the
+solver's per-iteration arithmetic is compiled (:mod:`flexrv.model.numerics.static_step`). The
+no-load curve starts each position from its image one crank revolution earlier and, for a design
+without manufacturing errors, evaluates only a sample of those starts (:func:`equilibrium_path`,
+``check_every``).
 
 Transmission error TE = theta_out - theta_in / i. Definitions used for the
 catalog quantities (Nabtesco-style catalogs define lost motion at +-3 % of the
