@@ -261,7 +261,7 @@ class Simulation:
         plan = _RunPlan.of(self.reducer, t_end, dt, output_every, segment_steps, restart)
         import exudyn as exu
 
-        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        newton_options = check_options("newton_options", newton_options, _newton_options_allowed(exu))
         if integrator is not None and integrator not in INTEGRATORS:
             raise InputError(f"integrator = {integrator!r} is not allowed: choose from {', '.join(INTEGRATORS)}")
         model = self.model if self.model is not None else self.build()
@@ -709,7 +709,15 @@ class _ExudynSegments:
         import exudyn as exu
 
         self.exu, self.model = exu, model
-        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        newton_options = check_options("newton_options", newton_options, _newton_options_allowed(exu))
+        from flexrv.model.integrator import COMPILED_ONLY_OPTIONS
+
+        own = sorted(set(newton_options) & set(COMPILED_ONLY_OPTIONS))
+        if own:
+            raise InputError(
+                f"newton_options {', '.join(map(repr, own))}: an option of the compiled integrator only "
+                "(integrator = 'compiled')"
+            )
         if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
             newton_options = MODEL_NEWTON.get(model_name, {}) | newton_options  # the user's settings win
         self.ss = ss = exu.SimulationSettings()
@@ -936,6 +944,14 @@ class _CompiledSegments:
         self._sync_stats()
         c = self.integ.counts()
         return {"newton": c["newton"], "jacobians": c["jacobians"], "segments": self._segments}
+
+
+def _newton_options_allowed(exu) -> dict[str, object]:
+    """The names ``newton_options`` may set: Exudyn's Newton settings and the compiled
+    integrator's own options (:data:`flexrv.model.integrator.COMPILED_ONLY_OPTIONS`)."""
+    from flexrv.model.integrator import COMPILED_ONLY_OPTIONS
+
+    return _newton_settings(exu) | COMPILED_ONLY_OPTIONS
 
 
 def _newton_settings(exu) -> dict[str, object]:
