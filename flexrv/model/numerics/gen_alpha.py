@@ -15,7 +15,10 @@ is copied): from the spectral radius rho_inf
     v = v_n + h (1 - gamma) a_alg_n + h gamma a*,   a* = (alpha_f a_n - alpha_m a_alg_n) / (1 - alpha_m),
     a = 0,
 
-and corrects with Newton on the residual r = M a + K q + D v - f(t_n+1, q, v): with
+(with ``extrapolate``, moved by the previous step's whole Newton correction e = q_n -
+q_pred,n when that step had the same size: q += e, v += gamma' e, a += beta' e, the
+direction of every Newton update below, so the iterates solve the same equations from
+a nearer start), and corrects with Newton on the residual r = M a + K q + D v - f(t_n+1, q, v): with
 beta' = (1 - alpha_m) / (h^2 beta (1 - alpha_f)) and gamma' = gamma / (h beta), the
 iteration matrix S = beta' M + K + gamma' D - df/dq - gamma' df/dv and the update
 S dx = r, q -= dx, v -= gamma' dx, a -= beta' dx. After convergence
@@ -137,6 +140,8 @@ def new_state(
     extrapolate: bool = False,
 ) -> GaState:
     """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0).
+    ``extrapolate``: the predictor moved by the previous step's Newton correction (module
+    docstring); False: Exudyn's predictor.
     ``blocks``: [(start, size), ...] dense diagonal blocks of the iteration matrix that couple
     only through the other coordinates (M, K, D and the force's Jacobians zero between two
     blocks): the Newton systems are then solved by block elimination
