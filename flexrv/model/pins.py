@@ -647,10 +647,10 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     iteration stops at the point just evaluated, its correction applied linearised leaves
     an error of that order (N R_next, N = (I - C J)^-1), and the records of that evaluation
     are moved to the corrected pose (:func:`_shift_records`, first order in the correction
-    of ~1e-12 m: remainder ~1e-21 m in the gaps). Measured on rv40e's call sequence: 2.41
-    -> 1.54 pin-kernel evaluations per call; recorded outputs against the history pass
-    1e-10 (rv40e) and 3.4e-10 (rv221) of their largest values (tests/test_rigspeed.py: 2e-9;
-    4e-6 without the records' move)."""
+    of ~1e-12 m: remainder ~1e-21 m in the gaps). Measured on rv40e's call sequence: 1.54
+    pin-kernel evaluations per call (the residual stop alone: 2.41); recorded outputs
+    against the history pass 1e-10 (rv40e) and 3.4e-10 (rv221) of their largest values
+    (tests/test_rigspeed.py: 2e-9; 4e-6 without the records' move)."""
     qh, delta, step, qf, av, sq, qp, sv = w.qh, w.delta, w.step, w.qf, w.av, w.sq, w.qp, w.sv
     vh, vp, weight, nw, ql, fl, jl, jvl = w.vh, w.vp, w.weight, w.nw, w.ql, w.fl, w.jl, w.jvl
     cm, res, base, tmp, nm, dlast, qfc, st = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc, w.st
