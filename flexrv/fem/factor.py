@@ -21,7 +21,10 @@ substitution instead of a forward and a backward one. SuperLU's own solve treats
 the right-hand sides one column at a time through its supernodes; here the
 forward substitution runs supernode by supernode on all columns at once (a dense
 triangular solve and a matrix product per supernode, level-3 BLAS), the
-supernodes read from the factor's L (consecutive columns whose patterns nest).
+supernodes read from the factor's L (consecutive columns whose patterns nest),
+each on the columns that are non-zero in its rows: a local load (a pin patch)
+fills only the supernodes on its elimination-tree path (on the rv40e disc, 4 % of
+L^-1 B is non-zero), so the substitution costs a fraction of a full solve.
 """
 
 from __future__ import annotations
@@ -145,7 +148,10 @@ def _supernodes(L: sp.csc_matrix) -> np.ndarray:
 
 
 def _forward_supernodal(L: sp.csc_matrix, Y: np.ndarray) -> None:
-    """Y <- L^-1 Y in place (Y C-contiguous (n, m)), supernode by supernode."""
+    """Y <- L^-1 Y in place (Y C-contiguous (n, m)), supernode by supernode, each on
+    the columns of Y that are non-zero in its rows: local loads (a pin patch, a bore)
+    reach only the supernodes on their elimination-tree paths, so most blocks of Y
+    stay zero and are skipped (exactly: a zero block neither changes nor updates)."""
     from scipy.linalg.blas import dtrsm
 
     L = sp.csc_matrix(L)
@@ -154,17 +160,25 @@ def _forward_supernodal(L: sp.csc_matrix, Y: np.ndarray) -> None:
     if not np.array_equal(ix[ip[:-1]], np.arange(L.shape[0])):
         raise InputError("the factor's L does not store its unit diagonal first in every column")
     bounds = _supernodes(L)
+    m = Y.shape[1]
     for a, b in zip(bounds[:-1], bounds[1:]):
+        Yb = Y[a:b]
+        live = Yb.any(axis=0)
+        k = np.count_nonzero(live)
+        if k == 0:
+            continue
         s = b - a
         rows = ix[ip[a] : ip[a + 1]]
         block = np.zeros((rows.size, s), order="F")
         for c in range(s):
             block[c:, c] = data[ip[a + c] : ip[a + c + 1]]
-        Yb = Y[a:b]
+        cols = np.flatnonzero(live) if 2 * k < m else slice(None)
+        Ys = Yb[:, cols]
         if s > 1:
-            Yb[...] = dtrsm(1.0, block[:s], Yb.T, side=1, lower=1, trans_a=1, diag=1).T
+            Ys = dtrsm(1.0, block[:s], Ys.T, side=1, lower=1, trans_a=1, diag=1).T
+            Yb[:, cols] = Ys
         if rows.size > s:
-            Y[rows[s:]] -= block[s:] @ Yb
+            Y[np.ix_(rows[s:], cols) if 2 * k < m else rows[s:]] -= block[s:] @ Ys
 
 
 def factorize(A: sp.spmatrix) -> SymmetricFactor:
