@@ -4,8 +4,8 @@ Choice of assembler: the stiffness, which every static condensation needs, is
 assembled here (:func:`p2_stiffness`), vectorised over the elements straight into
 Exudyn's node-wise ``x0 y0 z0 x1 y1 z1 ...`` DOF order of the mesh nodes, with
 scikit-fem's P2 element and quadrature rule; it equals scikit-fem's own assembly
-of the same bilinear form to round-off (tests/test_fem_assembly.py) at a third of
-its CPU time (rv40e carrier, 14.8k Tet10: 1.1 s against 3.5 s). The consistent
+of the same bilinear form to round-off (tests/test_fem_assembly.py) at about a
+third of its CPU time (docs/benchmarks.md). The consistent
 mass (an 11-point rule, needed by the modal reductions only) is assembled by
 scikit-fem's isoparametric P2 (``MeshTet2`` + ``ElementVector(ElementTetP2)``),
 whose DOF order (vertex DOFs, then edge DOFs, components interleaved per entity)

@@ -9,10 +9,9 @@ multilevel nested dissection (Karypis & Kumar 1998, :cite:`karypis1998`; the
 ``pymetis`` wheel) on the graph of the matrix compressed to supervariables (runs
 of consecutive columns with the same pattern: the three DOFs of a node), then
 expanded back to the DOFs. SuperLU factorises the permuted matrix in its natural
-order, symmetric mode, diagonal pivots. Measured (benchmarks/bench_bodies.py,
-docs/benchmarks.md) against SuperLU's MMD(A^T + A): rv40e carrier (72.9k DOF)
-L + U 43.6 M against 91.8 M entries and 3.1 s against 15.4 s CPU; rv221 disc
-(96.2k DOF) 49.2 M against 71.4 M and 2.8 s against 7.2 s.
+order, symmetric mode, diagonal pivots. Against SuperLU's own MMD(A^T + A) order
+on the carrier and disc bodies it keeps a half to two thirds of the fill and factorises two to
+five times faster (docs/benchmarks.md, benchmarks/bench_bodies.py).
 
 Condensation: with diagonal pivots, the LU factor of a symmetric matrix is
 A = L U, U = D L^T (L unit lower triangular, D = diag(U) > 0 for a positive
