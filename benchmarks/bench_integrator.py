@@ -1,16 +1,19 @@
 """Benchmark of the compiled generalized-alpha integrator against Exudyn's, paired in one
 process: rigid model of each preset, the same run on both integrators.
 
-Run:  python benchmarks/bench_integrator.py [--t-end 0.3] [--presets rv40e rv221] [--repeat 2]
+Run:  python benchmarks/bench_integrator.py [--t-end 0.3] [--presets rv40e rv221] [--repeat 2] [--split]
 
 The run starts at rated speed (speed and load ramps shortened to 5 ms, as
-benchmarks/bench_rigid.py) and lasts ``--t-end``. Printed per preset and integrator:
+benchmarks/bench_rigid.py) and lasts ``--t-end``. Three runs per repeat, alternating:
+Exudyn's integrator, the compiled one (its defaults) and the compiled one with Exudyn's
+predictor (``newton_options={"extrapolatedPredictor": False}``: the same steps and Newton
+iterations as Exudyn's). Printed per preset and run:
 
 * CPU s of the solve per simulated s (``time.process_time`` around the segment loop,
-  ``Simulation.timing["solve_cpu_s"]``; the best of ``--repeat`` runs) and the ratio
-  Exudyn / compiled;
+  ``Simulation.timing["solve_cpu_s"]``; the best of ``--repeat`` runs, and the spread) and
+  the ratio Exudyn / compiled;
 * Newton iterations, Jacobians and force-kernel calls per step;
-* TE mean and peak-to-peak over t > 0.05 s [arcsec] of both (the same answer);
+* TE mean and peak-to-peak over t > 0.05 s [arcsec];
 * the share of a compiled step outside the force kernel: 1 - (kernel calls x the
   kernel's cost per call) / solve time, the cost per call measured on the run's
   recorded states with the solver's own kernel arguments (warm starts carried from
@@ -18,6 +21,15 @@ benchmarks/bench_rigid.py) and lasts ``--t-end``. Printed per preset and integra
   the Jacobian, in a compiled loop, less the same loop without calls. The calls of a
   step at one state converge their inner solves at once, so this cost is a lower
   bound and the share outside the kernel an upper bound.
+
+``--split`` measures the split inside the run instead: a copy of the generated
+``fused_integrate`` with a CPU clock (libc ``clock``) read around its kernel call site
+and around the whole call, so per step: the kernel (its first call of a step, the
+others), the compiled loop around it (the generalized-alpha's linear algebra, the
+records) and Python (the returns every ``CHECK_EVERY`` steps, tables, checks). A clock
+read costs ~0.8 us (a system call; measured): of the two per kernel call about one is
+counted in the kernel's share, one in the loop's (~2 us per step each). The copy is not cached
+(a ctypes function is a dynamic global for numba): it compiles in every process.
 
 One-time numba compilation/loading is done before timing (a 20-step run of each).
 """
@@ -34,9 +46,20 @@ from _shared import quick_ramps
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+#: the runs of a repeat: (label, integrator, newton_options)
+RUNS = (
+    ("exudyn", "exudyn", None),
+    ("compiled", "compiled", None),
+    ("compiled*", "compiled", {"extrapolatedPredictor": False}),
+)
 
-def _run(sim, integrator: str, t_end: float):
-    res = sim.run(t_end=t_end, integrator=integrator, checkpoint_s=None)
+#: slots of the split's clock array: [unused (failure counters sum slot 0), kernel, whole calls,
+#: the steps' first kernel calls, first calls]
+_K, _CALL, _FIRST, _NFIRST = 1, 2, 3, 4
+
+
+def _run(sim, integrator: str, t_end: float, options):
+    res = sim.run(t_end=t_end, integrator=integrator, checkpoint_s=None, newton_options=options)
     t = res.time
     te = res["te"].values[t > 0.05]
     return res, dict(sim.timing), float(te.mean()), float(np.ptp(te))
@@ -71,14 +94,93 @@ def _kernel_cost(model, ts, qs, vs, calls_per_step: float) -> float:
     return (min(spent[0], spent[2]) - min(spent[1], spent[3])) / ((len(ts) - 1) * reps)
 
 
+def _clocked_integrate(model):
+    """A copy of the model's generated ``fused_integrate`` with CPU clocks around its kernel
+    call site and its whole call, accumulated into the last counter array (module docstring)."""
+    import importlib.util
+    import tempfile
+
+    from flexrv.model.core import registry
+
+    specs = [registry.spec_of(g) for g, _ in model.fused.slots]
+    src = registry._fused_source(specs, registry._source_hash(specs))
+    call = next((ln for ln in src.splitlines() if ln.strip().startswith("fused_kernel(st.q")), None)
+    if call is None:
+        raise RuntimeError("--split: the generated fused_integrate has no kernel call site it recognises")
+    ind = call[: len(call) - len(call.lstrip())]
+    clocked = (
+        f"{ind}c0 = _clock()\n{call}\n{ind}c1 = _clock() - c0\n{ind}ctrs[-1][{_K}] += c1\n"
+        f"{ind}if st.ip[I_IT] == 0:\n{ind}    ctrs[-1][{_FIRST}] += c1\n{ind}    ctrs[-1][{_NFIRST}] += 1\n"
+    )
+    done = f"ctrs[-1][{_CALL}] += _clock() - t_call\n"
+    src = (
+        src.replace(call + "\n", clocked)
+        .replace("import EVALUATE,", "import I_IT, EVALUATE,")
+        .replace("    n = times.shape[0]\n", "    t_call = _clock()\n    n = times.shape[0]\n")
+        .replace("                return i, 2\n", "                " + done + "                return i, 2\n")
+        .replace("            return i, 1\n", "            " + done + "            return i, 1\n")
+        .replace("            return i, 3\n", "            " + done + "            return i, 3\n")
+        .replace("    return n, 0\n", "    " + done + "    return n, 0\n")
+        .replace(
+            "from numba import njit\n",
+            "from numba import njit\nimport ctypes\n_clock = ctypes.CDLL(None).clock\n"
+            "_clock.restype = ctypes.c_long\n_clock.argtypes = []\n",
+        )
+    )
+    path = os.path.join(tempfile.mkdtemp(prefix="flexrv_split_"), "clocked_fused.py")
+    with open(path, "w") as fh:
+        fh.write(src)
+    spec = importlib.util.spec_from_file_location("clocked_fused", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.fused_integrate
+
+
+def split(name: str, t_end: float, repeat: int) -> None:
+    """Print the in-run split of a compiled step (``--split``; module docstring)."""
+    import flexrv.model.integrator as integrator
+    from flexrv.simulation import Simulation
+
+    sim = Simulation(quick_ramps(name))
+    model = sim.build()
+    model.fused.integrate_kernel = _clocked_integrate(model)
+    clocks = np.zeros(5, np.int64)  # libc clock(): microseconds
+    init = integrator.CompiledIntegrator.__init__
+
+    def with_clocks(self, *a, **k):
+        init(self, *a, **k)
+        self.ctrs = (*self.ctrs, clocks)
+
+    integrator.CompiledIntegrator.__init__ = with_clocks
+    try:
+        for label, integ, options in RUNS[1:]:
+            sim.run(t_end=0.002, integrator=integ, checkpoint_s=None, newton_options=options)  # (compile)
+            for _ in range(repeat):
+                clocks[:] = 0
+                sim.run(t_end=t_end, integrator=integ, checkpoint_s=None, newton_options=options)
+                tm = sim.timing
+                steps, calls = tm["steps"], model.fused.stats[0]
+                solve, kern, loop = tm["solve_cpu_s"] * 1e6 / steps, clocks[_K] / steps, clocks[_CALL] / steps
+                print(
+                    f"  {label:9s} split: {solve:6.1f} us per step = kernel {kern:5.1f} ({100 * kern / solve:.0f} %: "
+                    f"first call {clocks[_FIRST] / clocks[_NFIRST]:.1f} us, others "
+                    f"{(clocks[_K] - clocks[_FIRST]) / max(calls - clocks[_NFIRST], 1):.1f} us per call) + loop "
+                    f"{loop - kern:4.1f} + Python {solve - loop:4.1f}; outside the kernel "
+                    f"{100 * (1 - kern / solve):.0f} %; calls {calls / steps:.2f}, Newton "
+                    f"{tm['newton_iterations'] / steps:.2f} per step"
+                )
+    finally:
+        integrator.CompiledIntegrator.__init__ = init
+
+
 def bench(name: str, t_end: float, repeat: int) -> dict:
     import flexrv.simulation as S
     from flexrv.simulation import Simulation
 
     sim = Simulation(quick_ramps(name))
     model = sim.build()
-    for integ in ("exudyn", "compiled"):  # compile / load the kernels
-        sim.run(t_end=0.002, integrator=integ, checkpoint_s=None)
+    for _, integ, options in RUNS:  # compile / load the kernels
+        sim.run(t_end=0.002, integrator=integ, checkpoint_s=None, newton_options=options)
     states = {}
     orig = S._Records.__init__
 
@@ -90,12 +192,13 @@ def bench(name: str, t_end: float, repeat: int) -> dict:
     out = {}
     try:
         for _ in range(repeat):
-            for integ in ("exudyn", "compiled"):
-                res, timing, mean, pp = _run(sim, integ, t_end)
-                best = out.get(integ)
+            for label, integ, options in RUNS:
+                res, timing, mean, pp = _run(sim, integ, t_end, options)
+                best = out.get(label)
+                cpus = [timing["solve_cpu_s"], *(best["cpus"] if best else [])]
                 if best is None or timing["solve_cpu_s"] < best["cpu"]:
                     rec = states["records"]
-                    out[integ] = {
+                    out[label] = {
                         "cpu": timing["solve_cpu_s"],
                         "steps": timing["steps"],
                         "newton": timing["newton_iterations"],
@@ -105,6 +208,7 @@ def bench(name: str, t_end: float, repeat: int) -> dict:
                         "pp": pp,
                         "states": (rec.ts[: rec.k].copy(), rec.qs[: rec.k].copy(), rec.vs[: rec.k].copy()),
                     }
+                out[label]["cpus"] = cpus
     finally:
         S._Records.__init__ = orig
     c = out["compiled"]
@@ -119,19 +223,28 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.3)
     ap.add_argument("--presets", nargs="+", default=["rv40e", "rv221"])
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--split", action="store_true", help="the in-run split of a compiled step (module docstring)")
     args = ap.parse_args()
     for name in args.presets:
+        if args.split:
+            print(f"\n{name}: rigid model, t_end {args.t_end:g} s")
+            split(name, args.t_end, args.repeat)
+            continue
         out = bench(name, args.t_end, args.repeat)
         e, c = out["exudyn"], out["compiled"]
         print(f"\n{name}: rigid model, t_end {args.t_end:g} s, {c['steps']} steps")
-        for key, r in (("exudyn", e), ("compiled", c)):
+        for label, r in out.items():
+            spread = ", ".join(f"{x / args.t_end:.3f}" for x in sorted(r["cpus"]))
             print(
-                f"  {key:9s} CPU {r['cpu'] / args.t_end:7.3f} s per simulated s   "
+                f"  {label:9s} CPU {r['cpu'] / args.t_end:7.3f} s per simulated s ({spread})   "
                 f"Newton {r['newton'] / r['steps']:.2f}  Jacobians {r['jacobians'] / r['steps']:.2f}  "
                 f"kernel calls {r['calls'] / r['steps']:.2f} per step   "
                 f"TE mean {r['mean']:+.5f}  p-p {r['pp']:.4f} arcsec"
             )
-        print(f"  ratio Exudyn / compiled CPU: {e['cpu'] / c['cpu']:.2f}x")
+        print(
+            f"  ratio Exudyn / compiled CPU: {e['cpu'] / c['cpu']:.2f}x "
+            f"(compiled with Exudyn's predictor: {e['cpu'] / out['compiled*']['cpu']:.2f}x)"
+        )
         print(
             f"  compiled: kernel {c['per_call_us']:.1f} us per call, {100 * c['kernel_share']:.0f} % of the solve; "
             f"outside the kernel {100 * (1 - c['kernel_share']):.0f} % "

@@ -1,7 +1,11 @@
 """Benchmark of the rigid reducer model on the compiled integrator: the force kernel's
 cost per time step, split by element, and the share of a step outside it.
 
-Run:  python benchmarks/bench_rigid.py [--t-end 0.1] [--presets rv40e rv221]
+Run:  python benchmarks/bench_rigid.py [--t-end 0.1] [--presets rv40e rv221] [--sequences DIR]
+
+``--sequences DIR``: the recorded call sequence of each preset is read from
+``DIR/<preset>_<t-end>.npz`` if there, else recorded and written there, so that two checkouts
+(an A/B pair) replay the same calls.
 
 The run starts at rated speed (speed and load ramps shortened to 5 ms,
 ``_shared.quick_ramps``) so the timing measures steady operation under the preset's
@@ -152,7 +156,20 @@ def _replay_costs(model, seq, chunk: int = 100, repeats: int = 5) -> dict:
     return out
 
 
-def bench(name: str, t_end: float) -> dict:
+def _sequence(sim, name: str, t_end: float, folder: str | None) -> dict:
+    """The recorded call sequence (:func:`_record_calls`), from ``folder`` if saved there."""
+    path = None if folder is None else os.path.join(folder, f"{name}_{t_end:g}.npz")
+    if path is not None and os.path.exists(path):
+        with np.load(path) as z:
+            return {k: z[k] for k in z.files}
+    seq = _record_calls(sim, t_end)
+    if path is not None:
+        os.makedirs(folder, exist_ok=True)
+        np.savez(path, **seq)
+    return seq
+
+
+def bench(name: str, t_end: float, sequences: str | None = None) -> dict:
     from flexrv.simulation import Simulation
 
     sim = Simulation(quick_ramps(name))
@@ -164,7 +181,7 @@ def bench(name: str, t_end: float) -> dict:
     tm = dict(sim.timing)
     calls = model.fused.stats[0] - calls0
     te = res["te"].values[res.time > 0.02]
-    seq = _record_calls(sim, t_end)
+    seq = _sequence(sim, name, t_end, sequences)
     costs = _replay_costs(model, seq)
     steps = tm["steps"]
     n_calls = len(seq["t"])
@@ -191,12 +208,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--presets", nargs="*", default=["rv40e", "rv221"])
+    ap.add_argument("--sequences", default=None, help="folder of recorded call sequences (read, else written)")
     a = ap.parse_args()
     import flexrv
 
     print(f"flexrv from {os.path.dirname(flexrv.__file__)}")
     for name in a.presets:
-        r = bench(name, a.t_end)
+        r = bench(name, a.t_end, a.sequences)
         outside = 1.0 - r["kernel_us_per_step"] * 1e-6 * r["steps"] / r["solve_cpu_s"]
         print(
             f"{name}: compiled integrator, {r['steps']} steps, CPU {r['cpu_per_sim_s']:.3f} s per simulated s, "

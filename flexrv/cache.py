@@ -434,7 +434,7 @@ _BUILD_KINDS = {
 #: typical first-build time [s] of an entry, by kind, on one core of a quiet 2-core machine (benchmarks/
 #: bench_bodies.py: a preset's carrier 12-13 s, disc 11-26 s with their meshes); the notice quotes the
 #: time this cache's own earlier builds of the kind took when it has them
-TYPICAL_BUILD_S = {".compliance.json": 10.0, ".patches.json": 15.0, ".sweep.json": 15.0, ".cms.npz": 15.0, ".msh": 4.0}
+TYPICAL_BUILD_S = {".compliance.json": 5.0, ".patches.json": 6.0, ".sweep.json": 6.0, ".cms.npz": 15.0, ".msh": 4.0}
 #: file in the cache folder with the measured build time of each kind of entry
 BUILD_TIMES = "build_times.json"
 

@@ -96,6 +96,8 @@ SECTIONS: dict[str, dict[str, str]] = {
         "135-156.",
         "kahraman1994": "Kahraman, A. (1994). Planetary gear train dynamics. *ASME Journal of Mechanical Design* "
         "116(3), 713-720.",
+        "karypis1998": "Karypis, G., Kumar, V. (1998). A fast and high quality multilevel scheme for "
+        "partitioning irregular graphs. *SIAM Journal on Scientific Computing* 20(1), 359-392.",
         "li_lixing": "Li Lixing. Cycloid-pin gear load distribution with initial clearances (textbook method). "
         "As cited in the code; title, year and publisher not verified.",
         "lin1999": "Lin, J., Parker, R. G. (1999). Analytical characterization of the unique properties of "

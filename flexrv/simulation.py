@@ -105,7 +105,8 @@ STOP_SIGNALS = ("SIGINT", "SIGTERM")
 #: steps of the compiled integrator between two returns to Python, where the groups' per-step
 #: checks (a skipped pin, a penetration beyond the physical limit), the signals and the progress
 #: report run: the checks then see every CHECK_EVERY-th accepted state. 25: one pin-mesh period
-#: of the presets at the default step; a return costs ~90 us (mostly the drive and load tables)
+#: of the presets at the default step; a return costs ~50 us (the checks, the progress, the compiled
+#: call's argument unboxing ~12 us; the drive and load tables are made once per segment)
 CHECK_EVERY = 25
 
 
@@ -261,7 +262,7 @@ class Simulation:
         plan = _RunPlan.of(self.reducer, t_end, dt, output_every, segment_steps, restart)
         import exudyn as exu
 
-        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        newton_options = check_options("newton_options", newton_options, _newton_options_allowed(exu))
         if integrator is not None and integrator not in INTEGRATORS:
             raise InputError(f"integrator = {integrator!r} is not allowed: choose from {', '.join(INTEGRATORS)}")
         model = self.model if self.model is not None else self.build()
@@ -710,7 +711,15 @@ class _ExudynSegments:
         import exudyn as exu
 
         self.exu, self.model = exu, model
-        newton_options = check_options("newton_options", newton_options, _newton_settings(exu))
+        newton_options = check_options("newton_options", newton_options, _newton_options_allowed(exu))
+        from flexrv.model.integrator import COMPILED_ONLY_OPTIONS
+
+        own = sorted(set(newton_options) & set(COMPILED_ONLY_OPTIONS))
+        if own:
+            raise InputError(
+                f"newton_options {', '.join(map(repr, own))}: an option of the compiled integrator only "
+                "(integrator = 'compiled')"
+            )
         if model.info.get("ball_inertia", True):  # (quasi-static balls: Exudyn's defaults, see MODEL_NEWTON)
             newton_options = MODEL_NEWTON.get(model_name, {}) | newton_options  # the user's settings win
         self.ss = ss = exu.SimulationSettings()
@@ -937,6 +946,14 @@ class _CompiledSegments:
         self._sync_stats()
         c = self.integ.counts()
         return {"newton": c["newton"], "jacobians": c["jacobians"], "segments": self._segments}
+
+
+def _newton_options_allowed(exu) -> dict[str, object]:
+    """The names ``newton_options`` may set: Exudyn's Newton settings and the compiled
+    integrator's own options (:data:`flexrv.model.integrator.COMPILED_ONLY_OPTIONS`)."""
+    from flexrv.model.integrator import COMPILED_ONLY_OPTIONS
+
+    return _newton_settings(exu) | COMPILED_ONLY_OPTIONS
 
 
 def _newton_settings(exu) -> dict[str, object]:

@@ -130,7 +130,10 @@ def test_integrator_records_match_the_history_pass(name, model):
     ~1e-10 * R_p * 3e-6 rad ~ 3e-17 m on rv221, which the pin contact stiffness
     (~1e9 N/m) turns into ~3e-8 N on pin forces of ~200 N, ~2e-10, with the friction
     outputs more sensitive through the sliding speed; 2e-9 keeps a factor 2 over the
-    measured; the ball model's rows, recorded from their own elements, agree to
+    measured; where the rim Newton stops on its quadratic rule its records are moved to
+    the pose of its linearised last correction (pins._shift_records; measured 2026-11-28:
+    pin forces 9.7e-11 on rv40e, 3.4e-10 on rv221, all else <= 5.3e-10; 4e-6 without the
+    move); the ball model's rows, recorded from their own elements, agree to
     their quasi-static balls' local solve (bearing_kernel.quasi_static_balls, 1e-6
     of the row's largest load, BALL_FORCE_TOL), reached from the run's prediction
     in the one and from the previous sample in the other: measured 2026-11-24 on

@@ -136,8 +136,8 @@ def te(
 #: measured cost of the static solution per position [s] (loaded and no-load curves, outputs) and the
 #: fixed cost of a run (model, catalog points, files, figures) on one core (benchmarks/bench_te.py,
 #: benchmarks/bench_startup.py)
-SECONDS_PER_POSITION = 5e-4
-SECONDS_FIXED = 4.0
+SECONDS_PER_POSITION = 2.5e-4
+SECONDS_FIXED = 3.0
 
 
 def announce_positions(reducer, output_revolutions, crank_revolutions, points_per_mesh: int) -> str:

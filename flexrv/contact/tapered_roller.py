@@ -92,10 +92,16 @@ def _roller_directions(gam, angles):
     Newton keeps gamma fixed), not once per bearing evaluation."""
     z = angles.shape[0]
     ux, uy = np.empty(z), np.empty(z)
-    for i in range(z):
+    roller_directions_into(gam, angles, ux, uy)
+    return ux, uy
+
+
+@njit(cache=True)
+def roller_directions_into(gam, angles, ux, uy):
+    """:func:`_roller_directions` into given arrays (no allocation)."""
+    for i in range(angles.shape[0]):
         psi = gam + angles[i]
         ux[i], uy[i] = np.cos(psi), np.sin(psi)
-    return ux, uy
 
 
 @njit(cache=True)
@@ -144,12 +150,22 @@ def crank_support_force(dx, dy, gam, clear, sc, angles, is_linear, b0x, b0y):
     bearing displacement (bx, by) and the summed roller load. (b0x, b0y): Newton
     start for b (the previous solution; any value converges). The inner equation is
     solved to |R|_1 <= 1e-13 (k_bend |d|_1 + |F|_1 + summed roller load), or to its
-    round-off floor (a Newton step that no longer lowers |R|), i.e. b to ~1e-19 m."""
-    kb = sc.k_bend
+    round-off floor (a Newton step that no longer lowers |R|), i.e. b to ~1e-19 m.
+    The roller directions at the cage angle gamma, then :func:`crank_support_force_at`."""
     if is_linear:
         ux = uy = angles[:0]
     else:
         ux, uy = _roller_directions(gam, angles)
+    return crank_support_force_at(dx, dy, ux, uy, clear, sc, is_linear, b0x, b0y)
+
+
+@njit(cache=True)
+def crank_support_force_at(dx, dy, ux, uy, clear, sc, is_linear, b0x, b0y):
+    """:func:`crank_support_force` with the roller directions (ux, uy) of its cage angle
+    given (:func:`_roller_directions`; empty for the linear law): a caller that evaluates
+    one support at several d and the same cage angle (the elastic carrier's Newton)
+    computes them once."""
+    kb = sc.k_bend
     if kb <= 0.0:  # rigid crank: b = d
         fx, fy, kxx, kxy, kyy, gx, gy, qs = _bearing(dx, dy, clear, sc, ux, uy, is_linear)
         return fx, fy, kxx, kxy, kyy, gx, gy, dx, dy, qs

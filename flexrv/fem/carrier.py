@@ -42,13 +42,13 @@ Discretisation error of the default mesh (stated, not hidden): the sharp re-entr
 edges where the pillars meet the plates limit P2 to an energy convergence order of
 about 1.1 (h^(2 lambda), lambda = 0.545 for a 270-degree edge): rv40e 8 / 5.66 / 4 mm
 gives 1.607 / 1.645 / 1.672e-7 rad/(N m), order 1.08, Richardson value 1.729e-7, so the
-default mesh (6.67 mm, pillars 5.5 mm: 1.6250e-7, 24.7k nodes, ~20 s CPU, 1.3 GB) reads
-6 % stiff, i.e. about 0.7 % of the rv40e's total torsional compliance (the carrier's
+default mesh (6.67 mm, pillars 5.5 mm: 1.6250e-7, 24.7k nodes; its build cost in
+docs/benchmarks.md) reads 6 % stiff, i.e. about 0.7 % of the rv40e's total torsional compliance (the carrier's
 share is 11 %). Graded refinement at the pillar roots (``edge_size``, off by default)
 converges at the same order: 2 / 1 / 0.5 mm give 1.6607 / 1.6840 / 1.6948e-7 at 31k /
-48k / 83k nodes for 52 / 102 / 221 s CPU and up to 7 GB, so 1-2 % would cost 5-10x
-the present build; a real carrier's root fillets (not in the geometry) would remove
-the singularity (tests/test_convergence.py::TestConvergenceCarrierTorsion).
+48k / 83k nodes, so 1-2 % would cost several times the present build; a real
+carrier's root fillets (not in the geometry) would remove the singularity
+(tests/test_convergence.py::TestConvergenceCarrierTorsion).
 
 Cached as JSON under :func:`flexrv.cache.cache_dir` keyed by the mesh key, the
 material, the load split and the library versions.
@@ -345,8 +345,7 @@ def crank_support_compliance(reducer, size: float | None = None, cache: bool = T
     With the torque load vector g_c per unit output torque (tangential T / (N a_w)
     per crank), g_c^T C_eff g_c equals the FE torsional compliance
     :attr:`CarrierCompliance.torsional` (identity, tests/test_bodies.py). The
-    rigid-bore bound (a second factorisation, ~5 s CPU of the ~20 s cold build on
-    the presets, used by no model) is not computed here."""
+    rigid-bore bound (a second factorisation, used by no model) is not computed here."""
     c = carrier_compliance(reducer, size=size, rigid_bound=False, cache=cache)
     n = c.n_cranks
     s = c.split_input

@@ -553,9 +553,11 @@ def disc_patch_sweep(
     cache: bool = True,
 ) -> DiscPatchSweep:
     """The (z_rp x z_rp) pin-patch compliance of the disc body at ``n_angles`` crank
-    angles 2 pi k / (N n_angles) (one factorisation, the angles solved one after the
-    other), keyed on the body's geometry only (:func:`body_design`): the same model
-    as :func:`disc_compliance` for all pins at once, without the load pattern."""
+    angles 2 pi k / (N n_angles) (one factorisation; the patch loads W of all angles
+    in one forward substitution, C = V^T V with V = D^-1/2 L^-1 W,
+    :meth:`flexrv.fem.factor.SymmetricFactor.whitened`), keyed on the body's geometry
+    only (:func:`body_design`): the same model as :func:`disc_compliance` for all pins
+    at once, without the load pattern."""
     from flexrv.fem.body import _assemble, material_dict
     from flexrv.fem.carrier import rigid_master_transform
     from flexrv.fem.modal import factorize
@@ -576,14 +578,18 @@ def disc_patch_sweep(
         fe = _assemble(d, mat, mass=False)
         Z, _ = rigid_master_transform(fe.K.shape[0], d.nodes, hole_masters(d))
         Kr = sp.csc_matrix(Z.T @ (sp.csr_matrix(fe.K) @ Z))
-        solve = factorize(0.5 * (Kr + Kr.T))
+        W = sp.hstack(
+            [
+                pin_patch_loads(
+                    d, PinContactCase(points=p, directions=dirs, forces=np.zeros(len(p)), disc_torque=1.0), patch
+                )
+                for p, dirs in geo
+            ]
+        )
+        V = factorize(0.5 * (Kr + Kr.T)).whitened(sp.csc_matrix(Z.T @ W))  # W^T K^-1 W = V^T V
         mats = []
-        for p, dirs in geo:
-            W = pin_patch_loads(
-                d, PinContactCase(points=p, directions=dirs, forces=np.zeros(len(p)), disc_torque=1.0), patch
-            )
-            Wr = np.asarray((Z.T @ W).todense())
-            C = Wr.T @ solve(Wr)
+        for cols in np.split(np.arange(W.shape[1]), np.cumsum([len(p) for p, _ in geo])[:-1]):
+            C = V[:, cols].T @ V[:, cols]
             mats.append((0.5 * (C + C.T)).tolist())
         return DiscPatchSweep(
             angles=angles, matrices=mats, patch=patch, n_nodes=int(d.n_nodes), size=float(d.size), mesh_key=mres.key

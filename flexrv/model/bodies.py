@@ -17,8 +17,8 @@ def body_compliance_matrix(reducer, body: str) -> np.ndarray:
     the design has a ``[carrier]`` table), else (0, 0); ``"cycloid_disc"``: the discs'
     (n_discs, 3, 3) rim compliance if ``second_stage.disc_body_model = "condensed_fe"``, else
     (0, 3, 3). From the cached FE condensations (:mod:`flexrv.fem.carrier`,
-    :mod:`flexrv.fem.disc`; cold: about a minute each). Functions of the design without its
-    errors: shared by its error sets inside
+    :mod:`flexrv.fem.disc`; built once per design, docs/benchmarks.md gives the cost).
+    Functions of the design without its errors: shared by its error sets inside
     :func:`flexrv.design.manufacturing.shared_nominal_constants`."""
     from flexrv.design.manufacturing import nominal_shared
 

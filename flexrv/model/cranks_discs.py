@@ -103,7 +103,7 @@ from numba import njit
 
 from flexrv.contact.hertz import LINE_EXPONENT
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.contact.tapered_roller import SupportConstants, crank_support_force
+from flexrv.contact.tapered_roller import SupportConstants, crank_support_force_at, roller_directions_into
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
@@ -119,8 +119,9 @@ SupportLaw = law_type("SupportLaw", damping=float, linear=bool, k_bend=float, g=
 #: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
 #: the tapered-roller pair's constants (passed on to :func:`flexrv.contact.tapered_roller.crank_support_force`),
 #: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
-#: crank, bearing displacement = Newton start, bending share), the elastic carrier's support-point
-#: compliance (2N, 2N) (empty: rigid), its deflections (N, 4) and the work array (:func:`support_work_size`)
+#: crank, the bearings' state = Newton start (:data:`BEARING_STATE` columns), bending share), the
+#: elastic carrier's support-point compliance (2N, 2N) (empty: rigid), its deflections (N, 4), the
+#: roller directions at each cage angle (N, 2, Z) and the work array (:func:`support_work_size`)
 SupportPack = pack_type(
     "SupportPack",
     ("idx", (_I, (6,))),
@@ -135,6 +136,7 @@ SupportPack = pack_type(
     ("bend", (_F, 1)),
     ("carrier_c", (_F, 2)),
     ("ustate", (_F, 2)),
+    ("dirs", (_F, 3)),
     ("work", (_F, 1)),
 )
 #: the needle bearings' scalar law: contact K, exponent, c_max, depth, roller-resolved model (else the
@@ -190,16 +192,45 @@ def _add_btkb(jq, ii, b, kxx, kxy, kyy, w):
             jq[ii[s], ii[r]] -= w * (b[0, s] * kb0 + b[1, s] * kb1)
 
 
+#: the columns of a crank's bearing state (SupportPack field ``bstate``, per crank): the bearing
+#: displacement b (x, y) of its last solution, the crank-centre displacement d (x, y) it solved and
+#: the series tangent K_s (xx, xy, yy) there; a zero row (a reset) starts from b without the
+#: first-order change
+B_X, B_Y, B_DX, B_DY, B_KXX, B_KXY, B_KYY = 0, 1, 2, 3, 4, 5, 6
+BEARING_STATE = 7
+
+
+@njit(cache=True, inline="always")
+def _bearing_start(bstate, j, dx, dy, kb):
+    """The Newton start of crank j's bearing displacement at d: the last solution b_prev plus
+    its first-order change, b_prev + (I - K_s / k_bend)(d - d_prev) (db/dd = (K_b + k I)^-1 k
+    = I - K_s / k, :mod:`flexrv.contact.tapered_roller`), K_s the series tangent of the last
+    solution; the change is second order in d - d_prev. A reset state (K_s zero) or a rigid
+    crank: b_prev."""
+    b0x, b0y = bstate[j, B_X], bstate[j, B_Y]
+    kxx, kxy, kyy = bstate[j, B_KXX], bstate[j, B_KXY], bstate[j, B_KYY]
+    if kb > 0.0 and (kxx != 0.0 or kyy != 0.0):
+        ex, ey = dx - bstate[j, B_DX], dy - bstate[j, B_DY]
+        b0x += ex - (kxx * ex + kxy * ey) / kb
+        b0y += ey - (kxy * ex + kyy * ey) / kb
+    return b0x, b0y
+
+
 @njit(cache=True)
-def _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs):
+def _support_forces(d0x, d0y, u, dirs, clear, sc, linear, kb, bstate, fs, kk, hh, qs):
     """Spring force of every crank support at d = d0 - u (housing frame): fs (2N,)
     on the cranks, the block-diagonal tangent kk = -dfs/dd (2N, 2N), hh (2N, N)
-    = dfs/dgamma, the roller loads qs (N,); updates the bearing Newton starts."""
+    = dfs/dgamma, the roller loads qs (N,); updates the bearings' state (their Newton
+    starts, :func:`_bearing_start`; kb the crank's bending stiffness). ``dirs`` (N, 2, Z): each
+    support's roller directions at its cage angle (:func:`_support_approach`)."""
     for j in range(d0x.shape[0]):
-        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force(
-            d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1], gam[j], clear[j], sc, angles, linear, bstate[j, 0], bstate[j, 1]
+        dx, dy = d0x[j] - u[2 * j], d0y[j] - u[2 * j + 1]
+        b0x, b0y = _bearing_start(bstate, j, dx, dy, kb)
+        fx, fy, kxx, kxy, kyy, hx, hy, bx, by, qj = crank_support_force_at(
+            dx, dy, dirs[j, 0], dirs[j, 1], clear[j], sc, linear, b0x, b0y
         )
-        bstate[j, 0], bstate[j, 1] = bx, by
+        bstate[j, B_X], bstate[j, B_Y], bstate[j, B_DX], bstate[j, B_DY] = bx, by, dx, dy
+        bstate[j, B_KXX], bstate[j, B_KXY], bstate[j, B_KYY] = kxx, kxy, kyy
         fs[2 * j], fs[2 * j + 1] = fx, fy
         kk[2 * j, 2 * j], kk[2 * j, 2 * j + 1], kk[2 * j + 1, 2 * j], kk[2 * j + 1, 2 * j + 1] = kxx, kxy, kxy, kyy
         hh[2 * j, j], hh[2 * j + 1, j] = hx, hy
@@ -232,11 +263,11 @@ def _carrier_residual(u, ch, fs, res):
 
 
 @njit(cache=True)
-def _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res):
+def _carrier_evaluate(d0x, d0y, dirs, clear, sc, linear, kb, bstate, fs, kk, hh, qs, ch, u, res):
     """The elastic carrier's support forces at d = d0 - u and residual R = u + C_h f_s into
     ``res`` (tangent K into kk) for :func:`~flexrv.model.numerics.newton.newton_update`;
     returns (max|R|, max|u|)."""
-    _support_forces(d0x, d0y, u, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs)
+    _support_forces(d0x, d0y, u, dirs, clear, sc, linear, kb, bstate, fs, kk, hh, qs)
     r0 = _carrier_residual(u, ch, fs, res)
     umax = 0.0
     for r in range(u.shape[0]):
@@ -300,9 +331,11 @@ def _support_views(wk, n):
 
 
 @njit(cache=True, inline="always")
-def _support_approach(q, v, idx, bores, g, c, s, w):
+def _support_approach(q, v, idx, bores, g, c, s, angles, dirs, w):
     """Per crank: the bore's arm (rx, ry) in the housing frame, the rigid approach d0 of
-    the crank centre to its bore and its rate, the cage angle gamma; fs, u, K and H zeroed."""
+    the crank centre to its bore and its rate, the cage angle gamma and the roller
+    directions there into ``dirs`` (N, 2, Z; once per call: the carrier's Newton keeps
+    gamma); fs, u, K and H zeroed."""
     rx, ry, d0x, d0y, dvx, dvy, gam, fs = w.rx, w.ry, w.d0x, w.d0y, w.dvx, w.dvy, w.gam, w.fs
     u, kk, hh = w.u, w.kk, w.hh
     th, om = q[idx[2]], v[idx[2]]
@@ -316,6 +349,7 @@ def _support_approach(q, v, idx, bores, g, c, s, w):
         dvx[j] = v[jx] - v[idx[0]] + om * ry[j]
         dvy[j] = v[jy] - v[idx[1]] - om * rx[j]
         gam[j] = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
+        roller_directions_into(gam[j], angles, dirs[j, 0], dirs[j, 1])
     for r in range(2 * n):
         fs[r], u[r] = 0.0, 0.0
         for k in range(2 * n):
@@ -325,12 +359,12 @@ def _support_approach(q, v, idx, bores, g, c, s, w):
 
 
 @njit(cache=True, inline="always")
-def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, w):
+def _carrier_solve(q, idx, cc, c, s, clear, sc, dirs, linear, kb, bstate, ustate, w):
     """The elastic carrier's support-point deflection u = -C_h f_s(d0 - u) by the carrier
     Newton (numerics.newton), started from the first-order predictor of the previous
     call; the last correction applied linearised; u stored in ``ustate``."""
     ch, u, ulast, step, st, fs, kk, res = w.ch, w.u, w.ulast, w.step, w.st, w.fs, w.kk, w.res
-    ones, su, qp, nw, d0x, d0y, gam, hh = w.ones, w.su, w.qp, w.nw, w.d0x, w.d0y, w.gam, w.hh
+    ones, su, qp, nw, d0x, d0y, hh = w.ones, w.su, w.qp, w.nw, w.d0x, w.d0y, w.hh
     qs, u0, tmp, mm = w.qs, w.u0, w.tmp, w.mm
     n = ustate.shape[0]
     n2, m = 2 * n, 3 + 3 * n
@@ -359,7 +393,7 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, angles, linear, bstate, ustate, 
         apply_predictor(u, step, ones)
     newton_start(nw)
     while True:  # the carrier Newton (numerics.newton): R = u + C_h f_s(d0 - u), dR/du = I + C_h K
-        r1, scale = _carrier_evaluate(d0x, d0y, gam, clear, sc, angles, linear, bstate, fs, kk, hh, qs, ch, u, res)
+        r1, scale = _carrier_evaluate(d0x, d0y, dirs, clear, sc, linear, kb, bstate, fs, kk, hh, qs, ch, u, res)
         if newton_update(nw, r1, scale, u, u0, step, res, ch, kk, 1.0, tmp, mm, *CARRIER_NEWTON):
             break
     # the last Newton correction -step, linearised (O(|R|^2) exact): the result is smooth in q down to
@@ -513,8 +547,8 @@ def _support_jacobian(jq, jv, idx, with_arm, arm_term, w):
 @njit(cache=True)
 def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     """Crank supports (module docstring): Q into f[idx], Jacobians into jq, jv; the
-    force on each crank into out_fx, out_fy, the bearing displacement into bstate
-    (the next call's Newton start), the bending share of each support's
+    force on each crank into out_fx, out_fy, the bearings' state into bstate (the
+    next call's Newton start, :func:`_bearing_start`), the bending share of each support's
     tangential compliance into out_bend and, with an elastic carrier (``cc``, the
     (2N, 2N) support-point compliance in the carrier frame; (0, 0): rigid), the
     support points' deflection into ``ustate`` (N, 4): housing-frame x, y (the next
@@ -541,17 +575,17 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     (:func:`_support_loads`), the tangent (:func:`_support_tangent`) and the Jacobian rows
     (:func:`_support_jacobian`)."""
     idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
-    linear, g = pack.law.linear, pack.law.g
+    linear, g, kb = pack.law.linear, pack.law.g, pack.law.k_bend
     th = q[idx[2]]
     c, s = np.cos(th), np.sin(th)
     n = bores.shape[0]
     elastic = n > 0 and pack.carrier_c.shape[0] == 2 * n
     w = _support_views(pack.work, n)
-    _support_approach(q, v, idx, bores, g, c, s, w)
+    _support_approach(q, v, idx, bores, g, c, s, angles, pack.dirs, w)
     if elastic:
-        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, angles, linear, pack.bstate, pack.ustate, w)
+        _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, pack.dirs, linear, kb, pack.bstate, pack.ustate, w)
     else:
-        _support_forces(w.d0x, w.d0y, w.u, w.gam, clear, sc, angles, linear, pack.bstate, w.fs, w.kk, w.hh, w.qs)
+        _support_forces(w.d0x, w.d0y, w.u, pack.dirs, clear, sc, linear, kb, pack.bstate, w.fs, w.kk, w.hh, w.qs)
     _support_loads(f, idx, pack.law.damping, pack.law.k_bend, pack.fx, pack.fy, pack.bend, w)
     if not (jac or elastic):
         return
@@ -708,13 +742,16 @@ class CrankSupports(KernelGroup):
         self.c = p.support_damping
         self.law = SupportLaw.of(damping=self.c, linear=self.linear, k_bend=self.sc.k_bend, g=self.sc.g)
         self.fx, self.fy = np.zeros(self.n), np.zeros(self.n)
-        self.bstate = np.zeros((self.n, 2))
+        #: per crank the bearings' last solution, its d and K_s (BEARING_STATE columns: the Newton start)
+        self.bstate = np.zeros((self.n, BEARING_STATE))
         self.bend = np.zeros(self.n)
         #: (2N, 2N) support-point compliance of the elastic carrier, carrier frame [m/N]; (0, 0): rigid
         self.carrier_c = np.ascontiguousarray(p.carrier_compliance, dtype=float)
         if self.carrier_c.size and self.carrier_c.shape != (2 * self.n, 2 * self.n):
             raise ValueError(f"carrier_compliance has shape {self.carrier_c.shape}, expected {(2 * self.n,) * 2}")
         self.ustate = np.zeros((self.n, 4))
+        #: per crank the roller directions (x, y) at its cage angle (crank_support_kernel's scratch)
+        self.dirs = np.zeros((self.n, 2, len(self.angles)))
         #: crank_support_kernel's work array (the carrier Newton's predictor state, scratch)
         self.work = np.zeros(support_work_size(self.n))
 
@@ -736,6 +773,7 @@ class CrankSupports(KernelGroup):
             bend=self.bend,
             carrier_c=self.carrier_c,
             ustate=self.ustate,
+            dirs=self.dirs,
             work=np.zeros_like(self.work) if history else self.work,
         )
 

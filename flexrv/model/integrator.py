@@ -37,7 +37,14 @@ NEWTON_OPTIONS = {
     "maxModifiedNewtonIterations": "max_modified",
     "adaptInitialResidual": "adapt_initial_residual",
     "modifiedNewtonJacUpdatePerStep": "jacobian_each_step",
+    "extrapolatedPredictor": "extrapolate",
 }
+
+#: the compiled integrator's own Newton options (not Exudyn settings) and their defaults.
+#: ``extrapolatedPredictor``: a step's predictor moved by the previous step's Newton correction
+#: (:mod:`flexrv.model.numerics.gen_alpha`); False: Exudyn's predictor, the same steps and Newton
+#: iterations as Exudyn's integrator
+COMPILED_ONLY_OPTIONS = {"extrapolatedPredictor": True}
 
 #: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's
 #: minimumStepSize to 1e-3 dt)
@@ -78,7 +85,7 @@ def compiled_eligible(model) -> str | None:
 def compiled_newton_options(options: dict | None) -> dict:
     """The gen_alpha keywords of Exudyn-named Newton ``options``; an option the compiled
     integrator does not honour is an InputError naming it and the allowed ones."""
-    out = {}
+    out = {NEWTON_OPTIONS[k]: v for k, v in COMPILED_ONLY_OPTIONS.items()}
     for key, value in (options or {}).items():
         if key not in NEWTON_OPTIONS:
             raise InputError(
@@ -121,11 +128,13 @@ class CompiledIntegrator:
         self.timed = [(i, g) for i, (g, _) in enumerate(fused.slots) if g.time_field]
         ctrs = [c for _, c in fused.counters]
         self.ctrs = tuple(ctrs) if ctrs else (np.zeros(1, np.int64),)
-        #: the compiled entry points of fused_integrate for this model's argument types, by the number
-        #: of record arrays (skips numba's typing of the ~60 arguments on every call; valid while the
-        #: types stay: every array :meth:`_call` passes is a fresh or fixed float64/int64/bool
-        #: C-contiguous array of fixed dimension)
-        self._entry = {}
+        #: the compiled entry points of fused_integrate for this model's argument types, by the
+        #: record arrays' kinds (skips numba's typing of the ~60 arguments, ~10 ms, on every call;
+        #: valid while the types stay: every array :meth:`_call` passes is a fresh or fixed
+        #: float64/int64/bool C-contiguous array of fixed dimension), kept on the model's fused
+        #: element for the integrators of its later runs
+        self._entry = fused.__dict__.setdefault("integrate_entries", {})
+        self._src, self._key = None, None
         #: steps of the nominal size per compiled call (the caller's checks run in between)
         self.check_every = 10
 
@@ -169,26 +178,28 @@ class CompiledIntegrator:
     def segment(self, t0: float, t1: float, h: float, rec, out, after_call) -> tuple[int, float]:
         """Integrate from the current state at ``t0`` to ``t1`` with nominal step ``h`` (module
         docstring). Steps of the nominal size run :attr:`check_every` at a time in compiled
-        code, reduced ones one by one. ``rec`` (int64: next row, rows, segment end not
+        code (their time inputs evaluated once from the start or the return to the nominal
+        step), reduced ones up to the next test for doubling the step. ``rec`` (int64: next row, rows, segment end not
         recorded), ``rec_t`` inside ``out``: the recording state of ``fused_integrate``;
         ``after_call(t, steps)`` runs after every compiled call (checks, signals, progress) and
         returns True to stop. Returns (status, time reached): 0 done, -1 stopped by
         ``after_call``, else the failure status of ``fused_integrate``."""
         t, step, since = t0, h, 0
         end_recorded = rec[2]
-        grid = self._grid(t0, t1, h)  # the nominal steps' end times and time inputs, while on that grid
-        at = 0  # the next grid step
+        grid, at = None, 0  # the nominal steps' end times and time inputs from the last (re)start, the next one
         while t < t1 - 1e-10:
-            if step == h and grid is not None:
+            if step == h:
+                if grid is None:
+                    grid, at = self._grid(t, t1, h), 0
                 stop = min(at + self.check_every, len(grid[0]))
                 times, tables = grid[0][at:stop], [tb[at:stop] for tb in grid[1]]
             else:
                 grid = None
-                times = t + step * np.arange(1, (self.check_every if step == h else 1) + 1)
+                times = self._times(t, step, max(RECOVERY_STEPS - since, 1))
                 last = np.nonzero(times >= t1 - 1e-10)[0]
                 if len(last):
                     times = times[: last[0] + 1]
-                    times[-1] = min(times[-1], t1)
+                    times[-1] = t1  # (clipped, or a sum's round-off off the end)
                 tables = self.tables(times)
             rec[2] = end_recorded if times[-1] >= t1 - 1e-10 else 0
             done, status = self._call(times, t, out, rec, tables)
@@ -207,14 +218,18 @@ class CompiledIntegrator:
                 return -1, t
         return 0, t
 
-    def _grid(self, t0: float, t1: float, h: float) -> tuple | None:
-        """(end times t0 + k h of a segment's nominal steps, the last clipped to t1, their time
-        inputs): one vectorised evaluation per segment instead of one per compiled call."""
-        n = int(np.ceil((t1 - t0) / h - 1e-9))
-        if n < 1:
-            return None
-        times = t0 + h * np.arange(1, n + 1)
-        times[-1] = min(times[-1], t1)
+    @staticmethod
+    def _times(t: float, step: float, n: int) -> np.ndarray:
+        """The end times of ``n`` steps of ``step`` from ``t``, summed one by one (t += step, as
+        the steps are taken one at a time)."""
+        return np.cumsum(np.concatenate(([t], np.full(n, step))))[1:]
+
+    def _grid(self, t0: float, t1: float, h: float) -> tuple:
+        """(end times t0 + h, t0 + 2 h, ... of the nominal steps up to t1, the last clipped to t1,
+        their time inputs): one vectorised evaluation per segment (or per return to the nominal
+        step) instead of one per compiled call."""
+        times = self._times(t0, h, max(int(np.ceil((t1 - t0) / h - 1e-9)), 1))
+        times[-1] = t1
         return times, self.tables(times)
 
     def tables(self, times: np.ndarray) -> list:
@@ -253,12 +268,14 @@ class CompiledIntegrator:
             vs,
             valid,
         )
-        entry = self._entry.get(len(src))  # (the argument types differ only in the number of records)
+        if src is not self._src:  # (the argument types differ only in the record buffers, fixed in a run)
+            self._src, self._key = src, tuple((a.dtype.char, a.ndim) for a in (*src, *dst))
+        entry = self._entry.get(self._key)
         if entry is None:  # the compiled function for these types, called directly from then on
             n, status = fused.integrate_kernel(*args)
             from flexrv.model.kernels import _entry_point
 
-            self._entry[len(src)] = _entry_point(fused.integrate_kernel, args)
+            self._entry[self._key] = _entry_point(fused.integrate_kernel, args)
         else:
             n, status = entry(*args)
         for _, g in self.timed:

@@ -15,7 +15,10 @@ is copied): from the spectral radius rho_inf
     v = v_n + h (1 - gamma) a_alg_n + h gamma a*,   a* = (alpha_f a_n - alpha_m a_alg_n) / (1 - alpha_m),
     a = 0,
 
-and corrects with Newton on the residual r = M a + K q + D v - f(t_n+1, q, v): with
+(with ``extrapolate``, moved by the previous step's whole Newton correction e = q_n -
+q_pred,n when that step had the same size: q += e, v += gamma' e, a += beta' e, the
+direction of every Newton update below, so the iterates solve the same equations from
+a nearer start), and corrects with Newton on the residual r = M a + K q + D v - f(t_n+1, q, v): with
 beta' = (1 - alpha_m) / (h^2 beta (1 - alpha_f)) and gamma' = gamma / (h beta), the
 iteration matrix S = beta' M + K + gamma' D - df/dq - gamma' df/dv and the update
 S dx = r, q -= dx, v -= gamma' dx, a -= beta' dx. After convergence
@@ -60,13 +63,13 @@ from flexrv.model.numerics.linalg import lu_factor, lu_solve
 
 # -- indices into the state's float parameters ``par``
 P_ALPHA_M, P_ALPHA_F, P_GAMMA, P_BETA, P_RTOL, P_ATOL, P_CONTRACT, P_MAXNORM = range(8)
-P_H, P_R0, P_RES, P_LAST, P_HJAC = 8, 9, 10, 11, 12
-N_PAR = 13
+P_H, P_R0, P_RES, P_LAST, P_HJAC, P_HPREV = 8, 9, 10, 11, 12, 13
+N_PAR = 14
 # -- indices into the state's integer registers ``ip``
 I_PHASE, I_IT, I_JACREQ, I_FULL, I_RESTARTED, I_EXTRA, I_JAC, I_MAXIT, I_MAXMOD = range(9)
 I_NEWTON, I_JACOBIANS, I_CALLS, I_JACCALLS, I_ADAPT = 9, 10, 11, 12, 13
-I_EACHSTEP, I_FACTORED = 14, 15
-N_IP = 16
+I_EACHSTEP, I_FACTORED, I_EXTRAPOLATE = 14, 15, 16
+N_IP = 17
 # -- phases: what the evaluation the state machine asked for is
 PH_PREDICTOR, PH_ITERATE, PH_JACOBIAN = 0, 1, 2
 # -- results of after_eval
@@ -91,6 +94,8 @@ GaState = pack_type(
     ("aa0", (np.float64, 1)),
     ("r", (np.float64, 1)),
     ("dx", (np.float64, 1)),
+    ("qp", (np.float64, 1)),
+    ("e", (np.float64, 1)),
     ("mass", (np.float64, 2)),
     ("stiff", (np.float64, 2)),
     ("damp", (np.float64, 2)),
@@ -132,8 +137,11 @@ def new_state(
     adapt_initial_residual: bool = True,
     blocks=None,
     jacobian_each_step: bool = True,
+    extrapolate: bool = False,
 ) -> GaState:
     """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0).
+    ``extrapolate``: the predictor moved by the previous step's Newton correction (module
+    docstring); False: Exudyn's predictor.
     ``blocks``: [(start, size), ...] dense diagonal blocks of the iteration matrix that couple
     only through the other coordinates (M, K, D and the force's Jacobians zero between two
     blocks): the Newton systems are then solved by block elimination
@@ -160,7 +168,8 @@ def new_state(
     ip = np.zeros(N_IP, np.int64)
     ip[I_MAXIT], ip[I_MAXMOD], ip[I_ADAPT] = max_iterations, max_modified, int(adapt_initial_residual)
     ip[I_EACHSTEP] = int(jacobian_each_step)
-    vec = [np.zeros(n) for _ in range(10)]
+    ip[I_EXTRAPOLATE] = int(extrapolate)
+    vec = [np.zeros(n) for _ in range(12)]
     return GaState(
         par,
         ip,
@@ -185,6 +194,7 @@ def set_state(st: GaState, q, v, a, a_alg=None) -> None:
     """Start from (q, v, a); the algorithmic accelerations a_alg default to a (a restart,
     which also forgets the factorised iteration matrix)."""
     st.ip[I_FACTORED] = 0
+    st.par[P_HPREV] = 0.0
     st.q[:], st.v[:], st.a[:] = q, v, a
     st.aa[:] = a if a_alg is None else a_alg
 
@@ -225,6 +235,25 @@ def begin_step(st, h):
     kept = ip[I_EACHSTEP] == 0 and ip[I_FACTORED] != 0 and abs(st.par[P_HJAC] - h) <= 1e-9 * h
     ip[I_JAC] = 0 if kept else 1
     _predict(st)
+    for i in range(st.q.shape[0]):
+        st.qp[i] = st.q[i]
+    if ip[I_EXTRAPOLATE] and abs(st.par[P_HPREV] - h) <= 1e-9 * h:
+        _add_correction(st)
+
+
+@njit(cache=True, inline="always")
+def _add_correction(st):
+    """The predictor moved by the previous step's Newton correction e (the same step):
+    q += e, v += gamma' e, a += beta' e, along the Newton iterates' own directions, so the
+    converged state solves the same equations."""
+    par = st.par
+    h = par[P_H]
+    bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
+    gp = par[P_GAMMA] / (h * par[P_BETA])
+    for i in range(st.q.shape[0]):
+        st.q[i] += st.e[i]
+        st.v[i] += gp * st.e[i]
+        st.a[i] += bp * st.e[i]
 
 
 @njit(cache=True, inline="always")
@@ -398,8 +427,10 @@ def finish_step(st):
     par = st.par
     c = (1.0 - par[P_ALPHA_F]) / (1.0 - par[P_ALPHA_M])
     ok = True
+    par[P_HPREV] = par[P_H]
     for i in range(st.q.shape[0]):
         st.aa[i] += c * st.a[i]
+        st.e[i] = st.q[i] - st.qp[i]
         if not (math.isfinite(st.q[i]) and math.isfinite(st.v[i])):
             ok = False
     return ok

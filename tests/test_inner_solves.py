@@ -1,0 +1,118 @@
+"""The force kernel's inner solves: the pins' per-contact records after the rim Newton's
+quadratic stop, moved to the pose of the linearised last correction
+(flexrv.model.pins._shift_records), equal an exact evaluation of the pin kernel there; the
+crank bearings' first-order Newton start (flexrv.model.cranks_discs._bearing_start) is
+second order in the change of the crank's displacement."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from flexrv.design import load
+from flexrv.model.drive import drive_parameters
+
+
+def _rigid_pins():
+    """rv40e's pins with rigid discs and housing (the plain pin kernel), a loaded state with
+    sliding velocities (the friction records act)."""
+    from flexrv.model.factory import _members
+    from flexrv.model.pins import PinContacts
+
+    r = load("rv40e")
+    p = PinContacts.parameters(r, drive_parameters(r))
+    p = dataclasses.replace(p, disc_compliance=np.zeros((0, 3, 3)), housing_compliance=0.0)
+    mem = _members(p.drive)
+    q = np.concatenate([mem[f"disc{k}"].q0 for k in range(p.drive.n_discs)])
+    q[2::3] -= 3e-4  # the discs turned against their pins: loaded
+    v = np.zeros_like(q)
+    v[0::3], v[1::3], v[2::3] = 2e-4, -1e-4, 1e-2
+    return p, q, v
+
+
+def _evaluate(g, pack, q, v):
+    from flexrv.model.pins import pin_kernel
+
+    n = q.shape[0]
+    pin_kernel(q, v, np.zeros(n), np.zeros((n, n)), np.zeros((n, n)), True, pack.pins)
+    return {k: getattr(g, k).copy() for k in ("gap", "force", "nx", "ny", "rxn", "ft", "pw")}
+
+
+def test_shifted_records_equal_an_exact_evaluation_at_the_corrected_pose():
+    """After a quadratic stop the rim Newton applies its last correction dq linearised and
+    moves the last evaluation's records by dq (_shift_records: first order in dq through
+    the gap gradient and the normal's turn of the kernel's Jacobian, the contact and
+    friction laws evaluated again). Against an exact evaluation at q + dq (every pin, cold
+    closest points) for a correction of |dP| ~ 6e-10 m (the corrections of a run are
+    ~1e-12 m): gaps of the evaluated pins within 1e-15 m (the remainder ~h |dP|^2 ~
+    4e-17 m; measured 3e-16), forces, friction forces and powers within 1e-9 of their largest
+    value (measured 6e-11), the normals and arms within 1e-11 (the remainder (h |dP|)^2 ~
+    1e-11 at the tooth tip's curvature h = 4.7e3 /m; measured 5.9e-12, falling as |dq|^2 to
+    the closest points' own floor ~1e-13); a pin the kernel proved open keeps a positive lower
+    bound of its exact gap. Without the shift the records differ by ~1e-4 of the largest
+    force (checked: the comparison sees the correction)."""
+    from flexrv.model.pins import PinContacts, _shift_records
+
+    p, q, v = _rigid_pins()
+    idx = np.arange(q.shape[0], dtype=np.int64)
+    g, ref = PinContacts(p), PinContacts(p)
+    pack = g.pack(idx)
+    _evaluate(g, pack, q, v)
+    before = _evaluate(g, pack, q, v)  # the second call skips the pins its last exact gaps prove open
+    skipped = np.isnan(g.curv[..., 0])
+    assert skipped.sum() >= 10 and (before["force"] > 0).sum() >= 10
+    dq = np.zeros_like(q)
+    dq[0::3], dq[1::3], dq[2::3] = 2e-10, -1e-10, 3e-9
+    _shift_records(pack.pins, q, v, dq)
+    exact = _evaluate(ref, ref.pack(idx, history=True), q + dq, v)
+    shifted = {k: getattr(g, k) for k in exact}
+    fmax = np.abs(exact["force"]).max()
+    assert np.abs(before["force"] - exact["force"]).max() > 1e-5 * fmax  # the correction is seen
+    ev = ~skipped
+    assert np.abs(shifted["gap"] - exact["gap"])[ev].max() <= 1e-15
+    assert np.all(shifted["gap"][skipped] > 0.0) and np.all(shifted["gap"][skipped] <= exact["gap"][skipped])
+    assert np.all(exact["force"][skipped] == 0.0)
+    for key in ("force", "ft", "pw"):
+        scale = np.abs(exact[key]).max()
+        assert scale > 0.0 and np.abs(shifted[key] - exact[key]).max() <= 1e-9 * scale, key
+    for key in ("nx", "ny", "rxn"):
+        assert np.abs(shifted[key] - exact[key])[ev].max() <= 1e-11, key
+
+
+def test_bearing_start_is_second_order_in_the_displacement_change():
+    """The crank support's inner Newton starts from b_prev + (I - K_s / k_bend)(d - d_prev)
+    (db/dd = (K_b + k I)^-1 k = I - K_s / k, the series tangent K_s of the last solution).
+    Against the converged b at d_prev + e (crank_support_force, tests/test_rigspeed.py checks
+    it against an independent root finder) on rv40e's loaded support (|d| = 25 um, with and
+    without clearance): the start's error falls as |e|^2 (ratio <= 0.02 for |e| 10x
+    smaller; exactly 0.01 for a quadratic remainder) and is below 1e-3 of the previous
+    solution's (b_prev: first order, ~|e| k / (K_b + k)) at |e| = 1e-8 m. Measured: 4.9e-14 m
+    against 4.0e-9 m at |e| = 1e-8 m, ratio 0.0100 (5.5e-14 m with the clearance). A zero
+    state (a reset) starts from b_prev."""
+    from flexrv.contact.tapered_roller import crank_support_force
+    from flexrv.model.cranks_discs import BEARING_STATE, CrankSupports, _bearing_start
+
+    r = load("rv40e")
+    g = CrankSupports(CrankSupports.parameters(r, drive_parameters(r)))
+    sc, angles, kb = g.sc, g.angles, g.sc.k_bend
+    assert kb > 0.0 and not g.linear
+    for clear in (0.0, 2e-6):
+        d = np.array([15e-6, -20e-6])
+        gam = 0.7
+        fx, fy, kxx, kxy, kyy, _, _, bx, by, _ = crank_support_force(d[0], d[1], gam, clear, sc, angles, False, 0, 0)
+        state = np.zeros((1, BEARING_STATE))
+        state[0, :7] = bx, by, d[0], d[1], kxx, kxy, kyy
+        errs, prev = [], []
+        for eps in (1e-8, 1e-9):
+            e = eps * np.array([0.6, -0.8])
+            start = np.array(_bearing_start(state, 0, d[0] + e[0], d[1] + e[1], kb))
+            sol = crank_support_force(d[0] + e[0], d[1] + e[1], gam, clear, sc, angles, False, *start)
+            exact = np.array(sol[7:9])
+            errs.append(np.hypot(*(start - exact)))
+            prev.append(np.hypot(bx - exact[0], by - exact[1]))
+        assert errs[0] <= 1e-3 * prev[0], (errs, prev)
+        assert errs[1] <= 0.02 * errs[0], errs
+        zero = np.zeros((1, BEARING_STATE))
+        zero[0, :2] = bx, by
+        assert _bearing_start(zero, 0, d[0] + 1e-8, d[1], kb) == (bx, by)
