@@ -104,23 +104,35 @@ def _clocked_integrate(model):
 
     specs = [registry.spec_of(g) for g, _ in model.fused.slots]
     src = registry._fused_source(specs, registry._source_hash(specs))
-    call = next((ln for ln in src.splitlines() if ln.strip().startswith("fused_kernel(st.q")), None)
-    if call is None:
+    integrate = src.index("def fused_integrate(")
+    head, body = src[:integrate], src[integrate:]
+    lines = body.splitlines(keepends=True)
+    # the one evaluation site: from zeroing f to the last element's kernel call
+    first = next((i for i, ln in enumerate(lines) if ln.strip() == "f[:] = 0.0"), None)
+    last = max((i for i, ln in enumerate(lines) if ln.lstrip().startswith(f"k{len(specs) - 1}(q, v,")), default=None)
+    if first is None or last is None:
         raise RuntimeError("--split: the generated fused_integrate has no kernel call site it recognises")
-    ind = call[: len(call) - len(call.lstrip())]
+    ind = lines[first][: len(lines[first]) - len(lines[first].lstrip())]
     clocked = (
-        f"{ind}c0 = _clock()\n{call}\n{ind}c1 = _clock() - c0\n{ind}ctrs[-1][{_K}] += c1\n"
-        f"{ind}if st.ip[I_IT] == 0:\n{ind}    ctrs[-1][{_FIRST}] += c1\n{ind}    ctrs[-1][{_NFIRST}] += 1\n"
+        f"{ind}c0 = _clock()\n{''.join(lines[first : last + 1])}{ind}c1 = _clock() - c0\n"
+        f"{ind}if not rows:\n{ind}    ctrs[-1][{_K}] += c1\n"
+        f"{ind}    if st.ip[I_IT] == 0:\n{ind}        ctrs[-1][{_FIRST}] += c1\n{ind}        ctrs[-1][{_NFIRST}] += 1\n"
     )
-    done = f"ctrs[-1][{_CALL}] += _clock() - t_call\n"
+    body = "".join(lines[:first]) + clocked + "".join(lines[last + 1 :])
+
+    def done(pad: str) -> str:  # (the ROWS mode's counters are the element's: no clock there)
+        return f"{pad}if not rows:\n{pad}    ctrs[-1][{_CALL}] += _clock() - t_call\n"
+
+    body = (
+        body.replace("    n = qs.shape[0] if rows", "    t_call = _clock()\n    n = qs.shape[0] if rows")
+        .replace("                return i, 2\n", done("                ") + "                return i, 2\n")
+        .replace("                return i, 1\n", done("                ") + "                return i, 1\n")
+        .replace("                return i, 3\n", done("                ") + "                return i, 3\n")
+        .replace("    return n, 0\n", done("    ") + "    return n, 0\n")
+    )
     src = (
-        src.replace(call + "\n", clocked)
-        .replace("import EVALUATE,", "import I_IT, EVALUATE,")
-        .replace("    n = times.shape[0]\n", "    t_call = _clock()\n    n = times.shape[0]\n")
-        .replace("                return i, 2\n", "                " + done + "                return i, 2\n")
-        .replace("            return i, 1\n", "            " + done + "            return i, 1\n")
-        .replace("            return i, 3\n", "            " + done + "            return i, 3\n")
-        .replace("    return n, 0\n", "    " + done + "    return n, 0\n")
+        (head + body)
+        .replace("import CONVERGED,", "import I_IT, CONVERGED,")
         .replace(
             "from numba import njit\n",
             "from numba import njit\nimport ctypes\n_clock = ctypes.CDLL(None).clock\n"

@@ -263,7 +263,7 @@ def test_extrapolated_predictor_same_states_closer_start():
         gen_alpha.begin_step(st, h)
         status = gen_alpha.EVALUATE
         while status == gen_alpha.EVALUATE:
-            status = gen_alpha.after_eval(st, -K2 @ st.q, -K2, np.zeros((2, 2)))
+            status = gen_alpha.after_eval(st, -K2 @ st.q, -K2, np.zeros((2, 2)), None)
         assert status == gen_alpha.CONVERGED and gen_alpha.finish_step(st)
         assert np.max(np.abs(st.q - each[0][i + 1])) <= 1e-12
     mass, k, c, q0 = np.eye(3), 1.0, 4.0, np.array([0.5, 1.0, 1.5])
