@@ -237,6 +237,10 @@ def main(argv: list[str] | None = None) -> None:
     from flexrv.model.kernel_cache import stop_on_signal_while_compiling
 
     stop_on_signal_while_compiling()  # (a signal inside numba's compilation would otherwise be lost)
+    if argv is None:  # this process's own command line: a signal inside a long compiled call ends it
+        from flexrv.cli._signals import start_watchdog
+
+        start_watchdog()
     first_run_notice(args)
     no_args = _types("NoArgsIsHelpError")
     click_exc = _types("ClickException")
