@@ -516,6 +516,7 @@ def _uncertainty(names, lo, hi, x0, u, jw, s2: float, t95: float) -> dict:
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
+    corr[np.diag_indices_from(corr)] = np.where(sd > 0, 1.0, np.nan)  # exactly 1 by definition (not sd^2 / sd^2)
     x = lo + u * scale
     ident = {}
     for j, k in enumerate(names):
