@@ -212,7 +212,7 @@ def first_run_notice(args: list[str], stream=None) -> str | None:
 
     line = (
         f"flexrv {command}: first run: compiling numba kernels and building the design's FE bodies "
-        f"(once, about {FIRST_RUN_ESTIMATE_S / 60:.0f} min on 2 cores; later runs take seconds)"
+        f"(once, about {FIRST_RUN_ESTIMATE_S} s on 2 cores; later runs take seconds)"
     )
     print(line, file=sys.stderr if stream is None else stream, flush=True)
     return line

@@ -69,7 +69,7 @@ RUN_ENTRY_POINTS = {
 COMPILE_ESTIMATE_S = 45
 #: a whole first run [s] on 2 cores (kernels compiled in the background while the FE bodies of a preset
 #: are built; benchmarks/bench_first_run.py, docs/benchmarks.md), for the command line's notice
-FIRST_RUN_ESTIMATE_S = 60
+FIRST_RUN_ESTIMATE_S = 45
 
 
 def uncached_kernels(modules: dict | None = None) -> list[str]:
