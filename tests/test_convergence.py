@@ -169,21 +169,9 @@ class TestConvergenceCarrierTorsion:
         from flexrv.fem.assembly import assemble
         from flexrv.fem.carrier import bore_groups, clamped_flexibility, rbe3_loads, torque_load_vector
         from flexrv.meshing.mesh import generate_mesh
-        from flexrv.meshing.parts import CarrierSpec
+        from tests._parts import MINI_CARRIER
 
-        spec = CarrierSpec(
-            plate_radius=0.03,
-            input_thickness=0.006,
-            output_thickness=0.006,
-            gap=0.012,
-            crank_circle_radius=0.014,
-            crank_bore_radius=0.005,
-            n_cranks=3,
-            center_bore_radius=0.003,
-            pillar_circle_radius=0.016,
-            pillar_radius=0.003,
-            pillar_angles=tuple(np.pi / 3 + 2 * np.pi * k / 3 for k in range(3)),
-        )
+        spec = MINI_CARRIER
         g = torque_load_vector(3, spec.crank_circle_radius, 0.5)
         c = []
         for h in self.sizes:

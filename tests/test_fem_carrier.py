@@ -27,6 +27,7 @@ from flexrv.meshing import build_mesh
 from flexrv.meshing.mesh import generate_mesh
 from flexrv.meshing.parts import CarrierSpec, spec_for
 from flexrv.units import RAD_PER_ARCMIN
+from tests._parts import MINI_CARRIER
 
 #: coarse mesh of the rv40e carrier for the fast tests [m]: at most the 6.5 mm ligament between the
 #: 27 mm centre bore and the crank bores
@@ -38,20 +39,7 @@ def _cache(tmp_path, monkeypatch):
     monkeypatch.setenv("FLEXRV_CACHE_DIR", str(tmp_path))
 
 
-#: a small carrier (3 cranks, 3 pillars) for the exactness tests
-MINI = CarrierSpec(
-    plate_radius=0.03,
-    input_thickness=0.006,
-    output_thickness=0.006,
-    gap=0.012,
-    crank_circle_radius=0.014,
-    crank_bore_radius=0.005,
-    n_cranks=3,
-    center_bore_radius=0.003,
-    pillar_circle_radius=0.016,
-    pillar_radius=0.003,
-    pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
-)
+MINI = MINI_CARRIER
 
 
 @pytest.fixture(scope="module")

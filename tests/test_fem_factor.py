@@ -6,8 +6,6 @@ well-conditioned clamped stiffness, so they agree to round-off (measured ~1e-14)
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -30,7 +28,7 @@ from flexrv.fem.factor import _supervariables, factorize, nested_dissection_orde
 from flexrv.fem.modal import free_dofs
 from flexrv.meshing import build_mesh
 from flexrv.meshing.mesh import generate_mesh
-from flexrv.meshing.parts import CarrierSpec
+from tests._parts import MINI_CARRIER
 
 SIZE, LOCAL = 0.008, 0.004
 REL = 1e-10
@@ -49,20 +47,7 @@ def _mmd_solve(A, B):
     return lu.solve(np.asarray(B, dtype=float)), lu.nnz
 
 
-#: a small carrier (3 cranks, 3 pillars), steel
-MINI = CarrierSpec(
-    plate_radius=0.03,
-    input_thickness=0.006,
-    output_thickness=0.006,
-    gap=0.012,
-    crank_circle_radius=0.014,
-    crank_bore_radius=0.005,
-    n_cranks=3,
-    center_bore_radius=0.003,
-    pillar_circle_radius=0.016,
-    pillar_radius=0.003,
-    pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
-)
+MINI = MINI_CARRIER
 
 
 @pytest.fixture(scope="module")
