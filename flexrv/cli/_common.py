@@ -17,6 +17,8 @@ from flexrv.post.format import fmt  # noqa: F401  (one number format for every t
 #: (``[/x].toml`` is a valid file name, ``[s]`` a unit), styles are passed explicitly
 console = Console(markup=False)
 
+#: help of a command's design argument (a preset name or a TOML path)
+PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 JSON_HELP = "Print machine-readable JSON on stdout instead of a table."
 
 

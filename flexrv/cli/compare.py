@@ -6,8 +6,7 @@ from pathlib import Path
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, console, emit
-from flexrv.cli.design import PRESET_HELP
+from flexrv.cli._common import JSON_HELP, PRESET_HELP, console, emit
 
 
 def compare(

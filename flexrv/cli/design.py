@@ -8,10 +8,8 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from flexrv.cli._common import JSON_HELP, console, emit, fmt, render_nested
+from flexrv.cli._common import JSON_HELP, PRESET_HELP, console, emit, fmt, render_nested
 from flexrv.design import list_presets, load, to_toml
-
-PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
 
 def presets(json: bool = typer.Option(False, "--json", help=JSON_HELP)) -> None:

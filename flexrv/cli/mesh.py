@@ -10,10 +10,8 @@ from typing import Optional
 import typer
 from rich.table import Table
 
-from flexrv.cli._common import JSON_HELP, console, emit, fmt, kv_table
+from flexrv.cli._common import JSON_HELP, PRESET_HELP, console, emit, fmt, kv_table
 from flexrv.units import M_PER_MM
-
-PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
 
 class Part(str, enum.Enum):

@@ -10,14 +10,13 @@ import typer
 from flexrv.cli._common import (
     JSON_HELP,
     OVERWRITE_HELP,
+    PRESET_HELP,
     check_output_dir,
     console,
     emit,
     kv_table,
     skip_final_collection,
 )
-
-PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
 
 def _bar(enabled: bool):

@@ -11,6 +11,7 @@ import typer
 from flexrv.cli._common import (
     JSON_HELP,
     OVERWRITE_HELP,
+    PRESET_HELP,
     check_output_dir,
     console,
     emit,
@@ -21,8 +22,6 @@ from flexrv.cli.design import analytic_budget, budget_table
 from flexrv.post.definitions import DEFINITIONS, PLAY_FRACTIONS
 from flexrv.post.te import TE_ROWS
 from flexrv.units import RAD_PER_ARCMIN
-
-PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 
 
 def te(

@@ -8,9 +8,8 @@ from typing import List, Optional
 
 import typer
 
-from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, check_output_dir, console, emit
+from flexrv.cli._common import JSON_HELP, OVERWRITE_HELP, PRESET_HELP, check_output_dir, console, emit
 
-PRESET_HELP = "Preset name (see `flexrv presets`) or path to a design TOML file."
 MEASURED_HELP = "Measured-data CSV file (repeatable; format flexrv-measured-1, see docs/measured-data.md)."
 LOOP_MODEL_HELP = (
     "Prediction of a stiffness loop: stiffness-test (the dynamic virtual test, the bench's program, with "

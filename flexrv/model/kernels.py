@@ -396,14 +396,16 @@ class FusedForces:
         self._jac_ready = True
         return self.jq, self.jv
 
-    def full(self, t, q, v, jacobian: bool = True):
-        """Force and Jacobians on the MODEL's full vector (copies), for static solvers."""
+    def full(self, t, q, v, jacobian: bool = True, velocity: bool = True):
+        """Force and Jacobians on the MODEL's full vector (copies), for static solvers; dF/dv is
+        None unless ``jacobian`` and ``velocity`` (a static solver never reads it)."""
         n_model = len(q)
         self.memo, self._jac_ready = None, False  # the caller may change its arrays afterwards
         call = self._call if self._driver is None else self._call_rows
         if self.is_full:
             call(float(t), q, v, bool(jacobian))
-            return self.f.copy(), (self.jq.copy() if jacobian else None), (self.jv.copy() if jacobian else None)
+            jv = self.jv.copy() if jacobian and velocity else None
+            return self.f.copy(), (self.jq.copy() if jacobian else None), jv
         ix = self.index
         call(float(t), np.ascontiguousarray(q[ix]), np.ascontiguousarray(v[ix]), bool(jacobian))
         f = np.zeros(n_model)

@@ -177,11 +177,9 @@ class StaticModel:
         self.calls += 1
         fused = self.model.fused
         if fused is not None and fused.is_full and not fused.others:
-            # the fused element holds every force (the rigid model): its compiled call directly, without
-            # the velocity Jacobian a static solver never reads
-            fused.memo, fused._jac_ready = None, False
-            fused._call(float(theta_in), np.ascontiguousarray(q, dtype=float), self._zero, bool(jacobian))
-            f, dq = fused.f.copy(), (fused.jq.copy() if jacobian else None)
+            # the fused element holds every force (the rigid model): its call directly, without the
+            # velocity Jacobian a static solver never reads
+            f, dq, _ = fused.full(theta_in, np.ascontiguousarray(q, dtype=float), self._zero, jacobian, velocity=False)
         else:
             f, dq, _ = self.model.generalized_forces(theta_in, q, self._zero, jacobian=jacobian)
         self.last = (theta_in, q)  # the state the force groups' records belong to (_CurveRecords)
