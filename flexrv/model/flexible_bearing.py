@@ -564,10 +564,10 @@ def row_work(row: RowModel, record: bool = True) -> tuple:
 
 
 class RowElement:
-    """THE Exudyn glue of the bearing rows: one Exudyn element for one or
-    more rows (the reducer model: one per row, or one for all rows with quasi-static
-    balls, see :meth:`BallBearingGroup.add_to`), one compiled call
-    (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
+    """The Exudyn glue of bearing rows outside the reducer model (the stand-alone bearing
+    of :func:`add_main_bearing`; the reducer model's rows are a compiled element of its
+    fused kernel, :class:`BallBearingGroup`): one Exudyn element for one or more rows, one
+    compiled call (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
     evaluation into arrays preallocated here — per row the gather of its element
     coordinates from the nodes' (``idx``: row element coordinate -> nodes'
     coordinate; ``absolute``: the nodes hold absolute ball positions, the reference
@@ -581,10 +581,7 @@ class RowElement:
     ``record``: every call also fills each row's per-ball records (:attr:`records`,
     (Z, N_RECORD), :data:`flexrv.model.bearing_kernel.RECORD_FIELDS`) and keeps its
     element force (:meth:`frame_force`: the frame's six, element order), and
-    :attr:`memo` = (t, q, q_t) of the call they belong to, so a run records the
-    bearing's outputs from the integrator's own calls
-    (:class:`flexrv.model.kernels.HistoryRecorder`) instead of evaluating the rows
-    again per sample (~23 us per row and sample)."""
+    :attr:`memo` = (t, q, q_t) of the call they belong to."""
 
     def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None, record: bool = False):
         rows = [rows] if isinstance(rows, RowModel) else list(rows)
