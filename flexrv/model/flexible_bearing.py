@@ -79,7 +79,7 @@ from flexrv.model.bearing_kernel import (
     row_kernel,
     rows_kernel,
 )
-from flexrv.model.core.params import check_pack
+from flexrv.model.core.params import check_pack, empty_pack
 from flexrv.units import M_PER_MM
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
@@ -969,7 +969,7 @@ class BallBearingGroup(KernelGroup):
 
     @staticmethod
     def empty_pack():
-        return BearingRowsPack(())
+        return empty_pack(BearingRowsPack)
 
     def record_sources(self) -> dict:
         out = {}
