@@ -388,7 +388,7 @@ def test_cross_check_ball_model_against_exudyn(name):
     ramps, 0.12 s, the last 0.05 s: the criterion of :func:`cross_check`; a preset whose load
     is light (rv221: two steady responses, see :func:`test_cross_check_against_exudyn_every_preset`;
     its dominant line differed by 11 % in this short window) at its rated torque. Measured
-    rv40e: mean -202.4718 / -202.4721 arcsec, p-p 0.6836 / 0.6835 arcsec. ~15 s each."""
+    rv40e: mean -202.4718 / -202.4721 arcsec, p-p 0.6836 / 0.6835 arcsec. ~2 s each (warm)."""
     from tests.test_time_step import fast
 
     r = fast(name)
@@ -402,7 +402,7 @@ def test_cross_check_flexible_rings_against_exudyn():
     """The flexible main-bearing rings (condensed rings, balls with inertia: the block
     elimination of the balls' dense blocks, Jacobians kept across steps as Exudyn's
     integrator does above 100 coordinates), rv40e, shortened ramps, 0.12 s, the last
-    0.05 s: the criterion of :func:`cross_check`. ~20 s."""
+    0.05 s: the criterion of :func:`cross_check`. ~7 s (warm)."""
     from tests.test_time_step import fast
 
     cross_check(fast("rv40e"), 0.12, model="flexible", window=0.05)
