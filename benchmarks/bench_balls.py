@@ -1,10 +1,11 @@
 """Benchmark of the ball-bearing model (``--model balls``: ball-resolved main bearing,
-rigid rings): CPU seconds per simulated second (solve + outputs), the cost per call
-of the bearing rows and of the fused compiled element, Newton iterations per step,
-and the TE statistics (so speed never buys a different answer).
+rigid rings): CPU seconds per simulated second (solve + outputs), on Exudyn's integrator the
+cost per call of the fused compiled element (the bearing rows and the other contacts), Newton
+iterations per step, and the TE statistics (so speed never buys a different answer). The paired
+comparison of the integrators: ``bench_integrator.py --model balls``.
 
     python benchmarks/bench_balls.py [--presets rv221 rv40e] [--t-end 0.1] [--newton '{"...": ...}']
-                                     [--options '{"ball_inertia": true}']
+                                     [--options '{"ball_inertia": true}'] [--integrator compiled|exudyn]
 
 The preset's default ramps are kept; a short warm-up run (0.002 s) loads or
 compiles the numba kernels first (a cold compile inside the timed run cost
@@ -42,40 +43,20 @@ def _timed(obj, attr, acc, key):
     setattr(obj, attr, timed)
 
 
-def _timed_method(cls, attr, acc, key):
-    """Accumulate CPU time and calls of the method cls.attr (every instance) in acc[key]."""
-    fn = getattr(cls, attr)
-
-    def timed(self, *args, **kw):
-        c0 = time.process_time()
-        r = fn(self, *args, **kw)
-        acc[key][0] += time.process_time() - c0
-        acc[key][1] += 1
-        return r
-
-    setattr(cls, attr, timed)
-
-
-def bench(name: str, t_end: float, newton: dict | None, options: dict | None = None) -> dict:
+def bench(name: str, t_end: float, newton: dict | None, options: dict | None = None, integrator=None) -> dict:
     from flexrv.simulation import Simulation
 
     sim = Simulation(name, model="balls", model_options=options)
     model = sim.build()
     # numba load/compile, not timed (5-step segments: the segment starts take the outputs' history pass)
-    sim.run(t_end=0.002, newton_options=newton, segment_steps=5)
-    acc = {"row": [0.0, 0], "row_jac": [0.0, 0], "fused": [0.0, 0], "fused_jac": [0.0, 0]}
-    from flexrv.model.flexible_bearing import RowElement  # the row elements' user functions (glue + kernel)
-
-    saved = RowElement.force, RowElement.jacobian
-    _timed_method(RowElement, "force", acc, "row")
-    _timed_method(RowElement, "jacobian", acc, "row_jac")
+    sim.run(t_end=0.002, newton_options=newton, segment_steps=5, integrator=integrator)
+    acc = {"fused": [0.0, 0], "fused_jac": [0.0, 0]}  # (Exudyn's integrator: its user functions)
     if model.fused is not None:
         _timed(model.fused, "residual", acc, "fused")
         _timed(model.fused, "jacobian", acc, "fused_jac")
     c0 = time.process_time()
-    res = sim.run(t_end=t_end, newton_options=newton)
+    res = sim.run(t_end=t_end, newton_options=newton, integrator=integrator)
     cpu = time.process_time() - c0
-    RowElement.force, RowElement.jacobian = saved
     tm = sim.timing
     te = res["te"]
     sel = te.values[te["time"].values >= 0.5 * t_end]
@@ -105,6 +86,7 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--newton", default=None, help="newton_options as JSON")
     ap.add_argument("--options", default=None, help="model options as JSON, e.g. '{\"ball_inertia\": true}'")
+    ap.add_argument("--integrator", default=None, choices=("compiled", "exudyn"), help="default: the model's")
     a = ap.parse_args()
     import flexrv
 
@@ -112,7 +94,7 @@ def main() -> None:
     options = json.loads(a.options) if a.options else None
     print(f"flexrv from {os.path.dirname(flexrv.__file__)}; newton_options {newton}; model options {options}")
     for name in a.presets:
-        r = bench(name, a.t_end, newton, options)
+        r = bench(name, a.t_end, newton, options, a.integrator)
         print(
             f"{r['preset']} balls: n = {r['n']}, {r['steps']} steps for {r['simulated_s']:.3g} s, "
             f"Newton/step {r['newton_per_step']:.2f}, Jacobians {r['jacobians']}"
@@ -122,8 +104,7 @@ def main() -> None:
             f"{r['outputs_cpu_s']:.3f} s)"
         )
         print(
-            f"  row force {r['row_us']:.1f} us x {r['row_calls']}, row Jacobian {r['row_jac_us']:.1f} us x "
-            f"{r['row_jac_calls']}, fused residual {r['fused_us']:.1f} us x {r['fused_calls']}, fused Jacobian "
+            f"  fused residual {r['fused_us']:.1f} us x {r['fused_calls']}, fused Jacobian "
             f"{r['fused_jac_us']:.1f} us x {r['fused_jac_calls']}"
         )
         print(

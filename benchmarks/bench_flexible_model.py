@@ -10,11 +10,12 @@ so a speed change can be checked for an unchanged answer.
 
     python benchmarks/bench_flexible_model.py [--preset rv221] [--t-end 0.1] [--cold]
         [--models rigid,balls,flexible] [--harmonics K] [--parts main_bearing,crankshaft]
-        [--ring-options '{"condense": false}'] [--split]
+        [--ring-options '{"condense": false}'] [--split] [--integrator compiled|exudyn]
 
-``--split``: where a step's CPU goes (the preset with 5 ms ramps, the flexible-rings model):
-the bearing rows' force and Jacobian calls (compiled kernel and its Python glue), the fused
-element of the other contacts, and the rest (Exudyn: assembly, sparse LU, Newton, hooks); then
+``--split``: where a step's CPU goes on Exudyn's integrator (the preset with 5 ms ramps, the
+flexible-rings model): the fused element's force and Jacobian calls (the bearing rows and the other
+contacts, compiled, and their Python glue) and the rest (Exudyn: assembly, sparse LU, Newton,
+hooks); the compiled integrator's split: ``bench_integrator.py --model flexible --split``; then
 one factorisation of a matrix of the model's structure (the balls' dense blocks, the other
 coordinates) by block elimination (:mod:`flexrv.model.numerics.block_lu`), by the dense
 compiled LU and by LAPACK (scipy), CPU per factorisation.
@@ -39,18 +40,20 @@ import time
 import numpy as np
 
 
-def run(preset: str, model: str, t_end: float, options: dict, window: float | None = None) -> dict:
+def run(
+    preset: str, model: str, t_end: float, options: dict, window: float | None = None, integrator: str | None = None
+) -> dict:
     from flexrv.simulation import Simulation
 
     # warm-up: numba cache loads and one-time imports of the outputs path (xarray's first DataArray
     # imports its duck-array modules, ~0.36 s, which a 0.1 s run would count as 3.6 s per simulated s)
-    Simulation(preset, model=model, model_options=options).run(t_end=2e-3)
+    Simulation(preset, model=model, model_options=options).run(t_end=2e-3, integrator=integrator)
     sim = Simulation(preset, model=model, model_options=options)
     t0 = time.perf_counter()
     m = sim.build()
     build = time.perf_counter() - t0
     c0 = time.process_time()
-    res = sim.run(t_end=t_end)
+    res = sim.run(t_end=t_end, integrator=integrator)
     cpu = time.process_time() - c0
     t = sim.timing
     steps = max(t["steps"], 1)
@@ -105,22 +108,15 @@ def split(preset: str, t_end: float, window: float) -> None:
     """Print the CPU per step of the flexible-rings model by part (module docstring, ``--split``)."""
     from _shared import quick_ramps
 
-    from flexrv.model.flexible_bearing import RowElement
     from flexrv.simulation import Simulation
 
     sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
     model = sim.build()
-    sim.run(t_end=2e-3, segment_steps=5)  # numba loads, one-time imports
-    acc = {k: [0.0, 0] for k in ("row force", "row Jacobian", "fused force", "fused Jacobian")}
-    saved = RowElement.force, RowElement.jacobian
-    _timed_method(RowElement, "force", acc["row force"])
-    _timed_method(RowElement, "jacobian", acc["row Jacobian"])
+    sim.run(t_end=2e-3, segment_steps=5, integrator="exudyn")  # numba loads, one-time imports
+    acc = {k: [0.0, 0] for k in ("fused force", "fused Jacobian")}
     _timed_method(model.fused, "residual", acc["fused force"])
     _timed_method(model.fused, "jacobian", acc["fused Jacobian"])
-    try:
-        res = sim.run(t_end=t_end)
-    finally:
-        RowElement.force, RowElement.jacobian = saved
+    res = sim.run(t_end=t_end, integrator="exudyn")
     tm = sim.timing
     steps = max(tm["steps"], 1)
     solve = tm["solve_cpu_s"]
@@ -231,6 +227,7 @@ def main() -> None:
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
     parser.add_argument("--split", action="store_true", help="CPU per step by part (flexible rings, 5 ms ramps)")
     parser.add_argument("--paired-newton", default=None, help="newton_options (JSON) against the defaults, paired")
+    parser.add_argument("--integrator", default=None, choices=("compiled", "exudyn"), help="default: the model's")
     args = parser.parse_args()
     if args.paired_newton:
         paired_newton(
@@ -263,7 +260,7 @@ def main() -> None:
                 ring["harmonics"] = args.harmonics
             if ring:
                 opts["ring_options"] = ring
-        r = run(args.preset, model, args.t_end, opts, args.window)
+        r = run(args.preset, model, args.t_end, opts, args.window, args.integrator)
         print(
             f"{r['model']:10s} {r['coordinates']:5d} {r['build_s']:8.2f} {r['solve_s']:8.2f} "
             f"{r['wall_per_sim_s']:8.1f} {r['cpu_per_sim_s']:8.1f} {r['ms_per_step']:8.2f} "

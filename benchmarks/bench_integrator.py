@@ -1,7 +1,9 @@
 """Benchmark of the compiled generalized-alpha integrator against Exudyn's, paired in one
-process: rigid model of each preset, the same run on both integrators.
+process: a model (``--model``, default rigid; balls, flexible) of each preset, the same run
+on both integrators.
 
 Run:  python benchmarks/bench_integrator.py [--t-end 0.3] [--presets rv40e rv221] [--repeat 2] [--split]
+      [--model rigid|balls|flexible]
 
 The run starts at rated speed (speed and load ramps shortened to 5 ms, as
 benchmarks/bench_rigid.py) and lasts ``--t-end``. Three runs per repeat, alternating:
@@ -148,12 +150,12 @@ def _clocked_integrate(model):
     return mod.fused_integrate
 
 
-def split(name: str, t_end: float, repeat: int) -> None:
+def split(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> None:
     """Print the in-run split of a compiled step (``--split``; module docstring)."""
     import flexrv.model.integrator as integrator
     from flexrv.simulation import Simulation
 
-    sim = Simulation(quick_ramps(name))
+    sim = Simulation(quick_ramps(name), model=model_name)
     model = sim.build()
     model.fused.integrate_kernel = _clocked_integrate(model)
     clocks = np.zeros(5, np.int64)  # libc clock(): microseconds
@@ -185,11 +187,11 @@ def split(name: str, t_end: float, repeat: int) -> None:
         integrator.CompiledIntegrator.__init__ = init
 
 
-def bench(name: str, t_end: float, repeat: int) -> dict:
+def bench(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> dict:
     import flexrv.simulation as S
     from flexrv.simulation import Simulation
 
-    sim = Simulation(quick_ramps(name))
+    sim = Simulation(quick_ramps(name), model=model_name)
     model = sim.build()
     for _, integ, options in RUNS:  # compile / load the kernels
         sim.run(t_end=0.002, integrator=integ, checkpoint_s=None, newton_options=options)
@@ -224,9 +226,10 @@ def bench(name: str, t_end: float, repeat: int) -> dict:
     finally:
         S._Records.__init__ = orig
     c = out["compiled"]
-    per_call = _kernel_cost(model, *c["states"], c["calls"] / c["steps"])
-    c["kernel_share"] = c["calls"] * per_call / c["cpu"]
-    c["per_call_us"] = per_call * 1e6
+    if c["jacobians"] >= c["steps"]:  # (the replay computes a Jacobian at every state: not with kept ones)
+        per_call = _kernel_cost(model, *c["states"], c["calls"] / c["steps"])
+        c["kernel_share"] = c["calls"] * per_call / c["cpu"]
+        c["per_call_us"] = per_call * 1e6
     return out
 
 
@@ -236,15 +239,16 @@ def main() -> None:
     ap.add_argument("--presets", nargs="+", default=["rv40e", "rv221"])
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--split", action="store_true", help="the in-run split of a compiled step (module docstring)")
+    ap.add_argument("--model", default="rigid", choices=("rigid", "balls", "flexible"))
     args = ap.parse_args()
     for name in args.presets:
         if args.split:
-            print(f"\n{name}: rigid model, t_end {args.t_end:g} s")
-            split(name, args.t_end, args.repeat)
+            print(f"\n{name}: {args.model} model, t_end {args.t_end:g} s")
+            split(name, args.t_end, args.repeat, args.model)
             continue
-        out = bench(name, args.t_end, args.repeat)
+        out = bench(name, args.t_end, args.repeat, args.model)
         e, c = out["exudyn"], out["compiled"]
-        print(f"\n{name}: rigid model, t_end {args.t_end:g} s, {c['steps']} steps")
+        print(f"\n{name}: {args.model} model, t_end {args.t_end:g} s, {c['steps']} steps")
         for label, r in out.items():
             spread = ", ".join(f"{x / args.t_end:.3f}" for x in sorted(r["cpus"]))
             print(
@@ -257,6 +261,9 @@ def main() -> None:
             f"  ratio Exudyn / compiled CPU: {e['cpu'] / c['cpu']:.2f}x "
             f"(compiled with Exudyn's predictor: {e['cpu'] / out['compiled*']['cpu']:.2f}x)"
         )
+        if "kernel_share" not in c:
+            print("  compiled: Jacobians kept across steps, the kernel's share: --split")
+            continue
         print(
             f"  compiled: kernel {c['per_call_us']:.1f} us per call, {100 * c['kernel_share']:.0f} % of the solve; "
             f"outside the kernel {100 * (1 - c['kernel_share']):.0f} % "

@@ -530,10 +530,7 @@ def _announce_compile(model, integrator: str) -> None:
     """One line on stderr if the model's numba kernels compile now (first run) on ``integrator``."""
     from flexrv.model.kernel_cache import announce_compile
 
-    fused = ["integrate" if integrator == "compiled" else "fused"]
-    kinds = (fused if model.fused is not None else []) + (
-        ["rows"] if any(type(g).__module__ == "flexrv.model.flexible_bearing" for g in model.groups) else []
-    )
+    kinds = ["integrate" if integrator == "compiled" else "fused"] if model.fused is not None else []
     announce_compile(kinds=kinds)
 
 
@@ -866,7 +863,12 @@ class _CompiledSegments:
         from flexrv.model.integrator import CompiledIntegrator, compiled_newton_options
 
         self.model = model
-        options = dict(newton_options or {})
+        # the Exudyn path's per-model settings (_ExudynSegments): a Jacobian every step for the small dense
+        # systems, kept across steps above SPARSE_ABOVE coordinates; MODEL_NEWTON for balls with inertia
+        options = {"modifiedNewtonJacUpdatePerStep": model.n <= SPARSE_ABOVE}
+        if model.info.get("ball_inertia", True):
+            options |= MODEL_NEWTON.get(model.name, {})
+        options |= dict(newton_options or {})
         tolerance = (
             options.pop("relativeTolerance", newton_tolerance[0]),
             options.pop("absoluteTolerance", newton_tolerance[1]),

@@ -519,18 +519,18 @@ def test_short_rigid_run_same_te():
 
 @pytest.mark.parametrize("ball_inertia", [True, False])
 def test_fused_element_coexists_with_ball_bearing(ball_inertia):
-    """Ball-resolved main bearing (its own element): the fused element covers only
-    the kernel groups' members (carrier, cranks, discs; no rigid main bearing: with
-    ball inertia not the balls, with quasi-static balls every coordinate) and
-    generalized_forces = fused part scattered into the model vector + the ball
-    group, equal to the sum of every group's evaluate/jacobian (1e-9 rel.)."""
+    """Ball-resolved main bearing (the bearing rows, a compiled element of the fused
+    kernel): the fused element covers every coordinate (with ball inertia the balls too;
+    no rigid main bearing) and generalized_forces, the fused kernel's, equals the sum of
+    every group's evaluate/jacobian (1e-9 rel.)."""
     from flexrv.model.assembled import group_index
 
     m = build_model(_variant("rv40e", "empirical"), "balls", exudyn=False, ball_inertia=ball_inertia)
     q, v = _loaded(m)
     f, dq, dv = m.generalized_forces(0.002, q, v)
-    assert m.fused.is_full != ball_inertia and (m.fused.n < m.n) == ball_inertia
-    assert "main_bearing" not in [g.kind for g in m.fused.groups]
+    assert m.fused.is_full and m.fused.n == m.n and not m.fused.others
+    kinds = [g.kind for g in m.fused.groups]
+    assert "bearing_rows" in kinds and "main_bearing" not in kinds
     fr, dqr, dvr = np.zeros(m.n), np.zeros((m.n, m.n)), np.zeros((m.n, m.n))
     for g in m.groups:
         ix = np.arange(m.n)[group_index([m.members[n].offset for n in g.members], [m.members[n].n for n in g.members])]

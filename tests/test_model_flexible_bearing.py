@@ -638,3 +638,49 @@ def test_ball_inertia_option_routes():
     with pytest.raises(ConfigError, match="need rigid or uncondensed modal rings"):
         rows_from_design(r, ehl="dry", outer=[SimpleNamespace(condensed=True)] * 2, ball_inertia=False)
     assert row.ball_inertia
+
+
+@pytest.mark.parametrize("ball_inertia", [False, True])
+def test_rows_element_equals_the_row_glue(ball_inertia):
+    """The bearing rows as the compiled force element of the fused kernel
+    (:class:`BallBearingGroup`, kernel :func:`flexrv.model.bearing_kernel.rows_kernel`) give
+    the force and the Jacobians d F / d q, d F / d q_t of the Exudyn glue (:class:`RowElement`,
+    the same rows, f_q = -1, f_v = 0 and f_q = 0, f_v = -1) on the group's coordinates
+    [carrier, balls], at a loaded state with the carrier spinning (films: Hamrock-Dowson),
+    within 1e-12 of the largest entry (the two share the rows' film and ball warm starts,
+    so their iterations start from each other's results: round-off, not bit for bit), for
+    quasi-static balls (rows on the carrier only; their condensed Jacobians) and balls with
+    inertia (3 Z coordinates per row, absolute positions); the group declares the balls of
+    each row as a dense block of the model's Newton matrix (its own members, contiguous)."""
+    from flexrv.model.core.registry import dense_blocks
+    from flexrv.model.factory import build_model
+    from flexrv.model.flexible_bearing import _PERM, RowElement
+
+    m = build_model(load("rv40e"), "balls", exudyn=False, ball_inertia=ball_inertia)
+    group = next(g for g in m.groups if g.kind == "bearing_rows")
+    n = sum(m.members[name].n for name in group.members)
+    q = np.concatenate([m.members[name].q0 for name in group.members])
+    v = np.zeros(n)
+    q[:6] = [3e-6, -2e-6, 0.01, 4e-6, 2e-5, -1e-5]
+    v[:6] = [1e-4, 2e-4, 1.3, -1e-4, 1e-3, 2e-3]
+    rng = np.random.default_rng(5)
+    v[6:] = rng.normal(scale=1e-3, size=n - 6)
+    idxs = [np.concatenate([_PERM, 6 + k * r.n_ball_coordinates + np.arange(r.n_ball_coordinates)])
+            for k, r in enumerate(group.rows)]  # fmt: skip
+    glue = RowElement(group.rows, idxs, absolute=True)
+    for _ in range(2):  # the second call from the first's warm starts, as in a run
+        f, _ = group.evaluate(0.0, q, v)
+        jq, jv = group.jacobian(0.0, q, v)
+        ref_f = glue.force(list(q), list(v)).copy()
+        ref_q = glue.jacobian(list(q), list(v), -1.0, 0.0).copy()
+        ref_v = glue.jacobian(list(q), list(v), 0.0, -1.0).copy()
+        for got, ref in ((f, ref_f), (jq, ref_q), (jv, ref_v)):
+            np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    assert np.abs(ref_f[:6]).max() > 100.0 and np.abs(ref_q).max() > 1e7
+    assert m.info["ball_inertia"] is ball_inertia
+    blocks = dense_blocks(m)
+    if ball_inertia:
+        nb = 3 * group.rows[0].ball_count
+        assert blocks == [(m.members[f"main_bearing_balls{k}"].offset, nb) for k in range(2)]
+    else:
+        assert blocks == [] and group.members == ("carrier",)

@@ -180,7 +180,10 @@ def test_integrator_records_match_the_history_pass(name, model):
         if key == "pin_gap":
             continue
         floor = 1e-15 if key == "disc_rim_offset" else 0.0  # [m] the rim Newton's absolute tolerance
-        rel = 2e-9
+        # the flexible rings' run on the compiled integrator (Jacobians kept across steps, ~3.4 Newton
+        # corrections per step): the pins' rim Newton ends from other starts, measured 2026-11-28 on rv221
+        # pin forces 3.0e-9, the pins' torques 1.1e-9, the disc rims' rotation 1.7e-9 of their largest values
+        rel = 6e-9 if model == "flexible" and key.startswith(("pin_", "disc_", "housing_")) else 2e-9
         if model == "flexible" and key.startswith(("ball_", "main_bearing_", "ring_")):
             rel, floor = 2e-6, (1e-12 if key.startswith("ring_deformation") else 1e-8)  # [m], [N] (zero forces)
         elif model == "balls" and key.startswith(("ball_", "main_bearing_")):
@@ -226,51 +229,50 @@ def test_group_with_its_own_record_keeps_its_own_outputs_path(history):
 
 
 def test_recorder_checkpoint_round_trip_with_bearing_rows():
-    """The recorder's buffers of every recording element (the fused element and the
-    ball model's two row elements, balls with inertia) go into a checkpoint
-    (:meth:`HistoryRecorder.arrays`) and come back bit for bit
-    (:meth:`HistoryRecorder.fill`, as Simulation.resume does); a checkpoint of another
+    """The recorder's buffers of the ball model's recording element (the fused element,
+    the bearing rows' records among its entries: per row the per-ball records, the force on
+    the frame, the frame and modal coordinates and the frame's velocities; balls with
+    inertia) go into a checkpoint (:meth:`HistoryRecorder.arrays`) and come back bit for
+    bit (:meth:`HistoryRecorder.fill`, as Simulation.resume does); a checkpoint of another
     layout (a 1-D valid mask, or other buffers) is left to the history pass (nothing
-    filled). With quasi-static balls (the default) both rows share one element on the
-    carrier, whose records are both rows'."""
+    filled). With quasi-static balls (the default) the same entries."""
     from flexrv.model.kernels import HistoryRecorder
     from flexrv.simulation import Simulation
 
+    keys = ["balls0", "frame0", "x0", "xt0", "balls1", "frame1", "x1", "xt1"]
     sim = Simulation(_fast("rv221"), model="balls", model_options={"ball_inertia": True})
     sim.run(t_end=0.003, dt=1e-4)
     m = sim.model
+    group = m.groups[[g.name for g in m.groups].index("main_bearing")]
     rec = HistoryRecorder(m, 8)
-    assert len(rec.sources) == 3  # fused element + one element per bearing row
+    assert len(rec.sources) == 1  # the fused element: every force element of the model
+    assert [key for g, key, _ in rec.sources[0][2] if g is group] == keys
     q = np.asarray(m.mbs.systemData.GetODE2Coordinates())
     v = np.asarray(m.mbs.systemData.GetODE2Coordinates_t())
-    for element, index, *_ in rec.sources:  # their last calls at (0, q, v)
-        element.memo = (0.0, (q if len(index) == 0 else q[index]).copy(), (v if len(index) == 0 else v[index]).copy())
+    element = rec.sources[0][0]
+    element.memo = (0.0, q.copy(), v.copy())  # its last call at (0, q, v)
     for k in range(4):
         rec.store(k, 0.0, q, v)
-    rec.sources[1][0].memo = None  # row 0's element: its last call was elsewhere
+    element.memo = None  # its last call was elsewhere
     rec.store(4, 0.0, q, v)
-    assert rec.valid[:, :5].tolist() == [[True] * 5, [True] * 4 + [False], [True] * 5]
+    assert rec.valid[:, :5].tolist() == [[True] * 4 + [False]]
     arrays, valid = rec.arrays(5)
     back = HistoryRecorder(m, 8)
     back.fill(5, arrays, valid)
     assert np.array_equal(back.valid, rec.valid)
     assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(back.arrays(5)[0], arrays))  # NaN: no contact
-    balls = back.records(5)["data"][m.groups[[g.name for g in m.groups].index("main_bearing")]]["balls0"]
-    assert balls.shape[1:] == m.groups[[g.name for g in m.groups].index("main_bearing")].elements[0].records[0].shape
+    balls = back.records(5)["data"][group]["balls0"]
+    assert balls.shape[1:] == group.record_sources()["balls0"].shape
     assert np.max(balls[:4, :, 0]) > 1.0  # inner ball loads [N] of the loaded bearing
     other = HistoryRecorder(m, 8)
-    other.fill(5, arrays, valid[0])  # a rigid model's (one element's) mask layout
+    other.fill(5, arrays, valid[0])  # another mask layout
     other.fill(5, arrays[:-1], valid)
     assert not other.valid.any()
     sim = Simulation(_fast("rv221"), model="balls")
     sim.run(t_end=0.002, dt=1e-4)
     rec = HistoryRecorder(sim.model, 8)
-    assert len(rec.sources) == 2 and [key for _, key, _ in rec.sources[1][2]] == [
-        "balls0",
-        "frame0",
-        "balls1",
-        "frame1",
-    ]
+    group = sim.model.groups[[g.name for g in sim.model.groups].index("main_bearing")]
+    assert len(rec.sources) == 1 and [key for g, key, _ in rec.sources[0][2] if g is group] == keys
 
 
 def _pack_arrays(x, out):

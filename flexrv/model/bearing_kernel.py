@@ -1671,21 +1671,44 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
 
 
 @njit(cache=True)
+def row_part(qn, vn, absolute, jacobian, part):
+    """One row of the bearing rows' elements (:func:`row_element`, :func:`rows_kernel`):
+    ``part`` = (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, the row's :data:`RowPack`,
+    :func:`flexrv.model.flexible_bearing.kernel_inputs`). Gathers the row's element
+    coordinates and velocities qe[e] = qn[idx[e]], ve[e] = vn[idx[e]] (``absolute``: the
+    nodes hold absolute ball positions, the reference ``p.ball_ref`` is subtracted), then
+    :func:`row_eval` -- or, for quasi-static balls (``p.geometry.quasi_static_balls``; idx
+    covers the frame and modal coordinates only, qe / ve are the full work vectors),
+    :func:`quasi_static_balls`. Returns the row's Jacobians (d f / d q, d f / d q_t) over
+    its idx coordinates (valid with ``jacobian``); its force is f[:idx.shape[0]]."""
+    idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, p = part
+    n = idx.shape[0]
+    for e in range(n):
+        qe[e] = qn[idx[e]]
+        ve[e] = vn[idx[e]]
+    if p.geometry.quasi_static_balls:
+        quasi_static_balls(qe, ve, p, jacobian, rec, f, kbb, kx, cx)
+        return kx, cx
+    if absolute:
+        ball_ref = p.ball_ref
+        nz = ball_ref.shape[0]
+        b0 = n - 3 * nz
+        for j in range(nz):
+            for c in range(3):
+                qe[b0 + 3 * j + c] -= ball_ref[j, c]
+    row_eval(qe, ve, p, jacobian, rec, f, jq, jv)
+    return jq, jv
+
+
+@njit(cache=True)
 def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     """One call of the bearing rows' Exudyn element (the glue of
     :class:`flexrv.model.flexible_bearing.RowElement`, compiled, into preallocated
-    arrays). ``parts``: one tuple per row (idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, the
-    row's :data:`RowPack`, :func:`flexrv.model.flexible_bearing.kernel_inputs`).
-    Per row: its element coordinates and velocities qe[e] = qn[idx[e]], ve[e] =
-    vn[idx[e]] (``absolute``: the nodes hold absolute ball positions, the
-    reference ``p.ball_ref`` is subtracted), then :func:`row_eval` -- or, for
-    quasi-static balls (``p.geometry.quasi_static_balls``; idx covers the frame and modal
-    coordinates only, qe / ve are the full work vectors), :func:`quasi_static_balls`;
-    the rows' results summed in the nodes' coordinate order: the force out_f[idx[e]] +=
-    f[e], or with ``jacobian`` Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j
-    (entries no row touches stay zero: the rows interact only through the
-    carrier, so the row-row blocks are exact zeros, which Exudyn's sparse
-    assembly skips)."""
+    arrays). ``parts``: one tuple per row (:func:`row_part`). The rows' results summed
+    in the nodes' coordinate order: the force out_f[idx[e]] += f[e], or with ``jacobian``
+    Exudyn's -(f_q dF/dq + f_v dF/dq_t) into out_j (entries no row touches stay zero:
+    the rows interact only through the carrier, so the row-row blocks are exact zeros,
+    which Exudyn's sparse assembly skips)."""
     for part in parts:  # zero what the rows write
         idx = part[0]
         n = idx.shape[0]
@@ -1697,24 +1720,9 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
             for e in range(n):
                 out_f[idx[e]] = 0.0
     for part in parts:
-        idx, qe, ve, f, jq, jv, rec, kbb, kx, cx, p = part
+        idx, f = part[0], part[3]
         n = idx.shape[0]
-        for e in range(n):
-            qe[e] = qn[idx[e]]
-            ve[e] = vn[idx[e]]
-        if p.geometry.quasi_static_balls:
-            quasi_static_balls(qe, ve, p, jacobian, rec, f, kbb, kx, cx)
-            jq_, jv_ = kx, cx
-        else:
-            if absolute:
-                ball_ref = p.ball_ref
-                nz = ball_ref.shape[0]
-                b0 = n - 3 * nz
-                for j in range(nz):
-                    for c in range(3):
-                        qe[b0 + 3 * j + c] -= ball_ref[j, c]
-            row_eval(qe, ve, p, jacobian, rec, f, jq, jv)
-            jq_, jv_ = jq, jv
+        jq_, jv_ = row_part(qn, vn, absolute, jacobian, part)
         if jacobian:
             for r in range(n):
                 ir = idx[r]
@@ -1723,6 +1731,33 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
         else:
             for e in range(n):
                 out_f[idx[e]] += f[e]
+
+
+#: the compiled force element of the bearing rows (:class:`flexrv.model.flexible_bearing.BallBearingGroup`):
+#: ``parts``, one tuple per row (:func:`row_part`; idx into the model's coordinates, the balls' absolute)
+BearingRowsPack = pack_type("BearingRowsPack", ("parts", tuple))
+
+
+@njit(cache=True)
+def rows_kernel(q, v, f, jq, jv, jac, pack):
+    """The bearing rows as a compiled force element of the fused kernel
+    (:mod:`flexrv.model.core.registry`): every row's force added into f and, if ``jac``,
+    its Jacobians into jq, jv over the coordinates of its ``idx`` (:func:`row_part`, the
+    balls' coordinates absolute positions). The same per-row evaluation as the Exudyn
+    glue :func:`row_element`; the rows' sum is the force, the condensed Jacobians of
+    quasi-static balls are the rows' Jacobians on the frame and modal coordinates."""
+    for part in pack.parts:
+        idx, fr = part[0], part[3]
+        n = idx.shape[0]
+        jq_, jv_ = row_part(q, v, True, jac, part)
+        for e in range(n):
+            f[idx[e]] += fr[e]
+        if jac:
+            for r in range(n):
+                ir = idx[r]
+                for c in range(n):
+                    jq[ir, idx[c]] += jq_[r, c]
+                    jv[ir, idx[c]] += jv_[r, c]
 
 
 @njit(cache=True)

@@ -43,10 +43,13 @@ recovered from the recorded contact loads for the outputs and ``flexrv view``.
 (the uncondensed formulation, for verification), ``quasi_static=False`` gives
 the ring mass and modal damping (dynamic modes, then always uncondensed).
 
-The contact element of a row is one ``ObjectGenericODE2`` over the nodes
-[frame, modal rings' modes, balls]; its force and Jacobian are ONE compiled
-kernel, :func:`flexrv.model.bearing_kernel.row_kernel` (the only implementation
-of the bearing's physics: :func:`evaluate_row` and the outputs call it too).
+A row's contact element sees the coordinates [frame, modal rings' modes, balls];
+its force and Jacobian are ONE compiled kernel, :func:`flexrv.model.bearing_kernel.row_eval`
+(the only implementation of the bearing's physics: :func:`evaluate_row` and the
+outputs call it too). In the reducer model the rows are a compiled force element of
+the model's fused kernel (:class:`BallBearingGroup`, both integrators); the
+stand-alone bearing (:func:`add_main_bearing`) adds one Exudyn element per row
+(:class:`RowElement`).
 """
 
 from __future__ import annotations
@@ -58,11 +61,12 @@ import numpy as np
 
 from flexrv.contact.ball_raceway import RowContactGeometry, hertz_law
 from flexrv.errors import ConfigError
-from flexrv.model.base import ForceGroup, Output, exudyn_vector
+from flexrv.model.base import KernelGroup, Output, SummaryRow, exudyn_vector
 from flexrv.model.bearing_kernel import (
     BALL_FORCE_TOL,
     N_RECORD,
     RECORD_FIELDS,
+    BearingRowsPack,
     RowGeometry,
     RowPack,
     ball_workspace,
@@ -72,10 +76,10 @@ from flexrv.model.bearing_kernel import (
     ring_modal_amplitudes,
     row_element,
     row_force_kernel,
-    row_history,
     row_kernel,
+    rows_kernel,
 )
-from flexrv.model.core.params import check_pack
+from flexrv.model.core.params import check_pack, empty_pack
 from flexrv.units import M_PER_MM
 
 _REC = {name: i for i, name in enumerate(RECORD_FIELDS)}
@@ -355,7 +359,17 @@ def kernel_inputs(model: RowModel) -> RowPack:
     )
     check_pack(inputs)
     model._kernel_inputs = inputs
+    model._kernel_initial = (ws_i.copy(), ws_o.copy(), balls.copy())
     return inputs
+
+
+def fresh_kernel_inputs(model: RowModel) -> RowPack:
+    """The row's kernel inputs (:func:`kernel_inputs`) with fresh warm starts: the rings'
+    and the quasi-static balls' work arrays as first prepared, zero statistics (a history
+    pass that does not depend on the calls before it)."""
+    inputs = kernel_inputs(model)
+    ws_i, ws_o, balls = model._kernel_initial
+    return inputs._replace(ws_i=ws_i.copy(), ws_o=ws_o.copy(), balls=balls.copy(), state=np.zeros(8, np.int64))
 
 
 def set_ball_force_tolerance(model: RowModel, tol: float) -> None:
@@ -527,11 +541,33 @@ def initial_ball_displacements(model: RowModel) -> np.ndarray:
     return pos - model.ball_reference
 
 
+def row_work(row: RowModel, record: bool = True) -> tuple:
+    """The work arrays of one row's evaluation (:func:`flexrv.model.bearing_kernel.row_part`
+    after its idx): qe, ve, f over the kernel's full coordinate vector (quasi-static balls:
+    the work vectors also hold the balls); the row Jacobians jq, jv (n, n) with ball
+    inertia, zero-allocated (the kernel writes only its nonzero entries); the per-ball
+    records (Z, N_RECORD) if ``record`` (else none); for quasi-static balls the balls'
+    blocks kbb (3Z, 4) and the condensed Jacobians kx, cx (n, n) instead."""
+    m, full = row.n_coordinates, row.n_kernel
+    nj, nb, nk = (m, 0, 0) if row.ball_inertia else (0, 3 * row.ball_count, m)
+    return (
+        np.zeros(full),
+        np.zeros(full),
+        np.zeros(full),
+        np.zeros((nj, nj)),
+        np.zeros((nj, nj)),
+        np.zeros((row.ball_count if record else 0, N_RECORD)),
+        np.zeros((nb, 4)),
+        np.zeros((nk, nk)),
+        np.zeros((nk, nk)),
+    )
+
+
 class RowElement:
-    """THE Exudyn glue of the bearing rows: one Exudyn element for one or
-    more rows (the reducer model: one per row, or one for all rows with quasi-static
-    balls, see :meth:`BallBearingGroup.add_to`), one compiled call
-    (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
+    """The Exudyn glue of bearing rows outside the reducer model (the stand-alone bearing
+    of :func:`add_main_bearing`; the reducer model's rows are a compiled element of its
+    fused kernel, :class:`BallBearingGroup`): one Exudyn element for one or more rows, one
+    compiled call (:func:`flexrv.model.bearing_kernel.row_element`) per force or Jacobian
     evaluation into arrays preallocated here — per row the gather of its element
     coordinates from the nodes' (``idx``: row element coordinate -> nodes'
     coordinate; ``absolute``: the nodes hold absolute ball positions, the reference
@@ -545,10 +581,7 @@ class RowElement:
     ``record``: every call also fills each row's per-ball records (:attr:`records`,
     (Z, N_RECORD), :data:`flexrv.model.bearing_kernel.RECORD_FIELDS`) and keeps its
     element force (:meth:`frame_force`: the frame's six, element order), and
-    :attr:`memo` = (t, q, q_t) of the call they belong to, so a run records the
-    bearing's outputs from the integrator's own calls
-    (:class:`flexrv.model.kernels.HistoryRecorder`) instead of evaluating the rows
-    again per sample (~23 us per row and sample)."""
+    :attr:`memo` = (t, q, q_t) of the call they belong to."""
 
     def __init__(self, rows, idx=None, absolute: bool = False, stats: list | None = None, record: bool = False):
         rows = [rows] if isinstance(rows, RowModel) else list(rows)
@@ -567,27 +600,9 @@ class RowElement:
         self.stats = [0, 0] if stats is None else stats
         self._work = []
         for r, i in zip(rows, self.idx):
-            m = r.n_coordinates
-            if i.shape != (m,):
-                raise ValueError(f"coordinate map of shape {i.shape} for a row of {m} coordinates")
-            full = r.n_kernel  # quasi-static balls: the kernel's work vectors also hold the balls
-            # row Jacobians (m, m) with ball inertia; quasi-static balls: the balls' blocks (3Z, 4)
-            # and the condensed Jacobians kx, cx (m, m) instead
-            nj, nb, nk = (m, 0, 0) if r.ball_inertia else (0, 3 * r.ball_count, m)
-            self._work.append(
-                (
-                    i,
-                    np.zeros(full),
-                    np.zeros(full),
-                    np.zeros(full),
-                    np.zeros((nj, nj)),
-                    np.zeros((nj, nj)),
-                    np.zeros((r.ball_count if record else 0, N_RECORD)),
-                    np.zeros((nb, 4)),
-                    np.zeros((nk, nk)),
-                    np.zeros((nk, nk)),
-                )
-            )
+            if i.shape != (r.n_coordinates,):
+                raise ValueError(f"coordinate map of shape {i.shape} for a row of {r.n_coordinates} coordinates")
+            self._work.append((i, *row_work(r, record)))
         self.out_f, self.out_j = np.zeros(n), np.zeros((n, n))
         self._entry = None
         self._parts = None
@@ -863,8 +878,24 @@ def flexible_rings(
 _PERM = np.array([0, 1, 3, 4, 5, 2])
 
 
-class BallBearingGroup(ForceGroup):
-    """The ball-resolved main bearing as a force group of the reducer model
+@dataclass(frozen=True)
+class BearingRowsParameters:
+    """The ball-resolved main bearing's rows (:class:`RowModel`, one per row of the
+    back-to-back pair), the typed parameters of :class:`BallBearingGroup`."""
+
+    rows: tuple
+
+
+def bearing_rows_parameters(reducer, drive) -> BearingRowsParameters:
+    """The design's rows between rigid rings with quasi-static balls (the ball model's
+    default; the factory builds the flexible rings' and the balls' inertia variants with
+    :func:`rows_from_design`). ``drive`` is not read: the rows take their entrainment
+    speed from the carrier's coordinates."""
+    return BearingRowsParameters(tuple(rows_from_design(reducer, ball_inertia=False)))
+
+
+class BallBearingGroup(KernelGroup):
+    """The ball-resolved main bearing as a compiled force element of the reducer model
     (:mod:`flexrv.model.factory`), replacing the rigid model's 5-DOF element.
 
     Members: ``carrier`` (x, y, theta, z, rx, ry — the tilts are small, so the
@@ -872,78 +903,124 @@ class BallBearingGroup(ForceGroup):
     per row k, ``main_bearing_inner<k>`` / ``main_bearing_outer<k>`` (modal
     coordinates of an uncondensed flexible ring only; the inner ring's modes live
     in the carrier frame, the outer ring's in the housing) and
-    ``main_bearing_balls<k>`` (absolute ball-centre positions, 3 Z coordinates).
-    Each row's contact element (:func:`flexrv.model.bearing_kernel.row_kernel`)
-    sees the coordinates [frame(6), inner modes, outer modes, balls]; the group
-    scatters them.
-    """
+    ``main_bearing_balls<k>`` (absolute ball-centre positions, 3 Z coordinates, balls
+    with inertia only). Each row's contact element (:func:`flexrv.model.bearing_kernel.row_eval`)
+    sees the coordinates [frame(6), inner modes, outer modes, balls]; the element's
+    kernel (:func:`flexrv.model.bearing_kernel.rows_kernel`) gathers them per row from
+    the model's vector and sums the rows' forces and Jacobians, inside the fused kernel
+    of the model (both integrators). A row's own members form a dense diagonal block of
+    the Newton matrix (:meth:`dense_blocks`: the rows couple only through the carrier).
+
+    Records per row k: ``balls<k>`` (Z, N_RECORD) per-ball results, ``frame<k>`` the row's
+    force on the frame (element order x, y, z, rx, ry, rz), ``x<k>`` the row's frame and
+    modal-ring coordinates, ``xt<k>`` the frame's velocities: the outputs are built from
+    them alone (:func:`bearing_outputs`)."""
 
     name = "main_bearing"
-    analytic_jacobian = True
+    kind = "bearing_rows"
+    kernel = staticmethod(rows_kernel)
+    parameters = staticmethod(bearing_rows_parameters)
+    summary_rows = (
+        SummaryRow("max_ball_load_outer_N", "N", "largest ball-outer raceway normal load", "ball_load_outer", "max"),
+    )
 
-    def __init__(self, rows: list[RowModel]):
-        self.rows = rows
-        members, sizes, index = ["carrier"], [6], []
+    def __init__(self, params: BearingRowsParameters):
+        if not isinstance(params, BearingRowsParameters):  # a list of rows
+            params = BearingRowsParameters(tuple(params))
+        self.params = params
+        self.rows = rows = list(params.rows)
+        members, sizes, index, own = ["carrier"], [6], [], []
         for k, row in enumerate(rows):
-            parts = [_PERM]
+            parts, names = [_PERM], []
             for label, m in (("inner", row.m_inner), ("outer", row.m_outer), ("balls", row.n_ball_coordinates)):
                 if m == 0:
                     continue
                 start = sum(sizes)
-                members.append(f"main_bearing_{label}{k}")
+                names.append(f"main_bearing_{label}{k}")
                 sizes.append(m)
                 parts.append(np.arange(start, start + m))
-            index.append(np.concatenate(parts))
+            members += names
+            own.append(tuple(names))
+            index.append(np.concatenate(parts).astype(np.int64))
         self.members = tuple(members)
         self.sizes = sizes
         self._index = index  # per row: element coordinates in the group's local vector
-        self._n = int(sum(sizes))
-        #: the rows' Exudyn elements, their nodes' member names and, per row, (element, row in
-        #: it) (set by add_to)
-        self.elements, self._element_members, self._row_slots = [], [], []
+        self._own = own
+        #: per row, the live work arrays of its evaluation (records included; :func:`row_work`)
+        self._work = [row_work(row) for row in rows]
 
-    def add_to(self, mbs, nodes: list[int], sizes: list[int]) -> int:
-        """One Exudyn element per row over [carrier, the row's modal rings, its balls]
-        (:func:`add_row_element`, the one glue path). One element for both rows
-        would save one Python round trip per residual (~6 us, measured), but Exudyn
-        converts, copies and scans the element's dense Jacobian, which grows as
-        (6 + 6Z)^2 instead of 2 (6 + 3Z)^2: on two dense 120-coordinate blocks (the
-        condensed rows of rv40e) a synthetic system took 1.86 s instead of 1.31 s
-        for 1000 Jacobians. Rows with quasi-static balls between rigid
-        rings act on the carrier's six coordinates only: then ONE element carries
-        all rows (a 6 x 6 Jacobian; one Python call per evaluation instead of one
-        per row). Returns the first row's object number."""
-        stats, objects, pos = self.stats, [], 1
-        self.elements, self._element_members, self._row_slots = [], [], []
-        if all(not row.ring_nodes() and not row.ball_inertia for row in self.rows):
-            element = RowElement(self.rows, [_PERM.copy() for _ in self.rows], True, stats, record=True)
-            self.elements.append(element)
-            self._element_members.append([self.members[0]])
-            self._row_slots = [(0, k) for k in range(len(self.rows))]
-            return element.add_to(mbs, [nodes[0]])
-        for k, row in enumerate(self.rows):
-            count = 1 + len(row.ring_nodes())
-            row_nodes = [nodes[0]] + list(nodes[pos : pos + count])
-            self._element_members.append([self.members[0]] + list(self.members[pos : pos + count]))
-            pos += count
-            idx = np.concatenate([_PERM, np.arange(6, row.n_coordinates)])  # element coordinate -> local
-            element = RowElement(row, idx, True, stats, record=True)
-            self.elements.append(element)
-            self._row_slots.append((k, 0))
-            objects.append(element.add_to(mbs, row_nodes))
-        return objects[0]
+    def dense_blocks(self) -> list[tuple[str, ...]]:
+        """Per row with own members (modal rings' modes, balls with inertia): their names,
+        contiguous in the model's order — a dense diagonal block of the Newton matrix that
+        couples to the rest through the carrier only (the block elimination of the compiled
+        integrator, :func:`flexrv.model.core.registry.dense_blocks`)."""
+        return [names for names in self._own if names]
 
-    def recorded_elements(self) -> list:
-        """(element, its nodes' member names, [(group, key, live record array)]) per row
-        element (:class:`flexrv.model.kernels.HistoryRecorder`): row k's per-ball
-        records ``balls<k>`` and its force on the frame ``frame<k>`` (element order)."""
-        out = []
-        for i, (e, members) in enumerate(zip(self.elements, self._element_members)):
-            entries = []
-            for k, (element, j) in enumerate(self._row_slots):
-                if element == i:
-                    entries += [(self, f"balls{k}", e.records[j]), (self, f"frame{k}", e.frame_force(j))]
-            out.append((e, members, entries))
+    def pack(self, idx, history: bool = False):
+        """The rows' parts (:func:`flexrv.model.bearing_kernel.row_part`) on the coordinates
+        ``idx``; ``history``: fresh warm starts (the rows' initial local-solve states), the
+        same live work and record arrays."""
+        idx = np.asarray(idx, dtype=np.int64)
+        parts = []
+        for k, (row, work) in enumerate(zip(self.rows, self._work)):
+            p = fresh_kernel_inputs(row) if history else kernel_inputs(row)
+            parts.append((np.ascontiguousarray(idx[self._index[k]]), *work, p))
+        return BearingRowsPack(tuple(parts))
+
+    @staticmethod
+    def empty_pack():
+        return empty_pack(BearingRowsPack)
+
+    def record_sources(self) -> dict:
+        out = {}
+        for k, (row, work) in enumerate(zip(self.rows, self._work)):
+            qe, ve, f, rec = work[0], work[1], work[2], work[5]
+            out[f"balls{k}"] = rec
+            out[f"frame{k}"] = f[:6]
+            out[f"x{k}"] = qe[: 6 + row.m_inner + row.m_outer]
+            out[f"xt{k}"] = ve[:6]
+        return out
+
+    def outputs(self, t, rec) -> dict:
+        """The bearing's named outputs from the records (values: :func:`bearing_arrays`): the
+        reaction on the carrier (radial, axial, tilting); per ball (dims time, bearing_row,
+        ball) the inner and outer normal loads, the loaded inner contact angle, the central
+        film and the Hertz pressure at the inner contact; with flexible rings per row the
+        raceway deflection at the most-loaded contact and the rings' modal coordinates."""
+        frame = np.asarray(rec["frame0"])
+        fc = np.zeros(frame.shape)
+        for k in range(len(self.rows)):
+            fc[..., _PERM] += rec[f"frame{k}"]
+        history = [(rec[f"balls{k}"], rec[f"x{k}"]) for k in range(len(self.rows))]
+        speed = np.abs(np.asarray(rec["xt0"])[..., 5])  # the frame's phi_z rate: the carrier's
+        load_i, load_o, angle, film, p_max, defl, modal = bearing_arrays(self, speed, history)
+        dims = ("time", "bearing_row", "ball")
+        out = {
+            "main_bearing_radial_force": Output(
+                np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N", "radial reaction of the main bearing on the carrier"
+            ),
+            "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
+            "main_bearing_tilting_moment": Output(
+                np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m", "tilting reaction moment on the carrier"
+            ),
+            "ball_load_inner": Output(load_i, dims, "N", "ball-inner raceway normal load"),
+            "ball_load_outer": Output(load_o, dims, "N", "ball-outer raceway normal load"),
+            "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
+            "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
+            "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact"),
+        }
+        for label in ("inner", "outer"):
+            if any(m is None for m in modal[label]):
+                continue
+            out[f"ring_deformation_{label}"] = Output(
+                defl[label], ("time", "bearing_row"), "m", f"{label} raceway deflection at the most-loaded contact"
+            )
+            out[f"ring_modal_{label}"] = Output(
+                np.stack(modal[label], 1),
+                ("time", "bearing_row", f"mode_{label}"),
+                "1",
+                f"modal coordinates of the {label} rings",
+            )
         return out
 
     @property
@@ -953,7 +1030,8 @@ class BallBearingGroup(ForceGroup):
     def check(self) -> str | None:
         """Failure message if a condensed ring's local contact solve or the quasi-static
         balls' equilibrium did not converge in the last evaluation (the accepted state
-        of the step)."""
+        of the step on Exudyn's integrator; the state of every CHECK_EVERY-th accepted
+        step on the compiled one)."""
         states = [kernel_inputs(r).state for r in self.rows if hasattr(r, "_kernel_inputs")]
         if any(int(s[1]) for s in states):  # (rigid and modal rings: no local solve, never set)
             return "main bearing: the condensed rings' contact deflections did not converge"
@@ -995,79 +1073,6 @@ class BallBearingGroup(ForceGroup):
             )
         return out
 
-    def _element_state(self, q, v, k):
-        row = self.rows[k]
-        idx = self._index[k]
-        qe = q[..., idx].copy()
-        if row.ball_inertia:
-            qe[..., -3 * row.ball_count :] -= row.ball_reference.ravel()
-        return qe, v[..., idx], idx
-
-    def _force(self, q, v) -> np.ndarray:
-        """Generalized force of one state (compiled row kernels)."""
-        f = np.zeros(self._n)
-        for k in range(len(self.rows)):
-            qe, ve, idx = self._element_state(q, v, k)
-            f[idx] += row_force(self.rows[k], qe, ve)
-        return f
-
-    def evaluate(self, t, q, v, want_outputs: bool = False):
-        """Generalized forces for one state (n,) or a history (T, n) (one compiled
-        loop per row over the samples, :func:`flexrv.model.bearing_kernel.row_history`)."""
-        q = np.asarray(q, dtype=float)
-        v = np.asarray(v, dtype=float)
-        if q.ndim == 1:
-            return self._force(q, v), None
-        forces = np.zeros_like(q)
-        history = []
-        for k, row in enumerate(self.rows):
-            qe, ve, idx = self._element_state(q, v, k)
-            recs = np.zeros((q.shape[0], row.ball_count, N_RECORD))
-            forces[:, idx] += row_history(np.ascontiguousarray(qe), np.ascontiguousarray(ve), kernel_inputs(row), recs)
-            history.append((recs, qe))
-        out = bearing_outputs(self, q, v, forces, history) if want_outputs else None
-        return forces, out
-
-    def recorded_outputs(self, t, q, v, rec: dict, valid: np.ndarray) -> dict:
-        """Named outputs over a history (T,), (T, n), (T, n) (local coordinates) from the
-        run's records ``rec`` (:meth:`recorded_elements`' keys, (T, ...)), which are
-        filled in place at the samples not ``valid`` by the history pass
-        (:func:`~flexrv.model.bearing_kernel.row_history`) and are the same numbers
-        as :meth:`evaluate` to the condensed rings' local tolerance and, for rigid
-        rings, to round-off (the warm starts of the local solves and of the films
-        differ). Only the carrier's force enters :func:`bearing_outputs` (the
-        ``forces`` argument is (T, 6) here)."""
-        q = np.asarray(q, dtype=float)
-        v = np.asarray(v, dtype=float)
-        todo = np.flatnonzero(~np.asarray(valid, dtype=bool))
-        fc = np.zeros((q.shape[0], 6))
-        history = []
-        for k, row in enumerate(self.rows):
-            recs, frame = rec[f"balls{k}"], rec[f"frame{k}"]
-            qe, ve, _ = self._element_state(q, v, k)
-            if len(todo):
-                part = np.zeros((len(todo), row.ball_count, N_RECORD))
-                frame[todo] = row_history(
-                    np.ascontiguousarray(qe[todo]), np.ascontiguousarray(ve[todo]), kernel_inputs(row), part
-                )[:, :6]
-                recs[todo] = part
-            fc[:, _PERM] += frame
-            history.append((recs, qe))
-        return bearing_outputs(self, q, v, fc, history)
-
-    def jacobian(self, t, q, v):
-        q = np.asarray(q, dtype=float)
-        v = np.asarray(v, dtype=float)
-        jq = np.zeros((self._n, self._n))
-        jv = np.zeros((self._n, self._n))
-        for k, row in enumerate(self.rows):
-            qe, ve, idx = self._element_state(q, v, k)
-            dq, dv = row_jacobian(row, qe, ve)
-            ix = np.ix_(idx, idx)
-            jq[ix] += dq
-            jv[ix] += dv
-        return jq, jv
-
 
 def _law_film(law, load, speed) -> np.ndarray:
     """Central film h_c [m] of an EHL law at the given loads and speed (0 for dry laws)."""
@@ -1077,8 +1082,9 @@ def _law_film(law, load, speed) -> np.ndarray:
     return np.where(load > 0, h, 0.0)
 
 
-def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
-    """Named outputs of the bearing over a time history (see :class:`BallBearingGroup`).
+def bearing_arrays(group: BallBearingGroup, carrier_speed, history) -> tuple:
+    """The values of the bearing's outputs over a time history (:meth:`BallBearingGroup.outputs`):
+    (load_i, load_o, angle, film, p_max, defl, modal).
 
     Per ball (dims time, bearing_row, ball): inner/outer normal loads, loaded inner
     contact angle, central film thickness and maximum Hertz pressure at the inner
@@ -1090,12 +1096,14 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
     EHL h_c(Q, u) of the contact law at the entrainment speed of the carrier's
     rotation; the pressure is the Hertz p_max of the load (the EHL pressure spike
     is not resolved by the law, see :mod:`flexrv.ehl.law`).
-    ``history[k]`` is (per-ball records (T, Z, N_RECORD), element coordinates (T, n)) of row k.
+    ``carrier_speed``
+    (T,): |d theta / dt| of the carrier [rad/s]; ``history[k]``: (per-ball records (T, Z, N_RECORD),
+    the row's frame and modal-ring coordinates (T, 6 + modes)) of row k.
     """
     from flexrv.contact.hertz import point_contact
 
     rows = group.rows
-    n_t, n_r, n_b = q.shape[0], len(rows), rows[0].ball_count
+    n_t, n_r, n_b = carrier_speed.shape[0], len(rows), rows[0].ball_count
     shape = (n_t, n_r, n_b)
     load_i, load_o, angle = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     film, p_max = np.zeros(shape), np.zeros(shape)
@@ -1135,7 +1143,6 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
             else:
                 _, si, so, _ = row.slices()
                 modal[label][k][:] = qe[:, si if label == "inner" else so]
-    carrier_speed = np.abs(v[:, 2])
     for k, row in enumerate(rows):
         speed = (row.speed_factor * carrier_speed)[:, None]
         film[:, k] = _law_film(row.law_inner, load_i[:, k], speed)
@@ -1143,32 +1150,4 @@ def bearing_outputs(group: BallBearingGroup, q, v, forces, history) -> dict:
             ok = np.isfinite(load_i[:, k]).all(axis=-1)  # (a failed run's last samples may not be)
             p_max[:, k] = np.nan
             p_max[ok, k] = point_contact(load_i[ok, k], *row.inner_radii, row.e_eff).p_max
-    fc = forces[:, :6]  # on the carrier: x, y, theta, z, rx, ry
-    dims = ("time", "bearing_row", "ball")
-    out = {
-        "main_bearing_radial_force": Output(
-            np.hypot(fc[:, 0], fc[:, 1]), ("time",), "N", "radial reaction of the main bearing on the carrier"
-        ),
-        "main_bearing_axial_force": Output(fc[:, 3], ("time",), "N", "axial reaction on the carrier"),
-        "main_bearing_tilting_moment": Output(
-            np.hypot(fc[:, 4], fc[:, 5]), ("time",), "N m", "tilting reaction moment on the carrier"
-        ),
-        "ball_load_inner": Output(load_i, dims, "N", "ball-inner raceway normal load"),
-        "ball_load_outer": Output(load_o, dims, "N", "ball-outer raceway normal load"),
-        "ball_contact_angle": Output(np.degrees(angle), dims, "deg", "loaded inner contact angle"),
-        "ball_film_thickness": Output(film, dims, "m", "central EHL film thickness at the inner contact"),
-        "ball_max_pressure": Output(p_max, dims, "Pa", "maximum Hertz pressure at the inner contact"),
-    }
-    for label in ("inner", "outer"):
-        if any(m is None for m in modal[label]):
-            continue
-        out[f"ring_deformation_{label}"] = Output(
-            defl[label], ("time", "bearing_row"), "m", f"{label} raceway deflection at the most-loaded contact"
-        )
-        out[f"ring_modal_{label}"] = Output(
-            np.stack(modal[label], 1),
-            ("time", "bearing_row", f"mode_{label}"),
-            "1",
-            f"modal coordinates of the {label} rings",
-        )
-    return out
+    return load_i, load_o, angle, film, p_max, defl, modal

@@ -1,5 +1,8 @@
 """The compiled generalized-alpha integrator of a model whose forces all live in
-compiled kernels (the rigid model; :func:`compiled_eligible`).
+compiled kernels (the rigid model, the ball-resolved main bearing with rigid or flexible
+rings; :func:`compiled_eligible`). The dense diagonal blocks the elements declare (a
+bearing row's balls: :func:`flexrv.model.core.registry.dense_blocks`) are eliminated
+first in its Newton systems (:mod:`flexrv.model.numerics.block_lu`).
 
 :class:`CompiledIntegrator` drives the generated ``fused_integrate`` of the model's
 fused element (:mod:`flexrv.model.core.registry`, the algorithm in
@@ -27,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexrv.errors import InputError
-from flexrv.model.core.registry import INTEGRATE
+from flexrv.model.core.registry import INTEGRATE, dense_blocks
 from flexrv.model.numerics import gen_alpha
 
 #: Exudyn Newton settings the compiled integrator honours (name -> keyword of gen_alpha.new_state)
@@ -64,8 +67,8 @@ _STATUS = {
 
 def compiled_eligible(model) -> str | None:
     """None if ``model`` can run on the compiled integrator, else the reason: a group
-    outside the fused kernel (a Python group: balls, flexible rings, flexible crank), a
-    coordinate outside it, or a group with a per-step hook."""
+    outside the fused kernel (a Python group: the flexible crankshaft), a coordinate
+    outside it, or a group with a per-step hook."""
     from flexrv.model.base import ForceGroup
 
     fused = model.fused
@@ -119,7 +122,13 @@ class CompiledIntegrator:
             if m.damping_matrix is not None:
                 damp[s, s] = m.damping_matrix
         self.state = gen_alpha.new_state(
-            mass, stiff, damp, spectral_radius=spectral_radius, tolerance=tuple(tolerance), **(newton or {})
+            mass,
+            stiff,
+            damp,
+            spectral_radius=spectral_radius,
+            tolerance=tuple(tolerance),
+            blocks=dense_blocks(model) or None,
+            **(newton or {}),
         )
         #: the state's dense blocks, or None without (the block elimination is then not compiled in)
         self.blocks = self.state.blocks if self.state.blocks.shape[0] else None

@@ -2,13 +2,13 @@
 
 :class:`FusedForces` evaluates every registered compiled force element
 (:mod:`flexrv.model.core.registry`; here: gear stage, crank supports, needle bearings,
-pins, rigid main bearing, loads) of a model in ONE call of the fused kernel generated
+pins, rigid main bearing or the ball bearing's rows, loads) of a model in ONE call of the fused kernel generated
 for the elements present, a numba function that calls the elements' own compiled
 kernels (the physics stays in the elements' modules: one formula, one executor) on
 the model's coordinate vector. It backs both the single
 Exudyn ``ObjectGenericODE2`` of these groups (force and Jacobian user functions,
 :meth:`FusedForces.add_to`) and :meth:`flexrv.model.assembled.AssembledModel.generalized_forces`.
-Groups of other kinds (ball bearing, flexible crank) keep their own elements. The
+Groups of other kinds (flexible crank) keep their own elements. The
 generated ``fused_integrate`` (:mod:`flexrv.model.core.registry`) runs the compiled
 generalized-alpha around the same kernel (:mod:`flexrv.model.integrator`).
 
@@ -50,13 +50,22 @@ from numba import njit
 from flexrv.model.base import exudyn_vector
 from flexrv.model.core.registry import ELEMENTS, ROWS, ROWS_JAC, fused_functions, register, spec_of
 from flexrv.model.cranks_discs import CrankSupports, NeedleBearings
+from flexrv.model.flexible_bearing import BallBearingGroup
 from flexrv.model.gear_stage import GearMeshes
 from flexrv.model.loads import OutputLoads
 from flexrv.model.main_bearing_rigid import RigidMainBearing
 from flexrv.model.pins import PinContacts
 
 #: the compiled force elements, in the fused kernel's call order (one registry line each)
-for _element in (GearMeshes, CrankSupports, NeedleBearings, PinContacts, RigidMainBearing, OutputLoads):
+for _element in (
+    GearMeshes,
+    CrankSupports,
+    NeedleBearings,
+    PinContacts,
+    RigidMainBearing,
+    BallBearingGroup,
+    OutputLoads,
+):
     register(_element)
 
 

@@ -14,7 +14,8 @@ Field kinds of :func:`pack_type`: a law type (zeros of its fields; :func:`law_ty
 the model layer defines its constants, e.g. :class:`flexrv.contact.tapered_roller.SupportConstants`), ``(dtype,
 ndim)`` (an array of that many dimensions, empty in an absent element's pack) or
 ``(dtype, shape)`` (a fixed shape the kernel reads even when it has nothing to do,
-zeros in an absent element's pack).
+zeros in an absent element's pack) or ``tuple`` (a tuple of parts of one type, one per
+repeated unit, e.g. a bearing row; empty in an absent element's pack).
 """
 
 from __future__ import annotations
@@ -83,6 +84,8 @@ def empty_pack(cls):
             values.append(empty_pack(kind))
         elif _is_law(kind):
             values.append(kind.zero())
+        elif kind is tuple:
+            values.append(())
         else:
             dtype, shape = kind
             values.append(np.zeros((0,) * shape if isinstance(shape, int) else shape, dtype=dtype))
@@ -99,6 +102,9 @@ def check_pack(pack) -> None:
         elif _is_law(kind):
             if type(value) is not kind:
                 raise TypeError(f"{type(pack).__name__}.{field} must be a {kind.__name__}")
+        elif kind is tuple:
+            if not isinstance(value, tuple):
+                raise TypeError(f"{type(pack).__name__}.{field} must be a tuple")
         else:
             dtype, shape = kind
             ndim = shape if isinstance(shape, int) else len(shape)

@@ -94,6 +94,26 @@ def spec_of(group_obj) -> ElementSpec | None:
     return spec if spec is not None and isinstance(group_obj, spec.group) else None
 
 
+def dense_blocks(model) -> list[tuple[int, int]]:
+    """The dense diagonal blocks (start, size) of the Newton matrix of ``model`` that the
+    elements declare (``dense_blocks()``: groups of member names, contiguous in the model's
+    order, e.g. a bearing row's balls coupled through its condensed rings), each coupled
+    to the rest through other members only: the block elimination of the compiled
+    integrator (:mod:`flexrv.model.numerics.block_lu`). Empty: one dense LU."""
+    out = []
+    for g in model.groups:
+        declared = getattr(g, "dense_blocks", None)
+        if declared is None:
+            continue
+        for names in declared():
+            members = [model.members[m] for m in names]
+            start = members[0].offset
+            if any(m.offset != start + sum(x.n for x in members[:i]) for i, m in enumerate(members)):
+                raise ValueError(f"{g.name}: the members {names} of a dense block are not contiguous")
+            out.append((start, sum(m.n for m in members)))
+    return out
+
+
 _HASHES: dict[tuple, str] = {}
 
 

@@ -79,7 +79,8 @@ EVALUATE, CONVERGED, FAILED = 1, 0, -1
 #: residual, Newton correction, the constant matrices and the factorised iteration matrix; with
 #: dense diagonal blocks (``blocks`` (K, 2) of (start, size); empty: one dense LU), the block
 #: elimination's other coordinates ``xs``, its Y_k, blocks' LU, Schur complement, pivots and work vectors
-#: (:mod:`flexrv.model.numerics.block_lu`)
+#: (:mod:`flexrv.model.numerics.block_lu`), and the nonzero pattern of M, K, D by rows (row pointers ``rp``,
+#: column indices ``ci``: the residual's products skip the zeros)
 GaState = pack_type(
     "GaState",
     ("par", (np.float64, 1)),
@@ -109,6 +110,8 @@ GaState = pack_type(
     ("xpiv", (np.int64, 1)),
     ("tx", (np.float64, 1)),
     ("zx", (np.float64, 1)),
+    ("rp", (np.int64, 1)),
+    ("ci", (np.int64, 1)),
 )
 
 
@@ -170,6 +173,8 @@ def new_state(
     ip[I_EACHSTEP] = int(jacobian_each_step)
     ip[I_EXTRAPOLATE] = int(extrapolate)
     vec = [np.zeros(n) for _ in range(12)]
+    nonzero = (m != 0) | (stiff != 0) | (damp != 0)
+    rp = np.concatenate(([0], np.cumsum(nonzero.sum(axis=1)))).astype(np.int64)
     return GaState(
         par,
         ip,
@@ -187,6 +192,8 @@ def new_state(
         np.zeros(nx, np.int64),
         np.zeros(nx),
         np.zeros(nx),
+        rp,
+        np.nonzero(nonzero)[1].astype(np.int64),
     )
 
 
@@ -258,12 +265,13 @@ def _add_correction(st):
 
 @njit(cache=True, inline="always")
 def _residual(st, f):
-    """r = M a + K q + D v - f; returns ||r||_2 (NaN if not finite)."""
+    """r = M a + K q + D v - f over the nonzero entries of M, K, D; returns ||r||_2 (NaN if not finite)."""
     n = st.q.shape[0]
     s = 0.0
     for i in range(n):
         ri = -f[i]
-        for j in range(n):
+        for k in range(st.rp[i], st.rp[i + 1]):
+            j = st.ci[k]
             ri += st.mass[i, j] * st.a[j] + st.stiff[i, j] * st.q[j] + st.damp[i, j] * st.v[j]
         st.r[i] = ri
         s += ri * ri
