@@ -4,12 +4,12 @@ groups and the assembled model.
 A *member* is a body with its own Exudyn ``NodeGenericODE2`` (coordinates are
 absolute: reference 0, initial = nominal pose) and a constant mass matrix. A
 *force group* couples several members. The rigid reducer's groups (gear stage,
-crank supports, needle bearings, pins, rigid main bearing, loads) are
-:class:`KernelGroup` s: their physics is one numba-compiled kernel each, and the
-model evaluates all of them in ONE compiled call from ONE ``ObjectGenericODE2``
-(:class:`flexrv.model.kernels.FusedForces`; 95 % of a step was Python
-overhead with one numpy element per group). Other groups (ball-resolved bearing,
-flexible crank) keep one element each with a Python force function.
+crank supports, needle bearings, pins, rigid main bearing, loads) and the
+ball-resolved bearing's rows are :class:`KernelGroup` s: their physics is one
+numba-compiled kernel each, and the model evaluates all of them in ONE compiled call
+from ONE ``ObjectGenericODE2`` (:class:`flexrv.model.kernels.FusedForces`; with one
+numpy element per group, 95 % of a step was Python overhead). The flexible crank
+(Exudyn-native FFRF body) keeps its own element with a Python force function.
 The assembled model (:class:`flexrv.model.assembled.AssembledModel`) lives in its
 own module, above the kernels it calls.
 

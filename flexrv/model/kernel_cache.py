@@ -55,7 +55,8 @@ GENERATED_PREFIX = "flexrv.model.core._generated."
 #: the compiled functions a run calls directly, per kind of run or force element (they compile their
 #: callees into themselves): the fused element of the kernel groups on Exudyn's integrator or in a static
 #: solver (``fused``), the compiled integrator, which also evaluates that element for the run's Python
-#: calls (``integrate``: :meth:`flexrv.model.kernels.FusedForces.drive_with`), and the ball-bearing rows.
+#: calls (``integrate``: :meth:`flexrv.model.kernels.FusedForces.drive_with`), and the ball-bearing rows'
+#: own Exudyn element of the stand-alone bearing model (``rows``; in a reducer model the rows are in the fused kernel).
 #: A helper a run may never call (row_kernel, which the tests and the quasi-static path use;
 #: copy_records_if_same, which only Exudyn's path calls, a second to compile) stays uncached and must not
 #: trigger the notice
