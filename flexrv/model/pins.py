@@ -115,10 +115,12 @@ evaluation would only confirm the tolerance (the records moved to the corrected 
 :func:`_shift_records`), evaluates the pin kernel on the 3 n_discs local rim
 coordinates (3 x 3 blocks, no n x n arrays) and solves the small systems without
 LAPACK (:func:`inv_small`); a call at exactly the previous call's state adds that
-call's result. See :func:`_pin_condensed_kernel`. Per pin
-the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian's curvature terms
-reuse the curve's derivatives at the foot point from its Newton iteration, and
-the foot point's half-lobe test needs no arctangent
+call's result; a step's first call adds the previous first call's remaining predictor
+error. See :func:`_pin_condensed_kernel`. Per pin the closest point starts from its
+second-order prediction in the pin's motion (:func:`_pin_foot`), a pin proved open by
+the bound chained from the disc's last pose costs one subtraction (:func:`pin_kernel`),
+the Jacobian's curvature terms reuse the curve's derivatives at the foot point from its
+Newton iteration, and the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
 in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "The kernel's inner solves").
 
@@ -185,11 +187,10 @@ PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
 GRAD, HESS, SLACK, LAST_SIZE = 3, 5, 8, 9
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
 #: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
-#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact gaps (with the foot points'
-#: gradients), outputs per (disc, pin), per (disc, pin) the normal's turn h and the harmonics' b of the
-#: last evaluation with the Jacobian (NaN: skipped; :func:`_shift_records`), the warm starts' control, the
-#: counters of calls
-#: and of closest-point failures
+#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact evaluations (the slots above),
+#: each disc's pose (x, y, psi) at its last evaluation, outputs per (disc, pin), per (disc, pin) the
+#: normal's turn h and the harmonics' b of the last evaluation with the Jacobian (NaN: skipped;
+#: :func:`_shift_records`), the warm starts' control, the counters of calls and of closest-point failures
 PinPack = pack_type(
     "PinPack",
     ("idx", (_I, 1)),
@@ -297,10 +298,14 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
     relative to the disc (distance to a curve) up to the harmonics' variation, so
     with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
     pin whose bound is positive carries no force (and no Jacobian); its closest
-    point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
-    P0y, dphi/dPx, dphi/dPy) of the last exact evaluation (:func:`_pin_foot`). Friction
-    (module docstring): law.mu, law.v_reg; per (disc, pin) the friction force on the disc along t = z x n
-    into out_ft and its power f_t v_t (<= 0) into out_pw."""
+    point is not recomputed and out_gap holds the bound. last[kd, i] holds g0, P0 and the
+    foot point's derivatives of the last exact evaluation (:data:`GRAD`, :data:`HESS`,
+    :func:`_pin_foot`) and the last lower bound of g - 2 sum|A| at the disc's pose of the
+    last evaluation (:data:`SLACK`, ``pose``): no pin moved relative to the disc by more than
+    |c - c0| + (max|pin| + |c0|) |psi - psi0| since, so that bound less this motion is tried
+    first (no rotation, no root; never above the bound from g0, so the same pins are
+    solved). Friction (module docstring): law.mu, law.v_reg; per (disc, pin) the friction
+    force on the disc along t = z x n into out_ft and its power f_t v_t (<= 0) into out_pw."""
     law, pins, radii, profile, harm, last = (
         pack.law,
         pack.pins,
