@@ -113,9 +113,12 @@ def test_pin_friction_jacobian_with_disc_rim_condensation(v_scale):
     1e-6 of the largest entry (h = 3e-10; measured 8e-9). dF/dv: the force carries a
     noise eps_F from the rim Newton: the rim pose q_hub + delta is rounded differently
     for different Newton paths (a perturbation of one disc changes the shared
-    iteration count of all), eps_F ~ J r_p eps |q| ~ 1e9 * 0.06 * 2.2e-16 ~ 1e-8 N
-    (measured here: <= 1e-7, checked below as the spread of the force over Newton
-    starts). A central difference then errs by up to eps_F / h: with h_v = 1e-8 /
+    iteration count of all), eps_F ~ J r_p eps |q| ~ 1e9 * 0.06 * 2.2e-16 ~ 1e-8 N, and
+    the rim Newton stops within its tolerance (1e-10 of max|delta|, at least 1e-15 m), which
+    the contact stiffness (~1.7e9 N/m) turns into up to ~2e-6 N between two starts: checked
+    below as the spread of the force over Newton starts, bound 5e-6 N (measured 2.4e-6 N with
+    the closest points' second-order warm start, 6e-8 N without it, where the iterations
+    happened to end far inside the tolerance). A central difference then errs by up to eps_F / h: with h_v = 1e-8 /
     1e-7, 10 / 1 N s/m, i.e. 5e-6 / 4e-3 of the largest entry (2.3e6 / 268 N s/m), so
     the bounds are 1e-5 / 4e-3 (measured 4e-7 / 9e-5); the rigid-disc test above
     checks the friction Jacobian itself at 1e-6. The housing is rigid here (its
@@ -136,7 +139,7 @@ def test_pin_friction_jacobian_with_disc_rim_condensation(v_scale):
         g.dstate[:] = start * d0
         g.new_step()
         spread = max(spread, np.abs(g.evaluate(0.0, q, v)[0] - f0).max())
-    assert spread <= 1e-7
+    assert spread <= 5e-6
 
 
 @pytest.mark.parametrize("needle", ["empirical", "rollers"])

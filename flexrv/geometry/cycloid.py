@@ -211,7 +211,7 @@ _NEWTON = _jit(_closest_point_newton)
 _COLD_STARTS = np.linspace(-0.375, 0.375, 7)
 
 
-def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter):
+def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter, cos_half):
     """Foot point of P = (px, py) on C: Newton from the warm start ``phi0`` if it is
     finite, else (or if that fails or lands more than half a lobe from P's polar
     angle theta: a warm start from a far-away state, e.g. a diverging Newton trial,
@@ -225,7 +225,8 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
     py), |phi - theta| (mod 2 pi) <= lobe/2 is cos(phi - theta) |P| = px sin(phi)
     + py cos(phi) >= cos(lobe/2) |P|, and sin(phi), cos(phi) follow from C and C'
     at phi: R (z - 1) sin(phi) = z cx + d1y, R (z - 1) cos(phi) = z cy - d1x (an
-    arctangent per call would cost about 1.5 % of a rigid run)."""
+    arctangent per call would cost about 1.5 % of a rigid run); ``cos_half`` = cos(lobe/2)
+    (:func:`closest_point_settings`)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
     if np.isfinite(phi0):
         phi, conv, res, sd, nx, ny, _, cx, cy, d1x, d1y, d2x, d2y = _NEWTON(
@@ -233,7 +234,7 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
         )
         if conv or res <= 1e-12:
             along = px * (z_rp * cx + d1y) + py * (z_rp * cy - d1x)  # R (z - 1) |P| cos(phi - theta)
-            if along >= np.cos(0.5 * lobe) * radius * (z_rp - 1) * np.sqrt(px * px + py * py):
+            if along >= cos_half * radius * (z_rp - 1) * np.sqrt(px * px + py * py):
                 return phi, True, sd, nx, ny, d1x, d1y, d2x, d2y
     theta = np.arctan2(px, py)
     best = (theta, False, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan)
@@ -250,13 +251,13 @@ def _foot_point(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_ite
 _FOOT = _jit(_foot_point)
 
 
-def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter, out):
+def _pin_gap_kernel(px, py, phi0, z_rp, radius, eccentricity, max_step, tol, max_iter, cos_half, out):
     """Foot point, signed distance and outward normal of every point (flat
     arrays); out[0..3] = (s, nx, ny, phi). Returns the number of failures."""
     failed = 0
     for i in range(px.shape[0]):
         phi, ok, out[0, i], out[1, i], out[2, i], _, _, _, _ = _FOOT(
-            px[i], py[i], phi0[i], z_rp, radius, eccentricity, max_step, tol, max_iter
+            px[i], py[i], phi0[i], z_rp, radius, eccentricity, max_step, tol, max_iter, cos_half
         )
         failed += not ok
         out[3, i] = phi
@@ -365,11 +366,11 @@ def pin_gap(
 
 
 def closest_point_settings(z_rp: int, pin_circle_radius: float, tol: float = 1e-14, max_iter: int = 40):
-    """(max_step [rad], tolerance [rad], max_iter) of the closest-point Newton
+    """(max_step [rad], tolerance [rad], max_iter, cos(lobe / 2)) of the closest-point Newton
     iteration: steps clipped to an eighth of a lobe, tolerance ``tol`` scaled by
-    hypot(R_p, 1)."""
+    hypot(R_p, 1); the half lobe's cosine for the warm start's test (:func:`_foot_point`)."""
     lobe = 2.0 * np.pi / (z_rp - 1)
-    return float(lobe / 8.0), float(tol * np.hypot(pin_circle_radius, 1.0)), int(max_iter)
+    return float(lobe / 8.0), float(tol * np.hypot(pin_circle_radius, 1.0)), int(max_iter), float(np.cos(0.5 * lobe))
 
 
 # =========================================================================== curvature, arms, stiffness

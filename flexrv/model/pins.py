@@ -115,10 +115,12 @@ evaluation would only confirm the tolerance (the records moved to the corrected 
 :func:`_shift_records`), evaluates the pin kernel on the 3 n_discs local rim
 coordinates (3 x 3 blocks, no n x n arrays) and solves the small systems without
 LAPACK (:func:`inv_small`); a call at exactly the previous call's state adds that
-call's result. See :func:`_pin_condensed_kernel`. Per pin
-the closest point starts from the previous one (:func:`_pin_foot`), the Jacobian's curvature terms
-reuse the curve's derivatives at the foot point from its Newton iteration, and
-the foot point's half-lobe test needs no arctangent
+call's result; a step's first call adds the previous first call's remaining predictor
+error. See :func:`_pin_condensed_kernel`. Per pin the closest point starts from its
+second-order prediction in the pin's motion (:func:`_pin_foot`), a pin proved open by
+the bound chained from the disc's last pose costs one subtraction (:func:`pin_kernel`),
+the Jacobian's curvature terms reuse the curve's derivatives at the foot point from its
+Newton iteration, and the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
 in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "The kernel's inner solves").
 
@@ -170,6 +172,7 @@ PinLaw = law_type(
     max_step=float,
     tol=float,
     max_iter=int,
+    cos_half=float,
     mu=float,
     v_reg=float,
 )
@@ -177,12 +180,17 @@ _F, _I = np.float64, np.int64
 #: how :func:`pin_kernel` uses its warm starts: a cold restart of every closest point every
 #: ``restart_every`` calls (0: never after the first), pins provably open skipped (``skip_open``)
 PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
+#: the slots of a pin's ``last`` record (:func:`pin_kernel`, :func:`_pin_foot`): the exact gap g0 at the
+#: profile-frame position P0 of its last exact evaluation (0, 1, 2), the foot point's gradient dphi/dP (3, 4)
+#: and second derivatives d2phi/dP2 (xx, xy, yy: 5, 6, 7) there, and the lower bound of the gap less the
+#: harmonics' margin at the disc's pose of the last evaluation (``pose``), the chained bound's start (8)
+GRAD, HESS, SLACK, LAST_SIZE = 3, 5, 8, 9
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
 #: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
-#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact gaps, outputs per (disc,
-#: pin), per (disc, pin) the normal's turn h and the harmonics' b of the last evaluation with the
-#: Jacobian (NaN: skipped; :func:`_shift_records`), the warm starts' control, the counters of calls
-#: and of closest-point failures
+#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact evaluations (the slots above),
+#: each disc's pose (x, y, psi) at its last evaluation, outputs per (disc, pin), per (disc, pin) the
+#: normal's turn h and the harmonics' b of the last evaluation with the Jacobian (NaN: skipped;
+#: :func:`_shift_records`), the warm starts' control, the counters of calls and of closest-point failures
 PinPack = pack_type(
     "PinPack",
     ("idx", (_I, 1)),
@@ -194,6 +202,7 @@ PinPack = pack_type(
     ("harm", (_F, 3)),
     ("phi", (_F, 2)),
     ("last", (_F, 3)),
+    ("pose", (_F, 2)),
     ("gap", (_F, 2)),
     ("force", (_F, 2)),
     ("nx", (_F, 2)),
@@ -271,7 +280,14 @@ def _gap_curvature(ph, d1x, d1y, d2x, d2y, dist, nlx, nly, cr, sr, c, s, rx, ry,
 
 @njit(cache=True)
 def pin_kernel(q, v, f, jq, jv, jac, pack):
-    """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv.
+    """Pin–disc contacts (module docstring) on the coordinates ``pack.idx``: :func:`_pins_at`."""
+    _pins_at(q, v, f, jq, jv, jac, pack, pack.idx)
+
+
+@njit(cache=True)
+def _pins_at(q, v, f, jq, jv, jac, pack, idx):
+    """Pin–disc contacts (module docstring): Q into f[idx], Jacobians into jq, jv (``idx``: the
+    discs' (x, y, psi) coordinates, ``pack.idx`` or the rim condensation's local ones).
     Per (disc, pin): gap, force, housing normal (nx, ny) and arm torque r x n into
     the output arrays; phi is the closest-point warm start (updated; NaN: cold
     start; :func:`_pin_foot`). ``calls`` counts calls (a cold
@@ -282,12 +298,15 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     relative to the disc (distance to a curve) up to the harmonics' variation, so
     with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
     pin whose bound is positive carries no force (and no Jacobian); its closest
-    point is not recomputed and out_gap holds the bound. last[kd, i] = (g0, P0x,
-    P0y) of the last exact evaluation. Friction (module docstring): law.mu,
-    law.v_reg; per (disc, pin) the friction force on the disc along t = z x n
-    into out_ft and its power f_t v_t (<= 0) into out_pw."""
-    idx, law, pins, radii, profile, harm, last = (
-        pack.idx,
+    point is not recomputed and out_gap holds the bound. last[kd, i] holds g0, P0 and the
+    foot point's derivatives of the last exact evaluation (:data:`GRAD`, :data:`HESS`,
+    :func:`_pin_foot`) and the last lower bound of g - 2 sum|A| at the disc's pose of the
+    last evaluation (:data:`SLACK`, ``pose``): no pin moved relative to the disc by more than
+    |c - c0| + (max|pin| + |c0|) |psi - psi0| since, so that bound less this motion is tried
+    first (no rotation, no root; never above the bound from g0, so the same pins are
+    solved). Friction (module docstring): law.mu, law.v_reg; per (disc, pin) the friction
+    force on the disc along t = z x n into out_ft and its power f_t v_t (<= 0) into out_pw."""
+    law, pins, radii, profile, harm, last = (
         pack.law,
         pack.pins,
         pack.radii,
@@ -309,13 +328,24 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
     mu, v_reg = law.mu, law.v_reg  # friction: effective coefficient, regularisation speed
     fric = mu > 0.0 and v_reg > 0.0
     every, calls = pack.control.restart_every, pack.calls
-    reach, phi, failures, curv = pack.reach, pack.phi, pack.failures, pack.curv
+    reach, phi, failures, curv, pose = pack.reach, pack.phi, pack.failures, pack.curv, pack.pose
     cold = every > 0 and calls[0] % every == 0
     skip = pack.control.skip_open
     calls[0] += 1
+    chain = skip and not cold
+    arm2 = 0.0  # the largest |pin|^2 (the chained bound's arm)
+    if chain:
+        for i in range(pins.shape[0]):
+            arm2 = max(arm2, pins[i, 0] * pins[i, 0] + pins[i, 1] * pins[i, 1])
     for kd in range(profile.shape[0]):
         ix, iy, ip = idx[3 * kd], idx[3 * kd + 1], idx[3 * kd + 2]
         xd, yd, psi = q[ix], q[iy], q[ip]
+        # the largest motion of any pin relative to the disc since its last evaluation (NaN: none)
+        x0, y0 = pose[kd, 0], pose[kd, 1]
+        moved = np.sqrt((xd - x0) ** 2 + (yd - y0) ** 2) + (np.sqrt(arm2) + np.sqrt(x0 * x0 + y0 * y0)) * abs(
+            psi - pose[kd, 2]
+        )
+        pose[kd, 0], pose[kd, 1], pose[kd, 2] = xd, yd, psi
         c, s = np.cos(psi), np.sin(psi)
         d_r, d_rp, d_rot = profile[kd, 0], profile[kd, 1], profile[kd, 2]
         cr, sr = np.cos(d_rot), np.sin(d_rot)
@@ -325,20 +355,30 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
             margin += 2.0 * abs(harm[kd, h, 1])
         fx = fy = fp = 0.0
         for i in range(pins.shape[0]):
-            rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
-            lx, ly = c * rx + s * ry, -s * rx + c * ry  # disc frame
-            px, py = cr * lx + sr * ly, -sr * lx + cr * ly  # profile frame (rotation modification removed)
-            if skip and not cold:
-                bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
-                if bound > 0.0:  # provably open (NaN: never skipped)
+            if chain:  # the chained bound: no rotation, no root (NaN: not skipped)
+                bound = last[kd, i, SLACK] - moved
+                if bound > 0.0:
+                    last[kd, i, SLACK] = bound
                     out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
                     curv[kd, i, 0] = np.nan
                     continue
-            ph, dist, nlx, nly, d1x, d1y, d2x, d2y = _pin_foot(law, reach, phi, failures, kd, i, px, py, radius, cold)
+            rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
+            lx, ly = c * rx + s * ry, -s * rx + c * ry  # disc frame
+            px, py = cr * lx + sr * ly, -sr * lx + cr * ly  # profile frame (rotation modification removed)
+            if chain:
+                bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
+                if bound > 0.0:  # provably open (NaN: never skipped)
+                    last[kd, i, SLACK] = bound
+                    out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
+                    curv[kd, i, 0] = np.nan
+                    continue
+            ph, dist, nlx, nly, d1x, d1y, d2x, d2y = _pin_foot(
+                law, reach, phi, last, failures, kd, i, px, py, radius, cold
+            )
             gap = dist + r_nom + d_rp - radii[i]
             for h in range(harm.shape[1]):
                 gap -= harm[kd, h, 1] * np.cos(harm[kd, h, 0] * ph + harm[kd, h, 2])
-            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2] = gap, px, py
+            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2], last[kd, i, SLACK] = gap, px, py, gap - margin
             mx, my = cr * nlx - sr * nly, sr * nlx + cr * nly  # disc frame
             nx, ny = c * mx - s * my, s * mx + c * my  # housing frame
             rxn = rx * ny - ry * nx
@@ -412,25 +452,72 @@ def pin_kernel(q, v, f, jq, jv, jac, pack):
 
 
 @njit(cache=True, inline="always")
-def _pin_foot(law, reach, phi, failures, kd, i, px, py, radius, cold):
+def _pin_foot(law, reach, phi, last, failures, kd, i, px, py, radius, cold):
     """The closest point of pin i to disc k's pin-centre curve (radius R_p + dR_p) at its
-    profile-frame position (px, py): (phi, s, n_x, n_y, C'_x, C'_y, C''_x, C''_y) of
-    :func:`flexrv.geometry.cycloid._foot_point`, warm-started from phi[kd, i] (``cold``:
-    from the cold starts), phi into phi[kd, i], a failure counted in failures[0] (``law``,
-    ``reach``, ``phi``, ``failures``: the fields of :data:`PinPack`, taken from the pack once
-    per call: a field read from the pack per pin costs an atomic reference count pair, a
-    sixth of the kernel's time). A warm-started local minimum beyond the curve's reach on
-    its side may not be the nearest point (another flank): it is found again from the cold
-    starts (:func:`_curve_reach`)."""
+    profile-frame position P = (px, py): (phi, s, n_x, n_y, C'_x, C'_y, C''_x, C''_y) of
+    :func:`flexrv.geometry.cycloid._foot_point`, warm-started from the second-order prediction
+    of phi from the last exact evaluation (``cold``: from the cold starts), phi into phi[kd, i],
+    a failure counted in failures[0] (``law``, ``reach``, ``phi``, ``last``, ``failures``: the
+    fields of :data:`PinPack`, taken from the pack once per call: a field read from the pack
+    per pin costs an atomic reference count pair, a sixth of the kernel's time).
+
+    The prediction: the foot point solves F(phi, P) = (P - C(phi)) . C'(phi) = 0, so with D =
+    -dF/dphi = |C'|^2 - (P - C) . C'' (> 0 at a minimum) its derivatives are dphi/dP = g = C' / D
+    and d2phi/dP2 = (F_pp g g^T + C'' g^T + g C''^T) / D, F_pp = -3 C' . C'' + (P - C) . C'''
+    (:func:`_foot_derivatives`), stored in last[kd, i, GRAD:] at the last exact evaluation (P0 =
+    last[kd, i, 1:3]): phi + g . dP + dP^T (d2phi/dP2) dP / 2, dP = P - P0, is within O(|dP|^3)
+    of the foot point, so the Newton starts near the solution after a time step's motion as
+    after a Newton correction of the solver (from phi itself the start is off by ~1e-4 rad after
+    a step). A predicted change of more than ``max_step`` (a far jump, e.g. a solver restarting
+    elsewhere) or missing derivatives (NaN) start from phi[kd, i] itself. A warm-started local
+    minimum beyond the curve's reach on its side may not be the nearest point (another flank):
+    it is found again from the cold starts (:func:`_curve_reach`)."""
     z_rp, ecc, max_step, tol, max_iter = law.z_rp, law.eccentricity, law.max_step, law.tol, law.max_iter
-    start = np.nan if cold else phi[kd, i]
-    ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter)
+    ch = law.cos_half
+    start = np.nan
+    if not cold:
+        start = phi[kd, i]
+        dx, dy = px - last[kd, i, 1], py - last[kd, i, 2]
+        move = last[kd, i, GRAD] * dx + last[kd, i, GRAD + 1] * dy
+        bend = last[kd, i, HESS] * dx * dx + 2.0 * last[kd, i, HESS + 1] * dx * dy + last[kd, i, HESS + 2] * dy * dy
+        move += 0.5 * bend
+        if abs(move) < max_step:  # (NaN: no prediction)
+            start += move
+    ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter, ch)
     if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
-        ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter)
+        ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
+            px, py, np.nan, z_rp, radius, ecc, max_step, tol, max_iter, ch
+        )
     if not ok:
         failures[0] += 1
     phi[kd, i] = ph
+    _foot_derivatives(last, kd, i, ok, px, py, z_rp, dist, nlx, nly, d1x, d1y, d2x, d2y)
     return ph, dist, nlx, nly, d1x, d1y, d2x, d2y
+
+
+@njit(cache=True, inline="always")
+def _foot_derivatives(last, kd, i, ok, px, py, z_rp, dist, nlx, nly, d1x, d1y, d2x, d2y):
+    """dphi/dP and d2phi/dP2 of the foot point at P = (px, py) (:func:`_pin_foot`) into
+    last[kd, i, GRAD:GRAD + 2] and last[kd, i, HESS:HESS + 3] (NaN if not ``ok``). The
+    epitrochoid's third derivative from C and C'': with C = R e(phi) - a E(z phi), e(x) = (sin
+    x, cos x), C + C'' = a (z^2 - 1) E and C''' = -C' + a z (z^2 - 1) E', E' = Rot(-90 deg) E,
+    so C''' = -C' + z Rot(-90 deg)(C + C'')."""
+    den = d1x * d1x + d1y * d1y - dist * (nlx * d2x + nly * d2y)  # D = d2/dphi2 of |P - C|^2 / 2
+    if not (ok and den > 0.0):
+        for c in range(GRAD, HESS + 3):
+            last[kd, i, c] = np.nan
+        return
+    rx, ry = dist * nlx, dist * nly  # P - C at the foot point
+    cx, cy = px - rx, py - ry
+    d3x = -d1x + z_rp * (cy + d2y)
+    d3y = -d1y - z_rp * (cx + d2x)
+    fpp = -3.0 * (d1x * d2x + d1y * d2y) + rx * d3x + ry * d3y
+    inv = 1.0 / den
+    gx, gy = d1x * inv, d1y * inv
+    last[kd, i, GRAD], last[kd, i, GRAD + 1] = gx, gy
+    last[kd, i, HESS] = (fpp * gx * gx + 2.0 * d2x * gx) * inv
+    last[kd, i, HESS + 1] = (fpp * gx * gy + d2x * gy + d2y * gx) * inv
+    last[kd, i, HESS + 2] = (fpp * gy * gy + 2.0 * d2y * gy) * inv
 
 
 #: the rim Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
@@ -440,8 +527,9 @@ RIM_NEWTON = (80, 80, 0.0, 100.0)
 #: predicted next residual K_est max|step|^2 is at most QUAD_SAFETY of the tolerance; the carried
 #: K_est halves per call that measures a smaller K (QUAD_DECAY)
 QUAD_SAFETY, QUAD_DECAY = 0.01, 0.5
-#: the slot of the rim work flags (``st``, beside numerics.newton.VALID) that carries K_est
-QUAD_EST = 1
+#: the slots of the rim work flags (``st``, beside numerics.newton.VALID) that carry K_est and the
+#: weighted hub motion of the last step's first call (0: none; :func:`_rim_solve`)
+QUAD_EST, EXT_MOVE = 1, 2
 
 
 @njit(cache=True)
@@ -501,7 +589,7 @@ def _shift_records(pins, ql, vh, dq):
 
 
 @njit(cache=True)
-def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
+def _rim_residual(qh, vh, ql, fl, jl, jvl, pins, idx_rim, cm, weight, delta, res):
     """The rim condensation's residual R = delta - C Q(q_hub + delta) into ``res`` (J = dQ/dq
     into jl) for :func:`~flexrv.model.numerics.newton.newton_update`; returns (max|R|,
     max|delta|) weighted (psi times R_p)."""
@@ -512,8 +600,8 @@ def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
         for c in range(m):
             jl[r, c] = 0.0
             jvl[r, c] = 0.0
-    jac = m >= 0  # True, typed bool: the literal True would compile pin_kernel a second time
-    pin_kernel(ql, vh, fl, jl, jvl, jac, pins_loc)
+    jac = m >= 0  # True, typed bool: the literal True would compile _pins_at a second time
+    _pins_at(ql, vh, fl, jl, jvl, jac, pins, idx_rim)
     r1 = 0.0
     scale = 0.0
     for r in range(m):
@@ -529,7 +617,7 @@ def _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res):
 def pin_work_size(m: int) -> int:
     """Length of the rim condensation's work array (:func:`_pin_condensed_kernel`)
     for m = 3 n_discs local coordinates."""
-    return 4 + NEWTON_STATE + 15 * m + 11 * m * m
+    return 4 + NEWTON_STATE + 17 * m + 11 * m * m
 
 
 @njit(cache=True)
@@ -545,19 +633,18 @@ def pin_body_kernel(q, v, f, jq, jv, jac, pack):
     if cd.shape[0] == 0 and not ch > 0.0:
         pin_kernel(q, v, f, jq, jv, jac, pins)
         return
-    # the pin kernel's pack on the local rim coordinates (built here: one array to unbox, not sixteen)
-    pins_loc = PinPack(pack.idx_rim, *pins[1:])
-    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, pack.dstate, pack.housing, pack.work)
+    _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pack.idx_rim, cd, ch, pack.dstate, pack.housing, pack.work)
 
 
 #: views of the rim condensation's work array (:func:`_rim_views`, layout of :func:`pin_work_size`):
-#: st, the Newton state, 15 vectors (the last call's hub q, v, condensed force and rim offsets, the
+#: st, the Newton state, 17 vectors (the last call's hub q, v, condensed force and rim offsets, the
 #: hub state, the local rim coordinates and forces, delta, the Newton's base, step and residual,
-#: a_k stacked, the condensed force, the norms' weights), 11 matrices (S_q, S_v, the condensed
+#: a_k stacked, the condensed force, the norms' weights, the first-order prediction of this call and
+#: the remaining error of the last step's first call, :func:`_rim_solve`), 11 matrices (S_q, S_v, the condensed
 #: Jacobians, J, J_v, C, N, scratch, D, scratch)
 RimWork = namedtuple(
     "RimWork",
-    "st nw qp vp qfc dlast qh vh ql fl delta base step res av qf weight sq sv jc jvc jl jvl cm nm tmp dd t2",
+    "st nw qp vp qfc dlast qh vh ql fl delta base step res av qf weight pred ext sq sv jc jvc jl jvl cm nm tmp dd t2",
 )
 
 
@@ -568,12 +655,12 @@ def _rim_views(wk, m):
     st = wk[0:4]
     nw = wk[4 : 4 + NEWTON_STATE]
     o = 4 + NEWTON_STATE
-    vec = wk[o : o + 15 * m].reshape((15, m))  # the layout of pin_work_size: 15 vectors, then 11 matrices
-    mat = wk[o + 15 * m : o + 15 * m + 11 * mm].reshape((11, m, m))
+    vec = wk[o : o + 17 * m].reshape((17, m))  # the layout of pin_work_size: 17 vectors, then 11 matrices
+    mat = wk[o + 17 * m : o + 17 * m + 11 * mm].reshape((11, m, m))
     return RimWork(
         st, nw, vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7], vec[8], vec[9], vec[10], vec[11],
-        vec[12], vec[13], vec[14], mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7], mat[8], mat[9],
-        mat[10],
+        vec[12], vec[13], vec[14], vec[15], vec[16], mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7],
+        mat[8], mat[9], mat[10],
     )  # fmt: skip
 
 
@@ -633,11 +720,21 @@ def _rim_start(dstate, cd, ch, r_p, w):
 
 
 @njit(cache=True, inline="always")
-def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
+def _rim_solve(valid, first, pins, idx_rim, ch, dstate, hs, w):
     """The rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) =
     I - C J, from the first-order predictor of the previous call (``valid``); the last
     correction applied linearised (condensed force into w.qf, offsets into dstate) and the
     housing's rotation and rim offsets into hs. Returns the pins' torque on the discs.
+
+    A step's first call (``first``: the call with the Jacobian, which an integrator updating its
+    iteration matrix every step makes at each step's predictor; later calls of the step come
+    after small Newton corrections) moves the hub by a whole step's motion, and the first-order
+    predictor then leaves an error e quadratic in that motion. Consecutive steps move alike,
+    so the start adds the previous first call's error scaled by the square of the ratio of the
+    two motions' sizes (max|dq_hub| weighted, 1 at a constant speed and step): e_n+1 ~ e_n to
+    first order in the change between steps. A start farther than a tenth of max|delta| is not
+    used (numerics.newton.apply_predictor); the Newton converges to the same tolerance from any
+    start.
 
     Quadratic stop: after a full Newton step the residual is K |step|^2 (K the local
     constant of the quadratic convergence); each call that evaluates after a full step
@@ -656,17 +753,25 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     cm, res, base, tmp, nm, dlast, qfc, st = w.cm, w.res, w.base, w.tmp, w.nm, w.dlast, w.qfc, w.st
     m = qh.shape[0]
     nd = m // 3
+    pred, ext = w.pred, w.ext
+    moved = 0.0  # max|q_hub - q_hub,prev| weighted: the size of this call's motion
     if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
         for r in range(m):
             acc = 0.0
             for c in range(m):
                 acc += sq[r, c] * (qh[c] - qp[c]) + sv[r, c] * (vh[c] - vp[c])
             step[r] = acc
+            pred[r] = delta[r] + acc
+            moved = max(moved, abs(qh[r] - qp[r]) * weight[r])
+        if first and st[EXT_MOVE] > 0.0:  # a step's first call: the last one's remaining error, scaled
+            ratio = (moved / st[EXT_MOVE]) ** 2
+            for r in range(m):
+                step[r] += ratio * ext[r]
         apply_predictor(delta, step, weight)
     newton_start(nw)
     k_est, k_new, full, early = st[QUAD_EST], 0.0, 0.0, False
     while True:  # the rim Newton (numerics.newton): R = delta - C Q(q_hub + delta), dR/d(delta) = I - C J
-        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins_loc, cm, weight, delta, res)
+        r1, scale = _rim_residual(qh, vh, ql, fl, jl, jvl, pins, idx_rim, cm, weight, delta, res)
         if full > 0.0:  # after a full Newton step: its quadratic constant K = max|R| / max|step|^2
             k_new = max(k_new, r1 / (full * full))
         if newton_update(nw, r1, scale, delta, base, step, res, cm, jl, -1.0, tmp, nm, *RIM_NEWTON):
@@ -685,7 +790,7 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
     if early:  # the records to the pose of the linearised correction
         for r in range(m):
             tmp[0, r] = -step[r]
-        _shift_records(pins_loc, ql, vh, tmp[0])
+        _shift_records(pins, ql, vh, tmp[0])
     # the last Newton correction c = -N R, linearised (O(|R|^2) exact): the result is smooth in q and v
     # down to round-off, below the Newton tolerance (a finite difference of 1e-10 sees the condensation)
     s = 0.0
@@ -706,6 +811,10 @@ def _rim_solve(valid, pins_loc, ch, dstate, hs, w):
         dstate[r // 3, r % 3] = delta[r]
         dlast[r] = delta[r]
         qfc[r] = qf[r]
+    if first:  # the first-order predictor's error at this step's motion, for the next step's first call
+        st[EXT_MOVE] = moved if valid else 0.0
+        for r in range(m):
+            ext[r] = delta[r] - pred[r]
     return s
 
 
@@ -751,7 +860,7 @@ def _rim_tangent(ch, s, w):
 
 
 @njit(cache=True)
-def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, hs, wk):
+def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, idx_rim, cd, ch, dstate, hs, wk):
     """The rim condensation (module docstring, "Disc body", "Housing"): the pins act
     on the rim poses q_r = q_hub + delta of all discs, delta = C(q) Q(q_r, v), C =
     blockdiag(C_d,k) + c_h A A^T (cd empty: rigid disc bodies; c_h = 0: the discs
@@ -803,7 +912,7 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, pins_loc, cd, ch, dstate, 
         _add_condensed(f, jq, jv, jac, idx, w.qfc, w.jc, w.jvc)
         return
     _rim_start(dstate, cd, ch, pins.law.pin_circle_radius, w)
-    s = _rim_solve(valid, pins_loc, ch, dstate, hs, w)
+    s = _rim_solve(valid, jac, pins, idx_rim, ch, dstate, hs, w)
     _rim_tangent(ch, s, w)
     _add_condensed(f, jq, jv, jac, idx, w.qf, w.jc, w.jvc)
 
@@ -943,7 +1052,7 @@ class PinContacts(KernelGroup):
             _curve_reach(int(d.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(d.eccentricity))
             for kd in range(self.nd)
         ]
-        max_step, tol, max_iter = closest_point_settings(d.z_rp, p.pin_circle_radius)
+        max_step, tol, max_iter, cos_half = closest_point_settings(d.z_rp, p.pin_circle_radius)
         self.law = PinLaw.of(
             z_rp=d.z_rp,
             pin_circle_radius=p.pin_circle_radius,
@@ -956,6 +1065,7 @@ class PinContacts(KernelGroup):
             max_step=max_step,
             tol=tol,
             max_iter=max_iter,
+            cos_half=cos_half,
             mu=p.pin_friction,
             v_reg=d.friction_velocity,
         )
@@ -969,7 +1079,8 @@ class PinContacts(KernelGroup):
         self.ft, self.pw = np.zeros((self.nd, z)), np.zeros((self.nd, z))  # friction force on the disc, its power
         #: per (disc, pin) the normal's turn h and the harmonics' b of the last evaluation (_shift_records)
         self.curv = np.full((self.nd, z, 2), np.nan)
-        self.last = np.full((self.nd, z, 3), np.nan)
+        self.last = np.full((self.nd, z, LAST_SIZE), np.nan)
+        self.pose = np.full((self.nd, 3), np.nan)
         #: the solver's warm starts: a cold restart every restart_every calls, provably open pins skipped
         self.control = PinControl.of(restart_every=restart_every, skip_open=True)
         self.calls = np.zeros(1, dtype=np.int64)  # pin-kernel calls
@@ -1002,15 +1113,16 @@ class PinContacts(KernelGroup):
         return self.disc_c.shape[0] > 0
 
     def pack(self, idx, history=False):
-        phi, last, control, calls, failures = (
+        phi, last, pose, control, calls, failures = (
             self.phi,
             self.last,
+            self.pose,
             self.control,
             self.calls,
             self.failures,
         )
         if history:  # post-processing: cold start at the first sample, then warm; every gap exact
-            phi, last = np.full_like(self.phi, np.nan), np.full_like(self.last, np.nan)
+            phi, last, pose = (np.full_like(a, np.nan) for a in (self.phi, self.last, self.pose))
             control = PinControl.of(restart_every=0, skip_open=False)
             calls, failures = np.ones(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
             # the rim Newton too starts cold (delta = 0) at the first sample: the history pass and a group's
@@ -1029,6 +1141,7 @@ class PinContacts(KernelGroup):
             harm=self.harmonics,
             phi=phi,
             last=last,
+            pose=pose,
             gap=self.gap,
             force=self.force,
             nx=self.nx,
@@ -1163,6 +1276,7 @@ class PinContacts(KernelGroup):
         """Forget the closest-point warm start and the call counter."""
         self.phi[:] = np.nan
         self.last[:] = np.nan
+        self.pose[:] = np.nan
         self.calls[0] = 0
         self.gap[:] = 0.0
         self.dstate[:] = 0.0
