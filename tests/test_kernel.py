@@ -493,8 +493,11 @@ def test_blas_threads_setting(monkeypatch):
     monkeypatch.delenv("FLEXRV_BLAS_THREADS")
     from threadpoolctl import threadpool_info
 
-    with single_thread_blas():
-        assert all(p["num_threads"] == 1 for p in threadpool_info() if p["user_api"] == "blas")
+    before = {p["filepath"]: p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"}
+    for _ in range(2):  # the second time with the cached controller: the same limit, restored on exit
+        with single_thread_blas():
+            assert all(p["num_threads"] == 1 for p in threadpool_info() if p["user_api"] == "blas")
+        assert {p["filepath"]: p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"} == before
 
 
 # ----------------------------------------------------------------------------- short run

@@ -107,7 +107,7 @@ from flexrv.contact.tapered_roller import SupportConstants, crank_support_force_
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
-from flexrv.model.numerics.linalg import inv_small, matmul_small
+from flexrv.model.numerics.linalg import matmul_small
 from flexrv.model.numerics.newton import NEWTON_STATE, VALID, apply_predictor, newton_start, newton_update
 from flexrv.units import DEG_PER_RAD, M_PER_MM, M_PER_UM
 
@@ -118,7 +118,8 @@ _F, _I = np.float64, np.int64
 SupportLaw = law_type("SupportLaw", damping=float, linear=bool, k_bend=float, g=float)
 #: :func:`crank_support_kernel`'s pack: indices (carrier x, y, theta, then each crank's x, y, phi), law,
 #: the tapered-roller pair's constants (passed on to :func:`flexrv.contact.tapered_roller.crank_support_force`),
-#: as-built bores (N, 2) in the carrier frame and clearances, roller angles, outputs (force on each
+#: as-built bores (N, 2) in the carrier frame and clearances, the roller angles' cosines and sines (2, Z),
+#: outputs (force on each
 #: crank, the bearings' state = Newton start (:data:`BEARING_STATE` columns), bending share), the
 #: elastic carrier's support-point compliance (2N, 2N) (empty: rigid), its deflections (N, 4), the
 #: roller directions at each cage angle (N, 2, Z) and the work array (:func:`support_work_size`)
@@ -129,7 +130,7 @@ SupportPack = pack_type(
     ("roller_law", SupportConstants),
     ("bores", (_F, 2)),
     ("clear", (_F, 1)),
-    ("angles", (_F, 1)),
+    ("angle_cs", (_F, 2)),
     ("fx", (_F, 1)),
     ("fy", (_F, 1)),
     ("bstate", (_F, 2)),
@@ -331,7 +332,7 @@ def _support_views(wk, n):
 
 
 @njit(cache=True, inline="always")
-def _support_approach(q, v, idx, bores, g, c, s, angles, dirs, w):
+def _support_approach(q, v, idx, bores, g, c, s, angle_cs, dirs, w):
     """Per crank: the bore's arm (rx, ry) in the housing frame, the rigid approach d0 of
     the crank centre to its bore and its rate, the cage angle gamma and the roller
     directions there into ``dirs`` (N, 2, Z; once per call: the carrier's Newton keeps
@@ -349,7 +350,7 @@ def _support_approach(q, v, idx, bores, g, c, s, angles, dirs, w):
         dvx[j] = v[jx] - v[idx[0]] + om * ry[j]
         dvy[j] = v[jy] - v[idx[1]] - om * rx[j]
         gam[j] = 0.5 * (1.0 - g) * q[jp] + 0.5 * (1.0 + g) * th
-        roller_directions_into(gam[j], angles, dirs[j, 0], dirs[j, 1])
+        roller_directions_into(gam[j], angle_cs[0], angle_cs[1], dirs[j, 0], dirs[j, 1])
     for r in range(2 * n):
         fs[r], u[r] = 0.0, 0.0
         for k in range(2 * n):
@@ -383,7 +384,7 @@ def _carrier_solve(q, idx, cc, c, s, clear, sc, dirs, linear, kb, bstate, ustate
         u[2 * j], u[2 * j + 1] = ustate[j, 0], ustate[j, 1]
         if u[2 * j] != ulast[2 * j] or u[2 * j + 1] != ulast[2 * j + 1]:
             valid = False  # set from outside (reset, history pass): start from it
-    if valid:  # first-order predictor from the previous call (numerics.newton: trusted within a tenth)
+    if valid:  # first-order predictor from the previous call's u (numerics.newton: trusted within a tenth)
         for r in range(n2):
             acc = 0.0
             for col in range(m):
@@ -444,9 +445,10 @@ def _support_loads(f, idx, cd, kb, out_fx, out_fy, out_bend, w):
 def _support_tangent(q, idx, g, elastic, w):
     """dfs/dq over the local coordinates into ``w.df`` (elastic carrier: condensed,
     M (-K dd0 + H dgamma) - M K a dtheta) and, elastic, the predictor's S = du/dq and q
-    for the next call; returns the moment's arm term d(arm)/dtheta x fs."""
+    for the next calls (the calls without the Jacobian keep S and move only q,
+    :func:`_predictor_origin`); returns the moment's arm term d(arm)/dtheta x fs."""
     rx, ry, fs, u, d0, df, t2, gg = w.rx, w.ry, w.fs, w.u, w.d0, w.df, w.t2, w.gg
-    kk, ch, mm, tmp, zf, wc, av, hh = w.kk, w.ch, w.mm, w.tmp, w.zf, w.wc, w.av, w.hh
+    kk, ch, mm, zf, wc, av, hh = w.kk, w.ch, w.mm, w.zf, w.wc, w.av, w.hh
     su, qp, st = w.su, w.qp, w.st
     n = rx.shape[0]
     n2, m = 2 * n, 3 + 3 * n
@@ -481,10 +483,11 @@ def _support_tangent(q, idx, g, elastic, w):
         wc[r] = acc
     for j in range(n):  # -Z u - C_h Z fs
         av[2 * j], av[2 * j + 1] = u[2 * j + 1] - wc[2 * j], -u[2 * j] - wc[2 * j + 1]
-    matmul_small(kk, ch, tmp)
+    # M = (I + K C_h)^-1 = ((I + C_h K)^-1)^T (K and C_h symmetric): the transpose of the carrier Newton's
+    # last inverse, which it computed at the same K
     for r in range(n2):
-        tmp[r, r] += 1.0
-    inv_small(tmp, mm)  # M = (I + K C_h)^-1
+        for k in range(r + 1, n2):
+            mm[r, k], mm[k, r] = mm[k, r], mm[r, k]
     matmul_small(mm, df, t2)
     for r in range(n2):
         acc = 0.0  # M K a
@@ -504,10 +507,16 @@ def _support_tangent(q, idx, g, elastic, w):
         for col in range(m):
             su[r, col] = -su[r, col]
         su[r, 2] -= av[r]
-    for col in range(m):
-        qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
+    _predictor_origin(q, idx, qp)
     st[VALID] = 1.0
     return arm_term
+
+
+@njit(cache=True, inline="always")
+def _predictor_origin(q, idx, qp):
+    """qp = the local coordinates of q (the point the carrier predictor's S (q - qp) starts from)."""
+    for col in range(qp.shape[0]):
+        qp[col] = q[idx[col]] if col < 3 else q[idx[col + 3]]
 
 
 @njit(cache=True, inline="always")
@@ -562,36 +571,38 @@ def crank_support_kernel(q, v, f, jq, jv, jac, pack):
     last correction c applied linearised (f_s + K du, exact to O(|R|^2)); the condensed tangent is df_s =
     M (-K dd0 + H dgamma) - M K a dtheta with M = (I + K C_h)^-1 and a = (Z C_h - C_h Z) f_s the turn of
     C_h with the carrier (Z the 90-degree rotation); the carrier's moment takes the
-    arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev),
-    S = du/dq = -C_h df_s - a e_theta^T of the previous call (used where the predicted change is below a
-    tenth of max|u|), and stops on the residual rule above; the small systems are solved without
-    LAPACK (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
-    (a run's 4,000 solver calls replayed, CPU per call, loaded machine): 6.5-6.7 us compiled (8.2-8.3 us
-    called from Python); with ``carrier.body_model = "rigid"`` 2.6 us.
+    arm r + u. Cost: the Newton starts from the first-order predictor u_prev + S (q - q_prev), u_prev
+    and q_prev of the previous call and S = du/dq = -C_h df_s - a e_theta^T of the last call with the
+    Jacobian (used where the predicted change is below a tenth of max|u|; the calls without the Jacobian
+    compute no tangent), and stops on the residual rule above; M is the transpose of the carrier Newton's
+    last (I + C_h K)^-1 (K and C_h symmetric); the roller directions are one rotation of the stored
+    cosines and sines of the roller angles per cage angle; the small systems are solved without LAPACK
+    (:func:`flexrv.model.numerics.linalg.inv_small`) and nothing is allocated per call. Measured on rv40e
+    (a run's 2,400 solver calls replayed, CPU per call, loaded machine): 5.9 us compiled (rv221 5.0 us).
 
     Phases (each its own compiled function): the rigid approach of every support
     (:func:`_support_approach`), the elastic carrier's solve (:func:`_carrier_solve`) or
     the supports' forces at the rigid approach, the loads and outputs
     (:func:`_support_loads`), the tangent (:func:`_support_tangent`) and the Jacobian rows
     (:func:`_support_jacobian`)."""
-    idx, sc, bores, clear, angles = pack.idx, pack.roller_law, pack.bores, pack.clear, pack.angles
+    idx, sc, bores, clear = pack.idx, pack.roller_law, pack.bores, pack.clear
     linear, g, kb = pack.law.linear, pack.law.g, pack.law.k_bend
     th = q[idx[2]]
     c, s = np.cos(th), np.sin(th)
     n = bores.shape[0]
     elastic = n > 0 and pack.carrier_c.shape[0] == 2 * n
     w = _support_views(pack.work, n)
-    _support_approach(q, v, idx, bores, g, c, s, angles, pack.dirs, w)
+    _support_approach(q, v, idx, bores, g, c, s, pack.angle_cs, pack.dirs, w)
     if elastic:
         _carrier_solve(q, idx, pack.carrier_c, c, s, clear, sc, pack.dirs, linear, kb, pack.bstate, pack.ustate, w)
     else:
         _support_forces(w.d0x, w.d0y, w.u, pack.dirs, clear, sc, linear, kb, pack.bstate, w.fs, w.kk, w.hh, w.qs)
     _support_loads(f, idx, pack.law.damping, pack.law.k_bend, pack.fx, pack.fy, pack.bend, w)
-    if not (jac or elastic):
+    if not jac:
+        if elastic:  # the predictor's S of the last call with the Jacobian, from this call's q on
+            _predictor_origin(q, idx, w.qp)
         return
     arm_term = _support_tangent(q, idx, g, elastic, w)
-    if not jac:
-        return
     # (the linear legacy law keeps its Jacobian of tests/data/force_reference.npz: no arm term)
     _support_jacobian(jq, jv, idx, elastic or not linear, arm_term, w)
 
@@ -738,6 +749,8 @@ class CrankSupports(KernelGroup):
         self.clear = np.ascontiguousarray(p.support_clearances, dtype=float)
         self.sc = p.support_law
         self.angles = np.ascontiguousarray(p.support_roller_angles, dtype=float)
+        #: cos and sin of the roller angles (2, Z): the kernel's roller directions by one rotation per cage angle
+        self.angle_cs = np.ascontiguousarray([np.cos(self.angles), np.sin(self.angles)], dtype=float).reshape(2, -1)
         self.linear = bool(p.support_linear)
         self.c = p.support_damping
         self.law = SupportLaw.of(damping=self.c, linear=self.linear, k_bend=self.sc.k_bend, g=self.sc.g)
@@ -766,7 +779,7 @@ class CrankSupports(KernelGroup):
             roller_law=self.sc,
             bores=self.bores,
             clear=self.clear,
-            angles=self.angles,
+            angle_cs=self.angle_cs,
             fx=self.fx,
             fy=self.fy,
             bstate=self.bstate,

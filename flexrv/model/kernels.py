@@ -120,6 +120,24 @@ def blas_threads() -> int | None:
     return int(env) if env and int(env) > 0 else None
 
 
+#: threadpoolctl's controller and the number of imported modules when it was built: its scan of the
+#: process's shared libraries costs ~3-6 ms (measured on a simulation process), paid once and again only
+#: after new imports (which may load another BLAS)
+_BLAS_CONTROLLER: list = [None, -1]
+
+
+def _blas_controller():
+    """The process's threadpoolctl controller, rebuilt when modules were imported since."""
+    import sys
+
+    if _BLAS_CONTROLLER[1] != len(sys.modules):
+        from threadpoolctl import ThreadpoolController
+
+        _BLAS_CONTROLLER[0] = ThreadpoolController()
+        _BLAS_CONTROLLER[1] = len(sys.modules)
+    return _BLAS_CONTROLLER[0]
+
+
 @contextlib.contextmanager
 def single_thread_blas():
     """Context manager limiting BLAS to :func:`blas_threads` threads (threadpoolctl)."""
@@ -127,9 +145,7 @@ def single_thread_blas():
     if n is None:
         yield
         return
-    from threadpoolctl import threadpool_limits
-
-    with threadpool_limits(limits=n, user_api="blas"):
+    with _blas_controller().limit(limits=n, user_api="blas"):
         yield
 
 
