@@ -2,7 +2,8 @@
 quadratic stop, moved to the pose of the linearised last correction
 (flexrv.model.pins._shift_records), equal an exact evaluation of the pin kernel there; the
 crank bearings' first-order Newton start (flexrv.model.cranks_discs._bearing_start) is
-second order in the change of the crank's displacement."""
+second order in the change of the crank's displacement; the roller directions by rotation
+and the elastic carrier's calls without the Jacobian (no tangent) keep the answers."""
 
 from __future__ import annotations
 
@@ -205,3 +206,58 @@ def test_chained_open_pin_bound_skips_only_open_pins_and_keeps_the_forces():
         px, py = cr * lx + sr * ly, -sr * lx + cr * ly
         direct[kd] = g.last[kd, :, 0] - np.hypot(px - g.last[kd, :, 1], py - g.last[kd, :, 2])
     assert np.any(got["gap"][skipped] < direct[skipped] - 1e-12)
+
+
+def test_roller_directions_by_rotation_equal_the_angles_cosines():
+    """The crank supports' roller directions u_i = Rot(gamma) (cos a_i, sin a_i) (one rotation
+    of the stored cosines and sines per cage angle, tapered_roller.roller_directions_into)
+    equal (cos(gamma + a_i), sin(gamma + a_i)) to round-off on rv40e's rollers (2e-15 (1 + |gamma|):
+    the sum gamma + a_i itself is rounded to ~|gamma| eps; measured 3.5e-15 at gamma = 41.3), and
+    the element's stored table holds the cosines and sines of its roller angles."""
+    from flexrv.contact.tapered_roller import _roller_directions
+    from flexrv.model.cranks_discs import CrankSupports
+
+    r = load("rv40e")
+    g = CrankSupports(CrankSupports.parameters(r, drive_parameters(r)))
+    assert len(g.angles) > 0
+    np.testing.assert_array_equal(g.angle_cs, [np.cos(g.angles), np.sin(g.angles)])
+    for gam in (-2.9, 0.0, 0.7, 41.3):
+        ux, uy = _roller_directions(gam, g.angles)
+        tol = 2e-15 * (1.0 + abs(gam))
+        np.testing.assert_allclose(ux, np.cos(gam + g.angles), rtol=0, atol=tol)
+        np.testing.assert_allclose(uy, np.sin(gam + g.angles), rtol=0, atol=tol)
+
+
+def test_carrier_calls_without_jacobian_converge_to_the_fresh_solution():
+    """The elastic carrier's calls without the Jacobian compute no tangent: their successors start
+    from u_prev + S (q - q_prev) with the S of the last call with the Jacobian. Along a path of
+    calls (one with the Jacobian, then four without, each moving every crank by ~5 nm) the forces
+    equal a fresh solve from zero (a reset group) at each state to 1e-9 of the largest force (the
+    carrier Newton's tolerance: measured 4e-14), with the predictor in use (the solves stop
+    after at most 2 evaluations)."""
+    from flexrv.model.cranks_discs import CrankSupports, _support_views
+    from flexrv.model.numerics.newton import EVALS
+
+    r = load("rv40e")
+    p = CrankSupports.parameters(r, drive_parameters(r))
+    assert p.carrier_compliance.size
+    g, fresh = CrankSupports(p), CrankSupports(p)
+    n = p.drive.n_cranks
+    rng = np.random.default_rng(3)
+    q = np.zeros(6 + 3 * n)
+    q[2] = 0.3
+    c, s = np.cos(0.3), np.sin(0.3)
+    for j in range(n):
+        b = p.crank_bores[j]
+        q[6 + 3 * j : 8 + 3 * j] = [c * b[0] - s * b[1], s * b[0] + c * b[1]] + rng.normal(0.0, 20e-6, 2)
+        q[8 + 3 * j] = rng.normal()
+    v = np.zeros_like(q)
+    g.jacobian(0.0, q, v)
+    views = _support_views(g.work, n)
+    for k in range(4):
+        q = q + rng.normal(0.0, 5e-9, q.shape)
+        f = g.evaluate(0.0, q, v)[0]
+        assert views.nw[EVALS] <= 2
+        fresh.reset()
+        f0 = fresh.evaluate(0.0, q, v)[0]
+        np.testing.assert_allclose(f, f0, rtol=0, atol=1e-9 * np.abs(f0).max())
