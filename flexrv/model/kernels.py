@@ -121,8 +121,8 @@ def blas_threads() -> int | None:
 
 
 #: threadpoolctl's controller and the number of imported modules when it was built: its scan of the
-#: process's shared libraries costs ~3-6 ms (measured on a simulation process), paid once and again only
-#: after new imports (which may load another BLAS)
+#: process's shared libraries costs 2-4 ms CPU in a simulation process, paid once and again only after
+#: new imports (which may load another BLAS); entering the limit with it 0.04-0.07 ms
 _BLAS_CONTROLLER: list = [None, -1]
 
 
