@@ -261,3 +261,20 @@ def test_carrier_calls_without_jacobian_converge_to_the_fresh_solution():
         fresh.reset()
         f0 = fresh.evaluate(0.0, q, v)[0]
         np.testing.assert_allclose(f, f0, rtol=0, atol=1e-9 * np.abs(f0).max())
+
+
+def test_asymmetric_carrier_compliance_is_rejected():
+    """The condensed tangent takes M = (I + K C_h)^-1 as the transpose of the carrier Newton's
+    (I + C_h K)^-1, exact for a symmetric compliance (Maxwell-Betti); a compliance asymmetric by
+    more than 1e-9 of its largest entry is rejected with a message naming it."""
+    import pytest
+
+    from flexrv.model.cranks_discs import CrankSupports
+
+    r = load("rv40e")
+    p = CrankSupports.parameters(r, drive_parameters(r))
+    c = p.carrier_compliance.copy()
+    CrankSupports(dataclasses.replace(p, carrier_compliance=c))
+    c[0, 1] += 1e-6 * np.abs(c).max()
+    with pytest.raises(ValueError, match="carrier_compliance is not symmetric"):
+        CrankSupports(dataclasses.replace(p, carrier_compliance=c))

@@ -762,6 +762,10 @@ class CrankSupports(KernelGroup):
         self.carrier_c = np.ascontiguousarray(p.carrier_compliance, dtype=float)
         if self.carrier_c.size and self.carrier_c.shape != (2 * self.n, 2 * self.n):
             raise ValueError(f"carrier_compliance has shape {self.carrier_c.shape}, expected {(2 * self.n,) * 2}")
+        if self.carrier_c.size:  # (the kernel's condensed tangent uses C = C^T: M = ((I + C_h K)^-1)^T)
+            asym = np.abs(self.carrier_c - self.carrier_c.T).max()
+            if asym > 1e-9 * np.abs(self.carrier_c).max():
+                raise ValueError(f"carrier_compliance is not symmetric: max|C - C^T| = {asym:.3g} m/N")
         self.ustate = np.zeros((self.n, 4))
         #: per crank the roller directions (x, y) at its cage angle (crank_support_kernel's scratch)
         self.dirs = np.zeros((self.n, 2, len(self.angles)))
