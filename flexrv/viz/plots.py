@@ -9,18 +9,25 @@ import numpy as np
 
 from flexrv.post.results import Results
 
+#: resolution of the PNGs [dots per inch]
+FIGURE_DPI = 110
+
 
 class _AggFigures:
     """The part of ``matplotlib.pyplot`` the plots use (``figure``, ``subplots``, ``close``),
     without pyplot: each figure is a :class:`matplotlib.figure.Figure` on its own Agg canvas,
     drawn only into files. Nothing is registered with pyplot's figure manager, so no figure
-    stays alive after its last reference and no GUI backend is chosen or imported."""
+    stays alive after its last reference and no GUI backend is chosen or imported. A figure is
+    made at the resolution it is saved at (:data:`FIGURE_DPI`), so the text laid out for
+    ``tight_layout`` is reused by the drawing of the PNG instead of being laid out again at
+    another resolution."""
 
     @staticmethod
     def figure(figsize=None, **kwargs):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
+        kwargs.setdefault("dpi", FIGURE_DPI)
         fig = Figure(figsize=figsize, **kwargs)
         FigureCanvasAgg(fig)
         return fig
@@ -47,7 +54,7 @@ def _save(fig, path: Path) -> Path:
     from flexrv.cache import atomic_path
 
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+        fig.savefig(tmp, dpi=FIGURE_DPI, format="png")
     return path
 
 
