@@ -465,3 +465,36 @@ def test_force_map_image_draws_the_same_pixels_as_the_quad_mesh():
     fig, ax = plt.subplots()
     assert _force_map(ax, t**2, angle, c, 500.0) in ax.collections
     plt.close(fig)
+
+
+def test_save_draws_a_tight_layout_figure_once_with_the_same_pixels(tmp_path, monkeypatch):
+    """A figure laid out by ``tight_layout`` is drawn once by ``_save`` (matplotlib's ``savefig``
+    draws it twice while the figure keeps tight_layout's placeholder layout engine), and its PNG
+    has exactly the pixels of the same figure saved by plain ``savefig`` (reference: matplotlib
+    itself, the placeholder kept)."""
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    from flexrv.viz.plots import FIGURE_DPI, _plt, _save
+
+    def figure():
+        fig, axes = _plt().subplots(2, 1, figsize=(5, 4))
+        t = np.linspace(0.0, 1.0, 500)
+        axes[0].plot(t, np.sin(20 * t), label="a long legend entry")
+        axes[0].legend(loc="best")
+        axes[1].semilogy(t, 1e-3 + t**2)
+        axes[1].set_xlabel("time [s]")
+        fig.suptitle("a title")
+        fig.tight_layout()
+        return fig
+
+    reference = figure()
+    reference.savefig(tmp_path / "reference.png", dpi=FIGURE_DPI, format="png")
+    draws = []
+    original = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: draws.append(1) or original(self, renderer))
+    _save(figure(), tmp_path / "saved.png")
+    assert len(draws) == 1
+    a = np.asarray(Image.open(tmp_path / "reference.png"))
+    b = np.asarray(Image.open(tmp_path / "saved.png"))
+    assert a.shape == b.shape and np.array_equal(a, b)

@@ -51,8 +51,17 @@ def _plt() -> _AggFigures:
 
 
 def _save(fig, path: Path) -> Path:
+    """Write ``fig`` as a PNG at :data:`FIGURE_DPI`, atomically. A figure laid out by
+    ``tight_layout`` keeps a placeholder layout engine, for which matplotlib's ``savefig``
+    draws the whole figure once more before the drawing it saves (a pass that only a
+    constrained layout needs); the placeholder is dropped first, so the figure is drawn once
+    (the same pixels)."""
+    from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
     from flexrv.cache import atomic_path
 
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+        fig.set_layout_engine(None)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=FIGURE_DPI, format="png")
     return path
