@@ -213,7 +213,8 @@ def test_outer_medial_radius_table_and_the_tangent_ball_bound():
     the pins) the empty tangent ball is the osculating circle, so the sampled radius equals
     1 / |kappa(0)| of the closed-form curvature (flexrv.geometry.cycloid.center_curve_curvature)
     within 1 % (the samples' spacing; measured 2e-4); every bin is at least the global reach
-    (pins._curve_reach) and at most its cap. The bound itself (pins._ball_record): for 4,000
+    (pins._curve_reach) and at most its cap (8x the valley bin on the flanks).
+    The bound itself (pins._ball_record): for 4,000
     points P0 within +-30 um of the curve at random foot points and moves dP up to 60 um (four
     time steps' motion), the exact signed distance s(P0 + dP) (cycloid.pin_gap, its Newton to
     1e-14 rad from the cold starts) is never below rho - |P - O| (rigour; measured slack >= 0 to
@@ -231,7 +232,7 @@ def test_outer_medial_radius_table_and_the_tangent_ball_bound():
     table = _outer_ball_table(z, radius, ecc)
     lobe = 2.0 * np.pi / (z - 1)
     assert np.all(table >= _curve_reach(z, radius, ecc)[0] * (1 - 1e-12))
-    assert np.all(table <= 0.05 * radius * lobe) and table.max() > 20 * table.min()
+    assert np.all(table <= 0.05 * radius * lobe) and table.max() > 5 * table.min()
     rng = np.random.default_rng(5)
     n = 4000
     phi = rng.uniform(0.0, 2.0 * np.pi, n)
@@ -261,7 +262,7 @@ def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
     ~15 um relative to its disc, far more than the gaps of its neighbours in mesh) after an
     exact evaluation of every pin: the forces of the skipping kernel (chained and tangent-ball
     bounds, flexrv.model.pins.pin_kernel) equal an exact evaluation of every pin from the cold
-    starts to 1e-10 of the largest (round-off; measured ~1e-13); every skipped pin is open
+    starts to 1e-10 of the largest (round-off; measured 3.5e-13); every skipped pin is open
     there with its recorded gap a positive lower bound; and the tangent-ball bound proves open
     pins the 1-Lipschitz bound g0 - |P - P0| could not (that bound <= 0 for some skipped pin)."""
     from flexrv.model.pins import PinContacts
