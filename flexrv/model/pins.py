@@ -1009,12 +1009,12 @@ def _curve_reach(z_rp: int, radius: float, eccentricity: float) -> tuple[float, 
 def _outer_ball_table(z_rp: int, radius: float, eccentricity: float) -> np.ndarray:
     """Lower estimates of the outer medial radius over the bins [phi_j, phi_j+1) of one lobe
     (the samples of :func:`_medial_radii`) [m]: 0.9 of the smaller of the bin's two end
-    samples (the radius changes by < 5 % per sample on rv40e and rv221, most at the lobe's
-    tip), at most a twentieth of the lobe's arc radius x lobe, so that the tangent ball (of
-    diameter below a tenth of a lobe's arc) meets no part of C beyond the two neighbouring
-    lobes the samples were taken over. Rv221: 47 um at the tip, ~1 mm from a quarter lobe
-    on. The pin kernel's tangent-ball bound (:func:`_ball_record`) takes the bin of each
-    foot point."""
+    samples (below the cap the radius changes by at most 4.5 % per sample on rv40e, 6.5 % on
+    rv221, most near the valley phi = 0), at most a twentieth of the lobe's arc (radius x lobe),
+    so that the tangent ball (of diameter below a tenth of a lobe's arc) meets no part of C
+    beyond the two neighbouring lobes the samples were taken over. Rv221: 47 um in the
+    valley, the cap 0.88 mm over two thirds of the lobe. The pin kernel's tangent-ball bound
+    (:func:`_ball_record`) takes the bin of each foot point."""
     r_out, _ = _medial_radii(z_rp, radius, eccentricity)
     lobe = 2.0 * np.pi / (z_rp - 1)
     return np.minimum(0.9 * np.minimum(r_out, np.roll(r_out, -1)), 0.05 * radius * lobe)
