@@ -264,15 +264,17 @@ def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
     bounds, flexrv.model.pins.pin_kernel) equal an exact evaluation of every pin from the cold
     starts to 1e-10 of the largest (round-off; measured 3.5e-13); every skipped pin is open
     there with its recorded gap a positive lower bound; and the tangent-ball bound proves open
-    pins the 1-Lipschitz bound g0 - |P - P0| could not (that bound <= 0 for some skipped pin)."""
-    from flexrv.model.pins import PinContacts
+    pins the 1-Lipschitz bound g0 - |P - P0| could not (that bound <= 0 for some skipped pin),
+    some by the ball at their predicted foot point (pins._ball_predicted: the ball record
+    replaced while the pin's exact records stay those of the first evaluation)."""
+    from flexrv.model.pins import BALL, PinContacts
 
     p, q, v = _rigid_pins()
     idx = np.arange(q.shape[0], dtype=np.int64)
     g = PinContacts(p)
     pack = g.pack(idx)
     _evaluate(g, pack, q, v)
-    g0, p0 = g.last[..., 0].copy(), g.last[..., 1:3].copy()
+    g0, p0, o0 = g.last[..., 0].copy(), g.last[..., 1:3].copy(), g.last[..., BALL].copy()
     for _ in range(3):
         q[0::3] += 1.5e-5
         q[1::3] -= 0.5e-5
@@ -297,3 +299,4 @@ def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
         px, py = cr * lx + sr * ly, -sr * lx + cr * ly
         lip[kd] = g0[kd] - np.hypot(px - p0[kd, :, 0], py - p0[kd, :, 1])
     assert np.any(lip[never & skipped] <= 0.0)
+    assert np.any(never & skipped & (g.last[..., BALL] != o0))  # proved open by a ball at a predicted foot point

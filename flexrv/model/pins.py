@@ -141,7 +141,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.geometry.cycloid import _FOOT, closest_point_settings
+from flexrv.geometry.cycloid import _FOOT, _POINT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
@@ -186,8 +186,8 @@ PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
 #: and second derivatives d2phi/dP2 (xx, xy, yy: 5, 6, 7) there, the lower bound of the gap at the disc's
 #: pose of the last evaluation (``pose``), the chained bound's start (8), and the empty tangent ball's bound
 #: of the last exact evaluation (:func:`_ball_record`): its centre O (9, 10) and rho + r_nom + dr_rp - r_i -
-#: sum|A| (11), so that the gap at P is at least that less |P - O|
-GRAD, HESS, SLACK, BALL, LAST_SIZE = 3, 5, 8, 9, 12
+#: sum|A| (11), so that the gap at P is at least that less |P - O|, and r_nom + dr_rp - r_i - sum|A| (12)
+GRAD, HESS, SLACK, BALL, LAST_SIZE = 3, 5, 8, 9, 13
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
 #: inside (:func:`_curve_reach`) and its outer medial radius over one lobe's bins
 #: (:func:`_outer_ball_table`), as-built pins (z, 2) and radii, disc profile modifications (n_discs, 3) and
@@ -378,6 +378,8 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
                 bound = last[kd, i, BALL + 2] - np.sqrt(
                     (px - last[kd, i, BALL]) ** 2 + (py - last[kd, i, BALL + 1]) ** 2
                 )
+                if not bound > 0.0 and last[kd, i, SLACK] > 0.0:  # open before: the ball at the predicted foot
+                    bound = _ball_predicted(law, pack.ball, phi, last, kd, i, px, py, radius)
                 if bound > 0.0:  # provably open (NaN: never skipped)
                     last[kd, i, SLACK] = bound
                     out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
@@ -488,15 +490,7 @@ def _pin_foot(law, reach, phi, last, failures, kd, i, px, py, radius, cold):
     it is found again from the cold starts (:func:`_curve_reach`)."""
     z_rp, ecc, max_step, tol, max_iter = law.z_rp, law.eccentricity, law.max_step, law.tol, law.max_iter
     ch = law.cos_half
-    start = np.nan
-    if not cold:
-        start = phi[kd, i]
-        dx, dy = px - last[kd, i, 1], py - last[kd, i, 2]
-        move = last[kd, i, GRAD] * dx + last[kd, i, GRAD + 1] * dy
-        bend = last[kd, i, HESS] * dx * dx + 2.0 * last[kd, i, HESS + 1] * dx * dy + last[kd, i, HESS + 2] * dy * dy
-        move += 0.5 * bend
-        if abs(move) < max_step:  # (NaN: no prediction)
-            start += move
+    start = np.nan if cold else _predicted_foot(phi, last, kd, i, px, py, max_step)
     ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter, ch)
     if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
         ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
@@ -507,6 +501,46 @@ def _pin_foot(law, reach, phi, last, failures, kd, i, px, py, radius, cold):
     phi[kd, i] = ph
     _foot_derivatives(last, kd, i, ok, px, py, z_rp, dist, nlx, nly, d1x, d1y, d2x, d2y)
     return ph, dist, nlx, nly, d1x, d1y, d2x, d2y
+
+
+@njit(cache=True, inline="always")
+def _predicted_foot(phi, last, kd, i, px, py, max_step):
+    """The second-order prediction of pin i's foot point at P = (px, py) from its last exact
+    evaluation (:func:`_pin_foot`): phi + g . dP + dP^T H dP / 2, or phi itself where the
+    predicted change is ``max_step`` or more or the derivatives are missing (NaN)."""
+    start = phi[kd, i]
+    dx, dy = px - last[kd, i, 1], py - last[kd, i, 2]
+    move = last[kd, i, GRAD] * dx + last[kd, i, GRAD + 1] * dy
+    bend = last[kd, i, HESS] * dx * dx + 2.0 * last[kd, i, HESS + 1] * dx * dy + last[kd, i, HESS + 2] * dy * dy
+    move += 0.5 * bend
+    if abs(move) < max_step:  # (NaN: no prediction)
+        start += move
+    return start
+
+
+@njit(cache=True, inline="always")
+def _ball_predicted(law, table, phi, last, kd, i, px, py, radius):
+    """The tangent-ball bound of pin i at P = (px, py) from the ball at its predicted foot point
+    (:func:`_predicted_foot`), one curve evaluation: any curve point's outer tangent ball of
+    radius rho below its medial radius is empty (:func:`_ball_record`), and at the predicted
+    foot point P lies almost on the ball's axis, so the bound is the gap less the prediction's
+    error squared over 2 rho. A positive bound replaces the ball record (the foot point's own
+    records stay those of the last exact evaluation); returns the bound (NaN: none)."""
+    ph = _predicted_foot(phi, last, kd, i, px, py, law.max_step)
+    if not ph == ph:
+        return np.nan
+    cx, cy, d1x, d1y, _, _ = _POINT(ph, law.z_rp, radius, law.eccentricity)
+    inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
+    nx, ny = -d1y * inv, d1x * inv  # the outer normal (cycloid._closest_point_newton's n_out)
+    n = table.shape[1]
+    lobe = 2.0 * np.pi / (law.z_rp - 1)
+    rho = table[kd, min(int((ph % lobe) * (n / lobe)), n - 1)]
+    ox, oy = cx + rho * nx, cy + rho * ny
+    base = last[kd, i, BALL + 3]  # r_nom + dr_rp - r_i - sum|A| (NaN after a failure)
+    bound = rho + base - np.sqrt((px - ox) ** 2 + (py - oy) ** 2)
+    if bound > 0.0:
+        last[kd, i, BALL], last[kd, i, BALL + 1], last[kd, i, BALL + 2] = ox, oy, rho + base
+    return bound
 
 
 @njit(cache=True, inline="always")
@@ -555,7 +589,7 @@ def _ball_record(last, kd, i, px, py, dist, nlx, nly, table, z_rp, ph, base):
     |P - P0| (the ball's rho = s0 case, which the bound never falls below) loses the whole
     motion. A failed closest point (NaN) records nothing (never skipped)."""
     if not last[kd, i, GRAD] == last[kd, i, GRAD]:  # no converged foot point (_foot_derivatives)
-        last[kd, i, BALL + 2] = np.nan
+        last[kd, i, BALL + 2] = last[kd, i, BALL + 3] = np.nan
         return np.nan
     n = table.shape[0]
     lobe = 2.0 * np.pi / (z_rp - 1)
@@ -564,6 +598,7 @@ def _ball_record(last, kd, i, px, py, dist, nlx, nly, table, z_rp, ph, base):
     last[kd, i, BALL] = px + (rho - dist) * nlx
     last[kd, i, BALL + 1] = py + (rho - dist) * nly
     last[kd, i, BALL + 2] = rho + base
+    last[kd, i, BALL + 3] = base
     return dist + base
 
 
