@@ -262,7 +262,7 @@ def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
     ~15 um relative to its disc, far more than the gaps of its neighbours in mesh) after an
     exact evaluation of every pin: the forces of the skipping kernel (chained and tangent-ball
     bounds, flexrv.model.pins.pin_kernel) equal an exact evaluation of every pin from the cold
-    starts to 1e-10 of the largest (round-off; measured 3.5e-13); every skipped pin is open
+    starts to 1e-10 of the largest (round-off; measured 3.9e-13); every skipped pin is open
     there with its recorded gap a positive lower bound; and the tangent-ball bound proves open
     pins the 1-Lipschitz bound g0 - |P - P0| could not (that bound <= 0 for some skipped pin),
     some by the ball at their predicted foot point (pins._ball_predicted: the ball record
