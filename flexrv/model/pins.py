@@ -119,7 +119,8 @@ call's result; a step's first call adds the previous first call's remaining pred
 error. See :func:`_pin_condensed_kernel`. Per pin the closest point starts from its
 second-order prediction in the pin's motion (:func:`_pin_foot`), a pin proved open by
 the bound chained from the disc's last pose costs one subtraction, one proved open by the
-empty tangent ball of its last exact evaluation a rotation and a root (:func:`pin_kernel`),
+empty tangent ball of its last exact evaluation a rotation and a root, one at its predicted
+foot point's ball a curve evaluation more (:func:`pin_kernel`),
 the Jacobian's curvature terms reuse the curve's derivatives at the foot point from its
 Newton iteration, and the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
@@ -304,8 +305,9 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
     pin-centre curve, and s is at least rho - |P - O| for the empty tangent ball (centre O,
     radius rho) at the foot point of the last exact evaluation (:func:`_ball_record`: near
     contact the bound loses only the motion towards the profile and the tangential motion's
-    square over 2 rho, where the 1-Lipschitz bound g0 - |P - P0| loses the whole motion). A
-    pin whose bound is positive carries no force (and no Jacobian); its closest point is not
+    square over 2 rho, where the 1-Lipschitz bound g0 - |P - P0| loses the whole motion; a pin
+    open before and not proved open by it is tried against the ball at its predicted foot
+    point, :func:`_ball_predicted`). A pin whose bound is positive carries no force (and no Jacobian); its closest point is not
     recomputed and out_gap holds the bound. last[kd, i] holds g0, P0, the foot point's
     derivatives (:data:`GRAD`, :data:`HESS`, :func:`_pin_foot`) and the ball (:data:`BALL`) of
     the last exact evaluation and the last lower bound at the disc's pose of the last
