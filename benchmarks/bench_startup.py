@@ -11,7 +11,10 @@ and once with phase timers (a driver that wraps the library functions of each ph
 their modules are imported, so no import moves; a phase's CPU is the process's CPU spent
 inside it, nested phases excluded). The remainder of the instrumented run is the
 interpreter, the imports done outside the phases and the CLI's own glue. The caches must
-be warm (run each command once before).
+be warm (run each command once before); one unmeasured run per checkout and command compiles
+the modules' bytecode (into a folder outside the checkouts, as an installed package has it).
+The floor (the CPU of ``python -c`` programs that only import the libraries and load one
+cached numba kernel) is printed last.
 
 Ratios (the goals, paired in one process):
 
@@ -147,9 +150,52 @@ sys.exit(code)
 """
 
 
+#: compiled bytecode of the children's modules, outside the checkouts (an installed flexrv has its .pyc; a
+#: process that recompiles every module from source spends ~0.2 s CPU on it)
+PYCACHE = os.path.join(tempfile.gettempdir(), "flexrv-bench-pycache")
+
+
 def _env(checkout: str) -> dict:
     env = dict(os.environ, PYTHONPATH=checkout, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg")
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = PYCACHE
     return env
+
+
+#: the floor of a process: what any flexrv command that simulates pays before its own work, as
+#: ``python -c`` programs (label, code), each adding to the one before: the interpreter, the numerical
+#: libraries, numba's first load of a cached kernel (its target context: a one-line kernel of a module
+#: in a temporary folder, compiled by an unmeasured first run), the results' and figures' libraries,
+#: flexrv's CLI (the design model and the command modules)
+_KERNEL = "from numba import njit\n\n\n@njit(cache=True)\ndef one(x):\n    return x + 1.0\n"
+_LIBS = "import numpy, scipy, numba, exudyn"
+_FIRST = _LIBS + "\nimport floor_kernel\nfloor_kernel.one(1.0)"
+_OUT = _FIRST + "\nimport xarray, h5netcdf, matplotlib.figure, matplotlib.backends.backend_agg"
+FLOORS = [
+    ("python -c pass", "pass"),
+    ("import numpy, scipy, numba, exudyn", _LIBS),
+    ("+ numba's first cached kernel", _FIRST),
+    ("+ xarray, h5netcdf, matplotlib (Agg)", _OUT),
+    ("+ import flexrv.cli", _OUT + "\nimport flexrv.cli"),
+]
+
+
+def floors(checkout: str, repeat: int) -> None:
+    """CPU of the :data:`FLOORS` programs (medians of ``repeat``)."""
+    import statistics as st
+
+    print(f"floor [{checkout}] (CPU of a child process, median of {repeat}):")
+    with tempfile.TemporaryDirectory(prefix="flexrv-floor-") as folder:
+        Path(folder, "floor_kernel.py").write_text(_KERNEL)
+        env = dict(_env(checkout), PYTHONPATH=os.pathsep.join([folder, checkout]), NUMBA_CACHE_DIR=folder)
+        subprocess.run([sys.executable, "-c", _FIRST], env=env, cwd=folder, check=True)  # compiles the kernel
+        for label, code in FLOORS:
+            cpu = []
+            for _ in range(repeat):
+                c0 = children_cpu_s()
+                subprocess.run([sys.executable, "-c", code], env=env, cwd=folder, check=True)
+                cpu.append(children_cpu_s() - c0)
+            print(f"   {label:40s} {st.median(cpu):6.2f} s CPU")
 
 
 def plain(checkout: str, args: list[str], out: str) -> dict:
@@ -232,10 +278,13 @@ def main() -> None:
     ap.add_argument("--only", choices=sorted(COMMANDS), action="append", help="measure only this command")
     ap.add_argument("--checkout", action="append", help="flexrv checkout to run (default: this one); repeatable")
     ap.add_argument("--repeat", type=int, default=1, help="plain and instrumented runs per checkout (medians)")
+    ap.add_argument("--no-floor", action="store_true", help="skip the floor programs")
     a = ap.parse_args()
     checkouts = [str(Path(c).resolve()) for c in (a.checkout or [ROOT])]
     with tempfile.TemporaryDirectory(prefix="flexrv-startup-") as tmp:
         for name in a.only or list(COMMANDS):
+            for c in checkouts:  # unmeasured: compiles the bytecode of the modules the command imports
+                plain(c, COMMANDS[name], os.path.join(tmp, f"warm-{name}"))
             runs = {c: [] for c in checkouts}
             splits = {c: [] for c in checkouts}
             for i in range(a.repeat):
@@ -245,6 +294,8 @@ def main() -> None:
                     splits[c].append(instrumented(c, name, COMMANDS[name], out + "-i"))
             for c in checkouts:
                 report(name, c, runs[c], splits[c])
+        if not a.no_floor:
+            floors(checkouts[-1], max(a.repeat, 3))
 
 
 if __name__ == "__main__":

@@ -208,6 +208,101 @@ def test_chained_open_pin_bound_skips_only_open_pins_and_keeps_the_forces():
     assert np.any(got["gap"][skipped] < direct[skipped] - 1e-12)
 
 
+def test_outer_medial_radius_table_and_the_tangent_ball_bound():
+    """The pin-centre curve's outer medial radius over one lobe (flexrv.model.pins._medial_radii,
+    _outer_ball_table) on rv40e: at the lobe's valley phi = 0 (the curve's concave side facing
+    the pins) the empty tangent ball is the osculating circle, so the sampled radius equals
+    1 / |kappa(0)| of the closed-form curvature (flexrv.geometry.cycloid.center_curve_curvature)
+    within 1 % (the samples' spacing; measured 2e-4); every bin is at least the global reach
+    (pins._curve_reach) and at most its cap (8x the valley bin on the flanks).
+    The bound itself (pins._ball_record): for 4,000
+    points P0 within +-30 um of the curve at random foot points and moves dP up to 60 um (four
+    time steps' motion), the exact signed distance s(P0 + dP) (cycloid.pin_gap, its Newton to
+    1e-14 rad from the cold starts) is never below rho - |P - O| (rigour; measured slack >= 0 to
+    round-off), and for most of the moves (random directions) strictly above the 1-Lipschitz
+    bound s0 - |dP|, which it is never below."""
+    from flexrv.geometry.cycloid import center_curve, center_curve_curvature, pin_gap
+    from flexrv.model.pins import BALL, GRAD, LAST_SIZE, _ball_record, _curve_reach, _medial_radii, _outer_ball_table
+
+    r = load("rv40e")
+    d = drive_parameters(r)
+    z, radius, ecc = int(d.z_rp), float(r.second_stage.pin_circle_radius), float(d.eccentricity)
+    r_out, _ = _medial_radii(z, radius, ecc)
+    kappa = abs(float(center_curve_curvature(0.0, z, radius, ecc)))
+    assert abs(r_out[0] * kappa - 1.0) < 1e-2
+    table = _outer_ball_table(z, radius, ecc)
+    lobe = 2.0 * np.pi / (z - 1)
+    assert np.all(table >= _curve_reach(z, radius, ecc)[0] * (1 - 1e-12))
+    assert np.all(table <= 0.05 * radius * lobe) and table.max() > 5 * table.min()
+    rng = np.random.default_rng(5)
+    n = 4000
+    phi = rng.uniform(0.0, 2.0 * np.pi, n)
+    c, d1, _ = center_curve(phi, z, radius, ecc)
+    t = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    n_out = np.stack([-t[:, 1], t[:, 0]], axis=1)
+    s0 = rng.uniform(-30e-6, 30e-6, n)
+    p0 = c + s0[:, None] * n_out
+    dp = rng.normal(size=(n, 2)) * rng.uniform(0.0, 60e-6, n)[:, None] / np.sqrt(2.0)
+    last = np.zeros((1, n, LAST_SIZE))
+    last[0, :, GRAD] = 1.0  # a converged foot point
+    worst, better = np.inf, 0
+    for i in range(n):
+        at0 = _ball_record(last, 0, i, p0[i, 0], p0[i, 1], s0[i], n_out[i, 0], n_out[i, 1], table, z, phi[i], 0.0)
+        assert at0 == s0[i]
+        pt = p0[i] + dp[i]
+        bound = last[0, i, BALL + 2] - np.hypot(pt[0] - last[0, i, BALL], pt[1] - last[0, i, BALL + 1])
+        exact = float(pin_gap(pt, z, radius, 0.0, ecc)[0])
+        worst = min(worst, exact - bound)
+        better += bound > s0[i] - np.hypot(*dp[i]) + 1e-9
+    assert worst >= -1e-12, worst
+    assert better > n // 2
+
+
+def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
+    """A time step's motion (disc centres 1.5e-5 m, rotations 3e-5 rad per call: a pin moves
+    ~15 um relative to its disc, far more than the gaps of its neighbours in mesh) after an
+    exact evaluation of every pin: the forces of the skipping kernel (chained and tangent-ball
+    bounds, flexrv.model.pins.pin_kernel) equal an exact evaluation of every pin from the cold
+    starts to 1e-10 of the largest (round-off; measured 3.9e-13); every skipped pin is open
+    there with its recorded gap a positive lower bound; and the tangent-ball bound proves open
+    pins the 1-Lipschitz bound g0 - |P - P0| could not (that bound <= 0 for some skipped pin),
+    some by the ball at their predicted foot point (pins._ball_predicted: the ball record
+    replaced while the pin's exact records stay those of the first evaluation)."""
+    from flexrv.model.pins import BALL, PinContacts
+
+    p, q, v = _rigid_pins()
+    idx = np.arange(q.shape[0], dtype=np.int64)
+    g = PinContacts(p)
+    pack = g.pack(idx)
+    _evaluate(g, pack, q, v)
+    g0, p0, o0 = g.last[..., 0].copy(), g.last[..., 1:3].copy(), g.last[..., BALL].copy()
+    for _ in range(3):
+        q[0::3] += 1.5e-5
+        q[1::3] -= 0.5e-5
+        q[2::3] += 3e-5
+        got = _evaluate(g, pack, q, v)
+        skipped = np.isnan(g.curv[..., 0])
+        ref = PinContacts(p)
+        exact = _evaluate(ref, ref.pack(idx, history=True), q, v)
+        fmax = np.abs(exact["force"]).max()
+        assert fmax > 0.0 and skipped.sum() >= 10
+        assert np.abs(got["force"] - exact["force"]).max() <= 1e-10 * fmax
+        assert np.all(exact["force"][skipped] == 0.0)
+        assert np.all(got["gap"][skipped] > 0.0) and np.all(got["gap"][skipped] <= exact["gap"][skipped] + 1e-15)
+    # the 1-Lipschitz bound from the first exact evaluation, at the final pose, for the pins skipped since
+    never = np.all(g.last[..., 1:3] == p0, axis=-1)
+    c, s = np.cos(q[2::3]), np.sin(q[2::3])
+    lip = np.empty_like(g0)
+    for kd in range(g.nd):
+        r = g.pins - q[3 * kd : 3 * kd + 2]
+        lx, ly = c[kd] * r[:, 0] + s[kd] * r[:, 1], -s[kd] * r[:, 0] + c[kd] * r[:, 1]
+        cr, sr = np.cos(g.profile[kd, 2]), np.sin(g.profile[kd, 2])
+        px, py = cr * lx + sr * ly, -sr * lx + cr * ly
+        lip[kd] = g0[kd] - np.hypot(px - p0[kd, :, 0], py - p0[kd, :, 1])
+    assert np.any(lip[never & skipped] <= 0.0)
+    assert np.any(never & skipped & (g.last[..., BALL] != o0))  # proved open by a ball at a predicted foot point
+
+
 def test_roller_directions_by_rotation_equal_the_angles_cosines():
     """The crank supports' roller directions u_i = Rot(gamma) (cos a_i, sin a_i) (one rotation
     of the stored cosines and sines per cage angle, tapered_roller.roller_directions_into)

@@ -324,14 +324,16 @@ def test_cli_refuses_compiled_for_python_groups(tmp_path, capfd):
 # -------------------------------------------------------------- cross-check against Exudyn
 
 
-def te_of(reducer, integrator, t_end, model="rigid", window=None):
+def te_of(reducer, integrator, t_end, model="rigid", window=None, newton_tolerance=None):
     """(mean, p-p, frequencies, amplitudes, results) of the TE of ``model`` over the steady
-    window (``window`` [s]: the last ``window`` of the run instead) on tests/test_time_step.py's grid."""
+    window (``window`` [s]: the last ``window`` of the run instead) on tests/test_time_step.py's grid;
+    ``newton_tolerance`` (relative, absolute) instead of the run's default."""
     from flexrv.post.spectra import amplitude_spectrum
     from flexrv.simulation import Simulation
     from tests.test_time_step import GRID
 
-    res = Simulation(reducer, model=model).run(t_end=t_end, integrator=integrator)
+    kw = {} if newton_tolerance is None else {"newton_tolerance": newton_tolerance}
+    res = Simulation(reducer, model=model).run(t_end=t_end, integrator=integrator, **kw)
     assert res.attrs["status"] == "completed" and res.attrs["integrator"] == integrator
     t0, t1 = res.steady_window() if window is None else (t_end - window, t_end)
     tg = np.arange(int(round(t0 / GRID)), int(round(t1 / GRID)) + 1) * GRID
@@ -412,10 +414,27 @@ def test_cross_check_flexible_rings_against_exudyn():
 @pytest.mark.parametrize("name", list_presets())
 def test_cross_check_full_default_run(name):
     """The full default run (default ramps and t_end) of every preset, both integrators,
-    the criterion of :func:`cross_check`. ~30 s each."""
+    the criterion of :func:`cross_check`. A preset at a light load (rv221 at 20 of 3000
+    N m: two steady responses, tests/test_time_step.py) is held to what Exudyn's own
+    integrator shows there: the compiled TE mean within 0.05 arcsec of the span of
+    Exudyn's means at its default Newton tolerance, 10x tighter and 3x looser (which land
+    on different responses: measured -30.2020 / -30.3477 / -30.1707 arcsec, 0.146 apart
+    between default and tight; compiled -30.3483), the dominant line within 2 % of
+    Exudyn's at the default. ~30 s each."""
     r = load(name)
-    light = r.operating.load_torque_Nm < 0.1 * r.operating.rated_torque_Nm
-    cross_check(r, None, unique=not light)
+    if r.operating.load_torque_Nm >= 0.1 * r.operating.rated_torque_Nm:
+        cross_check(r, None)
+        return
+    from flexrv.simulation import DEFAULT_NEWTON_TOLERANCE
+
+    rel, ab = DEFAULT_NEWTON_TOLERANCE
+    means = [te_of(r, "exudyn", None, newton_tolerance=(rel * k, ab * k))[0] for k in (0.1, 3.0)]
+    m0, _, f0, a0, _ = te_of(r, "exudyn", None)
+    m1, _, f1, a1, _ = te_of(r, "compiled", None)
+    assert np.array_equal(f0, f1)
+    assert min(means + [m0]) - 0.05 < m1 < max(means + [m0]) + 0.05
+    i = int(np.argmax(a0 * (f0 > 0)))
+    assert abs(a1[i] - a0[i]) < 0.02 * a0[i]
 
 
 def test_same_steps_as_exudyn_through_step_reductions():

@@ -121,6 +121,67 @@ def test_te_spectrum_labels_in_words_with_window_and_resolution(tmp_path, captur
     assert hi / lo == pytest.approx(3e4, rel=1e-6)
 
 
+def test_log_axis_labels_plain_text_the_same_ticks_as_matplotlib():
+    """The spectrum's log axis labels the same ticks with the same values as matplotlib's default
+    formatter (LogFormatterSciNotation, mathtext), written as plain text with Unicode
+    superscripts: 10^-3 -> "10⁻³", 2 x 10^-3 -> "2×10⁻³"; no label needs the mathtext parser
+    (no "$"). Reference: the default formatter's labels on the same axis, converted by hand."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    from flexrv.viz.plots import _plt, plain_log_label, spectrum_axis
+
+    assert plain_log_label(r"$\mathdefault{10^{-3}}$") == "10\u207b\u00b3"
+    assert plain_log_label(r"$\mathdefault{2\times10^{-3}}$") == "2\u00d710\u207b\u00b3"
+    assert plain_log_label(r"$\mathdefault{10^{12}}$") == "10\u00b9\u00b2"
+    assert plain_log_label("") == "" and plain_log_label(r"$\mathdefault{0}$") == "0"
+    assert plain_log_label(r"$x^{\alpha}$") == r"$x^{\alpha}$"  # not a log label: unchanged
+    expected = {
+        "-": "\u207b",
+        **{str(d): "\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079"[d] for d in range(10)},
+    }
+    for span in (4.0, 0.6):  # four decades: decades labelled; less than one: minor ticks labelled too
+        fig, ax = _plt().subplots(figsize=(6, 3))
+        f = np.linspace(0.0, 100.0, 201)
+        spectrum_axis(ax, f, 1e-3 * (1.0 + np.sin(f)) + 1e-4, {}, 1.0, decades=span)
+        fig.canvas.draw()
+        for minor in (False, True):
+            ticks = ax.yaxis.get_minorticklocs() if minor else ax.yaxis.get_majorticklocs()
+            shown = [t.get_text() for t in ax.yaxis.get_ticklabels(minor=minor)]
+            default = LogFormatterSciNotation(10.0, labelOnlyBase=False)
+            default.set_axis(ax.yaxis)
+            default.set_locs(ticks)
+            for label, tick in zip(shown, ticks):
+                ref = default(tick)
+                assert "$" not in label
+                if ref:
+                    body = ref[len(r"$\mathdefault{") : -2].replace(r"\times", "\u00d7")
+                    head, _, exp = body.partition("^{")
+                    assert label == head + "".join(expected[c] for c in exp.rstrip("}"))
+                else:
+                    assert label == ""
+        assert any(t.get_text() for t in ax.yaxis.get_ticklabels())
+
+
+def test_plot_figures_are_not_kept_by_pyplot():
+    """The plots' figures (``_plt()``) live on their own Agg canvas: pyplot's figure manager
+    holds none of them (a loop of runs frees each figure with its last reference), and they
+    save PNGs."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from flexrv.viz.plots import _plt
+
+    before = plt.get_fignums()
+    fig, axes = _plt().subplots(2, 1, figsize=(4, 3), sharex=True)
+    axes[0].plot([0, 1], [0, 1])
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=50)
+    assert buf.getvalue()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert plt.get_fignums() == before
+    assert _plt().figure(figsize=(2, 2)).canvas.get_renderer() is not None
+
+
 def test_hysteresis_plot_marks_fit_range_lost_motion_hysteresis(tmp_path, captured):
     """Bilinear loop (k = 100 N m/arcmin, band +-0.5 arcmin) with a 0.2 arcmin hysteresis: the
     legend states the figures; the lost-motion marker spans the figures' two angles."""
@@ -404,3 +465,36 @@ def test_force_map_image_draws_the_same_pixels_as_the_quad_mesh():
     fig, ax = plt.subplots()
     assert _force_map(ax, t**2, angle, c, 500.0) in ax.collections
     plt.close(fig)
+
+
+def test_save_draws_a_tight_layout_figure_once_with_the_same_pixels(tmp_path, monkeypatch):
+    """A figure laid out by ``tight_layout`` is drawn once by ``_save`` (matplotlib's ``savefig``
+    draws it twice while the figure keeps tight_layout's placeholder layout engine), and its PNG
+    has exactly the pixels of the same figure saved by plain ``savefig`` (reference: matplotlib
+    itself, the placeholder kept)."""
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    from flexrv.viz.plots import FIGURE_DPI, _plt, _save
+
+    def figure():
+        fig, axes = _plt().subplots(2, 1, figsize=(5, 4))
+        t = np.linspace(0.0, 1.0, 500)
+        axes[0].plot(t, np.sin(20 * t), label="a long legend entry")
+        axes[0].legend(loc="best")
+        axes[1].semilogy(t, 1e-3 + t**2)
+        axes[1].set_xlabel("time [s]")
+        fig.suptitle("a title")
+        fig.tight_layout()
+        return fig
+
+    reference = figure()
+    reference.savefig(tmp_path / "reference.png", dpi=FIGURE_DPI, format="png")
+    draws = []
+    original = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: draws.append(1) or original(self, renderer))
+    _save(figure(), tmp_path / "saved.png")
+    assert len(draws) == 1
+    a = np.asarray(Image.open(tmp_path / "reference.png"))
+    b = np.asarray(Image.open(tmp_path / "saved.png"))
+    assert a.shape == b.shape and np.array_equal(a, b)

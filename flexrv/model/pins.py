@@ -118,7 +118,9 @@ LAPACK (:func:`inv_small`); a call at exactly the previous call's state adds tha
 call's result; a step's first call adds the previous first call's remaining predictor
 error. See :func:`_pin_condensed_kernel`. Per pin the closest point starts from its
 second-order prediction in the pin's motion (:func:`_pin_foot`), a pin proved open by
-the bound chained from the disc's last pose costs one subtraction (:func:`pin_kernel`),
+the bound chained from the disc's last pose costs one subtraction, one proved open by the
+empty tangent ball of its last exact evaluation a rotation and a root, one at its predicted
+foot point's ball a curve evaluation more (:func:`pin_kernel`),
 the Jacobian's curvature terms reuse the curve's derivatives at the foot point from its
 Newton iteration, and the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
@@ -140,7 +142,7 @@ import numpy as np
 from numba import njit
 
 from flexrv.contact.laws import _friction_one, _impact_one
-from flexrv.geometry.cycloid import _FOOT, closest_point_settings
+from flexrv.geometry.cycloid import _FOOT, _POINT, closest_point_settings
 from flexrv.model.base import KernelGroup, Output, SummaryRow
 from flexrv.model.core.params import empty_pack, law_type, pack_type
 from flexrv.model.drive import DriveParameters
@@ -182,12 +184,15 @@ _F, _I = np.float64, np.int64
 PinControl = law_type("PinControl", restart_every=int, skip_open=bool)
 #: the slots of a pin's ``last`` record (:func:`pin_kernel`, :func:`_pin_foot`): the exact gap g0 at the
 #: profile-frame position P0 of its last exact evaluation (0, 1, 2), the foot point's gradient dphi/dP (3, 4)
-#: and second derivatives d2phi/dP2 (xx, xy, yy: 5, 6, 7) there, and the lower bound of the gap less the
-#: harmonics' margin at the disc's pose of the last evaluation (``pose``), the chained bound's start (8)
-GRAD, HESS, SLACK, LAST_SIZE = 3, 5, 8, 9
+#: and second derivatives d2phi/dP2 (xx, xy, yy: 5, 6, 7) there, the lower bound of the gap at the disc's
+#: pose of the last evaluation (``pose``), the chained bound's start (8), and the empty tangent ball's bound
+#: of the last exact evaluation (:func:`_ball_record`): its centre O (9, 10) and rho + r_nom + dr_rp - r_i -
+#: sum|A| (11), so that the gap at P is at least that less |P - O|, and r_nom + dr_rp - r_i - sum|A| (12)
+GRAD, HESS, SLACK, BALL, LAST_SIZE = 3, 5, 8, 9, 13
 #: :func:`pin_kernel`'s pack: indices (x, y, psi per disc), law, per disc the curve's reach outside /
-#: inside (:func:`_curve_reach`), as-built pins (z, 2) and radii, disc profile modifications (n_discs,
-#: 3) and harmonics (n_discs, H, 3), closest-point warm starts, last exact evaluations (the slots above),
+#: inside (:func:`_curve_reach`) and its outer medial radius over one lobe's bins
+#: (:func:`_outer_ball_table`), as-built pins (z, 2) and radii, disc profile modifications (n_discs, 3) and
+#: harmonics (n_discs, H, 3), closest-point warm starts, last exact evaluations (the slots above),
 #: each disc's pose (x, y, psi) at its last evaluation, outputs per (disc, pin), per (disc, pin) the
 #: normal's turn h and the harmonics' b of the last evaluation with the Jacobian (NaN: skipped;
 #: :func:`_shift_records`), the warm starts' control, the counters of calls and of closest-point failures
@@ -196,6 +201,7 @@ PinPack = pack_type(
     ("idx", (_I, 1)),
     ("law", PinLaw),
     ("reach", (_F, 2)),
+    ("ball", (_F, 2)),
     ("pins", (_F, 2)),
     ("radii", (_F, 1)),
     ("profile", (_F, 2)),
@@ -294,18 +300,23 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
     restart every ``control.restart_every`` calls), ``failures`` the closest-point
     failures; ``control.skip_open`` allows skipping pins that are provably open.
 
-    Skipping (exact for the forces): the gap is 1-Lipschitz in the pin's position
-    relative to the disc (distance to a curve) up to the harmonics' variation, so
-    with the last exact gap g0 at position P0, g >= g0 - |P - P0| - 2 sum|A|. A
-    pin whose bound is positive carries no force (and no Jacobian); its closest
-    point is not recomputed and out_gap holds the bound. last[kd, i] holds g0, P0 and the
-    foot point's derivatives of the last exact evaluation (:data:`GRAD`, :data:`HESS`,
-    :func:`_pin_foot`) and the last lower bound of g - 2 sum|A| at the disc's pose of the
-    last evaluation (:data:`SLACK`, ``pose``): no pin moved relative to the disc by more than
-    |c - c0| + (max|pin| + |c0|) |psi - psi0| since, so that bound less this motion is tried
-    first (no rotation, no root; never above the bound from g0, so the same pins are
-    solved). Friction (module docstring): law.mu, law.v_reg; per (disc, pin) the friction
-    force on the disc along t = z x n into out_ft and its power f_t v_t (<= 0) into out_pw."""
+    Skipping (exact for the forces): with the harmonics at their worst the gap is at least s(P)
+    + r_nom + dr_rp - r_i - sum|A|, s(P) the pin centre's signed distance from the pin-centre
+    curve, and s is at least rho - |P - O| for the empty tangent ball (centre O, radius rho) at
+    the foot point of the last exact evaluation (:func:`_ball_record`: near contact the bound
+    loses only the motion towards the profile and the tangential motion's square over 2 rho,
+    where the 1-Lipschitz bound g0 - |P - P0| loses the whole motion; a pin open before and not
+    proved open by it is tried against the ball at its predicted foot point,
+    :func:`_ball_predicted`). A pin whose bound is positive carries no force (and no Jacobian);
+    its closest point is not recomputed and out_gap holds the bound. last[kd, i] holds g0, P0,
+    the foot point's derivatives (:data:`GRAD`, :data:`HESS`, :func:`_pin_foot`) and the ball
+    (:data:`BALL`) of the last exact evaluation and the last lower bound at the disc's pose of
+    the last evaluation (:data:`SLACK`, ``pose``): s is 1-Lipschitz and no pin moved relative to
+    the disc by more than |c - c0| + (max|pin| + |c0|) |psi - psi0| since, so that bound less
+    this motion is tried first (no rotation, no root; never above the ball's bound, |P - O|
+    being 1-Lipschitz in P, so the same pins are solved). Friction (module docstring): law.mu,
+    law.v_reg; per (disc, pin) the friction force on the disc along t = z x n into out_ft and
+    its power f_t v_t (<= 0) into out_pw."""
     law, pins, radii, profile, harm, last = (
         pack.law,
         pack.pins,
@@ -365,8 +376,12 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
             rx, ry = pins[i, 0] - xd, pins[i, 1] - yd  # housing frame, disc centre to pin
             lx, ly = c * rx + s * ry, -s * rx + c * ry  # disc frame
             px, py = cr * lx + sr * ly, -sr * lx + cr * ly  # profile frame (rotation modification removed)
-            if chain:
-                bound = last[kd, i, 0] - np.sqrt((px - last[kd, i, 1]) ** 2 + (py - last[kd, i, 2]) ** 2) - margin
+            if chain:  # the empty tangent ball's bound (_ball_record)
+                bound = last[kd, i, BALL + 2] - np.sqrt(
+                    (px - last[kd, i, BALL]) ** 2 + (py - last[kd, i, BALL + 1]) ** 2
+                )
+                if not bound > 0.0 and last[kd, i, SLACK] > 0.0:  # open before: the ball at the predicted foot
+                    bound = _ball_predicted(law, pack.ball, phi, last, kd, i, px, py, radius)
                 if bound > 0.0:  # provably open (NaN: never skipped)
                     last[kd, i, SLACK] = bound
                     out_gap[kd, i], out_f[kd, i], out_ft[kd, i], out_pw[kd, i] = bound, 0.0, 0.0, 0.0
@@ -375,10 +390,13 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
             ph, dist, nlx, nly, d1x, d1y, d2x, d2y = _pin_foot(
                 law, reach, phi, last, failures, kd, i, px, py, radius, cold
             )
-            gap = dist + r_nom + d_rp - radii[i]
+            base = r_nom + d_rp - radii[i]
+            gap = dist + base
+            base -= 0.5 * margin  # the gap less its harmonics at their worst, less s
             for h in range(harm.shape[1]):
                 gap -= harm[kd, h, 1] * np.cos(harm[kd, h, 0] * ph + harm[kd, h, 2])
-            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2], last[kd, i, SLACK] = gap, px, py, gap - margin
+            last[kd, i, 0], last[kd, i, 1], last[kd, i, 2] = gap, px, py
+            last[kd, i, SLACK] = _ball_record(last, kd, i, px, py, dist, nlx, nly, pack.ball[kd], law.z_rp, ph, base)
             mx, my = cr * nlx - sr * nly, sr * nlx + cr * nly  # disc frame
             nx, ny = c * mx - s * my, s * mx + c * my  # housing frame
             rxn = rx * ny - ry * nx
@@ -474,15 +492,7 @@ def _pin_foot(law, reach, phi, last, failures, kd, i, px, py, radius, cold):
     it is found again from the cold starts (:func:`_curve_reach`)."""
     z_rp, ecc, max_step, tol, max_iter = law.z_rp, law.eccentricity, law.max_step, law.tol, law.max_iter
     ch = law.cos_half
-    start = np.nan
-    if not cold:
-        start = phi[kd, i]
-        dx, dy = px - last[kd, i, 1], py - last[kd, i, 2]
-        move = last[kd, i, GRAD] * dx + last[kd, i, GRAD + 1] * dy
-        bend = last[kd, i, HESS] * dx * dx + 2.0 * last[kd, i, HESS + 1] * dx * dy + last[kd, i, HESS + 2] * dy * dy
-        move += 0.5 * bend
-        if abs(move) < max_step:  # (NaN: no prediction)
-            start += move
+    start = np.nan if cold else _predicted_foot(phi, last, kd, i, px, py, max_step)
     ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(px, py, start, z_rp, radius, ecc, max_step, tol, max_iter, ch)
     if ok and not cold and not (0.0 <= dist < reach[kd, 0] or 0.0 < -dist < reach[kd, 1]):
         ph, ok, dist, nlx, nly, d1x, d1y, d2x, d2y = _FOOT(
@@ -493,6 +503,46 @@ def _pin_foot(law, reach, phi, last, failures, kd, i, px, py, radius, cold):
     phi[kd, i] = ph
     _foot_derivatives(last, kd, i, ok, px, py, z_rp, dist, nlx, nly, d1x, d1y, d2x, d2y)
     return ph, dist, nlx, nly, d1x, d1y, d2x, d2y
+
+
+@njit(cache=True, inline="always")
+def _predicted_foot(phi, last, kd, i, px, py, max_step):
+    """The second-order prediction of pin i's foot point at P = (px, py) from its last exact
+    evaluation (:func:`_pin_foot`): phi + g . dP + dP^T H dP / 2, or phi itself where the
+    predicted change is ``max_step`` or more or the derivatives are missing (NaN)."""
+    start = phi[kd, i]
+    dx, dy = px - last[kd, i, 1], py - last[kd, i, 2]
+    move = last[kd, i, GRAD] * dx + last[kd, i, GRAD + 1] * dy
+    bend = last[kd, i, HESS] * dx * dx + 2.0 * last[kd, i, HESS + 1] * dx * dy + last[kd, i, HESS + 2] * dy * dy
+    move += 0.5 * bend
+    if abs(move) < max_step:  # (NaN: no prediction)
+        start += move
+    return start
+
+
+@njit(cache=True, inline="always")
+def _ball_predicted(law, table, phi, last, kd, i, px, py, radius):
+    """The tangent-ball bound of pin i at P = (px, py) from the ball at its predicted foot point
+    (:func:`_predicted_foot`), one curve evaluation: any curve point's outer tangent ball of
+    radius rho below its medial radius is empty (:func:`_ball_record`), and at the predicted
+    foot point P lies almost on the ball's axis, so the bound is the gap less the prediction's
+    error squared over 2 rho. A positive bound replaces the ball record (the foot point's own
+    records stay those of the last exact evaluation); returns the bound (NaN: none)."""
+    ph = _predicted_foot(phi, last, kd, i, px, py, law.max_step)
+    if not ph == ph:
+        return np.nan
+    cx, cy, d1x, d1y, _, _ = _POINT(ph, law.z_rp, radius, law.eccentricity)
+    inv = 1.0 / np.sqrt(d1x * d1x + d1y * d1y)
+    nx, ny = -d1y * inv, d1x * inv  # the outer normal (cycloid._closest_point_newton's n_out)
+    n = table.shape[1]
+    lobe = 2.0 * np.pi / (law.z_rp - 1)
+    rho = table[kd, min(int((ph % lobe) * (n / lobe)), n - 1)]
+    ox, oy = cx + rho * nx, cy + rho * ny
+    base = last[kd, i, BALL + 3]  # r_nom + dr_rp - r_i - sum|A| (NaN after a failure)
+    bound = rho + base - np.sqrt((px - ox) ** 2 + (py - oy) ** 2)
+    if bound > 0.0:
+        last[kd, i, BALL], last[kd, i, BALL + 1], last[kd, i, BALL + 2] = ox, oy, rho + base
+    return bound
 
 
 @njit(cache=True, inline="always")
@@ -518,6 +568,40 @@ def _foot_derivatives(last, kd, i, ok, px, py, z_rp, dist, nlx, nly, d1x, d1y, d
     last[kd, i, HESS] = (fpp * gx * gx + 2.0 * d2x * gx) * inv
     last[kd, i, HESS + 1] = (fpp * gx * gy + d2x * gy + d2y * gx) * inv
     last[kd, i, HESS + 2] = (fpp * gy * gy + 2.0 * d2y * gy) * inv
+
+
+@njit(cache=True, inline="always")
+def _ball_record(last, kd, i, px, py, dist, nlx, nly, table, z_rp, ph, base):
+    """The empty tangent ball of pin i's exact evaluation at P0 = (px, py) (signed distance s0 =
+    ``dist`` from the pin-centre curve along its outer normal n = (nlx, nly); ``base`` = r_nom +
+    dr_rp - r_i - sum|A|, so that the gap at any P is at least s(P) + base) into
+    last[kd, i, BALL:BALL + 3]; returns the bound at P0 itself.
+
+    The open ball of radius rho = max(R, s0) about O = C0 + rho n, C0 = P0 - s0 n the foot point
+    ph, holds no point of the curve: for rho = R, a lower estimate of the curve's outer medial
+    radius over ph's bin of the lobe (``table``, :func:`_outer_ball_table`; lobes of 2 pi /
+    (z_rp - 1)), by the medial radius' definition; for rho = s0 > R it is the ball about P0
+    whose radius is P0's distance to the curve. Being empty and touching the curve from outside,
+    the ball lies outside, so every P has s(P) >= rho - |P - O|: a P outside the ball is at least
+    as far from the curve's inner side as from the ball (a path from inside reaches the ball only
+    across the curve), and a P in the ball is outside at least rho - |P - O| from the ball's
+    boundary. Hence g(P) >= rho - |P - O| + base. Near contact (s0 << R) this is s0 + (motion
+    along n) - (motion along the tangent)^2 / (2 R) to second order: a pin sliding along the
+    profile at a step's motion keeps a bound near its gap, where the 1-Lipschitz bound g0 -
+    |P - P0| (the ball's rho = s0 case, which the bound never falls below) loses the whole
+    motion. A failed closest point (NaN) records nothing (never skipped)."""
+    if not last[kd, i, GRAD] == last[kd, i, GRAD]:  # no converged foot point (_foot_derivatives)
+        last[kd, i, BALL + 2] = last[kd, i, BALL + 3] = np.nan
+        return np.nan
+    n = table.shape[0]
+    lobe = 2.0 * np.pi / (z_rp - 1)
+    j = min(int((ph % lobe) * (n / lobe)), n - 1)
+    rho = max(table[j], dist)
+    last[kd, i, BALL] = px + (rho - dist) * nlx
+    last[kd, i, BALL + 1] = py + (rho - dist) * nly
+    last[kd, i, BALL + 2] = rho + base
+    last[kd, i, BALL + 3] = base
+    return dist + base
 
 
 #: the rim Newton's caps and round-off rule (numerics.newton.newton_update: max_evals, max_steps,
@@ -918,20 +1002,15 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, idx_rim, cd, ch, dstate, h
 
 
 @functools.lru_cache(maxsize=64)
-def _curve_reach(z_rp: int, radius: float, eccentricity: float, samples: int = 400) -> tuple[float, float]:
-    """Lower estimates of the reach of the pin-centre curve C on its outer side
-    (the side of n_out, positive signed distance) and its inner side [m]: the
-    smallest radius of a disc tangent to C on that side that contains no other
-    point of C (the distance to the medial axis). A point P at distance d below the
-    reach on the side of a foot point found by a local search has that foot point
-    as its nearest point on C (the ball of radius d about P lies in the empty
-    tangent ball), so the pin kernel trusts a warm-started closest point only
-    then. Computed from ``samples`` points over one lobe against the points of the
-    lobe and its two neighbours on each side (the curve repeats per lobe; farther
-    parts are > 10 mm away), the medial radius at point i being min_j |C_j - C_i|^2
-    / (2 (C_j - C_i) . n_i) over the j on that side, times 0.9 for the sampling
-    (rv40e: 71.4 um outside, at the lobe's tip, and 4.6 mm inside; 400 and 2,000
-    samples agree to 1e-3)."""
+def _medial_radii(z_rp: int, radius: float, eccentricity: float, samples: int = 400) -> tuple[np.ndarray, np.ndarray]:
+    """The medial radius of the pin-centre curve C at ``samples`` points phi_i = i lobe /
+    samples of one lobe (lobe = 2 pi / (z_rp - 1)), on its outer side (the side of n_out,
+    positive signed distance) and its inner side [m]: the radius of the largest disc
+    tangent to C at C_i on that side that contains no other point of C (the distance to the
+    medial axis along the normal), min_j |C_j - C_i|^2 / (2 (C_j - C_i) . n_i) over the
+    points C_j on that side, taken over the lobe and its two neighbours on each side (the
+    curve repeats per lobe; farther parts are > 10 mm away). Unscaled samples: the callers
+    take 0.9 of them for the sampling (400 and 2,000 samples agree to 1e-3)."""
     from flexrv.geometry.cycloid import center_curve
 
     lobe = 2.0 * np.pi / (z_rp - 1)
@@ -949,8 +1028,33 @@ def _curve_reach(z_rp: int, radius: float, eccentricity: float, samples: int = 4
     for side in (1.0, -1.0):
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.where((side * dn > 0.0) & same, dd / (2.0 * side * dn), np.inf)
-        out.append(0.9 * float(np.min(r)))
+        out.append(np.min(r, axis=1))
     return out[0], out[1]
+
+
+def _curve_reach(z_rp: int, radius: float, eccentricity: float) -> tuple[float, float]:
+    """Lower estimates of the reach of the pin-centre curve C on its outer and its inner
+    side [m]: the smallest medial radius on that side (:func:`_medial_radii`) times 0.9 for
+    the sampling (rv40e: 71.4 um outside, at the lobe's tip, and 4.6 mm inside). A point P
+    at distance d below the reach on the side of a foot point found by a local search has
+    that foot point as its nearest point on C (the ball of radius d about P lies in the
+    empty tangent ball), so the pin kernel trusts a warm-started closest point only then."""
+    r_out, r_in = _medial_radii(z_rp, radius, eccentricity)
+    return 0.9 * float(np.min(r_out)), 0.9 * float(np.min(r_in))
+
+
+def _outer_ball_table(z_rp: int, radius: float, eccentricity: float) -> np.ndarray:
+    """Lower estimates of the outer medial radius over the bins [phi_j, phi_j+1) of one lobe
+    (the samples of :func:`_medial_radii`) [m]: 0.9 of the smaller of the bin's two end
+    samples (below the cap the radius changes by at most 4.5 % per sample on rv40e, 6.5 % on
+    rv221, most near the valley phi = 0), at most a twentieth of the lobe's arc (radius x lobe),
+    so that the tangent ball (of diameter below a tenth of a lobe's arc) meets no part of C
+    beyond the two neighbouring lobes the samples were taken over. Rv221: 47 um in the
+    valley, the cap 0.88 mm over two thirds of the lobe. The pin kernel's tangent-ball bound
+    (:func:`_ball_record`) takes the bin of each foot point."""
+    r_out, _ = _medial_radii(z_rp, radius, eccentricity)
+    lobe = 2.0 * np.pi / (z_rp - 1)
+    return np.minimum(0.9 * np.minimum(r_out, np.roll(r_out, -1)), 0.05 * radius * lobe)
 
 
 # ---------------------------------------------------------------- the element's parameters from the design
@@ -1071,6 +1175,13 @@ class PinContacts(KernelGroup):
         )
         #: per disc the pin-centre curve's reach outside, inside [m] (:func:`_curve_reach`)
         self.reach = np.array(reach, dtype=float).reshape(self.nd, 2)
+        #: per disc the outer medial radius over one lobe's bins [m] (:func:`_outer_ball_table`)
+        self.ball = np.array(
+            [
+                _outer_ball_table(int(d.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(d.eccentricity))
+                for kd in range(self.nd)
+            ]
+        )
         self.mu, self.v_reg = p.pin_friction, d.friction_velocity
         z = len(self.pins)
         self.phi = np.full((self.nd, z), np.nan)
@@ -1135,6 +1246,7 @@ class PinContacts(KernelGroup):
             idx=idx,
             law=self.law,
             reach=self.reach,
+            ball=self.ball,
             pins=self.pins,
             radii=self.radii,
             profile=self.profile,

@@ -1,3 +1,12 @@
-"""Post-processing: the Results object (xarray), save/load, TE, spectra, statistics."""
+"""Post-processing: the Results object (xarray), save/load, TE, spectra, statistics.
 
-from flexrv.post.results import Results  # noqa: F401
+``flexrv.post.Results`` is imported on first access: the package's light modules (number
+formats, definitions) do not import xarray."""
+
+
+def __getattr__(name: str):
+    if name == "Results":
+        from flexrv.post.results import Results
+
+        return Results
+    raise AttributeError(f"module 'flexrv.post' has no attribute {name!r}")

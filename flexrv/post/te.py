@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from flexrv.cache import atomic_write_text, to_jsonable
 from flexrv.post import definitions as defs
 from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, RAD_PER_ARCMIN
+
+if TYPE_CHECKING:  # xarray is imported where a Dataset is made (te_dataset)
+    import xarray as xr
 
 
 def te_dataset(result, reducer) -> xr.Dataset:
@@ -27,6 +30,8 @@ def te_dataset(result, reducer) -> xr.Dataset:
     (pin, needle, support and mesh forces, pins in contact, ...), with their
     units and long names. Catalog numbers and the solver figures are attributes.
     """
+    import xarray as xr
+
     data = {
         "te": (("position",), result.te * ARCSEC_PER_RAD, {"units": "arcsec", "long_name": "loaded TE"}),
         "te_no_load": (
