@@ -1349,21 +1349,74 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
     converges on the residual, which is exact). The azimuths' cosines and sines
     are the normalised in-plane coordinates (no sin/cos of the atan2).
 
-    Phases (each its own compiled function): the frame's kinematics
+    Phases (each its own compiled function): :func:`_row_front` -- the frame's kinematics
     (:func:`_frame_kinematics`), pass 1 with the rings undeflected
     (:func:`_row_geometry`), the contacts and the condensed rings' local solves
-    (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
-    ball (:func:`_row_pass2`), the condensed rings' dense blocks
+    (:func:`_row_contacts`) -- then :func:`_row_back` -- pass 2 with the forces and the
+    Jacobian blocks of every ball (:func:`_row_pass2`), the condensed rings' dense blocks
     (:func:`_condensed_row_jacobian`)."""
-    ball_ref, geometry, state, balls = p.ball_ref, p.geometry, p.state, p.balls
+    _row_back(q, qt, p, jacobian, rec, f, jq, jv, _row_front(q, qt, p, jacobian))
+
+
+@njit(cache=True)
+def _row_front(q, qt, p, jacobian):
+    """The first phases of :func:`row_eval` (the frame's kinematics, pass 1 and the contacts
+    with the condensed rings' local solves): (A, G, entrainment speed, :data:`RowPass1`,
+    :data:`RowContacts`), for :func:`_row_back`."""
+    geometry = p.geometry
+    cond_i = p.comp_i.shape[0] > 0
+    cond_o = p.comp_o.shape[0] > 0
+    p.state[1] = 0
+    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
+    speed = geometry.speed_factor * abs(qt[5])
+    pre = _row_geometry(
+        q,
+        qt,
+        p.ball_ref,
+        geometry,
+        p.tab_i,
+        p.zsign[0],
+        p.tab_o,
+        p.zsign[1],
+        cond_i,
+        cond_o,
+        jacobian,
+        a,
+        (om0, om1, om2),
+    )
+    con = _row_contacts(
+        geometry,
+        p.zsign[0],
+        p.zsign[1],
+        p.law_i,
+        p.law_o,
+        p.comp_i,
+        p.comp_o,
+        p.ws_i,
+        p.ws_o,
+        jacobian,
+        speed,
+        pre,
+        p.state,
+    )
+    return a, g, speed, pre, con
+
+
+@njit(cache=True)
+def _row_back(q, qt, p, jacobian, rec, f, jq, jv, front):
+    """The last phases of :func:`row_eval` from :func:`_row_front`'s results ``front`` (computed
+    with a ``jacobian`` mode that allocates the same arrays: any true mode): the outputs
+    cleared, pass 2 with the forces and the Jacobian blocks, the condensed rings' dense blocks.
+    It writes only f, jq, jv, rec and the quasi-static balls' sensitivities, so one front
+    serves several modes at the same state (:func:`_ball_solve`)."""
+    a, g, speed, pre, con = front
+    geometry, balls = p.geometry, p.balls
     tab_i, tab_o, zs_i, zs_o = p.tab_i, p.tab_o, p.zsign[0], p.zsign[1]
-    law_i, law_o, comp_i, comp_o, ws_i, ws_o = p.law_i, p.law_o, p.comp_i, p.comp_o, p.ws_i, p.ws_o
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
-    cond_i = comp_i.shape[0] > 0
-    cond_o = comp_o.shape[0] > 0
-    state[1] = 0
-    nz = ball_ref.shape[0]
+    cond_i = p.comp_i.shape[0] > 0
+    cond_o = p.comp_o.shape[0] > 0
+    nz = p.ball_ref.shape[0]
     b0 = 6 + m_i + m_o
     f[:] = 0.0
     if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
@@ -1377,17 +1430,30 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
         else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
             _zero_written(jq, b0, nz)
             _zero_written(jv, b0, nz)
-    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
-    speed = geometry.speed_factor * abs(qt[5])
-    pre = _row_geometry(
-        q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, (om0, om1, om2)
-    )
-    con = _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state)
     p2 = _row_pass2(
-        q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+        q,
+        qt,
+        geometry,
+        tab_i,
+        zs_i,
+        tab_o,
+        zs_o,
+        p.law_i,
+        p.law_o,
+        balls,
+        jacobian,
+        speed,
+        a,
+        g,
+        pre,
+        con,
+        rec,
+        f,
+        jq,
+        jv,
     )
     if jacobian and (cond_i or cond_o):
-        _condensed_row_jacobian(law_i, law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
+        _condensed_row_jacobian(p.law_i, p.law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
 
 
 @njit(cache=True)
@@ -1477,7 +1543,17 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     ~3e-9 N, the round-off of 111 N loads on rv221). ``f`` (n,): the row's forces
     and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
     last evaluation (at the returned balls and velocities). Returns the number of
-    Newton steps (-1: not converged in ``max_iter``)."""
+    Newton steps (-1: not converged in ``max_iter``). :func:`_ball_solve` with no Jacobian."""
+    empty = np.empty((0, 0))
+    return _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, empty, empty)
+
+
+@njit(cache=True)
+def _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, kx, cx):
+    """:func:`ball_equilibrium`, and with kx, cx of shape (nx, nx) (else (0, 0)) the condensed
+    Jacobians of the returned balls (:func:`row_eval`'s CONDENSED_BALLS mode) from the last
+    evaluation's geometry and contacts (:func:`_row_back` on the same :func:`_row_front`):
+    the contacts are evaluated once at the solution, not again for the Jacobian."""
     nz = p.ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
     recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
@@ -1486,7 +1562,8 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        row_eval(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv)
+        front = _row_front(q, qt, p, BALL_BLOCKS)
+        _row_back(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv, front)
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1509,7 +1586,10 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
                 step[j, off + 2] = -(adj[2, 0] * r0 + adj[2, 1] * r1 + adj[2, 2] * r2) / det
             for c in range(3):
                 dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
-        if err <= atol and dv <= vtol:
+        done = err <= atol and dv <= vtol
+        if (done or it == max_iter) and kx.shape[0] > 0:
+            _row_back(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx, front)
+        if done:
             return it
         if it == max_iter:
             break
@@ -1627,8 +1707,8 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
     failure is counted in state[4], flagged in state[5] and not stored). Out: f[:nx]
     the force on x (f (n,) work), the per-ball records ``rec`` and, with
     ``jacobian``, the condensed Jacobians kx, cx (nx, nx) (:func:`row_eval`'s
-    CONDENSED_BALLS mode), whose S is stored. A
-    Jacobian call at the state of the last solution (Exudyn's usual order) reuses
+    CONDENSED_BALLS mode, from the solve's last evaluation: :func:`_ball_solve`), whose S is
+    stored. A Jacobian call at the state of the last solution (Exudyn's usual order) reuses
     it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
     geometry, state = p.geometry, p.state
     nz = p.ball_ref.shape[0]
@@ -1647,13 +1727,15 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
             qt[nx + e] = bt[e]
     else:
         _predict_balls(q, qt, p.ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        kxs = kx if jacobian else np.empty((0, 0))  # (the solve's last evaluation gives the Jacobians)
+        cxs = cx if jacobian else np.empty((0, 0))
         its = -1
         for attempt in range(2):
             if attempt == 1:  # once more from the last solution
                 for e in range(nb):
                     q[nx + e] = b[e]
                     qt[nx + e] = bt[e]
-            its = ball_equilibrium(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec)
+            its = _ball_solve(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec, kxs, cxs)
             if its >= 0:
                 break
         state[5] = 0
@@ -1666,6 +1748,7 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
                 xl[c] = q[c]
                 xtl[c] = qt[c]
             flag[0] = 1.0
+        return
     if jacobian:
         row_eval(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
 
