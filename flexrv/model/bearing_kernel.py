@@ -1172,17 +1172,49 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
     cond_o = vf_o.shape[0] > 0
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
+    # quasi-static balls between rigid rings: each ball's condensed share in closed form (6 x 3 blocks)
+    rigid = jacobian == CONDENSED_BALLS and m_i == 0 and m_o == 0 and not cond_i and not cond_o
     for j in range(load_i.shape[0]):
         etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
         bj = b0 + 3 * j
         qi, qo = load_i[j], load_o[j]
-        jl[:, :] = 0.0
-        vl[:, :] = 0.0
         if not cond_i:  # (condensed rings: the blocks' factors below)
             _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
         if not cond_o:
             _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
         et = (etx, ety, 0.0)
+        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+        if rigid:
+            for c in range(3):  # -(skew(Ap) G)[:, c]
+                g0, g1, g2 = g[0, c], g[1, c], g[2, c]
+                t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
+                t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
+                t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
+            gain_i = _film_speed_gain(law_i, speed, film_i[j]) * dudw
+            gain_o = _film_speed_gain(law_o, speed, film_o[j]) * dudw
+            _condense_rigid_ball(
+                k_i,
+                d_i,
+                k_o,
+                d_o,
+                t_i,
+                etx,
+                ety,
+                radius * cage_ratio,
+                geometry,
+                gain_i,
+                gain_o,
+                nrm_i[j],
+                nrm_o[j],
+                jq,
+                jv,
+                s_balls[3 * j : 3 * j + 3],
+                inv3,
+                tm3,
+            )
+            continue
+        jl[:, :] = 0.0
+        vl[:, :] = 0.0
         for c1 in range(3):
             for c2 in range(3):
                 ee = et[c1] * et[c2]
@@ -1192,7 +1224,6 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
             jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
             vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
         # T_i = [I | -[Ap]x G | A basis_i]
-        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
         for c in range(3):  # -(skew(Ap) G)[:, c]
             g0, g1, g2 = g[0, c], g[1, c], g[2, c]
             t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
@@ -1598,6 +1629,71 @@ def _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, kx, cx):
                 q[b0 + 3 * j + c] += step[j, c]
                 qt[b0 + 3 * j + c] = step[j, 3 + c]
     return -1
+
+
+@njit(cache=True, inline="always")
+def _condense_rigid_ball(
+    k_i, d_i, k_o, d_o, t, etx, ety, cage_arm, geometry, gain_i, gain_o, n_i, n_o, kx, cx, s_ball, inv, tm
+):
+    """:func:`_condense_ball` of one quasi-static ball between rigid rings, from its blocks
+    without the (9 x 9) square: with the inner contact's K_i, D_i and T (3 x 6) the frame's
+    blocks are J_xx = A T, J_xb = -A, V_xx = B T - (A d_i) e_5^T, V_xb = -B (A = T^T K_i,
+    B = T^T D_i, d_i the inner film-speed displacement gain_i n_i); the ball's J_bb = K_i + K_o
+    + K_cage, J_bx = -K_i T + k_c r c e_5^T, V_bb = D_i + D_o - c_c e_t e_t^T, V_bx = -D_i T +
+    (c_c r c + K_i d_i + K_o d_o) e_5^T (r c = ``cage_arm``: the ball's radius times the cage
+    ratio). Then kx += A (T - S) and cx += B (T - S) - (A d_i) e_5^T + A J_bb^-1 (V_bx + V_bb S)
+    with S = -J_bb^-1 J_bx (into ``s_ball``): :func:`_condense_ball`'s sums, the same products
+    of the same blocks regrouped (tests/test_model_flexible_bearing.py compares the two)."""
+    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
+    et = (etx, ety, 0.0)
+    jbb = np.empty((3, 3))
+    vbb = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            ee = et[r] * et[c]
+            eye = 1.0 if r == c else 0.0
+            jbb[r, c] = k_i[r, c] + k_o[r, c] - cage_k * ee - pocket_k * (eye - ee)
+            vbb[r, c] = d_i[r, c] + d_o[r, c] - cage_c * ee
+    det = adjugate3(jbb, inv)
+    for r in range(3):
+        for c in range(3):
+            inv[r, c] /= det
+    c5k = np.empty(3)  # the ball's column 5 of J_bx and V_bx
+    c5v = np.empty(3)
+    for r in range(3):
+        kd_i = gain_i * (k_i[r, 0] * n_i[0] + k_i[r, 1] * n_i[1] + k_i[r, 2] * n_i[2])
+        kd_o = gain_o * (k_o[r, 0] * n_o[0] + k_o[r, 1] * n_o[1] + k_o[r, 2] * n_o[2])
+        c5k[r] = cage_k * cage_arm * et[r]
+        c5v[r] = cage_c * cage_arm * et[r] + kd_i + kd_o
+    jbx = np.empty((3, 6))
+    vbx = np.empty((3, 6))
+    for r in range(3):
+        for c in range(6):
+            jbx[r, c] = -(k_i[r, 0] * t[0, c] + k_i[r, 1] * t[1, c] + k_i[r, 2] * t[2, c])
+            vbx[r, c] = -(d_i[r, 0] * t[0, c] + d_i[r, 1] * t[1, c] + d_i[r, 2] * t[2, c])
+        jbx[r, 5] += c5k[r]
+        vbx[r, 5] += c5v[r]
+    for r in range(3):  # S = -J_bb^-1 J_bx
+        for c in range(6):
+            s_ball[r, c] = -(inv[r, 0] * jbx[0, c] + inv[r, 1] * jbx[1, c] + inv[r, 2] * jbx[2, c])
+    for c in range(6):  # Tm = J_bb^-1 (V_bx + V_bb S)
+        w0 = vbx[0, c] + vbb[0, 0] * s_ball[0, c] + vbb[0, 1] * s_ball[1, c] + vbb[0, 2] * s_ball[2, c]
+        w1 = vbx[1, c] + vbb[1, 0] * s_ball[0, c] + vbb[1, 1] * s_ball[1, c] + vbb[1, 2] * s_ball[2, c]
+        w2 = vbx[2, c] + vbb[2, 0] * s_ball[0, c] + vbb[2, 1] * s_ball[1, c] + vbb[2, 2] * s_ball[2, c]
+        for r in range(3):
+            tm[r, c] = inv[r, 0] * w0 + inv[r, 1] * w1 + inv[r, 2] * w2
+    for r in range(6):
+        a0 = t[0, r] * k_i[0, 0] + t[1, r] * k_i[1, 0] + t[2, r] * k_i[2, 0]  # A = T^T K_i, row r
+        a1 = t[0, r] * k_i[0, 1] + t[1, r] * k_i[1, 1] + t[2, r] * k_i[2, 1]
+        a2 = t[0, r] * k_i[0, 2] + t[1, r] * k_i[1, 2] + t[2, r] * k_i[2, 2]
+        v0 = t[0, r] * d_i[0, 0] + t[1, r] * d_i[1, 0] + t[2, r] * d_i[2, 0]  # B = T^T D_i, row r
+        v1 = t[0, r] * d_i[0, 1] + t[1, r] * d_i[1, 1] + t[2, r] * d_i[2, 1]
+        v2 = t[0, r] * d_i[0, 2] + t[1, r] * d_i[1, 2] + t[2, r] * d_i[2, 2]
+        for c in range(6):
+            e0, e1, e2 = t[0, c] - s_ball[0, c], t[1, c] - s_ball[1, c], t[2, c] - s_ball[2, c]
+            kx[r, c] += a0 * e0 + a1 * e1 + a2 * e2
+            cx[r, c] += v0 * e0 + v1 * e1 + v2 * e2 + a0 * tm[0, c] + a1 * tm[1, c] + a2 * tm[2, c]
+        cx[r, 5] -= gain_i * (a0 * n_i[0] + a1 * n_i[1] + a2 * n_i[2])  # -(A d_i) e_5^T
 
 
 @njit(cache=True)
