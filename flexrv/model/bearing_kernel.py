@@ -1158,7 +1158,8 @@ def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
 def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv):
     """Every ball's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
     (b0..b0+2)] into the work blocks jl, vl (the helpers at ball index b0), then scattered
-    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS); the
+    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS; between rigid
+    rings each ball's share in closed form, :func:`_condense_rigid_ball`); the
     condensed rings' contacts keep their T rows and contact factors for
     :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
