@@ -6,6 +6,14 @@ comparison of the integrators: ``bench_integrator.py --model balls``.
 
     python benchmarks/bench_balls.py [--presets rv221 rv40e] [--t-end 0.1] [--newton '{"...": ...}']
                                      [--options '{"ball_inertia": true}'] [--integrator compiled|exudyn]
+    python benchmarks/bench_balls.py --row-modes [--presets rv40e]
+
+``--row-modes``: the rows' own cost (one row, quasi-static balls, at a solved state of a short
+compiled run, 5 ms ramps) per evaluation mode of ``row_eval`` (force, the ball solve's blocks, the
+condensed Jacobian, the front phases alone), and the Jacobian call of every row at the run's recorded
+states, paired in one process: the ball solve then a separate CONDENSED_BALLS evaluation at the
+solution, against the solve that returns the condensed Jacobian of its last evaluation (the
+library's order), with the largest difference of the two Jacobians.
 
 The preset's default ramps are kept; a short warm-up run (0.002 s) loads or
 compiles the numba kernels first (a cold compile inside the timed run cost
@@ -80,6 +88,89 @@ def bench(name: str, t_end: float, newton: dict | None, options: dict | None = N
     }
 
 
+def row_modes(name: str) -> None:
+    """Print the ``--row-modes`` costs (module docstring)."""
+    from _shared import quick_ramps
+    from numba import njit
+
+    import flexrv.simulation as S
+    from flexrv.model import bearing_kernel as bk
+    from flexrv.simulation import Simulation
+
+    sim = Simulation(quick_ramps(name), model="balls")
+    model = sim.build()
+    kept = {}
+    orig = S._Records.__init__
+
+    def keep(self, *a, **k):
+        orig(self, *a, **k)
+        kept["records"] = self
+
+    S._Records.__init__ = keep
+    try:
+        sim.run(t_end=0.012, integrator="compiled", checkpoint_s=None)
+    finally:
+        S._Records.__init__ = orig
+    rec = kept["records"]
+    qs, vs = rec.qs[: rec.k].copy(), rec.vs[: rec.k].copy()
+    ((_, pack),) = [(g, p) for (g, _), p in zip(model.fused.slots, model.fused.packs) if g.kind == "bearing_rows"]
+    row_eval, solve_balls, front = bk.row_eval, bk.quasi_static_balls, bk._row_front
+    cb, bb = bk.CONDENSED_BALLS, bk.BALL_BLOCKS
+
+    @njit
+    def modes(q, v, p, mode, reps, rec, f, a, b):
+        for _ in range(reps):
+            if mode < 0:
+                front(q, v, p, bb)
+            else:
+                row_eval(q, v, p, mode, rec, f, a, b)
+
+    @njit
+    def jacobian_calls(qs, vs, separate, pack, out):
+        for i in range(1, qs.shape[0]):
+            for part in pack.parts:
+                idx, qe, ve, f, _, _, rec, kbb, kx, cx, p = part
+                for e in range(idx.shape[0]):
+                    qe[e] = qs[i, idx[e]]
+                    ve[e] = vs[i, idx[e]]
+                if separate:
+                    solve_balls(qe, ve, p, False, rec, f, kbb, kx, cx)
+                    row_eval(qe, ve, p, cb, np.empty((0, rec.shape[1])), f, kx, cx)
+                else:
+                    solve_balls(qe, ve, p, True, rec, f, kbb, kx, cx)
+                out[i] += np.abs(kx).sum() + 1e3 * np.abs(cx).sum()
+
+    _, qe, ve, f, _, _, _, kbb, kx, cx, p = pack.parts[0]
+    q, v, no_rec, empty = qe.copy(), ve.copy(), np.empty((0, bk.N_RECORD)), np.empty((0, 0))
+    print(f"{name}: one row, Z = {p.ball_ref.shape[0]}, per evaluation at a solved state:")
+    for label, mode, a, b in (
+        ("force", 0, empty, empty),
+        ("ball solve's blocks", bb, kbb, empty),
+        ("condensed Jacobian", cb, kx, cx),
+        ("front phases alone", -1, empty, empty),
+    ):
+        modes(q, v, p, mode, 1, no_rec, f, a, b)
+        c0 = time.process_time()
+        modes(q, v, p, mode, 3000, no_rec, f, a, b)
+        print(f"  {label:22s} {(time.process_time() - c0) / 3000 * 1e6:7.2f} us")
+    spent, sums = {True: [], False: []}, {}
+    for separate in (True, False, True, False, True, False):
+        for g in model.groups:
+            g.reset()
+        out = np.zeros(qs.shape[0])
+        c0 = time.process_time()
+        jacobian_calls(qs, vs, separate, pack, out)
+        spent[separate].append(time.process_time() - c0)
+        sums[separate] = out
+    per = {k: min(t[1:]) / (qs.shape[0] - 1) * 1e6 for k, t in spent.items()}
+    diff = np.max(np.abs(sums[True] - sums[False])) / np.max(np.abs(sums[True]))
+    print(
+        f"  Jacobian call of all rows at {qs.shape[0] - 1} recorded states: solve + separate evaluation "
+        f"{per[True]:.1f} us, the solve's own {per[False]:.1f} us ({per[True] / per[False]:.2f}x); "
+        f"Jacobians' sums equal within {diff:.1e} relative"
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--presets", nargs="*", default=["rv221", "rv40e"])
@@ -87,7 +178,12 @@ def main() -> None:
     ap.add_argument("--newton", default=None, help="newton_options as JSON")
     ap.add_argument("--options", default=None, help="model options as JSON, e.g. '{\"ball_inertia\": true}'")
     ap.add_argument("--integrator", default=None, choices=("compiled", "exudyn"), help="default: the model's")
+    ap.add_argument("--row-modes", action="store_true", help="the rows' own cost per evaluation mode (docstring)")
     a = ap.parse_args()
+    if a.row_modes:
+        for name in a.presets:
+            row_modes(name)
+        return
     import flexrv
 
     newton = json.loads(a.newton) if a.newton else None

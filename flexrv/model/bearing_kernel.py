@@ -1158,7 +1158,8 @@ def _row_local_blocks(b0, qt, geometry, pre, con, ebr, jq):
 def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw, a, g, pre, con, wk, ebr, jq, jv):
     """Every ball's Jacobian blocks: its (b0 + 3)^2 square [x (0..b0-1), the ball
     (b0..b0+2)] into the work blocks jl, vl (the helpers at ball index b0), then scattered
-    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS); the
+    into jq, jv -- or, for quasi-static balls, condensed into them (CONDENSED_BALLS; between rigid
+    rings each ball's share in closed form, :func:`_condense_rigid_ball`); the
     condensed rings' contacts keep their T rows and contact factors for
     :func:`_condensed_row_jacobian`. ``wk``: :func:`_row_pass2`'s work arrays; ``ebr``:
     :func:`_row_forces`' cage directions and radii."""
@@ -1172,17 +1173,49 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
     cond_o = vf_o.shape[0] > 0
     b0 = 6 + m_i + m_o
     nx_i = 6 + m_i
+    # quasi-static balls between rigid rings: each ball's condensed share in closed form (6 x 3 blocks)
+    rigid = jacobian == CONDENSED_BALLS and m_i == 0 and m_o == 0 and not cond_i and not cond_o
     for j in range(load_i.shape[0]):
         etx, ety, radius = ebr[j, 0], ebr[j, 1], ebr[j, 2]
         bj = b0 + 3 * j
         qi, qo = load_i[j], load_o[j]
-        jl[:, :] = 0.0
-        vl[:, :] = 0.0
         if not cond_i:  # (condensed rings: the blocks' factors below)
             _contact_blocks(qi, dq_i[j], cd_i[j], len_i[j], nrm_i[j, 0], nrm_i[j, 1], nrm_i[j, 2], etx, ety, k_i, d_i)
         if not cond_o:
             _contact_blocks(qo, dq_o[j], cd_o[j], len_o[j], nrm_o[j, 0], nrm_o[j, 1], nrm_o[j, 2], etx, ety, k_o, d_o)
         et = (etx, ety, 0.0)
+        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
+        if rigid:
+            for c in range(3):  # -(skew(Ap) G)[:, c]
+                g0, g1, g2 = g[0, c], g[1, c], g[2, c]
+                t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
+                t_i[1, 3 + c] = -(ap2 * g0 - ap0 * g2)
+                t_i[2, 3 + c] = -(-ap1 * g0 + ap0 * g1)
+            gain_i = _film_speed_gain(law_i, speed, film_i[j]) * dudw
+            gain_o = _film_speed_gain(law_o, speed, film_o[j]) * dudw
+            _condense_rigid_ball(
+                k_i,
+                d_i,
+                k_o,
+                d_o,
+                t_i,
+                etx,
+                ety,
+                radius * cage_ratio,
+                geometry,
+                gain_i,
+                gain_o,
+                nrm_i[j],
+                nrm_o[j],
+                jq,
+                jv,
+                s_balls[3 * j : 3 * j + 3],
+                inv3,
+                tm3,
+            )
+            continue
+        jl[:, :] = 0.0
+        vl[:, :] = 0.0
         for c1 in range(3):
             for c2 in range(3):
                 ee = et[c1] * et[c2]
@@ -1192,7 +1225,6 @@ def _row_ball_jacobians(jacobian, geometry, law_i, law_o, m_i, m_o, speed, dudw,
             jl[b0 + c1, 5] += cage_k * radius * cage_ratio * et[c1]
             vl[b0 + c1, 5] += cage_c * radius * cage_ratio * et[c1]
         # T_i = [I | -[Ap]x G | A basis_i]
-        ap0, ap1, ap2 = arm[j, 0], arm[j, 1], arm[j, 2]
         for c in range(3):  # -(skew(Ap) G)[:, c]
             g0, g1, g2 = g[0, c], g[1, c], g[2, c]
             t_i[0, 3 + c] = -(-ap2 * g1 + ap1 * g2)
@@ -1349,21 +1381,74 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
     converges on the residual, which is exact). The azimuths' cosines and sines
     are the normalised in-plane coordinates (no sin/cos of the atan2).
 
-    Phases (each its own compiled function): the frame's kinematics
+    Phases (each its own compiled function): :func:`_row_front` -- the frame's kinematics
     (:func:`_frame_kinematics`), pass 1 with the rings undeflected
     (:func:`_row_geometry`), the contacts and the condensed rings' local solves
-    (:func:`_row_contacts`), pass 2 with the forces and the Jacobian blocks of every
-    ball (:func:`_row_pass2`), the condensed rings' dense blocks
+    (:func:`_row_contacts`) -- then :func:`_row_back` -- pass 2 with the forces and the
+    Jacobian blocks of every ball (:func:`_row_pass2`), the condensed rings' dense blocks
     (:func:`_condensed_row_jacobian`)."""
-    ball_ref, geometry, state, balls = p.ball_ref, p.geometry, p.state, p.balls
+    _row_back(q, qt, p, jacobian, rec, f, jq, jv, _row_front(q, qt, p, jacobian))
+
+
+@njit(cache=True)
+def _row_front(q, qt, p, jacobian):
+    """The first phases of :func:`row_eval` (the frame's kinematics, pass 1 and the contacts
+    with the condensed rings' local solves): (A, G, entrainment speed, :data:`RowPass1`,
+    :data:`RowContacts`), for :func:`_row_back`."""
+    geometry = p.geometry
+    cond_i = p.comp_i.shape[0] > 0
+    cond_o = p.comp_o.shape[0] > 0
+    p.state[1] = 0
+    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
+    speed = geometry.speed_factor * abs(qt[5])
+    pre = _row_geometry(
+        q,
+        qt,
+        p.ball_ref,
+        geometry,
+        p.tab_i,
+        p.zsign[0],
+        p.tab_o,
+        p.zsign[1],
+        cond_i,
+        cond_o,
+        jacobian,
+        a,
+        (om0, om1, om2),
+    )
+    con = _row_contacts(
+        geometry,
+        p.zsign[0],
+        p.zsign[1],
+        p.law_i,
+        p.law_o,
+        p.comp_i,
+        p.comp_o,
+        p.ws_i,
+        p.ws_o,
+        jacobian,
+        speed,
+        pre,
+        p.state,
+    )
+    return a, g, speed, pre, con
+
+
+@njit(cache=True)
+def _row_back(q, qt, p, jacobian, rec, f, jq, jv, front):
+    """The last phases of :func:`row_eval` from :func:`_row_front`'s results ``front`` (computed
+    with a ``jacobian`` mode that allocates the same arrays: any true mode): the outputs
+    cleared, pass 2 with the forces and the Jacobian blocks, the condensed rings' dense blocks.
+    It writes only f, jq, jv, rec and the quasi-static balls' sensitivities, so one front
+    serves several modes at the same state (:func:`_ball_solve`)."""
+    a, g, speed, pre, con = front
+    geometry, balls = p.geometry, p.balls
     tab_i, tab_o, zs_i, zs_o = p.tab_i, p.tab_o, p.zsign[0], p.zsign[1]
-    law_i, law_o, comp_i, comp_o, ws_i, ws_o = p.law_i, p.law_o, p.comp_i, p.comp_o, p.ws_i, p.ws_o
     m_i = tab_i.shape[2]
     m_o = tab_o.shape[2]
-    cond_i = comp_i.shape[0] > 0
-    cond_o = comp_o.shape[0] > 0
-    state[1] = 0
-    nz = ball_ref.shape[0]
+    cond_i = p.comp_i.shape[0] > 0
+    cond_o = p.comp_o.shape[0] > 0
+    nz = p.ball_ref.shape[0]
     b0 = 6 + m_i + m_o
     f[:] = 0.0
     if jacobian == BALL_BLOCKS or jacobian == CONDENSED_BALLS:
@@ -1377,17 +1462,30 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
         else:  # block-sparse: only the x rows and columns and the balls' own 3x3 blocks are written
             _zero_written(jq, b0, nz)
             _zero_written(jv, b0, nz)
-    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
-    speed = geometry.speed_factor * abs(qt[5])
-    pre = _row_geometry(
-        q, qt, ball_ref, geometry, tab_i, zs_i, tab_o, zs_o, cond_i, cond_o, jacobian, a, (om0, om1, om2)
-    )
-    con = _row_contacts(geometry, zs_i, zs_o, law_i, law_o, comp_i, comp_o, ws_i, ws_o, jacobian, speed, pre, state)
     p2 = _row_pass2(
-        q, qt, geometry, tab_i, zs_i, tab_o, zs_o, law_i, law_o, balls, jacobian, speed, a, g, pre, con, rec, f, jq, jv
+        q,
+        qt,
+        geometry,
+        tab_i,
+        zs_i,
+        tab_o,
+        zs_o,
+        p.law_i,
+        p.law_o,
+        balls,
+        jacobian,
+        speed,
+        a,
+        g,
+        pre,
+        con,
+        rec,
+        f,
+        jq,
+        jv,
     )
     if jacobian and (cond_i or cond_o):
-        _condensed_row_jacobian(law_i, law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
+        _condensed_row_jacobian(p.law_i, p.law_o, speed, b0, 6 + m_i, con, p2, jq, jv)
 
 
 @njit(cache=True)
@@ -1477,7 +1575,17 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     ~3e-9 N, the round-off of 111 N loads on rv221). ``f`` (n,): the row's forces
     and ``rec`` (Z, N_RECORD, or (0, N_RECORD): none) its per-ball records at the
     last evaluation (at the returned balls and velocities). Returns the number of
-    Newton steps (-1: not converged in ``max_iter``)."""
+    Newton steps (-1: not converged in ``max_iter``). :func:`_ball_solve` with no Jacobian."""
+    empty = np.empty((0, 0))
+    return _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, empty, empty)
+
+
+@njit(cache=True)
+def _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, kx, cx):
+    """:func:`ball_equilibrium`, and with kx, cx of shape (nx, nx) (else (0, 0)) the condensed
+    Jacobians of the returned balls (:func:`row_eval`'s CONDENSED_BALLS mode) from the last
+    evaluation's geometry and contacts (:func:`_row_back` on the same :func:`_row_front`):
+    the contacts are evaluated once at the solution, not again for the Jacobian."""
     nz = p.ball_ref.shape[0]
     b0 = q.shape[0] - 3 * nz
     recs = rec if rec.shape[0] == nz else np.empty((nz, N_RECORD))
@@ -1486,7 +1594,8 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        row_eval(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv)
+        front = _row_front(q, qt, p, BALL_BLOCKS)
+        _row_back(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv, front)
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1509,7 +1618,10 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
                 step[j, off + 2] = -(adj[2, 0] * r0 + adj[2, 1] * r1 + adj[2, 2] * r2) / det
             for c in range(3):
                 dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
-        if err <= atol and dv <= vtol:
+        done = err <= atol and dv <= vtol
+        if (done or it == max_iter) and kx.shape[0] > 0:
+            _row_back(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx, front)
+        if done:
             return it
         if it == max_iter:
             break
@@ -1518,6 +1630,71 @@ def ball_equilibrium(q, qt, p, tol, max_iter, f, kbb, rec):
                 q[b0 + 3 * j + c] += step[j, c]
                 qt[b0 + 3 * j + c] = step[j, 3 + c]
     return -1
+
+
+@njit(cache=True, inline="always")
+def _condense_rigid_ball(
+    k_i, d_i, k_o, d_o, t, etx, ety, cage_arm, geometry, gain_i, gain_o, n_i, n_o, kx, cx, s_ball, inv, tm
+):
+    """:func:`_condense_ball` of one quasi-static ball between rigid rings, from its blocks
+    without the (9 x 9) square: with the inner contact's K_i, D_i and T (3 x 6) the frame's
+    blocks are J_xx = A T, J_xb = -A, V_xx = B T - (A d_i) e_5^T, V_xb = -B (A = T^T K_i,
+    B = T^T D_i, d_i the inner film-speed displacement gain_i n_i); the ball's J_bb = K_i + K_o
+    + K_cage, J_bx = -K_i T + k_c r c e_5^T, V_bb = D_i + D_o - c_c e_t e_t^T, V_bx = -D_i T +
+    (c_c r c + K_i d_i + K_o d_o) e_5^T (r c = ``cage_arm``: the ball's radius times the cage
+    ratio). Then kx += A (T - S) and cx += B (T - S) - (A d_i) e_5^T + A J_bb^-1 (V_bx + V_bb S)
+    with S = -J_bb^-1 J_bx (into ``s_ball``): :func:`_condense_ball`'s sums, the same products
+    of the same blocks regrouped (tests/test_model_flexible_bearing.py compares the two)."""
+    cage_k, cage_c, pocket_k = geometry.cage_stiffness, geometry.cage_damping, geometry.pocket_stiffness
+    et = (etx, ety, 0.0)
+    jbb = np.empty((3, 3))
+    vbb = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            ee = et[r] * et[c]
+            eye = 1.0 if r == c else 0.0
+            jbb[r, c] = k_i[r, c] + k_o[r, c] - cage_k * ee - pocket_k * (eye - ee)
+            vbb[r, c] = d_i[r, c] + d_o[r, c] - cage_c * ee
+    det = adjugate3(jbb, inv)
+    for r in range(3):
+        for c in range(3):
+            inv[r, c] /= det
+    c5k = np.empty(3)  # the ball's column 5 of J_bx and V_bx
+    c5v = np.empty(3)
+    for r in range(3):
+        kd_i = gain_i * (k_i[r, 0] * n_i[0] + k_i[r, 1] * n_i[1] + k_i[r, 2] * n_i[2])
+        kd_o = gain_o * (k_o[r, 0] * n_o[0] + k_o[r, 1] * n_o[1] + k_o[r, 2] * n_o[2])
+        c5k[r] = cage_k * cage_arm * et[r]
+        c5v[r] = cage_c * cage_arm * et[r] + kd_i + kd_o
+    jbx = np.empty((3, 6))
+    vbx = np.empty((3, 6))
+    for r in range(3):
+        for c in range(6):
+            jbx[r, c] = -(k_i[r, 0] * t[0, c] + k_i[r, 1] * t[1, c] + k_i[r, 2] * t[2, c])
+            vbx[r, c] = -(d_i[r, 0] * t[0, c] + d_i[r, 1] * t[1, c] + d_i[r, 2] * t[2, c])
+        jbx[r, 5] += c5k[r]
+        vbx[r, 5] += c5v[r]
+    for r in range(3):  # S = -J_bb^-1 J_bx
+        for c in range(6):
+            s_ball[r, c] = -(inv[r, 0] * jbx[0, c] + inv[r, 1] * jbx[1, c] + inv[r, 2] * jbx[2, c])
+    for c in range(6):  # Tm = J_bb^-1 (V_bx + V_bb S)
+        w0 = vbx[0, c] + vbb[0, 0] * s_ball[0, c] + vbb[0, 1] * s_ball[1, c] + vbb[0, 2] * s_ball[2, c]
+        w1 = vbx[1, c] + vbb[1, 0] * s_ball[0, c] + vbb[1, 1] * s_ball[1, c] + vbb[1, 2] * s_ball[2, c]
+        w2 = vbx[2, c] + vbb[2, 0] * s_ball[0, c] + vbb[2, 1] * s_ball[1, c] + vbb[2, 2] * s_ball[2, c]
+        for r in range(3):
+            tm[r, c] = inv[r, 0] * w0 + inv[r, 1] * w1 + inv[r, 2] * w2
+    for r in range(6):
+        a0 = t[0, r] * k_i[0, 0] + t[1, r] * k_i[1, 0] + t[2, r] * k_i[2, 0]  # A = T^T K_i, row r
+        a1 = t[0, r] * k_i[0, 1] + t[1, r] * k_i[1, 1] + t[2, r] * k_i[2, 1]
+        a2 = t[0, r] * k_i[0, 2] + t[1, r] * k_i[1, 2] + t[2, r] * k_i[2, 2]
+        v0 = t[0, r] * d_i[0, 0] + t[1, r] * d_i[1, 0] + t[2, r] * d_i[2, 0]  # B = T^T D_i, row r
+        v1 = t[0, r] * d_i[0, 1] + t[1, r] * d_i[1, 1] + t[2, r] * d_i[2, 1]
+        v2 = t[0, r] * d_i[0, 2] + t[1, r] * d_i[1, 2] + t[2, r] * d_i[2, 2]
+        for c in range(6):
+            e0, e1, e2 = t[0, c] - s_ball[0, c], t[1, c] - s_ball[1, c], t[2, c] - s_ball[2, c]
+            kx[r, c] += a0 * e0 + a1 * e1 + a2 * e2
+            cx[r, c] += v0 * e0 + v1 * e1 + v2 * e2 + a0 * tm[0, c] + a1 * tm[1, c] + a2 * tm[2, c]
+        cx[r, 5] -= gain_i * (a0 * n_i[0] + a1 * n_i[1] + a2 * n_i[2])  # -(A d_i) e_5^T
 
 
 @njit(cache=True)
@@ -1627,8 +1804,8 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
     failure is counted in state[4], flagged in state[5] and not stored). Out: f[:nx]
     the force on x (f (n,) work), the per-ball records ``rec`` and, with
     ``jacobian``, the condensed Jacobians kx, cx (nx, nx) (:func:`row_eval`'s
-    CONDENSED_BALLS mode), whose S is stored. A
-    Jacobian call at the state of the last solution (Exudyn's usual order) reuses
+    CONDENSED_BALLS mode, from the solve's last evaluation: :func:`_ball_solve`), whose S is
+    stored. A Jacobian call at the state of the last solution (Exudyn's usual order) reuses
     it without a new solve (f and rec are then not written). kbb (3Z, 4): work."""
     geometry, state = p.geometry, p.state
     nz = p.ball_ref.shape[0]
@@ -1647,13 +1824,15 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
             qt[nx + e] = bt[e]
     else:
         _predict_balls(q, qt, p.ball_ref, geometry.cage_ratio, b, bt, sm, xl, xtl)
+        kxs = kx if jacobian else np.empty((0, 0))  # (the solve's last evaluation gives the Jacobians)
+        cxs = cx if jacobian else np.empty((0, 0))
         its = -1
         for attempt in range(2):
             if attempt == 1:  # once more from the last solution
                 for e in range(nb):
                     q[nx + e] = b[e]
                     qt[nx + e] = bt[e]
-            its = ball_equilibrium(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec)
+            its = _ball_solve(q, qt, p, geometry.ball_force_tol, BALL_MAXIT, f, kbb, rec, kxs, cxs)
             if its >= 0:
                 break
         state[5] = 0
@@ -1666,6 +1845,7 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
                 xl[c] = q[c]
                 xtl[c] = qt[c]
             flag[0] = 1.0
+        return
     if jacobian:
         row_eval(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
 
