@@ -166,6 +166,23 @@ def test_foot_point_prediction_is_third_order_in_the_pin_motion():
     assert errs[1e-6] <= 3e-3 * errs[1e-5], errs
 
 
+def _skips_only_open_pins(g, p, idx, q, v, got):
+    """(skipped mask, exact evaluation) after asserting that ``got`` (an evaluation of
+    ``g`` that skipped pins by a bound) has the forces of an exact evaluation of every pin
+    (a fresh element, history pack: no skips) to 1e-10 of the largest, skipped >= 10 pins,
+    and that every skipped pin is open in the exact evaluation."""
+    from flexrv.model.pins import PinContacts
+
+    skipped = np.isnan(g.curv[..., 0])
+    ref = PinContacts(p)
+    exact = _evaluate(ref, ref.pack(idx, history=True), q, v)
+    fmax = np.abs(exact["force"]).max()
+    assert fmax > 0.0 and skipped.sum() >= 10
+    assert np.abs(got["force"] - exact["force"]).max() <= 1e-10 * fmax
+    assert np.all(exact["force"][skipped] == 0.0)
+    return skipped, exact
+
+
 def test_chained_open_pin_bound_skips_only_open_pins_and_keeps_the_forces():
     """The pin kernel's chained bound (flexrv.model.pins.pin_kernel: the last lower bound of
     the gap less the largest motion of any pin relative to the disc since the disc's last
@@ -187,13 +204,7 @@ def test_chained_open_pin_bound_skips_only_open_pins_and_keeps_the_forces():
         q[0::3] += 1e-8
         q[2::3] += 1e-7
         got = _evaluate(g, pack, q, v)
-    skipped = np.isnan(g.curv[..., 0])
-    ref = PinContacts(p)
-    exact = _evaluate(ref, ref.pack(idx, history=True), q, v)
-    fmax = np.abs(exact["force"]).max()
-    assert skipped.sum() >= 10 and fmax > 0.0
-    assert np.abs(got["force"] - exact["force"]).max() <= 1e-10 * fmax
-    assert np.all(exact["force"][skipped] == 0.0)
+    skipped, exact = _skips_only_open_pins(g, p, idx, q, v, got)
     assert np.all(got["gap"][skipped] > 0.0) and np.all(got["gap"][skipped] <= exact["gap"][skipped])
     assert np.array_equal(g.last[..., SLACK][skipped], got["gap"][skipped])
     # the direct bound from the last exact evaluation, recomputed here: the chained ones lie below it
@@ -281,13 +292,7 @@ def test_tangent_ball_bound_skips_only_open_pins_over_a_steps_motion():
         q[1::3] -= 0.5e-5
         q[2::3] += 3e-5
         got = _evaluate(g, pack, q, v)
-        skipped = np.isnan(g.curv[..., 0])
-        ref = PinContacts(p)
-        exact = _evaluate(ref, ref.pack(idx, history=True), q, v)
-        fmax = np.abs(exact["force"]).max()
-        assert fmax > 0.0 and skipped.sum() >= 10
-        assert np.abs(got["force"] - exact["force"]).max() <= 1e-10 * fmax
-        assert np.all(exact["force"][skipped] == 0.0)
+        skipped, exact = _skips_only_open_pins(g, p, idx, q, v, got)
         assert np.all(got["gap"][skipped] > 0.0) and np.all(got["gap"][skipped] <= exact["gap"][skipped] + 1e-15)
     # the 1-Lipschitz bound from the first exact evaluation, at the final pose, for the pins skipped since
     never = np.all(g.last[..., 1:3] == p0, axis=-1)
