@@ -126,6 +126,22 @@ Newton iteration, and the foot point's half-lobe test needs no arctangent
 (:func:`flexrv.geometry.cycloid._foot_point`). Measured per element and time step
 in ``benchmarks/bench_rigid.py`` (docs/integrator.md, "The kernel's inner solves").
 
+Skipping open pins (exact for the forces; :func:`_pins_at`): with the harmonics at their
+worst the gap is at least s(P) + r_nom + dr_rp - r_i - sum|A|, s(P) the pin centre's signed
+distance from the pin-centre curve, and s is at least rho - |P - O| for the empty tangent
+ball (centre O, radius rho) at the foot point of the last exact evaluation
+(:func:`_ball_record`: near contact the bound loses only the motion towards the profile and
+the tangential motion's square over 2 rho, where the 1-Lipschitz bound g0 - |P - P0| loses
+the whole motion; a pin open before and not proved open by it is tried against the ball at
+its predicted foot point, :func:`_ball_predicted`). A pin whose bound is positive carries no
+force (and no Jacobian); its closest point is not recomputed and out_gap holds the bound.
+last[kd, i] holds g0, P0, the foot point's derivatives (:data:`GRAD`, :data:`HESS`,
+:func:`_pin_foot`) and the ball (:data:`BALL`) of the last exact evaluation and the last
+lower bound at the disc's pose of the last evaluation (:data:`SLACK`, ``pose``): s is
+1-Lipschitz and no pin moved relative to the disc by more than |c - c0| + (max|pin| + |c0|)
+|psi - psi0| since, so that bound less this motion is tried first (no rotation, no root;
+never above the ball's bound, |P - O| being 1-Lipschitz in P, so the same pins are solved).
+
 One compiled kernel (:func:`pin_kernel`, numba) is the only executor: the group's
 evaluate/jacobian and the model's fused element call it. Solver calls skip pins
 that are provably open (see :func:`pin_kernel`; exact for forces and Jacobians);
@@ -300,40 +316,12 @@ def _pins_at(q, v, f, jq, jv, jac, pack, idx):
     restart every ``control.restart_every`` calls), ``failures`` the closest-point
     failures; ``control.skip_open`` allows skipping pins that are provably open.
 
-    Skipping (exact for the forces): with the harmonics at their worst the gap is at least s(P)
-    + r_nom + dr_rp - r_i - sum|A|, s(P) the pin centre's signed distance from the pin-centre
-    curve, and s is at least rho - |P - O| for the empty tangent ball (centre O, radius rho) at
-    the foot point of the last exact evaluation (:func:`_ball_record`: near contact the bound
-    loses only the motion towards the profile and the tangential motion's square over 2 rho,
-    where the 1-Lipschitz bound g0 - |P - P0| loses the whole motion; a pin open before and not
-    proved open by it is tried against the ball at its predicted foot point,
-    :func:`_ball_predicted`). A pin whose bound is positive carries no force (and no Jacobian);
-    its closest point is not recomputed and out_gap holds the bound. last[kd, i] holds g0, P0,
-    the foot point's derivatives (:data:`GRAD`, :data:`HESS`, :func:`_pin_foot`) and the ball
-    (:data:`BALL`) of the last exact evaluation and the last lower bound at the disc's pose of
-    the last evaluation (:data:`SLACK`, ``pose``): s is 1-Lipschitz and no pin moved relative to
-    the disc by more than |c - c0| + (max|pin| + |c0|) |psi - psi0| since, so that bound less
-    this motion is tried first (no rotation, no root; never above the ball's bound, |P - O|
-    being 1-Lipschitz in P, so the same pins are solved). Friction (module docstring): law.mu,
+    Skipping: the module docstring ("Skipping open pins"). Friction (module docstring): law.mu,
     law.v_reg; per (disc, pin) the friction force on the disc along t = z x n into out_ft and
     its power f_t v_t (<= 0) into out_pw."""
-    law, pins, radii, profile, harm, last = (
-        pack.law,
-        pack.pins,
-        pack.radii,
-        pack.profile,
-        pack.harm,
-        pack.last,
-    )
-    out_gap, out_f, out_nx, out_ny, out_rxn, out_ft, out_pw = (
-        pack.gap,
-        pack.force,
-        pack.nx,
-        pack.ny,
-        pack.rxn,
-        pack.ft,
-        pack.pw,
-    )
+    law, pins, radii, profile, harm, last = pack.law, pack.pins, pack.radii, pack.profile, pack.harm, pack.last
+    out_gap, out_f, out_nx, out_ny = pack.gap, pack.force, pack.nx, pack.ny
+    out_rxn, out_ft, out_pw = pack.rxn, pack.ft, pack.pw
     R_p, r_nom = law.pin_circle_radius, law.pin_radius
     k, expo, c_max, depth = law.k, law.exponent, law.c_max, law.depth
     mu, v_reg = law.mu, law.v_reg  # friction: effective coefficient, regularisation speed
