@@ -3,11 +3,11 @@
 in one session; with ``--elements``, the force kernel's cost per step by element in both.
 
 Run:  python benchmarks/bench_integrator_baseline.py --baseline DIR [--presets rv40e rv221]
-      [--t-end 0.2] [--repeat 2] [--elements]
+      [--t-end 0.2] [--repeat 2] [--model rigid|balls|flexible] [--elements]
 
 ``DIR`` is a checkout of the earlier code (e.g. ``git worktree add --detach /tmp/base REV``);
 its numba cache is warmed by a first untimed run. Per preset and repeat, three children run
-the rigid model from rated speed (ramps shortened to 5 ms, as ``_shared.quick_ramps``) for
+the model (``--model``, default rigid) from rated speed (ramps shortened to 5 ms, as ``_shared.quick_ramps``) for
 ``--t-end`` simulated seconds after a 2 ms warm-up run in the same process:
 
 * ``baseline exudyn``: ``DIR``'s flexrv, Exudyn's integrator (its only one);
@@ -33,17 +33,17 @@ from pathlib import Path
 import numpy as np
 from _shared import ROOT
 
-#: the child's program: argv = preset, t_end, integrator ("" for the checkout's default path)
+#: the child's program: argv = preset, t_end, integrator ("" for the checkout's default path), model
 _CHILD = r"""
 import inspect, json, sys
 import numpy as np
 from flexrv.design import load
 from flexrv.simulation import Simulation
 
-name, t_end, integ = sys.argv[1], float(sys.argv[2]), sys.argv[3]
+name, t_end, integ, model = sys.argv[1], float(sys.argv[2]), sys.argv[3], sys.argv[4]
 r = load(name)
 op = r.operating.model_copy(update={"speed_ramp_time_s": 0.005, "load_ramp_start_s": 0.0, "load_ramp_end_s": 0.005})
-sim = Simulation(r.model_copy(update={"operating": op}))
+sim = Simulation(r.model_copy(update={"operating": op}), model=model)
 kw = {"checkpoint_s": None}
 if integ:
     kw["integrator"] = integ
@@ -99,10 +99,12 @@ print("RESULT " + json.dumps(out))
 """
 
 
-def _child(checkout: Path, preset: str, t_end: float, integ: str, cwd: str, program: str = _CHILD) -> dict:
+def _child(
+    checkout: Path, preset: str, t_end: float, integ: str, cwd: str, program: str = _CHILD, model: str = "rigid"
+) -> dict:
     env = dict(os.environ, PYTHONPATH=str(checkout), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     out = subprocess.run(
-        [sys.executable, "-c", program, preset, str(t_end), integ],
+        [sys.executable, "-c", program, preset, str(t_end), integ, model],
         cwd=cwd,
         env=env,
         capture_output=True,
@@ -139,6 +141,7 @@ def main() -> None:
     ap.add_argument("--presets", nargs="+", default=["rv40e", "rv221"])
     ap.add_argument("--t-end", type=float, default=0.2)
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--model", default="rigid", help="rigid, balls or flexible (not with --elements)")
     ap.add_argument("--elements", action="store_true", help="the kernel's cost per step by element")
     args = ap.parse_args()
     if args.elements:
@@ -152,17 +155,17 @@ def main() -> None:
     cwd = tempfile.mkdtemp(prefix="flexrv_bench_")
     for preset in args.presets:
         for _, checkout, integ in runs:  # (numba caches warm, bodies built)
-            _child(checkout, preset, 0.003, integ, cwd)
+            _child(checkout, preset, 0.003, integ, cwd, model=args.model)
         best: dict[str, dict] = {}
         for _ in range(args.repeat):
             for label, checkout, integ in runs:
-                r = _child(checkout, preset, args.t_end, integ, cwd)
+                r = _child(checkout, preset, args.t_end, integ, cwd, model=args.model)
                 r["cpus"] = [r["cpu"], *best.get(label, {}).get("cpus", [])]
                 if label not in best or r["cpu"] < best[label]["cpu"]:
                     best[label] = r
                 else:
                     best[label]["cpus"] = r["cpus"]
-        print(f"\n{preset}: rigid model, t_end {args.t_end:g} s")
+        print(f"\n{preset}: {args.model} model, t_end {args.t_end:g} s")
         for label, r in best.items():
             spread = ", ".join(f"{x / args.t_end:.3f}" for x in sorted(r["cpus"]))
             print(
