@@ -62,36 +62,17 @@ print("RESULT " + json.dumps({"cpu": tm["solve_cpu_s"], "steps": tm["steps"],
 
 #: the ``--elements`` child: argv = preset, t_end, folder of this checkout's benchmarks
 _ELEMENTS = r"""
-import inspect, json, sys
-import numpy as np
+import json, sys
 sys.path.insert(0, sys.argv[3])
 from _shared import quick_ramps
-from bench_rigid import _replay_costs
+from bench_rigid import _record_calls, _replay_costs
 from flexrv.simulation import Simulation
 
-name, t_end = sys.argv[1], float(sys.argv[2])
-sim = Simulation(quick_ramps(name))
+sim = Simulation(quick_ramps(sys.argv[1]))
 model = sim.build()
-fused = model.fused
-kw = {"checkpoint_s": None}
-if "integrator" in inspect.signature(sim.run).parameters:
-    kw["integrator"] = "exudyn"
-sim.run(t_end=0.002, **kw)
-seq = {"t": [], "q": [], "v": [], "jac": []}
-orig = fused._call
-def rec(t, q, v, jac):
-    seq["t"].append(float(t)); seq["q"].append(np.array(q, dtype=float))
-    seq["v"].append(np.array(v, dtype=float)); seq["jac"].append(bool(jac))
-    return orig(t, q, v, jac)
-fused._call = rec
-sim.run(t_end=t_end, **kw)
-del fused._call
-seq = {k: np.array(v) for k, v in seq.items()}
-if not fused.is_full:
-    seq["q"], seq["v"] = seq["q"][:, fused.index], seq["v"][:, fused.index]
-steps = sim.timing["steps"]
+seq = _record_calls(sim, float(sys.argv[2]))
+steps, calls = seq["steps"], len(seq["t"])
 costs = _replay_costs(model, seq)
-calls = len(seq["t"])
 out = {k: v / steps for k, v in costs.items() if k != "pin_evaluations"}
 out["pin evaluations per call"] = costs.get("pin_evaluations", 0) / calls
 out["calls per step"] = calls / steps

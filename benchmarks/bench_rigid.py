@@ -31,6 +31,7 @@ One-time numba compilation/loading is done before timing (a 20-step run of each 
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
 import time
 
@@ -57,7 +58,9 @@ def _record_calls(sim, t_end: float) -> dict:
 
     fused._call = rec
     try:
-        res = sim.run(t_end=t_end, integrator="exudyn", checkpoint_s=None)
+        # (a checkout older than the compiled integrator has only Exudyn's: bench_integrator_baseline.py)
+        only = "integrator" not in inspect.signature(sim.run).parameters
+        res = sim.run(t_end=t_end, checkpoint_s=None, **({} if only else {"integrator": "exudyn"}))
     finally:
         del fused._call
     out = {k: np.array(v) for k, v in seq.items()}
