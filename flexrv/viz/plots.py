@@ -393,14 +393,18 @@ def plot_hysteresis(angle_arcmin, torque, path, title: str = "torsional hysteres
 
 
 def standard_plots(res, directory=None) -> list[Path]:
-    """TE, speeds, pin forces and TE spectrum PNGs into ``directory`` (default cwd)."""
+    """TE, speeds, pin forces and TE spectrum PNGs into ``directory`` (default cwd), the
+    cyclic collector paused meanwhile (:func:`flexrv.post.io.collector_paused`)."""
+    from flexrv.post.io import collector_paused
+
     d = Path(directory) if directory is not None else Path.cwd()
     d.mkdir(parents=True, exist_ok=True)
-    paths = [plot_te(res, d / "te.png"), plot_speeds(res, d / "speeds.png")]
-    if "pin_force" in res.ds:
-        paths.append(plot_pin_forces(res, d / "pin_forces.png"))
-    if res.steady("te").size > 16 and float(np.abs(res["omega_in"].values).max()) > 0:
-        paths.append(plot_te_spectrum(res, d / "te_spectrum.png"))
+    with collector_paused():
+        paths = [plot_te(res, d / "te.png"), plot_speeds(res, d / "speeds.png")]
+        if "pin_force" in res.ds:
+            paths.append(plot_pin_forces(res, d / "pin_forces.png"))
+        if res.steady("te").size > 16 and float(np.abs(res["omega_in"].values).max()) > 0:
+            paths.append(plot_te_spectrum(res, d / "te_spectrum.png"))
     return paths
 
 

@@ -210,11 +210,15 @@ def plot_pin_force_map(ds, path) -> Path:
 
 
 def te_plots(ds, summary: dict, directory) -> list[Path]:
-    """All three plots into ``directory``."""
+    """All three plots into ``directory`` (the cyclic collector paused meanwhile:
+    :func:`flexrv.post.io.collector_paused`)."""
+    from flexrv.post.io import collector_paused
+
     d = Path(directory)
     spectrum = summary.get("spectral_resolution_orders") is not None  # a run too short has none
-    return [
-        plot_te_curve(ds, d / "te.png"),
-        *([plot_te_spectrum(ds, summary, d / "te_spectrum.png")] if spectrum else []),
-        plot_pin_force_map(ds, d / "pin_forces.png"),
-    ]
+    with collector_paused():
+        return [
+            plot_te_curve(ds, d / "te.png"),
+            *([plot_te_spectrum(ds, summary, d / "te_spectrum.png")] if spectrum else []),
+            plot_pin_force_map(ds, d / "pin_forces.png"),
+        ]
