@@ -88,19 +88,22 @@ TITLE_Y = 1.0
 LAYOUT_MARGINS_IN = {"left": 0.9, "bottom": 0.58, "title": 0.36, "edge": 0.15}
 
 
-def _fixed_layout(fig, *, left=None, right=None, bottom=None, top=None, hspace=None) -> None:
-    """Place the subplots of ``fig`` with margins given in inches (default
-    :data:`LAYOUT_MARGINS_IN`, no title), so the layout follows from the figure's size: the
-    same room for the labels on every figure of a kind, computed without drawing. matplotlib's
-    ``tight_layout`` measures every tick label and title first, which costs an extra pass over
-    the ticks (a fifth to a quarter of such a figure's drawing)."""
+def _fixed_layout(fig, *, left=None, right=None, bottom=None, top=None, gap=None) -> None:
+    """Place the subplots of ``fig`` with margins and the gap between rows given in inches
+    (default :data:`LAYOUT_MARGINS_IN`, no title), so the layout follows from the figure's size:
+    the same room for the labels on every figure of a kind, computed without drawing.
+    matplotlib's ``tight_layout`` measures every tick label and title first, which costs an
+    extra pass over the ticks (a fifth to a quarter of such a figure's drawing)."""
     m = LAYOUT_MARGINS_IN
     w, h = fig.get_size_inches()
     left = m["left"] if left is None else left
     right = m["edge"] if right is None else right
     bottom = m["bottom"] if bottom is None else bottom
     top = m["edge"] if top is None else top
-    kw = {} if hspace is None else {"hspace": hspace}
+    kw = {}
+    if gap is not None:  # matplotlib's hspace: the gap over the mean height of a row's axes
+        rows = fig.axes[0].get_subplotspec().get_gridspec().nrows if fig.axes else 1
+        kw["hspace"] = gap * rows / max(h - top - bottom - (rows - 1) * gap, 1e-9)
     fig.subplots_adjust(left=left / w, right=1.0 - right / w, bottom=bottom / h, top=1.0 - top / h, **kw)
 
 
@@ -134,7 +137,7 @@ def plot_speeds(res, path) -> Path:
     axes[1].set_ylabel("speed [r/min]")
     axes[1].set_xlabel("time [s]")
     axes[1].legend(loc="best")
-    _fixed_layout(fig, hspace=0.1)
+    _fixed_layout(fig, gap=0.2)
     return _save(fig, Path(path))
 
 
