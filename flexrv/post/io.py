@@ -211,7 +211,7 @@ def _write_netcdf4(ds, path) -> None:
     dimensions' scales; the file's attributes and ``_NCProperties`` (who wrote it)."""
     import h5py
 
-    from flexrv import __version__
+    from flexrv._version import __version__
 
     dimids: dict[str, int] = {}
     for var in ds.variables.values():
