@@ -106,9 +106,10 @@ def collector_paused():
     still frees everything that is not in a cycle); afterwards it runs as before and collects
     the block's cycles with its next young-generation pass. Writing figures and NetCDF files
     makes tens of thousands of short-lived container objects (matplotlib artists, ticks,
-    transforms; h5py handles), which trigger full collections: each one walks the whole heap
-    of a process that has imported numba, Exudyn and scipy (~2e5 objects), ~0.1 s a pass, for
-    no garbage of the process's own. A block inside another one (or with the collector
+    transforms; h5py handles), which under Python's default thresholds (a notebook, a script;
+    the CLI raises them) trigger full collections: each one walks the whole heap of a process
+    that has imported numba, Exudyn and scipy (~2e5 objects), ~0.1 s a pass, for no garbage of
+    the process's own. A block inside another one (or with the collector
     switched off by the caller) leaves the collector as it found it."""
     if not gc.isenabled():
         yield
