@@ -2,7 +2,7 @@
 --t-end 0.4`` goes, as whole processes: imports, design, model build, the computation
 itself, outputs, files, figures.
 
-    python benchmarks/bench_startup.py [--only te|simulate] [--checkout DIR ...] [--repeat N]
+    python benchmarks/bench_startup.py [--only te|simulate] [--checkout DIR ...] [--repeat N] [--in-process RUNS]
 
 Each command runs in a child process twice per checkout (``--checkout``, default this one;
 give several, e.g. ``--checkout /path/to/main --checkout .``, to pair them in one session,
@@ -14,7 +14,9 @@ interpreter, the imports done outside the phases and the CLI's own glue. The cac
 be warm (run each command once before); one unmeasured run per checkout and command compiles
 the modules' bytecode (into a folder outside the checkouts, as an installed package has it).
 The floor (the CPU of ``python -c`` programs that only import the libraries and load one
-cached numba kernel) is printed last.
+cached numba kernel) is printed last. ``--in-process RUNS`` instead runs each command RUNS times in
+one process (the instrumented driver, per checkout, alternating) and prints every run's CPU and wall
+and the last run's phases: what a warm process (a notebook, a study calling the CLI) pays per command.
 
 Ratios (the goals, paired in one process):
 
@@ -76,8 +78,9 @@ PHASES = {
     ],
 }
 
-#: the child's driver: wraps the phase functions when their modules are imported, runs the CLI,
-#: writes {phase: [cpu, wall]}, the curves' CPU and the solve wall to the file FLEXRV_BENCH_OUT
+#: the child's driver: wraps the phase functions when their modules are imported, runs the CLI
+#: FLEXRV_BENCH_RUNS times in the one process, writes the last run's {phase: [cpu, wall]}, curves' CPU and
+#: solve wall, and every run's [cpu, wall], to the file FLEXRV_BENCH_OUT
 DRIVER = r"""
 import functools, importlib.machinery, json, os, sys, time
 T0, W0 = time.process_time(), time.perf_counter()
@@ -137,13 +140,19 @@ class Hook:
 
 sys.meta_path.insert(0, Hook())
 from flexrv.cli import main
-code = 0
-try:
-    main(sys.argv[1:])
-except SystemExit as exc:
-    code = exc.code or 0
+code, runs = 0, []
+for _ in range(int(os.environ.get("FLEXRV_BENCH_RUNS", "1"))):
+    acc.clear(); del curves[:], solve[:]
+    c0, w0 = time.process_time(), time.perf_counter()
+    try:
+        main(sys.argv[1:])
+    except SystemExit as exc:
+        code = exc.code or 0
+    runs.append([time.process_time() - c0, time.perf_counter() - w0])
+    if code:
+        break
 out = {"phases": acc, "cpu": time.process_time() - T0, "wall": time.perf_counter() - W0,
-       "curves_cpu": curves, "solve_wall": solve, "code": code}
+       "curves_cpu": curves, "solve_wall": solve, "code": code, "runs": runs}
 with open(os.environ["FLEXRV_BENCH_OUT"], "w") as f:
     json.dump(out, f)
 sys.exit(code)
@@ -215,11 +224,17 @@ def plain(checkout: str, args: list[str], out: str) -> dict:
     return {"wall": wall, "cpu": cpu, "solve_wall": data.get("wall_time_s")}
 
 
-def instrumented(checkout: str, name: str, args: list[str], out: str) -> dict:
-    """The phase split of one run (the driver above)."""
+def instrumented(checkout: str, name: str, args: list[str], out: str, runs: int = 1) -> dict:
+    """The phase split of one run (the driver above); with ``runs`` > 1 the command runs that many
+    times in one process and the split is the last run's."""
     with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as f:
         path = f.name
-    env = dict(_env(checkout), FLEXRV_BENCH_OUT=path, FLEXRV_BENCH_PHASES=json.dumps(PHASES[name]))
+    env = dict(
+        _env(checkout),
+        FLEXRV_BENCH_OUT=path,
+        FLEXRV_BENCH_PHASES=json.dumps(PHASES[name]),
+        FLEXRV_BENCH_RUNS=str(runs),
+    )
     p = subprocess.run(
         [sys.executable, "-c", DRIVER, *args, "--out", out, "--overwrite"],
         env=env,
@@ -273,15 +288,50 @@ def report(name: str, checkout: str, runs: list[dict], splits: list[dict]) -> No
         )
 
 
+def in_process(name: str, checkouts: list[str], repeat: int, runs: int, tmp: str) -> None:
+    """The command run ``runs`` times in one process per checkout (a warm process: imports, bodies and
+    kernels loaded by the first run), ``repeat`` processes per checkout, alternating; prints every run's
+    CPU and wall (medians over the processes) and the last run's phase split."""
+    import statistics as st
+
+    data = {c: [] for c in checkouts}
+    for i in range(repeat):
+        for k, c in enumerate(checkouts):
+            data[c].append(instrumented(c, name, COMMANDS[name], os.path.join(tmp, f"warm-{name}-{i}-{k}"), runs))
+    labels = list(dict.fromkeys(label for label, _ in PHASES[name]))
+    for c in checkouts:
+        per_run = [
+            (st.median(d["runs"][r][0] for d in data[c]), st.median(d["runs"][r][1] for d in data[c]))
+            for r in range(runs)
+        ]
+        print(f"{name} in one process [{c}], {runs} runs (medians of {repeat} processes):")
+        print("   runs' CPU  " + "  ".join(f"{cpu:6.2f}" for cpu, _ in per_run) + " s")
+        print("   runs' wall " + "  ".join(f"{wall:6.2f}" for _, wall in per_run) + " s")
+        inside = 0.0
+        for label in labels:
+            cs = [d["phases"][label][0] for d in data[c] if label in d["phases"]]
+            if cs:
+                inside += st.median(cs)
+                print(f"   last run: {label:34s} {st.median(cs):6.3f} s CPU")
+        print(f"   last run: {'outside the phases':34s} {per_run[-1][0] - inside:6.3f} s CPU")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", choices=sorted(COMMANDS), action="append", help="measure only this command")
     ap.add_argument("--checkout", action="append", help="flexrv checkout to run (default: this one); repeatable")
     ap.add_argument("--repeat", type=int, default=1, help="plain and instrumented runs per checkout (medians)")
     ap.add_argument("--no-floor", action="store_true", help="skip the floor programs")
+    ap.add_argument(
+        "--in-process", type=int, metavar="RUNS", default=0, help="instead: each command RUNS times in one process"
+    )
     a = ap.parse_args()
     checkouts = [str(Path(c).resolve()) for c in (a.checkout or [ROOT])]
     with tempfile.TemporaryDirectory(prefix="flexrv-startup-") as tmp:
+        if a.in_process:
+            for name in a.only or list(COMMANDS):
+                in_process(name, checkouts, a.repeat, a.in_process, tmp)
+            return
         for name in a.only or list(COMMANDS):
             for c in checkouts:  # unmeasured: compiles the bytecode of the modules the command imports
                 plain(c, COMMANDS[name], os.path.join(tmp, f"warm-{name}"))

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flexrv.viz.plots import _plt, _save
+from flexrv.viz.plots import TITLE_Y, _fixed_layout, _plt, _save
 
 
 def _envelope(x: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -35,6 +35,12 @@ def _zoom_window(deg: np.ndarray, te: np.ndarray, period: float) -> tuple[float,
         if sel.sum() > 1 and np.ptp(te[sel]) > best:
             best, start = float(np.ptp(te[sel])), a
     return start, min(start + period, deg[-1])
+
+
+#: margins [in] of the TE curve (:func:`flexrv.viz.plots._fixed_layout`): the last x tick label
+#: (the end of the run, an axis limit) overhangs the right edge by half its width; a 10-12 pt
+#: title above; between the panels the upper one's x labels and the lower one's title
+_CURVE_RIGHT_IN, _CURVE_TOP_IN, _CURVE_GAP_IN = 0.25, 0.36, 0.8
 
 
 def plot_te_curve(ds, path) -> Path:
@@ -63,8 +69,8 @@ def plot_te_curve(ds, path) -> Path:
         ax.set_ylabel("TE − mean [arcsec]")
         ax.legend(loc="upper left", fontsize=8)
         ax.grid(alpha=0.3)
-        ax.set_title(f"Quasi-static transmission error, {ds.attrs['preset']}")
-        fig.tight_layout()
+        ax.set_title(f"Quasi-static transmission error, {ds.attrs['preset']}", y=TITLE_Y)
+        _fixed_layout(fig, right=_CURVE_RIGHT_IN, top=_CURVE_TOP_IN)
         return _save(fig, Path(path))
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6.4), gridspec_kw={"height_ratios": [1, 1.15]})
     bins = int(np.ceil(revolutions * 8))
@@ -82,6 +88,7 @@ def plot_te_curve(ds, path) -> Path:
         f"Quasi-static transmission error, {ds.attrs['preset']}: {revolutions:.3g} crank revolutions "
         "(min-max envelope per 1/8 crank revolution)",
         fontsize=10,
+        y=TITLE_Y,
     )
     top.legend(loc="upper left", fontsize=8, ncol=2)
     top.grid(alpha=0.3)
@@ -99,12 +106,13 @@ def plot_te_curve(ds, path) -> Path:
         f"one crank revolution, {a:.4g}–{b:.4g}° ({int(np.sum(sel))} positions"
         + ("; grey lines: pin-mesh periods)" if mesh else ")"),
         fontsize=10,
+        y=TITLE_Y,
     )
     lo_z, hi_z = float(np.nanmin(te_c[sel])), float(np.nanmax(te_c[sel]))
     bottom.set_ylim(lo_z - 0.05 * (hi_z - lo_z), hi_z + 0.3 * (hi_z - lo_z))
     bottom.legend(loc="upper right", fontsize=8, ncol=2)
     bottom.grid(alpha=0.3, axis="y")
-    fig.tight_layout()
+    _fixed_layout(fig, right=_CURVE_RIGHT_IN, top=_CURVE_TOP_IN, gap=_CURVE_GAP_IN)
     return _save(fig, Path(path))
 
 
@@ -157,7 +165,8 @@ def plot_te_spectrum(ds, summary: dict, path) -> Path:
         f"TE spectrum, {ds.attrs['preset']} (loaded, {summary['output_revolutions']:.3g} output rev., "
         f"resolution {res:.3g} order)"
         if res
-        else f"TE spectrum, {ds.attrs['preset']}"
+        else f"TE spectrum, {ds.attrs['preset']}",
+        y=TITLE_Y,
     )
     return _save(fig, Path(path))
 
@@ -202,7 +211,9 @@ def plot_pin_force_map(ds, path) -> Path:
             ax.set_ylabel(f"disc {k + 1}: pin number" if c == 0 else "")
             if k < nd - 1:
                 ax.tick_params(labelbottom=False)
-        axes[0, c].set_title("whole run" if c == 0 else f"one crank revolution, {a:.4g}–{b:.4g}°", fontsize=10)
+        axes[0, c].set_title(
+            "whole run" if c == 0 else f"one crank revolution, {a:.4g}–{b:.4g}°", fontsize=10, y=TITLE_Y
+        )
         axes[-1, c].set_xlabel("output angle [deg]")
     fig.colorbar(im, ax=axes.ravel().tolist(), label="pin force [N]", fraction=0.03, pad=0.02)
     fig.suptitle(f"Pin forces, {ds.attrs['preset']} at {ds.attrs['torque_Nm']:.4g} N m")
@@ -210,11 +221,15 @@ def plot_pin_force_map(ds, path) -> Path:
 
 
 def te_plots(ds, summary: dict, directory) -> list[Path]:
-    """All three plots into ``directory``."""
+    """All three plots into ``directory`` (the cyclic collector paused meanwhile:
+    :func:`flexrv.post.io.collector_paused`)."""
+    from flexrv.post.io import collector_paused
+
     d = Path(directory)
     spectrum = summary.get("spectral_resolution_orders") is not None  # a run too short has none
-    return [
-        plot_te_curve(ds, d / "te.png"),
-        *([plot_te_spectrum(ds, summary, d / "te_spectrum.png")] if spectrum else []),
-        plot_pin_force_map(ds, d / "pin_forces.png"),
-    ]
+    with collector_paused():
+        return [
+            plot_te_curve(ds, d / "te.png"),
+            *([plot_te_spectrum(ds, summary, d / "te_spectrum.png")] if spectrum else []),
+            plot_pin_force_map(ds, d / "pin_forces.png"),
+        ]
