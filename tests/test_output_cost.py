@@ -1,124 +1,17 @@
-"""The result files and figures of a command written at a fraction of their former cost with the
-same content: the NetCDF-4 file of the direct h5py writer (:func:`flexrv.post.io.write_netcdf`)
-against the file xarray's h5netcdf writer makes of the same dataset, object by object and
-attribute by attribute; the datasets it does not take go through xarray; the figures drawn with
-the cyclic collector paused, which frees every figure afterwards."""
+"""A command's figures and result files at less cost with the same content: the figures' pixels
+with fixed titles and the PNG settings equal matplotlib's defaults, the fixed layout keeps every
+label inside the figure near ``tight_layout``'s, and figures and files are written with the
+cyclic collector paused, which frees everything afterwards."""
 
 from __future__ import annotations
 
 import gc
-import json
 import weakref
 
-import h5py
 import numpy as np
 import pytest
-import xarray as xr
 
-from flexrv.post.io import _netcdf4_writable, collector_paused, write_netcdf
-
-
-def _ref_names(f, value):
-    """An HDF5 attribute with object references as the names of the objects they point to."""
-    if value.dtype.names == ("dataset", "dimension"):  # a dimension scale's REFERENCE_LIST
-        return sorted((f[ref].name, int(axis)) for ref, axis in value)
-    return [[f[ref].name for ref in refs] for refs in value]  # a variable's DIMENSION_LIST
-
-
-def _dump(path) -> dict:
-    """Every object of an HDF5 file: dtype, shape, maxshape, chunks, filters, fill value, values
-    (bit for bit), whether it is a dimension scale, and every attribute with its stored type
-    and shape (references resolved to names); the root's ``_NCProperties`` only as its prefix."""
-    out = {}
-    with h5py.File(path, "r") as f:
-        for name, obj in [("/", f), *((k, f[k]) for k in f)]:
-            attrs = {}
-            for key in obj.attrs:
-                aid = obj.attrs.get_id(key)
-                value = obj.attrs[key]
-                if key in ("REFERENCE_LIST", "DIMENSION_LIST"):
-                    value = _ref_names(f, value)
-                elif key == "_NCProperties":  # fixed-length ASCII text naming the writer
-                    attrs[key] = (aid.dtype.kind, aid.shape, h5py.check_string_dtype(aid.dtype).encoding, value[:10])
-                    continue
-                else:
-                    value = np.asarray(value).tolist()
-                attrs[key] = (str(aid.dtype), aid.shape, h5py.check_string_dtype(aid.dtype), repr(value))
-            entry = {"attrs": attrs}
-            if name != "/":
-                data = obj[()]
-                entry.update(
-                    dtype=str(obj.dtype),
-                    shape=obj.shape,
-                    maxshape=obj.maxshape,
-                    chunks=obj.chunks,
-                    compression=obj.compression,
-                    fill=repr(obj.fillvalue),
-                    values=data.tolist() if data.dtype.kind == "O" else data.tobytes(),
-                    scale=h5py.h5ds.is_scale(obj.id),
-                )
-            out[name] = entry
-    return out
-
-
-def _results_like() -> xr.Dataset:
-    """A dataset shaped like a run's results: an indexed time axis with units, plain dimensions
-    (crank, pin), a text coordinate, float64/float32/int64 variables of one to three dimensions with NaN, text
-    attributes (non-ASCII, JSON) and number attributes on the file and the variables."""
-    rng = np.random.default_rng(7)
-    t = np.arange(0.0, 0.05, 1e-3)
-    force = rng.random((t.size, 2, 5))
-    force[3, 1, 2] = np.nan
-    data = {
-        "te": xr.Variable(("time",), rng.normal(size=t.size), {"units": "arcsec", "long_name": "TE ″"}),
-        "crank_speed": xr.Variable(("time", "crank"), rng.normal(size=(t.size, 2)), {"units": "rad/s"}),
-        "pin_force": xr.Variable(
-            ("time", "crank", "pin"),
-            force,
-            {"units": "N", "long_name": "pin force", "summary_rows": json.dumps([["a", "N", "µ text", "max"]])},
-        ),
-        "pins_in_contact": xr.Variable(("time", "crank"), rng.integers(0, 5, (t.size, 2)), {"units": "1"}),
-        "gap": xr.Variable(("pin",), np.linspace(0, 1, 5, dtype=np.float32), {"units": "m", "scale": 2}),
-    }
-    element = np.array(["first_stage_mesh", "pins", "µ-bearing"])
-    data["share"] = xr.Variable(("element",), [20.0, 50.0, 30.0], {"units": "%"})
-    coords = {"time": ("time", t, {"units": "s", "long_name": "time"}), "element": ("element", element)}
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update({"preset": "rv40e", "dt_s": 1e-3, "steady": 1, "ratio": np.float64(81.0), "note": "α – β"})
-    return ds
-
-
-def _both(ds, tmp_path):
-    """The dataset written by write_netcdf and by xarray's h5netcdf writer."""
-    direct, reference = tmp_path / "direct.nc", tmp_path / "xarray.nc"
-    write_netcdf(ds, direct)
-    ds.to_netcdf(reference, engine="h5netcdf")
-    return direct, reference
-
-
-def _assert_same_file(direct, reference) -> None:
-    a, b = _dump(direct), _dump(reference)
-    assert list(a) == list(b)  # the same objects in the same order
-    for name in b:
-        assert a[name] == b[name], name
-    back, ref = xr.load_dataset(direct, engine="h5netcdf"), xr.load_dataset(reference, engine="h5netcdf")
-    xr.testing.assert_identical(back, ref)
-    assert list(back.variables) == list(ref.variables) and list(back.attrs) == list(ref.attrs)
-
-
-def test_netcdf_direct_writer_makes_xarrays_file(tmp_path):
-    """The direct writer's file equals xarray's h5netcdf file of the same dataset in every object
-    (order, dtype, shape, layout, fill value, values bit for bit with NaN in place, dimension
-    scales) and every attribute (stored type, shape, value; the scales' references by name);
-    read back by xarray it is identical to the dataset written. The one difference allowed is
-    the writer named in ``_NCProperties`` (its ``version=2`` prefix is compared)."""
-    ds = _results_like()
-    assert _netcdf4_writable(ds)
-    direct, reference = _both(ds, tmp_path)
-    _assert_same_file(direct, reference)
-    xr.testing.assert_identical(xr.load_dataset(direct, engine="h5netcdf"), ds)
-    with h5py.File(direct, "r") as f:
-        assert f.attrs["_NCProperties"].decode().startswith("version=2,flexrv=")
+from flexrv.post.io import collector_paused
 
 
 @pytest.fixture(scope="module")
@@ -127,44 +20,6 @@ def run():
     from flexrv.simulation import Simulation
 
     return Simulation("rv40e").run(t_end=0.02, dt=1e-4)
-
-
-def test_netcdf_direct_writer_on_a_run(tmp_path, run):
-    """A 20 ms rigid rv40e run's results (every declared output, the run's attributes) take the
-    direct writer and give xarray's file (:func:`test_netcdf_direct_writer_makes_xarrays_file`);
-    ``Results.load`` reads them back equal to the run in memory."""
-    from flexrv.post.results import Results
-
-    res = run
-    assert _netcdf4_writable(res.ds)
-    direct, reference = _both(res.ds, tmp_path)
-    _assert_same_file(direct, reference)
-    (tmp_path / "run").mkdir()
-    direct.rename(tmp_path / "run" / "results.nc")
-    back = Results.load(tmp_path / "run")
-    xr.testing.assert_identical(back.ds, res.ds)
-
-
-@pytest.mark.parametrize("case", ["date variable", "bool variable", "read from a file", "scalar", "list attribute"])
-def test_netcdf_other_datasets_go_through_xarray(tmp_path, case):
-    """Datasets the direct writer does not take (date or bool variables, a dataset carrying its
-    file's encoding, a 0-d variable, an attribute that is a list) are written by xarray and read
-    back identical to the dataset written."""
-    ds = _results_like()
-    if case == "date variable":
-        ds["stamp"] = ("pin", np.arange(5).astype("datetime64[s]").astype("datetime64[ns]"))
-    elif case == "bool variable":
-        ds["contact"] = ("pin", np.array([True, False, True, True, False]))
-    elif case == "read from a file":
-        ds.to_netcdf(tmp_path / "src.nc", engine="h5netcdf")
-        ds = xr.load_dataset(tmp_path / "src.nc", engine="h5netcdf")
-    elif case == "scalar":
-        ds["torque"] = ((), 3.0)
-    else:
-        ds.attrs["levels"] = [1.0, 2.0]
-    assert not _netcdf4_writable(ds)
-    write_netcdf(ds, tmp_path / "out.nc")
-    xr.testing.assert_identical(xr.load_dataset(tmp_path / "out.nc", engine="h5netcdf"), ds)
 
 
 def test_collector_paused_runs_no_collection_and_frees_afterwards():

@@ -136,14 +136,8 @@ def xarray_without_dask() -> None:
 
 
 def write_netcdf(ds, path) -> Path:
-    """Write ``ds`` to ``path`` atomically as NetCDF-4 (HDF5).
-
-    A dataset of numeric variables on dimensions that are either plain or indexed by their own
-    one-dimensional coordinate, with text and number attributes and no encoding of its own (what
-    flexrv builds) is written by :func:`_write_netcdf4` with h5py: the file xarray's h5netcdf
-    writer makes (variables, dimensions, attributes, fill values, values), without that writer's
-    per-variable bookkeeping (a dozen HDF5 look-ups per variable, ~4 ms each variable). Any other
-    dataset goes through xarray (``engine="h5netcdf"``).
+    """Write ``ds`` to ``path`` atomically (NetCDF4 via h5netcdf), with the cyclic collector
+    paused (:func:`collector_paused`).
 
     xarray's writer asks dask for the active scheduler to choose its file lock, importing
     ``dask.base`` and ``distributed`` (~0.5 s CPU together). A process that has imported
@@ -151,107 +145,9 @@ def write_netcdf(ds, path) -> Path:
     default (the threaded lock) either way: a module not imported yet is hidden from that probe
     (:func:`_modules_hidden`)."""
     path = Path(path)
-    direct = _netcdf4_writable(ds)
     with collector_paused(), _modules_hidden(("dask", "dask.base", "distributed")), atomic_path(path) as tmp:
-        if direct:
-            _write_netcdf4(ds, tmp)
-        else:
-            ds.to_netcdf(tmp, engine="h5netcdf")
+        ds.to_netcdf(tmp, engine="h5netcdf")
     return path
-
-
-#: the HDF5 dimension-scale name of a dimension without a coordinate variable (the NetCDF-4 convention)
-_NOT_A_VARIABLE = b"This is a netCDF dimension but not a netCDF variable."
-
-#: attribute names the NetCDF-4 layout or xarray's encoding own
-_RESERVED_ATTRS = frozenset(
-    {"_FillValue", "missing_value", "_Netcdf4Dimid", "_Netcdf4Coordinates", "_NCProperties", "CLASS", "NAME"}
-    | {"REFERENCE_LIST", "DIMENSION_LIST", "coordinates", "dtype", "scale_factor", "add_offset", "calendar"}
-)
-
-
-def _plain_attrs(attrs) -> bool:
-    """True if every attribute is text or a real number (not a bool) under a name of its own."""
-    for key, value in attrs.items():
-        if not isinstance(key, str) or key in _RESERVED_ATTRS or isinstance(value, (bool, np.bool_)):
-            return False
-        if not isinstance(value, (str, int, float, np.integer, np.floating)):
-            return False
-    return True
-
-
-def _netcdf4_writable(ds) -> bool:
-    """True if :func:`_write_netcdf4` writes ``ds`` as xarray's h5netcdf writer does: integer,
-    float and text variables of at least one dimension, none of size 0; every coordinate the index of its
-    own dimension; plain attributes (:func:`_plain_attrs`); no encoding set (a dataset read from
-    a file carries its file's)."""
-    if set(ds.encoding) - {"source"} or ds.encoding.get("unlimited_dims") or not _plain_attrs(ds.attrs):
-        return False
-    for name, var in ds.variables.items():
-        if not isinstance(name, str) or var.encoding or var.dtype.kind not in "iufU" or var.ndim == 0:
-            return False
-        if (name in ds.coords or name in ds.dims) and var.dims != (name,):
-            return False
-        if 0 in var.shape or not _plain_attrs(var.attrs) or not all(isinstance(d, str) for d in var.dims):
-            return False
-    return True
-
-
-def _attr_value(value):
-    """An attribute as NetCDF-4 stores it: text as a UTF-8 string, a number as a 1-element array."""
-    return value if isinstance(value, str) else np.atleast_1d(np.asarray(value))
-
-
-def _write_netcdf4(ds, path) -> None:
-    """Write ``ds`` (:func:`_netcdf4_writable`) to ``path`` in the NetCDF-4 layout xarray's
-    h5netcdf writer makes: the dimensions numbered in order of first use over the variables;
-    a dimension without a coordinate variable as an empty dimension scale (``>f4``, its size
-    in its name); every variable a contiguous dataset (text as variable-length UTF-8) in the dataset's order with
-    ``_Netcdf4Coordinates`` (its dimensions' numbers), ``_Netcdf4Dimid`` (its first one's), a
-    float variable's fill value NaN (``_FillValue``) and its attributes, attached to its
-    dimensions' scales; the file's attributes and ``_NCProperties`` (who wrote it)."""
-    import h5py
-
-    from flexrv._version import __version__
-
-    dimids: dict[str, int] = {}
-    for var in ds.variables.values():
-        for dim in var.dims:
-            dimids.setdefault(dim, len(dimids))
-    with h5py.File(path, "w", track_order=True) as f:
-        for key, value in ds.attrs.items():
-            f.attrs[key] = _attr_value(value)
-        scales = {}
-        for dim, dimid in dimids.items():
-            if dim not in ds.variables:
-                scale = f.create_dataset(dim, shape=(ds.sizes[dim],), dtype=">f4", track_order=True)
-                scale.attrs["_Netcdf4Dimid"] = np.int32(dimid)
-                scale.make_scale(_NOT_A_VARIABLE + f"{ds.sizes[dim]:10}".encode("ascii"))
-                scales[dim] = scale
-        datasets = {}
-        for name, var in ds.variables.items():
-            values = np.ascontiguousarray(var.values)
-            fill = np.nan if values.dtype.kind == "f" else None
-            if values.dtype.kind == "U":
-                h5 = f.create_dataset(name, data=values.astype(object), dtype=h5py.string_dtype(), track_order=True)
-            else:
-                h5 = f.create_dataset(name, data=values, fillvalue=fill, track_order=True)
-            if var.dims == (name,):
-                h5.make_scale(name)
-                scales[name] = h5
-            h5.attrs["_Netcdf4Coordinates"] = np.array([dimids[d] for d in var.dims], dtype=np.int32)
-            h5.attrs["_Netcdf4Dimid"] = np.int32(dimids[var.dims[0]])
-            if fill is not None:
-                h5.attrs["_FillValue"] = np.array([fill], dtype=values.dtype)
-            for key, value in var.attrs.items():
-                h5.attrs[key] = _attr_value(value)
-            datasets[name] = h5
-        for name, var in ds.variables.items():
-            if var.dims != (name,):
-                for axis, dim in enumerate(var.dims):
-                    datasets[name].dims[axis].attach_scale(scales[dim])
-        provenance = f"version=2,flexrv={__version__},hdf5={h5py.version.hdf5_version},h5py={h5py.__version__}"
-        f.attrs["_NCProperties"] = np.array(provenance, dtype=h5py.string_dtype("ascii", len(provenance)))
 
 
 def save_partial(res, directory) -> Path:
