@@ -130,6 +130,7 @@ def _clocked_integrate(model):
         .replace("                return i, 2\n", done("                ") + "                return i, 2\n")
         .replace("                return i, 1\n", done("                ") + "                return i, 1\n")
         .replace("                return i, 3\n", done("                ") + "                return i, 3\n")
+        .replace("                return i + 1, 4\n", done("                ") + "                return i + 1, 4\n")
         .replace("    return n, 0\n", done("    ") + "    return n, 0\n")
     )
     src = (
