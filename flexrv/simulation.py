@@ -858,8 +858,10 @@ class _ExudynSegments:
 
 class _CompiledSegments:
     """Segments on the compiled generalized-alpha (:mod:`flexrv.model.integrator`): the
-    steps of a segment in compiled code, back in Python every :data:`CHECK_EVERY` steps
-    for the groups' per-step checks, the signals and the progress report."""
+    steps of a segment in compiled code, the elements' compiled per-step checks after every
+    accepted step there; back in Python every :data:`CHECK_EVERY` steps for the groups'
+    Python checks (every :data:`RETURN_EVERY` steps without any), the signals and the
+    progress report."""
 
     def __init__(self, model, spectral_radius, newton_tolerance, newton_options, plan: _RunPlan):
         from flexrv.model.base import ForceGroup
