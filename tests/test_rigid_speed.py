@@ -54,7 +54,8 @@ def test_compiled_check_stops_at_exudyns_step():
     pin contact penetrates by more): both integrators stop with the pins' message at the same
     step (the compiled one with Exudyn's predictor takes the same steps; its check runs after
     every accepted step as Exudyn's pre-step hook does, where the Python check used to see
-    every 25th state). Measured: the same time to the printed digits."""
+    every 25th state). Measured: both t = 0.0043 s, penetration 0.0915 um; the Python check every
+    25 steps stopped the compiled run at 0.005 s (0.0887 um)."""
     from flexrv.simulation import Simulation
     from tests.test_time_step import fast
 
