@@ -1106,9 +1106,7 @@ class NeedleBearings(KernelGroup):
         self.hx = np.ascontiguousarray(p.holes[..., 0].T)  # (nc, nd) hole centres in the disc frames
         self.hy = np.ascontiguousarray(p.holes[..., 1].T)
         self.clear = np.ascontiguousarray(p.clearances, dtype=float)
-        self.depth = d.contact_depth
-        self.limit = p.penetration_limit  # design contact.needle_penetration_limit_um
-        self.z_c, self.z_rp = d.z_c, d.z_rp
+        self.z_c = d.z_c
         self.k = float(p.k)
         if p.model == "empirical":
             self.roller_angles = np.zeros(0)

@@ -1164,7 +1164,6 @@ class PinContacts(KernelGroup):
         self.harmonics = np.ascontiguousarray(p.profile_harmonics, dtype=float).reshape(self.nd, -1, 3)
         self.k, self.e = p.pin_k, p.pin_exponent
         self.c_max, self.depth = p.pin_c_max, d.contact_depth
-        self.limit = p.pin_penetration_limit  # design contact.pin_penetration_limit_um
         reach = [
             _curve_reach(int(d.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(d.eccentricity))
             for kd in range(self.nd)
@@ -1410,9 +1409,7 @@ class PinContacts(KernelGroup):
         self.work[:] = 0.0
 
     def check(self) -> str | None:
-        if pin_penetrated(self.gap, self.calls, self.limit):
-            return (
-                f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
-                f"{self.limit * 1e6:.3g} um"
-            )
+        limit = self.law.penetration_limit  # design contact.pin_penetration_limit_um
+        if pin_penetrated(self.gap, self.calls, limit):
+            return f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit {limit * 1e6:.3g} um"
         return None
