@@ -102,12 +102,15 @@ SEGMENT_STEPS = 1000
 #: signal numbers that stop a run gracefully (partial results kept): Ctrl-C, kill
 STOP_SIGNALS = ("SIGINT", "SIGTERM")
 
-#: steps of the compiled integrator between two returns to Python, where the groups' per-step
-#: checks (a skipped pin, a penetration beyond the physical limit), the signals and the progress
-#: report run: the checks then see every CHECK_EVERY-th accepted state. 25: one pin-mesh period
-#: of the presets at the default step; a return costs ~50 us (the checks, the progress, the compiled
-#: call's argument unboxing ~12 us; the drive and load tables are made once per segment)
+#: steps of the compiled integrator between two returns to Python where a group's per-step check
+#: runs in Python (no compiled ``step_check``; the signals and the progress report run there too):
+#: those checks see every CHECK_EVERY-th accepted state. 25: one pin-mesh period of the presets at
+#: the default step; a return costs ~50 us (the checks, the progress, the compiled call's argument
+#: unboxing ~13 us; the drive and load tables are made once per segment)
 CHECK_EVERY = 25
+#: steps between two returns where every check is compiled (run after every accepted step in the
+#: loop): the signals and the progress report only, ~15 ms apart on the rigid model
+RETURN_EVERY = 250
 
 
 def check_time_options(reducer, t_end: float | None, dt: float = DEFAULT_DT) -> float:
@@ -855,8 +858,10 @@ class _ExudynSegments:
 
 class _CompiledSegments:
     """Segments on the compiled generalized-alpha (:mod:`flexrv.model.integrator`): the
-    steps of a segment in compiled code, back in Python every :data:`CHECK_EVERY` steps
-    for the groups' per-step checks, the signals and the progress report."""
+    steps of a segment in compiled code, the elements' compiled per-step checks after every
+    accepted step there; back in Python every :data:`CHECK_EVERY` steps for the groups'
+    Python checks (every :data:`RETURN_EVERY` steps without any), the signals and the
+    progress report."""
 
     def __init__(self, model, spectral_radius, newton_tolerance, newton_options, plan: _RunPlan):
         from flexrv.model.base import ForceGroup
@@ -874,8 +879,10 @@ class _CompiledSegments:
             options.pop("absoluteTolerance", newton_tolerance[1]),
         )
         self.integ = CompiledIntegrator(model, spectral_radius, tolerance, compiled_newton_options(options))
-        self.integ.check_every = CHECK_EVERY
-        self.checkers = [g for g in model.groups if type(g).check is not ForceGroup.check]
+        self.checkers = [
+            g for g in model.groups if type(g).check is not ForceGroup.check and g not in self.integ.checked
+        ]
+        self.integ.check_every = CHECK_EVERY if self.checkers else RETURN_EVERY
         self._segments = 0
         self._t = plan.t_start
 

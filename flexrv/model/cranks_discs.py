@@ -142,7 +142,8 @@ SupportPack = pack_type(
 )
 #: the needle bearings' scalar law: contact K, exponent, c_max, depth, roller-resolved model (else the
 #: empirical radial law), pitch ratio g = D/d_m, disc teeth z_c, friction coefficient, friction radius
-#: d/2 [m], regularisation speed
+#: d/2 [m], regularisation speed, and the per-step check's limits (:func:`needle_check`): half a pin pitch
+#: pi / z_rp [rad] of a disc's departure from its conjugate rotation, the needle penetration [m]
 NeedleLaw = law_type(
     "NeedleLaw",
     k=float,
@@ -155,6 +156,8 @@ NeedleLaw = law_type(
     mu=float,
     friction_radius=float,
     v_reg=float,
+    skip_limit=float,
+    penetration_limit=float,
 )
 #: :func:`needle_kernel`'s pack: indices (each crank's x, y, phi, then each disc's x, y, psi), law,
 #: disc eccentric phases chi0, as-built eccentricities, phase errors, hole centres x, y (cranks,
@@ -1054,6 +1057,29 @@ def needle_kernel(q, v, f, jq, jv, jac, pack):
     pack.min_gap[0] = min_gap
 
 
+@njit(cache=True)
+def needle_check(departure, min_gap, skip_limit, penetration_limit) -> int:
+    """The needle bearings' per-step check (:meth:`NeedleBearings.check`, and
+    :func:`needle_step_check` in the compiled integrator's steps) on the last call's results: 1 if a
+    disc departs from its conjugate rotation by more than ``skip_limit`` (a skipped pin: the cause,
+    so it comes first; NaN: not evaluated yet, never a skip), 2 if the smallest gap ``min_gap[0]``
+    is a penetration beyond ``penetration_limit`` [m] (the symptom), else 0."""
+    for k in range(departure.shape[0]):
+        if abs(departure[k]) > skip_limit:
+            return 1
+    if min_gap[0] < -penetration_limit:
+        return 2
+    return 0
+
+
+@njit(cache=True)
+def needle_step_check(pack) -> int:
+    """The needle bearings' per-step check on their pack (:data:`NeedlePack`) after an accepted step
+    of the compiled integrator (:mod:`flexrv.model.core.registry`): :func:`needle_check`."""
+    law = pack.law
+    return needle_check(pack.departure, pack.min_gap, law.skip_limit, law.penetration_limit)
+
+
 class NeedleBearings(KernelGroup):
     """All crank–disc needle bearings in one element (members: cranks, discs)."""
 
@@ -1061,6 +1087,7 @@ class NeedleBearings(KernelGroup):
     kind = "needles"
     summary_rows = (SummaryRow("max_needle_force_N", "N", "largest needle-bearing force", "needle_force", "max"),)
     kernel = staticmethod(needle_kernel)
+    step_check = staticmethod(needle_step_check)
     friction_outputs = ("needle_friction_power",)
 
     parameters = staticmethod(needle_parameters)
@@ -1079,9 +1106,7 @@ class NeedleBearings(KernelGroup):
         self.hx = np.ascontiguousarray(p.holes[..., 0].T)  # (nc, nd) hole centres in the disc frames
         self.hy = np.ascontiguousarray(p.holes[..., 1].T)
         self.clear = np.ascontiguousarray(p.clearances, dtype=float)
-        self.depth = d.contact_depth
-        self.limit = p.penetration_limit  # design contact.needle_penetration_limit_um
-        self.z_c, self.z_rp = d.z_c, d.z_rp
+        self.z_c = d.z_c
         self.k = float(p.k)
         if p.model == "empirical":
             self.roller_angles = np.zeros(0)
@@ -1099,6 +1124,8 @@ class NeedleBearings(KernelGroup):
             mu=p.friction,
             friction_radius=p.friction_radius,
             v_reg=d.friction_velocity,
+            skip_limit=math.pi / d.z_rp,
+            penetration_limit=max(20.0 * d.contact_depth, p.penetration_limit),
         )
         self.mu = p.friction if d.friction_velocity > 0.0 else 0.0
         z = len(self.roller_angles)
@@ -1171,20 +1198,18 @@ class NeedleBearings(KernelGroup):
         self.gap_min[0] = np.inf
 
     def check(self) -> str | None:
-        # a skipped pin first: it is the cause, and the needle penetration it then produces the symptom
-        # (on Python floats: numpy's reductions on these few values cost ~4 us per step)
-        departure = self.departure.tolist()
-        limit = math.pi / self.z_rp
-        if any(abs(d) > limit for d in departure):  # (NaN: not evaluated yet, never a skip)
+        law = self.law
+        code = needle_check(self.departure, self.gap_min, law.skip_limit, law.penetration_limit)
+        if code == 1:
             dep = self.departure
             k = int(np.nanargmax(np.abs(dep)))
             return (
                 f"disc {k} skipped a pin: its rotation departs from the conjugate value by "
-                f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {limit * DEG_PER_RAD:.3g} deg)"
+                f"{dep[k] * DEG_PER_RAD:.3g} deg (more than half a pin pitch, {law.skip_limit * DEG_PER_RAD:.3g} deg)"
             )
-        if self.gap_min[0] < -max(20.0 * self.depth, self.limit):
+        if code == 2:
             return (
                 f"needle-bearing penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
-                f"{max(20.0 * self.depth, self.limit) * 1e6:.3g} um"
+                f"{law.penetration_limit * 1e6:.3g} um"
             )
         return None

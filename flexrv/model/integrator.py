@@ -12,9 +12,10 @@ from Python during the run: :meth:`flexrv.model.kernels.FusedForces.drive_with`)
 drive and the loads (Python callables of time) enter as tables of the elements' time
 inputs at the step ends, evaluated vectorised once per call
 (:meth:`~flexrv.model.base.KernelGroup.time_inputs_many`).
-The compiled loop returns to Python every ``check_every`` steps, where the groups'
-per-step checks run on the last accepted state (a skipped pin, a penetration beyond
-the physical limit) as in the Exudyn path's pre-step hook.
+The elements' compiled per-step checks (``step_check``: a skipped pin, a penetration
+beyond the physical limit) run in the loop after every accepted step, as the Exudyn
+path's pre-step hook runs the groups' checks; the compiled loop returns to Python every
+``check_every`` steps (the caller's remaining checks, signals, progress).
 
 Time stepping as Exudyn's adaptive step (its settings of flexrv.simulation): t += h,
 the last step of a segment clipped to its end; a step whose Newton iteration fails is
@@ -62,6 +63,7 @@ RECOVERY_ITERATIONS = 7
 _STATUS = {
     1: "Newton iteration failed at the minimum step",
     3: "the state became NaN/inf",
+    4: "a force element's per-step check failed",
 }
 
 
@@ -135,6 +137,8 @@ class CompiledIntegrator:
         fused.drive_with(self.state, self.blocks)  # the element's evaluations from Python: the same entry point
         self.massless = any(not np.any(np.diag(m.mass_matrix)) for m in model.members.values())
         self.timed = [(i, g) for i, (g, _) in enumerate(fused.slots) if g.time_field]
+        #: the groups whose per-step check runs in the compiled loop after every accepted step
+        self.checked = [g for g, _ in fused.slots if getattr(type(g), "step_check", None) is not None]
         ctrs = [c for _, c in fused.counters]
         self.ctrs = tuple(ctrs) if ctrs else (np.zeros(1, np.int64),)
         #: the compiled entry points of fused_integrate for this model's argument types, by the
@@ -308,4 +312,9 @@ class CompiledIntegrator:
         if status == 2:
             for g, c in self.fused.counters:
                 return g.failure_message
+        if status == 4:  # the groups' checks name the failure (the same conditions as their step_check)
+            for g in self.checked:
+                msg = g.check()
+                if msg:
+                    return msg
         return _STATUS.get(status, f"compiled integrator status {status}")

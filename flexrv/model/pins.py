@@ -176,7 +176,8 @@ from flexrv.units import M_PER_UM
 
 #: the pin contacts' scalar law: pin count, pin circle radius R_p [m], nominal pin radius [m],
 #: eccentricity [m], contact law K, exponent, c_max, depth, the closest-point Newton's settings
-#: (:func:`flexrv.geometry.cycloid.closest_point_settings`), friction coefficient and speed (0: off)
+#: (:func:`flexrv.geometry.cycloid.closest_point_settings`), friction coefficient and speed (0: off), the
+#: penetration beyond which a run stops as failed [m] (:func:`pin_penetrated`)
 PinLaw = law_type(
     "PinLaw",
     z_rp=int,
@@ -193,6 +194,7 @@ PinLaw = law_type(
     cos_half=float,
     mu=float,
     v_reg=float,
+    penetration_limit=float,
 )
 _F, _I = np.float64, np.int64
 #: how :func:`pin_kernel` uses its warm starts: a cold restart of every closest point every
@@ -989,6 +991,28 @@ def _pin_condensed_kernel(q, v, f, jq, jv, jac, pins, idx_rim, cd, ch, dstate, h
     _add_condensed(f, jq, jv, jac, idx, w.qf, w.jc, w.jvc)
 
 
+@njit(cache=True)
+def pin_penetrated(gap, calls, limit) -> bool:
+    """Whether the last call's smallest pin gap is a penetration beyond ``limit`` [m] (no call
+    yet: never): the pins' per-step check (:meth:`PinContacts.check`, and :func:`pin_step_check`
+    in the compiled integrator's steps)."""
+    if calls[0] == 0:
+        return False
+    low = np.inf
+    for kd in range(gap.shape[0]):
+        for i in range(gap.shape[1]):
+            low = min(low, gap[kd, i])
+    return low < -limit
+
+
+@njit(cache=True)
+def pin_step_check(pack) -> int:
+    """The pins' per-step check on their pack (:data:`PinBodyPack`) after an accepted step of the
+    compiled integrator (:mod:`flexrv.model.core.registry`): 1 if :func:`pin_penetrated`, else 0."""
+    pins = pack.pins
+    return 1 if pin_penetrated(pins.gap, pins.calls, pins.law.penetration_limit) else 0
+
+
 @functools.lru_cache(maxsize=64)
 def _medial_radii(z_rp: int, radius: float, eccentricity: float, samples: int = 400) -> tuple[np.ndarray, np.ndarray]:
     """The medial radius of the pin-centre curve C at ``samples`` points phi_i = i lobe /
@@ -1123,6 +1147,7 @@ class PinContacts(KernelGroup):
         SummaryRow("min_pin_gap_m", "m", "smallest pin-profile gap (negative: penetration)", "pin_gap", "min"),
     )
     kernel = staticmethod(pin_body_kernel)
+    step_check = staticmethod(pin_step_check)
     friction_outputs = ("pin_friction_power",)
     failure_message = "pin gap: closest-point iteration did not converge"
 
@@ -1139,7 +1164,6 @@ class PinContacts(KernelGroup):
         self.harmonics = np.ascontiguousarray(p.profile_harmonics, dtype=float).reshape(self.nd, -1, 3)
         self.k, self.e = p.pin_k, p.pin_exponent
         self.c_max, self.depth = p.pin_c_max, d.contact_depth
-        self.limit = p.pin_penetration_limit  # design contact.pin_penetration_limit_um
         reach = [
             _curve_reach(int(d.z_rp), float(p.pin_circle_radius + self.profile[kd, 0]), float(d.eccentricity))
             for kd in range(self.nd)
@@ -1160,6 +1184,7 @@ class PinContacts(KernelGroup):
             cos_half=cos_half,
             mu=p.pin_friction,
             v_reg=d.friction_velocity,
+            penetration_limit=p.pin_penetration_limit,
         )
         #: per disc the pin-centre curve's reach outside, inside [m] (:func:`_curve_reach`)
         self.reach = np.array(reach, dtype=float).reshape(self.nd, 2)
@@ -1384,9 +1409,7 @@ class PinContacts(KernelGroup):
         self.work[:] = 0.0
 
     def check(self) -> str | None:
-        if self.min_gap < -self.limit:
-            return (
-                f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit "
-                f"{self.limit * 1e6:.3g} um"
-            )
+        limit = self.law.penetration_limit  # design contact.pin_penetration_limit_um
+        if pin_penetrated(self.gap, self.calls, limit):
+            return f"pin-disc penetration {-self.min_gap * 1e6:.3g} um exceeds the physical limit {limit * 1e6:.3g} um"
         return None

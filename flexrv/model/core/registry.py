@@ -5,7 +5,10 @@ A compiled force element is a :class:`~flexrv.model.base.KernelGroup` subclass w
 the element's generalized forces into f and, if ``jac``, its Jacobians into jq, jv over
 the coordinates ``pack.idx``), a typed ``pack`` (:mod:`flexrv.model.core.params`), its
 declared outputs (``outputs``), friction outputs (``friction_outputs``) and summary rows
-(``summary_rows``). ONE line registers it: ``register(MyElement)``. The order of
+(``summary_rows``) and optionally a compiled per-step check (``step_check``, a static numba
+function ``step_check(pack) -> int``, nonzero: the state is unphysical, the group's ``check``
+then names why; the compiled integrator runs it after every accepted step). ONE line registers
+it: ``register(MyElement)``. The order of
 registration is the order of the calls in the fused kernel (the order in which the
 elements' forces are summed).
 
@@ -166,6 +169,10 @@ def _fused_source(specs, callee_hash: str) -> str:
     ]
     for i, s in enumerate(specs):
         lines.append(f"from {s.kernel.py_func.__module__} import {s.kernel.py_func.__name__} as k{i}")
+    checks = [(i, _step_check(s)) for i, s in enumerate(specs)]
+    checks = [(i, c) for i, c in checks if c is not None]
+    for i, c in checks:
+        lines.append(f"from {c.py_func.__module__} import {c.py_func.__name__} as c{i}")
     lines += ["", "", "@njit(cache=True)", f"def fused_kernel(q, v, f, jq, jv, jac, {packs}):"]
     lines += _evaluate_lines(4, n, "q", "v", "jac")
     tin = "".join(f"tin{i}, " for i, _ in timed)
@@ -185,8 +192,17 @@ def _fused_source(specs, callee_hash: str) -> str:
         "            s, d = src[r], dst[r]",
     ]
     lines += _copy_lines(12, "d[i, c]", "s[c]", "s.shape[0]")
-    lines += _integrate_source(n, timed, packs, tin)
+    lines += _integrate_source(n, timed, packs, tin, [i for i, _ in checks])
     return "\n".join(lines)
+
+
+def _step_check(spec):
+    """The element's compiled per-step check (module docstring), or None."""
+    check = inspect.getattr_static(spec.group, "step_check", None)
+    check = getattr(check, "__func__", check)
+    if check is not None and not hasattr(check, "py_func"):
+        raise TypeError(f"{spec.group.__name__}.step_check must be a compiled (numba) static function")
+    return check
 
 
 def _evaluate_lines(indent: int, n: int, q: str, v: str, jac: str) -> list[str]:
@@ -197,17 +213,19 @@ def _evaluate_lines(indent: int, n: int, q: str, v: str, jac: str) -> list[str]:
     return lines + [f"{pad}k{i}({q}, {v}, f, jq, jv, {jac}, p{i})" for i in range(n)]
 
 
-def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
+def _integrate_source(n: int, timed: list, packs: str, tin: str, checks=()) -> list[str]:
     """Lines of the generated ``fused_integrate``: with ``mode`` :data:`INTEGRATE`, the compiled
     generalized-alpha (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the
     steps ending at ``times``; returns (steps done, status: 0 done, 1 Newton failed, 2 an
-    element's inner solve failed, 3 non-finite state). Step i writes the elements' time inputs
-    of row i of their tables; an accepted step is recorded (state into ``ts``, ``qs``, ``vs``
-    row ``rec[0]``, the elements' records into ``dst``) if its end time is at least ``rec_t[1]``
-    after the last record ``rec_t[0]`` (or no row is recorded yet), while rows remain
-    (``rec[1]``), except the last step of the call when ``rec[2]`` (a segment's end, recorded
-    as the next one's start). ``blocks``: the state's dense diagonal blocks (``st.blocks``),
-    or None for a state without (the block elimination is then not compiled in).
+    element's inner solve failed, 3 non-finite state, 4 an element's per-step check failed at
+    the accepted state of the last step done; ``checks``: the elements with a ``step_check``).
+    Step i writes the elements' time inputs of row i of their tables; an accepted step is
+    recorded (state into ``ts``, ``qs``, ``vs`` row ``rec[0]``, the elements' records into
+    ``dst``) if its end time is at least ``rec_t[1]`` after the last record ``rec_t[0]`` (or no
+    row is recorded yet), while rows remain (``rec[1]``), except the last step of the call when
+    ``rec[2]`` (a segment's end, recorded as the next one's start). ``blocks``: the state's
+    dense diagonal blocks (``st.blocks``), or None for a state without (the block elimination is
+    then not compiled in).
 
     With ``mode`` :data:`ROWS` (:data:`ROWS_JAC`: with the Jacobians), the elements evaluated
     at every row i of ``qs``, ``vs`` with the time inputs of row i, their records copied into
@@ -255,6 +273,13 @@ def _integrate_source(n: int, timed: list, packs: str, tin: str) -> list[str]:
         "                return i, 1",
         "            if not finish_step(st):",
         "                return i, 3",
+    ]
+    if checks:
+        lines += [
+            "            if " + " or ".join(f"c{i}(p{i}) != 0" for i in checks) + ":",
+            "                return i + 1, 4",
+        ]
+    lines += [
         "            k = rec[0]",
         "            due = k == 0 or times[i] >= rec_t[0] + rec_t[1]",
         "            if not ((i < n - 1 or rec[2] == 0) and k < rec[1] and due):",

@@ -288,8 +288,11 @@ def _factor(st, jq, jv, blocks):
     gp = par[P_GAMMA] / (h * par[P_BETA])
     n = st.q.shape[0]
     s = st.lu
-    for i in range(n):
+    for i in range(n):  # (the entries where M, K, D are zero: the same sum, bit for bit, without the zeros)
         for j in range(n):
+            s[i, j] = (0.0 - jq[i, j]) - gp * jv[i, j]
+        for k in range(st.rp[i], st.rp[i + 1]):
+            j = st.ci[k]
             s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
     st.par[P_HJAC] = h
