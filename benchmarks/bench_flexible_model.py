@@ -183,9 +183,12 @@ def factorisations(model, repeat: int = 30) -> None:
     )
 
 
-def paired_newton(preset: str, t_end: float, window: float, options: dict, repeat: int = 2) -> None:
+def paired_newton(
+    preset: str, t_end: float, window: float, options: dict, repeat: int = 2, integrator: str | None = None
+) -> None:
     """Print the flexible-rings model's solve with the default Newton settings and with
-    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``)."""
+    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``;
+    ``integrator``: the model's default if None)."""
     from _shared import quick_ramps
 
     from flexrv.simulation import Simulation
@@ -195,8 +198,8 @@ def paired_newton(preset: str, t_end: float, window: float, options: dict, repea
         for opts in (None, options):
             sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
             sim.build()
-            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts)  # numba loads, one-time imports
-            res = sim.run(t_end=t_end, newton_options=opts)
+            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts, integrator=integrator)  # numba loads
+            res = sim.run(t_end=t_end, newton_options=opts, integrator=integrator)
             tm = sim.timing
             steps = max(tm["steps"], 1)
             te = res["te"].sel(time=slice(t_end - window, None)).values
@@ -235,6 +238,7 @@ def main() -> None:
             args.t_end,
             0.5 * args.t_end if args.window is None else args.window,
             json.loads(args.paired_newton),
+            integrator=args.integrator,
         )
         return
     if args.split:
