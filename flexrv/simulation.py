@@ -70,13 +70,6 @@ DEFAULT_DT = 1e-4
 #: dense system, as the rigid model), and run faster with Exudyn's 0.5 (benchmarks/bench_balls.py)
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
-#: the compiled integrator's own Newton settings per model (over MODEL_NEWTON, under the user's
-#: newton_options). The flexible rings keep their Jacobian across steps; a new one when the residual
-#: contracts worse than 0.25 per iteration took rv40e from 3.42 to 2.77 Newton iterations per step,
-#: 1.35 -> 1.21 ms per step, TE the same to 1e-4 arcsec (benchmarks/bench_flexible_model.py
-#: --paired-newton): its Jacobian and block elimination cost less than Exudyn's (see MODEL_NEWTON)
-COMPILED_MODEL_NEWTON = {"flexible": {"modifiedNewtonContractivity": 0.25}}
-
 
 #: largest number of time steps of one run (~1.5 h of wall time for the rigid model
 #: at ~2.5 ms per step); more is refused before any work with a step-count estimate
@@ -874,7 +867,7 @@ class _CompiledSegments:
         # systems, kept across steps above SPARSE_ABOVE coordinates; MODEL_NEWTON for balls with inertia
         options = {"modifiedNewtonJacUpdatePerStep": model.n <= SPARSE_ABOVE}
         if model.info.get("ball_inertia", True):
-            options |= MODEL_NEWTON.get(model.name, {}) | COMPILED_MODEL_NEWTON.get(model.name, {})
+            options |= MODEL_NEWTON.get(model.name, {})
         options |= dict(newton_options or {})
         tolerance = (
             options.pop("relativeTolerance", newton_tolerance[0]),
