@@ -10,7 +10,7 @@ so a speed change can be checked for an unchanged answer.
 
     python benchmarks/bench_flexible_model.py [--preset rv221] [--t-end 0.1] [--cold]
         [--models rigid,balls,flexible] [--harmonics K] [--parts main_bearing,crankshaft]
-        [--ring-options '{"condense": false}'] [--split] [--integrator compiled|exudyn]
+        [--ring-options '{"condense": false}'] [--split] [--rows] [--integrator compiled|exudyn]
 
 ``--split``: where a step's CPU goes on Exudyn's integrator (the preset with 5 ms ramps, the
 flexible-rings model): the fused element's force and Jacobian calls (the bearing rows and the other
@@ -19,6 +19,13 @@ hooks); the compiled integrator's split: ``bench_integrator.py --model flexible 
 one factorisation of a matrix of the model's structure (the balls' dense blocks, the other
 coordinates) by block elimination (:mod:`flexrv.model.numerics.block_lu`), by the dense
 compiled LU and by LAPACK (scipy), CPU per factorisation.
+
+``--rows``: the condensed rows' own cost on the compiled integrator (the preset with 5 ms ramps,
+the flexible-rings model): a run's local solves (chord iterations per solve, solves per step), then
+per recorded state of that run (each state once, in order, the warm starts carried as in the run) the
+cost of both rows' calls by phase: kinematics and pass 1, the compliance factors of every ring at the
+balls' azimuths, the front (pass 1 with the contacts and the condensed rings' local solves), the force
+call and the call with the Jacobian.
 
 ``--paired-newton JSON``: the flexible-rings model (5 ms ramps) with the simulation's Newton
 settings and with these ``newton_options`` on top, alternating, twice each in one process:
@@ -38,6 +45,9 @@ import tempfile
 import time
 
 import numpy as np
+
+#: flexrv.model.bearing_kernel once :func:`rows` imported it (a global of the compiled phases)
+bk = None
 
 
 def run(
@@ -183,9 +193,129 @@ def factorisations(model, repeat: int = 30) -> None:
     )
 
 
-def paired_newton(preset: str, t_end: float, window: float, options: dict, repeat: int = 2) -> None:
+def _row_phases(qs, vs, pack, mode, jac):
+    """One pass of both rows over the recorded states (``--rows``), phase ``mode``: 0 the call
+    (row_eval), 1 the front (pass 1, contacts, local solves), 2 kinematics and pass 1, 3 that and the
+    condensed rings' compliance factors at the balls' azimuths; a checksum. Compiled by :func:`rows`
+    (``bk``: flexrv.model.bearing_kernel, set there)."""
+    tot = 0.0
+    for i in range(1, qs.shape[0]):
+        for part in pack.parts:
+            idx, qe, ve, f, jq, jv, rec, _, _, _, p = part
+            for e in range(idx.shape[0]):
+                qe[e] = qs[i, idx[e]]
+                ve[e] = vs[i, idx[e]]
+            nz = p.ball_ref.shape[0]
+            b0 = idx.shape[0] - 3 * nz
+            for j in range(nz):
+                for c in range(3):
+                    qe[b0 + 3 * j + c] -= p.ball_ref[j, c]
+            if mode == 0:
+                bk.row_eval(qe, ve, p, jac, rec, f, jq, jv)
+                tot += f[0]
+            elif mode == 1:
+                tot += bk._row_front(qe, ve, p, jac)[4].load_i[0]
+            else:
+                a, _, om0, om1, om2 = bk._frame_kinematics(qe, ve)
+                cond_i, cond_o = p.comp_i.shape[0] > 0, p.comp_o.shape[0] > 0
+                pre = bk._row_geometry(
+                    qe,
+                    ve,
+                    p.ball_ref,
+                    p.geometry,
+                    p.tab_i,
+                    p.zsign[0],
+                    p.tab_o,
+                    p.zsign[1],
+                    cond_i,
+                    cond_o,
+                    jac,
+                    a,
+                    (om0, om1, om2),
+                )
+                tot += pre.e0_i[0, 0]
+                if mode == 3:
+                    for psi, comp, zs in ((pre.psi_i, p.comp_i, p.zsign[0]), (pre.psi_o, p.comp_o, p.zsign[1])):
+                        if comp.shape[0] > 0:
+                            wl = np.empty((nz, 3, comp.shape[2]))
+                            bk._local_factors(psi, comp, zs, wl)
+                            tot += wl[0, 0, 0]
+    return tot
+
+
+def rows(preset: str, t_end: float) -> None:
+    """Print the condensed rows' cost by phase (module docstring, ``--rows``)."""
+    global bk
+    from _shared import quick_ramps
+    from numba import njit
+
+    import flexrv.simulation as S
+    from flexrv.model import bearing_kernel
+    from flexrv.simulation import Simulation
+
+    bk = bearing_kernel  # (a global of the compiled _row_phases)
+    sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
+    model = sim.build()
+    sim.run(t_end=2e-3, segment_steps=5, integrator="compiled")  # numba loads, one-time imports
+    ((_, pack),) = [(g, p) for (g, _), p in zip(model.fused.slots, model.fused.packs) if g.kind == "bearing_rows"]
+    kept, orig = {}, S._Records.__init__
+
+    def keep(self, *a, **k):
+        orig(self, *a, **k)
+        kept["records"] = self
+
+    s0 = [part[10].state.copy() for part in pack.parts]
+    S._Records.__init__ = keep
+    try:
+        sim.run(t_end=t_end, integrator="compiled", checkpoint_s=None)
+    finally:
+        S._Records.__init__ = orig
+    steps = max(sim.timing["steps"], 1)
+    p = pack.parts[0][10]
+    print(
+        f"{preset} flexible rings, 5 ms ramps, {t_end:g} s compiled: {steps} steps, Z = {p.ball_ref.shape[0]}, "
+        f"ring modes {p.comp_i.shape[2]} / {p.comp_o.shape[2]}"
+    )
+    for k, (part, a) in enumerate(zip(pack.parts, s0)):
+        d = part[10].state - a
+        print(
+            f"  row {k}: {d[3] / steps:.2f} local solves per step, {d[2] / max(d[3], 1):.2f} chord iterations "
+            f"per solve, {d[0]} not converged"
+        )
+    rec = kept["records"]
+    qs, vs = rec.qs[: rec.k].copy(), rec.vs[: rec.k].copy()
+    phases = njit(_row_phases)
+    cost = {}
+    for label, mode, jac in (
+        ("kinematics, pass 1", 2, False),
+        ("+ compliance factors", 3, False),
+        ("front (+ local solves)", 1, False),
+        ("force call", 0, False),
+        ("call with the Jacobian", 0, True),
+    ):
+        phases(qs, vs, pack, mode, jac)  # compile, warm starts
+        best = np.inf
+        for _ in range(1 if jac else 3):
+            for g in model.groups:
+                g.reset()
+            c0 = time.process_time()
+            phases(qs, vs, pack, mode, jac)
+            best = min(best, time.process_time() - c0)
+        cost[label] = 1e6 * best / (qs.shape[0] - 1)
+        print(f"  {label:24s} {cost[label]:8.1f} us per state (both rows)")
+    c = list(cost.values())
+    print(
+        f"  by difference: compliance factors {c[1] - c[0]:.1f}, contacts and local solves {c[2] - c[1]:.1f}, "
+        f"pass 2 {c[3] - c[2]:.1f}, the Jacobian {c[4] - c[3]:.1f} us"
+    )
+
+
+def paired_newton(
+    preset: str, t_end: float, window: float, options: dict, repeat: int = 2, integrator: str | None = None
+) -> None:
     """Print the flexible-rings model's solve with the default Newton settings and with
-    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``)."""
+    ``options`` on top, alternating ``repeat`` times (module docstring, ``--paired-newton``;
+    ``integrator``: the model's default if None)."""
     from _shared import quick_ramps
 
     from flexrv.simulation import Simulation
@@ -195,8 +325,8 @@ def paired_newton(preset: str, t_end: float, window: float, options: dict, repea
         for opts in (None, options):
             sim = Simulation(quick_ramps(preset), model="flexible", model_options={"parts": ["main_bearing"]})
             sim.build()
-            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts)  # numba loads, one-time imports
-            res = sim.run(t_end=t_end, newton_options=opts)
+            sim.run(t_end=2e-3, segment_steps=5, newton_options=opts, integrator=integrator)  # numba loads
+            res = sim.run(t_end=t_end, newton_options=opts, integrator=integrator)
             tm = sim.timing
             steps = max(tm["steps"], 1)
             te = res["te"].sel(time=slice(t_end - window, None)).values
@@ -226,6 +356,7 @@ def main() -> None:
     )
     parser.add_argument("--cold", action="store_true", help="mesh and reduce the rings in an empty cache")
     parser.add_argument("--split", action="store_true", help="CPU per step by part (flexible rings, 5 ms ramps)")
+    parser.add_argument("--rows", action="store_true", help="the condensed rows' cost by phase (compiled)")
     parser.add_argument("--paired-newton", default=None, help="newton_options (JSON) against the defaults, paired")
     parser.add_argument("--integrator", default=None, choices=("compiled", "exudyn"), help="default: the model's")
     args = parser.parse_args()
@@ -235,7 +366,11 @@ def main() -> None:
             args.t_end,
             0.5 * args.t_end if args.window is None else args.window,
             json.loads(args.paired_newton),
+            integrator=args.integrator,
         )
+        return
+    if args.rows:
+        rows(args.preset, args.t_end)
         return
     if args.split:
         split(args.preset, args.t_end, 0.5 * args.t_end if args.window is None else args.window)
