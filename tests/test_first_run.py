@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from tests._procs import sigint_default
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -114,6 +116,7 @@ def test_first_line_within_seconds_and_signal_while_building_bodies(tmp_path, si
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=sigint_default,
     )
     try:
         first = proc.stderr.readline()
