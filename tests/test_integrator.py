@@ -383,12 +383,7 @@ def test_cross_check_against_exudyn_every_preset(name):
         cross_check(r.model_copy(update={"operating": op}), 0.3)
 
 
-#: rv40e in the default suite; every other preset's ball model compiles a fused kernel of its own
-#: (about a minute cold on 2 cores), so it runs with the slow set
-BALL_CROSS_CHECK = [n if n == "rv40e" else pytest.param(n, marks=pytest.mark.slow) for n in list_presets()]
-
-
-@pytest.mark.parametrize("name", BALL_CROSS_CHECK)
+@pytest.mark.parametrize("name", list_presets())
 def test_cross_check_ball_model_against_exudyn(name):
     """The ball-resolved main bearing (quasi-static balls between rigid rings; the rows a
     compiled element of the fused kernel on both integrators), every preset, shortened
