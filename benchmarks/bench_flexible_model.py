@@ -216,23 +216,7 @@ def _row_phases(qs, vs, pack, mode, jac):
             elif mode == 1:
                 tot += bk._row_front(qe, ve, p, jac)[4].load_i[0]
             else:
-                a, _, om0, om1, om2 = bk._frame_kinematics(qe, ve)
-                cond_i, cond_o = p.comp_i.shape[0] > 0, p.comp_o.shape[0] > 0
-                pre = bk._row_geometry(
-                    qe,
-                    ve,
-                    p.ball_ref,
-                    p.geometry,
-                    p.tab_i,
-                    p.zsign[0],
-                    p.tab_o,
-                    p.zsign[1],
-                    cond_i,
-                    cond_o,
-                    jac,
-                    a,
-                    (om0, om1, om2),
-                )
+                pre = bk._row_pass1(qe, ve, p, jac)[2]
                 tot += pre.e0_i[0, 0]
                 if mode == 3:
                     for psi, comp, zs in ((pre.psi_i, p.comp_i, p.zsign[0]), (pre.psi_o, p.comp_o, p.zsign[1])):

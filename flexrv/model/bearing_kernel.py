@@ -1391,21 +1391,17 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
 
 
 @njit(cache=True)
-def _row_front(q, qt, p, jacobian):
-    """The first phases of :func:`row_eval` (the frame's kinematics, pass 1 and the contacts
-    with the condensed rings' local solves): (A, G, entrainment speed, :data:`RowPass1`,
-    :data:`RowContacts`), for :func:`_row_back`."""
-    geometry = p.geometry
+def _row_pass1(q, qt, p, jacobian):
+    """The frame's kinematics and pass 1 of a row (:func:`_frame_kinematics`, :func:`_row_geometry`
+    with the rings undeflected) from its pack ``p``: (A, G, :data:`RowPass1`)."""
+    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
     cond_i = p.comp_i.shape[0] > 0
     cond_o = p.comp_o.shape[0] > 0
-    p.state[1] = 0
-    a, g, om0, om1, om2 = _frame_kinematics(q, qt)
-    speed = geometry.speed_factor * abs(qt[5])
     pre = _row_geometry(
         q,
         qt,
         p.ball_ref,
-        geometry,
+        p.geometry,
         p.tab_i,
         p.zsign[0],
         p.tab_o,
@@ -1416,6 +1412,18 @@ def _row_front(q, qt, p, jacobian):
         a,
         (om0, om1, om2),
     )
+    return a, g, pre
+
+
+@njit(cache=True)
+def _row_front(q, qt, p, jacobian):
+    """The first phases of :func:`row_eval` (the frame's kinematics, pass 1 and the contacts
+    with the condensed rings' local solves): (A, G, entrainment speed, :data:`RowPass1`,
+    :data:`RowContacts`), for :func:`_row_back`."""
+    geometry = p.geometry
+    p.state[1] = 0
+    a, g, pre = _row_pass1(q, qt, p, jacobian)
+    speed = geometry.speed_factor * abs(qt[5])
     con = _row_contacts(
         geometry,
         p.zsign[0],
