@@ -114,16 +114,16 @@ def row_modes(name: str) -> None:
     rec = kept["records"]
     qs, vs = rec.qs[: rec.k].copy(), rec.vs[: rec.k].copy()
     ((_, pack),) = [(g, p) for (g, _), p in zip(model.fused.slots, model.fused.packs) if g.kind == "bearing_rows"]
-    row_eval, solve_balls, front = bk.row_eval, bk.quasi_static_balls, bk._row_front
+    row_eval, solve_balls, front, as_mode = bk.row_eval, bk.quasi_static_balls, bk._row_front, bk._mode
     cb, bb = bk.CONDENSED_BALLS, bk.BALL_BLOCKS
 
     @njit
     def modes(q, v, p, mode, reps, rec, f, a, b):
         for _ in range(reps):
             if mode < 0:
-                front(q, v, p, bb)
+                front(q, v, p, as_mode(bb))
             else:
-                row_eval(q, v, p, mode, rec, f, a, b)
+                row_eval(q, v, p, as_mode(mode), rec, f, a, b)
 
     @njit
     def jacobian_calls(qs, vs, separate, pack, out):
@@ -134,10 +134,10 @@ def row_modes(name: str) -> None:
                     qe[e] = qs[i, idx[e]]
                     ve[e] = vs[i, idx[e]]
                 if separate:
-                    solve_balls(qe, ve, p, False, rec, f, kbb, kx, cx)
-                    row_eval(qe, ve, p, cb, np.empty((0, rec.shape[1])), f, kx, cx)
+                    solve_balls(qe, ve, p, as_mode(False), rec, f, kbb, kx, cx)
+                    row_eval(qe, ve, p, as_mode(cb), np.empty((0, rec.shape[1])), f, kx, cx)
                 else:
-                    solve_balls(qe, ve, p, True, rec, f, kbb, kx, cx)
+                    solve_balls(qe, ve, p, as_mode(True), rec, f, kbb, kx, cx)
                 out[i] += np.abs(kx).sum() + 1e3 * np.abs(cx).sum()
 
     _, qe, ve, f, _, _, _, kbb, kx, cx, p = pack.parts[0]

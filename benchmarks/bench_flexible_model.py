@@ -211,12 +211,12 @@ def _row_phases(qs, vs, pack, mode, jac):
                 for c in range(3):
                     qe[b0 + 3 * j + c] -= p.ball_ref[j, c]
             if mode == 0:
-                bk.row_eval(qe, ve, p, jac, rec, f, jq, jv)
+                bk.row_eval(qe, ve, p, bk._mode(jac), rec, f, jq, jv)
                 tot += f[0]
             elif mode == 1:
-                tot += bk._row_front(qe, ve, p, jac)[4].load_i[0]
+                tot += bk._row_front(qe, ve, p, bk._mode(jac))[4].load_i[0]
             else:
-                pre = bk._row_pass1(qe, ve, p, jac)[2]
+                pre = bk._row_pass1(qe, ve, p, bk._mode(jac))[2]
                 tot += pre.e0_i[0, 0]
                 if mode == 3:
                     for psi, comp, zs in ((pre.psi_i, p.comp_i, p.zsign[0]), (pre.psi_o, p.comp_o, p.zsign[1])):

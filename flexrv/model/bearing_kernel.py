@@ -133,6 +133,22 @@ BALL_BLOCKS = 2
 #: balls' work array (:func:`ball_workspace`)
 CONDENSED_BALLS = 3
 
+
+@njit(cache=True, inline="always")
+def _mode(jacobian):
+    """A ``jacobian`` mode (False, True, :data:`BALL_BLOCKS`, :data:`CONDENSED_BALLS`) as a run-time
+    int64. Every call of a row phase passes its mode through here (and :func:`row_part` its
+    ``absolute`` through :func:`_flag`): numba specializes a compiled callee on a literal or a
+    boolean argument, and each specialization of a phase compiles its whole call tree again
+    (~10-20 s each); the branches on the mode cost nothing at run time."""
+    return np.int64(jacobian)
+
+
+@njit(cache=True, inline="always")
+def _flag(value):
+    """``value`` as a run-time boolean (not a literal: see :func:`_mode`)."""
+    return bool(value)
+
 #: a row's geometry and cage (lengths [m]): ball count, inner and outer groove centre radius and z,
 #: inner and outer offsets, ball radius over pitch radius, speed factor, cage ratio, cage stiffness
 #: and damping, pocket stiffness; the balls' model (quasi-static: solved inside the element, else
@@ -757,12 +773,12 @@ def row_kernel(q, qt, p, jacobian, rec):
         nk = nx if jacobian else 0
         kx = np.empty((nk, nk))
         cx = np.empty((nk, nk))
-        quasi_static_balls(qf, vf, p, jacobian, rec, f, np.empty((nb, 4)), kx, cx)
+        quasi_static_balls(qf, vf, p, _mode(jacobian), rec, f, np.empty((nb, 4)), kx, cx)
         return f[:nx].copy(), kx, cx
     nj = n if jacobian else 0
     jq = np.zeros((nj, nj))  # (zero: row_eval clears only the entries it writes)
     jv = np.zeros((nj, nj))
-    row_eval(q, qt, p, jacobian, rec, f, jq, jv)
+    row_eval(q, qt, p, _mode(jacobian), rec, f, jq, jv)
     return f, jq, jv
 
 
@@ -1387,7 +1403,8 @@ def row_eval(q, qt, p, jacobian, rec, f, jq, jv):
     (:func:`_row_contacts`) -- then :func:`_row_back` -- pass 2 with the forces and the
     Jacobian blocks of every ball (:func:`_row_pass2`), the condensed rings' dense blocks
     (:func:`_condensed_row_jacobian`)."""
-    _row_back(q, qt, p, jacobian, rec, f, jq, jv, _row_front(q, qt, p, jacobian))
+    mode = _mode(jacobian)
+    _row_back(q, qt, p, mode, rec, f, jq, jv, _row_front(q, qt, p, mode))
 
 
 @njit(cache=True)
@@ -1422,7 +1439,7 @@ def _row_front(q, qt, p, jacobian):
     :data:`RowContacts`), for :func:`_row_back`."""
     geometry = p.geometry
     p.state[1] = 0
-    a, g, pre = _row_pass1(q, qt, p, jacobian)
+    a, g, pre = _row_pass1(q, qt, p, _mode(jacobian))
     speed = geometry.speed_factor * abs(qt[5])
     con = _row_contacts(
         geometry,
@@ -1565,7 +1582,7 @@ def _condensed_contact_matrix(factors, normals, cd, wg):
 @njit(cache=True)
 def row_force_kernel(q, qt, p):
     """Generalized force of a row element (see :func:`row_kernel`)."""
-    return row_kernel(q, qt, p, False, np.empty((0, N_RECORD)))[0]
+    return row_kernel(q, qt, p, _flag(False), np.empty((0, N_RECORD)))[0]
 
 
 @njit(cache=True)
@@ -1602,8 +1619,8 @@ def _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, kx, cx):
     step = np.empty((nz, 6))  # per ball: the Newton correction and the new velocity
     adj = np.empty((3, 3))
     for it in range(max_iter + 1):
-        front = _row_front(q, qt, p, BALL_BLOCKS)
-        _row_back(q, qt, p, BALL_BLOCKS, recs, f, kbb, jv, front)
+        front = _row_front(q, qt, p, _mode(BALL_BLOCKS))
+        _row_back(q, qt, p, _mode(BALL_BLOCKS), recs, f, kbb, jv, front)
         scale = BALL_LOAD_SCALE
         for j in range(nz):
             scale = max(scale, recs[j, 0], recs[j, 1])
@@ -1628,7 +1645,7 @@ def _ball_solve(q, qt, p, tol, max_iter, f, kbb, rec, kx, cx):
                 dv = max(dv, abs(step[j, 3 + c] - qt[b0 + 3 * j + c]))
         done = err <= atol and dv <= vtol
         if (done or it == max_iter) and kx.shape[0] > 0:
-            _row_back(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx, front)
+            _row_back(q, qt, p, _mode(CONDENSED_BALLS), np.empty((0, N_RECORD)), f, kx, cx, front)
         if done:
             return it
         if it == max_iter:
@@ -1855,7 +1872,7 @@ def quasi_static_balls(q, qt, p, jacobian, rec, f, kbb, kx, cx):
             flag[0] = 1.0
         return
     if jacobian:
-        row_eval(q, qt, p, CONDENSED_BALLS, np.empty((0, N_RECORD)), f, kx, cx)
+        row_eval(q, qt, p, _mode(CONDENSED_BALLS), np.empty((0, N_RECORD)), f, kx, cx)
 
 
 @njit(cache=True)
@@ -1875,7 +1892,7 @@ def row_part(qn, vn, absolute, jacobian, part):
         qe[e] = qn[idx[e]]
         ve[e] = vn[idx[e]]
     if p.geometry.quasi_static_balls:
-        quasi_static_balls(qe, ve, p, jacobian, rec, f, kbb, kx, cx)
+        quasi_static_balls(qe, ve, p, _mode(jacobian), rec, f, kbb, kx, cx)
         return kx, cx
     if absolute:
         ball_ref = p.ball_ref
@@ -1884,7 +1901,7 @@ def row_part(qn, vn, absolute, jacobian, part):
         for j in range(nz):
             for c in range(3):
                 qe[b0 + 3 * j + c] -= ball_ref[j, c]
-    row_eval(qe, ve, p, jacobian, rec, f, jq, jv)
+    row_eval(qe, ve, p, _mode(jacobian), rec, f, jq, jv)
     return jq, jv
 
 
@@ -1910,7 +1927,7 @@ def row_element(qn, vn, absolute, jacobian, f_q, f_v, out_f, out_j, parts):
     for part in parts:
         idx, f = part[0], part[3]
         n = idx.shape[0]
-        jq_, jv_ = row_part(qn, vn, absolute, jacobian, part)
+        jq_, jv_ = row_part(qn, vn, _flag(absolute), _mode(jacobian), part)
         if jacobian:
             for r in range(n):
                 ir = idx[r]
@@ -1937,7 +1954,7 @@ def rows_kernel(q, v, f, jq, jv, jac, pack):
     for part in pack.parts:
         idx, fr = part[0], part[3]
         n = idx.shape[0]
-        jq_, jv_ = row_part(q, v, True, jac, part)
+        jq_, jv_ = row_part(q, v, _flag(True), _mode(jac), part)
         for e in range(n):
             f[idx[e]] += fr[e]
         if jac:
@@ -1969,11 +1986,11 @@ def row_history(qs, vts, p, recs):
         for i in range(nt):
             qf[:nx] = qs[i]
             vf[:nx] = vts[i]
-            quasi_static_balls(qf, vf, p, False, recs[i], f, kbb, empty, empty)
+            quasi_static_balls(qf, vf, p, _mode(False), recs[i], f, kbb, empty, empty)
             out[i] = f[:nx]
         return out
     for i in range(nt):
-        row_eval(qs[i], vts[i], p, False, recs[i], out[i], empty, empty)
+        row_eval(qs[i], vts[i], p, _mode(False), recs[i], out[i], empty, empty)
     return out
 
 
