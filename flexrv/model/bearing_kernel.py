@@ -149,6 +149,7 @@ def _flag(value):
     """``value`` as a run-time boolean (not a literal: see :func:`_mode`)."""
     return bool(value)
 
+
 #: a row's geometry and cage (lengths [m]): ball count, inner and outer groove centre radius and z,
 #: inner and outer offsets, ball radius over pitch radius, speed factor, cage ratio, cage stiffness
 #: and damping, pocket stiffness; the balls' model (quasi-static: solved inside the element, else
