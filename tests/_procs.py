@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+from pathlib import Path
 
 
 def sigint_default() -> None:
@@ -12,3 +13,11 @@ def sigint_default() -> None:
     ignored, every child inherits that, and Python then leaves it ignored: the signal would do
     nothing whatever flexrv does, and the test would test how pytest was started."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def stored_files(folder: Path, pattern: str = "*.json") -> list[Path]:
+    """The files of ``folder`` matching ``pattern`` whose write has finished. An atomic write's
+    temporary file (``.<name>.<pid>.<random>.tmp<suffix>``, :func:`flexrv.cache.atomic_write_text`)
+    is hidden and not one of them, though pathlib's glob matches hidden names: a test that kills a
+    run once a file is stored must not count a file still being written."""
+    return sorted(p for p in folder.glob(pattern) if not p.name.startswith("."))

@@ -28,6 +28,7 @@ from flexrv.design import load
 from flexrv.design.tolerances import load_tolerances, parse_tolerances
 from flexrv.errors import ConfigError, InputError
 from flexrv.studies.tolerance import OUTPUTS, TolerancePlan, parse_spec, sobol_indices, te_task, yield_estimate
+from tests._procs import stored_files
 
 ROOT = Path(__file__).resolve().parents[1]
 #: smoke resolution of the CLI studies: 0.1 crank revolution at 2 points per pin mesh
@@ -415,7 +416,7 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     t0 = time.time()
     try:
         while time.time() - t0 < 300:
-            if cases.is_dir() and len(list(cases.glob("*.json"))) >= 1:
+            if cases.is_dir() and len(stored_files(cases)) >= 1:
                 break
             if proc.poll() is not None:
                 break
@@ -423,7 +424,7 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     finally:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)
-    done = {p.name: p.stat().st_mtime_ns for p in cases.glob("*.json")}
+    done = {p.name: p.stat().st_mtime_ns for p in stored_files(cases)}
     assert 1 <= len(done) < 4, done
     res = _cli(*args[4:])
     assert res.returncode == 0, res.stderr
