@@ -121,6 +121,17 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
+def temp_file_writer(name: str) -> int | None:
+    """The process id of the atomic write (:func:`atomic_path`) whose temporary file is called
+    ``name`` (``.<target>.<pid>.<random>.tmp<suffix>``), or None if ``name`` is not one.
+
+    >>> temp_file_writer(".case_3.json.4242.k2x9_q.tmp.json"), temp_file_writer("case_3.json")
+    (4242, None)
+    """
+    match = _TMP_RE.match(name)
+    return None if match is None else int(match["pid"])
+
+
 def remove_stale_temp_files(directory: str | os.PathLike) -> list[Path]:
     """Delete the temporary files of atomic writes that were killed before their
     rename (``.<name>.<pid>.<random>.tmp<suffix>``) in ``directory``: those of
@@ -130,11 +141,8 @@ def remove_stale_temp_files(directory: str | os.PathLike) -> list[Path]:
     if not d.is_dir():
         return removed
     for path in d.glob(".*.tmp*"):
-        match = _TMP_RE.match(path.name)
-        if match is None:
-            continue
-        pid = int(match["pid"])
-        if pid == os.getpid() or _pid_alive(pid):
+        pid = temp_file_writer(path.name)
+        if pid is None or pid == os.getpid() or _pid_alive(pid):
             continue
         with contextlib.suppress(OSError):
             path.unlink()

@@ -16,8 +16,10 @@ def sigint_default() -> None:
 
 
 def stored_files(folder: Path, pattern: str = "*.json") -> list[Path]:
-    """The files of ``folder`` matching ``pattern`` whose write has finished. An atomic write's
-    temporary file (``.<name>.<pid>.<random>.tmp<suffix>``, :func:`flexrv.cache.atomic_write_text`)
-    is hidden and not one of them, though pathlib's glob matches hidden names: a test that kills a
-    run once a file is stored must not count a file still being written."""
-    return sorted(p for p in folder.glob(pattern) if not p.name.startswith("."))
+    """The files of ``folder`` matching ``pattern`` whose write has finished: not an atomic write's
+    temporary file (:func:`flexrv.cache.temp_file_writer`), which pathlib's glob also matches
+    (``.<name>.<pid>.<random>.tmp.json``): a test that kills a run once a file is stored must not
+    count a file still being written."""
+    from flexrv.cache import temp_file_writer
+
+    return sorted(p for p in folder.glob(pattern) if temp_file_writer(p.name) is None)

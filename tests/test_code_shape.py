@@ -89,27 +89,27 @@ def constant_mode_calls(source: str) -> tuple[list[str], dict[str, int]]:
     "callee:line", and the number of calls found per phase."""
     bad, found = [], dict.fromkeys(ROW_PHASES, 0)
 
-    def helper_of(node):
+    def called(node):  # the name a call calls, else None
         return node.func.id if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) else None
 
     for fn in ast.walk(ast.parse(source)):
         if not isinstance(fn, ast.FunctionDef):
             continue
         bound = {
-            t.id: helper_of(a.value)
+            t.id: called(a.value)
             for a in ast.walk(fn)
             if isinstance(a, ast.Assign)
             for t in a.targets
             if isinstance(t, ast.Name)
         }
         for call in ast.walk(fn):
-            name = call.func.id if isinstance(call, ast.Call) and isinstance(call.func, ast.Name) else None
+            name = called(call)
             if name not in ROW_PHASES:
                 continue
             found[name] += 1
             for index, helper in ROW_PHASES[name].items():
                 arg = call.args[index] if index < len(call.args) else None
-                ok = helper_of(arg) == helper or (isinstance(arg, ast.Name) and bound.get(arg.id) == helper)
+                ok = called(arg) == helper or (isinstance(arg, ast.Name) and bound.get(arg.id) == helper)
                 if not ok:
                     bad.append(f"{name}:{call.lineno}")
     return bad, found
