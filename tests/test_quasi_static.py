@@ -236,6 +236,15 @@ def test_outputs_are_the_solver_evaluations_at_the_converged_states():
             assert np.all(exact[got["pin_force"].values > 0])
             continue
         assert np.allclose(a, b, rtol=0.0, atol=1e-8 * np.abs(b).max() + 1e-18), name
+    # a position that did not converge (NaN state) is NaN in every output; the others keep their values
+    # (every position converged: the record buffers are used unmasked; else masked copies)
+    bad = qs.copy()
+    bad[3] = np.nan
+    part = records.outputs(angles, bad)
+    keep = np.arange(len(angles)) != 3
+    for name, o in got.items():
+        assert np.all(np.isnan(part[name].values[3])), name
+        assert np.array_equal(part[name].values[keep], o.values[keep]), name
 
 
 def test_cli_te_json_matches_saved_results(tmp_path):
