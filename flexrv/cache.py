@@ -132,6 +132,17 @@ def temp_file_writer(name: str) -> int | None:
     return None if match is None else int(match["pid"])
 
 
+def finished_files(directory: str | os.PathLike, pattern: str = "*.json") -> list[Path]:
+    """The files of ``directory`` matching ``pattern`` whose write has finished, sorted: not an
+    atomic write's temporary file (:func:`temp_file_writer`), which a glob also matches
+    (``.<name>.<pid>.<random>.tmp.json`` ends in ``.json``); [] if ``directory`` does not exist.
+    What counts as a stored case of a study, or a stored file of a run that is being killed."""
+    d = Path(directory)
+    if not d.is_dir():
+        return []
+    return sorted(p for p in d.glob(pattern) if temp_file_writer(p.name) is None)
+
+
 def remove_stale_temp_files(directory: str | os.PathLike) -> list[Path]:
     """Delete the temporary files of atomic writes that were killed before their
     rename (``.<name>.<pid>.<random>.tmp<suffix>``) in ``directory``: those of

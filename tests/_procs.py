@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import signal
-from pathlib import Path
 
 
 def sigint_default() -> None:
@@ -13,13 +12,3 @@ def sigint_default() -> None:
     ignored, every child inherits that, and Python then leaves it ignored: the signal would do
     nothing whatever flexrv does, and the test would test how pytest was started."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
-def stored_files(folder: Path, pattern: str = "*.json") -> list[Path]:
-    """The files of ``folder`` matching ``pattern`` whose write has finished: not an atomic write's
-    temporary file (:func:`flexrv.cache.temp_file_writer`), which pathlib's glob also matches
-    (``.<name>.<pid>.<random>.tmp.json``): a test that kills a run once a file is stored must not
-    count a file still being written."""
-    from flexrv.cache import temp_file_writer
-
-    return sorted(p for p in folder.glob(pattern) if temp_file_writer(p.name) is None)

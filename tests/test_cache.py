@@ -17,7 +17,14 @@ import pytest
 
 import flexrv
 from flexrv import cache
-from flexrv.cache import atomic_write_text, cache_dir, cached_entry, library_versions, remove_stale_temp_files
+from flexrv.cache import (
+    atomic_write_text,
+    cache_dir,
+    cached_entry,
+    finished_files,
+    library_versions,
+    remove_stale_temp_files,
+)
 
 
 @pytest.fixture()
@@ -187,6 +194,19 @@ def test_atomic_write_mode_and_stale_temp_files(tmp_path):
     shutil.rmtree(tmp_path)
     assert remove_stale_temp_files(tmp_path) == []
     assert cache.STAMP_SUFFIX.endswith(".json")
+
+
+def test_finished_files_leave_out_writes_in_progress(tmp_path):
+    """A glob for ``*.json`` also matches an atomic write's temporary file
+    (``.<name>.<pid>.<random>.tmp.json``); :func:`flexrv.cache.finished_files` counts only the
+    files whose write finished (what a study counts as its stored cases)."""
+    assert finished_files(tmp_path / "missing") == []
+    (tmp_path / f".case_1.json.{os.getpid()}.k2x9_q.tmp.json").write_text("{")
+    assert len(list(tmp_path.glob("*.json"))) == 1 and finished_files(tmp_path) == []
+    atomic_write_text(tmp_path / "case_0.json", "{}")
+    (tmp_path / "notes.txt").write_text("x")
+    assert finished_files(tmp_path) == [tmp_path / "case_0.json"]
+    assert finished_files(tmp_path, "*.txt") == [tmp_path / "notes.txt"]
 
 
 def test_cli_cache_dir_option(tmp_path):

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from flexrv.cache import finished_files
 from flexrv.errors import ConfigError
 from flexrv.sweep import load_spec, run_sweep
-from tests._procs import stored_files
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -66,12 +66,12 @@ def test_sweep_killed_and_resumed(tmp_path):
     cases_dir = out / "cases"
     deadline = time.time() + 120
     while time.time() < deadline:
-        if cases_dir.exists() and len(stored_files(cases_dir)) >= 2:
+        if cases_dir.exists() and len(finished_files(cases_dir)) >= 2:
             break
         time.sleep(0.1)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
-    done_before = {p.name: (p.stat().st_mtime_ns, p.read_text()) for p in stored_files(cases_dir)}
+    done_before = {p.name: (p.stat().st_mtime_ns, p.read_text()) for p in finished_files(cases_dir)}
     total = 8
     assert 2 <= len(done_before) < total, "the kill must land part-way through the sweep"
 
@@ -84,7 +84,7 @@ def test_sweep_killed_and_resumed(tmp_path):
     for name, (mtime, text) in done_before.items():  # nothing finished was recomputed
         path = cases_dir / name
         assert path.stat().st_mtime_ns == mtime and path.read_text() == text
-    records = [json.loads(p.read_text()) for p in stored_files(cases_dir)]
+    records = [json.loads(p.read_text()) for p in finished_files(cases_dir)]
     assert len(records) == total
     failed = [r for r in records if r["status"] != "ok"]
     # e = 1.3 (x2 sun variants) raise in the task

@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from flexrv.cache import finished_files
 from flexrv.design import load
 from flexrv.design.tolerances import load_tolerances, parse_tolerances
 from flexrv.errors import ConfigError, InputError
 from flexrv.studies.tolerance import OUTPUTS, TolerancePlan, parse_spec, sobol_indices, te_task, yield_estimate
-from tests._procs import stored_files
 
 ROOT = Path(__file__).resolve().parents[1]
 #: smoke resolution of the CLI studies: 0.1 crank revolution at 2 points per pin mesh
@@ -416,7 +416,7 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     t0 = time.time()
     try:
         while time.time() - t0 < 300:
-            if cases.is_dir() and len(stored_files(cases)) >= 1:
+            if cases.is_dir() and len(finished_files(cases)) >= 1:
                 break
             if proc.poll() is not None:
                 break
@@ -424,7 +424,7 @@ def test_sigkill_resume_identical(local_run, tmp_path):
     finally:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)
-    done = {p.name: p.stat().st_mtime_ns for p in stored_files(cases)}
+    done = {p.name: p.stat().st_mtime_ns for p in finished_files(cases)}
     assert 1 <= len(done) < 4, done
     res = _cli(*args[4:])
     assert res.returncode == 0, res.stderr
@@ -570,3 +570,27 @@ def test_study_sobol_and_what_if(tmp_path):
     bores = [r["overrides"]["errors"]["cranks"]["bore_tangential_um"] for r in records]
     x0 = np.asarray(_table(out)["x"][0][:3])
     assert any(np.allclose(b, 0.5 * x0, rtol=0, atol=1e-12) for b in bores if isinstance(b, list))
+
+
+def test_a_study_stopped_before_its_first_stored_case_leaves_no_folder(tmp_path, monkeypatch):
+    """A study that stops before any case is stored removes the folder it created, also when a
+    case was being written at that moment: the atomic write's temporary file
+    (``.<name>.<pid>.<random>.tmp.json``, which a ``*.json`` glob matches) is not a stored case.
+    A folder with a stored case is kept (the study resumes from it)."""
+    import flexrv.studies.tolerance as study
+
+    def stopped(out, *args, written="", **kw):
+        cases = out / "runs" / "cases"
+        cases.mkdir(parents=True)
+        (cases / f".case_0.json.{os.getpid()}.k2x9_q.tmp.json").write_text("{")
+        if written:
+            (cases / written).write_text("{}")
+        raise KeyboardInterrupt
+
+    for name, kept in (("", False), ("case_1.json", True)):
+        out = tmp_path / f"study{int(kept)}"
+        monkeypatch.setattr(study, "_run_in", lambda o, *a, **k: stopped(o, *a, written=name, **k))
+        cfg = study.StudyConfig(design="rv40e", samples=2, tolerances="rv40e", out=str(out))
+        with pytest.raises(KeyboardInterrupt):
+            study.run_study(cfg, progress=False)
+        assert out.exists() is kept, name

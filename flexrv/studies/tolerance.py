@@ -657,8 +657,11 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     try:
         return _run_in(out, cfg, specs, reducer, tol, design_data, progress)
     except BaseException:
-        # a study refused (or stopped) before its first evaluation leaves no folder behind
-        if created and not any((out / "runs" / "cases").glob("*.json")):
+        # a study refused (or stopped) before its first stored case leaves no folder behind (a
+        # case still being written when the study stopped is not stored)
+        from flexrv.cache import finished_files
+
+        if created and not finished_files(out / "runs" / "cases"):
             import shutil
 
             shutil.rmtree(out, ignore_errors=True)
