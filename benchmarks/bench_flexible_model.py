@@ -22,10 +22,10 @@ compiled LU and by LAPACK (scipy), CPU per factorisation.
 
 ``--rows``: the condensed rows' own cost on the compiled integrator (the preset with 5 ms ramps,
 the flexible-rings model): a run's local solves (chord iterations per solve, solves per step), then
-per recorded state of that run (each state once, in order, the warm starts carried as in the run) the
-cost of both rows' calls by phase: kinematics and pass 1, the compliance factors of every ring at the
-balls' azimuths, the front (pass 1 with the contacts and the condensed rings' local solves), the force
-call and the call with the Jacobian.
+per recorded state of that run (each state once, in order, the warm starts carried as in the run; best
+of 3 passes, one BLAS thread as in a simulation) the cost of both rows' calls by phase: kinematics and
+pass 1, the compliance factors of every ring at the balls' azimuths, the front (pass 1 with the
+contacts and the condensed rings' local solves), the force call and the call with the Jacobian.
 
 ``--paired-newton JSON``: the flexible-rings model (5 ms ramps) with the simulation's Newton
 settings and with these ``newton_options`` on top, alternating, twice each in one process:
@@ -235,6 +235,7 @@ def rows(preset: str, t_end: float) -> None:
 
     import flexrv.simulation as S
     from flexrv.model import bearing_kernel
+    from flexrv.model.kernels import single_thread_blas
     from flexrv.simulation import Simulation
 
     bk = bearing_kernel  # (a global of the compiled _row_phases)
@@ -277,14 +278,15 @@ def rows(preset: str, t_end: float) -> None:
         ("force call", 0, False),
         ("call with the Jacobian", 0, True),
     ):
-        phases(qs, vs, pack, mode, jac)  # compile, warm starts
         best = np.inf
-        for _ in range(1 if jac else 3):
-            for g in model.groups:
-                g.reset()
-            c0 = time.process_time()
-            phases(qs, vs, pack, mode, jac)
-            best = min(best, time.process_time() - c0)
+        with single_thread_blas():  # as in a simulation: the Jacobian's LAPACK inverse and BLAS products
+            phases(qs, vs, pack, mode, jac)  # compile, warm starts
+            for _ in range(3):
+                for g in model.groups:
+                    g.reset()
+                c0 = time.process_time()
+                phases(qs, vs, pack, mode, jac)
+                best = min(best, time.process_time() - c0)
         cost[label] = 1e6 * best / (qs.shape[0] - 1)
         print(f"  {label:24s} {cost[label]:8.1f} us per state (both rows)")
     c = list(cost.values())
