@@ -266,15 +266,14 @@ def test_mesh_convergence_fast():
 @pytest.mark.slow
 def test_mesh_convergence_carrier_slow():
     """rv40e carrier torsional compliance (RBE3 bores, flange held) on global sizes
-    8, 6.73, 5.66 mm (ratio 2^(1/4), pillar size 0.6875 x global; 17k-39k nodes):
-    the compliance increases monotonically (displacement FE converges from the
-    stiff side), observed Richardson rate p > 0.5, the extrapolated value within
-    8 % of the finest mesh. Measured once on 8, 5.66, 4 mm (99k nodes, 570 s CPU,
-    10 GB, too heavy for a test): 1.607e-7, 1.645e-7, 1.672e-7 rad/(N m),
-    p = 1.08, extrapolated 1.729e-7 (the re-entrant pillar roots and bore edges
-    limit the rate)."""
+    6, 5.05, 4.24 mm (ratio 2^(1/4), pillar size 0.6875 x global; the coarsest the 6.5 mm
+    ligament beside the 27 mm crank bores allows; 34k-85k nodes, ~80 s CPU, 4 GB): the
+    compliance increases monotonically (displacement FE converges from the stiff side),
+    observed Richardson rate p > 0.5, the extrapolated value within 8 % of the finest mesh.
+    Measured: 1.6512e-7, 1.6643e-7, 1.6731e-7 rad/(N m), p = 2.3, extrapolated 1.691e-7
+    (1.1 % above the finest)."""
     rv = load("rv40e")
-    h = [0.008, 0.008 / 2**0.25, 0.008 / math.sqrt(2)]
+    h = [0.006, 0.006 / 2**0.25, 0.006 / math.sqrt(2)]
     c = [carrier_compliance(rv, size=x, local_size=0.6875 * x, rigid_bound=False, cache=False).torsional for x in h]
     assert c[0] < c[1] < c[2]
     p = _observed_rate(h, c)
