@@ -159,26 +159,7 @@ def error_fields(reducer) -> dict[str, FieldInfo]:
     z = reducer.second_stage.pin_count
     zc = reducer.second_stage.disc_teeth
     out = {}
-    names = [
-        "pins.pin_radius_um",
-        "pins.pin_radial_position_um",
-        "pins.pin_tangential_position_um",
-        "cranks.eccentricity_um",
-        "cranks.eccentric_phase_arcmin",
-        "cranks.bore_radial_um",
-        "cranks.bore_tangential_um",
-        "discs.equidistant_um",
-        "discs.shift_um",
-        "discs.rotation_arcmin",
-        "discs.hole_radial_um",
-        "discs.hole_tangential_um",
-        "first_stage.sun_runout_um",
-        "first_stage.planet_runout_um",
-        "first_stage.planet_phase_arcmin",
-        "clearances.needle_extra_clearance_um",
-        "clearances.support_clearance_um",
-        *(f"discs.harmonic_order_{n}_um" for n in sorted({1, 2, zc, z})),
-    ]
+    names = [*_allowed_names(), *(f"discs.harmonic_order_{n}_um" for n in sorted({1, 2, zc, z}))]
     for key in names:
         out[key] = field_info(reducer, key)
     return out
@@ -239,6 +220,8 @@ def field_info(reducer, key: str) -> FieldInfo:
 
 
 def _allowed_names() -> list[str]:
+    """The tolerance-able error fields other than the disc profile's harmonics (whose orders
+    depend on the design: :func:`error_fields`)."""
     return [
         "pins.pin_radius_um",
         "pins.pin_radial_position_um",

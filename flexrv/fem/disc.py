@@ -102,29 +102,13 @@ def pin_contact_case(reducer, output_torque: float, crank_angle: float = 0.0, di
     (centre - (r_i + gap_i) n_i, n the profile -> pin normal) and the force
     direction -n_i on the disc."""
     from flexrv.analysis.pin_load import reducer_pin_loads
-    from flexrv.geometry.as_built import as_built, as_built_pin_gap
-    from flexrv.geometry.cycloid import nominal_disc_pose, to_disc_frame
 
-    ss = reducer.second_stage
     res = reducer_pin_loads(reducer, output_torque, crank_angle=crank_angle, disc=disc)
-    ab = as_built(reducer)
-    center, rot = nominal_disc_pose(ss.pin_count, ss.eccentricity, crank_angle + float(ab.chi0[disc]))
     # at the no-load contact pose, where the solver takes the moment arms (the
     # elastic rotation beyond it, ~1e-4 rad, moves the points by < R_p * 1e-4)
-    p = to_disc_frame(ab.pins, center, rot + res.backlash_rotation)
-    gap, normal, _ = as_built_pin_gap(
-        p,
-        ab.pin_radii,
-        ss.pin_count,
-        ss.pin_circle_radius,
-        ss.pin_radius,
-        ss.eccentricity,
-        tuple(float(v) for v in ab.disc_profile[disc]),
-        ab.profile_harmonics[disc],
-    )
-    points = p - (np.asarray(ab.pin_radii) + gap)[:, None] * normal
+    points, directions = contact_geometry(reducer, crank_angle, disc, rotation=res.backlash_rotation)
     return PinContactCase(
-        points=points, directions=-normal, forces=np.asarray(res.forces, dtype=float), disc_torque=float(res.torque)
+        points=points, directions=directions, forces=np.asarray(res.forces, dtype=float), disc_torque=float(res.torque)
     )
 
 
@@ -503,18 +487,22 @@ def body_design(reducer):
     return nominal_design(reducer).model_copy(update={"second_stage": ss})
 
 
-def contact_geometry(reducer, crank_angle: float, disc: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def contact_geometry(
+    reducer, crank_angle: float, disc: int = 0, rotation: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Contact points (z_rp, 2) and force directions on the disc (z_rp, 2), disc frame,
-    of every pin of ``reducer``'s disc ``disc`` at its conjugate pose (as
-    :func:`pin_contact_case`, without the load solve: on the unmodified profile of
-    :func:`body_design` every pin touches)."""
+    of every pin of ``reducer``'s disc ``disc`` at its conjugate pose turned by ``rotation``
+    [rad] (:func:`pin_contact_case` gives the backlash rotation of its load solve; on the
+    unmodified profile of :func:`body_design` every pin touches at the conjugate pose): the
+    pins' centres in the disc frame, their foot points on the as-built profile (centre -
+    (r_i + gap_i) n_i, n the profile -> pin normal) and the directions -n_i."""
     from flexrv.geometry.as_built import as_built, as_built_pin_gap
     from flexrv.geometry.cycloid import nominal_disc_pose, to_disc_frame
 
     ss = reducer.second_stage
     ab = as_built(reducer)
     center, rot = nominal_disc_pose(ss.pin_count, ss.eccentricity, crank_angle + float(ab.chi0[disc]))
-    p = to_disc_frame(ab.pins, center, rot)
+    p = to_disc_frame(ab.pins, center, rot + rotation)
     gap, normal, _ = as_built_pin_gap(
         p,
         ab.pin_radii,
