@@ -79,6 +79,7 @@ from flexrv.model.numerics.static_step import (
     largest_stiffness_per_mass,
     scaled_norms,
     shifted_newton_step,
+    turned_deviation,
     work_arrays,
 )
 from flexrv.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD
@@ -566,15 +567,16 @@ def equilibrium_path(
     misses = 0
     unchecked: list[int] = []
     for k, th in enumerate(angles):
-        imaged = False
-        guess = _warm_start(qs, its, kin, k, last) if k else q_start
-        if image is not None and k >= image.period and its[k - image.period] >= 0:
-            guess, imaged = image(qs[k - image.period], kin[k - image.period], kin[k]), True
+        imaged = image is not None and k >= image.period and its[k - image.period] >= 0
+        if imaged:  # (the image replaces the extrapolated start)
+            guess = image(qs[k - image.period], kin[k - image.period], kin[k])
             if check_every > 1 and k >= 2 * image.period and k % check_every:
                 qs[k], its[k], last = guess, 0, k
                 unchecked.append(k)
                 _report(progress, k, len(angles))
                 continue
+        else:
+            guess = _warm_start(qs, its, kin, k, last) if k else q_start
         qs[k], its[k] = _solve_or_restart(sm, th, guess, kin[k])
         if its[k] < 0:
             continue
@@ -661,13 +663,11 @@ def _periodic_image(sm: StaticModel, angles: np.ndarray):
             if a in lab and b in lab:
                 ia.append(mem.offset + lab.index(a))
                 ib.append(mem.offset + lab.index(b))
-    ia, ib = np.array(ia, dtype=int), np.array(ib, dtype=int)
+    ia, ib = np.array(ia, dtype=np.int64), np.array(ib, dtype=np.int64)
     c, sn = math.cos(dth), math.sin(dth)
 
     def image(q_earlier, kin_earlier, kin_now):
-        d = q_earlier - kin_earlier
-        d[ia], d[ib] = c * d[ia] - sn * d[ib], sn * d[ia] + c * d[ib]
-        return kin_now + d
+        return turned_deviation(q_earlier, kin_earlier, kin_now, ia, ib, c, sn)
 
     image.period = period
     return image

@@ -1,5 +1,6 @@
 """The per-iteration arithmetic of the quasi-static equilibrium solver
-(:meth:`flexrv.model.quasi_static.StaticModel.solve`), compiled: at the model's 15-30
+(:meth:`flexrv.model.quasi_static.StaticModel.solve`) and the per-position image of the
+periodic route (:func:`flexrv.model.quasi_static.equilibrium_path`), compiled: at the model's 15-30
 coordinates numpy's call overhead (LAPACK's solve with its checks, the norms, the
 temporaries) costs more than the arithmetic, about 40 us per iteration against the fused
 force kernel's 25-55 us, so these loops are used instead. Verified against numpy in
@@ -72,3 +73,18 @@ def shifted_newton_step(jac, f, shift, mass, arm, max_step, halve, a, piv, dq):
 def work_arrays(n: int) -> tuple[np.ndarray, np.ndarray]:
     """The (a, piv) work arrays of :func:`shifted_newton_step` for n coordinates."""
     return np.empty((n, n)), np.empty(n, dtype=np.int64)
+
+
+@njit(cache=True)
+def turned_deviation(q_earlier, kin_earlier, kin_now, ia, ib, c, s):
+    """kin_now + d with d = q_earlier - kin_earlier, its in-plane pairs (d[ia], d[ib]) turned by
+    the angle of cosine ``c`` and sine ``s``: the image of an equilibrium one crank revolution
+    later (:func:`flexrv.model.quasi_static._periodic_image`). A new array."""
+    out = q_earlier - kin_earlier
+    for j in range(ia.shape[0]):
+        x, y = out[ia[j]], out[ib[j]]
+        out[ia[j]] = c * x - s * y
+        out[ib[j]] = s * x + c * y
+    for i in range(out.shape[0]):
+        out[i] += kin_now[i]
+    return out
