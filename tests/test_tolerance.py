@@ -33,6 +33,10 @@ from flexrv.studies.tolerance import OUTPUTS, TolerancePlan, parse_spec, sobol_i
 ROOT = Path(__file__).resolve().parents[1]
 #: smoke resolution of the CLI studies: 0.1 crank revolution at 2 points per pin mesh
 SMOKE = ["--crank-revolutions", "0.1", "--points-per-mesh", "2"]
+#: the tiny study of the LocalCluster run and of the runs compared with it (4 samples, seed 3, no what-if)
+STUDY = ["rv40e", "--tolerances", "rv40e", "--samples", "4", "--seed", "3", "--what-if-samples", "0", *SMOKE]
+#: that study on a LocalCluster of one worker
+LOCAL_STUDY = [*STUDY, "--workers", "1"]
 
 
 @pytest.fixture(scope="module")
@@ -310,18 +314,7 @@ def local_run(tmp_path_factory):
     """A tiny study on a LocalCluster (1 worker): 4 samples, no what-if."""
     out = tmp_path_factory.mktemp("tol") / "local"
     res = _cli(
-        "rv40e",
-        "--tolerances",
-        "rv40e",
-        "--samples",
-        "4",
-        "--seed",
-        "3",
-        "--workers",
-        "1",
-        "--what-if-samples",
-        "0",
-        *SMOKE,
+        *LOCAL_STUDY,
         "--out",
         str(out),
         "--json",
@@ -344,18 +337,7 @@ def test_study_outputs_and_rerun_identical(local_run, tmp_path):
     assert ok.sum() >= 3
     assert np.all(t["torsional_rigidity_Nm_per_arcmin"][ok] > 100.0)
     again = _cli(
-        "rv40e",
-        "--tolerances",
-        "rv40e",
-        "--samples",
-        "4",
-        "--seed",
-        "3",
-        "--workers",
-        "1",
-        "--what-if-samples",
-        "0",
-        *SMOKE,
+        *LOCAL_STUDY,
         "--out",
         str(out),
         "--json",
@@ -363,18 +345,7 @@ def test_study_outputs_and_rerun_identical(local_run, tmp_path):
     assert again.returncode == 0 and json.loads(again.stdout)["computed_now"] == 0
     fresh = tmp_path / "fresh"
     res = _cli(
-        "rv40e",
-        "--tolerances",
-        "rv40e",
-        "--samples",
-        "4",
-        "--seed",
-        "3",
-        "--workers",
-        "1",
-        "--what-if-samples",
-        "0",
-        *SMOKE,
+        *LOCAL_STUDY,
         "--out",
         str(fresh),
         "--json",
@@ -393,18 +364,7 @@ def test_sigkill_resume_identical(local_run, tmp_path):
         "-m",
         "flexrv",
         "tolerance",
-        "rv40e",
-        "--tolerances",
-        "rv40e",
-        "--samples",
-        "4",
-        "--seed",
-        "3",
-        "--workers",
-        "1",
-        "--what-if-samples",
-        "0",
-        *SMOKE,
+        *LOCAL_STUDY,
         "--out",
         str(out),
         "--json",
@@ -477,18 +437,9 @@ def test_real_dask_scheduler_and_workers(local_run, tmp_path):
             client.wait_for_workers(2, timeout=120)
         out = tmp_path / "remote"
         res = _cli(
-            "rv40e",
-            "--tolerances",
-            "rv40e",
-            "--samples",
-            "4",
-            "--seed",
-            "3",
+            *STUDY,
             "--scheduler",
             addr,
-            "--what-if-samples",
-            "0",
-            *SMOKE,
             "--out",
             str(out),
             "--json",
