@@ -40,6 +40,21 @@ def _cache(tmp_path, monkeypatch):
 
 
 MINI = MINI_CARRIER
+#: a carrier whose slender pillars dominate its torsion (3 pillars of r = 3 mm, 40 mm long, between
+#: 8 mm plates): the pillar-frame closed form's test case
+PILLAR_FRAME = CarrierSpec(
+    plate_radius=0.04,
+    input_thickness=0.008,
+    output_thickness=0.008,
+    gap=0.04,
+    crank_circle_radius=0.015,
+    crank_bore_radius=0.005,
+    n_cranks=3,
+    center_bore_radius=0.0,
+    pillar_circle_radius=0.025,
+    pillar_radius=0.003,
+    pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
+)
 
 
 @pytest.fixture(scope="module")
@@ -177,19 +192,7 @@ def test_pillars_between_rigid_plates_match_the_built_in_frame():
     sway + pillar torsion, :func:`pillar_frame_stiffness`) within 1.5 % (observed
     0.3-0.5 % on three meshes; the residual is the 3-D clamp effect at the
     pillar roots and the mesh)."""
-    spec = CarrierSpec(
-        plate_radius=0.04,
-        input_thickness=0.008,
-        output_thickness=0.008,
-        gap=0.04,
-        crank_circle_radius=0.015,
-        crank_bore_radius=0.005,
-        n_cranks=3,
-        center_bore_radius=0.0,
-        pillar_circle_radius=0.025,
-        pillar_radius=0.003,
-        pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
-    )
+    spec = PILLAR_FRAME
     mesh = generate_mesh(spec, "carrier", 0.008, local_size=0.0015, cache=False).data
     E, nu = 2.1e11, 0.3
     fe = assemble(mesh.nodes, mesh.tets, E, nu, 7800.0)
@@ -237,19 +240,7 @@ def test_mesh_convergence_fast():
     from above (stiffness decreases monotonically: 5288, 5255, 5229 N m/rad
     observed), the observed rate p > 0.3 (0.62 observed: non-nested meshes and
     the re-entrant pillar roots), the finest within 1 % of the closed form."""
-    spec = CarrierSpec(
-        plate_radius=0.04,
-        input_thickness=0.008,
-        output_thickness=0.008,
-        gap=0.04,
-        crank_circle_radius=0.015,
-        crank_bore_radius=0.005,
-        n_cranks=3,
-        center_bore_radius=0.0,
-        pillar_circle_radius=0.025,
-        pillar_radius=0.003,
-        pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
-    )
+    spec = PILLAR_FRAME
     E, nu = 2.1e11, 0.3
     k_cf = pillar_frame_stiffness(3, spec.pillar_circle_radius, spec.pillar_radius, spec.gap, E, nu)
     h = [0.003, 0.003 / math.sqrt(2), 0.0015]
@@ -273,7 +264,7 @@ def test_mesh_convergence_carrier_slow():
     Measured: 1.6512e-7, 1.6643e-7, 1.6731e-7 rad/(N m), p = 2.3, extrapolated 1.691e-7
     (1.1 % above the finest)."""
     rv = load("rv40e")
-    h = [0.006, 0.006 / 2**0.25, 0.006 / math.sqrt(2)]
+    h = [COARSE, COARSE / 2**0.25, COARSE / math.sqrt(2)]
     c = [carrier_compliance(rv, size=x, local_size=0.6875 * x, rigid_bound=False, cache=False).torsional for x in h]
     assert c[0] < c[1] < c[2]
     p = _observed_rate(h, c)
