@@ -25,13 +25,10 @@ from flexrv.fem.carrier import (
 from flexrv.fem.static import solve_static
 from flexrv.meshing import build_mesh
 from flexrv.meshing.mesh import generate_mesh
-from flexrv.meshing.parts import CarrierSpec, spec_for
+from flexrv.meshing.parts import spec_for
 from flexrv.units import RAD_PER_ARCMIN
-from tests._parts import MINI_CARRIER
-
-#: coarse mesh of the rv40e carrier for the fast tests [m]: at most the 6.5 mm ligament between the
-#: 27 mm centre bore and the crank bores
-COARSE = 0.006
+from tests._parts import MINI_CARRIER, PILLAR_FRAME
+from tests._parts import RV40E_CARRIER_COARSE as COARSE
 
 
 @pytest.fixture(autouse=True)
@@ -40,21 +37,6 @@ def _cache(tmp_path, monkeypatch):
 
 
 MINI = MINI_CARRIER
-#: a carrier whose slender pillars dominate its torsion (3 pillars of r = 3 mm, 40 mm long, between
-#: 8 mm plates): the pillar-frame closed form's test case
-PILLAR_FRAME = CarrierSpec(
-    plate_radius=0.04,
-    input_thickness=0.008,
-    output_thickness=0.008,
-    gap=0.04,
-    crank_circle_radius=0.015,
-    crank_bore_radius=0.005,
-    n_cranks=3,
-    center_bore_radius=0.0,
-    pillar_circle_radius=0.025,
-    pillar_radius=0.003,
-    pillar_angles=tuple(math.pi / 3 + 2 * math.pi * k / 3 for k in range(3)),
-)
 
 
 @pytest.fixture(scope="module")

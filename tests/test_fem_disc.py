@@ -23,6 +23,7 @@ from flexrv.fem.disc import (
 )
 from flexrv.meshing import build_mesh
 from flexrv.units import RAD_PER_ARCMIN
+from tests._parts import RV40E_CARRIER_COARSE
 
 SIZE, LOCAL = 0.008, 0.004
 
@@ -180,8 +181,8 @@ def test_body_compliances_for_the_budget():
     from flexrv.fem.disc import body_compliances
 
     rv = load("rv40e")
-    b = body_compliances(rv, carrier_size=0.006, disc_size=0.008, disc_angles=1)
-    c = carrier_compliance(rv, size=0.006)
+    b = body_compliances(rv, carrier_size=RV40E_CARRIER_COARSE, disc_size=0.008, disc_angles=1)
+    c = carrier_compliance(rv, size=RV40E_CARRIER_COARSE)
     d = disc_compliance(rv, size=0.008)
     assert b["carrier"]["compliance_rad_per_Nm"] == c.torsional
     # the budget's disc: patch compliances of the unmodified body (flexrv.fem.disc.disc_torsion_sweep, keyed on

@@ -66,7 +66,7 @@ def test_sweep_killed_and_resumed(tmp_path):
     cases_dir = out / "cases"
     deadline = time.time() + 120
     while time.time() < deadline:
-        if cases_dir.exists() and len(finished_files(cases_dir)) >= 2:
+        if len(finished_files(cases_dir)) >= 2:
             break
         time.sleep(0.1)
     os.killpg(proc.pid, signal.SIGKILL)
