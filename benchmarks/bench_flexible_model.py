@@ -167,7 +167,7 @@ def factorisations(model, repeat: int = 30) -> None:
     nx, nb = len(xs), int(blocks[:, 1].sum())
     w, piv, ys = s.copy(), np.zeros(n, np.int64), np.zeros((nb, nx))
     dk = np.zeros(block_lu.work_sizes(blocks, xs)[1])
-    schur, xpiv, lu = np.zeros((nx, nx)), np.zeros(nx, np.int64), np.zeros((n, n))
+    schur, xpiv, lu, by = np.zeros((nx, nx)), np.zeros(nx, np.int64), np.zeros((n, n)), np.zeros((nx, nx))
 
     def cpu(fn) -> float:
         fn()
@@ -177,7 +177,7 @@ def factorisations(model, repeat: int = 30) -> None:
         return 1e3 * (time.process_time() - c0) / repeat
 
     def blocked():
-        block_lu.block_factor(w, blocks, xs, piv, ys, dk, schur, xpiv)
+        block_lu.block_factor(w, blocks, xs, piv, ys, dk, schur, xpiv, by)
 
     t_block = cpu(blocked)
     t_dense = cpu(lambda: linalg.lu_factor(s, lu, piv))

@@ -8,13 +8,16 @@ Run:  python benchmarks/bench_integrator.py [--t-end 0.3] [--presets rv40e rv221
 The run starts at rated speed (speed and load ramps shortened to 5 ms, as
 benchmarks/bench_rigid.py) and lasts ``--t-end``. Three runs per repeat, alternating:
 Exudyn's integrator, the compiled one (its defaults) and the compiled one with Exudyn's
-predictor (``newton_options={"extrapolatedPredictor": False}``: the same steps and Newton
-iterations as Exudyn's). Printed per preset and run:
+predictor (compiled*, ``newton_options={"extrapolatedPredictor": False}``: the same steps and
+Newton iterations as Exudyn's). The flexible rings, whose default is Exudyn's predictor with
+partial Jacobians (:mod:`flexrv.model.numerics.gen_alpha`), run compiled* with the extrapolated
+one and a fourth run, compiled-, without partial Jacobians (the settings before them).
+Printed per preset and run:
 
 * CPU s of the solve per simulated s (``time.process_time`` around the segment loop,
   ``Simulation.timing["solve_cpu_s"]``; the best of ``--repeat`` runs, and the spread) and
   the ratio Exudyn / compiled;
-* Newton iterations, Jacobians and force-kernel calls per step;
+* Newton iterations, Jacobians (full; partial ones in brackets) and force-kernel calls per step;
 * TE mean and peak-to-peak over t > 0.05 s [arcsec];
 * the share of a compiled step outside the force kernel: 1 - (kernel calls x the
   kernel's cost per call) / solve time, the cost per call measured on the run's
@@ -48,12 +51,28 @@ from _shared import quick_ramps
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-#: the runs of a repeat: (label, integrator, newton_options)
+#: the runs of a repeat: (label, integrator, newton_options); compiled* the compiled integrator with
+#: the other predictor than its default for the model (the rigid and ball models extrapolate, the
+#: flexible rings keep their iteration matrix and use Exudyn's: flexrv.simulation.KEPT_MATRIX_COMPILED)
 RUNS = (
     ("exudyn", "exudyn", None),
     ("compiled", "compiled", None),
     ("compiled*", "compiled", {"extrapolatedPredictor": False}),
 )
+#: the flexible rings' runs: compiled- is the compiled integrator without partial Jacobians, with the
+#: extrapolated predictor (its settings before the partial Jacobians)
+FLEXIBLE_RUNS = (
+    ("exudyn", "exudyn", None),
+    ("compiled", "compiled", None),
+    ("compiled*", "compiled", {"extrapolatedPredictor": True}),
+    ("compiled-", "compiled", {"partialJacobian": False, "extrapolatedPredictor": True}),
+)
+
+
+def runs(model_name: str) -> tuple:
+    """The runs of a repeat for ``model_name`` (:data:`RUNS`, :data:`FLEXIBLE_RUNS`)."""
+    return FLEXIBLE_RUNS if model_name == "flexible" else RUNS
+
 
 #: slots of the split's clock array: [unused (failure counters sum slot 0), kernel, whole calls,
 #: the steps' first kernel calls, first calls]
@@ -168,7 +187,7 @@ def split(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> No
 
     integrator.CompiledIntegrator.__init__ = with_clocks
     try:
-        for label, integ, options in RUNS[1:]:
+        for label, integ, options in runs(model_name)[1:]:
             sim.run(t_end=0.002, integrator=integ, checkpoint_s=None, newton_options=options)  # (compile)
             for _ in range(repeat):
                 clocks[:] = 0
@@ -194,7 +213,7 @@ def bench(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> di
 
     sim = Simulation(quick_ramps(name), model=model_name)
     model = sim.build()
-    for _, integ, options in RUNS:  # compile / load the kernels
+    for _, integ, options in runs(model_name):  # compile / load the kernels
         sim.run(t_end=0.002, integrator=integ, checkpoint_s=None, newton_options=options)
     states = {}
     orig = S._Records.__init__
@@ -207,7 +226,7 @@ def bench(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> di
     out = {}
     try:
         for _ in range(repeat):
-            for label, integ, options in RUNS:
+            for label, integ, options in runs(model_name):
                 res, timing, mean, pp = _run(sim, integ, t_end, options)
                 best = out.get(label)
                 cpus = [timing["solve_cpu_s"], *(best["cpus"] if best else [])]
@@ -218,6 +237,7 @@ def bench(name: str, t_end: float, repeat: int, model_name: str = "rigid") -> di
                         "steps": timing["steps"],
                         "newton": timing["newton_iterations"],
                         "jacobians": timing["jacobians"],
+                        "partial": timing.get("partial_jacobians", 0),
                         "calls": model.fused.stats[0],
                         "mean": mean,
                         "pp": pp,
@@ -254,14 +274,15 @@ def main() -> None:
             spread = ", ".join(f"{x / args.t_end:.3f}" for x in sorted(r["cpus"]))
             print(
                 f"  {label:9s} CPU {r['cpu'] / args.t_end:7.3f} s per simulated s ({spread})   "
-                f"Newton {r['newton'] / r['steps']:.2f}  Jacobians {r['jacobians'] / r['steps']:.2f}  "
+                f"Newton {r['newton'] / r['steps']:.2f}  Jacobians {r['jacobians'] / r['steps']:.2f} "
+                f"(partial {r['partial'] / r['steps']:.2f})  "
                 f"kernel calls {r['calls'] / r['steps']:.2f} per step   "
                 f"TE mean {r['mean']:+.5f}  p-p {r['pp']:.4f} arcsec"
             )
-        print(
-            f"  ratio Exudyn / compiled CPU: {e['cpu'] / c['cpu']:.2f}x "
-            f"(compiled with Exudyn's predictor: {e['cpu'] / out['compiled*']['cpu']:.2f}x)"
-        )
+        other = e["cpu"] / out["compiled*"]["cpu"]
+        print(f"  ratio Exudyn / compiled CPU: {e['cpu'] / c['cpu']:.2f}x (compiled*: {other:.2f}x)")
+        if "compiled-" in out:
+            print(f"  compiled- / compiled CPU: {out['compiled-']['cpu'] / c['cpu']:.2f}x")
         if "kernel_share" not in c:
             print("  compiled: Jacobians kept across steps, the kernel's share: --split")
             continue

@@ -70,6 +70,13 @@ DEFAULT_DT = 1e-4
 #: dense system, as the rigid model), and run faster with Exudyn's 0.5 (benchmarks/bench_balls.py)
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
+#: the compiled integrator's own settings where the iteration matrix is kept across steps (above
+#: SPARSE_ABOVE coordinates: the flexible rings). With its partial Jacobians (the elements outside the
+#: balls' blocks fresh every step, flexrv.model.numerics.gen_alpha) Exudyn's predictor needed fewer
+#: full Jacobians than the extrapolated one (rv40e 0.10 / 0.16 per step, rv221 0.20 / 0.25) and less CPU
+#: (rv40e 9.5 / 11.1, rv221 6.5 / 7.4 s per simulated s; benchmarks/bench_integrator.py --model flexible)
+KEPT_MATRIX_COMPILED = {"extrapolatedPredictor": False}
+
 
 #: largest number of time steps of one run (~1.5 h of wall time for the rigid model
 #: at ~2.5 ms per step); more is refused before any work with a step-count estimate
@@ -309,6 +316,7 @@ class Simulation:
             simulated_s=float(records.ts[k - 1]) if k else 0.0,
             newton_iterations=counts["newton"],
             jacobians=counts["jacobians"],
+            partial_jacobians=counts.get("partial_jacobians", 0),
             segments=counts["segments"],
             checkpoint_s=checkpoint.spent if checkpoint is not None else 0.0,
             force_calls={g.name: g.stats[0] for g in model.groups},
@@ -871,6 +879,8 @@ class _CompiledSegments:
         # the Exudyn path's per-model settings (_ExudynSegments): a Jacobian every step for the small dense
         # systems, kept across steps above SPARSE_ABOVE coordinates; MODEL_NEWTON for balls with inertia
         options = {"modifiedNewtonJacUpdatePerStep": model.n <= SPARSE_ABOVE}
+        if model.n > SPARSE_ABOVE:
+            options |= KEPT_MATRIX_COMPILED
         if model.info.get("ball_inertia", True):
             options |= MODEL_NEWTON.get(model.name, {})
         options |= dict(newton_options or {})
@@ -954,7 +964,12 @@ class _CompiledSegments:
     def counts(self) -> dict:
         self._sync_stats()
         c = self.integ.counts()
-        return {"newton": c["newton"], "jacobians": c["jacobians"], "segments": self._segments}
+        return {
+            "newton": c["newton"],
+            "jacobians": c["jacobians"],
+            "partial_jacobians": c["partial_jacobians"],
+            "segments": self._segments,
+        }
 
 
 def _newton_options_allowed(exu) -> dict[str, object]:

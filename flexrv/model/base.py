@@ -206,6 +206,10 @@ class KernelGroup(ForceGroup):
     kernel = None
     #: field of the pack that holds the time inputs at t (:meth:`time_inputs`), "" if none
     time_field: str = ""
+    #: the element's Jacobian costs several force calls (the bearing rows' condensed rings): the
+    #: compiled integrator keeps it between full Jacobians while it refreshes the other elements'
+    #: every step (partial Jacobians, :mod:`flexrv.model.numerics.gen_alpha`)
+    costly_jacobian: bool = False
     #: names of the outputs that are dissipated friction power [W] (>= 0), summed into ``friction_power``
     friction_outputs: tuple[str, ...] = ()
     #: rows of the run summary computed from this element's outputs (:class:`SummaryRow`)

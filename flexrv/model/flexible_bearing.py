@@ -919,6 +919,7 @@ class BallBearingGroup(KernelGroup):
     name = "main_bearing"
     kind = "bearing_rows"
     kernel = staticmethod(rows_kernel)
+    costly_jacobian = True
     parameters = staticmethod(bearing_rows_parameters)
     summary_rows = (
         SummaryRow("max_ball_load_outer_N", "N", "largest ball-outer raceway normal load", "ball_load_outer", "max"),

@@ -42,13 +42,17 @@ NEWTON_OPTIONS = {
     "adaptInitialResidual": "adapt_initial_residual",
     "modifiedNewtonJacUpdatePerStep": "jacobian_each_step",
     "extrapolatedPredictor": "extrapolate",
+    "partialJacobian": "partial_jacobian",
 }
 
 #: the compiled integrator's own Newton options (not Exudyn settings) and their defaults.
 #: ``extrapolatedPredictor``: a step's predictor moved by the previous step's Newton correction
 #: (:mod:`flexrv.model.numerics.gen_alpha`); False: Exudyn's predictor, the same steps and Newton
-#: iterations as Exudyn's integrator
-COMPILED_ONLY_OPTIONS = {"extrapolatedPredictor": True}
+#: iterations as Exudyn's integrator. ``partialJacobian``: with dense blocks and a kept iteration
+#: matrix (the flexible rings), every step refreshes the Jacobians of the elements other than the costly
+#: ones (gen_alpha's partial Jacobians; :func:`partial_jacobian_allowed`); False: only the contraction
+#: test refreshes the matrix, as Exudyn's modified Newton
+COMPILED_ONLY_OPTIONS = {"extrapolatedPredictor": True, "partialJacobian": True}
 
 #: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's
 #: minimumStepSize to 1e-3 dt)
@@ -87,6 +91,18 @@ def compiled_eligible(model) -> str | None:
     return None
 
 
+def partial_jacobian_allowed(fused, blocks) -> bool:
+    """True if the fused element's cheap elements (``costly_jacobian`` False) act on no
+    coordinate of the dense ``blocks`` [(start, size), ...] and a costly one is present: the
+    condition of gen_alpha's partial Jacobians (only the Schur complement changes)."""
+    inside = np.zeros(fused.n, bool)
+    for start, size in blocks:
+        inside[start : start + size] = True
+    costly = [getattr(g, "costly_jacobian", False) for g, _ in fused.slots]
+    cheap_inside = any(inside[fused.index[idx]].any() for (g, idx), c in zip(fused.slots, costly) if not c)
+    return bool(blocks) and any(costly) and not cheap_inside
+
+
 def compiled_newton_options(options: dict | None) -> dict:
     """The gen_alpha keywords of Exudyn-named Newton ``options``; an option the compiled
     integrator does not honour is an InputError naming it and the allowed ones."""
@@ -123,14 +139,17 @@ class CompiledIntegrator:
                 stiff[s, s] = m.stiffness_matrix
             if m.damping_matrix is not None:
                 damp[s, s] = m.damping_matrix
+        blocks = dense_blocks(model)
+        newton = dict(newton or {})
+        newton["partial_jacobian"] = newton.get("partial_jacobian", False) and partial_jacobian_allowed(fused, blocks)
         self.state = gen_alpha.new_state(
             mass,
             stiff,
             damp,
             spectral_radius=spectral_radius,
             tolerance=tuple(tolerance),
-            blocks=dense_blocks(model) or None,
-            **(newton or {}),
+            blocks=blocks or None,
+            **newton,
         )
         #: the state's dense blocks, or None without (the block elimination is then not compiled in)
         self.blocks = self.state.blocks if self.state.blocks.shape[0] else None
@@ -183,6 +202,7 @@ class CompiledIntegrator:
         return {
             "newton": int(ip[gen_alpha.I_NEWTON]),
             "jacobians": int(ip[gen_alpha.I_JACOBIANS]),
+            "partial_jacobians": int(ip[gen_alpha.I_PARTIALS]),
             "calls": int(ip[gen_alpha.I_CALLS]),
             "jacobian_calls": int(ip[gen_alpha.I_JACCALLS]),
         }

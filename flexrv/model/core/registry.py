@@ -164,8 +164,8 @@ def _fused_source(specs, callee_hash: str) -> str:
         "",
         "from numba import njit",
         "",
-        "from flexrv.model.numerics.gen_alpha import CONVERGED, EVALUATE, FAILED, I_JAC, after_eval, begin_step, "
-        "finish_step",
+        "from flexrv.model.numerics.gen_alpha import CONVERGED, EVALUATE, FAILED, I_JAC, JAC_FULL, after_eval, "
+        "begin_step, finish_step, zero_outer",
     ]
     for i, s in enumerate(specs):
         lines.append(f"from {s.kernel.py_func.__module__} import {s.kernel.py_func.__name__} as k{i}")
@@ -192,7 +192,8 @@ def _fused_source(specs, callee_hash: str) -> str:
         "            s, d = src[r], dst[r]",
     ]
     lines += _copy_lines(12, "d[i, c]", "s[c]", "s.shape[0]")
-    lines += _integrate_source(n, timed, packs, tin, [i for i, _ in checks])
+    costly = [i for i, s in enumerate(specs) if getattr(s.group, "costly_jacobian", False)]
+    lines += _integrate_source(n, timed, packs, tin, [i for i, _ in checks], costly)
     return "\n".join(lines)
 
 
@@ -205,15 +206,26 @@ def _step_check(spec):
     return check
 
 
-def _evaluate_lines(indent: int, n: int, q: str, v: str, jac: str) -> list[str]:
+def _evaluate_lines(indent: int, n: int, q: str, v: str, jac: str, costly=()) -> list[str]:
     """Lines of one evaluation of the elements at (``q``, ``v``): f (and, if ``jac``, the
-    Jacobians) zeroed, then every element's kernel once, in registration order."""
+    Jacobians) zeroed, then every element's kernel once, in registration order; the elements
+    ``costly`` add their Jacobians (if ``jck``) into ``jqc``, ``jvc`` (set by the caller's lines:
+    with ``kept``, the state's kept arrays, and the others' Jacobians live outside the blocks only)."""
     pad = " " * indent
     lines = [f"{pad}f[:] = 0.0", f"{pad}if {jac}:", f"{pad}    jq[:, :] = 0.0", f"{pad}    jv[:, :] = 0.0"]
-    return lines + [f"{pad}k{i}({q}, {v}, f, jq, jv, {jac}, p{i})" for i in range(n)]
+    if costly:
+        lines[1:] = [
+            f"{pad}if {jac} and kept:",
+            f"{pad}    zero_outer(st, jq, jv)",
+            f"{pad}elif {jac}:",
+            f"{pad}    jq[:, :] = 0.0",
+            f"{pad}    jv[:, :] = 0.0",
+        ]
+    args = {i: "jqc, jvc, jck" if i in costly else f"jq, jv, {jac}" for i in range(n)}
+    return lines + [f"{pad}k{i}({q}, {v}, f, {args[i]}, p{i})" for i in range(n)]
 
 
-def _integrate_source(n: int, timed: list, packs: str, tin: str, checks=()) -> list[str]:
+def _integrate_source(n: int, timed: list, packs: str, tin: str, checks=(), costly=()) -> list[str]:
     """Lines of the generated ``fused_integrate``: with ``mode`` :data:`INTEGRATE`, the compiled
     generalized-alpha (:mod:`flexrv.model.numerics.gen_alpha`, reverse communication) over the
     steps ending at ``times``; returns (steps done, status: 0 done, 1 Newton failed, 2 an
@@ -225,7 +237,9 @@ def _integrate_source(n: int, timed: list, packs: str, tin: str, checks=()) -> l
     row is recorded yet), while rows remain (``rec[1]``), except the last step of the call when
     ``rec[2]`` (a segment's end, recorded as the next one's start). ``blocks``: the state's
     dense diagonal blocks (``st.blocks``), or None for a state without (the block elimination is
-    then not compiled in).
+    then not compiled in). The elements ``costly`` (``costly_jacobian``) put their Jacobians into
+    the state's kept arrays ``st.jqk``, ``st.jvk`` when it has them (partial Jacobians), and only
+    when the state asks for every element's (``ip[I_JAC]`` = JAC_FULL).
 
     With ``mode`` :data:`ROWS` (:data:`ROWS_JAC`: with the Jacobians), the elements evaluated
     at every row i of ``qs``, ``vs`` with the time inputs of row i, their records copied into
@@ -258,7 +272,17 @@ def _integrate_source(n: int, timed: list, packs: str, tin: str, checks=()) -> l
         "            for c in ctrs:",
         "                before += c[0]",
     ]
-    lines += _evaluate_lines(12, n, "q", "v", "jac")
+    if costly:
+        lines += [
+            "            kept = not rows and st.jqk.shape[0] > 0",
+            f"            jck = mode == {ROWS_JAC} if rows else st.ip[I_JAC] == JAC_FULL",
+            "            jqc = st.jqk if kept else jq",
+            "            jvc = st.jvk if kept else jv",
+            "            if kept and jck:",
+            "                jqc[:, :] = 0.0",
+            "                jvc[:, :] = 0.0",
+        ]
+    lines += _evaluate_lines(12, n, "q", "v", "jac", costly)
     lines += [
         "            after = 0",
         "            for c in ctrs:",

@@ -62,17 +62,18 @@ def work_sizes(blocks: np.ndarray, xs: np.ndarray) -> tuple[int, int]:
 
 
 @njit(cache=True)
-def block_factor(s, blocks, xs, piv, ys, dk, schur, xpiv):
+def block_factor(s, blocks, xs, piv, ys, dk, schur, xpiv, by):
     """Factor ``s`` (n x n, read only) by block elimination (module docstring): ``dk`` (the
     sum of the blocks' squared sizes) the blocks' LU factors, each contiguous (the inner
     loops vectorise; a strided view of ``s`` ran 1.7x slower), ``piv`` (n,) their pivots
-    (local to each block), ``ys`` (sum of the block sizes, n_x) the Y_k stacked, ``schur``
-    (n_x, n_x) and ``xpiv`` (n_x,) the factored Schur complement. False if a block or the
-    Schur complement is singular."""
+    (local to each block), ``ys`` (sum of the block sizes, n_x) the Y_k stacked, ``by``
+    (n_x, n_x) the sum of the B_k Y_k (kept: a matrix that differs only in A has the Schur
+    complement A - by), ``schur`` (n_x, n_x) and ``xpiv`` (n_x,) the factored Schur
+    complement. False if a block or the Schur complement is singular."""
     nx = xs.shape[0]
     for a in range(nx):
         for c in range(nx):
-            schur[a, c] = s[xs[a], xs[c]]
+            by[a, c] = 0.0
     o = 0
     o2 = 0
     for kb in range(blocks.shape[0]):
@@ -108,15 +109,18 @@ def block_factor(s, blocks, xs, piv, ys, dk, schur, xpiv):
             inv = 1.0 / d[i, i]
             for c in range(nx):
                 y[i, c] *= inv
-        for a in range(nx):  # Schur complement A - B_k Y_k
+        for a in range(nx):  # the sum of B_k Y_k
             ra = xs[a]
             for i in range(m):
                 bai = s[ra, b0 + i]
                 if bai != 0.0:
                     for c in range(nx):
-                        schur[a, c] -= bai * y[i, c]
+                        by[a, c] += bai * y[i, c]
         o += m
         o2 += m * m
+    for a in range(nx):  # the Schur complement A - sum B_k Y_k
+        for c in range(nx):
+            schur[a, c] = s[xs[a], xs[c]] - by[a, c]
     return lu_factor(schur, schur, xpiv)
 
 

@@ -37,6 +37,20 @@ with one extra iteration, a second failure switches to full Newton; after
 earlier step of the same size (within 1e-9 relative) and computes a new one only when
 the contraction test above asks for it or after a restart.
 
+Partial Jacobians (``partial_jacobian``, with dense blocks and ``jacobian_each_step`` False):
+the elements whose Jacobian is costly (the bearing rows' condensed rings, about four force calls)
+put it into the state's own arrays ``jqk``, ``jvk`` (the caller's :data:`I_JAC` is then
+:data:`JAC_FULL` for them, :data:`JAC_PARTIAL` for the others), which keep it between full
+Jacobians. A step that keeps the factorised matrix asks instead for a partial Jacobian at its
+predictor: the other elements' Jacobians, fresh, with the kept ones. These elements touch only
+coordinates outside the dense blocks (the caller checks it), so the blocks' factors D_k = L_k U_k,
+Y_k and the sum of B_k Y_k stay, and only the Schur complement (n_x x n_x) is formed and factored
+again. Measured on rv40e's flexible rings: the contacts outside the rows (the needle bearings
+opening and closing, the pins) change their Jacobians from step to step, the rows' hardly (the
+rows' Jacobian 11 steps old, the others' current: the iteration's contraction 0.003; every
+Jacobian one step old: 0.6); Newton iterations per step 3.37 -> 1.69, full Jacobians 0.17 -> 0.10
+(benchmarks/bench_integrator.py --model flexible, docs/integrator.md).
+
 Reverse communication: the functions here never call the force; the caller (the
 generated ``fused_integrate`` of :mod:`flexrv.model.core.registry`, or the test's
 driver) evaluates f (and, when :data:`I_JAC` asks, df/dq, df/dv) at the state the
@@ -68,8 +82,10 @@ N_PAR = 14
 # -- indices into the state's integer registers ``ip``
 I_PHASE, I_IT, I_JACREQ, I_FULL, I_RESTARTED, I_EXTRA, I_JAC, I_MAXIT, I_MAXMOD = range(9)
 I_NEWTON, I_JACOBIANS, I_CALLS, I_JACCALLS, I_ADAPT = 9, 10, 11, 12, 13
-I_EACHSTEP, I_FACTORED, I_EXTRAPOLATE = 14, 15, 16
-N_IP = 17
+I_EACHSTEP, I_FACTORED, I_EXTRAPOLATE, I_PARTIAL, I_PARTIALS = 14, 15, 16, 17, 18
+N_IP = 19
+# -- values of ip[I_JAC]: no Jacobian, every element's, the elements' outside the kept ones (partial)
+JAC_NONE, JAC_FULL, JAC_PARTIAL = 0, 1, 2
 # -- phases: what the evaluation the state machine asked for is
 PH_PREDICTOR, PH_ITERATE, PH_JACOBIAN = 0, 1, 2
 # -- results of after_eval
@@ -78,9 +94,10 @@ EVALUATE, CONVERGED, FAILED = 1, 0, -1
 #: the integrator state: parameters, registers, current and start-of-step vectors,
 #: residual, Newton correction, the constant matrices and the factorised iteration matrix; with
 #: dense diagonal blocks (``blocks`` (K, 2) of (start, size); empty: one dense LU), the block
-#: elimination's other coordinates ``xs``, its Y_k, blocks' LU, Schur complement, pivots and work vectors
-#: (:mod:`flexrv.model.numerics.block_lu`), and the nonzero pattern of M, K, D by rows (row pointers ``rp``,
-#: column indices ``ci``: the residual's products skip the zeros)
+#: elimination's other coordinates ``xs``, its Y_k, blocks' LU, Schur complement, pivots and work vectors,
+#: the sum of the B_k Y_k (:mod:`flexrv.model.numerics.block_lu`), the nonzero pattern of M, K, D by rows (row
+#: pointers ``rp``, column indices ``ci``: the residual's products skip the zeros) and the kept Jacobians of the
+#: costly elements ``jqk``, ``jvk`` (n x n with partial Jacobians, else 0 x 0)
 GaState = pack_type(
     "GaState",
     ("par", (np.float64, 1)),
@@ -110,8 +127,11 @@ GaState = pack_type(
     ("xpiv", (np.int64, 1)),
     ("tx", (np.float64, 1)),
     ("zx", (np.float64, 1)),
+    ("by", (np.float64, 2)),
     ("rp", (np.int64, 1)),
     ("ci", (np.int64, 1)),
+    ("jqk", (np.float64, 2)),
+    ("jvk", (np.float64, 2)),
 )
 
 
@@ -141,6 +161,7 @@ def new_state(
     blocks=None,
     jacobian_each_step: bool = True,
     extrapolate: bool = False,
+    partial_jacobian: bool = False,
 ) -> GaState:
     """A fresh integrator state for the constant matrices M, K, D (n x n; K, D default 0).
     ``extrapolate``: the predictor moved by the previous step's Newton correction (module
@@ -151,7 +172,10 @@ def new_state(
     (:mod:`flexrv.model.numerics.block_lu`); None: one dense LU. ``jacobian_each_step``
     False: a step starts with the factorised iteration matrix of an earlier step of the
     same size (a new one only when the contraction test asks for it, Exudyn's
-    ``modifiedNewtonJacUpdatePerStep = False``)."""
+    ``modifiedNewtonJacUpdatePerStep = False``). ``partial_jacobian``: with blocks and
+    ``jacobian_each_step`` False, a step that keeps the factorised matrix refreshes the Jacobians
+    of the elements other than the costly ones (module docstring; the caller checks that these
+    elements stay outside the blocks); ignored otherwise."""
     m = np.ascontiguousarray(mass, dtype=float)
     n = m.shape[0]
     z = np.zeros((n, n))
@@ -172,6 +196,8 @@ def new_state(
     ip[I_MAXIT], ip[I_MAXMOD], ip[I_ADAPT] = max_iterations, max_modified, int(adapt_initial_residual)
     ip[I_EACHSTEP] = int(jacobian_each_step)
     ip[I_EXTRAPOLATE] = int(extrapolate)
+    partial = bool(partial_jacobian) and len(bl) > 0 and not jacobian_each_step
+    ip[I_PARTIAL] = int(partial)
     vec = [np.zeros(n) for _ in range(12)]
     nonzero = (m != 0) | (stiff != 0) | (damp != 0)
     rp = np.concatenate(([0], np.cumsum(nonzero.sum(axis=1)))).astype(np.int64)
@@ -192,8 +218,11 @@ def new_state(
         np.zeros(nx, np.int64),
         np.zeros(nx),
         np.zeros(nx),
+        np.zeros((nx, nx)),
         rp,
         np.nonzero(nonzero)[1].astype(np.int64),
+        np.zeros((n, n) if partial else (0, 0)),
+        np.zeros((n, n) if partial else (0, 0)),
     )
 
 
@@ -221,11 +250,18 @@ def _predict(st):
 
 
 @njit(cache=True, inline="always")
+def _factored_at(st, h):
+    """True if the factorised iteration matrix is of step size h (within 1e-9 relative)."""
+    return st.ip[I_FACTORED] != 0 and abs(st.par[P_HJAC] - h) <= 1e-9 * h
+
+
+@njit(cache=True, inline="always")
 def begin_step(st, h):
     """Start a step of size h from the current state: store it as the start of the step,
     predict, and ask for an evaluation with the Jacobian (the Jacobian of every step), or
     without it when the iteration matrix of an earlier step of this size is kept
-    (``jacobian_each_step`` False)."""
+    (``jacobian_each_step`` False; with partial Jacobians, with the Jacobians of the elements
+    other than the costly ones)."""
     for i in range(st.q.shape[0]):  # (loops: a slice copy compiles its error message's formatting)
         st.q0[i] = st.q[i]
         st.v0[i] = st.v[i]
@@ -239,8 +275,8 @@ def begin_step(st, h):
     ip[I_EXTRA] = 0
     ip[I_JACREQ] = 0
     ip[I_PHASE] = PH_PREDICTOR
-    kept = ip[I_EACHSTEP] == 0 and ip[I_FACTORED] != 0 and abs(st.par[P_HJAC] - h) <= 1e-9 * h
-    ip[I_JAC] = 0 if kept else 1
+    kept = ip[I_EACHSTEP] == 0 and _factored_at(st, h)
+    ip[I_JAC] = (JAC_PARTIAL if ip[I_PARTIAL] else JAC_NONE) if kept else JAC_FULL
     _predict(st)
     for i in range(st.q.shape[0]):
         st.qp[i] = st.q[i]
@@ -279,25 +315,67 @@ def _residual(st, f):
 
 
 @njit(cache=True, inline="always")
+def zero_outer(st, jq, jv):
+    """Zero ``jq``, ``jv`` on the coordinates outside the dense blocks (xs, xs): with partial
+    Jacobians the only entries the cheap elements write and :func:`_factor` reads (n_x^2
+    entries instead of n^2 per evaluation with the Jacobian)."""
+    xs = st.xs
+    for a in range(xs.shape[0]):
+        for c in range(xs.shape[0]):
+            jq[xs[a], xs[c]] = 0.0
+            jv[xs[a], xs[c]] = 0.0
+
+
+@njit(cache=True, inline="always")
 def _factor(st, jq, jv, blocks):
-    """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; False if singular.
-    ``blocks``: ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
+    """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; with partial Jacobians
+    (``st.jqk`` not empty) df/dq is the costly elements' kept ``st.jqk`` plus the other
+    elements' ``jq``, read on the coordinates outside the blocks only (:func:`zero_outer`), the
+    same for df/dv; with ``ip[I_JAC]`` = :data:`JAC_PARTIAL` only the Schur complement of the
+    dense blocks, from their kept factors (module docstring). False if singular. ``blocks``:
+    ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
     par = st.par
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
+    jqk, jvk = st.jqk, st.jvk
+    if blocks is not None and blocks.shape[0] > 0 and st.ip[I_JAC] == JAC_PARTIAL:
+        xs, m, k, d = st.xs, st.mass, st.stiff, st.damp
+        for a in range(xs.shape[0]):
+            i = xs[a]
+            for c in range(xs.shape[0]):
+                j = xs[c]
+                dq = jq[i, j] + jqk[i, j]
+                dv = jv[i, j] + jvk[i, j]
+                st.schur[a, c] = bp * m[i, j] + k[i, j] + gp * d[i, j] - dq - gp * dv - st.by[a, c]
+        st.ip[I_PARTIALS] += 1
+        ok = lu_factor(st.schur, st.schur, st.xpiv)
+        st.ip[I_FACTORED] = int(ok)
+        return ok
     n = st.q.shape[0]
     s = st.lu
-    for i in range(n):  # (the entries where M, K, D are zero: the same sum, bit for bit, without the zeros)
-        for j in range(n):
-            s[i, j] = (0.0 - jq[i, j]) - gp * jv[i, j]
-        for k in range(st.rp[i], st.rp[i + 1]):
-            j = st.ci[k]
-            s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
+    if jqk.shape[0] > 0:  # the costly elements' Jacobians in jqk, jvk, the others' in jq, jv on (xs, xs) only
+        for i in range(n):
+            for j in range(n):
+                s[i, j] = (0.0 - jqk[i, j]) - gp * jvk[i, j]
+            for k in range(st.rp[i], st.rp[i + 1]):
+                j = st.ci[k]
+                s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jqk[i, j] - gp * jvk[i, j]
+        xs = st.xs
+        for a in range(xs.shape[0]):
+            for c in range(xs.shape[0]):
+                s[xs[a], xs[c]] -= jq[xs[a], xs[c]] + gp * jv[xs[a], xs[c]]
+    else:
+        for i in range(n):  # (the entries where M, K, D are zero: the same sum, bit for bit, without the zeros)
+            for j in range(n):
+                s[i, j] = (0.0 - jq[i, j]) - gp * jv[i, j]
+            for k in range(st.rp[i], st.rp[i + 1]):
+                j = st.ci[k]
+                s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
     st.ip[I_JACOBIANS] += 1
     st.par[P_HJAC] = h
     if blocks is not None and blocks.shape[0] > 0:
-        ok = block_factor(s, blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv)
+        ok = block_factor(s, blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.by)
     else:
         ok = lu_factor(s, s, st.piv)  # in place
     st.ip[I_FACTORED] = int(ok)
@@ -322,7 +400,7 @@ def _correct(st, blocks):
     st.ip[I_IT] += 1
     st.ip[I_NEWTON] += 1
     st.ip[I_PHASE] = PH_ITERATE
-    st.ip[I_JAC] = 0
+    st.ip[I_JAC] = JAC_NONE
     return EVALUATE
 
 
@@ -342,7 +420,7 @@ def _restart(st):
         st.aa[i] = st.aa0[i]
     _predict(st)
     ip[I_PHASE] = PH_JACOBIAN
-    ip[I_JAC] = 1
+    ip[I_JAC] = JAC_FULL
     return EVALUATE
 
 
@@ -396,21 +474,23 @@ def _iterate(st, res, blocks):
     if ip[I_JACREQ] or ip[I_FULL]:  # a new Jacobian at this state first
         ip[I_JACREQ] = 0
         ip[I_PHASE] = PH_JACOBIAN
-        ip[I_JAC] = 1
+        ip[I_JAC] = JAC_FULL
         return EVALUATE
     return _correct(st, blocks)
 
 
 @njit(cache=True, inline="always")
 def after_eval(st, f, jq, jv, blocks):
-    """Take the evaluation f (and df/dq, df/dv if ``ip[I_JAC]``) at the current state;
+    """Take the evaluation f (and df/dq, df/dv if ``ip[I_JAC]``: every element's, or with
+    :data:`JAC_PARTIAL` those of the elements other than the costly ones, whose kept
+    Jacobians are in ``st.jqk``, ``st.jvk``) at the current state;
     return :data:`EVALUATE` (evaluate again at the new current state, with the Jacobian if
     ``ip[I_JAC]``), :data:`CONVERGED` or :data:`FAILED`. ``blocks``: ``st.blocks``, or None
     for a state without dense blocks: the block elimination is then pruned at compile time
     (not compiled in; the rigid models' integrator)."""
     ip = st.ip
     ip[I_CALLS] += 1
-    ip[I_JACCALLS] += ip[I_JAC]
+    ip[I_JACCALLS] += ip[I_JAC] == JAC_FULL
     res = _residual(st, f)
     phase = ip[I_PHASE]
     if phase == PH_PREDICTOR:
