@@ -59,8 +59,8 @@ RUNS = (
     ("compiled", "compiled", None),
     ("compiled*", "compiled", {"extrapolatedPredictor": False}),
 )
-#: the flexible rings' runs: compiled- is the compiled integrator without partial Jacobians, with the
-#: extrapolated predictor (its settings before the partial Jacobians)
+#: the flexible rings' runs (their default predictor is Exudyn's); compiled- is the compiled integrator
+#: without partial Jacobians, with the extrapolated predictor (its settings before the partial Jacobians)
 FLEXIBLE_RUNS = (
     ("exudyn", "exudyn", None),
     ("compiled", "compiled", None),

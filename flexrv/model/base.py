@@ -208,7 +208,9 @@ class KernelGroup(ForceGroup):
     time_field: str = ""
     #: the element's Jacobian costs several force calls (the bearing rows' condensed rings): the
     #: compiled integrator keeps it between full Jacobians while it refreshes the other elements'
-    #: every step (partial Jacobians, :mod:`flexrv.model.numerics.gen_alpha`)
+    #: every step (partial Jacobians, :mod:`flexrv.model.numerics.gen_alpha`). On the class: it can
+    #: be (the generated integrator routes its Jacobian); on an instance: it is (an element may set
+    #: it per instance, :func:`flexrv.model.integrator.partial_jacobian_allowed` reads the instance)
     costly_jacobian: bool = False
     #: names of the outputs that are dissipated friction power [W] (>= 0), summed into ``friction_power``
     friction_outputs: tuple[str, ...] = ()

@@ -919,6 +919,8 @@ class BallBearingGroup(KernelGroup):
     name = "main_bearing"
     kind = "bearing_rows"
     kernel = staticmethod(rows_kernel)
+    #: its Jacobian can be costly (the integrator routes it, :class:`~flexrv.model.base.KernelGroup`);
+    #: an instance's is where a row has a condensed ring (set in __init__)
     costly_jacobian = True
     parameters = staticmethod(bearing_rows_parameters)
     summary_rows = (
@@ -945,6 +947,10 @@ class BallBearingGroup(KernelGroup):
             index.append(np.concatenate(parts).astype(np.int64))
         self.members = tuple(members)
         self.sizes = sizes
+        #: the condensed rings' dense tangents (~1 ms per Jacobian call on rv40e, about four force calls)
+        #: make the Jacobian costly; between rigid rings the quasi-static balls' condensed Jacobian comes
+        #: with the ball solve (partial Jacobians there: rv40e 2.96 -> 3.16 s per simulated s, not used)
+        self.costly_jacobian = any(_is_condensed(r) for row in rows for r in (row.inner, row.outer))
         self._index = index  # per row: element coordinates in the group's local vector
         self._own = own
         #: per row, the live work arrays of its evaluation (records included; :func:`row_work`)

@@ -48,10 +48,10 @@ NEWTON_OPTIONS = {
 #: the compiled integrator's own Newton options (not Exudyn settings) and their defaults.
 #: ``extrapolatedPredictor``: a step's predictor moved by the previous step's Newton correction
 #: (:mod:`flexrv.model.numerics.gen_alpha`); False: Exudyn's predictor, the same steps and Newton
-#: iterations as Exudyn's integrator. ``partialJacobian``: with dense blocks and a kept iteration
-#: matrix (the flexible rings), every step refreshes the Jacobians of the elements other than the costly
-#: ones (gen_alpha's partial Jacobians; :func:`partial_jacobian_allowed`); False: only the contraction
-#: test refreshes the matrix, as Exudyn's modified Newton
+#: iterations as Exudyn's integrator. ``partialJacobian``: where an element's Jacobian is costly (the
+#: bearing rows of the ball and flexible-ring models), it is kept and the other elements' refreshed at
+#: every step (gen_alpha's partial Jacobians; :func:`partial_jacobian_allowed`); False: every element's
+#: Jacobian at every step or, with a kept matrix, when the contraction test asks, as Exudyn's modified Newton
 COMPILED_ONLY_OPTIONS = {"extrapolatedPredictor": True, "partialJacobian": True}
 
 #: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's
@@ -92,15 +92,15 @@ def compiled_eligible(model) -> str | None:
 
 
 def partial_jacobian_allowed(fused, blocks) -> bool:
-    """True if the fused element's cheap elements (``costly_jacobian`` False) act on no
-    coordinate of the dense ``blocks`` [(start, size), ...] and a costly one is present: the
-    condition of gen_alpha's partial Jacobians (only the Schur complement changes)."""
+    """True if a costly element (``costly_jacobian``) is present and the fused element's cheap
+    elements act on no coordinate of the dense ``blocks`` [(start, size), ...]: the condition of
+    gen_alpha's partial Jacobians (with a kept matrix only the Schur complement changes)."""
     inside = np.zeros(fused.n, bool)
     for start, size in blocks:
         inside[start : start + size] = True
     costly = [getattr(g, "costly_jacobian", False) for g, _ in fused.slots]
     cheap_inside = any(inside[fused.index[idx]].any() for (g, idx), c in zip(fused.slots, costly) if not c)
-    return bool(blocks) and any(costly) and not cheap_inside
+    return any(costly) and not cheap_inside
 
 
 def compiled_newton_options(options: dict | None) -> dict:

@@ -37,19 +37,22 @@ with one extra iteration, a second failure switches to full Newton; after
 earlier step of the same size (within 1e-9 relative) and computes a new one only when
 the contraction test above asks for it or after a restart.
 
-Partial Jacobians (``partial_jacobian``, with dense blocks and ``jacobian_each_step`` False):
-the elements whose Jacobian is costly (the bearing rows' condensed rings, about four force calls)
-put it into the state's own arrays ``jqk``, ``jvk`` (the caller's :data:`I_JAC` is then
-:data:`JAC_FULL` for them, :data:`JAC_PARTIAL` for the others), which keep it between full
-Jacobians. A step that keeps the factorised matrix asks instead for a partial Jacobian at its
-predictor: the other elements' Jacobians, fresh, with the kept ones. These elements touch only
-coordinates outside the dense blocks (the caller checks it), so the blocks' factors D_k = L_k U_k,
-Y_k and the sum of B_k Y_k stay, and only the Schur complement (n_x x n_x) is formed and factored
-again. Measured on rv40e's flexible rings: the contacts outside the rows (the needle bearings
-opening and closing, the pins) change their Jacobians from step to step, the rows' hardly (the
-rows' Jacobian 11 steps old, the others' current: the iteration's contraction 0.003; every
-Jacobian one step old: 0.6); Newton iterations per step 3.37 -> 1.69, full Jacobians 0.17 -> 0.10
-(benchmarks/bench_integrator.py --model flexible, docs/integrator.md).
+Partial Jacobians (``partial_jacobian``): the elements whose Jacobian is costly (the bearing
+rows: the flexible rings' condensed tangents, about four force calls; the quasi-static balls'
+condensed Jacobian) put it into the state's own arrays ``jqk``, ``jvk`` only when the state asks
+for every element's (:data:`I_JAC` = :data:`JAC_FULL`), which keep it; a step's predictor asks
+for the other elements' Jacobians only (:data:`JAC_PARTIAL`) once the kept arrays hold one, where
+it would otherwise ask for every element's (a step without a kept matrix) or none (a step that
+keeps the factorised matrix). The contraction test and a restart ask for every element's, as
+before. With dense blocks the other elements touch only coordinates outside them (the caller
+checks it, ``xs``; without blocks ``xs`` is every coordinate), so a step that keeps the matrix
+keeps the blocks' factors D_k = L_k U_k, Y_k and the sum of B_k Y_k, and forms and factors only
+the Schur complement (n_x x n_x) again. Measured (docs/integrator.md): the contacts outside the
+rows (the needle bearings opening and closing, the pins) change their Jacobians from step to
+step, the rows' hardly: the Newton iteration's contraction with the rows' Jacobian 11 steps old
+and the others' current 0.003 on the flexible rings, 0.001 on the quasi-static balls (every
+Jacobian one step old: 0.6 / 0.7). The flexible rings' Newton iterations per step 3.37 -> 1.69,
+full Jacobians 0.17 -> 0.10 (benchmarks/bench_integrator.py --model flexible).
 
 Reverse communication: the functions here never call the force; the caller (the
 generated ``fused_integrate`` of :mod:`flexrv.model.core.registry`, or the test's
@@ -82,8 +85,8 @@ N_PAR = 14
 # -- indices into the state's integer registers ``ip``
 I_PHASE, I_IT, I_JACREQ, I_FULL, I_RESTARTED, I_EXTRA, I_JAC, I_MAXIT, I_MAXMOD = range(9)
 I_NEWTON, I_JACOBIANS, I_CALLS, I_JACCALLS, I_ADAPT = 9, 10, 11, 12, 13
-I_EACHSTEP, I_FACTORED, I_EXTRAPOLATE, I_PARTIAL, I_PARTIALS = 14, 15, 16, 17, 18
-N_IP = 19
+I_EACHSTEP, I_FACTORED, I_EXTRAPOLATE, I_PARTIAL, I_PARTIALS, I_KEPT = 14, 15, 16, 17, 18, 19
+N_IP = 20
 # -- values of ip[I_JAC]: no Jacobian, every element's, the elements' outside the kept ones (partial)
 JAC_NONE, JAC_FULL, JAC_PARTIAL = 0, 1, 2
 # -- phases: what the evaluation the state machine asked for is
@@ -172,10 +175,9 @@ def new_state(
     (:mod:`flexrv.model.numerics.block_lu`); None: one dense LU. ``jacobian_each_step``
     False: a step starts with the factorised iteration matrix of an earlier step of the
     same size (a new one only when the contraction test asks for it, Exudyn's
-    ``modifiedNewtonJacUpdatePerStep = False``). ``partial_jacobian``: with blocks and
-    ``jacobian_each_step`` False, a step that keeps the factorised matrix refreshes the Jacobians
-    of the elements other than the costly ones (module docstring; the caller checks that these
-    elements stay outside the blocks); ignored otherwise."""
+    ``modifiedNewtonJacUpdatePerStep = False``). ``partial_jacobian``: the costly elements'
+    Jacobians kept, the others' refreshed at every step's predictor (module docstring; the
+    caller checks that these elements stay outside the blocks)."""
     m = np.ascontiguousarray(mass, dtype=float)
     n = m.shape[0]
     z = np.zeros((n, n))
@@ -185,8 +187,8 @@ def new_state(
         bl, xs = block_structure(n, blocks)
         if not all(has_block_structure(a, bl) for a in (m, stiff, damp)):
             raise ValueError("the mass, stiffness or damping matrix couples two of the dense blocks")
-    else:
-        bl, xs = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
+    else:  # (partial Jacobians: every coordinate is outside the blocks)
+        bl, xs = np.zeros((0, 2), np.int64), np.arange(n if partial_jacobian else 0, dtype=np.int64)
     (nb, nd), nx = work_sizes(bl, xs), len(xs)
     par = np.zeros(N_PAR)
     par[P_ALPHA_M], par[P_ALPHA_F], par[P_GAMMA], par[P_BETA] = coefficients(spectral_radius)
@@ -196,7 +198,7 @@ def new_state(
     ip[I_MAXIT], ip[I_MAXMOD], ip[I_ADAPT] = max_iterations, max_modified, int(adapt_initial_residual)
     ip[I_EACHSTEP] = int(jacobian_each_step)
     ip[I_EXTRAPOLATE] = int(extrapolate)
-    partial = bool(partial_jacobian) and len(bl) > 0 and not jacobian_each_step
+    partial = bool(partial_jacobian)
     ip[I_PARTIAL] = int(partial)
     vec = [np.zeros(n) for _ in range(12)]
     nonzero = (m != 0) | (stiff != 0) | (damp != 0)
@@ -260,8 +262,8 @@ def begin_step(st, h):
     """Start a step of size h from the current state: store it as the start of the step,
     predict, and ask for an evaluation with the Jacobian (the Jacobian of every step), or
     without it when the iteration matrix of an earlier step of this size is kept
-    (``jacobian_each_step`` False; with partial Jacobians, with the Jacobians of the elements
-    other than the costly ones)."""
+    (``jacobian_each_step`` False); with partial Jacobians whose kept arrays hold one, with
+    the Jacobians of the elements other than the costly ones in both cases."""
     for i in range(st.q.shape[0]):  # (loops: a slice copy compiles its error message's formatting)
         st.q0[i] = st.q[i]
         st.v0[i] = st.v[i]
@@ -276,7 +278,10 @@ def begin_step(st, h):
     ip[I_JACREQ] = 0
     ip[I_PHASE] = PH_PREDICTOR
     kept = ip[I_EACHSTEP] == 0 and _factored_at(st, h)
-    ip[I_JAC] = (JAC_PARTIAL if ip[I_PARTIAL] else JAC_NONE) if kept else JAC_FULL
+    if ip[I_KEPT]:
+        ip[I_JAC] = JAC_PARTIAL
+    else:
+        ip[I_JAC] = JAC_NONE if kept else JAC_FULL
     _predict(st)
     for i in range(st.q.shape[0]):
         st.qp[i] = st.q[i]
@@ -331,15 +336,16 @@ def _factor(st, jq, jv, blocks):
     """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; with partial Jacobians
     (``st.jqk`` not empty) df/dq is the costly elements' kept ``st.jqk`` plus the other
     elements' ``jq``, read on the coordinates outside the blocks only (:func:`zero_outer`), the
-    same for df/dv; with ``ip[I_JAC]`` = :data:`JAC_PARTIAL` only the Schur complement of the
-    dense blocks, from their kept factors (module docstring). False if singular. ``blocks``:
-    ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
+    same for df/dv; with ``ip[I_JAC]`` = :data:`JAC_PARTIAL` and the blocks' factors of this
+    step size only the Schur complement, from the kept factors (module docstring). False if
+    singular. ``blocks``: ``st.blocks``, or None for a state without blocks (:func:`after_eval`)."""
     par = st.par
     h = par[P_H]
     bp = (1.0 - par[P_ALPHA_M]) / (h * h * par[P_BETA] * (1.0 - par[P_ALPHA_F]))
     gp = par[P_GAMMA] / (h * par[P_BETA])
     jqk, jvk = st.jqk, st.jvk
-    if blocks is not None and blocks.shape[0] > 0 and st.ip[I_JAC] == JAC_PARTIAL:
+    partial = st.ip[I_JAC] == JAC_PARTIAL
+    if partial and blocks is not None and blocks.shape[0] > 0 and _factored_at(st, h):
         xs, m, k, d = st.xs, st.mass, st.stiff, st.damp
         for a in range(xs.shape[0]):
             i = xs[a]
@@ -372,7 +378,11 @@ def _factor(st, jq, jv, blocks):
             for k in range(st.rp[i], st.rp[i + 1]):
                 j = st.ci[k]
                 s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
-    st.ip[I_JACOBIANS] += 1
+    if partial:
+        st.ip[I_PARTIALS] += 1
+    else:
+        st.ip[I_JACOBIANS] += 1
+        st.ip[I_KEPT] = int(jqk.shape[0] > 0)
     st.par[P_HJAC] = h
     if blocks is not None and blocks.shape[0] > 0:
         ok = block_factor(s, blocks, st.xs, st.piv, st.ys, st.dk, st.schur, st.xpiv, st.by)
