@@ -340,7 +340,7 @@ def test_partial_jacobians():
         qs, costly = _partial_system(st, 0.01, 200, kc, e, k, c, xs)
         ip = st.ip
         runs[label] = (qs, costly, ip[gen_alpha.I_JACOBIANS], ip[gen_alpha.I_PARTIALS], ip[gen_alpha.I_NEWTON])
-    full, kept, part = runs["full"], runs["kept"], runs["partial"]
+    full, kept = runs["full"], runs["kept"]
     assert kept[3] == 0 and full[2] == 200
     for label in ("partial", "partial each step", "partial, no blocks"):
         r = runs[label]
