@@ -38,8 +38,8 @@ earlier step of the same size (within 1e-9 relative) and computes a new one only
 the contraction test above asks for it or after a restart.
 
 Partial Jacobians (``partial_jacobian``): the elements whose Jacobian is costly (the bearing
-rows: the flexible rings' condensed tangents, about four force calls; the quasi-static balls'
-condensed Jacobian) put it into the state's own arrays ``jqk``, ``jvk`` only when the state asks
+rows with condensed rings: their dense tangents, about four force calls) put it into the
+state's own arrays ``jqk``, ``jvk`` only when the state asks
 for every element's (:data:`I_JAC` = :data:`JAC_FULL`), which keep it; a step's predictor asks
 for the other elements' Jacobians only (:data:`JAC_PARTIAL`) once the kept arrays hold one, where
 it would otherwise ask for every element's (a step without a kept matrix) or none (a step that
@@ -50,9 +50,9 @@ keeps the blocks' factors D_k = L_k U_k, Y_k and the sum of B_k Y_k, and forms a
 the Schur complement (n_x x n_x) again. Measured (docs/integrator.md): the contacts outside the
 rows (the needle bearings opening and closing, the pins) change their Jacobians from step to
 step, the rows' hardly: the Newton iteration's contraction with the rows' Jacobian 11 steps old
-and the others' current 0.003 on the flexible rings, 0.001 on the quasi-static balls (every
-Jacobian one step old: 0.6 / 0.7). The flexible rings' Newton iterations per step 3.37 -> 1.69,
-full Jacobians 0.17 -> 0.10 (benchmarks/bench_integrator.py --model flexible).
+and the others' current 0.003 on the flexible rings (every Jacobian one step old: 0.6). Their
+Newton iterations per step 3.37 -> 1.69, full Jacobians 0.17 -> 0.10
+(benchmarks/bench_integrator.py --model flexible).
 
 Reverse communication: the functions here never call the force; the caller (the
 generated ``fused_integrate`` of :mod:`flexrv.model.core.registry`, or the test's
