@@ -419,16 +419,17 @@ def test_choice_of_the_integrator():
 
 
 def test_compiled_only_option_refused_on_exudyn():
-    """``extrapolatedPredictor`` is the compiled integrator's own option: on Exudyn's
-    integrator one InputError naming it; a wrong type is refused by name as any Newton
-    option."""
+    """``extrapolatedPredictor`` and ``partialJacobian`` are the compiled integrator's own
+    options: on Exudyn's integrator one InputError naming them; a wrong type is refused by
+    name as any Newton option."""
     from flexrv.simulation import Simulation
 
     sim = Simulation("rv40e")
-    with pytest.raises(InputError, match="'extrapolatedPredictor': an option of the compiled integrator only"):
-        sim.run(t_end=1e-3, integrator="exudyn", newton_options={"extrapolatedPredictor": False})
-    with pytest.raises(InputError, match="extrapolatedPredictor"):
-        sim.run(t_end=1e-3, newton_options={"extrapolatedPredictor": 1.5})
+    for option in ("extrapolatedPredictor", "partialJacobian"):
+        with pytest.raises(InputError, match=f"'{option}': an option of the compiled integrator only"):
+            sim.run(t_end=1e-3, integrator="exudyn", newton_options={option: False})
+        with pytest.raises(InputError, match=option):
+            sim.run(t_end=1e-3, newton_options={option: 1.5})
 
 
 def test_cli_refuses_compiled_for_python_groups(tmp_path, capfd):
