@@ -71,10 +71,11 @@ DEFAULT_DT = 1e-4
 MODEL_NEWTON = {"balls": {"modifiedNewtonContractivity": 0.25}}
 
 #: the compiled integrator's own settings where the iteration matrix is kept across steps (above
-#: SPARSE_ABOVE coordinates: the flexible rings). With its partial Jacobians (the elements outside the
-#: balls' blocks fresh every step, flexrv.model.numerics.gen_alpha) Exudyn's predictor needed fewer
-#: full Jacobians than the extrapolated one (rv40e 0.10 / 0.16 per step, rv221 0.20 / 0.25) and less CPU
-#: (rv40e 9.5 / 11.1, rv221 6.5 / 7.4 s per simulated s; benchmarks/bench_integrator.py --model flexible)
+#: SPARSE_ABOVE coordinates) and partial Jacobians act (flexrv.model.integrator.partial_jacobians: the
+#: flexible rings). With them (the elements outside the balls' blocks fresh every step,
+#: flexrv.model.numerics.gen_alpha) Exudyn's predictor needed fewer full Jacobians than the extrapolated one
+#: (rv40e 0.10 / 0.16 per step, rv221 0.20 / 0.25) and less CPU (rv40e 9.5 / 11.1, rv221 6.5 / 7.4 s per
+#: simulated s; benchmarks/bench_integrator.py --model flexible)
 KEPT_MATRIX_COMPILED = {"extrapolatedPredictor": False}
 
 
@@ -873,13 +874,13 @@ class _CompiledSegments:
 
     def __init__(self, model, spectral_radius, newton_tolerance, newton_options, plan: _RunPlan):
         from flexrv.model.base import ForceGroup
-        from flexrv.model.integrator import CompiledIntegrator, compiled_newton_options
+        from flexrv.model.integrator import CompiledIntegrator, compiled_newton_options, partial_jacobians
 
         self.model = model
         # the Exudyn path's per-model settings (_ExudynSegments): a Jacobian every step for the small dense
         # systems, kept across steps above SPARSE_ABOVE coordinates; MODEL_NEWTON for balls with inertia
         options = {"modifiedNewtonJacUpdatePerStep": model.n <= SPARSE_ABOVE}
-        if model.n > SPARSE_ABOVE:
+        if model.n > SPARSE_ABOVE and partial_jacobians(model):
             options |= KEPT_MATRIX_COMPILED
         if model.info.get("ball_inertia", True):
             options |= MODEL_NEWTON.get(model.name, {})

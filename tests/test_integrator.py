@@ -368,6 +368,24 @@ def test_partial_jacobians_only_for_cheap_elements_outside_the_blocks():
     assert not partial_jacobian_allowed(fused, [(2, 3), (5, 3)])
 
 
+def test_partial_jacobians_by_model():
+    """Which models run with partial Jacobians by default: the flexible rings (bearing rows with
+    condensed rings) do, measured on a 6-step run (the first step's full Jacobian, then one partial
+    per step); the rigid model (no costly element) and the quasi-static balls between rigid rings
+    (their Jacobian comes with the ball solve) do not; ``partialJacobian`` False turns them off."""
+    from flexrv.model.integrator import partial_jacobians
+    from flexrv.simulation import Simulation
+
+    sim = Simulation("rv40e", model="flexible")
+    sim.run(t_end=6e-4)
+    t = sim.timing
+    assert partial_jacobians(sim.build()) and t["partial_jacobians"] >= t["steps"] - 1 >= 5
+    sim.run(t_end=6e-4, newton_options={"partialJacobian": False})
+    assert sim.timing["partial_jacobians"] == 0 and sim.timing["jacobians"] >= 1
+    for model in ("rigid", "balls"):
+        assert not partial_jacobians(Simulation("rv40e", model=model).build())
+
+
 def test_extrapolated_predictor_same_states_closer_start():
     """extrapolate=True (the predictor moved by the previous step's Newton correction,
     along the iterates' own directions (dq, gamma' dq, beta' dq)) converges to the states

@@ -33,6 +33,7 @@ import numpy as np
 from flexrv.errors import InputError
 from flexrv.model.core.registry import INTEGRATE, dense_blocks
 from flexrv.model.numerics import gen_alpha
+from flexrv.model.numerics.block_lu import block_structure
 
 #: Exudyn Newton settings the compiled integrator honours (name -> keyword of gen_alpha.new_state)
 NEWTON_OPTIONS = {
@@ -95,12 +96,16 @@ def partial_jacobian_allowed(fused, blocks) -> bool:
     """True if a costly element (``costly_jacobian``) is present and the fused element's cheap
     elements act on no coordinate of the dense ``blocks`` [(start, size), ...]: the condition of
     gen_alpha's partial Jacobians (with a kept matrix only the Schur complement changes)."""
-    inside = np.zeros(fused.n, bool)
-    for start, size in blocks:
-        inside[start : start + size] = True
+    _, outside = block_structure(fused.n, blocks)
     costly = [getattr(g, "costly_jacobian", False) for g, _ in fused.slots]
-    cheap_inside = any(inside[fused.index[idx]].any() for (g, idx), c in zip(fused.slots, costly) if not c)
-    return any(costly) and not cheap_inside
+    cheap = [fused.index[idx] for (g, idx), c in zip(fused.slots, costly) if not c]
+    return any(costly) and all(np.isin(ix, outside).all() for ix in cheap)
+
+
+def partial_jacobians(model) -> bool:
+    """True if the compiled integrator of ``model`` runs with partial Jacobians by default
+    (:func:`partial_jacobian_allowed` for its fused element and dense blocks)."""
+    return model.fused is not None and partial_jacobian_allowed(model.fused, dense_blocks(model))
 
 
 def compiled_newton_options(options: dict | None) -> dict:
