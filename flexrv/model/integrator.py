@@ -50,9 +50,10 @@ NEWTON_OPTIONS = {
 #: ``extrapolatedPredictor``: a step's predictor moved by the previous step's Newton correction
 #: (:mod:`flexrv.model.numerics.gen_alpha`); False: Exudyn's predictor, the same steps and Newton
 #: iterations as Exudyn's integrator. ``partialJacobian``: where an element's Jacobian is costly (the
-#: bearing rows of the ball and flexible-ring models), it is kept and the other elements' refreshed at
-#: every step (gen_alpha's partial Jacobians; :func:`partial_jacobian_allowed`); False: every element's
-#: Jacobian at every step or, with a kept matrix, when the contraction test asks, as Exudyn's modified Newton
+#: bearing rows with condensed rings: the flexible-ring model), it is kept and the other elements'
+#: refreshed at every step (gen_alpha's partial Jacobians; :func:`partial_jacobians`); False: every
+#: element's Jacobian at every step or, with a kept matrix, when the contraction test asks, as Exudyn's
+#: modified Newton
 COMPILED_ONLY_OPTIONS = {"extrapolatedPredictor": True, "partialJacobian": True}
 
 #: smallest reduced step, as a fraction of the nominal step (flexrv.simulation sets Exudyn's
@@ -144,16 +145,15 @@ class CompiledIntegrator:
                 stiff[s, s] = m.stiffness_matrix
             if m.damping_matrix is not None:
                 damp[s, s] = m.damping_matrix
-        blocks = dense_blocks(model)
         newton = dict(newton or {})
-        newton["partial_jacobian"] = newton.get("partial_jacobian", False) and partial_jacobian_allowed(fused, blocks)
+        newton["partial_jacobian"] = newton.get("partial_jacobian", False) and partial_jacobians(model)
         self.state = gen_alpha.new_state(
             mass,
             stiff,
             damp,
             spectral_radius=spectral_radius,
             tolerance=tuple(tolerance),
-            blocks=blocks or None,
+            blocks=dense_blocks(model) or None,
             **newton,
         )
         #: the state's dense blocks, or None without (the block elimination is then not compiled in)
