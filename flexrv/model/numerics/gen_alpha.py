@@ -332,6 +332,20 @@ def zero_outer(st, jq, jv):
 
 
 @njit(cache=True, inline="always")
+def _assemble(st, jq, jv, bp, gp):
+    """st.lu = beta' M + K + gamma' D - jq - gamma' jv (the entries where M, K, D are zero: the
+    same sum, bit for bit, without the zeros)."""
+    s = st.lu
+    n = st.q.shape[0]
+    for i in range(n):
+        for j in range(n):
+            s[i, j] = (0.0 - jq[i, j]) - gp * jv[i, j]
+        for k in range(st.rp[i], st.rp[i + 1]):
+            j = st.ci[k]
+            s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
+
+
+@njit(cache=True, inline="always")
 def _factor(st, jq, jv, blocks):
     """Factorise S = beta' M + K + gamma' D - df/dq - gamma' df/dv; with partial Jacobians
     (``st.jqk`` not empty) df/dq is the costly elements' kept ``st.jqk`` plus the other
@@ -358,26 +372,15 @@ def _factor(st, jq, jv, blocks):
         ok = lu_factor(st.schur, st.schur, st.xpiv)
         st.ip[I_FACTORED] = int(ok)
         return ok
-    n = st.q.shape[0]
     s = st.lu
     if jqk.shape[0] > 0:  # the costly elements' Jacobians in jqk, jvk, the others' in jq, jv on (xs, xs) only
-        for i in range(n):
-            for j in range(n):
-                s[i, j] = (0.0 - jqk[i, j]) - gp * jvk[i, j]
-            for k in range(st.rp[i], st.rp[i + 1]):
-                j = st.ci[k]
-                s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jqk[i, j] - gp * jvk[i, j]
+        _assemble(st, jqk, jvk, bp, gp)
         xs = st.xs
         for a in range(xs.shape[0]):
             for c in range(xs.shape[0]):
                 s[xs[a], xs[c]] -= jq[xs[a], xs[c]] + gp * jv[xs[a], xs[c]]
     else:
-        for i in range(n):  # (the entries where M, K, D are zero: the same sum, bit for bit, without the zeros)
-            for j in range(n):
-                s[i, j] = (0.0 - jq[i, j]) - gp * jv[i, j]
-            for k in range(st.rp[i], st.rp[i + 1]):
-                j = st.ci[k]
-                s[i, j] = bp * st.mass[i, j] + st.stiff[i, j] + gp * st.damp[i, j] - jq[i, j] - gp * jv[i, j]
+        _assemble(st, jq, jv, bp, gp)
     if partial:
         st.ip[I_PARTIALS] += 1
     else:
