@@ -545,3 +545,32 @@ def test_a_study_stopped_before_its_first_stored_case_leaves_no_folder(tmp_path,
         with pytest.raises(KeyboardInterrupt):
             study.run_study(cfg, progress=False)
         assert out.exists() is kept, name
+
+
+def test_a_stalled_static_solve_is_retried_with_the_ladder(rv40e, monkeypatch):
+    """A ConvergenceError of the static solve is retried with the next settings of
+    SOLVER_LADDER (tolerance x0.1, then max_iter x5); the attempt that succeeded is
+    returned, and the last error is raised when every attempt stalls."""
+    import flexrv.model.quasi_static as qs
+    from flexrv.errors import ConvergenceError
+    from flexrv.studies.tolerance import SOLVER_LADDER, loaded_te_with_retries
+
+    seen = []
+
+    def stalls(times):
+        def fake(reducer, options, **kw):
+            seen.append((options, kw))
+            if len(seen) <= times:
+                raise ConvergenceError(f"stalled {len(seen)}")
+            return "result"
+
+        return fake
+
+    monkeypatch.setattr(qs, "loaded_te", stalls(2))
+    assert loaded_te_with_retries(rv40e, 1e-6, 200, points_per_mesh=3) == ("result", 2)
+    assert [o for o, _ in seen] == [{"force_tol": 1e-6 * f, "max_iter": int(200 * i)} for f, i in SOLVER_LADDER]
+    assert all(kw == {"points_per_mesh": 3} for _, kw in seen)
+    seen.clear()
+    monkeypatch.setattr(qs, "loaded_te", stalls(len(SOLVER_LADDER)))
+    with pytest.raises(ConvergenceError, match=f"stalled {len(SOLVER_LADDER)}"):
+        loaded_te_with_retries(rv40e, 1e-6, 200)

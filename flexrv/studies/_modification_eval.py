@@ -108,30 +108,18 @@ def build_quantities(reducer, resolution: dict) -> dict[str, float]:
     """The :data:`QUANTITIES` of one build at ``resolution`` (keys ``crank_revolutions``,
     ``points_per_mesh``, ``catalog_positions``, ``force_tol``, ``max_iter``). A stalled
     static solve is retried with the tolerance ladder of ``flexrv tolerance``
-    (:data:`flexrv.studies.tolerance.SOLVER_LADDER`) before it raises."""
-    from flexrv.errors import ConvergenceError
+    (:func:`flexrv.studies.tolerance.loaded_te_with_retries`) before it raises."""
     from flexrv.geometry.as_built import assembly_penetration
-    from flexrv.model.quasi_static import loaded_te
-    from flexrv.studies.tolerance import SOLVER_LADDER
+    from flexrv.studies.tolerance import loaded_te_with_retries
 
-    last = None
-    for f_tol, f_it in SOLVER_LADDER:
-        try:
-            res = loaded_te(
-                reducer,
-                crank_revolutions=resolution["crank_revolutions"],
-                points_per_mesh=int(resolution["points_per_mesh"]),
-                catalog_positions=int(resolution["catalog_positions"]),
-                options={
-                    "force_tol": resolution["force_tol"] * f_tol,
-                    "max_iter": int(resolution["max_iter"] * f_it),
-                },
-            )
-            break
-        except ConvergenceError as exc:
-            last = exc
-    else:
-        raise last
+    res, _ = loaded_te_with_retries(
+        reducer,
+        resolution["force_tol"],
+        resolution["max_iter"],
+        crank_revolutions=resolution["crank_revolutions"],
+        points_per_mesh=int(resolution["points_per_mesh"]),
+        catalog_positions=int(resolution["catalog_positions"]),
+    )
     s = res.summary()
     force = np.asarray(res.outputs["pin_force"].values, dtype=float)
     pressure = pin_contact_pressure(reducer, res.input_angle, force)

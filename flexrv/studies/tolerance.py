@@ -137,6 +137,24 @@ _SPEC = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+0-9.eEinfI
 SOLVER_LADDER = ((1.0, 1.0), (0.1, 1.0), (1.0, 5.0))
 
 
+def loaded_te_with_retries(reducer, force_tol: float, max_iter: int, **kw):
+    """:func:`flexrv.model.quasi_static.loaded_te` of ``reducer`` (``kw``: its other keywords)
+    with the static solver's ``force_tol`` and ``max_iter``; where it stalls (ConvergenceError),
+    solved again with the next settings of :data:`SOLVER_LADDER`. Returns (result, the index
+    of the attempt that succeeded); the last attempt's error is raised if none does."""
+    from flexrv.errors import ConvergenceError
+    from flexrv.model.quasi_static import loaded_te
+
+    last = None
+    for attempt, (f_tol, f_it) in enumerate(SOLVER_LADDER):
+        try:
+            options = {"force_tol": force_tol * f_tol, "max_iter": int(max_iter * f_it)}
+            return loaded_te(reducer, options=options, **kw), attempt
+        except ConvergenceError as exc:
+            last = exc
+    raise last
+
+
 def te_task(
     reducer,
     crank_revolutions: float | None = 1.0,
@@ -152,31 +170,21 @@ def te_task(
     tolerance at a position where the contact set changes (measured: residual
     0.03 N vs 0.011 N); the stall depends on the iteration history, so the
     sample is re-solved with the tolerance x0.1 and then with max_iter x5
-    (:data:`SOLVER_LADDER`) before it is recorded as failed. Every attempt solves
-    the same equations to a residual below 1e-5 of a rated pin force, so the
-    outputs agree to far below the sampling scatter; ``attempt`` records which one
-    succeeded."""
-    from flexrv.errors import ConvergenceError
-    from flexrv.model.quasi_static import loaded_te
-
+    (:data:`SOLVER_LADDER`, :func:`loaded_te_with_retries`) before it is recorded as
+    failed. Every attempt solves the same equations to a residual below 1e-5 of a rated
+    pin force, so the outputs agree to far below the sampling scatter; ``attempt`` records
+    which one succeeded."""
     if output_revolutions is not None:
         crank_revolutions = None
-    last = None
-    for attempt, (f_tol, f_it) in enumerate(SOLVER_LADDER):
-        try:
-            res = loaded_te(
-                reducer,
-                torque=torque,
-                output_revolutions=output_revolutions,
-                crank_revolutions=crank_revolutions,
-                points_per_mesh=points_per_mesh,
-                options={"force_tol": force_tol * f_tol, "max_iter": int(max_iter * f_it)},
-            )
-            break
-        except ConvergenceError as exc:
-            last = exc
-    else:
-        raise last
+    res, attempt = loaded_te_with_retries(
+        reducer,
+        force_tol,
+        max_iter,
+        torque=torque,
+        output_revolutions=output_revolutions,
+        crank_revolutions=crank_revolutions,
+        points_per_mesh=points_per_mesh,
+    )
     s = res.summary()
     out = {k: float(s[k]) for k in OUTPUTS}
     out["positions"] = int(s["positions"])

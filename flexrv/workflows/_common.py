@@ -215,6 +215,16 @@ def _change_words(delta: float, scale: float, rel_small: float = 0.05) -> str:
     return "negligible" if abs(delta) < rel_small * scale else "significant"
 
 
+def _rigid_flexible(path: Path) -> tuple[dict, dict, float, float]:
+    """A workflow's compare.json at ``path``: its rigid and flexible summaries and the
+    flexible model's TE mean and peak-to-peak less the rigid model's [arcsec]."""
+    import json
+
+    n = json.loads(path.read_text())
+    r, f = n["rigid"], n["flexible"]
+    return r, f, f["te_mean_arcsec"] - r["te_mean_arcsec"], f["te_pp_arcsec"] - r["te_pp_arcsec"]
+
+
 def answer_section(results_root: Path | None = None, smoke: bool = False) -> list[str]:
     """The report's short answer, computed from the saved workflow outputs that exist
     (rigid_vs_flexible/compare.json, ring_deformation.nc, lubrication_film.nc,
@@ -222,8 +232,6 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
     none does. Every qualitative word (negligible / significant, larger / smaller,
     reproduced / not) is decided from the numbers: a change is called negligible below
     5 % of the reference magnitude (the rigid model's TE peak-to-peak, or its mean)."""
-    import json
-
     import numpy as np
     import xarray as xr
 
@@ -234,10 +242,7 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
     lines: list[str] = []
     cmp = root / f"rigid_vs_flexible{sfx}" / "compare.json"
     if cmp.exists():
-        n = json.loads(cmp.read_text())
-        r, f = n["rigid"], n["flexible"]
-        d_mean = f["te_mean_arcsec"] - r["te_mean_arcsec"]
-        d_pp = f["te_pp_arcsec"] - r["te_pp_arcsec"]
+        r, f, d_mean, d_pp = _rigid_flexible(cmp)
         ratio = f["te_pp_arcsec"] / r["te_pp_arcsec"] if r["te_pp_arcsec"] else float("nan")
         sr, sf = SEED_TE["rigid"], SEED_TE["flexible"]
         seed_ratio = (sf["te_max_arcsec"] - sf["te_min_arcsec"]) / (sr["te_max_arcsec"] - sr["te_min_arcsec"])
@@ -306,10 +311,7 @@ def answer_section(results_root: Path | None = None, smoke: bool = False) -> lis
         )
     crank = root / f"crankshaft_flexibility{sfx}" / "compare.json"
     if crank.exists():
-        n = json.loads(crank.read_text())
-        r, f = n["rigid"], n["flexible"]
-        d_mean = f["te_mean_arcsec"] - r["te_mean_arcsec"]
-        d_pp = f["te_pp_arcsec"] - r["te_pp_arcsec"]
+        r, f, d_mean, d_pp = _rigid_flexible(crank)
         lines.append(
             f"* **Crankshaft torsion** (rv40e): shifts the TE mean by {d_mean:+.2f} arcsec and the "
             f"ripple by {d_pp:+.3f} arcsec ({_change_words(d_pp, r['te_pp_arcsec'])} against the "
